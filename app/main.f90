@@ -1,0 +1,4 @@
+program sprc_main
+   implicit none
+   print '(a)', 'sprc'
+end program sprc_main

@@ -1,0 +1,56 @@
+!> Unit-test driver: `unit [SUITE [TEST]]` runs all suites, one suite, or one
+!> test; prints one line per test and `N passed, M failed` last; exits non-zero
+!> on any failure or an unknown selection.
+program sprc_unit_tests
+   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
+   use sprc_testsuite, only: testsuite_type, new_testsuite, run_testsuite
+   use sprc_test_core, only: collect_core
+   use sprc_test_poly, only: collect_poly
+   use sprc_test_sparse, only: collect_sparse
+   use sprc_test_exact, only: collect_exact
+   use sprc_test_namelist, only: collect_namelist
+   use sprc_test_scene, only: collect_scene
+   implicit none
+
+   type(testsuite_type), allocatable :: suites(:)
+   character(len=:), allocatable :: suite_name, test_name
+   integer :: i, npass, nfail, nrun
+
+   suites = [ &
+      new_testsuite('core', collect_core), &
+      new_testsuite('poly', collect_poly), &
+      new_testsuite('sparse', collect_sparse), &
+      new_testsuite('exact', collect_exact), &
+      new_testsuite('namelist', collect_namelist), &
+      new_testsuite('scene', collect_scene) &
+      ]
+
+   call get_arg(1, suite_name)
+   call get_arg(2, test_name)
+   npass = 0
+   nfail = 0
+   nrun = 0
+   do i = 1, size(suites)
+      if (len(suite_name) > 0 .and. suite_name /= suites(i)%name) cycle
+      nrun = nrun + 1
+      call run_testsuite(suites(i), test_name, output_unit, npass, nfail)
+   end do
+   if (nrun == 0 .or. npass + nfail == 0) then
+      write (error_unit, '(a)') 'unit: no suite or test matches "'//suite_name//' '//test_name//'"'
+      nfail = nfail + 1
+   end if
+   write (output_unit, '(i0," passed, ",i0," failed")') npass, nfail
+   if (nfail > 0) error stop 1
+
+contains
+
+   subroutine get_arg(i, arg)
+      integer, intent(in) :: i
+      character(len=:), allocatable, intent(out) :: arg
+      integer :: length
+      call get_command_argument(i, length=length)
+      allocate (character(len=length) :: arg)
+      if (length > 0) call get_command_argument(i, arg)
+   end subroutine get_arg
+
+end program sprc_unit_tests

@@ -1,0 +1,209 @@
+!> Tests of the core layer: error type, timers, LAPACK interfaces and the
+!> translation of LAPACK status.
+module sprc_test_core
+   use sprc_core_kinds, only: wp, dp, i4, i8
+   use sprc_core_error, only: error_type, fatal_error, stat_name, stat_invalid_input, &
+      & stat_singular, stat_not_positive_definite
+   use sprc_core_timer, only: timer_type, wall_time
+   use sprc_core_lapack, only: dgesv, dgecon, dgetrf, dlange, dpotrf, dpotrs, dgeqp3, dgesvd, &
+      & dgemm, dsyrk, dsysv, lapack_info_error
+   use sprc_testsuite, only: unittest_type, new_unittest, check
+   implicit none
+   private
+
+   public :: collect_core
+
+contains
+
+   subroutine collect_core(testsuite)
+      type(unittest_type), allocatable, intent(out) :: testsuite(:)
+      testsuite = [ &
+         new_unittest('kinds', test_kinds), &
+         new_unittest('error_default_stat', test_error_default_stat), &
+         new_unittest('error_names', test_error_names), &
+         new_unittest('timer_accumulates', test_timer), &
+         new_unittest('dgesv_hilbert4', test_dgesv), &
+         new_unittest('dgecon_diagonal', test_dgecon), &
+         new_unittest('dpotrf_spd_and_not', test_dpotrf), &
+         new_unittest('dgeqp3_rank', test_dgeqp3_rank), &
+         new_unittest('dgesvd_known', test_dgesvd), &
+         new_unittest('dgemm_dsyrk', test_dgemm_dsyrk), &
+         new_unittest('dsysv_indefinite', test_dsysv), &
+         new_unittest('lapack_info_translation', test_info_translation) &
+         ]
+   end subroutine collect_core
+
+   subroutine test_kinds(error)
+      type(error_type), allocatable, intent(out) :: error
+      call check(error, precision(1.0_wp) >= 15 .and. range(1.0_dp) >= 307, 'wp is at least double')
+      if (allocated(error)) return
+      call check(error, range(1_i4) >= 9 .and. range(1_i8) >= 18, 'integer kinds')
+   end subroutine test_kinds
+
+   subroutine test_error_default_stat(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(error_type), allocatable :: e
+      call fatal_error(e, 'bad thing')
+      call check(error, e%stat, stat_invalid_input, 'default status')
+      if (allocated(error)) return
+      call check(error, e%message, 'bad thing')
+      if (allocated(error)) return
+      call fatal_error(e, 'x', stat_singular)
+      call check(error, e%stat, stat_singular, 'explicit status')
+   end subroutine test_error_default_stat
+
+   subroutine test_error_names(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: s
+      do s = 0, 8
+         call check(error, stat_name(s) /= 'unknown status', 'every status has a name')
+         if (allocated(error)) return
+      end do
+      call check(error, stat_name(99), 'unknown status')
+   end subroutine test_error_names
+
+   subroutine test_timer(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(timer_type) :: t
+      real(wp) :: t0, x
+      integer :: i
+      call check(error, .not. t%running(), 'new timer is stopped')
+      if (allocated(error)) return
+      t0 = wall_time()
+      call t%start()
+      x = 0.0_wp
+      do i = 1, 100000
+         x = x + sqrt(real(i, wp))
+      end do
+      call t%stop()
+      call t%stop() ! stopping twice must not add time
+      call check(error, t%elapsed >= 0.0_wp .and. t%elapsed <= wall_time() - t0 + 1.0e-9_wp .and. x > 0.0_wp, &
+         'elapsed within the outer interval')
+      if (allocated(error)) return
+      call t%reset()
+      call check(error, t%elapsed, 0.0_wp, 0.0_wp, 'reset')
+   end subroutine test_timer
+
+   !> Hilbert 4x4 with right-hand side H*1: the solution is ones, up to cond(H)*eps ~ 1.6e4*eps.
+   subroutine test_dgesv(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(dp) :: a(4, 4), b(4, 1)
+      integer :: ipiv(4), info, i, j
+      do j = 1, 4
+         do i = 1, 4
+            a(i, j) = 1.0_dp/real(i + j - 1, dp)
+         end do
+      end do
+      b(:, 1) = sum(a, dim=2)
+      call dgesv(4, 1, a, 4, ipiv, b, 4, info)
+      call check(error, info, 0, 'dgesv info')
+      if (allocated(error)) return
+      call check(error, maxval(abs(b(:, 1) - 1.0_dp)), 0.0_dp, 1.0e-11_dp, 'Hilbert solve')
+   end subroutine test_dgesv
+
+   !> diag(1, 1e-3): 1-norm condition number is exactly 1e3; dgecon estimates rcond.
+   subroutine test_dgecon(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(dp) :: a(2, 2), work(8), anorm, rcond
+      integer :: ipiv(2), iwork(2), info
+      a = reshape([1.0_dp, 0.0_dp, 0.0_dp, 1.0e-3_dp], [2, 2])
+      anorm = dlange('1', 2, 2, a, 2, work)
+      call dgetrf(2, 2, a, 2, ipiv, info)
+      call dgecon('1', 2, a, 2, anorm, rcond, work, iwork, info)
+      call check(error, rcond, 1.0e-3_dp, 1.0e-14_dp, 'rcond of diag(1,1e-3)', rel=.true.)
+   end subroutine test_dgecon
+
+   subroutine test_dpotrf(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(dp) :: a(3, 3), b(3, 1)
+      integer :: info
+      type(error_type), allocatable :: e
+      ! 1D Laplace stencil: SPD; A*[1,2,3] = [0,0,4]
+      a = reshape([2.0_dp, -1.0_dp, 0.0_dp, -1.0_dp, 2.0_dp, -1.0_dp, 0.0_dp, -1.0_dp, 2.0_dp], [3, 3])
+      b(:, 1) = [0.0_dp, 0.0_dp, 4.0_dp]
+      call dpotrf('L', 3, a, 3, info)
+      call dpotrs('L', 3, 1, a, 3, b, 3, info)
+      call check(error, maxval(abs(b(:, 1) - [1.0_dp, 2.0_dp, 3.0_dp])), 0.0_dp, 1.0e-14_dp, 'Cholesky solve')
+      if (allocated(error)) return
+      a = reshape([1.0_dp, 2.0_dp, 0.0_dp, 2.0_dp, 1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp], [3, 3])
+      call dpotrf('L', 3, a, 3, info)
+      call check(error, info, 2, 'indefinite matrix fails at minor 2')
+      if (allocated(error)) return
+      call lapack_info_error('dpotrf', info, 'test', e)
+      call check(error, e%stat, stat_not_positive_definite, 'translated status')
+   end subroutine test_dpotrf
+
+   !> Columns c1, c2, c1+c2 and 2*c1: rank 2, found by pivoted QR with a relative tolerance.
+   subroutine test_dgeqp3_rank(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(dp) :: a(5, 4), tau(4), work(200)
+      integer :: jpvt(4), info, rank, k
+      a(:, 1) = [1.0_dp, 2.0_dp, 3.0_dp, 4.0_dp, 5.0_dp]
+      a(:, 2) = [1.0_dp, -1.0_dp, 0.5_dp, 0.0_dp, 2.0_dp]
+      a(:, 3) = a(:, 1) + a(:, 2)
+      a(:, 4) = 2.0_dp*a(:, 1)
+      jpvt = 0
+      call dgeqp3(5, 4, a, 5, jpvt, tau, work, size(work), info)
+      rank = 0
+      do k = 1, 4
+         if (abs(a(k, k)) > 1.0e-12_dp*abs(a(1, 1))) rank = rank + 1
+      end do
+      call check(error, rank, 2, 'numerical rank')
+   end subroutine test_dgeqp3_rank
+
+   !> Singular values of [[3,0],[4,5]] are sqrt(45) and sqrt(5) (A^T A has eigenvalues 45 and 5).
+   subroutine test_dgesvd(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(dp) :: a(2, 2), s(2), u(1, 1), vt(1, 1), work(64)
+      integer :: info
+      a = reshape([3.0_dp, 4.0_dp, 0.0_dp, 5.0_dp], [2, 2])
+      call dgesvd('N', 'N', 2, 2, a, 2, s, u, 1, vt, 1, work, size(work), info)
+      call check(error, s(1), sqrt(45.0_dp), 1.0e-14_dp, 'sigma_1', rel=.true.)
+      if (allocated(error)) return
+      call check(error, s(2), sqrt(5.0_dp), 1.0e-14_dp, 'sigma_2', rel=.true.)
+   end subroutine test_dgesvd
+
+   subroutine test_dgemm_dsyrk(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(dp) :: a(3, 2), c(2, 2), g(2, 2)
+      a = reshape([1.0_dp, 2.0_dp, 3.0_dp, -1.0_dp, 0.5_dp, 4.0_dp], [3, 2])
+      c = 0.0_dp
+      call dgemm('T', 'N', 2, 2, 3, 1.0_dp, a, 3, a, 3, 0.0_dp, c, 2)
+      call check(error, maxval(abs(c - matmul(transpose(a), a))), 0.0_dp, 1.0e-14_dp, 'dgemm A^T A')
+      if (allocated(error)) return
+      g = 0.0_dp
+      call dsyrk('U', 'T', 2, 3, 1.0_dp, a, 3, 0.0_dp, g, 2)
+      call check(error, abs(g(1, 1) - c(1, 1)) + abs(g(1, 2) - c(1, 2)) + abs(g(2, 2) - c(2, 2)), &
+         0.0_dp, 1.0e-14_dp, 'dsyrk upper triangle')
+   end subroutine test_dgemm_dsyrk
+
+   !> A small KKT matrix [[2,1],[1,0]] is symmetric indefinite: dsysv solves it.
+   subroutine test_dsysv(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(dp) :: a(2, 2), b(2, 1), work(64)
+      integer :: ipiv(2), info
+      a = reshape([2.0_dp, 1.0_dp, 1.0_dp, 0.0_dp], [2, 2])
+      b(:, 1) = [4.0_dp, 1.0_dp] ! x = (1, 2)
+      call dsysv('U', 2, 1, a, 2, ipiv, b, 2, work, size(work), info)
+      call check(error, info, 0, 'dsysv info')
+      if (allocated(error)) return
+      call check(error, maxval(abs(b(:, 1) - [1.0_dp, 2.0_dp])), 0.0_dp, 1.0e-14_dp, 'KKT solution')
+   end subroutine test_dsysv
+
+   subroutine test_info_translation(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(error_type), allocatable :: e
+      call lapack_info_error('dgesv', 0, 'ok', e)
+      call check(error, .not. allocated(e), 'info 0 is no error')
+      if (allocated(error)) return
+      call lapack_info_error('dgesv', 3, 'patch 7', e)
+      call check(error, e%stat, stat_singular, 'dgesv info>0 is singular')
+      if (allocated(error)) return
+      call check(error, index(e%message, 'patch 7') > 0 .and. index(e%message, 'dgesv') > 0, &
+         'message names context and routine: '//e%message)
+      if (allocated(error)) return
+      call lapack_info_error('dgesv', -4, 'x', e)
+      call check(error, e%stat, stat_invalid_input, 'negative info')
+   end subroutine test_info_translation
+
+end module sprc_test_core

@@ -1,0 +1,163 @@
+!> A small unit-test harness modelled on test-drive's API: tests are
+!> `subroutine test(error)` that allocate `error` on failure; suites collect
+!> tests; `check` compares values with stated tolerances.
+module sprc_testsuite
+   use sprc_core_kinds, only: wp, i8
+   use sprc_core_error, only: error_type, fatal_error, stat_internal
+   implicit none
+   private
+
+   public :: unittest_type, testsuite_type, new_unittest, new_testsuite
+   public :: check, test_failed, run_testsuite, error_type, collect_interface
+
+   abstract interface
+      !> A test: allocates `error` when it fails.
+      subroutine test_interface(error)
+         import :: error_type
+         type(error_type), allocatable, intent(out) :: error
+      end subroutine test_interface
+   end interface
+
+   !> One named test.
+   type :: unittest_type
+      character(len=:), allocatable :: name
+      procedure(test_interface), pointer, nopass :: test => null()
+   end type unittest_type
+
+   abstract interface
+      !> Fills the list of tests of a suite.
+      subroutine collect_interface(testsuite)
+         import :: unittest_type
+         type(unittest_type), allocatable, intent(out) :: testsuite(:)
+      end subroutine collect_interface
+   end interface
+
+   !> A named collection of tests.
+   type :: testsuite_type
+      character(len=:), allocatable :: name
+      procedure(collect_interface), pointer, nopass :: collect => null()
+   end type testsuite_type
+
+   !> Compare an actual value with an expected one; allocate `error` on mismatch.
+   interface check
+      module procedure :: check_logical, check_int, check_int8, check_real, check_string
+   end interface check
+
+contains
+
+   function new_unittest(name, test) result(self)
+      character(len=*), intent(in) :: name
+      procedure(test_interface) :: test
+      type(unittest_type) :: self
+      self%name = name
+      self%test => test
+   end function new_unittest
+
+   function new_testsuite(name, collect) result(self)
+      character(len=*), intent(in) :: name
+      procedure(collect_interface) :: collect
+      type(testsuite_type) :: self
+      self%name = name
+      self%collect => collect
+   end function new_testsuite
+
+   !> Mark a test as failed with a message.
+   subroutine test_failed(error, message)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), intent(in) :: message
+      call fatal_error(error, message, stat_internal)
+   end subroutine test_failed
+
+   subroutine check_logical(error, condition, message)
+      type(error_type), allocatable, intent(out) :: error
+      logical, intent(in) :: condition
+      character(len=*), intent(in) :: message
+      if (.not. condition) call test_failed(error, message)
+   end subroutine check_logical
+
+   subroutine check_int(error, actual, expected, message)
+      type(error_type), allocatable, intent(out) :: error
+      integer, intent(in) :: actual, expected
+      character(len=*), intent(in), optional :: message
+      character(len=64) :: buf
+      if (actual == expected) return
+      write (buf, '("expected ",i0,", got ",i0)') expected, actual
+      call test_failed(error, prefixed(message, trim(buf)))
+   end subroutine check_int
+
+   subroutine check_int8(error, actual, expected, message)
+      type(error_type), allocatable, intent(out) :: error
+      integer(i8), intent(in) :: actual, expected
+      character(len=*), intent(in), optional :: message
+      character(len=64) :: buf
+      if (actual == expected) return
+      write (buf, '("expected ",i0,", got ",i0)') expected, actual
+      call test_failed(error, prefixed(message, trim(buf)))
+   end subroutine check_int8
+
+   !> Real comparison: |actual - expected| <= thr, or with `rel`,
+   !> |actual - expected| <= thr*|expected|. NaN never passes.
+   subroutine check_real(error, actual, expected, thr, message, rel)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), intent(in) :: actual, expected, thr
+      character(len=*), intent(in), optional :: message
+      logical, intent(in), optional :: rel
+      character(len=160) :: buf
+      real(wp) :: diff, bound
+      logical :: relative
+
+      relative = .false.
+      if (present(rel)) relative = rel
+      diff = abs(actual - expected)
+      bound = thr
+      if (relative) bound = thr*abs(expected)
+      if (diff <= bound) return
+      write (buf, '("expected ",es24.16,", got ",es24.16," (diff ",es9.2,", allowed ",es9.2,")")') &
+         expected, actual, diff, bound
+      call test_failed(error, prefixed(message, trim(buf)))
+   end subroutine check_real
+
+   subroutine check_string(error, actual, expected, message)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), intent(in) :: actual, expected
+      character(len=*), intent(in), optional :: message
+      if (actual == expected) return
+      call test_failed(error, prefixed(message, 'expected "'//expected//'", got "'//actual//'"'))
+   end subroutine check_string
+
+   pure function prefixed(message, detail) result(text)
+      character(len=*), intent(in), optional :: message
+      character(len=*), intent(in) :: detail
+      character(len=:), allocatable :: text
+      text = detail
+      if (present(message)) text = message//': '//detail
+   end function prefixed
+
+   !> Run the tests of one suite whose names match `selection` ('' = all);
+   !> print one line per test to `unit`; add to the pass/fail counters.
+   subroutine run_testsuite(suite, selection, unit, npass, nfail)
+      type(testsuite_type), intent(in) :: suite
+      character(len=*), intent(in) :: selection
+      integer, intent(in) :: unit
+      integer, intent(inout) :: npass, nfail
+      type(unittest_type), allocatable :: tests(:)
+      type(error_type), allocatable :: error
+      integer :: i
+
+      call suite%collect(tests)
+      do i = 1, size(tests)
+         if (len(selection) > 0 .and. selection /= tests(i)%name) cycle
+         call tests(i)%test(error)
+         if (allocated(error)) then
+            nfail = nfail + 1
+            write (unit, '(a)') 'FAIL '//suite%name//'/'//tests(i)%name//': '//error%message
+            deallocate (error)
+         else
+            npass = npass + 1
+            write (unit, '(a)') 'ok   '//suite%name//'/'//tests(i)%name
+         end if
+         flush (unit)
+      end do
+   end subroutine run_testsuite
+
+end module sprc_testsuite
