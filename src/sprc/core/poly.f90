@@ -50,10 +50,13 @@
 !>
 !> ## Performance contract
 !> `eval`, `eval_grad`, `eval_hess` and `eval_points` are pure, allocate
-!> nothing, use a small power table of s (no `**` with real exponents) and do
-!> not check array sizes: callers pass s(dim) and outputs with at least
-!> `nterms` rows (only the leading block is written). They read the basis only,
-!> so one basis object may be shared by all threads of an OpenMP patch loop.
+!> nothing and do not check array sizes: callers pass s(dim) and outputs with
+!> at least `nterms` rows (only the leading block is written). Values come from
+!> a recurrence along the graded order, one multiply per term (no `**`);
+!> every first or second derivative of a term is an integer multiple of a
+!> lower term, so derivatives cost one gather and one multiply per entry.
+!> They read the basis only, so one basis object may be shared by all threads
+!> of an OpenMP patch loop; copying it allocates only `exponents`.
 module sprc_core_poly
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
@@ -102,14 +105,17 @@ module sprc_core_poly
       integer :: nhess = 0
       !> exponents(:, i) = (a, b, c) of term i, x^a y^b z^c; c = 0 in 2D.
       integer, allocatable :: exponents(:, :)
-      ! Fixed-size tables used by the hot paths, so copies of the basis allocate
-      ! nothing and the loops have compile-time strides. Exponents of a derivative
-      ! that vanishes are clamped to 0 with a zero coefficient, which keeps the
-      ! evaluation branch-free.
-      integer :: vexp(3, poly_max_terms) = 0
-      integer :: gexp(3, poly_max_terms, 3) = 0
+      ! Fixed-size tables for the hot paths (set by new_poly_basis):
+      ! p_i = p_parent(i) * s_var(i), where parent(i) < i lowers the first nonzero
+      ! exponent of term i; d p_i/ds_k = gcoef(i,k) p_gidx(i,k);
+      ! d2 p_i/ds_k ds_l = hcoef(i,m) p_hidx(i,m) for the m-th Voigt pair (k,l).
+      ! A vanishing derivative has coefficient 0 and points at term 1, which keeps
+      ! the loops branch-free.
+      integer :: parent(poly_max_terms) = 1
+      integer :: var(poly_max_terms) = 1
+      integer :: gidx(poly_max_terms, 3) = 1
       real(wp) :: gcoef(poly_max_terms, 3) = 0.0_wp
-      integer :: hexp(3, poly_max_terms, 6) = 0
+      integer :: hidx(poly_max_terms, 6) = 1
       real(wp) :: hcoef(poly_max_terms, 6) = 0.0_wp
    contains
       !> Values p(s) of all terms.
@@ -154,7 +160,7 @@ contains
       !> Set if `dim` or `degree` is out of range (stat_invalid_input).
       type(error_type), allocatable, intent(out) :: error
       character(len=16) :: buf
-      integer :: i, m, k, l, e(3)
+      integer :: i, m, k, l, e(3), exps(3, poly_max_terms)
       real(wp) :: c1, c2
 
       if (dim /= 2 .and. dim /= 3) then
@@ -172,23 +178,29 @@ contains
       self%degree = degree
       self%nterms = poly_nterms(dim, degree)
       self%nhess = merge(3, 6, dim == 2)
-      call generate_exponents(dim, degree, self%vexp)
-      self%exponents = self%vexp(:, 1:self%nterms)
+      call generate_exponents(dim, degree, exps)
+      self%exponents = exps(:, 1:self%nterms)
 
+      do i = 2, self%nterms
+         e = exps(:, i)
+         self%var(i) = findloc(e > 0, .true., 1)
+         e(self%var(i)) = e(self%var(i)) - 1
+         self%parent(i) = self%term_index(e(1), e(2), e(3))
+      end do
       do i = 1, self%nterms
          do k = 1, dim
-            e = self%vexp(:, i)
+            e = exps(:, i)
             call lower(e, k, self%gcoef(i, k))
-            self%gexp(:, i, k) = e
+            self%gidx(i, k) = self%term_index(e(1), e(2), e(3))
          end do
          do m = 1, self%nhess
             call hess_pair(dim, m, k, l)
             ! If the first lowering vanishes, its zero coefficient zeroes the product.
-            e = self%vexp(:, i)
+            e = exps(:, i)
             call lower(e, k, c1)
             call lower(e, l, c2)
             self%hcoef(i, m) = c1*c2
-            self%hexp(:, i, m) = e
+            self%hidx(i, m) = self%term_index(e(1), e(2), e(3))
          end do
       end do
    end subroutine new_poly_basis
@@ -217,8 +229,9 @@ contains
       end do
    end subroutine generate_exponents
 
-   !> Differentiate the monomial with exponents `e` once in variable k:
-   !> coefficient e(k), exponent e(k)-1; a vanishing derivative gives coef 0, e unchanged.
+   !> Differentiate the monomial with exponents `e` once in variable k: coefficient e(k),
+   !> exponent e(k)-1. A vanishing derivative gives coefficient 0 and leaves e unchanged
+   !> (any valid term will do, its value is multiplied by 0).
    pure subroutine lower(e, k, coef)
       integer, intent(inout) :: e(3)
       integer, intent(in) :: k
@@ -272,22 +285,6 @@ contains
       end do
    end subroutine scale_points
 
-   !> pw(j, k) = s_k**j for j = 0..3; variables beyond dim are 0 (only pw(0,k) = 1 is used).
-   pure subroutine power_table(dim, s, pw)
-      integer, intent(in) :: dim
-      real(wp), intent(in) :: s(:)
-      real(wp), intent(out) :: pw(0:3, 3)
-      integer :: k
-
-      pw(0, :) = 1.0_wp
-      pw(1:3, :) = 0.0_wp
-      do k = 1, dim
-         pw(1, k) = s(k)
-         pw(2, k) = s(k)*s(k)
-         pw(3, k) = pw(2, k)*s(k)
-      end do
-   end subroutine power_table
-
    !> Values of all terms at the scaled point s: p(1:nterms).
    pure subroutine eval(self, s, p)
       class(poly_basis_type), intent(in) :: self
@@ -295,12 +292,11 @@ contains
       real(wp), intent(in) :: s(:)
       !> Term values; p(1:nterms) is written.
       real(wp), intent(inout) :: p(:)
-      real(wp) :: pw(0:3, 3)
       integer :: i
 
-      call power_table(self%dim, s, pw)
-      do i = 1, self%nterms
-         p(i) = pw(self%vexp(1, i), 1)*pw(self%vexp(2, i), 2)*pw(self%vexp(3, i), 3)
+      p(1) = 1.0_wp
+      do i = 2, self%nterms
+         p(i) = p(self%parent(i))*s(self%var(i))
       end do
    end subroutine eval
 
@@ -313,16 +309,14 @@ contains
       real(wp), intent(inout) :: dp(:, :)
       !> Patch size: if present, return physical derivatives (times 1/h).
       real(wp), intent(in), optional :: h
-      real(wp) :: pw(0:3, 3), f
+      real(wp) :: p(poly_max_terms)
       integer :: i, k
 
-      f = 1.0_wp
-      if (present(h)) f = 1.0_wp/h
-      call power_table(self%dim, s, pw)
+      call self%eval(s, p)
+      if (present(h)) p(1:self%nterms) = p(1:self%nterms)/h
       do k = 1, self%dim
          do i = 1, self%nterms
-            dp(i, k) = f*self%gcoef(i, k)*pw(self%gexp(1, i, k), 1)*pw(self%gexp(2, i, k), 2) &
-               & *pw(self%gexp(3, i, k), 3)
+            dp(i, k) = self%gcoef(i, k)*p(self%gidx(i, k))
          end do
       end do
    end subroutine eval_grad
@@ -337,16 +331,14 @@ contains
       real(wp), intent(inout) :: d2p(:, :)
       !> Patch size: if present, return physical derivatives (times 1/h**2).
       real(wp), intent(in), optional :: h
-      real(wp) :: pw(0:3, 3), f
+      real(wp) :: p(poly_max_terms)
       integer :: i, m
 
-      f = 1.0_wp
-      if (present(h)) f = 1.0_wp/(h*h)
-      call power_table(self%dim, s, pw)
+      call self%eval(s, p)
+      if (present(h)) p(1:self%nterms) = p(1:self%nterms)/(h*h)
       do m = 1, self%nhess
          do i = 1, self%nterms
-            d2p(i, m) = f*self%hcoef(i, m)*pw(self%hexp(1, i, m), 1)*pw(self%hexp(2, i, m), 2) &
-               & *pw(self%hexp(3, i, m), 3)
+            d2p(i, m) = self%hcoef(i, m)*p(self%hidx(i, m))
          end do
       end do
    end subroutine eval_hess
@@ -362,13 +354,13 @@ contains
       real(wp), intent(in) :: s(:, :)
       !> Design matrix; pmat(1:npoints, 1:nterms) is written.
       real(wp), intent(inout) :: pmat(:, :)
-      real(wp) :: pw(0:3, 3)
       integer :: i, j
 
-      do j = 1, size(s, 2)
-         call power_table(self%dim, s(:, j), pw)
-         do i = 1, self%nterms
-            pmat(j, i) = pw(self%vexp(1, i), 1)*pw(self%vexp(2, i), 2)*pw(self%vexp(3, i), 3)
+      ! Term-outer loop: each column is one contiguous, vectorisable sweep over the points.
+      pmat(1:size(s, 2), 1) = 1.0_wp
+      do i = 2, self%nterms
+         do j = 1, size(s, 2)
+            pmat(j, i) = pmat(j, self%parent(i))*s(self%var(i), j)
          end do
       end do
    end subroutine eval_points
@@ -386,7 +378,7 @@ contains
       !> Set if k is out of range or d has the wrong shape (stat_invalid_input).
       type(error_type), allocatable, intent(out) :: error
       character(len=64) :: buf
-      integer :: j, i
+      integer :: j
 
       if (k < 1 .or. k > self%dim) then
          write (buf, '("k = ",i0," is not in 1..",i0)') k, self%dim
@@ -399,11 +391,10 @@ contains
          call fatal_error(error, 'poly derivative_matrix: '//trim(buf), stat_invalid_input)
          return
       end if
+      ! Column j holds the single nonzero of d/ds_k p_j: gcoef(j,k) at row gidx(j,k).
       d = 0.0_wp
       do j = 1, self%nterms
-         if (self%gcoef(j, k) == 0.0_wp) cycle
-         i = self%term_index(self%gexp(1, j, k), self%gexp(2, j, k), self%gexp(3, j, k))
-         d(i, j) = self%gcoef(j, k)
+         d(self%gidx(j, k), j) = self%gcoef(j, k)
       end do
    end subroutine derivative_matrix
 
