@@ -476,8 +476,8 @@ contains
    !> Completeness: f(s) = prod_{m=1..p} (alpha_m + beta_m . s), a random polynomial of degree p
    !> computed without the basis, is sampled at 2*nterms+5 random points in [-1,1]^dim and fitted by
    !> least squares (dgelsd) with the degree-p basis. The fit must have full rank and reproduce f at
-   !> fresh points to 1e-10 relative to max|f| (design-matrix condition numbers here are <= ~1e3,
-   !> so round-off is ~1e-13). A degree p+1 product is not reproduced (misfit > 1e-6), which shows
+   !> fresh points to 1e-10 relative to max|f| (design-matrix condition numbers for such samples
+   !> are ~20, at most ~1e2 in 2000 numpy trials, so round-off is ~1e-14). A degree p+1 product is not reproduced (misfit > 1e-6), which shows
    !> the check has teeth.
    subroutine test_reproduction(error)
       type(error_type), allocatable, intent(out) :: error

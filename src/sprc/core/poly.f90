@@ -368,7 +368,8 @@ contains
    !> Exact coefficient-space differentiation: d/ds_k [p(s) . a] = p(s) . (d a) for every a.
    !> Differentiation lowers the degree, so the result stays in the basis; d is nilpotent
    !> (d**(degree+1) = 0) and second derivatives are products d_k d_l (which commute).
-   !> For physical derivatives multiply by 1/h.
+   !> For physical derivatives multiply by 1/h. With a design matrix P from `eval_points`,
+   !> P d is the matrix of d/ds_k at all points (one dgemm).
    pure subroutine derivative_matrix(self, k, d, error)
       class(poly_basis_type), intent(in) :: self
       !> Variable, 1..dim.
