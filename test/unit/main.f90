@@ -10,6 +10,8 @@ program sprc_unit_tests
    use sprc_test_exact, only: collect_exact
    use sprc_test_namelist, only: collect_namelist
    use sprc_test_scene, only: collect_scene
+   use sprc_test_geometry, only: collect_geometry
+   use sprc_test_grid, only: collect_grid
    implicit none
 
    type(testsuite_type), allocatable :: suites(:)
@@ -22,7 +24,9 @@ program sprc_unit_tests
       new_testsuite('sparse', collect_sparse), &
       new_testsuite('exact', collect_exact), &
       new_testsuite('namelist', collect_namelist), &
-      new_testsuite('scene', collect_scene) &
+      new_testsuite('scene', collect_scene), &
+      new_testsuite('geometry', collect_geometry), &
+      new_testsuite('grid', collect_grid) &
       ]
 
    call get_arg(1, suite_name)
