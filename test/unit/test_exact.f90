@@ -725,6 +725,8 @@ contains
    subroutine test_no_nan(error)
       type(error_type), allocatable, intent(out) :: error
       type(case_type) :: c
+      type(kirsch_type) :: kir
+      type(lame_sphere_type) :: sph
       integer :: ic, ip, dim, ns
       real(wp) :: offsets(5), x(3), s(6), u(3), t(3), n(3)
 
@@ -744,6 +746,24 @@ contains
                & all(abs(t(1:dim)) <= huge(1.0_wp)), 'finite values off the body, '//c%label)
             if (allocated(error)) return
          end do
+      end do
+      ! Offsets far below the floor, normal and subnormal, where x - center is not rounded away.
+      call new_kirsch(kir, [0.0_wp, 0.0_wp], 1.0_wp, 1.0_wp, young, poisson, plane_strain, error)
+      if (allocated(error)) return
+      call new_lame_sphere(sph, [0.0_wp, 0.0_wp, 0.0_wp], 1.0_wp, 2.0_wp, 1.0_wp, 0.0_wp, young, poisson, error)
+      if (allocated(error)) return
+      do ip = 1, 2
+         x = merge(1.0e-300_wp, 1.0e-310_wp, ip == 1)*[1.0_wp, -1.0_wp, 1.0_wp]
+         call kir%stress(x(1:2), s(1:3))
+         call kir%displacement(x(1:2), u(1:2))
+         call check(error, all(abs(s(1:3)) <= huge(1.0_wp)) .and. all(abs(u(1:2)) <= huge(1.0_wp)), &
+            & 'finite Kirsch values at a tiny offset')
+         if (allocated(error)) return
+         call sph%stress(x, s)
+         call sph%displacement(x, u)
+         call check(error, all(abs(s) <= huge(1.0_wp)) .and. all(abs(u) <= huge(1.0_wp)), &
+            & 'finite sphere values at a tiny offset')
+         if (allocated(error)) return
       end do
    end subroutine test_no_nan
 
