@@ -266,6 +266,7 @@ contains
          select case (text(s%pos:s%pos))
          case ('/')
             s%pos = s%pos + 1
+            call check_line_end(text, source, s, group, error)
             exit
          case ('&')
             call fatal_error(error, where//"unterminated group: '&"//snippet(text, s%pos + 1)// &
@@ -286,6 +287,25 @@ contains
       end do
       group%items = group%items(1:nitem)
    end subroutine parse_group
+
+   !> After a group's closing `/` only blanks or a comment may follow on the
+   !> line: Fortran skips the rest of that line, so a group there would be lost.
+   subroutine check_line_end(text, source, s, group, error)
+      character(len=*), intent(in) :: text, source
+      type(scanner_type), intent(in) :: s
+      type(nml_group_type), intent(in) :: group
+      type(error_type), allocatable, intent(out) :: error
+      integer :: j
+      j = s%pos
+      do while (j <= len(text))
+         if (text(j:j) /= ' ' .and. text(j:j) /= achar(9)) exit
+         j = j + 1
+      end do
+      if (j > len(text)) return
+      if (index('!'//achar(10)//achar(13), text(j:j)) > 0) return
+      call fatal_error(error, source//':'//int_text(s%line)//': &'//group%name//": text '"//snippet(text, j)// &
+         & "' after the closing '/' on the same line: Fortran ignores the rest of that line; start it on a new line")
+   end subroutine check_line_end
 
    !> Parse `key = value, ...` at the scanner position.
    subroutine parse_item(text, s, group, item, error)

@@ -821,10 +821,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       logical :: found
       call nml_get_array(g, key, value, dim, dim, found, error)
-      if (allocated(error)) then
-         error%message = error%message//' (one per coordinate in '//int_text(dim)//'D)'
-         return
-      end if
+      if (allocated(error)) return
       if (.not. found .and. required) call nml_field_error(g, key, 'required ('//int_text(dim)//' values)', error)
    end subroutine get_vector
 
@@ -1223,7 +1220,7 @@ contains
       real(wp), intent(in) :: x
       character(len=:), allocatable :: text
       character(len=40) :: buf
-      character(len=8) :: fmt
+      character(len=16) :: fmt
       character(len=:), allocatable :: digits, sign
       real(wp) :: y
       integer :: d, ios, epos, e, n
