@@ -6,7 +6,7 @@ module sprc_test_namelist
    use sprc_core_error, only: error_type, stat_invalid_input, stat_io
    use sprc_io_namelist, only: nml_group_type, parse_namelist, read_text_file, nml_get, nml_get_array, &
       & nml_has, nml_check_consumed, nml_field_error, nml_group_error, nml_item_text, nml_integer, nml_real, &
-      & nml_string, nml_logical, max_repeat
+      & nml_string, nml_logical, max_repeat, max_groups, max_items, max_values
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed
    implicit none
    private
@@ -33,6 +33,7 @@ contains
          new_unittest('known_groups', test_known_groups), &
          new_unittest('syntax_errors', test_syntax_errors), &
          new_unittest('non_text_content', test_non_text), &
+         new_unittest('size_limits', test_limits), &
          new_unittest('utf8_accepted', test_utf8), &
          new_unittest('read_text_file', test_read_file), &
          new_unittest('read_text_file_errors', test_read_file_errors) &
@@ -481,6 +482,32 @@ contains
       ! A truncated multi-byte sequence at the end of the text.
       call expect_parse_error(error, "&g a = 1 / !"//achar(195), 'invalid UTF-8')
    end subroutine test_non_text
+
+   !> Hostile sizes fail cleanly instead of costing quadratic time.
+   subroutine test_limits(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(nml_group_type), allocatable :: groups(:)
+      type(error_type), allocatable :: e
+      character(len=:), allocatable :: text
+      character(len=16) :: key
+      integer :: i
+
+      call parse_namelist(repeat('&g /'//nl, max_groups), 'f.nml', groups, e)
+      call check(error, .not. allocated(e) .and. size(groups) == max_groups, 'max_groups groups accepted')
+      if (allocated(error)) return
+      call expect_parse_error(error, repeat('&g /'//nl, max_groups + 1), 'f.nml:10001: more than 10000 namelist groups')
+      if (allocated(error)) return
+      text = '&g'
+      do i = 1, max_items + 1
+         write (key, '(" k",i0,"=1")') i
+         text = text//trim(key)
+      end do
+      call expect_parse_error(error, text//' /', 'f.nml:1: &g: more than 1000 keys in one group')
+      if (allocated(error)) return
+      call expect_parse_error(error, '&g a = 100000*1, 2 /', 'f.nml:1: &g: a: more than 100000 values')
+      if (allocated(error)) return
+      call check(error, max_values == max_repeat, 'one repeat may fill a key')
+   end subroutine test_limits
 
    subroutine test_utf8(error)
       type(error_type), allocatable, intent(out) :: error

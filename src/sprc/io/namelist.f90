@@ -26,7 +26,7 @@ module sprc_io_namelist
 
    public :: nml_value_type, nml_item_type, nml_group_type
    public :: nml_integer, nml_real, nml_string, nml_logical
-   public :: max_text_size, max_repeat
+   public :: max_text_size, max_repeat, max_groups, max_items, max_values
    public :: read_text_file, check_text, parse_namelist
    public :: nml_get, nml_get_array, nml_has, nml_check_consumed
    public :: nml_field_error, nml_group_error, nml_item_text
@@ -38,6 +38,10 @@ module sprc_io_namelist
    integer, parameter :: max_text_size = 16*1024*1024
    !> Largest repeat count `r` of `r*c`: bounds memory when a getter expands it.
    integer, parameter :: max_repeat = 100000
+   !> Most groups in a text, keys in a group, values (repeats expanded) of a key.
+   !> Far above any scene; they keep hostile input from costing quadratic time
+   !> in duplicate checks or overflowing value counts.
+   integer, parameter :: max_groups = 10000, max_items = 1000, max_values = 100000
 
    !> One value constant of an item, possibly repeated (`r*c`).
    type :: nml_value_type
@@ -221,6 +225,11 @@ contains
                & "' outside a namelist group (a group starts with &name and ends with /)")
             return
          end if
+         if (ngroup == max_groups) then
+            call fatal_error(error, source//':'//int_text(s%line)//': more than '//int_text(max_groups)// &
+               & ' namelist groups')
+            return
+         end if
          call parse_group(text, source, s, group, error, known_groups)
          if (allocated(error)) return
          call append_group(groups, ngroup, group)
@@ -273,6 +282,10 @@ contains
                & "' on line "//int_text(s%line)//" starts before the closing '/'")
             return
          end select
+         if (nitem == max_items) then
+            call fatal_error(error, where//'more than '//int_text(max_items)//' keys in one group')
+            return
+         end if
          call parse_item(text, s, group, item, error)
          if (allocated(error)) return
          do i = 1, nitem
@@ -316,7 +329,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(nml_value_type) :: value
       character(len=:), allocatable :: where
-      integer :: nvalue
+      integer :: nvalue, total
 
       where = group%source//':'//int_text(s%line)//': &'//group%name//': '
       item%line = s%line
@@ -348,6 +361,7 @@ contains
       s%pos = s%pos + 1
       allocate (item%values(0))
       nvalue = 0
+      total = 0
       do
          call skip_blanks(text, s)
          if (s%pos > len(text)) exit
@@ -365,6 +379,12 @@ contains
             return
          end if
          call append_value(item%values, nvalue, value)
+         total = total + value%count
+         if (total > max_values) then
+            call fatal_error(error, group%source//':'//int_text(item%line)//': &'//group%name//': '//item%key// &
+               & ': more than '//int_text(max_values)//' values')
+            return
+         end if
          if (s%pos <= len(text)) then
             if (text(s%pos:s%pos) == ',') s%pos = s%pos + 1
          end if
