@@ -419,6 +419,13 @@ contains
       call check(error, s%contacts(1)%has_kappa, 'kappa given')
       if (allocated(error)) return
       summary = scene_summary(s)
+      ! Contact surfaces are neither traction-free nor traction boundaries.
+      call check(error, index(summary, 'traction-free (no &bc): none') > 0, 'contact surfaces are not traction-free')
+      if (allocated(error)) return
+      call check_switch(error, summary, 'SPR-C traction equilibrium', 'off (no traction boundary)')
+      if (allocated(error)) return
+      call check_switch(error, summary, 'SPR-C contact', 'on (NOT AVAILABLE in this version)')
+      if (allocated(error)) return
       call check_switch(error, summary, 'contact', 'on (NOT AVAILABLE in this version: cannot run yet)')
       if (allocated(error)) return
       call check(error, index(summary, 'NOT RUNNABLE: this version cannot run contact') > 0, 'plain statement')

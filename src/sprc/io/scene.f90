@@ -929,6 +929,7 @@ contains
          text = text//'  '//bc_line(scene%bcs(i))//nl
       end do
       text = text//'  traction-free (no &bc): '//none_if_empty(free_surfaces(scene))//nl
+      if (size(scene%contacts) > 0) text = text//'  contact surfaces: '//surfaces_of_type(scene, 'contact')//nl
       if (scene%exact%present) then
          text = text//'exact solution: '//exact_line(scene%exact)//nl
       else
@@ -939,8 +940,8 @@ contains
       end do
       text = text//switches(scene)
       if (size(scene%contacts) > 0) then
-         text = text//'NOT RUNNABLE: this version cannot run contact (&contact) yet; the scene is valid, '// &
-            & '`sprc run` will refuse it.'//nl
+         text = text//'NOT RUNNABLE: this version cannot run contact (&contact) yet; the scene is valid '// &
+            & 'but cannot be run.'//nl
       end if
       ! Lines are separated, not terminated: the driver prints the text as one record.
       text = text(1:len(text) - 1)
@@ -1019,13 +1020,17 @@ contains
       if (len(list) == 0) text = 'none'
    end function none_if_empty
 
-   !> Type of the &bc on shape `k`; 'free' when none names it.
+   !> Type of the &bc on shape `k`; without one, 'contact' for a contact
+   !> surface, else 'free'.
    function surface_type(scene, k) result(type)
       type(scene_type), intent(in) :: scene
       integer, intent(in) :: k
       character(len=:), allocatable :: type
       integer :: i
       type = 'free'
+      do i = 1, size(scene%contacts)
+         if (scene%contacts(i)%slave_surface_index == k .or. scene%contacts(i)%master_surface_index == k) type = 'contact'
+      end do
       do i = 1, size(scene%bcs)
          if (scene%bcs(i)%shape_index == k) type = scene%bcs(i)%type
       end do
@@ -1037,7 +1042,7 @@ contains
       integer :: k
       text = ''
       do k = 1, size(scene%shapes)
-         if (any(scene%bcs%shape_index == k)) cycle
+         if (any(scene%bcs%shape_index == k) .or. surface_type(scene, k) == 'contact') cycle
          text = join(text, "'"//scene%shapes(k)%name//"'")
       end do
    end function free_surfaces
