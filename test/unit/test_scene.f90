@@ -1,16 +1,532 @@
-!> Tests of the scene area (filled in by its issue work).
+!> Tests of scene input: the example scenes and the built-in default validate,
+!> defaults are filled, directions normalised, the summary states what the
+!> scene switches on and off, and every malformed scene in
+!> test/data/scenes/bad/ fails with the message its EXPECT line demands.
 module sprc_test_scene
-   use sprc_testsuite, only: unittest_type
+   use sprc_core_kinds, only: wp
+   use sprc_core_error, only: error_type, stat_invalid_input, stat_io, stat_unsupported
+   use sprc_io_namelist, only: read_text_file
+   use sprc_io_scene, only: scene_type, read_scene, read_scene_text, default_scene_text, scene_summary
+   use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed
    implicit none
    private
 
    public :: collect_scene
 
+   character(len=*), parameter :: nl = new_line('a')
+   character(len=*), parameter :: bad_dir = 'test/data/scenes/bad/'
+   !> Minimum number of malformed scene files the suite must hold.
+   integer, parameter :: min_bad_files = 35
+
+   !> A small valid 2D scene; tests edit it with `replaced`.
+   character(len=*), parameter :: minimal = &
+      & "&scene analysis='plane_stress' levels=2 box_min=0,0 box_size=4 /"//nl// &
+      & "&body name='b' young=1 poisson=0 /"//nl// &
+      & "&shape body='b' op='add' kind='box' name='sq' lower=1,1 upper=3,3 /"//nl
+
 contains
 
    subroutine collect_scene(testsuite)
       type(unittest_type), allocatable, intent(out) :: testsuite(:)
-      allocate (testsuite(0))
+      testsuite = [ &
+         new_unittest('default_equals_example_file', test_default_file), &
+         new_unittest('default_scene_validates', test_default_scene), &
+         new_unittest('kirsch_example', test_kirsch), &
+         new_unittest('lame_sphere_example', test_lame_sphere), &
+         new_unittest('defaults_filled', test_defaults), &
+         new_unittest('directions_normalised', test_normalised), &
+         new_unittest('shape_fields_per_kind', test_shape_fields), &
+         new_unittest('choices_case_insensitive', test_case), &
+         new_unittest('summary_switches_order1', test_summary_order1), &
+         new_unittest('summary_switches_order2', test_summary_order2), &
+         new_unittest('summary_switches_off', test_summary_off), &
+         new_unittest('summary_real_format', test_summary_reals), &
+         new_unittest('contact_accepted_not_runnable', test_contact), &
+         new_unittest('missing_file', test_missing_file), &
+         new_unittest('expect_has_enough_entries', test_expect_count), &
+         new_unittest('malformed_files', test_malformed) &
+         ]
    end subroutine collect_scene
+
+   !> Read a scene from text; any error fails the test.
+   subroutine read_ok(text, scene, error)
+      character(len=*), intent(in) :: text
+      type(scene_type), intent(out) :: scene
+      type(error_type), allocatable, intent(out) :: error
+      type(error_type), allocatable :: e
+      call read_scene_text(text, 'test.nml', scene, e)
+      if (allocated(e)) call test_failed(error, 'unexpected error: '//e%message)
+   end subroutine read_ok
+
+   subroutine read_file_ok(path, scene, error)
+      character(len=*), intent(in) :: path
+      type(scene_type), intent(out) :: scene
+      type(error_type), allocatable, intent(out) :: error
+      type(error_type), allocatable :: e
+      call read_scene(path, scene, e)
+      if (allocated(e)) call test_failed(error, path//': unexpected error: '//e%message)
+   end subroutine read_file_ok
+
+   !> `text` with the first `old` replaced by `new`.
+   function replaced(text, old, new) result(out)
+      character(len=*), intent(in) :: text, old, new
+      character(len=:), allocatable :: out
+      integer :: i
+      i = index(text, old)
+      out = text
+      if (i > 0) out = text(1:i - 1)//new//text(i + len(old):)
+   end function replaced
+
+   !> Whether `summary` has the line `  label: state...`.
+   logical function has_switch(summary, label, state)
+      character(len=*), intent(in) :: summary, label, state
+      has_switch = index(summary, nl//'  '//label//': '//state) > 0
+   end function has_switch
+
+   subroutine check_switch(error, summary, label, state)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), intent(in) :: summary, label, state
+      call check(error, has_switch(summary, label, state), 'summary lacks "'//label//': '//state//'" in:'//nl//summary)
+   end subroutine check_switch
+
+   subroutine test_default_file(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(error_type), allocatable :: e
+      character(len=:), allocatable :: text, builtin
+      call read_text_file('example/scenes/lame_cylinder.nml', text, e)
+      if (allocated(e)) then
+         call test_failed(error, e%message)
+         return
+      end if
+      builtin = default_scene_text()
+      call check(error, len(builtin), len(text), 'length of default_scene_text() vs the example file')
+      if (allocated(error)) return
+      call check(error, builtin == text, 'default_scene_text() equals example/scenes/lame_cylinder.nml byte for byte')
+   end subroutine test_default_file
+
+   subroutine test_default_scene(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: s
+      call read_ok(default_scene_text(), s, error)
+      if (allocated(error)) return
+      call check(error, s%analysis, 'plane_strain', 'analysis')
+      if (allocated(error)) return
+      call check(error, s%dim, 2, 'dim')
+      if (allocated(error)) return
+      call check(error, s%order, 1, 'order')
+      if (allocated(error)) return
+      call check(error, size(s%levels) == 4 .and. all(s%levels == [3, 4, 5, 6]), 'levels 3..6')
+      if (allocated(error)) return
+      call check(error, s%box_size, 25.0_wp, 0.0_wp, 'box_size')
+      if (allocated(error)) return
+      call check(error, s%output, 'out/lame', 'output')
+      if (allocated(error)) return
+      call check(error, size(s%bodies), 1, 'bodies')
+      if (allocated(error)) return
+      call check(error, s%bodies(1)%young, 1000.0_wp, 0.0_wp, 'young')
+      if (allocated(error)) return
+      call check(error, s%bodies(1)%poisson, 0.3_wp, 0.0_wp, 'poisson')
+      if (allocated(error)) return
+      call check(error, size(s%shapes), 4, 'shapes')
+      if (allocated(error)) return
+      call check(error, s%shapes(2)%name//' '//s%shapes(2)%op//' '//s%shapes(2)%kind, 'inner subtract disk', 'shape 2')
+      if (allocated(error)) return
+      call check(error, all(s%shapes%body_index == 1), 'shape body indices')
+      if (allocated(error)) return
+      call check(error, size(s%bcs), 3, 'bcs')
+      if (allocated(error)) return
+      call check(error, s%bcs(1)%type, 'pressure', 'bc 1 type')
+      if (allocated(error)) return
+      call check(error, s%bcs(1)%value, 1.0_wp, 0.0_wp, 'pressure value')
+      if (allocated(error)) return
+      call check(error, s%bcs(1)%shape_index, 2, 'bc 1 is on shape 2 (inner)')
+      if (allocated(error)) return
+      call check(error, s%bcs(3)%shape_index, 4, 'bc 3 is on shape 4 (sym_y)')
+      if (allocated(error)) return
+      call check(error, s%exact%present, 'exact present')
+      if (allocated(error)) return
+      call check(error, s%exact%kind, 'lame_cylinder', 'exact kind')
+      if (allocated(error)) return
+      call check(error, s%exact%r_in, 5.0_wp, 0.0_wp, 'r_in')
+      if (allocated(error)) return
+      call check(error, s%exact%r_out, 20.0_wp, 0.0_wp, 'r_out')
+      if (allocated(error)) return
+      call check(error, s%exact%p_out, 0.0_wp, 0.0_wp, 'p_out defaults to 0')
+      if (allocated(error)) return
+      call check(error, size(s%contacts), 0, 'no contact')
+   end subroutine test_default_scene
+
+   subroutine test_kirsch(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: s
+      character(len=:), allocatable :: summary
+      call read_file_ok('example/scenes/kirsch_plate.nml', s, error)
+      if (allocated(error)) return
+      call check(error, s%analysis, 'plane_stress', 'analysis')
+      if (allocated(error)) return
+      call check(error, size(s%levels) == 4 .and. all(s%levels == [3, 4, 5, 6]), 'levels 3..6')
+      if (allocated(error)) return
+      call check(error, s%exact%kind, 'kirsch', 'exact kind')
+      if (allocated(error)) return
+      call check(error, s%exact%radius, 1.0_wp, 0.0_wp, 'hole radius')
+      if (allocated(error)) return
+      call check(error, s%shapes(s%bcs(1)%shape_index)%kind, 'box', 'exact traction on the plate edges')
+      if (allocated(error)) return
+      call check(error, s%bcs(1)%type, 'exact_traction', 'bc type')
+      if (allocated(error)) return
+      summary = scene_summary(s)
+      call check_switch(error, summary, 'SPR-C symmetry', "on (surfaces 'sym_x', 'sym_y')")
+      if (allocated(error)) return
+      call check_switch(error, summary, 'SPR-C traction equilibrium', "on (surfaces 'edges', 'hole')")
+   end subroutine test_kirsch
+
+   subroutine test_lame_sphere(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: s
+      call read_file_ok('example/scenes/lame_sphere.nml', s, error)
+      if (allocated(error)) return
+      call check(error, s%dim, 3, 'solid is 3D')
+      if (allocated(error)) return
+      call check(error, size(s%box_min), 3, 'box_min has 3 values')
+      if (allocated(error)) return
+      call check(error, size(s%bodies(1)%body_force), 3, 'body_force has 3 values')
+      if (allocated(error)) return
+      call check(error, s%exact%kind, 'lame_sphere', 'exact kind')
+      if (allocated(error)) return
+      call check(error, s%bcs(2)%type//' '//s%bcs(3)%type//' '//s%bcs(4)%type, 'symmetry symmetry symmetry', &
+         & 'three symmetry planes')
+   end subroutine test_lame_sphere
+
+   subroutine test_defaults(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: s
+      call read_ok(minimal, s, error)
+      if (allocated(error)) return
+      call check(error, s%title, '', 'title default')
+      if (allocated(error)) return
+      call check(error, s%order, 1, 'order default')
+      if (allocated(error)) return
+      call check(error, s%refine_boundary, 0, 'refine_boundary default')
+      if (allocated(error)) return
+      call check(error, s%recovery, 'both', 'recovery default')
+      if (allocated(error)) return
+      call check(error, s%output, '', 'output default')
+      if (allocated(error)) return
+      call check(error, size(s%bodies(1)%body_force), 2, 'body_force size')
+      if (allocated(error)) return
+      call check(error, all(abs(s%bodies(1)%body_force) <= 0.0_wp), 'body_force default 0')
+      if (allocated(error)) return
+      call check(error, .not. s%exact%present, 'no exact')
+      if (allocated(error)) return
+      call check(error, size(s%bcs), 0, 'no bcs')
+      if (allocated(error)) return
+      call check(error, index(scene_summary(s), "traction-free (no &bc): 'sq'") > 0, 'sq listed as traction-free')
+   end subroutine test_defaults
+
+   subroutine test_normalised(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: s
+      character(len=:), allocatable :: text
+      ! (3, 4)/5 = (0.6, 0.8): the division rounds once, so allow a few ulps.
+      real(wp), parameter :: tol = 4*epsilon(1.0_wp)
+      text = minimal//"&shape body='b' op='intersect' kind='halfspace' name='h' point=2,2 normal=3,4 /"//nl
+      call read_ok(text, s, error)
+      if (allocated(error)) return
+      call check(error, s%shapes(2)%normal(1), 0.6_wp, tol, 'normal x', rel=.true.)
+      if (allocated(error)) return
+      call check(error, s%shapes(2)%normal(2), 0.8_wp, tol, 'normal y', rel=.true.)
+      if (allocated(error)) return
+      text = "&scene analysis='solid' levels=1 box_min=0,0,0 box_size=4 /"//nl// &
+         & "&body name='b' young=1 poisson=0.2 /"//nl// &
+         & "&shape body='b' op='add' kind='cylinder' name='c' point=2,2,0 axis=0,0,-7 radius=1 /"//nl
+      call read_ok(text, s, error)
+      if (allocated(error)) return
+      call check(error, s%shapes(1)%axis(3), -1.0_wp, tol, 'axis normalised')
+      if (allocated(error)) return
+      call check(error, abs(s%shapes(1)%axis(1)) + abs(s%shapes(1)%axis(2)), 0.0_wp, tol, 'axis x, y stay 0')
+   end subroutine test_normalised
+
+   subroutine test_shape_fields(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: s
+      character(len=:), allocatable :: text
+      text = minimal// &
+         & "&shape body='b' op='subtract' kind='ellipse' name='e' center=2,2 semi_axes=0.5,0.25 /"//nl// &
+         & "&shape body='b' op='add' kind='disk' name='d' center=1,1 radius=0.5 /"//nl
+      call read_ok(text, s, error)
+      if (allocated(error)) return
+      call check(error, allocated(s%shapes(1)%lower) .and. allocated(s%shapes(1)%upper) .and. &
+         & .not. allocated(s%shapes(1)%center), 'box has lower/upper only')
+      if (allocated(error)) return
+      call check(error, s%shapes(2)%semi_axes(2), 0.25_wp, 0.0_wp, 'ellipse semi_axes')
+      if (allocated(error)) return
+      call check(error, .not. allocated(s%shapes(2)%normal), 'ellipse has no normal')
+      if (allocated(error)) return
+      call check(error, s%shapes(3)%radius, 0.5_wp, 0.0_wp, 'disk radius')
+   end subroutine test_shape_fields
+
+   subroutine test_case(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: s
+      character(len=:), allocatable :: text
+      text = replaced(minimal, "analysis='plane_stress'", "ANALYSIS='Plane_Stress' Recovery='SPR'")
+      call read_ok(text, s, error)
+      if (allocated(error)) return
+      call check(error, s%analysis//' '//s%recovery, 'plane_stress spr', 'choices stored in lower case')
+   end subroutine test_case
+
+   subroutine test_summary_order1(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: s
+      character(len=:), allocatable :: summary
+      call read_ok(default_scene_text(), s, error)
+      if (allocated(error)) return
+      summary = scene_summary(s)
+      call check(error, summary(len(summary):len(summary)) /= nl, 'lines are separated, not terminated')
+      if (allocated(error)) return
+      call check(error, index(summary, "scene 'Thick cylinder under internal pressure, quarter model'") == 1, 'title')
+      if (allocated(error)) return
+      call check(error, index(summary, "traction-free (no &bc): 'outer'") > 0, 'outer is traction-free')
+      if (allocated(error)) return
+      call check(error, index(summary, "shape 'sym_x': intersect halfspace, point = 0.0, 0.0, normal = -1.0, 0.0") > 0, &
+         & 'shape line')
+      if (allocated(error)) return
+      call check(error, index(summary, 'exact solution: lame_cylinder') > 0, 'exact solution line')
+      if (allocated(error)) return
+      call check_switch(error, summary, 'recovery SPR', 'on')
+      if (allocated(error)) return
+      call check_switch(error, summary, 'recovery SPR-C', 'on')
+      if (allocated(error)) return
+      call check_switch(error, summary, 'SPR-C internal equilibrium', 'on')
+      if (allocated(error)) return
+      call check_switch(error, summary, 'SPR-C compatibility', 'off (order 1: holds identically)')
+      if (allocated(error)) return
+      call check_switch(error, summary, 'SPR-C traction equilibrium', "on (surfaces 'outer', 'inner')")
+      if (allocated(error)) return
+      call check_switch(error, summary, 'SPR-C symmetry', "on (surfaces 'sym_x', 'sym_y')")
+      if (allocated(error)) return
+      call check_switch(error, summary, 'SPR-C contact', 'off')
+      if (allocated(error)) return
+      call check_switch(error, summary, 'contact', 'off (no &contact)')
+      if (allocated(error)) return
+      call check_switch(error, summary, 'error columns (err_*, theta_*)', 'on (exact solution lame_cylinder)')
+      if (allocated(error)) return
+      call check_switch(error, summary, 'estimate columns (eta_*)', 'on')
+      if (allocated(error)) return
+      call check_switch(error, summary, 'output files', 'on (out/lame.csv, out/lame.svg, out/lame.h5, out/lame.xdmf)')
+      if (allocated(error)) return
+      call check(error, index(summary, 'NOT') == 0, 'nothing unavailable')
+   end subroutine test_summary_order1
+
+   subroutine test_summary_order2(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: s
+      character(len=:), allocatable :: summary
+      call read_ok(replaced(default_scene_text(), 'order    = 1', 'order    = 2'), s, error)
+      if (allocated(error)) return
+      call check(error, s%order, 2, 'order 2 read')
+      if (allocated(error)) return
+      summary = scene_summary(s)
+      call check_switch(error, summary, 'SPR-C compatibility', 'on (order 2)')
+   end subroutine test_summary_order2
+
+   subroutine test_summary_off(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: s
+      character(len=:), allocatable :: summary, text
+      ! recovery = 'spr': SPR on, SPR-C and its constraints off.
+      call read_ok(replaced(minimal, 'box_size=4', "box_size=4 recovery='spr'"), s, error)
+      if (allocated(error)) return
+      summary = scene_summary(s)
+      call check_switch(error, summary, 'recovery SPR', 'on')
+      if (allocated(error)) return
+      call check_switch(error, summary, 'recovery SPR-C', 'off')
+      if (allocated(error)) return
+      call check_switch(error, summary, 'SPR-C constraints', "off (recovery = 'spr')")
+      if (allocated(error)) return
+      call check_switch(error, summary, 'error columns (err_*, theta_*)', 'off (no &exact)')
+      if (allocated(error)) return
+      call check_switch(error, summary, 'output files', "off (output = '')")
+      if (allocated(error)) return
+      call check(error, index(summary, 'exact solution: none') > 0, 'no exact solution')
+      if (allocated(error)) return
+      ! recovery = 'none': no estimate either.
+      call read_ok(replaced(minimal, 'box_size=4', "box_size=4 recovery='none'"), s, error)
+      if (allocated(error)) return
+      summary = scene_summary(s)
+      call check_switch(error, summary, 'recovery SPR', 'off')
+      if (allocated(error)) return
+      call check_switch(error, summary, 'estimate columns (eta_*)', 'off')
+      if (allocated(error)) return
+      ! A displacement boundary is neither a traction nor a symmetry boundary.
+      text = replaced(minimal, 'box_size=4', "box_size=4 recovery='sprc'")//"&bc on='sq' type='displacement' vector=0,0 /"
+      call read_ok(text, s, error)
+      if (allocated(error)) return
+      summary = scene_summary(s)
+      call check_switch(error, summary, 'SPR-C traction equilibrium', 'off (no traction boundary)')
+      if (allocated(error)) return
+      call check_switch(error, summary, 'SPR-C symmetry', 'off (no symmetry boundary)')
+      if (allocated(error)) return
+      call check(error, index(summary, 'traction-free (no &bc): none') > 0, 'no traction-free surface')
+   end subroutine test_summary_off
+
+   subroutine test_summary_reals(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: s
+      character(len=:), allocatable :: summary, text
+      ! Shortest text that reads back as the same double, worked out by hand.
+      text = replaced(minimal, 'young=1 poisson=0', 'young=2.1d11 poisson=-0.25 body_force=2.5e-7, -9.81')
+      ! 0.1 + 0.2 rounds to the double printed as 0.30000000000000004 (17 digits).
+      text = replaced(text, 'upper=3,3', 'upper=3,0.30000000000000004')
+      text = replaced(text, 'lower=1,1', 'lower=1,0.1')
+      text = replaced(text, 'box_size=4', 'box_size=1.0e20')
+      call read_ok(text, s, error)
+      if (allocated(error)) return
+      summary = scene_summary(s)
+      call check(error, index(summary, 'young = 210000000000.0, poisson = -0.25, body_force = 2.5e-7, -9.81') > 0, &
+         & 'body line in:'//nl//summary)
+      if (allocated(error)) return
+      call check(error, index(summary, 'box_size        = 1.0e20') > 0, 'large value in exponent form')
+      if (allocated(error)) return
+      call check(error, index(summary, 'box_min         = 0.0, 0.0') > 0, 'zeros')
+      if (allocated(error)) return
+      call check(error, index(summary, 'lower = 1.0, 0.1, upper = 3.0, 0.30000000000000004') > 0, &
+         & '17 significant digits when needed')
+   end subroutine test_summary_reals
+
+   subroutine test_contact(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: s
+      character(len=:), allocatable :: summary, text
+      text = "&scene analysis='plane_strain' levels=3 box_min=0,0 box_size=4 /"//nl// &
+         & "&body name='punch' young=1000 poisson=0.3 /"//nl// &
+         & "&body name='block' young=2000 poisson=0.25 /"//nl// &
+         & "&shape body='punch' op='add' kind='disk' name='tip' center=2,3 radius=1 /"//nl// &
+         & "&shape body='block' op='add' kind='box' name='top' lower=0,0 upper=4,2 /"//nl// &
+         & "&contact slave='punch' master='block' slave_surface='tip' master_surface='top'"//nl// &
+         & "         friction='coulomb' mu=0.3 kappa=10 /"//nl
+      call read_ok(text, s, error)
+      if (allocated(error)) return
+      call check(error, size(s%contacts), 1, 'one contact')
+      if (allocated(error)) return
+      call check(error, s%contacts(1)%slave_index == 1 .and. s%contacts(1)%master_index == 2, 'body indices')
+      if (allocated(error)) return
+      call check(error, s%contacts(1)%slave_surface_index == 1 .and. s%contacts(1)%master_surface_index == 2, &
+         & 'surface indices')
+      if (allocated(error)) return
+      call check(error, s%contacts(1)%mu, 0.3_wp, 0.0_wp, 'mu')
+      if (allocated(error)) return
+      call check(error, s%contacts(1)%has_kappa, 'kappa given')
+      if (allocated(error)) return
+      summary = scene_summary(s)
+      ! Contact surfaces are neither traction-free nor traction boundaries.
+      call check(error, index(summary, 'traction-free (no &bc): none') > 0, 'contact surfaces are not traction-free')
+      if (allocated(error)) return
+      call check_switch(error, summary, 'SPR-C traction equilibrium', 'off (no traction boundary)')
+      if (allocated(error)) return
+      call check_switch(error, summary, 'SPR-C contact', 'on (NOT AVAILABLE in this version)')
+      if (allocated(error)) return
+      call check_switch(error, summary, 'contact', 'on (NOT AVAILABLE in this version: cannot run yet)')
+      if (allocated(error)) return
+      call check(error, index(summary, 'NOT RUNNABLE: this version cannot run contact') > 0, 'plain statement')
+   end subroutine test_contact
+
+   subroutine test_missing_file(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(error_type), allocatable :: e
+      type(scene_type) :: s
+      call read_scene(bad_dir//'does_not_exist.nml', s, e)
+      call check(error, allocated(e), 'a missing file fails')
+      if (allocated(error)) return
+      call check(error, e%stat, stat_io, 'missing file is stat_io')
+      if (allocated(error)) return
+      call check(error, index(e%message, bad_dir//'does_not_exist.nml') > 0, 'message names the path')
+   end subroutine test_missing_file
+
+   !> The non-comment lines of EXPECT.
+   subroutine expect_lines(lines, error)
+      character(len=256), allocatable, intent(out) :: lines(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(error_type), allocatable :: e
+      character(len=:), allocatable :: text
+      integer :: start, stop, n
+      call read_text_file(bad_dir//'EXPECT', text, e)
+      if (allocated(e)) then
+         call test_failed(error, e%message)
+         return
+      end if
+      allocate (lines(count([(text(n:n) == nl, n=1, len(text))])))
+      n = 0
+      start = 1
+      do while (start <= len(text))
+         stop = index(text(start:), nl) + start - 1
+         if (stop < start) stop = len(text) + 1
+         if (stop > start .and. text(start:start) /= '#') then
+            n = n + 1
+            lines(n) = text(start:stop - 1)
+         end if
+         start = stop + 1
+      end do
+      lines = lines(1:n)
+   end subroutine expect_lines
+
+   subroutine test_expect_count(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=256), allocatable :: lines(:)
+      call expect_lines(lines, error)
+      if (allocated(error)) return
+      call check(error, size(lines) >= min_bad_files, 'EXPECT lists at least 35 malformed files')
+   end subroutine test_expect_count
+
+   subroutine test_malformed(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=256), allocatable :: lines(:)
+      integer :: i
+      call expect_lines(lines, error)
+      if (allocated(error)) return
+      do i = 1, size(lines)
+         call check_malformed(trim(lines(i)), error)
+         if (allocated(error)) return
+      end do
+   end subroutine test_malformed
+
+   !> One EXPECT line: `file|substring|...`, optionally a field `stat=NAME`.
+   subroutine check_malformed(line, error)
+      character(len=*), intent(in) :: line
+      type(error_type), allocatable, intent(out) :: error
+      type(error_type), allocatable :: e
+      type(scene_type) :: s
+      character(len=:), allocatable :: file, field
+      integer :: start, bar, expected_stat
+
+      bar = index(line, '|')
+      if (bar <= 1) then
+         call test_failed(error, 'bad EXPECT line: '//line)
+         return
+      end if
+      file = line(1:bar - 1)
+      call read_scene(bad_dir//file, s, e)
+      if (.not. allocated(e)) then
+         call test_failed(error, file//': accepted, but it is malformed')
+         return
+      end if
+      expected_stat = stat_invalid_input
+      start = bar + 1
+      do while (start <= len(line))
+         bar = index(line(start:), '|') + start - 1
+         if (bar < start) bar = len(line) + 1
+         field = line(start:bar - 1)
+         start = bar + 1
+         select case (field)
+         case ('stat=io'); expected_stat = stat_io
+         case ('stat=unsupported'); expected_stat = stat_unsupported
+         case ('stat=invalid_input'); expected_stat = stat_invalid_input
+         case default
+            call check(error, index(e%message, field) > 0, file//': message "'//e%message//'" lacks "'//field//'"')
+            if (allocated(error)) return
+         end select
+      end do
+      call check(error, e%stat, expected_stat, file//': status of "'//e%message//'"')
+   end subroutine check_malformed
 
 end module sprc_test_scene

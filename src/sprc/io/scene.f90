@@ -1,0 +1,1274 @@
+!> Scene files (SCENE.md): read every group, validate everything before any
+!> computation, and describe what the scene switches on and off.
+!>
+!> Every error names the file, line, group, field and offending value, e.g.
+!> `scene.nml:7: &body: poisson = 0.5: must satisfy -1 < poisson < 0.5 ...`.
+module sprc_io_scene
+   use sprc_core_kinds, only: wp, i8
+   use sprc_core_error, only: error_type, fatal_error, stat_unsupported
+   use sprc_io_namelist, only: nml_group_type, parse_namelist, read_text_file, nml_get, nml_get_array, &
+      & nml_has, nml_check_consumed, nml_field_error, nml_group_error, nml_item_text
+   implicit none
+   private
+
+   public :: scene_type, body_type, shape_type, bc_type, exact_type, contact_type
+   public :: read_scene, read_scene_text, default_scene_text, scene_summary
+
+   !> One elastic body.
+   type :: body_type
+      !> Unique non-empty name.
+      character(len=:), allocatable :: name
+      !> Young's modulus, > 0.
+      real(wp) :: young = 0.0_wp
+      !> Poisson's ratio, -1 < poisson < 0.5.
+      real(wp) :: poisson = 0.0_wp
+      !> Body force per unit volume, `dim` values.
+      real(wp), allocatable :: body_force(:)
+   end type body_type
+
+   !> One CSG primitive of a body; its surface keeps `name`.
+   !> Array fields are allocated (with `dim` values) only for the kinds using them.
+   type :: shape_type
+      !> Name of the body it builds.
+      character(len=:), allocatable :: body
+      !> Index of that body in `scene%bodies`.
+      integer :: body_index = 0
+      !> 'add' | 'subtract' | 'intersect'.
+      character(len=:), allocatable :: op
+      !> 'disk' | 'sphere' | 'ellipse' | 'ellipsoid' | 'box' | 'halfspace' | 'cylinder'.
+      character(len=:), allocatable :: kind
+      !> Unique non-empty name of the surface.
+      character(len=:), allocatable :: name
+      !> Centre (disk, sphere, ellipse, ellipsoid).
+      real(wp), allocatable :: center(:)
+      !> Radius (disk, sphere, cylinder), > 0.
+      real(wp) :: radius = 0.0_wp
+      !> Semi-axes (ellipse, ellipsoid), all > 0.
+      real(wp), allocatable :: semi_axes(:)
+      !> Corners (box), lower < upper componentwise.
+      real(wp), allocatable :: lower(:), upper(:)
+      !> A point on the plane (halfspace) or on the axis (cylinder).
+      real(wp), allocatable :: point(:)
+      !> Unit outward normal (halfspace): the body side is (x - point).normal <= 0.
+      real(wp), allocatable :: normal(:)
+      !> Unit axis direction (cylinder).
+      real(wp), allocatable :: axis(:)
+   end type shape_type
+
+   !> A boundary condition on one shape surface.
+   type :: bc_type
+      !> Name of the shape surface.
+      character(len=:), allocatable :: on
+      !> Index of that shape in `scene%shapes`.
+      integer :: shape_index = 0
+      !> 'free' | 'pressure' | 'traction' | 'displacement' | 'symmetry' |
+      !> 'exact_traction' | 'exact_displacement'.
+      character(len=:), allocatable :: type
+      !> Pressure (type 'pressure'): t = -value n.
+      real(wp) :: value = 0.0_wp
+      !> Traction or displacement (types 'traction', 'displacement'), `dim` values.
+      real(wp), allocatable :: vector(:)
+   end type bc_type
+
+   !> The analytical solution, if any.
+   type :: exact_type
+      !> Whether the scene has an `&exact` group.
+      logical :: present = .false.
+      !> 'lame_cylinder' | 'lame_sphere' | 'kirsch'.
+      character(len=:), allocatable :: kind
+      !> Centre, `dim` values.
+      real(wp), allocatable :: center(:)
+      !> Lamé: inner and outer radius, inner and outer pressure.
+      real(wp) :: r_in = 0.0_wp, r_out = 0.0_wp, p_in = 0.0_wp, p_out = 0.0_wp
+      !> Kirsch: hole radius and remote uniaxial stress along x.
+      real(wp) :: radius = 0.0_wp, s_inf = 0.0_wp
+   end type exact_type
+
+   !> A contact pair between two bodies.
+   type :: contact_type
+      !> Body names and their indices in `scene%bodies`.
+      character(len=:), allocatable :: slave, master
+      integer :: slave_index = 0, master_index = 0
+      !> Shape surfaces in contact and their indices in `scene%shapes`.
+      character(len=:), allocatable :: slave_surface, master_surface
+      integer :: slave_surface_index = 0, master_surface_index = 0
+      !> 'frictionless' | 'coulomb' | 'stick'.
+      character(len=:), allocatable :: friction
+      !> Friction coefficient (coulomb), >= 0.
+      real(wp) :: mu = 0.0_wp
+      !> Stabilisation parameter, > 0 when given.
+      real(wp) :: kappa = 0.0_wp
+      logical :: has_kappa = .false.
+   end type contact_type
+
+   !> A validated scene, defaults filled in.
+   type :: scene_type
+      !> Name of the source (file name) it was read from.
+      character(len=:), allocatable :: source
+      character(len=:), allocatable :: title
+      !> 'plane_stress' | 'plane_strain' | 'solid'.
+      character(len=:), allocatable :: analysis
+      !> 2 for plane_stress and plane_strain, 3 for solid.
+      integer :: dim = 0
+      !> FE degree, 1 or 2.
+      integer :: order = 1
+      !> Uniform grid levels, strictly increasing.
+      integer, allocatable :: levels(:)
+      !> Extra levels on cut elements, 0..6.
+      integer :: refine_boundary = 0
+      !> Corner of the level-0 cell, `dim` values.
+      real(wp), allocatable :: box_min(:)
+      !> Edge of the level-0 cell, > 0.
+      real(wp) :: box_size = 0.0_wp
+      !> 'none' | 'spr' | 'sprc' | 'both'.
+      character(len=:), allocatable :: recovery
+      !> Prefix of the files written; '' writes none.
+      character(len=:), allocatable :: output
+      type(body_type), allocatable :: bodies(:)
+      type(shape_type), allocatable :: shapes(:)
+      type(bc_type), allocatable :: bcs(:)
+      type(exact_type) :: exact
+      type(contact_type), allocatable :: contacts(:)
+   end type scene_type
+
+   character(len=*), parameter :: known_groups(6) = [character(len=7) :: 'scene', 'body', 'shape', 'bc', &
+      & 'exact', 'contact']
+   character(len=*), parameter :: scene_keys = 'title analysis order levels refine_boundary box_min box_size '// &
+      & 'recovery output'
+   character(len=*), parameter :: body_keys = 'name young poisson body_force'
+   character(len=*), parameter :: shape_fields = 'center radius semi_axes lower upper point normal axis'
+   character(len=*), parameter :: shape_keys = 'body op kind name '//shape_fields
+   character(len=*), parameter :: bc_fields = 'value vector'
+   character(len=*), parameter :: bc_keys = 'on type '//bc_fields
+   character(len=*), parameter :: exact_fields = 'center r_in r_out p_in p_out radius s_inf'
+   character(len=*), parameter :: exact_keys = 'kind '//exact_fields
+   character(len=*), parameter :: contact_keys = 'slave master slave_surface master_surface friction mu kappa'
+
+   character(len=*), parameter :: analyses = 'plane_stress plane_strain solid'
+   character(len=*), parameter :: recoveries = 'none spr sprc both'
+   character(len=*), parameter :: ops = 'add subtract intersect'
+   character(len=*), parameter :: shape_kinds = 'disk sphere ellipse ellipsoid box halfspace cylinder'
+   character(len=*), parameter :: bc_types = 'free pressure traction displacement symmetry exact_traction '// &
+      & 'exact_displacement'
+   character(len=*), parameter :: exact_kinds = 'lame_cylinder lame_sphere kirsch hertz_cylinder hertz_sphere'
+   character(len=*), parameter :: frictions = 'frictionless coulomb stick'
+
+   !> Deepest uniform level accepted, 2D and 3D: 4^14 and 8^9 cells are already
+   !> far beyond what a direct solver handles.
+   integer, parameter :: max_level_2d = 14, max_level_3d = 9
+   integer, parameter :: max_refine_boundary = 6
+
+contains
+
+   !> Read and validate a scene file. A missing or unreadable file is
+   !> `stat_io`; a bad scene `stat_invalid_input`; a valid request this
+   !> version cannot run (hertz_* exact solutions) `stat_unsupported`.
+   subroutine read_scene(path, scene, error)
+      !> Path of the scene file; messages name it.
+      character(len=*), intent(in) :: path
+      type(scene_type), intent(out) :: scene
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: text
+
+      call read_text_file(path, text, error)
+      if (allocated(error)) return
+      call read_scene_text(text, path, scene, error)
+   end subroutine read_scene
+
+   !> Read and validate a scene given as namelist text.
+   subroutine read_scene_text(text, source_name, scene, error)
+      !> The scene file's text.
+      character(len=*), intent(in) :: text
+      !> Name of the source for messages (a file name).
+      character(len=*), intent(in) :: source_name
+      type(scene_type), intent(out) :: scene
+      type(error_type), allocatable, intent(out) :: error
+      type(nml_group_type), allocatable :: groups(:)
+
+      scene%source = source_name
+      call parse_namelist(text, source_name, groups, error, known_groups)
+      if (allocated(error)) return
+      if (size(groups) == 0) then
+         if (len_trim(text) == 0) then
+            call fatal_error(error, source_name//': empty file: a scene needs a &scene group and at least one &body')
+         else
+            call fatal_error(error, source_name//': no namelist group in the file (only comments or blanks): '// &
+               & 'a scene needs a &scene group and at least one &body')
+         end if
+         return
+      end if
+      call read_scene_group(groups, scene, error)
+      if (allocated(error)) return
+      call read_bodies(groups, scene, error)
+      if (allocated(error)) return
+      call read_shapes(groups, scene, error)
+      if (allocated(error)) return
+      call read_exact(groups, scene, error)
+      if (allocated(error)) return
+      call read_bcs(groups, scene, error)
+      if (allocated(error)) return
+      call read_contacts(groups, scene, error)
+   end subroutine read_scene_text
+
+   !> The built-in default scene: the Lamé cylinder study of SCENE.md,
+   !> byte-identical to example/scenes/lame_cylinder.nml.
+   function default_scene_text() result(text)
+      character(len=:), allocatable :: text
+      character(len=*), parameter :: nl = new_line('a')
+      text = &
+         "&scene"//nl// &
+         "  title    = 'Thick cylinder under internal pressure, quarter model'"//nl// &
+         "  analysis = 'plane_strain'   ! 'plane_stress' | 'plane_strain' | 'solid' (3D)"//nl// &
+         "  order    = 1                ! FE degree, 1 or 2"//nl// &
+         "  levels   = 3, 4, 5, 6       ! uniform grid levels: one analysis each (the study)"//nl// &
+         "  refine_boundary = 0         ! extra levels on cut elements, 2:1 balanced"//nl// &
+         "  box_min  = 0.0, 0.0         ! corner of the level-0 cell (2 or 3 values)"//nl// &
+         "  box_size = 25.0             ! edge of the level-0 square/cube"//nl// &
+         "  recovery = 'both'           ! 'none' | 'spr' | 'sprc' | 'both'"//nl// &
+         "  output   = 'out/lame'       ! prefix of the files written; '' writes none"//nl// &
+         "/"//nl// &
+         "&body  name='cylinder' young=1000.0 poisson=0.3 body_force=0.0, 0.0 /"//nl// &
+         "&shape body='cylinder' op='add'       kind='disk'      name='outer' center=0,0 radius=20 /"//nl// &
+         "&shape body='cylinder' op='subtract'  kind='disk'      name='inner' center=0,0 radius=5 /"//nl// &
+         "&shape body='cylinder' op='intersect' kind='halfspace' name='sym_x' point=0,0 normal=-1,0 /"//nl// &
+         "&shape body='cylinder' op='intersect' kind='halfspace' name='sym_y' point=0,0 normal=0,-1 /"//nl// &
+         "&bc    on='inner' type='pressure' value=1.0 /"//nl// &
+         "&bc    on='sym_x' type='symmetry' /"//nl// &
+         "&bc    on='sym_y' type='symmetry' /"//nl// &
+         "&exact kind='lame_cylinder' center=0,0 r_in=5 r_out=20 p_in=1.0 /"//nl
+   end function default_scene_text
+
+   ! ---------------------------------------------------------------- &scene
+
+   subroutine read_scene_group(groups, scene, error)
+      type(nml_group_type), intent(inout) :: groups(:)
+      type(scene_type), intent(inout) :: scene
+      type(error_type), allocatable, intent(out) :: error
+      integer :: ig, i, max_level
+      logical :: found
+
+      ig = 0
+      do i = 1, size(groups)
+         if (groups(i)%name /= 'scene') cycle
+         if (ig > 0) then
+            call nml_group_error(groups(i), 'a second &scene group (the first is on line '// &
+               & int_text(groups(ig)%line)//'): a scene file has exactly one', error)
+            return
+         end if
+         ig = i
+      end do
+      if (ig == 0) then
+         call fatal_error(error, groups(1)%source//': no &scene group: a scene file needs exactly one '// &
+            & '(analysis, levels, box_min, box_size)')
+         return
+      end if
+      associate (g => groups(ig))
+         call check_keys(g, scene_keys, error)
+         if (allocated(error)) return
+         scene%title = ''
+         call nml_get(g, 'title', scene%title, found, error)
+         if (allocated(error)) return
+         call get_choice(g, 'analysis', analyses, .true., scene%analysis, error)
+         if (allocated(error)) return
+         scene%dim = 2
+         if (scene%analysis == 'solid') scene%dim = 3
+         call nml_get(g, 'order', scene%order, found, error)
+         if (allocated(error)) return
+         if (scene%order /= 1 .and. scene%order /= 2) then
+            call nml_field_error(g, 'order', 'must be 1 or 2 (the FE degree)', error)
+            return
+         end if
+         max_level = max_level_2d
+         if (scene%dim == 3) max_level = max_level_3d
+         call nml_get_array(g, 'levels', scene%levels, 1, max_level + 1, found, error)
+         if (allocated(error)) return
+         if (.not. found) then
+            call nml_field_error(g, 'levels', 'required (the uniform grid levels of the study, e.g. 3, 4, 5)', error)
+            return
+         end if
+         if (any(scene%levels < 0 .or. scene%levels > max_level)) then
+            call nml_field_error(g, 'levels', 'each level must be 0 to '//int_text(max_level)//' in '// &
+               & int_text(scene%dim)//'D', error)
+            return
+         end if
+         do i = 2, size(scene%levels)
+            if (scene%levels(i) <= scene%levels(i - 1)) then
+               call nml_field_error(g, 'levels', 'must be strictly increasing', error)
+               return
+            end if
+         end do
+         call nml_get(g, 'refine_boundary', scene%refine_boundary, found, error)
+         if (allocated(error)) return
+         if (scene%refine_boundary < 0 .or. scene%refine_boundary > max_refine_boundary) then
+            call nml_field_error(g, 'refine_boundary', 'must be 0 to '//int_text(max_refine_boundary), error)
+            return
+         end if
+         call get_vector(g, 'box_min', scene%dim, .true., scene%box_min, error)
+         if (allocated(error)) return
+         call get_positive(g, 'box_size', .true., scene%box_size, error)
+         if (allocated(error)) return
+         scene%recovery = 'both'
+         call get_choice(g, 'recovery', recoveries, .false., scene%recovery, error)
+         if (allocated(error)) return
+         scene%output = ''
+         call nml_get(g, 'output', scene%output, found, error)
+         if (allocated(error)) return
+         call nml_check_consumed(g, error)
+      end associate
+   end subroutine read_scene_group
+
+   ! ----------------------------------------------------------------- &body
+
+   subroutine read_bodies(groups, scene, error)
+      type(nml_group_type), intent(inout) :: groups(:)
+      type(scene_type), intent(inout) :: scene
+      type(error_type), allocatable, intent(out) :: error
+      integer :: ig, n, j
+      logical :: found
+
+      allocate (scene%bodies(count_groups(groups, 'body')))
+      if (size(scene%bodies) == 0) then
+         call fatal_error(error, scene%source//': no &body group: a scene needs at least one body')
+         return
+      end if
+      n = 0
+      do ig = 1, size(groups)
+         if (groups(ig)%name /= 'body') cycle
+         n = n + 1
+         associate (g => groups(ig), body => scene%bodies(n))
+            call check_keys(g, body_keys, error)
+            if (allocated(error)) return
+            call get_name(g, 'name', body%name, error)
+            if (allocated(error)) return
+            do j = 1, n - 1
+               if (scene%bodies(j)%name == body%name) then
+                  call nml_field_error(g, 'name', 'duplicate body name', error)
+                  return
+               end if
+            end do
+            call get_positive(g, 'young', .true., body%young, error)
+            if (allocated(error)) return
+            call nml_get(g, 'poisson', body%poisson, found, error)
+            if (allocated(error)) return
+            if (.not. found) then
+               call nml_field_error(g, 'poisson', 'required (Poisson''s ratio, -1 < poisson < 0.5)', error)
+               return
+            end if
+            if (body%poisson >= 0.5_wp) then
+               call nml_field_error(g, 'poisson', 'must satisfy -1 < poisson < 0.5 (the incompressible limit '// &
+                  & 'is not supported by displacement finite elements)', error)
+               return
+            else if (body%poisson <= -1.0_wp) then
+               call nml_field_error(g, 'poisson', 'must satisfy -1 < poisson < 0.5', error)
+               return
+            end if
+            allocate (body%body_force(scene%dim), source=0.0_wp)
+            call get_vector(g, 'body_force', scene%dim, .false., body%body_force, error)
+            if (allocated(error)) return
+            call nml_check_consumed(g, error)
+            if (allocated(error)) return
+         end associate
+      end do
+   end subroutine read_bodies
+
+   ! ---------------------------------------------------------------- &shape
+
+   subroutine read_shapes(groups, scene, error)
+      type(nml_group_type), intent(inout) :: groups(:)
+      type(scene_type), intent(inout) :: scene
+      type(error_type), allocatable, intent(out) :: error
+      integer :: ig, n, j
+      integer, allocatable :: nshape(:)
+
+      allocate (scene%shapes(count_groups(groups, 'shape')))
+      allocate (nshape(size(scene%bodies)), source=0)
+      n = 0
+      do ig = 1, size(groups)
+         if (groups(ig)%name /= 'shape') cycle
+         n = n + 1
+         associate (g => groups(ig), shape => scene%shapes(n))
+            call check_keys(g, shape_keys, error)
+            if (allocated(error)) return
+            call get_name(g, 'body', shape%body, error)
+            if (allocated(error)) return
+            shape%body_index = body_index(scene, shape%body)
+            if (shape%body_index == 0) then
+               call nml_field_error(g, 'body', 'no &body has this name; bodies: '//body_names(scene), error)
+               return
+            end if
+            call get_choice(g, 'op', ops, .true., shape%op, error)
+            if (allocated(error)) return
+            if (nshape(shape%body_index) == 0 .and. shape%op /= 'add') then
+               call nml_field_error(g, 'op', "the first shape of body '"//shape%body// &
+                  & "' must have op = 'add' (a body starts from a shape, then adds, subtracts or intersects)", error)
+               return
+            end if
+            nshape(shape%body_index) = nshape(shape%body_index) + 1
+            call get_choice(g, 'kind', shape_kinds, .true., shape%kind, error)
+            if (allocated(error)) return
+            if (kind_dim(shape%kind) /= 0 .and. kind_dim(shape%kind) /= scene%dim) then
+               call nml_field_error(g, 'kind', 'is a '//int_text(kind_dim(shape%kind))//'D shape; analysis = '''// &
+                  & scene%analysis//''' is '//int_text(scene%dim)//'D', error)
+               return
+            end if
+            call get_name(g, 'name', shape%name, error)
+            if (allocated(error)) return
+            do j = 1, n - 1
+               if (scene%shapes(j)%name == shape%name) then
+                  call nml_field_error(g, 'name', 'duplicate shape name (shape names are unique across the scene)', &
+                     & error)
+                  return
+               end if
+            end do
+            call read_shape_fields(g, scene%dim, shape, error)
+            if (allocated(error)) return
+            call nml_check_consumed(g, error)
+            if (allocated(error)) return
+         end associate
+      end do
+      do j = 1, size(scene%bodies)
+         if (nshape(j) == 0) then
+            call fatal_error(error, scene%source//": body '"//scene%bodies(j)%name// &
+               & "' has no &shape: every body is built from at least one shape")
+            return
+         end if
+      end do
+   end subroutine read_shapes
+
+   !> Geometric fields of a shape, as its kind requires.
+   subroutine read_shape_fields(g, dim, shape, error)
+      type(nml_group_type), intent(inout) :: g
+      integer, intent(in) :: dim
+      type(shape_type), intent(inout) :: shape
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: fields
+      integer :: i
+
+      select case (shape%kind)
+      case ('disk', 'sphere'); fields = 'center radius'
+      case ('ellipse', 'ellipsoid'); fields = 'center semi_axes'
+      case ('box'); fields = 'lower upper'
+      case ('halfspace'); fields = 'point normal'
+      case default; fields = 'point axis radius'
+      end select
+      call check_fields(g, shape_fields, fields, '', "kind = '"//shape%kind//"'", error)
+      if (allocated(error)) return
+      if (has_word(fields, 'center')) call get_vector(g, 'center', dim, .true., shape%center, error)
+      if (allocated(error)) return
+      if (has_word(fields, 'point')) call get_vector(g, 'point', dim, .true., shape%point, error)
+      if (allocated(error)) return
+      if (has_word(fields, 'radius')) call get_positive(g, 'radius', .true., shape%radius, error)
+      if (allocated(error)) return
+      if (has_word(fields, 'semi_axes')) then
+         call get_vector(g, 'semi_axes', dim, .true., shape%semi_axes, error)
+         if (allocated(error)) return
+         if (any(shape%semi_axes <= 0.0_wp)) then
+            call nml_field_error(g, 'semi_axes', 'every semi-axis must be > 0', error)
+            return
+         end if
+      end if
+      if (has_word(fields, 'lower')) then
+         call get_vector(g, 'lower', dim, .true., shape%lower, error)
+         if (allocated(error)) return
+         call get_vector(g, 'upper', dim, .true., shape%upper, error)
+         if (allocated(error)) return
+         do i = 1, dim
+            if (shape%lower(i) >= shape%upper(i)) then
+               call nml_field_error(g, 'upper', 'must exceed lower = '//nml_item_text(g, 'lower')// &
+                  & ' in every component (component '//int_text(i)//' does not)', error)
+               return
+            end if
+         end do
+      end if
+      if (has_word(fields, 'normal')) call get_direction(g, 'normal', dim, shape%normal, error)
+      if (allocated(error)) return
+      if (has_word(fields, 'axis')) call get_direction(g, 'axis', dim, shape%axis, error)
+   end subroutine read_shape_fields
+
+   !> Dimension of a shape kind; 0 for kinds valid in 2D and 3D.
+   pure integer function kind_dim(kind)
+      character(len=*), intent(in) :: kind
+      select case (kind)
+      case ('disk', 'ellipse', 'lame_cylinder', 'kirsch'); kind_dim = 2
+      case ('sphere', 'ellipsoid', 'cylinder', 'lame_sphere'); kind_dim = 3
+      case default; kind_dim = 0
+      end select
+   end function kind_dim
+
+   ! ------------------------------------------------------------------- &bc
+
+   subroutine read_bcs(groups, scene, error)
+      type(nml_group_type), intent(inout) :: groups(:)
+      type(scene_type), intent(inout) :: scene
+      type(error_type), allocatable, intent(out) :: error
+      integer :: ig, n
+      integer, allocatable :: line_of(:)
+      character(len=:), allocatable :: fields
+      logical :: found
+
+      allocate (scene%bcs(count_groups(groups, 'bc')))
+      allocate (line_of(size(scene%shapes)), source=0)
+      n = 0
+      do ig = 1, size(groups)
+         if (groups(ig)%name /= 'bc') cycle
+         n = n + 1
+         associate (g => groups(ig), bc => scene%bcs(n))
+            call check_keys(g, bc_keys, error)
+            if (allocated(error)) return
+            call get_name(g, 'on', bc%on, error)
+            if (allocated(error)) return
+            bc%shape_index = shape_index(scene, bc%on)
+            if (bc%shape_index == 0) then
+               call nml_field_error(g, 'on', 'no &shape has this name; surfaces: '//shape_names(scene), error)
+               return
+            end if
+            if (line_of(bc%shape_index) > 0) then
+               call nml_field_error(g, 'on', 'this surface already has a &bc (on line '// &
+                  & int_text(line_of(bc%shape_index))//'): one &bc per surface', error)
+               return
+            end if
+            line_of(bc%shape_index) = g%line
+            call get_choice(g, 'type', bc_types, .true., bc%type, error)
+            if (allocated(error)) return
+            select case (bc%type)
+            case ('pressure'); fields = 'value'
+            case ('traction', 'displacement'); fields = 'vector'
+            case default; fields = ''
+            end select
+            call check_fields(g, bc_fields, fields, '', "type = '"//bc%type//"'", error)
+            if (allocated(error)) return
+            if (fields == 'value') then
+               call nml_get(g, 'value', bc%value, found, error)
+               if (allocated(error)) return
+            end if
+            if (fields == 'vector') call get_vector(g, 'vector', scene%dim, .true., bc%vector, error)
+            if (allocated(error)) return
+            if (index(bc%type, 'exact_') == 1 .and. .not. scene%exact%present) then
+               call nml_field_error(g, 'type', 'needs an &exact group (the exact solution it prescribes)', error)
+               return
+            end if
+            call nml_check_consumed(g, error)
+            if (allocated(error)) return
+         end associate
+      end do
+   end subroutine read_bcs
+
+   ! ---------------------------------------------------------------- &exact
+
+   subroutine read_exact(groups, scene, error)
+      type(nml_group_type), intent(inout) :: groups(:)
+      type(scene_type), intent(inout) :: scene
+      type(error_type), allocatable, intent(out) :: error
+      integer :: ig, i
+      logical :: found
+
+      ig = 0
+      do i = 1, size(groups)
+         if (groups(i)%name /= 'exact') cycle
+         if (ig > 0) then
+            call nml_group_error(groups(i), 'a second &exact group (the first is on line '// &
+               & int_text(groups(ig)%line)//'): at most one exact solution', error)
+            return
+         end if
+         ig = i
+      end do
+      if (ig == 0) return
+      associate (g => groups(ig), exact => scene%exact)
+         call check_keys(g, exact_keys, error)
+         if (allocated(error)) return
+         call get_choice(g, 'kind', exact_kinds, .true., exact%kind, error)
+         if (allocated(error)) return
+         if (index(exact%kind, 'hertz_') == 1) then
+            call nml_field_error(g, 'kind', 'not available in this version (contact is not implemented yet)', &
+               & error, stat_unsupported)
+            return
+         end if
+         if (kind_dim(exact%kind) /= scene%dim) then
+            call nml_field_error(g, 'kind', 'is a '//int_text(kind_dim(exact%kind))//'D solution; analysis = '''// &
+               & scene%analysis//''' is '//int_text(scene%dim)//'D', error)
+            return
+         end if
+         if (exact%kind == 'kirsch') then
+            call check_fields(g, exact_fields, 'center radius s_inf', '', "kind = 'kirsch'", error)
+            if (allocated(error)) return
+            call get_vector(g, 'center', scene%dim, .true., exact%center, error)
+            if (allocated(error)) return
+            call get_positive(g, 'radius', .true., exact%radius, error)
+            if (allocated(error)) return
+            call nml_get(g, 's_inf', exact%s_inf, found, error)
+            if (allocated(error)) return
+         else
+            call check_fields(g, exact_fields, 'center r_in r_out p_in', 'p_out', "kind = '"//exact%kind//"'", error)
+            if (allocated(error)) return
+            call get_vector(g, 'center', scene%dim, .true., exact%center, error)
+            if (allocated(error)) return
+            call get_positive(g, 'r_in', .true., exact%r_in, error)
+            if (allocated(error)) return
+            call get_positive(g, 'r_out', .true., exact%r_out, error)
+            if (allocated(error)) return
+            if (exact%r_out <= exact%r_in) then
+               call nml_field_error(g, 'r_out', 'must exceed r_in = '//nml_item_text(g, 'r_in'), error)
+               return
+            end if
+            call nml_get(g, 'p_in', exact%p_in, found, error)
+            if (allocated(error)) return
+            call nml_get(g, 'p_out', exact%p_out, found, error)
+            if (allocated(error)) return
+         end if
+         call nml_check_consumed(g, error)
+         if (allocated(error)) return
+         exact%present = .true.
+      end associate
+   end subroutine read_exact
+
+   ! -------------------------------------------------------------- &contact
+
+   subroutine read_contacts(groups, scene, error)
+      type(nml_group_type), intent(inout) :: groups(:)
+      type(scene_type), intent(inout) :: scene
+      type(error_type), allocatable, intent(out) :: error
+      integer :: ig, n
+      logical :: found
+
+      allocate (scene%contacts(count_groups(groups, 'contact')))
+      n = 0
+      do ig = 1, size(groups)
+         if (groups(ig)%name /= 'contact') cycle
+         n = n + 1
+         associate (g => groups(ig), c => scene%contacts(n))
+            call check_keys(g, contact_keys, error)
+            if (allocated(error)) return
+            call get_body_ref(g, 'slave', scene, c%slave, c%slave_index, error)
+            if (allocated(error)) return
+            call get_body_ref(g, 'master', scene, c%master, c%master_index, error)
+            if (allocated(error)) return
+            if (c%master_index == c%slave_index) then
+               call nml_field_error(g, 'master', 'must differ from slave: contact is between two bodies', error)
+               return
+            end if
+            call get_surface_ref(g, 'slave_surface', scene, c%slave_index, c%slave_surface, &
+               & c%slave_surface_index, error)
+            if (allocated(error)) return
+            call get_surface_ref(g, 'master_surface', scene, c%master_index, c%master_surface, &
+               & c%master_surface_index, error)
+            if (allocated(error)) return
+            c%friction = 'frictionless'
+            call get_choice(g, 'friction', frictions, .false., c%friction, error)
+            if (allocated(error)) return
+            if (c%friction == 'coulomb') then
+               call nml_get(g, 'mu', c%mu, found, error)
+               if (allocated(error)) return
+               if (.not. found) then
+                  call nml_field_error(g, 'mu', "required for friction = 'coulomb' (the friction coefficient)", error)
+                  return
+               end if
+               if (c%mu < 0.0_wp) then
+                  call nml_field_error(g, 'mu', 'must be >= 0', error)
+                  return
+               end if
+            else if (nml_has(g, 'mu')) then
+               call nml_field_error(g, 'mu', "applies only to friction = 'coulomb'", error)
+               return
+            end if
+            call get_positive(g, 'kappa', .false., c%kappa, error)
+            if (allocated(error)) return
+            c%has_kappa = nml_has(g, 'kappa')
+            call nml_check_consumed(g, error)
+            if (allocated(error)) return
+         end associate
+      end do
+   end subroutine read_contacts
+
+   subroutine get_body_ref(g, key, scene, name, index, error)
+      type(nml_group_type), intent(inout) :: g
+      character(len=*), intent(in) :: key
+      type(scene_type), intent(in) :: scene
+      character(len=:), allocatable, intent(out) :: name
+      integer, intent(out) :: index
+      type(error_type), allocatable, intent(out) :: error
+      index = 0
+      call get_name(g, key, name, error)
+      if (allocated(error)) return
+      index = body_index(scene, name)
+      if (index == 0) call nml_field_error(g, key, 'no &body has this name; bodies: '//body_names(scene), error)
+   end subroutine get_body_ref
+
+   !> A shape surface that must belong to body `ibody`.
+   subroutine get_surface_ref(g, key, scene, ibody, name, index, error)
+      type(nml_group_type), intent(inout) :: g
+      character(len=*), intent(in) :: key
+      type(scene_type), intent(in) :: scene
+      integer, intent(in) :: ibody
+      character(len=:), allocatable, intent(out) :: name
+      integer, intent(out) :: index
+      type(error_type), allocatable, intent(out) :: error
+      index = 0
+      call get_name(g, key, name, error)
+      if (allocated(error)) return
+      index = shape_index(scene, name)
+      if (index == 0) then
+         call nml_field_error(g, key, 'no &shape has this name; surfaces: '//shape_names(scene), error)
+      else if (scene%shapes(index)%body_index /= ibody) then
+         call nml_field_error(g, key, "is a surface of body '"//scene%shapes(index)%body//"', not of '"// &
+            & scene%bodies(ibody)%name//"'", error)
+      end if
+   end subroutine get_surface_ref
+
+   ! -------------------------------------------------------------- helpers
+
+   !> Fail on a key outside `keys` (blank separated), listing the valid keys.
+   subroutine check_keys(g, keys, error)
+      type(nml_group_type), intent(in) :: g
+      character(len=*), intent(in) :: keys
+      type(error_type), allocatable, intent(out) :: error
+      integer :: k
+      do k = 1, size(g%items)
+         if (.not. has_word(keys, g%items(k)%key)) then
+            call nml_field_error(g, g%items(k)%key, 'unknown key; valid keys: '//comma_list(keys), error)
+            return
+         end if
+      end do
+   end subroutine check_keys
+
+   !> Of the kind-dependent `all` fields, `needed` must be given, `optional`
+   !> may be, the rest must not be: they do not apply to `what`.
+   subroutine check_fields(g, all, needed, optional, what, error)
+      type(nml_group_type), intent(in) :: g
+      character(len=*), intent(in) :: all, needed, optional, what
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: word, applies
+      integer :: pos
+
+      applies = 'none'
+      if (len_trim(needed//optional) > 0) applies = comma_list(trim(needed//' '//optional))
+      pos = 1
+      do
+         call next_word(all, pos, word)
+         if (len(word) == 0) exit
+         if (nml_has(g, word) .and. .not. (has_word(needed, word) .or. has_word(optional, word))) then
+            call nml_field_error(g, word, 'does not apply to '//what//' (its fields: '//applies//')', error)
+            return
+         end if
+         if (.not. nml_has(g, word) .and. has_word(needed, word)) then
+            call nml_field_error(g, word, 'required for '//what, error)
+            return
+         end if
+      end do
+   end subroutine check_fields
+
+   !> A string from a list of choices (case-insensitive, stored in lower case);
+   !> `value` keeps its default when the key is absent and not required.
+   subroutine get_choice(g, key, choices, required, value, error)
+      type(nml_group_type), intent(inout) :: g
+      character(len=*), intent(in) :: key, choices
+      logical, intent(in) :: required
+      character(len=:), allocatable, intent(inout) :: value
+      type(error_type), allocatable, intent(out) :: error
+      logical :: found
+      call nml_get(g, key, value, found, error)
+      if (allocated(error)) return
+      if (.not. found) then
+         if (required) call nml_field_error(g, key, 'required; one of '//quoted_list(choices), error)
+         return
+      end if
+      value = lower(value)
+      if (.not. has_word(choices, value) .or. len(value) == 0) then
+         call nml_field_error(g, key, 'must be one of '//quoted_list(choices), error)
+      end if
+   end subroutine get_choice
+
+   !> A required non-empty name.
+   subroutine get_name(g, key, value, error)
+      type(nml_group_type), intent(inout) :: g
+      character(len=*), intent(in) :: key
+      character(len=:), allocatable, intent(out) :: value
+      type(error_type), allocatable, intent(out) :: error
+      logical :: found
+      value = ''
+      call nml_get(g, key, value, found, error)
+      if (allocated(error)) return
+      if (.not. found) then
+         call nml_field_error(g, key, 'required', error)
+      else if (len_trim(value) == 0) then
+         call nml_field_error(g, key, 'must not be empty', error)
+      end if
+   end subroutine get_name
+
+   !> A real > 0; `value` keeps its default when absent and not required.
+   subroutine get_positive(g, key, required, value, error)
+      type(nml_group_type), intent(inout) :: g
+      character(len=*), intent(in) :: key
+      logical, intent(in) :: required
+      real(wp), intent(inout) :: value
+      type(error_type), allocatable, intent(out) :: error
+      logical :: found
+      call nml_get(g, key, value, found, error)
+      if (allocated(error)) return
+      if (.not. found) then
+         if (required) call nml_field_error(g, key, 'required', error)
+      else if (value <= 0.0_wp) then
+         call nml_field_error(g, key, 'must be > 0', error)
+      end if
+   end subroutine get_positive
+
+   !> A vector of exactly `dim` reals.
+   subroutine get_vector(g, key, dim, required, value, error)
+      type(nml_group_type), intent(inout) :: g
+      character(len=*), intent(in) :: key
+      integer, intent(in) :: dim
+      logical, intent(in) :: required
+      real(wp), allocatable, intent(inout) :: value(:)
+      type(error_type), allocatable, intent(out) :: error
+      logical :: found
+      call nml_get_array(g, key, value, dim, dim, found, error)
+      if (allocated(error)) return
+      if (.not. found .and. required) call nml_field_error(g, key, 'required ('//int_text(dim)//' values)', error)
+   end subroutine get_vector
+
+   !> A required nonzero direction, stored normalised.
+   subroutine get_direction(g, key, dim, value, error)
+      type(nml_group_type), intent(inout) :: g
+      character(len=*), intent(in) :: key
+      integer, intent(in) :: dim
+      real(wp), allocatable, intent(inout) :: value(:)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: length
+      call get_vector(g, key, dim, .true., value, error)
+      if (allocated(error)) return
+      length = norm2(value)
+      if (.not. (length > 0.0_wp)) then
+         call nml_field_error(g, key, 'must be a nonzero vector', error)
+         return
+      end if
+      value = value/length
+   end subroutine get_direction
+
+   pure integer function count_groups(groups, name) result(n)
+      type(nml_group_type), intent(in) :: groups(:)
+      character(len=*), intent(in) :: name
+      integer :: i
+      n = 0
+      do i = 1, size(groups)
+         if (groups(i)%name == name) n = n + 1
+      end do
+   end function count_groups
+
+   pure integer function body_index(scene, name) result(k)
+      type(scene_type), intent(in) :: scene
+      character(len=*), intent(in) :: name
+      do k = 1, size(scene%bodies)
+         if (scene%bodies(k)%name == name) return
+      end do
+      k = 0
+   end function body_index
+
+   pure integer function shape_index(scene, name) result(k)
+      type(scene_type), intent(in) :: scene
+      character(len=*), intent(in) :: name
+      do k = 1, size(scene%shapes)
+         if (.not. allocated(scene%shapes(k)%name)) cycle
+         if (scene%shapes(k)%name == name) return
+      end do
+      k = 0
+   end function shape_index
+
+   function body_names(scene) result(text)
+      type(scene_type), intent(in) :: scene
+      character(len=:), allocatable :: text
+      integer :: k
+      text = ''
+      do k = 1, size(scene%bodies)
+         if (.not. allocated(scene%bodies(k)%name)) cycle
+         if (k > 1) text = text//', '
+         text = text//"'"//scene%bodies(k)%name//"'"
+      end do
+   end function body_names
+
+   function shape_names(scene) result(text)
+      type(scene_type), intent(in) :: scene
+      character(len=:), allocatable :: text
+      integer :: k
+      text = ''
+      do k = 1, size(scene%shapes)
+         if (.not. allocated(scene%shapes(k)%name)) cycle
+         if (len(text) > 0) text = text//', '
+         text = text//"'"//scene%shapes(k)%name//"'"
+      end do
+   end function shape_names
+
+   ! -------------------------------------------------------------- summary
+
+   !> The validated scene, defaults filled in, and what it switches on and
+   !> off (SCENE.md); lines separated by new_line('a'), for `sprc check`.
+   function scene_summary(scene) result(text)
+      type(scene_type), intent(in) :: scene
+      character(len=:), allocatable :: text
+      character(len=*), parameter :: nl = new_line('a')
+      integer :: i, j
+
+      text = "scene '"//scene%title//"' from "//scene%source//nl
+      text = text//'  analysis        = '//scene%analysis//' ('//int_text(scene%dim)//'D)'//nl
+      text = text//'  order           = '//int_text(scene%order)//nl
+      text = text//'  levels          = '//int_list(scene%levels)//nl
+      text = text//'  refine_boundary = '//int_text(scene%refine_boundary)//nl
+      text = text//'  box_min         = '//real_list(scene%box_min)//nl
+      text = text//'  box_size        = '//real_text(scene%box_size)//nl
+      text = text//'  recovery        = '//scene%recovery//nl
+      text = text//"  output          = '"//scene%output//"'"//nl
+      do i = 1, size(scene%bodies)
+         associate (b => scene%bodies(i))
+            text = text//"body '"//b%name//"': young = "//real_text(b%young)//', poisson = '// &
+               & real_text(b%poisson)//', body_force = '//real_list(b%body_force)//nl
+         end associate
+         do j = 1, size(scene%shapes)
+            if (scene%shapes(j)%body_index == i) text = text//'  '//shape_line(scene%shapes(j))//nl
+         end do
+      end do
+      text = text//'boundary conditions:'//nl
+      do i = 1, size(scene%bcs)
+         text = text//'  '//bc_line(scene%bcs(i))//nl
+      end do
+      text = text//'  traction-free (no &bc): '//none_if_empty(free_surfaces(scene))//nl
+      if (size(scene%contacts) > 0) text = text//'  contact surfaces: '//surfaces_of_type(scene, 'contact')//nl
+      if (scene%exact%present) then
+         text = text//'exact solution: '//exact_line(scene%exact)//nl
+      else
+         text = text//'exact solution: none'//nl
+      end if
+      do i = 1, size(scene%contacts)
+         text = text//'contact: '//contact_line(scene%contacts(i))//nl
+      end do
+      text = text//switches(scene)
+      if (size(scene%contacts) > 0) then
+         text = text//'NOT RUNNABLE: this version cannot run contact (&contact) yet; the scene is valid '// &
+            & 'but cannot be run.'//nl
+      end if
+      ! Lines are separated, not terminated: the driver prints the text as one record.
+      text = text(1:len(text) - 1)
+   end function scene_summary
+
+   !> The list of SCENE.md 'What a scene switches on', one `label: state` per line.
+   function switches(scene) result(text)
+      type(scene_type), intent(in) :: scene
+      character(len=:), allocatable :: text
+      character(len=*), parameter :: nl = new_line('a')
+      logical :: spr, sprc
+      character(len=:), allocatable :: surfaces
+
+      spr = scene%recovery == 'spr' .or. scene%recovery == 'both'
+      sprc = scene%recovery == 'sprc' .or. scene%recovery == 'both'
+      text = 'what this scene switches on and off:'//nl
+      text = text//'  recovery SPR: '//on_off(spr)//nl
+      text = text//'  recovery SPR-C: '//on_off(sprc)//nl
+      if (sprc) then
+         text = text//'  SPR-C internal equilibrium: on'//nl
+         if (scene%order == 1) then
+            text = text//'  SPR-C compatibility: off (order 1: holds identically)'//nl
+         else
+            text = text//'  SPR-C compatibility: on (order '//int_text(scene%order)//')'//nl
+         end if
+         surfaces = traction_surfaces(scene)
+         if (len(surfaces) > 0) then
+            text = text//'  SPR-C traction equilibrium: on (surfaces '//surfaces//')'//nl
+         else
+            text = text//'  SPR-C traction equilibrium: off (no traction boundary)'//nl
+         end if
+         surfaces = surfaces_of_type(scene, 'symmetry')
+         if (len(surfaces) > 0) then
+            text = text//'  SPR-C symmetry: on (surfaces '//surfaces//')'//nl
+         else
+            text = text//'  SPR-C symmetry: off (no symmetry boundary)'//nl
+         end if
+         if (size(scene%contacts) > 0) then
+            text = text//'  SPR-C contact: on (NOT AVAILABLE in this version)'//nl
+         else
+            text = text//'  SPR-C contact: off (no &contact)'//nl
+         end if
+      else
+         text = text//"  SPR-C constraints: off (recovery = '"//scene%recovery//"')"//nl
+      end if
+      if (size(scene%contacts) > 0) then
+         text = text//'  contact: on (NOT AVAILABLE in this version: cannot run yet)'//nl
+      else
+         text = text//'  contact: off (no &contact)'//nl
+      end if
+      if (scene%exact%present) then
+         text = text//'  error columns (err_*, theta_*): on (exact solution '//scene%exact%kind//')'//nl
+      else
+         text = text//'  error columns (err_*, theta_*): off (no &exact)'//nl
+      end if
+      text = text//'  estimate columns (eta_*): '//on_off(spr .or. sprc)//nl
+      if (len(scene%output) > 0) then
+         text = text//'  output files: on ('//scene%output//'.csv, '//scene%output//'.svg, '//scene%output// &
+            & '.h5, '//scene%output//'.xdmf)'//nl
+      else
+         text = text//"  output files: off (output = '')"//nl
+      end if
+   end function switches
+
+   function on_off(flag) result(text)
+      logical, intent(in) :: flag
+      character(len=:), allocatable :: text
+      text = 'off'
+      if (flag) text = 'on'
+   end function on_off
+
+   function none_if_empty(list) result(text)
+      character(len=*), intent(in) :: list
+      character(len=:), allocatable :: text
+      text = list
+      if (len(list) == 0) text = 'none'
+   end function none_if_empty
+
+   !> Type of the &bc on shape `k`; without one, 'contact' for a contact
+   !> surface, else 'free'.
+   function surface_type(scene, k) result(type)
+      type(scene_type), intent(in) :: scene
+      integer, intent(in) :: k
+      character(len=:), allocatable :: type
+      integer :: i
+      type = 'free'
+      do i = 1, size(scene%contacts)
+         if (scene%contacts(i)%slave_surface_index == k .or. scene%contacts(i)%master_surface_index == k) type = 'contact'
+      end do
+      do i = 1, size(scene%bcs)
+         if (scene%bcs(i)%shape_index == k) type = scene%bcs(i)%type
+      end do
+   end function surface_type
+
+   function free_surfaces(scene) result(text)
+      type(scene_type), intent(in) :: scene
+      character(len=:), allocatable :: text
+      integer :: k
+      text = ''
+      do k = 1, size(scene%shapes)
+         if (any(scene%bcs%shape_index == k) .or. surface_type(scene, k) == 'contact') cycle
+         text = join(text, "'"//scene%shapes(k)%name//"'")
+      end do
+   end function free_surfaces
+
+   !> Surfaces where the traction is known: free (explicit or implicit),
+   !> pressure, traction, exact_traction.
+   function traction_surfaces(scene) result(text)
+      type(scene_type), intent(in) :: scene
+      character(len=:), allocatable :: text
+      integer :: k
+      text = ''
+      do k = 1, size(scene%shapes)
+         select case (surface_type(scene, k))
+         case ('free', 'pressure', 'traction', 'exact_traction')
+            text = join(text, "'"//scene%shapes(k)%name//"'")
+         end select
+      end do
+   end function traction_surfaces
+
+   function surfaces_of_type(scene, type) result(text)
+      type(scene_type), intent(in) :: scene
+      character(len=*), intent(in) :: type
+      character(len=:), allocatable :: text
+      integer :: k
+      text = ''
+      do k = 1, size(scene%shapes)
+         if (surface_type(scene, k) == type) text = join(text, "'"//scene%shapes(k)%name//"'")
+      end do
+   end function surfaces_of_type
+
+   function shape_line(shape) result(text)
+      type(shape_type), intent(in) :: shape
+      character(len=:), allocatable :: text
+      text = "shape '"//shape%name//"': "//shape%op//' '//shape%kind
+      if (allocated(shape%center)) text = text//', center = '//real_list(shape%center)
+      if (allocated(shape%point)) text = text//', point = '//real_list(shape%point)
+      if (allocated(shape%semi_axes)) text = text//', semi_axes = '//real_list(shape%semi_axes)
+      if (allocated(shape%lower)) text = text//', lower = '//real_list(shape%lower)
+      if (allocated(shape%upper)) text = text//', upper = '//real_list(shape%upper)
+      if (allocated(shape%normal)) text = text//', normal = '//real_list(shape%normal)
+      if (allocated(shape%axis)) text = text//', axis = '//real_list(shape%axis)
+      select case (shape%kind)
+      case ('disk', 'sphere', 'cylinder'); text = text//', radius = '//real_text(shape%radius)
+      end select
+   end function shape_line
+
+   function bc_line(bc) result(text)
+      type(bc_type), intent(in) :: bc
+      character(len=:), allocatable :: text
+      text = "on '"//bc%on//"': "//bc%type
+      if (bc%type == 'pressure') text = text//', value = '//real_text(bc%value)
+      if (allocated(bc%vector)) text = text//', vector = '//real_list(bc%vector)
+   end function bc_line
+
+   function exact_line(exact) result(text)
+      type(exact_type), intent(in) :: exact
+      character(len=:), allocatable :: text
+      text = exact%kind//', center = '//real_list(exact%center)
+      if (exact%kind == 'kirsch') then
+         text = text//', radius = '//real_text(exact%radius)//', s_inf = '//real_text(exact%s_inf)
+      else
+         text = text//', r_in = '//real_text(exact%r_in)//', r_out = '//real_text(exact%r_out)// &
+            & ', p_in = '//real_text(exact%p_in)//', p_out = '//real_text(exact%p_out)
+      end if
+   end function exact_line
+
+   function contact_line(c) result(text)
+      type(contact_type), intent(in) :: c
+      character(len=:), allocatable :: text
+      text = "slave '"//c%slave//"' surface '"//c%slave_surface//"', master '"//c%master//"' surface '"// &
+         & c%master_surface//"', friction = "//c%friction
+      if (c%friction == 'coulomb') text = text//', mu = '//real_text(c%mu)
+      if (c%has_kappa) text = text//', kappa = '//real_text(c%kappa)
+      text = text//' (NOT AVAILABLE in this version)'
+   end function contact_line
+
+   ! ---------------------------------------------------------- text utils
+
+   function join(list, item) result(text)
+      character(len=*), intent(in) :: list, item
+      character(len=:), allocatable :: text
+      if (len(list) == 0) then
+         text = item
+      else
+         text = list//', '//item
+      end if
+   end function join
+
+   !> Next blank-separated word of `list` from `pos` ('' at the end).
+   pure subroutine next_word(list, pos, word)
+      character(len=*), intent(in) :: list
+      integer, intent(inout) :: pos
+      character(len=:), allocatable, intent(out) :: word
+      integer :: j
+      do while (pos <= len(list))
+         if (list(pos:pos) /= ' ') exit
+         pos = pos + 1
+      end do
+      j = pos
+      do while (j <= len(list))
+         if (list(j:j) == ' ') exit
+         j = j + 1
+      end do
+      word = list(pos:j - 1)
+      pos = j
+   end subroutine next_word
+
+   pure logical function has_word(list, word)
+      character(len=*), intent(in) :: list, word
+      has_word = index(' '//list//' ', ' '//word//' ') > 0 .and. len_trim(word) == len(word) .and. len(word) > 0
+   end function has_word
+
+   function comma_list(list) result(text)
+      character(len=*), intent(in) :: list
+      character(len=:), allocatable :: text, word
+      integer :: pos
+      text = ''
+      pos = 1
+      do
+         call next_word(list, pos, word)
+         if (len(word) == 0) exit
+         text = join(text, word)
+      end do
+   end function comma_list
+
+   function quoted_list(list) result(text)
+      character(len=*), intent(in) :: list
+      character(len=:), allocatable :: text, word
+      integer :: pos
+      text = ''
+      pos = 1
+      do
+         call next_word(list, pos, word)
+         if (len(word) == 0) exit
+         text = join(text, "'"//word//"'")
+      end do
+   end function quoted_list
+
+   pure function lower(text) result(low)
+      character(len=*), intent(in) :: text
+      character(len=len(text)) :: low
+      integer :: i
+      low = text
+      do i = 1, len(text)
+         if (text(i:i) >= 'A' .and. text(i:i) <= 'Z') low(i:i) = achar(iachar(text(i:i)) + 32)
+      end do
+   end function lower
+
+   pure function int_text(i) result(text)
+      integer, intent(in) :: i
+      character(len=:), allocatable :: text
+      character(len=16) :: buf
+      write (buf, '(i0)') i
+      text = trim(buf)
+   end function int_text
+
+   function int_list(values) result(text)
+      integer, intent(in) :: values(:)
+      character(len=:), allocatable :: text
+      integer :: i
+      text = ''
+      do i = 1, size(values)
+         text = join(text, int_text(values(i)))
+      end do
+   end function int_list
+
+   function real_list(values) result(text)
+      real(wp), intent(in) :: values(:)
+      character(len=:), allocatable :: text
+      integer :: i
+      text = ''
+      do i = 1, size(values)
+         text = join(text, real_text(values(i)))
+      end do
+   end function real_list
+
+   !> Shortest decimal text that reads back as the same real: fixed notation
+   !> for moderate exponents (`1000.0`, `0.3`), else `2.5e-07` style.
+   function real_text(x) result(text)
+      real(wp), intent(in) :: x
+      character(len=:), allocatable :: text
+      character(len=40) :: buf
+      character(len=16) :: fmt
+      character(len=:), allocatable :: digits, sign
+      real(wp) :: y
+      integer :: d, ios, epos, e, n
+
+      do d = 1, 17
+         write (fmt, '("(es40.",i0,")")') d - 1
+         write (buf, fmt) x
+         read (buf, *, iostat=ios) y
+         ! Bitwise identity is what 'reads back as the same real' means.
+         if (ios == 0 .and. transfer(y, 0_i8) == transfer(x, 0_i8)) exit
+      end do
+      buf = adjustl(buf)
+      sign = ''
+      if (buf(1:1) == '-') then
+         sign = '-'
+         buf = buf(2:)
+      end if
+      epos = index(buf, 'E')
+      read (buf(epos + 1:), *) e
+      digits = buf(1:1)//buf(3:epos - 1)
+      if (buf(2:2) /= '.') digits = buf(1:1)
+      n = len(digits)
+      do while (n > 1)
+         if (digits(n:n) /= '0') exit
+         n = n - 1
+      end do
+      digits = digits(1:n)
+      if (digits == '0') e = 0
+      if (e >= 0 .and. e < 15) then
+         if (n <= e + 1) then
+            text = sign//digits//repeat('0', e + 1 - n)//'.0'
+         else
+            text = sign//digits(1:e + 1)//'.'//digits(e + 2:)
+         end if
+      else if (e < 0 .and. e >= -4) then
+         text = sign//'0.'//repeat('0', -e - 1)//digits
+      else
+         if (n == 1) then
+            text = sign//digits//'.0e'//int_text(e)
+         else
+            text = sign//digits(1:1)//'.'//digits(2:)//'e'//int_text(e)
+         end if
+      end if
+   end function real_text
+
+end module sprc_io_scene
