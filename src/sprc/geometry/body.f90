@@ -10,12 +10,13 @@
 !> Round-off and snapping: a shape's class of a box comes from its certified
 !> range [fmin, fmax] of phi with a snapping tolerance
 !> tol = snap_ulps * epsilon * (largest |coordinate| of the box + shape%scale),
-!> i.e. a few ulps of the coordinate magnitude: fmax <= tol is inside,
+!> i.e. a few ulps of the coordinate magnitude X: fmax <= tol is inside,
 !> fmin >= -tol is outside. A face computed a few ulps off a grid plane
-!> therefore does not produce a sliver cut, while a genuine offset (1e-12 of
-!> the cell size is ~1e-12 of the coordinates for a cell of the box size,
-!> far above tol ~ 1e-15) is still a cut. Contact of zero measure (a circle
-!> tangent to a cell edge, a plane through a cell face) gives fmin = 0: outside.
+!> therefore does not produce a sliver cut. tol ~ 1e-15 X, so a genuine
+!> offset of 1e-12 of the cell size h is still a cut as long as h > ~1e-3 X
+!> (about ten levels below a level-0 cell of size X). Contact of zero
+!> measure (a circle tangent to a cell edge, a plane through a cell face)
+!> gives fmin = 0: outside.
 module sprc_geometry_body
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
@@ -264,7 +265,8 @@ contains
       call unmasked_cuts(self%ops, classes, list, n)
    end subroutine surface_at
 
-   !> Unit outward normal of the body at x on shape i's surface: the shape's
+   !> Unit outward normal of the body at x on shape i's surface (1 <= i <= nshape,
+   !> size(normal) >= size(x)): the shape's
    !> normalised gradient, flipped for a subtracted shape (its outside is the
    !> body's inside). Shape i's conventions apply on its own edges (box).
    pure subroutine outward_normal(self, x, i, normal)
