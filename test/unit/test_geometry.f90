@@ -141,10 +141,12 @@ contains
    !> of the coordinate magnitude), and since every range is exact, the
    !> lattice's extremes come within L * (half a lattice cell diagonal) of it,
    !> L a Lipschitz bound of phi on the box. A loose but valid bound fails.
+   !> phi is convex for every kind, so fmax is also checked against the
+   !> largest corner value to rounding.
    subroutine test_phi_range(error)
       type(error_type), allocatable, intent(out) :: error
       type(shape_type) :: shapes(ncatalogue)
-      real(wp) :: lo(3), hi(3), x(3), fmin, fmax, smin, smax, f, rtol, reach, spacing(3)
+      real(wp) :: lo(3), hi(3), x(3), fmin, fmax, smin, smax, f, rtol, reach, spacing(3), cmax
       integer :: s, k, j, d, m, nsample
       integer(i8) :: seed
       character(len=200) :: buf
@@ -175,6 +177,14 @@ contains
             call check(error, smin >= fmin - rtol .and. smax <= fmax + rtol, 'not an enclosure: '//trim(buf))
             if (allocated(error)) return
             call check(error, smin <= fmin + reach .and. smax >= fmax - reach, 'not tight: '//trim(buf))
+            if (allocated(error)) return
+            ! every phi is convex, so its maximum is attained at a corner: to rounding
+            cmax = -huge(1.0_wp)
+            do j = 0, 2**d - 1
+               x(1:d) = lattice_point(lo(1:d), hi(1:d), 2, j)
+               cmax = max(cmax, shapes(s)%phi(x(1:d)))
+            end do
+            call check(error, abs(cmax - fmax) <= rtol, 'fmax not attained at a corner: '//trim(buf))
             if (allocated(error)) return
          end do
       end do
