@@ -1,0 +1,425 @@
+!> A body: shapes combined in file order by CSG (SCENE.md, `&shape`).
+!>
+!> body = (((s_1 op_2 s_2) op_3 s_3) ... ), op_1 = add; add is union (min of
+!> the level sets), intersect is intersection (max), subtract is A minus B
+!> (max(a, -b)). Every shape appears once in this read-once formula, so
+!> three-valued (Kleene) logic on the shapes' classes of a box (inside,
+!> outside, cut) is sound, and a shape's influence on the result can be tested
+!> by setting it to inside and to outside in turn (`active_shapes`).
+!>
+!> Round-off and snapping: a shape's class of a box comes from its certified
+!> range [fmin, fmax] of phi with a snapping tolerance
+!> tol = snap_ulps * epsilon * (largest |coordinate| of the box + shape%scale),
+!> i.e. a few ulps of the coordinate magnitude X: fmax <= tol is inside,
+!> fmin >= -tol is outside. A face computed a few ulps off a grid plane
+!> therefore does not produce a sliver cut. tol ~ 1e-15 X, so a genuine
+!> offset of 1e-12 of the cell size h is still a cut as long as h > ~1e-3 X
+!> (about ten levels below a level-0 cell of size X). Contact of zero
+!> measure (a circle tangent to a cell edge, a plane through a cell face)
+!> gives fmin = 0: outside.
+module sprc_geometry_body
+   use sprc_core_kinds, only: wp
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
+   use sprc_geometry_region, only: region_type, cell_outside, cell_inside, cell_cut
+   use sprc_geometry_shape, only: shape_type, shape_kind_name
+   implicit none
+   private
+
+   public :: body_type, new_body
+   public :: csg_add, csg_subtract, csg_intersect, csg_op_name, csg_op_from_name
+   public :: snap_ulps, snap_tolerance
+
+   !> CSG operations (values are stable).
+   integer, parameter :: csg_add = 1
+   integer, parameter :: csg_subtract = 2
+   integer, parameter :: csg_intersect = 3
+
+   character(len=*), parameter :: op_names(3) = [character(len=9) :: 'add', 'subtract', 'intersect']
+
+   !> Snapping tolerance in ulps of the coordinate magnitude (module notes).
+   real(wp), parameter :: snap_ulps = 4.0_wp
+
+   !> A named body: its shapes and their CSG operations, in file order.
+   type, extends(region_type) :: body_type
+      !> Name of the body.
+      character(len=:), allocatable :: name
+      !> Space dimension (from the first shape); 0 while empty.
+      integer :: dim = 0
+      !> Number of shapes.
+      integer :: nshape = 0
+      !> Shapes in file order, (nshape).
+      type(shape_type), allocatable :: shapes(:)
+      !> CSG operation of each shape, (nshape); ops(1) = csg_add.
+      integer, allocatable :: ops(:)
+   contains
+      procedure :: add_shape
+      procedure :: shape_index
+      procedure :: phi => body_phi
+      procedure :: classify_box
+      procedure :: shape_classes
+      procedure :: active_shapes
+      procedure :: is_boundary_on
+      procedure :: surface_at
+      procedure :: outward_normal
+   end type body_type
+
+contains
+
+   !> An empty body with a name.
+   subroutine new_body(self, name)
+      type(body_type), intent(out) :: self
+      character(len=*), intent(in) :: name
+      self%name = name
+      allocate (self%shapes(0), self%ops(0))
+   end subroutine new_body
+
+   !> Name of a CSG operation ('add', ...); '' for an unknown one.
+   pure function csg_op_name(op) result(name)
+      integer, intent(in) :: op
+      character(len=:), allocatable :: name
+      if (op >= 1 .and. op <= size(op_names)) then
+         name = trim(op_names(op))
+      else
+         name = ''
+      end if
+   end function csg_op_name
+
+   !> CSG operation of a name ('add' -> csg_add, ...); 0 for an unknown name.
+   pure integer function csg_op_from_name(name) result(op)
+      character(len=*), intent(in) :: name
+      do op = 1, size(op_names)
+         if (trim(adjustl(name)) == trim(op_names(op))) return
+      end do
+      op = 0
+   end function csg_op_from_name
+
+   !> Append a shape with its operation. Errors: unknown op, first op not add,
+   !> a shape not constructed, a dimension different from the body's, a
+   !> non-blank name already used in this body (boundary conditions would be
+   !> ambiguous).
+   subroutine add_shape(self, op, shape, error)
+      class(body_type), intent(inout) :: self
+      integer, intent(in) :: op
+      type(shape_type), intent(in) :: shape
+      type(error_type), allocatable, intent(out) :: error
+      type(shape_type), allocatable :: shapes(:)
+      integer, allocatable :: ops(:)
+      character(len=:), allocatable :: where
+      integer :: n
+
+      where = "body '"//body_name(self)//"', shape '"//shape_name(shape)//"': "
+      if (op < 1 .or. op > size(op_names)) then
+         call fatal_error(error, where//'unknown op '//int_str(op)//' (expected add, subtract or intersect)', &
+            & stat_invalid_input)
+         return
+      end if
+      if (self%nshape == 0 .and. op /= csg_add) then
+         call fatal_error(error, where//"the first shape's op must be 'add', got '"//csg_op_name(op)//"'", &
+            & stat_invalid_input)
+         return
+      end if
+      if (shape%kind == 0) then
+         call fatal_error(error, where//'shape was not constructed', stat_invalid_input)
+         return
+      end if
+      if (self%nshape > 0 .and. shape%dim /= self%dim) then
+         call fatal_error(error, where//shape_kind_name(shape%kind)//' has dimension '//int_str(shape%dim)// &
+            & ', the body has dimension '//int_str(self%dim), stat_invalid_input)
+         return
+      end if
+      if (len_trim(shape_name(shape)) > 0) then
+         if (self%shape_index(shape%name) > 0) then
+            call fatal_error(error, where//'name already used by another shape of the body', stat_invalid_input)
+            return
+         end if
+      end if
+
+      n = self%nshape
+      allocate (shapes(n + 1), ops(n + 1))
+      if (n > 0) then
+         shapes(1:n) = self%shapes(1:n)
+         ops(1:n) = self%ops(1:n)
+      end if
+      shapes(n + 1) = shape
+      ops(n + 1) = op
+      call move_alloc(shapes, self%shapes)
+      call move_alloc(ops, self%ops)
+      self%nshape = n + 1
+      self%dim = shape%dim
+   end subroutine add_shape
+
+   !> Index of the shape with this name; 0 if none.
+   pure integer function shape_index(self, name) result(idx)
+      class(body_type), intent(in) :: self
+      character(len=*), intent(in) :: name
+      do idx = 1, self%nshape
+         if (shape_name(self%shapes(idx)) == name) return
+      end do
+      idx = 0
+   end function shape_index
+
+   !> Level set of the body at x: union min, intersect max, subtract max(a, -b).
+   !> An empty body is outside everywhere (huge).
+   pure real(wp) function body_phi(self, x) result(f)
+      class(body_type), intent(in) :: self
+      real(wp), intent(in) :: x(:)
+      integer :: k
+
+      f = huge(1.0_wp)
+      if (self%nshape == 0) return
+      f = self%shapes(1)%phi(x)
+      do k = 2, self%nshape
+         select case (self%ops(k))
+         case (csg_add)
+            f = min(f, self%shapes(k)%phi(x))
+         case (csg_intersect)
+            f = max(f, self%shapes(k)%phi(x))
+         case (csg_subtract)
+            f = max(f, -self%shapes(k)%phi(x))
+         end select
+      end do
+   end function body_phi
+
+   !> Snapping tolerance of a shape's level set over the box [lo, hi] (module notes).
+   pure real(wp) function snap_tolerance(shape, lo, hi) result(tol)
+      type(shape_type), intent(in) :: shape
+      real(wp), intent(in) :: lo(:), hi(:)
+      tol = snap_ulps*epsilon(1.0_wp)*(max(maxval(abs(lo)), maxval(abs(hi))) + shape%scale)
+   end function snap_tolerance
+
+   !> Class (cell_inside / cell_outside / cell_cut) of each shape alone over
+   !> the box [lo, hi], from its certified range with the snapping tolerance.
+   !> classes has size >= nshape.
+   pure subroutine shape_classes(self, lo, hi, classes)
+      class(body_type), intent(in) :: self
+      real(wp), intent(in) :: lo(:), hi(:)
+      integer, intent(out) :: classes(:)
+      real(wp) :: fmin, fmax, tol
+      integer :: k
+
+      do k = 1, self%nshape
+         call self%shapes(k)%phi_range(lo, hi, fmin, fmax)
+         tol = snap_tolerance(self%shapes(k), lo, hi)
+         classes(k) = class_of_range(fmin, fmax, tol)
+      end do
+   end subroutine shape_classes
+
+   !> Class of the box [lo, hi] (size dim each): the shapes' classes combined
+   !> by three-valued CSG logic. Never misses a cut; may return cell_cut for a
+   !> box covered only by a union of several shapes (none alone covering it).
+   pure integer function classify_box(self, lo, hi) result(cls)
+      class(body_type), intent(in) :: self
+      real(wp), intent(in) :: lo(:), hi(:)
+      integer :: classes(self%nshape)
+
+      call self%shape_classes(lo, hi, classes)
+      cls = evaluate(self%ops, classes)
+   end function classify_box
+
+   !> Shapes whose surface may pass through the box [lo, hi] and matters
+   !> there: the shape is cut by the box and the body's class is not decided
+   !> without it (setting it to inside and to outside gives different or
+   !> undecided results). list(1:n), in file order; size(list) >= nshape.
+   pure subroutine active_shapes(self, lo, hi, list, n)
+      class(body_type), intent(in) :: self
+      real(wp), intent(in) :: lo(:), hi(:)
+      integer, intent(out) :: list(:)
+      integer, intent(out) :: n
+      integer :: classes(self%nshape)
+
+      call self%shape_classes(lo, hi, classes)
+      call unmasked_cuts(self%ops, classes, list, n)
+   end subroutine active_shapes
+
+   !> True if x lies on the part of shape i's surface that bounds the body:
+   !> |phi_i(x)| <= tol and the body's membership near x depends on shape i
+   !> (the same masking test as `active_shapes`, with the point classes of
+   !> every shape: inside if phi < -tol, outside if phi > tol, else on).
+   pure logical function is_boundary_on(self, x, i, tol) result(on)
+      class(body_type), intent(in) :: self
+      real(wp), intent(in) :: x(:)
+      integer, intent(in) :: i
+      real(wp), intent(in) :: tol
+      integer :: classes(self%nshape)
+
+      on = .false.
+      if (i < 1 .or. i > self%nshape) return
+      call point_classes(self, x, tol, classes)
+      if (classes(i) /= cell_cut) return
+      on = .not. masked(self%ops, classes, i)
+   end function is_boundary_on
+
+   !> All shapes on whose surface x lies as a boundary of the body (see
+   !> `is_boundary_on`), in file order: list(1:n), n = 0 if x is not on the
+   !> boundary, n >= 2 at a CSG edge or corner. The rule for a single answer
+   !> is list(1), the first in file order. size(list) >= nshape.
+   pure subroutine surface_at(self, x, tol, list, n)
+      class(body_type), intent(in) :: self
+      real(wp), intent(in) :: x(:)
+      real(wp), intent(in) :: tol
+      integer, intent(out) :: list(:)
+      integer, intent(out) :: n
+      integer :: classes(self%nshape)
+
+      call point_classes(self, x, tol, classes)
+      call unmasked_cuts(self%ops, classes, list, n)
+   end subroutine surface_at
+
+   !> Unit outward normal of the body at x on shape i's surface (1 <= i <= nshape,
+   !> size(normal) >= size(x)): the shape's
+   !> normalised gradient, flipped for a subtracted shape (its outside is the
+   !> body's inside). Shape i's conventions apply on its own edges (box).
+   pure subroutine outward_normal(self, x, i, normal)
+      class(body_type), intent(in) :: self
+      real(wp), intent(in) :: x(:)
+      integer, intent(in) :: i
+      real(wp), intent(out) :: normal(:)
+      real(wp) :: g(size(x)), length
+
+      g = self%shapes(i)%gradient(x)
+      length = norm2(g)
+      if (length > 0.0_wp) then
+         g = g/length
+      else
+         ! Only at an ellipsoid's center, which is never on its surface.
+         g = 0.0_wp
+         g(1) = 1.0_wp
+      end if
+      if (self%ops(i) == csg_subtract) g = -g
+      normal(1:size(x)) = g
+   end subroutine outward_normal
+
+   ! ------------------------------------------------------------ three-valued logic
+
+   pure integer function class_of_range(fmin, fmax, tol) result(cls)
+      real(wp), intent(in) :: fmin, fmax, tol
+      if (fmax <= tol) then
+         cls = cell_inside
+      else if (fmin >= -tol) then
+         cls = cell_outside
+      else
+         cls = cell_cut
+      end if
+   end function class_of_range
+
+   !> Point classes: inside (phi < -tol), outside (phi > tol), on (cell_cut) otherwise.
+   pure subroutine point_classes(self, x, tol, classes)
+      type(body_type), intent(in) :: self
+      real(wp), intent(in) :: x(:), tol
+      integer, intent(out) :: classes(:)
+      real(wp) :: f
+      integer :: k
+      do k = 1, self%nshape
+         f = self%shapes(k)%phi(x)
+         if (f < -tol) then
+            classes(k) = cell_inside
+         else if (f > tol) then
+            classes(k) = cell_outside
+         else
+            classes(k) = cell_cut
+         end if
+      end do
+   end subroutine point_classes
+
+   !> Class of the body from the shapes' classes.
+   pure integer function evaluate(ops, classes) result(cls)
+      integer, intent(in) :: ops(:), classes(:)
+      integer :: k
+      cls = cell_outside
+      if (size(classes) == 0) return
+      cls = classes(1)
+      do k = 2, size(classes)
+         cls = combine(cls, ops(k), classes(k))
+      end do
+   end function evaluate
+
+   pure integer function combine(a, op, b) result(cls)
+      integer, intent(in) :: a, op, b
+      select case (op)
+      case (csg_add)
+         cls = kleene_union(a, b)
+      case (csg_intersect)
+         cls = kleene_intersect(a, b)
+      case default
+         cls = kleene_intersect(a, complement(b))
+      end select
+   end function combine
+
+   pure integer function kleene_union(a, b) result(cls)
+      integer, intent(in) :: a, b
+      if (a == cell_inside .or. b == cell_inside) then
+         cls = cell_inside
+      else if (a == cell_outside .and. b == cell_outside) then
+         cls = cell_outside
+      else
+         cls = cell_cut
+      end if
+   end function kleene_union
+
+   pure integer function kleene_intersect(a, b) result(cls)
+      integer, intent(in) :: a, b
+      cls = complement(kleene_union(complement(a), complement(b)))
+   end function kleene_intersect
+
+   pure integer function complement(a) result(cls)
+      integer, intent(in) :: a
+      select case (a)
+      case (cell_inside)
+         cls = cell_outside
+      case (cell_outside)
+         cls = cell_inside
+      case default
+         cls = cell_cut
+      end select
+   end function complement
+
+   !> True if the body's class does not depend on shape i: inside and outside
+   !> for shape i give the same decided class.
+   pure logical function masked(ops, classes, i)
+      integer, intent(in) :: ops(:), classes(:), i
+      integer :: trial(size(classes)), as_inside
+      trial = classes
+      trial(i) = cell_inside
+      as_inside = evaluate(ops, trial)
+      trial(i) = cell_outside
+      masked = as_inside /= cell_cut .and. as_inside == evaluate(ops, trial)
+   end function masked
+
+   pure subroutine unmasked_cuts(ops, classes, list, n)
+      integer, intent(in) :: ops(:), classes(:)
+      integer, intent(out) :: list(:), n
+      integer :: k
+      n = 0
+      do k = 1, size(classes)
+         if (classes(k) /= cell_cut) cycle
+         if (masked(ops, classes, k)) cycle
+         n = n + 1
+         list(n) = k
+      end do
+   end subroutine unmasked_cuts
+
+   ! ------------------------------------------------------------ text
+
+   pure function body_name(self) result(name)
+      type(body_type), intent(in) :: self
+      character(len=:), allocatable :: name
+      name = ''
+      if (allocated(self%name)) name = self%name
+   end function body_name
+
+   pure function shape_name(shape) result(name)
+      type(shape_type), intent(in) :: shape
+      character(len=:), allocatable :: name
+      name = ''
+      if (allocated(shape%name)) name = shape%name
+   end function shape_name
+
+   pure function int_str(i) result(s)
+      integer, intent(in) :: i
+      character(len=:), allocatable :: s
+      character(len=16) :: buf
+      write (buf, '(i0)') i
+      s = trim(buf)
+   end function int_str
+
+end module sprc_geometry_body
