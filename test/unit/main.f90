@@ -12,6 +12,7 @@ program sprc_unit_tests
    use sprc_test_scene, only: collect_scene
    use sprc_test_geometry, only: collect_geometry
    use sprc_test_grid, only: collect_grid
+   use sprc_test_model, only: collect_model
    implicit none
 
    type(testsuite_type), allocatable :: suites(:)
@@ -26,7 +27,8 @@ program sprc_unit_tests
       new_testsuite('namelist', collect_namelist), &
       new_testsuite('scene', collect_scene), &
       new_testsuite('geometry', collect_geometry), &
-      new_testsuite('grid', collect_grid) &
+      new_testsuite('grid', collect_grid), &
+      new_testsuite('model', collect_model) &
       ]
 
    call get_arg(1, suite_name)

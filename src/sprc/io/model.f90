@@ -1,0 +1,117 @@
+!> From a validated scene to the objects the analysis works with: geometry
+!> bodies (one per `&body`, shapes in file order) and the exact solution.
+!>
+!> The scene reader has already validated every field; errors here are the
+!> constructors' own checks, prefixed with the scene group they came from.
+module sprc_io_model
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_unsupported
+   use sprc_core_material, only: plane_stress, plane_strain, solid
+   use sprc_geometry_shape, only: geometry_shape => shape_type, new_disk, new_sphere, new_ellipse, &
+      & new_ellipsoid, new_box, new_halfspace, new_cylinder
+   use sprc_geometry_body, only: geometry_body => body_type, new_body, csg_op_from_name
+   use sprc_exact_solution, only: exact_solution_type
+   use sprc_exact_lame, only: lame_cylinder_type, lame_sphere_type, new_lame_cylinder, new_lame_sphere
+   use sprc_exact_kirsch, only: kirsch_type, new_kirsch
+   use sprc_io_scene, only: scene_type, shape_type
+   implicit none
+   private
+
+   public :: build_bodies, build_exact, analysis_kind
+
+contains
+
+   !> The analysis constant of sprc_core_material for the scene's `analysis`.
+   pure integer function analysis_kind(scene)
+      type(scene_type), intent(in) :: scene
+      select case (scene%analysis)
+      case ('plane_stress'); analysis_kind = plane_stress
+      case ('plane_strain'); analysis_kind = plane_strain
+      case default; analysis_kind = solid
+      end select
+   end function analysis_kind
+
+   !> One geometry body per `&body`, its shapes added in file order.
+   subroutine build_bodies(scene, bodies, error)
+      type(scene_type), intent(in) :: scene
+      type(geometry_body), allocatable, intent(out) :: bodies(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(geometry_shape) :: shape
+      integer :: b, s
+
+      allocate (bodies(size(scene%bodies)))
+      do b = 1, size(scene%bodies)
+         call new_body(bodies(b), scene%bodies(b)%name)
+      end do
+      do s = 1, size(scene%shapes)
+         call build_shape(scene%shapes(s), shape, error)
+         if (.not. allocated(error)) then
+            b = scene%shapes(s)%body_index
+            call bodies(b)%add_shape(csg_op_from_name(scene%shapes(s)%op), shape, error)
+         end if
+         if (allocated(error)) then
+            error%message = '&shape '''//scene%shapes(s)%name//''': '//error%message
+            return
+         end if
+      end do
+   end subroutine build_bodies
+
+   subroutine build_shape(spec, shape, error)
+      type(shape_type), intent(in) :: spec
+      type(geometry_shape), intent(out) :: shape
+      type(error_type), allocatable, intent(out) :: error
+
+      select case (spec%kind)
+      case ('disk'); call new_disk(shape, spec%name, spec%center, spec%radius, error)
+      case ('sphere'); call new_sphere(shape, spec%name, spec%center, spec%radius, error)
+      case ('ellipse'); call new_ellipse(shape, spec%name, spec%center, spec%semi_axes, error)
+      case ('ellipsoid'); call new_ellipsoid(shape, spec%name, spec%center, spec%semi_axes, error)
+      case ('box'); call new_box(shape, spec%name, spec%lower, spec%upper, error)
+      case ('halfspace'); call new_halfspace(shape, spec%name, spec%point, spec%normal, error)
+      case ('cylinder'); call new_cylinder(shape, spec%name, spec%point, spec%axis, spec%radius, error)
+      case default
+         call fatal_error(error, 'unknown shape kind '''//spec%kind//'''', stat_invalid_input)
+      end select
+   end subroutine build_shape
+
+   !> The scene's exact solution, with the material of its first body (the
+   !> closed forms are single-body solutions). Not allocated without `&exact`.
+   subroutine build_exact(scene, exact, error)
+      type(scene_type), intent(in) :: scene
+      class(exact_solution_type), allocatable, intent(out) :: exact
+      type(error_type), allocatable, intent(out) :: error
+
+      if (.not. scene%exact%present) return
+      associate (spec => scene%exact, young => scene%bodies(1)%young, nu => scene%bodies(1)%poisson)
+         select case (spec%kind)
+         case ('lame_cylinder')
+            allocate (lame_cylinder_type :: exact)
+            select type (exact)
+            type is (lame_cylinder_type)
+               call new_lame_cylinder(exact, spec%center, spec%r_in, spec%r_out, spec%p_in, spec%p_out, &
+                  young, nu, analysis_kind(scene), error)
+            end select
+         case ('lame_sphere')
+            allocate (lame_sphere_type :: exact)
+            select type (exact)
+            type is (lame_sphere_type)
+               call new_lame_sphere(exact, spec%center, spec%r_in, spec%r_out, spec%p_in, spec%p_out, &
+                  young, nu, error)
+            end select
+         case ('kirsch')
+            allocate (kirsch_type :: exact)
+            select type (exact)
+            type is (kirsch_type)
+               call new_kirsch(exact, spec%center, spec%radius, spec%s_inf, young, nu, analysis_kind(scene), error)
+            end select
+         case default
+            call fatal_error(error, '&exact: kind '''//spec%kind//''' is not available in this version', &
+               stat_unsupported)
+         end select
+      end associate
+      if (allocated(error)) then
+         error%message = '&exact: '//error%message
+         deallocate (exact)
+      end if
+   end subroutine build_exact
+
+end module sprc_io_model

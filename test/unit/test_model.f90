@@ -1,0 +1,138 @@
+!> Tests of the scene -> geometry bodies and exact solution glue.
+module sprc_test_model
+   use sprc_core_kinds, only: wp
+   use sprc_core_error, only: error_type
+   use sprc_geometry_body, only: body_type
+   use sprc_geometry_region, only: cell_inside, cell_outside, cell_cut
+   use sprc_exact_solution, only: exact_solution_type
+   use sprc_io_scene, only: scene_type, read_scene, read_scene_text, default_scene_text
+   use sprc_io_model, only: build_bodies, build_exact
+   use sprc_testsuite, only: unittest_type, new_unittest, check
+   implicit none
+   private
+
+   public :: collect_model
+
+contains
+
+   subroutine collect_model(testsuite)
+      type(unittest_type), allocatable, intent(out) :: testsuite(:)
+      testsuite = [ &
+         new_unittest('default_scene_body', test_default_body), &
+         new_unittest('default_scene_exact_pressure', test_default_exact), &
+         new_unittest('kirsch_example', test_kirsch_example), &
+         new_unittest('lame_sphere_example', test_sphere_example), &
+         new_unittest('no_exact_group', test_no_exact) &
+         ]
+   end subroutine collect_model
+
+   subroutine load(path, scene, error)
+      character(len=*), intent(in) :: path
+      type(scene_type), intent(out) :: scene
+      type(error_type), allocatable, intent(out) :: error
+      if (len(path) == 0) then
+         call read_scene_text(default_scene_text(), 'default', scene, error)
+      else
+         call read_scene(path, scene, error)
+      end if
+   end subroutine load
+
+   !> Quarter annulus 5 < r < 20, x >= 0, y >= 0: points and boxes with known answers.
+   subroutine test_default_body(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(body_type), allocatable :: bodies(:)
+
+      call load('', scene, error)
+      if (allocated(error)) return
+      call build_bodies(scene, bodies, error)
+      if (allocated(error)) return
+      call check(error, size(bodies) == 1 .and. bodies(1)%nshape == 4, 'one body with four shapes')
+      if (allocated(error)) return
+      call check(error, bodies(1)%phi([10.0_wp, 10.0_wp]) < 0.0_wp, 'r = 14.1 in the first quadrant is inside')
+      if (allocated(error)) return
+      call check(error, bodies(1)%phi([1.0_wp, 1.0_wp]) > 0.0_wp .and. bodies(1)%phi([-10.0_wp, 10.0_wp]) > 0.0_wp &
+         .and. bodies(1)%phi([15.0_wp, 15.0_wp]) > 0.0_wp, 'hole, mirrored quadrant and r = 21.2 are outside')
+      if (allocated(error)) return
+      call check(error, bodies(1)%classify_box([8.0_wp, 8.0_wp], [9.0_wp, 9.0_wp]), cell_inside, 'box inside')
+      if (allocated(error)) return
+      call check(error, bodies(1)%classify_box([-1.0_wp, 8.0_wp], [0.0_wp, 9.0_wp]), cell_outside, &
+         'box beyond the symmetry plane x = 0')
+      if (allocated(error)) return
+      call check(error, bodies(1)%classify_box([19.0_wp, 0.0_wp], [21.0_wp, 1.0_wp]), cell_cut, 'box on r = 20')
+   end subroutine test_default_body
+
+   !> t = sigma.n = -p_in n on the inner surface (n = (-1, 0) at (5, 0)): t = (1, 0).
+   subroutine test_default_exact(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      class(exact_solution_type), allocatable :: exact
+      real(wp) :: t(2)
+
+      call load('', scene, error)
+      if (allocated(error)) return
+      call build_exact(scene, exact, error)
+      if (allocated(error)) return
+      call check(error, allocated(exact), 'exact solution built')
+      if (allocated(error)) return
+      call exact%traction([5.0_wp, 0.0_wp], [-1.0_wp, 0.0_wp], t)
+      call check(error, abs(t(1) - 1.0_wp) + abs(t(2)), 0.0_wp, 1.0e-14_wp, 'inner pressure traction')
+      if (allocated(error)) return
+      call check(error, exact%young, 1000.0_wp, 0.0_wp, 'material of the first body')
+   end subroutine test_default_exact
+
+   !> Kirsch: sigma_xx = 3 s_inf at the top of the hole; the body excludes the hole.
+   subroutine test_kirsch_example(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      class(exact_solution_type), allocatable :: exact
+      type(body_type), allocatable :: bodies(:)
+      real(wp) :: sigma(3)
+
+      call load('example/scenes/kirsch_plate.nml', scene, error)
+      if (allocated(error)) return
+      call build_exact(scene, exact, error)
+      if (allocated(error)) return
+      call build_bodies(scene, bodies, error)
+      if (allocated(error)) return
+      call exact%stress([scene%exact%center(1), scene%exact%center(2) + scene%exact%radius], sigma)
+      call check(error, sigma(1), 3.0_wp*scene%exact%s_inf, 1.0e-12_wp, 'stress concentration', rel=.true.)
+      if (allocated(error)) return
+      call check(error, bodies(1)%phi(scene%exact%center + 0.5_wp*scene%exact%radius) > 0.0_wp, &
+         'the hole is outside the body')
+   end subroutine test_kirsch_example
+
+   !> Lame sphere: sigma.n = -p_in n at r_in along x.
+   subroutine test_sphere_example(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      class(exact_solution_type), allocatable :: exact
+      real(wp) :: t(3), x(3)
+
+      call load('example/scenes/lame_sphere.nml', scene, error)
+      if (allocated(error)) return
+      call build_exact(scene, exact, error)
+      if (allocated(error)) return
+      x = scene%exact%center + [scene%exact%r_in, 0.0_wp, 0.0_wp]
+      call exact%traction(x, [-1.0_wp, 0.0_wp, 0.0_wp], t)
+      call check(error, maxval(abs(t - [scene%exact%p_in, 0.0_wp, 0.0_wp])), 0.0_wp, &
+         1.0e-13_wp*abs(scene%exact%p_in), 'inner pressure traction')
+   end subroutine test_sphere_example
+
+   subroutine test_no_exact(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      class(exact_solution_type), allocatable :: exact
+      character(len=*), parameter :: text = &
+         "&scene analysis='plane_stress' levels=2 box_min=0,0 box_size=1 /"//new_line('a')// &
+         "&body name='b' young=1 poisson=0.2 /"//new_line('a')// &
+         "&shape body='b' op='add' kind='box' name='sq' lower=0.1,0.1 upper=0.9,0.9 /"//new_line('a')
+
+      call read_scene_text(text, 'inline', scene, error)
+      if (allocated(error)) return
+      call build_exact(scene, exact, error)
+      if (allocated(error)) return
+      call check(error, .not. allocated(exact), 'no exact solution without &exact')
+   end subroutine test_no_exact
+
+end module sprc_test_model
