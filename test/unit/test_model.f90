@@ -22,7 +22,8 @@ contains
          new_unittest('default_scene_exact_pressure', test_default_exact), &
          new_unittest('kirsch_example', test_kirsch_example), &
          new_unittest('lame_sphere_example', test_sphere_example), &
-         new_unittest('no_exact_group', test_no_exact) &
+         new_unittest('no_exact_group', test_no_exact), &
+         new_unittest('facade_reexports', test_facade) &
          ]
    end subroutine collect_model
 
@@ -134,5 +135,22 @@ contains
       if (allocated(error)) return
       call check(error, .not. allocated(exact), 'no exact solution without &exact')
    end subroutine test_no_exact
+
+   !> `use sprc` alone is enough to read a scene and build its objects.
+   subroutine test_facade(error)
+      use sprc, only: sprc_scene => scene_type, sprc_read => read_scene_text, sprc_text => default_scene_text, &
+         & sprc_bodies => build_bodies, geometry_body_type, sprc_version_number, get_sprc_version
+      type(error_type), allocatable, intent(out) :: error
+      type(sprc_scene) :: scene
+      type(geometry_body_type), allocatable :: bodies(:)
+      integer :: major, minor, patch
+
+      call sprc_read(sprc_text(), 'default', scene, error)
+      if (allocated(error)) return
+      call sprc_bodies(scene, bodies, error)
+      if (allocated(error)) return
+      call get_sprc_version(major, minor, patch)
+      call check(error, sprc_version_number, 10000*major + 100*minor + patch, 'version number')
+   end subroutine test_facade
 
 end module sprc_test_model

@@ -1,0 +1,25 @@
+!> sprc: the one stable Fortran API. `use sprc` gives the public types and
+!> procedures of every layer; the layer modules (sprc_<layer>_<x>) stay
+!> available for finer-grained use, but only what is re-exported here is
+!> promised to stay source-compatible between minor versions.
+module sprc
+   use sprc_core_kinds, only: wp, dp, i4, i8
+   use sprc_core_error, only: error_type, fatal_error, stat_name, stat_success, stat_invalid_input, &
+      & stat_singular, stat_not_positive_definite, stat_not_converged, stat_io, stat_out_of_memory, &
+      & stat_unsupported, stat_internal
+   use sprc_core_timer, only: timer_type, wall_time
+   use sprc_core_material, only: plane_stress, plane_strain, solid, voigt_size, material_matrix, &
+      & compliance_matrix
+   use sprc_core_poly, only: poly_basis_type, new_poly_basis, scale_point, scale_points
+   use sprc_exact_solution, only: exact_solution_type
+   use sprc_exact_lame, only: lame_cylinder_type, lame_sphere_type, new_lame_cylinder, new_lame_sphere
+   use sprc_exact_kirsch, only: kirsch_type, new_kirsch
+   use sprc_geometry_region, only: region_type, cell_outside, cell_inside, cell_cut
+   use sprc_geometry_shape, only: geometry_shape_type => shape_type
+   use sprc_geometry_body, only: geometry_body_type => body_type, new_body
+   use sprc_io_scene, only: scene_type, read_scene, read_scene_text, scene_summary, default_scene_text
+   use sprc_io_model, only: build_bodies, build_exact
+   use sprc_version, only: sprc_version_string, sprc_version_number, get_sprc_version
+   implicit none
+   public
+end module sprc
