@@ -13,6 +13,7 @@ program sprc_unit_tests
    use sprc_test_geometry, only: collect_geometry
    use sprc_test_grid, only: collect_grid
    use sprc_test_model, only: collect_model
+   use sprc_test_quadrature, only: collect_quadrature
    implicit none
 
    type(testsuite_type), allocatable :: suites(:)
@@ -28,7 +29,8 @@ program sprc_unit_tests
       new_testsuite('scene', collect_scene), &
       new_testsuite('geometry', collect_geometry), &
       new_testsuite('grid', collect_grid), &
-      new_testsuite('model', collect_model) &
+      new_testsuite('model', collect_model), &
+      new_testsuite('quadrature', collect_quadrature) &
       ]
 
    call get_arg(1, suite_name)
