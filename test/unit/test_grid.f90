@@ -82,6 +82,7 @@ contains
          new_unittest('hanging-q2-3d', test_hanging_q2_3d), &
          new_unittest('hanging-edge-only-3d', test_hanging_edge_only), &
          new_unittest('hanging-hand-2d', test_hanging_hand), &
+         new_unittest('hanging-chain', test_hanging_chain), &
          new_unittest('degenerate-aligned', test_degenerate_aligned), &
          new_unittest('degenerate-tiny-body', test_degenerate_tiny), &
          new_unittest('degenerate-empty-full', test_degenerate_empty_full), &
@@ -690,19 +691,32 @@ contains
       integer, intent(in) :: dim, p, level, refine
       real(wp), intent(in) :: box_min(3), box_size
       type(grid_type) :: grid
-      type(grid_nodes_type) :: nodes
-      type(hanging_type) :: hang
-      type(lcg_type) :: rng
-      real(wp) :: coef(0:2, 0:2, 0:2), err, x(3), lo(3), hi(3), val, h
-      real(wp), allocatable :: ubar(:), u(:), shape(:)
-      integer :: i, n, k, e, corner, a, b, c
 
       call grid%build(region, dim, box_min, box_size, level, refine, error)
       if (allocated(error)) return
+      call check_hanging(error, grid, p)
+   end subroutine hanging_case
+
+   subroutine check_hanging(error, grid, p, chain_rounds)
+      type(error_type), allocatable, intent(out) :: error
+      type(grid_type), intent(in) :: grid
+      integer, intent(in) :: p
+      integer, intent(out), optional :: chain_rounds
+      type(grid_nodes_type) :: nodes
+      type(hanging_type) :: hang
+      type(lcg_type) :: rng
+      real(wp) :: coef(0:2, 0:2, 0:2), err, x(3), lo(3), hi(3), val, h, box_min(3), box_size
+      real(wp), allocatable :: ubar(:), u(:), shape(:)
+      integer :: i, n, k, e, corner, a, b, c, dim
+
+      dim = grid%dim
+      box_min = grid%box_min
+      box_size = grid%box_size
       call nodes%build(grid, p, error)
       if (allocated(error)) return
       call hang%build(grid, nodes, error)
       if (allocated(error)) return
+      if (present(chain_rounds)) chain_rounds = hang%chain_rounds
       call check(error, hang%n_hanging > 0, 'no hanging nodes: the test would prove nothing')
       if (allocated(error)) return
       call check(error, all(hang%free_index(hang%free_node) == [(i, i=1, hang%n_free)]), 'free numbering')
@@ -752,7 +766,46 @@ contains
       end do
       ! Same round-off argument: |u| <= a few, chains multiply at most two rows of shape values.
       call check(error, err <= 1.0e-12_wp, 'discontinuous field across a hanging node')
-   end subroutine hanging_case
+   end subroutine check_hanging
+
+   !> A constraint chain, on a hand-made unbalanced grid (the balanced build never makes
+   !> one): D = [.5,1]x[0,.5] (level 1), C = [.25,.5]^2 (level 2), E = [.375,.5]x[.125,.25]
+   !> (level 3). E's corner (.375,.25) hangs on C's edge, whose end (.5,.25) hangs on D's.
+   subroutine test_hanging_chain(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(grid_type) :: grid
+      integer :: rounds, i, j, p
+      integer :: lev(3), crd(2, 3)
+      integer(i8) :: key(3)
+      lev = [1, 2, 3]
+      crd = reshape([1, 0, 1, 1, 3, 1], [2, 3])
+      do i = 1, 3
+         key(i) = morton_encode(ishft(crd(:, i), grid_max_level - lev(i)))
+      end do
+      grid%dim = 2
+      grid%box_size = 1.0_wp
+      grid%level = 1
+      grid%max_level = 3
+      grid%n_leaves = 3
+      allocate (grid%leaf_level(3), grid%leaf_coord(2, 3), grid%leaf_class(3), grid%leaf_key(3))
+      ! Sort the three leaves by key by hand (selection).
+      do j = 1, 3
+         i = minloc(key, 1)
+         grid%leaf_level(j) = lev(i)
+         grid%leaf_coord(:, j) = crd(:, i)
+         grid%leaf_key(j) = key(i)
+         key(i) = huge(1_i8)
+      end do
+      grid%leaf_class = cell_inside
+      do p = 1, 2
+         call check_hanging(error, grid, p, rounds)
+         if (allocated(error)) return
+         if (p == 1) then
+            call check(error, rounds >= 1, 'the Q1 chain was not seen')
+            if (allocated(error)) return
+         end if
+      end do
+   end subroutine test_hanging_chain
 
    !> A ball of radius 0.31 box_size, placed like `ball` relative to the box.
    function scaled_ball(dim, box_min, box_size) result(r)
