@@ -119,38 +119,47 @@ contains
       logical, allocatable, intent(out) :: hanging(:)
       type(rows_type), intent(out) :: rows
       type(error_type), allocatable, intent(out) :: error
-      integer, allocatable :: idx(:, :), owner(:)
+      integer, allocatable :: idx(:, :), owner(:), side_nodes(:, :), n_side(:)
       real(wp), allocatable :: shape(:)
-      integer :: d, p, nen, e, c, k, j, n, first, last, dir(3), side(3), anchor(3), r(3), sc, nnz
+      integer :: d, p, nen, e, c, k, j, m, n, first, last, dir(3, 26), ndir, r(3), sc, pos
+      integer :: coarse(0:26), parent(grid%dim), dir_p(3), slot
 
       d = grid%dim
       p = nodes%degree
       nen = nodes%nodes_per_element
       idx = element_node_index(d, p)
+      call side_tables(d, p, idx, dir, ndir, side_nodes, n_side)
       allocate (shape(nen), hanging(nodes%n_nodes), owner(nodes%n_nodes))
       hanging = .false.
       owner = 0
-      dir = 0
       r = 0
       ! First pass: which nodes hang, and on which coarse element (owner).
       do e = 1, grid%n_leaves
-         do k = 0, 3**d - 1
-            dir = [mod(k, 3) - 1, mod(k/3, 3) - 1, mod(k/9, 3) - 1]
-            if (d == 2) dir(3) = 0
-            ! Faces and edges only: a corner contact never leaves a node inside a coarse face or edge.
-            if (count(dir /= 0) == 0 .or. count(dir /= 0) == d) cycle
-            call grid%neighbour(e, dir(1:d), first, last)
-            if (first /= last) cycle
-            c = first
-            if (grid%leaf_level(c) >= grid%leaf_level(e)) cycle
-            side = merge(p, 0, dir > 0)
+         ! No leaf is coarser than the uniform level, so leaves of that level have no coarser neighbour.
+         if (grid%leaf_level(e) <= grid%level) cycle
+         ! The cell across direction k lies in the parent's neighbour across dir_p (the
+         ! components of k that leave the parent); one query per distinct dir_p.
+         coarse = -1
+         parent = grid%leaf_coord(:, e)/2
+         do k = 1, ndir
+            dir_p = 0
+            dir_p(1:d) = merge(dir(1:d, k), 0, mod(grid%leaf_coord(:, e), 2) == merge(1, 0, dir(1:d, k) > 0))
+            if (all(dir_p == 0)) cycle
+            slot = (dir_p(1) + 1) + 3*(dir_p(2) + 1) + 9*(dir_p(3) + 1)
+            if (coarse(slot) < 0) then
+               coarse(slot) = 0
+               call grid%find_cell(grid%leaf_level(e) - 1, parent + dir_p(1:d), first, last)
+               if (first == last) then
+                  if (grid%leaf_level(first) < grid%leaf_level(e)) coarse(slot) = first
+               end if
+            end if
+            c = coarse(slot)
+            if (c == 0) cycle
             sc = 2**(nodes%lattice_level - grid%leaf_level(c))
-            anchor(1:d) = grid%leaf_coord(:, c)*sc
-            do j = 1, nen
-               if (any(dir(1:d) /= 0 .and. idx(:, j) /= side(1:d))) cycle
-               n = nodes%connectivity(j, e)
+            do m = 1, n_side(k)
+               n = nodes%connectivity(side_nodes(m, k), e)
                if (hanging(n)) cycle
-               r(1:d) = nodes%lattice(:, n) - anchor(1:d)
+               r(1:d) = nodes%lattice(:, n) - grid%leaf_coord(:, c)*sc
                if (any(r(1:d) < 0 .or. r(1:d) > sc)) then
                   call fatal_error(error, 'hanging nodes: a node is not on its coarse neighbour', stat_internal)
                   return
@@ -162,37 +171,89 @@ contains
          end do
       end do
 
-      ! Second pass: the rows.
+      ! Second pass: the rows. A master whose shape function vanishes on the hanging
+      ! node's face or edge is left out (decided on the integer lattice).
       allocate (rows%ptr(nodes%n_nodes + 1))
       rows%ptr(1) = 1
       do n = 1, nodes%n_nodes
-         nnz = 1
-         if (hanging(n)) nnz = nen
-         rows%ptr(n + 1) = rows%ptr(n) + nnz
+         pos = 1
+         if (hanging(n)) then
+            call offsets(n, r, sc)
+            pos = 0
+            do j = 1, nen
+               if (is_master(r, sc, idx(:, j))) pos = pos + 1
+            end do
+         end if
+         rows%ptr(n + 1) = rows%ptr(n) + pos
       end do
       allocate (rows%col(rows%ptr(nodes%n_nodes + 1) - 1), rows%val(rows%ptr(nodes%n_nodes + 1) - 1))
       do n = 1, nodes%n_nodes
+         pos = rows%ptr(n)
          if (.not. hanging(n)) then
-            rows%col(rows%ptr(n)) = n
-            rows%val(rows%ptr(n)) = 1.0_wp
+            rows%col(pos) = n
+            rows%val(pos) = 1.0_wp
             cycle
          end if
-         c = owner(n)
-         sc = 2**(nodes%lattice_level - grid%leaf_level(c))
-         r(1:d) = nodes%lattice(:, n) - grid%leaf_coord(:, c)*sc
+         call offsets(n, r, sc)
          ! r / sc is a multiple of 1/4: exact in binary, so are the shape values.
          call element_shape(d, p, real(r(1:d), wp)/real(sc, wp), shape)
-         ! A master whose shape function vanishes on the hanging node's face or edge
-         ! (decided on the integer lattice, not by comparing reals) gets column 0: dropped.
          do j = 1, nen
-            k = rows%ptr(n) + j - 1
-            rows%col(k) = nodes%connectivity(j, c)
-            rows%val(k) = shape(j)
-            if (any(mod(r(1:d)*p, sc) == 0 .and. r(1:d)*p/sc /= idx(:, j))) rows%col(k) = 0
+            if (.not. is_master(r, sc, idx(:, j))) cycle
+            rows%col(pos) = nodes%connectivity(j, owner(n))
+            rows%val(pos) = shape(j)
+            pos = pos + 1
          end do
       end do
       call compress(rows)
+
+   contains
+
+      !> Lattice offset r of hanging node n from its owner's lowest corner, owner size sc.
+      subroutine offsets(n, r, sc)
+         integer, intent(in) :: n
+         integer, intent(out) :: r(3), sc
+         sc = 2**(nodes%lattice_level - grid%leaf_level(owner(n)))
+         r = 0
+         r(1:d) = nodes%lattice(:, n) - grid%leaf_coord(:, owner(n))*sc
+      end subroutine offsets
+
+      !> Does the coarse node with Lagrange index `ij` carry weight at offset r? Not if
+      !> along some axis r sits on another node position (the 1D factor is then zero).
+      pure logical function is_master(r, sc, ij)
+         integer, intent(in) :: r(3), sc, ij(:)
+         is_master = .not. any(mod(r(1:d)*p, sc) == 0 .and. r(1:d)*p/sc /= ij)
+      end function is_master
+
    end subroutine direct_constraints
+
+   !> Directions of the faces and edges of an element (corners are left out: a corner
+   !> contact never puts a node inside a coarse face or edge) and, for each, the local
+   !> nodes on that side.
+   pure subroutine side_tables(d, p, idx, dir, ndir, side_nodes, n_side)
+      integer, intent(in) :: d, p, idx(:, :)
+      integer, intent(out) :: dir(3, 26), ndir
+      integer, allocatable, intent(out) :: side_nodes(:, :), n_side(:)
+      integer :: k, j, t(3), side(3)
+
+      allocate (side_nodes(size(idx, 2), 26), n_side(26))
+      ndir = 0
+      dir = 0
+      n_side = 0
+      side_nodes = 0
+      do k = 0, 3**d - 1
+         t = [mod(k, 3) - 1, mod(k/3, 3) - 1, mod(k/9, 3) - 1]
+         if (d == 2) t(3) = 0
+         if (count(t /= 0) == 0 .or. count(t /= 0) == d) cycle
+         ndir = ndir + 1
+         dir(:, ndir) = t
+         side = merge(p, 0, t > 0)
+         do j = 1, size(idx, 2)
+            if (any(t(1:d) /= 0 .and. idx(:, j) /= side(1:d))) cycle
+            n_side(ndir) = n_side(ndir) + 1
+            side_nodes(n_side(ndir), ndir) = j
+         end do
+      end do
+   end subroutine side_tables
 
    !> Replace every hanging column by its own row (one round of chain substitution).
    subroutine substitute(rows, hanging)
@@ -240,7 +301,7 @@ contains
       call move_alloc(new%val, rows%val)
    end subroutine substitute
 
-   !> Sort each row by column, sum duplicates and drop column-0 entries, in place.
+   !> Sort each row by column and sum duplicates, in place.
    subroutine compress(rows)
       type(rows_type), intent(inout) :: rows
       integer :: n, k, i, pos, start, col_k
@@ -252,7 +313,6 @@ contains
          do k = rows%ptr(n), rows%ptr(n + 1) - 1
             col_k = rows%col(k)
             val_k = rows%val(k)
-            if (col_k == 0) cycle
             ! Insertion into the (short) row under construction.
             i = pos - 1
             do while (i >= start)

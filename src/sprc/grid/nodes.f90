@@ -124,7 +124,7 @@ contains
       integer, intent(in) :: degree
       type(error_type), allocatable, intent(out) :: error
       integer, allocatable :: idx(:, :), table(:)
-      integer :: d, nen, e, j, size_e, step, g(3), node, cap
+      integer :: d, nen, e, j, size_e, step, g(3), node, cap, estimate
       real(wp) :: h
 
       if (degree /= 1 .and. degree /= 2) then
@@ -144,11 +144,13 @@ contains
       self%n_elements = grid%n_leaves
       self%lattice_level = grid%max_level + 1
 
+      ! Each element adds about degree**dim nodes of its own; the lattice grows if that is short.
+      estimate = grid%n_leaves*degree**d + 64
       cap = 16
-      do while (cap < 2*(grid%n_leaves*degree**d + 64))
+      do while (cap < 2*estimate)
          cap = 2*cap
       end do
-      allocate (table(0:2*cap - 1), self%lattice(d, cap), self%connectivity(nen, grid%n_leaves))
+      allocate (table(0:cap - 1), self%lattice(d, estimate), self%connectivity(nen, grid%n_leaves))
       table = 0
       g = 0
       do e = 1, grid%n_leaves
@@ -206,9 +208,10 @@ contains
       type(grid_nodes_type), intent(in) :: self
       integer, allocatable, intent(inout) :: table(:)
       integer(i8) :: s, mask
-      integer :: i, g(3)
+      integer :: i, g(3), size_old
+      size_old = size(table)
       deallocate (table)
-      allocate (table(0:4*self%n_nodes - 1))
+      allocate (table(0:2*size_old - 1))
       table = 0
       mask = int(size(table), i8) - 1_i8
       g = 0
