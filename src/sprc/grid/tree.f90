@@ -21,7 +21,7 @@
 !> sum over l of (n_inside + n_cut + n_outside)(l) * 2**(-dim*l) = 1.
 module sprc_grid_tree
    use sprc_core_kinds, only: wp, i8
-   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_internal
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_geometry_region, only: region_type, cell_outside, cell_inside, cell_cut
    use sprc_grid_morton, only: morton_encode
    implicit none
