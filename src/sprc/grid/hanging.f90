@@ -4,12 +4,13 @@
 !> A node of an element E is hanging when it lies on a face or edge that E
 !> shares with a coarser active leaf C and is not a node of C. Continuity then
 !> requires u_h = sum_k N_k^C(x_h) u_k over C's nodes (multi-point constraint
-!> from the coarse neighbour's shape functions). Masters can themselves hang
-!> where the 2:1 balance does not reach (balance is enforced between active
-!> leaves only, so a coarse element next to external space may carry a
-!> hanging node on its own boundary); such chains are substituted until every
-!> master is free. Masters always sit on strictly coarser elements, so the
-!> substitution ends within grid_max_level rounds.
+!> from the coarse neighbour's shape functions). A master that hangs itself
+!> (a chain) cannot occur on grids from `grid_type%build`: its balance makes
+!> every level-(l-1) neighbour of a level-l leaf's parent exist, and all
+!> masters of a hanging node of that leaf lie on the parent's closure. Grids
+!> made otherwise may have chains; they are substituted until every master is
+!> free. Masters sit on strictly coarser elements, so this ends within
+!> grid_max_level rounds (`chain_rounds` tells how many were needed).
 !>
 !> T has one row per node (n_all = nodes%n_nodes: only nodes of active
 !> elements exist) and one column per free node, numbered in node order.
