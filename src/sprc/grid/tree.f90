@@ -1,0 +1,615 @@
+!> Hierarchical Cartesian grid of one body (the cgFEM / FEAVox family).
+!>
+!> Level 0 is the cube (square) [box_min, box_min + box_size]^dim; a cell of
+!> level l with integer coordinates c (0 <= c < 2**l) splits into 2**dim
+!> children 2c + {0,1}^dim. `build` refines top-down to the uniform `level`,
+!> skipping external subtrees and copying the class of internal cells to their
+!> children without asking the region, refines cut cells `refine_boundary`
+!> more levels, and then enforces 2:1 balance across faces, edges and corners
+!> between active leaves (a ripple that sweeps the levels from the finest one
+!> down; new leaves are classified when they appear).
+!>
+!> Only active leaves (internal and cut) are stored: external space is never
+!> materialised. They are sorted by the Morton key of their lowest corner at
+!> the common resolution `grid_max_level`, so the descendants of any cell are
+!> a contiguous run and a cell or point query is one binary search.
+!>
+!> Leaf counts per level: `n_inside(l)`, `n_cut(l)`, `n_outside(l)`. External
+!> cells coarser than the uniform level are counted as the number of cells of
+!> the uniform level they cover, so a uniform grid (refine_boundary = 0) has
+!> n_inside + n_cut + n_outside = 2**(dim*level) at its level, and in general
+!> sum over l of (n_inside + n_cut + n_outside)(l) * 2**(-dim*l) = 1.
+module sprc_grid_tree
+   use sprc_core_kinds, only: wp, i8
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
+   use sprc_geometry_region, only: region_type, cell_outside, cell_inside, cell_cut
+   use sprc_grid_morton, only: morton_encode
+   implicit none
+   private
+
+   public :: grid_type, grid_max_level
+
+   !> Finest level a grid may hold (level + refine_boundary <= grid_max_level).
+   integer, parameter :: grid_max_level = 20
+
+   integer(i8), parameter :: hash_prime = 2147483647_i8
+
+   !> The active leaves of one body's grid, sorted by Morton key.
+   type :: grid_type
+      !> Space dimension, 2 or 3.
+      integer :: dim = 0
+      !> Lowest corner of the level-0 cell (entries beyond `dim` are zero).
+      real(wp) :: box_min(3) = 0.0_wp
+      !> Edge length of the level-0 cell.
+      real(wp) :: box_size = 0.0_wp
+      !> Uniform level and number of extra boundary levels asked for.
+      integer :: level = 0, refine_boundary = 0
+      !> Finest level among the leaves.
+      integer :: max_level = 0
+      !> Number of active leaves (the elements of the analysis mesh).
+      integer :: n_leaves = 0
+      !> Level of each leaf.
+      integer, allocatable :: leaf_level(:)
+      !> Integer coordinates (dim, n_leaves) of each leaf at its own level.
+      integer, allocatable :: leaf_coord(:, :)
+      !> `cell_inside` or `cell_cut` for each leaf.
+      integer, allocatable :: leaf_class(:)
+      !> Morton key of each leaf's lowest corner at resolution `grid_max_level`; ascending.
+      integer(i8), allocatable :: leaf_key(:)
+      !> Leaf counts per level by class (external: see the module notes).
+      integer(i8) :: n_inside(0:grid_max_level) = 0_i8
+      integer(i8) :: n_cut(0:grid_max_level) = 0_i8
+      integer(i8) :: n_outside(0:grid_max_level) = 0_i8
+      !> Leaves split by the 2:1 balance.
+      integer :: n_balance_splits = 0
+   contains
+      procedure :: build => grid_build
+      procedure :: cell_width => grid_cell_width
+      procedure :: leaf_box => grid_leaf_box
+      procedure :: find_cell => grid_find_cell
+      procedure :: neighbour => grid_neighbour
+      procedure :: locate_point => grid_locate_point
+   end type grid_type
+
+   !> Working state of a build: growable leaf arrays and a hash of every stored cell
+   !> (value > 0: leaf index; -1: split cell; absent: external or not yet made).
+   type :: builder_type
+      integer :: dim = 0, level = 0, top = 0
+      real(wp) :: box_min(3) = 0.0_wp, box_size = 0.0_wp
+      integer :: n = 0, n_splits = 0
+      logical :: bad_class = .false.
+      integer, allocatable :: lev(:), crd(:, :), cls(:)
+      logical, allocatable :: alive(:)
+      integer(i8), allocatable :: hkey(:)
+      integer, allocatable :: hval(:)
+      integer :: hcount = 0
+      integer(i8) :: n_outside(0:grid_max_level) = 0_i8
+   end type builder_type
+
+contains
+
+   !> Build the grid of `region` in the box [box_min, box_min + box_size]^dim: uniform
+   !> `level`, `refine_boundary` extra levels on cut cells, then 2:1 balance.
+   subroutine grid_build(self, region, dim, box_min, box_size, level, refine_boundary, error)
+      class(grid_type), intent(out) :: self
+      class(region_type), intent(in) :: region
+      integer, intent(in) :: dim
+      real(wp), intent(in) :: box_min(:)
+      real(wp), intent(in) :: box_size
+      integer, intent(in) :: level, refine_boundary
+      type(error_type), allocatable, intent(out) :: error
+      type(builder_type) :: b
+      integer :: root(3), root_class
+
+      call check_input(dim, box_min, box_size, level, refine_boundary, error)
+      if (allocated(error)) return
+
+      b%dim = dim
+      b%level = level
+      b%top = level + refine_boundary
+      b%box_min(1:dim) = box_min(1:dim)
+      b%box_size = box_size
+      call builder_init(b)
+
+      root = 0
+      root_class = classify(b, region, 0, root)
+      call descend(b, region, 0, root, root_class)
+      call balance(b, region)
+      if (b%bad_class) then
+         call fatal_error(error, 'grid build: the region returned a class other than cell_outside, '// &
+            & 'cell_inside or cell_cut', stat_invalid_input)
+         return
+      end if
+
+      self%dim = dim
+      self%box_min(1:dim) = box_min(1:dim)
+      self%box_size = box_size
+      self%level = level
+      self%refine_boundary = refine_boundary
+      self%n_outside = b%n_outside
+      self%n_balance_splits = b%n_splits
+      call finalize(self, b)
+   end subroutine grid_build
+
+   subroutine check_input(dim, box_min, box_size, level, refine_boundary, error)
+      integer, intent(in) :: dim
+      real(wp), intent(in) :: box_min(:)
+      real(wp), intent(in) :: box_size
+      integer, intent(in) :: level, refine_boundary
+      type(error_type), allocatable, intent(out) :: error
+      character(len=32) :: buf
+
+      if (dim /= 2 .and. dim /= 3) then
+         write (buf, '(i0)') dim
+         call fatal_error(error, 'grid build: dim must be 2 or 3, got '//trim(buf), stat_invalid_input)
+      else if (size(box_min) < dim) then
+         write (buf, '(i0)') size(box_min)
+         call fatal_error(error, 'grid build: box_min needs dim entries, got '//trim(buf), stat_invalid_input)
+      else if (.not. all(abs(box_min(1:dim)) <= huge(1.0_wp))) then
+         call fatal_error(error, 'grid build: box_min is not finite', stat_invalid_input)
+      else if (.not. (box_size > 0.0_wp .and. box_size <= huge(1.0_wp))) then
+         write (buf, '(es12.4)') box_size
+         call fatal_error(error, 'grid build: box_size must be positive and finite, got '//trim(adjustl(buf)), &
+            & stat_invalid_input)
+      else if (level < 0) then
+         write (buf, '(i0)') level
+         call fatal_error(error, 'grid build: level must be >= 0, got '//trim(buf), stat_invalid_input)
+      else if (refine_boundary < 0) then
+         write (buf, '(i0)') refine_boundary
+         call fatal_error(error, 'grid build: refine_boundary must be >= 0, got '//trim(buf), stat_invalid_input)
+      else if (level > grid_max_level - refine_boundary) then
+         write (buf, '(i0)') grid_max_level
+         call fatal_error(error, 'grid build: level + refine_boundary exceeds the maximum level '//trim(buf), &
+            & stat_invalid_input)
+      end if
+   end subroutine check_input
+
+   !> Edge length of a cell of level `level`.
+   pure real(wp) function grid_cell_width(self, level) result(h)
+      class(grid_type), intent(in) :: self
+      integer, intent(in) :: level
+      h = self%box_size*2.0_wp**(-level)
+   end function grid_cell_width
+
+   !> Box [lo, hi] (size dim) of leaf `leaf`.
+   pure subroutine grid_leaf_box(self, leaf, lo, hi)
+      class(grid_type), intent(in) :: self
+      integer, intent(in) :: leaf
+      real(wp), intent(out) :: lo(:), hi(:)
+      call cell_box(self%dim, self%box_min, self%box_size, self%leaf_level(leaf), self%leaf_coord(:, leaf), lo, hi)
+   end subroutine grid_leaf_box
+
+   !> Leaves that cover the cell (`level`, `coord`): if one leaf of this or a coarser
+   !> level contains the cell, first = last = that leaf; if the cell is refined,
+   !> first..last are all leaves inside it (a contiguous Morton run, possibly
+   !> including leaves that do not touch a given face); first > last when the
+   !> cell is external or outside the box. One binary search.
+   pure subroutine grid_find_cell(self, level, coord, first, last)
+      class(grid_type), intent(in) :: self
+      integer, intent(in) :: level
+      integer, intent(in) :: coord(:)
+      integer, intent(out) :: first, last
+      integer(i8) :: k0, k1
+      integer :: j, shift, d
+
+      first = 1
+      last = 0
+      d = self%dim
+      if (level < 0 .or. level > grid_max_level .or. self%n_leaves == 0) return
+      if (any(coord(1:d) < 0) .or. any(coord(1:d) >= 2**level)) return
+      shift = grid_max_level - level
+      k0 = morton_encode(ishft(coord(1:d), shift))
+      k1 = k0 + ishft(1_i8, d*shift) - 1_i8
+      j = last_le(self%leaf_key, self%n_leaves, k0)
+      if (j > 0) then
+         if (self%leaf_level(j) <= level .and. k0 <= last_key(self, j)) then
+            first = j
+            last = j
+            return
+         end if
+         if (self%leaf_key(j) == k0) then
+            first = j
+         else
+            first = j + 1
+         end if
+      end if
+      last = last_le(self%leaf_key, self%n_leaves, k1)
+   end subroutine grid_find_cell
+
+   !> Leaves across a face, edge or corner of `leaf`: the cell of the same level
+   !> shifted by `dir` (entries -1, 0, 1), answered as in `find_cell`.
+   pure subroutine grid_neighbour(self, leaf, dir, first, last)
+      class(grid_type), intent(in) :: self
+      integer, intent(in) :: leaf
+      integer, intent(in) :: dir(:)
+      integer, intent(out) :: first, last
+      integer :: d
+      d = self%dim
+      call self%find_cell(self%leaf_level(leaf), self%leaf_coord(1:d, leaf) + dir(1:d), first, last)
+   end subroutine grid_neighbour
+
+   !> Leaf containing the point `x`, 0 if the point is outside the box or in external
+   !> space. A point on a shared face belongs to the leaf on its upper side (floor convention).
+   pure integer function grid_locate_point(self, x) result(leaf)
+      class(grid_type), intent(in) :: self
+      real(wp), intent(in) :: x(:)
+      integer :: ic(3), d, k, j, nfine
+      integer(i8) :: kp
+      real(wp) :: t
+
+      leaf = 0
+      d = self%dim
+      if (self%n_leaves == 0) return
+      nfine = 2**grid_max_level
+      do k = 1, d
+         t = (x(k) - self%box_min(k))/self%box_size
+         if (.not. (t >= 0.0_wp .and. t <= 1.0_wp)) return
+         ic(k) = min(int(t*real(nfine, wp)), nfine - 1)
+      end do
+      kp = morton_encode(ic(1:d))
+      j = last_le(self%leaf_key, self%n_leaves, kp)
+      if (j > 0) then
+         if (kp <= last_key(self, j)) leaf = j
+      end if
+   end function grid_locate_point
+
+   !> Last key of the Morton range covered by leaf `j`.
+   pure integer(i8) function last_key(self, j)
+      type(grid_type), intent(in) :: self
+      integer, intent(in) :: j
+      last_key = self%leaf_key(j) + ishft(1_i8, self%dim*(grid_max_level - self%leaf_level(j))) - 1_i8
+   end function last_key
+
+   !> Index of the last entry of the ascending `keys(1:n)` that is <= k (0 if none).
+   pure integer function last_le(keys, n, k) result(j)
+      integer(i8), intent(in) :: keys(:)
+      integer, intent(in) :: n
+      integer(i8), intent(in) :: k
+      integer :: lo, hi, mid
+      lo = 0
+      hi = n
+      do while (lo < hi)
+         mid = lo + (hi - lo + 1)/2
+         if (keys(mid) <= k) then
+            lo = mid
+         else
+            hi = mid - 1
+         end if
+      end do
+      j = lo
+   end function last_le
+
+   pure subroutine cell_box(dim, box_min, box_size, level, coord, lo, hi)
+      integer, intent(in) :: dim, level, coord(:)
+      real(wp), intent(in) :: box_min(:), box_size
+      real(wp), intent(out) :: lo(:), hi(:)
+      real(wp) :: h
+      ! Powers of two scale exactly, so neighbouring cells share bit-identical faces.
+      h = box_size*2.0_wp**(-level)
+      lo(1:dim) = box_min(1:dim) + real(coord(1:dim), wp)*h
+      hi(1:dim) = box_min(1:dim) + real(coord(1:dim) + 1, wp)*h
+   end subroutine cell_box
+
+   ! ---------------------------------------------------------------- building
+
+   subroutine builder_init(b)
+      type(builder_type), intent(inout) :: b
+      integer, parameter :: cap0 = 1024
+      allocate (b%lev(cap0), b%crd(3, cap0), b%cls(cap0), b%alive(cap0))
+      allocate (b%hkey(0:2*cap0 - 1), b%hval(0:2*cap0 - 1))
+      b%hkey = 0_i8
+      b%hval = 0
+   end subroutine builder_init
+
+   integer function classify(b, region, level, coord) result(cls)
+      type(builder_type), intent(inout) :: b
+      class(region_type), intent(in) :: region
+      integer, intent(in) :: level, coord(3)
+      real(wp) :: lo(3), hi(3)
+      call cell_box(b%dim, b%box_min, b%box_size, level, coord, lo, hi)
+      cls = region%classify_box(lo(1:b%dim), hi(1:b%dim))
+      if (cls /= cell_outside .and. cls /= cell_inside .and. cls /= cell_cut) then
+         b%bad_class = .true.
+         cls = cell_cut
+      end if
+   end function classify
+
+   !> Offset of child `k` (0 .. 2**dim - 1): bit i of k is the offset along axis i+1.
+   pure function child_offset(k) result(off)
+      integer, intent(in) :: k
+      integer :: off(3)
+      off = [iand(k, 1), iand(ishft(k, -1), 1), iand(ishft(k, -2), 1)]
+   end function child_offset
+
+   recursive subroutine descend(b, region, level, coord, cls)
+      type(builder_type), intent(inout) :: b
+      class(region_type), intent(in) :: region
+      integer, intent(in) :: level, coord(3), cls
+      integer :: k, child(3), child_class
+
+      if (cls == cell_outside) then
+         call add_outside(b, level)
+      else if (level < b%level .or. (cls == cell_cut .and. level < b%top)) then
+         call hash_put(b, cell_key(b%dim, level, coord), -1)
+         do k = 0, 2**b%dim - 1
+            child = 2*coord + child_offset(k)
+            if (b%dim == 2) child(3) = 0
+            child_class = cell_inside
+            if (cls == cell_cut) child_class = classify(b, region, level + 1, child)
+            call descend(b, region, level + 1, child, child_class)
+         end do
+      else
+         call add_leaf(b, level, coord, cls)
+      end if
+   end subroutine descend
+
+   !> Count an external cell; one coarser than the uniform level counts as the
+   !> uniform-level cells it covers.
+   subroutine add_outside(b, level)
+      type(builder_type), intent(inout) :: b
+      integer, intent(in) :: level
+      if (level < b%level) then
+         b%n_outside(b%level) = b%n_outside(b%level) + ishft(1_i8, b%dim*(b%level - level))
+      else
+         b%n_outside(level) = b%n_outside(level) + 1_i8
+      end if
+   end subroutine add_outside
+
+   subroutine add_leaf(b, level, coord, cls)
+      type(builder_type), intent(inout) :: b
+      integer, intent(in) :: level, coord(3), cls
+      if (b%n == size(b%lev)) call grow_leaves(b)
+      b%n = b%n + 1
+      b%lev(b%n) = level
+      b%crd(:, b%n) = coord
+      b%cls(b%n) = cls
+      b%alive(b%n) = .true.
+      call hash_put(b, cell_key(b%dim, level, coord), b%n)
+   end subroutine add_leaf
+
+   subroutine grow_leaves(b)
+      type(builder_type), intent(inout) :: b
+      integer, allocatable :: ilev(:), icrd(:, :), icls(:)
+      logical, allocatable :: ialive(:)
+      integer :: cap
+      cap = 2*size(b%lev)
+      allocate (ilev(cap), icrd(3, cap), icls(cap), ialive(cap))
+      ilev(1:b%n) = b%lev(1:b%n)
+      icrd(:, 1:b%n) = b%crd(:, 1:b%n)
+      icls(1:b%n) = b%cls(1:b%n)
+      ialive(1:b%n) = b%alive(1:b%n)
+      call move_alloc(ilev, b%lev)
+      call move_alloc(icrd, b%crd)
+      call move_alloc(icls, b%cls)
+      call move_alloc(ialive, b%alive)
+   end subroutine grow_leaves
+
+   !> Replace leaf `i` by its non-external children.
+   subroutine split_leaf(b, region, i)
+      type(builder_type), intent(inout) :: b
+      class(region_type), intent(in) :: region
+      integer, intent(in) :: i
+      integer :: level, coord(3), cls, k, child(3), child_class
+
+      level = b%lev(i)
+      coord = b%crd(:, i)
+      cls = b%cls(i)
+      b%alive(i) = .false.
+      b%n_splits = b%n_splits + 1
+      call hash_put(b, cell_key(b%dim, level, coord), -1)
+      do k = 0, 2**b%dim - 1
+         child = 2*coord + child_offset(k)
+         if (b%dim == 2) child(3) = 0
+         child_class = cell_inside
+         if (cls == cell_cut) child_class = classify(b, region, level + 1, child)
+         if (child_class == cell_outside) then
+            call add_outside(b, level + 1)
+         else
+            call add_leaf(b, level + 1, child, child_class)
+         end if
+      end do
+   end subroutine split_leaf
+
+   !> 2:1 balance across faces, edges and corners. A leaf of level l needs every
+   !> level-(l-1) neighbour of its parent to exist (or to be external): a coarser
+   !> leaf covering such a cell is split down to level l-1. Levels are swept from
+   !> the finest down, so leaves made while sweeping level l (all of level < l)
+   !> are checked when their own level is swept.
+   subroutine balance(b, region)
+      type(builder_type), intent(inout) :: b
+      class(region_type), intent(in) :: region
+      integer :: l, i, n0, parent(3), q(3), d(3), k, ndir
+      integer(i8) :: pkey, last_parent
+
+      ndir = 3**b%dim
+      do l = b%top, b%level + 2, -1
+         n0 = b%n
+         last_parent = -1_i8
+         do i = 1, n0
+            if (.not. b%alive(i) .or. b%lev(i) /= l) cycle
+            parent = b%crd(:, i)/2
+            pkey = cell_key(b%dim, l - 1, parent)
+            if (pkey == last_parent) cycle
+            last_parent = pkey
+            do k = 0, ndir - 1
+               d = [mod(k, 3) - 1, mod(k/3, 3) - 1, mod(k/9, 3) - 1]
+               if (b%dim == 2) d(3) = 0
+               if (all(d == 0)) cycle
+               q = parent + d
+               if (any(q(1:b%dim) < 0) .or. any(q(1:b%dim) >= 2**(l - 1))) cycle
+               call ensure_cell(b, region, l - 1, q)
+            end do
+         end do
+      end do
+   end subroutine balance
+
+   !> Make the cell (level, coord) exist unless it is external.
+   subroutine ensure_cell(b, region, level, coord)
+      type(builder_type), intent(inout) :: b
+      class(region_type), intent(in) :: region
+      integer, intent(in) :: level, coord(3)
+      integer :: m, v
+
+      if (hash_get(b, cell_key(b%dim, level, coord)) /= 0) return
+      v = 0
+      do m = level - 1, 0, -1
+         v = hash_get(b, cell_key(b%dim, m, ishft(coord, -(level - m))))
+         if (v /= 0) exit
+      end do
+      if (v <= 0) return
+      do
+         call split_leaf(b, region, v)
+         m = m + 1
+         if (m == level) exit
+         v = hash_get(b, cell_key(b%dim, m, ishft(coord, -(level - m))))
+         if (v <= 0) exit
+      end do
+   end subroutine ensure_cell
+
+   !> Move the live leaves into `grid`, sorted by Morton key, and count them per level.
+   subroutine finalize(grid, b)
+      type(grid_type), intent(inout) :: grid
+      type(builder_type), intent(inout) :: b
+      integer(i8), allocatable :: keys(:)
+      integer, allocatable :: idx(:), perm(:)
+      integer :: n, i, j, d
+
+      deallocate (b%hkey, b%hval)
+      d = b%dim
+      n = count(b%alive(1:b%n))
+      allocate (keys(n), idx(n))
+      j = 0
+      do i = 1, b%n
+         if (.not. b%alive(i)) cycle
+         j = j + 1
+         idx(j) = i
+         keys(j) = morton_encode(ishft(b%crd(1:d, i), grid_max_level - b%lev(i)))
+      end do
+      call radix_sort(keys, perm)
+      grid%n_leaves = n
+      allocate (grid%leaf_level(n), grid%leaf_coord(d, n), grid%leaf_class(n), grid%leaf_key(n))
+      grid%max_level = b%level
+      do j = 1, n
+         i = idx(perm(j))
+         grid%leaf_key(j) = keys(perm(j))
+         grid%leaf_level(j) = b%lev(i)
+         grid%leaf_coord(:, j) = b%crd(1:d, i)
+         grid%leaf_class(j) = b%cls(i)
+         grid%max_level = max(grid%max_level, b%lev(i))
+         if (b%cls(i) == cell_inside) then
+            grid%n_inside(b%lev(i)) = grid%n_inside(b%lev(i)) + 1_i8
+         else
+            grid%n_cut(b%lev(i)) = grid%n_cut(b%lev(i)) + 1_i8
+         end if
+      end do
+   end subroutine finalize
+
+   !> Ascending permutation of non-negative keys: LSD radix sort, 16-bit digits.
+   subroutine radix_sort(keys, perm)
+      integer(i8), intent(in) :: keys(:)
+      integer, allocatable, intent(out) :: perm(:)
+      integer, allocatable :: tmp(:), cnt(:)
+      integer :: n, i, pass, digit, npass
+      integer(i8) :: kmax
+
+      n = size(keys)
+      allocate (perm(n), tmp(n), cnt(0:65536))
+      perm = [(i, i=1, n)]
+      kmax = 0_i8
+      if (n > 0) kmax = maxval(keys)
+      npass = 0
+      do while (kmax > 0_i8)
+         npass = npass + 1
+         kmax = ishft(kmax, -16)
+      end do
+      do pass = 0, npass - 1
+         cnt = 0
+         do i = 1, n
+            digit = int(iand(ishft(keys(perm(i)), -16*pass), 65535_i8))
+            cnt(digit + 1) = cnt(digit + 1) + 1
+         end do
+         do i = 1, 65536
+            cnt(i) = cnt(i) + cnt(i - 1)
+         end do
+         do i = 1, n
+            digit = int(iand(ishft(keys(perm(i)), -16*pass), 65535_i8))
+            cnt(digit) = cnt(digit) + 1
+            tmp(cnt(digit)) = perm(i)
+         end do
+         perm = tmp
+      end do
+   end subroutine radix_sort
+
+   ! ---------------------------------------------------------------- cell hash
+
+   !> Key of a cell unique over all levels: its Morton key with a marker bit above it.
+   pure integer(i8) function cell_key(dim, level, coord)
+      integer, intent(in) :: dim, level, coord(3)
+      cell_key = ior(morton_encode(coord(1:dim)), ishft(1_i8, dim*level))
+   end function cell_key
+
+   pure integer(i8) function hash_slot(key, mask)
+      integer(i8), intent(in) :: key, mask
+      ! Both products stay below 2**62: no integer overflow.
+      hash_slot = iand(modulo(modulo(key, hash_prime)*1103515245_i8 + ishft(key, -31)*40503_i8, hash_prime), mask)
+   end function hash_slot
+
+   integer function hash_get(b, key) result(val)
+      type(builder_type), intent(in) :: b
+      integer(i8), intent(in) :: key
+      integer(i8) :: s, mask
+      mask = int(size(b%hkey), i8) - 1_i8
+      s = hash_slot(key, mask)
+      val = 0
+      do while (b%hkey(s) /= 0_i8)
+         if (b%hkey(s) == key) then
+            val = b%hval(s)
+            return
+         end if
+         s = iand(s + 1_i8, mask)
+      end do
+   end function hash_get
+
+   subroutine hash_put(b, key, val)
+      type(builder_type), intent(inout) :: b
+      integer(i8), intent(in) :: key
+      integer, intent(in) :: val
+      integer(i8) :: s, mask
+      if (2*(b%hcount + 1) > size(b%hkey)) call hash_grow(b)
+      mask = int(size(b%hkey), i8) - 1_i8
+      s = hash_slot(key, mask)
+      do while (b%hkey(s) /= 0_i8)
+         if (b%hkey(s) == key) then
+            b%hval(s) = val
+            return
+         end if
+         s = iand(s + 1_i8, mask)
+      end do
+      b%hkey(s) = key
+      b%hval(s) = val
+      b%hcount = b%hcount + 1
+   end subroutine hash_put
+
+   subroutine hash_grow(b)
+      type(builder_type), intent(inout) :: b
+      integer(i8), allocatable :: okey(:)
+      integer, allocatable :: oval(:)
+      integer(i8) :: i, s, mask
+      call move_alloc(b%hkey, okey)
+      call move_alloc(b%hval, oval)
+      allocate (b%hkey(0:2*size(okey) - 1), b%hval(0:2*size(okey) - 1))
+      b%hkey = 0_i8
+      b%hval = 0
+      mask = int(size(b%hkey), i8) - 1_i8
+      do i = 0, size(okey, kind=i8) - 1_i8
+         if (okey(i) == 0_i8) cycle
+         s = hash_slot(okey(i), mask)
+         do while (b%hkey(s) /= 0_i8)
+            s = iand(s + 1_i8, mask)
+         end do
+         b%hkey(s) = okey(i)
+         b%hval(s) = oval(i)
+      end do
+   end subroutine hash_grow
+
+end module sprc_grid_tree
