@@ -29,7 +29,7 @@ contains
          '  sprc                          run the built-in default scene (Lame cylinder study)'//nl// &
          '  sprc run SCENE.nml [--output PREFIX] [--levels 3,4,5] [--threads N] [--points Q] [--quiet]'//nl// &
          '  sprc check SCENE.nml          validate; print the scene and what it switches on and off'//nl// &
-         '  sprc mesh SCENE.nml [--points Q]   grid, classification, quadrature per level'//nl// &
+         '  sprc mesh SCENE.nml [--levels 3,4] [--points Q]   grid, classification, quadrature per level'//nl// &
          '  sprc --help | --version'//nl//nl// &
          'exit status: 0 success; 2 bad input (the message names the group, field and value);'//nl// &
          '             1 numerical failure, or a capability this version does not have yet'
@@ -117,7 +117,7 @@ contains
       case ('run')
          allowed = any(option == [character(len=9) :: '--output', '--levels', '--threads', '--points'])
       case ('mesh')
-         allowed = option == '--points'
+         allowed = option == '--points' .or. option == '--levels'
       case default
          allowed = .false.
       end select

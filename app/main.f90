@@ -5,6 +5,7 @@ program sprc_main
    use sprc_core_error, only: error_type
    use sprc_version, only: sprc_version_string
    use sprc_io_scene, only: scene_type, read_scene, read_scene_text, scene_summary, default_scene_text
+   use sprc_io_study, only: mesh_row_type, mesh_study, format_mesh_row, study_levels
    use sprc_app_cli, only: cli_type, parse_cli, usage_text
    implicit none
 
@@ -25,7 +26,9 @@ program sprc_main
       call run_default()
    case ('check')
       call check_scene(cli%scene_path)
-   case ('run', 'mesh')
+   case ('mesh')
+      call mesh_scene(cli)
+   case ('run')
       call check_scene_quietly(cli%scene_path)
       call fail(1, 'sprc '//cli%command//': '//not_yet())
    end select
@@ -35,9 +38,9 @@ contains
    !> What this version can and cannot do, stated plainly (issue: never pretend).
    function not_yet() result(text)
       character(len=:), allocatable :: text
-      text = 'this version ('//sprc_version_string//') reads and validates scenes only; '// &
-         'the analysis pipeline (grid, cut-cell quadrature, FE solve, SPR/SPR-C recovery, '// &
-         'error report) is not implemented yet'
+      text = 'this version ('//sprc_version_string//') reads and validates scenes and builds their '// &
+         'grids (sprc mesh); the cut-cell quadrature, FE solve, SPR/SPR-C recovery and the error '// &
+         'report are not implemented yet'
    end function not_yet
 
    subroutine run_default()
@@ -46,8 +49,9 @@ contains
 
       write (output_unit, '(a)') 'sprc '//sprc_version_string
       write (output_unit, '(a)') 'Can do now:    sprc check SCENE.nml (read and validate a scene, '// &
-         'list what it switches on and off), --help, --version.'
-      write (output_unit, '(a)') 'Cannot do yet: sprc run / sprc mesh and this default study: '//not_yet()//'.'
+         'list what it switches on and off), sprc mesh SCENE.nml (grid cell counts per level), '// &
+         '--help, --version.'
+      write (output_unit, '(a)') 'Cannot do yet: sprc run and this default study: '//not_yet()//'.'
       write (output_unit, '(a)') 'The built-in default scene (example/scenes/lame_cylinder.nml) validates as:'
       write (output_unit, '(a)') ''
       call read_scene_text(default_scene_text(), '<built-in default scene>', scene, error)
@@ -64,6 +68,28 @@ contains
       if (allocated(error)) call fail(2, error%message)
       write (output_unit, '(a)') scene_summary(scene)
    end subroutine check_scene
+
+   !> `sprc mesh`: one line per level and body (SCENE.md).
+   subroutine mesh_scene(cli)
+      type(cli_type), intent(in) :: cli
+      type(scene_type) :: scene
+      type(error_type), allocatable :: error
+      type(mesh_row_type), allocatable :: rows(:)
+      integer, allocatable :: levels(:)
+      integer :: i
+
+      call read_scene(cli%scene_path, scene, error)
+      if (allocated(error)) call fail(2, error%message)
+      call study_levels(scene, cli%levels, levels, error)
+      if (allocated(error)) call fail(2, error%message)
+      write (error_unit, '(a)') 'sprc mesh: cell counts only; the measure and boundary_measure keys '// &
+         'arrive with the cut-cell quadrature'
+      call mesh_study(scene, levels, rows, error)
+      if (allocated(error)) call fail(1, error%message)
+      do i = 1, size(rows)
+         write (output_unit, '(a)') format_mesh_row(rows(i))
+      end do
+   end subroutine mesh_scene
 
    subroutine check_scene_quietly(path)
       character(len=*), intent(in) :: path

@@ -158,6 +158,9 @@ module sprc_io_scene
    integer, parameter :: max_level_2d = 14, max_level_3d = 9
    integer, parameter :: max_refine_boundary = 6
 
+   character(len=*), parameter :: name_chars = &
+      'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-.'
+
 contains
 
    !> Read and validate a scene file. A missing or unreadable file is
@@ -777,7 +780,8 @@ contains
       end if
    end subroutine get_choice
 
-   !> A required non-empty name.
+   !> A required non-empty name of letters, digits, '_', '-' and '.': names
+   !> appear in `key=value` output lines and as HDF5 group names.
    subroutine get_name(g, key, value, error)
       type(nml_group_type), intent(inout) :: g
       character(len=*), intent(in) :: key
@@ -791,6 +795,8 @@ contains
          call nml_field_error(g, key, 'required', error)
       else if (len_trim(value) == 0) then
          call nml_field_error(g, key, 'must not be empty', error)
+      else if (verify(value, name_chars) /= 0) then
+         call nml_field_error(g, key, 'may contain only letters, digits, ''_'', ''-'' and ''.''', error)
       end if
    end subroutine get_name
 

@@ -1,0 +1,117 @@
+!> Studies over the levels of a scene: what `sprc mesh` (and later
+!> `sprc run`) computes, as rows of data; the driver or the C API format them.
+module sprc_io_study
+   use sprc_core_kinds, only: wp, i8
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
+   use sprc_core_timer, only: timer_type
+   use sprc_geometry_body, only: body_type
+   use sprc_grid_tree, only: grid_type
+   use sprc_io_scene, only: scene_type
+   use sprc_io_model, only: build_bodies
+   implicit none
+   private
+
+   public :: mesh_row_type, mesh_study, format_mesh_row, study_levels
+
+   !> One line of `sprc mesh`: a body's grid at one level.
+   type :: mesh_row_type
+      integer :: level = 0
+      character(len=:), allocatable :: body
+      !> Leaves of each class, summed over all levels of the grid; external
+      !> cells coarser than `level` count as the level-`level` cells they cover.
+      integer(i8) :: internal = 0, cut = 0, external = 0
+      !> Seconds to build, classify and balance the grid.
+      real(wp) :: t_mesh = 0.0_wp
+   end type mesh_row_type
+
+contains
+
+   !> The levels of a study: the scene's, or `override` when given (each
+   !> must respect the scene's limits: 0..14 in 2D, 0..9 in 3D).
+   subroutine study_levels(scene, override, levels, error)
+      type(scene_type), intent(in) :: scene
+      integer, intent(in), optional :: override(:)
+      integer, allocatable, intent(out) :: levels(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: top, i
+      character(len=16) :: buf
+
+      levels = scene%levels
+      if (.not. present(override)) return
+      if (size(override) == 0) return
+      top = merge(14, 9, scene%dim == 2)
+      do i = 1, size(override)
+         if (override(i) < 0 .or. override(i) > top) then
+            write (buf, '(i0)') override(i)
+            call fatal_error(error, '--levels: level '//trim(buf)//' is out of range for a '// &
+               merge('2D', '3D', scene%dim == 2)//' scene (0..'//merge('14', '9 ', scene%dim == 2)//')', &
+               stat_invalid_input)
+            return
+         end if
+      end do
+      levels = override
+   end subroutine study_levels
+
+   !> Build each body's grid at each level and count its cells.
+   subroutine mesh_study(scene, levels, rows, error)
+      type(scene_type), intent(in) :: scene
+      integer, intent(in) :: levels(:)
+      type(mesh_row_type), allocatable, intent(out) :: rows(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type), allocatable :: bodies(:)
+      type(grid_type) :: grid
+      type(timer_type) :: timer
+      integer :: l, b, k
+
+      call build_bodies(scene, bodies, error)
+      if (allocated(error)) return
+      allocate (rows(size(levels)*size(bodies)))
+      k = 0
+      do l = 1, size(levels)
+         do b = 1, size(bodies)
+            k = k + 1
+            call timer%reset()
+            call timer%start()
+            call grid%build(bodies(b), scene%dim, scene%box_min, scene%box_size, levels(l), &
+               scene%refine_boundary, error)
+            call timer%stop()
+            if (allocated(error)) then
+               error%message = 'body '''//bodies(b)%name//''', level '//itoa(levels(l))//': '//error%message
+               return
+            end if
+            rows(k)%level = levels(l)
+            rows(k)%body = bodies(b)%name
+            rows(k)%internal = sum(grid%n_inside)
+            rows(k)%cut = sum(grid%n_cut)
+            rows(k)%external = sum(grid%n_outside)
+            rows(k)%t_mesh = timer%elapsed
+         end do
+      end do
+   end subroutine mesh_study
+
+   !> `level=4 body=cylinder internal=1234 cut=210 external=604 ...` (SCENE.md).
+   function format_mesh_row(row) result(line)
+      type(mesh_row_type), intent(in) :: row
+      character(len=:), allocatable :: line
+      character(len=32) :: t
+
+      write (t, '(es10.3)') row%t_mesh
+      line = 'level='//itoa(row%level)//' body='//row%body//' internal='//itoa8(row%internal)// &
+         ' cut='//itoa8(row%cut)//' external='//itoa8(row%external)//' t_mesh='//trim(adjustl(t))
+   end function format_mesh_row
+
+   pure function itoa(i) result(s)
+      integer, intent(in) :: i
+      character(len=:), allocatable :: s
+      s = itoa8(int(i, i8))
+   end function itoa
+
+   pure function itoa8(i) result(s)
+      integer(i8), intent(in) :: i
+      character(len=:), allocatable :: s
+      character(len=24) :: buf
+      write (buf, '(i0)') i
+      s = trim(buf)
+   end function itoa8
+
+end module sprc_io_study
