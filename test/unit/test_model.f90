@@ -7,6 +7,7 @@ module sprc_test_model
    use sprc_exact_solution, only: exact_solution_type
    use sprc_io_scene, only: scene_type, read_scene, read_scene_text, default_scene_text
    use sprc_io_model, only: build_bodies, build_exact
+   use sprc_grid_tree, only: grid_type
    use sprc_testsuite, only: unittest_type, new_unittest, check
    implicit none
    private
@@ -23,7 +24,9 @@ contains
          new_unittest('kirsch_example', test_kirsch_example), &
          new_unittest('lame_sphere_example', test_sphere_example), &
          new_unittest('no_exact_group', test_no_exact), &
-         new_unittest('facade_reexports', test_facade) &
+         new_unittest('facade_reexports', test_facade), &
+         new_unittest('grid_quarter_annulus', test_grid_annulus), &
+         new_unittest('grid_sphere_octant', test_grid_octant) &
          ]
    end subroutine collect_model
 
@@ -152,5 +155,63 @@ contains
       call get_sprc_version(major, minor, patch)
       call check(error, sprc_version_number, 10000*major + 100*minor + patch, 'version number')
    end subroutine test_facade
+
+   subroutine test_grid_annulus(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      call load('', scene, error)
+      if (allocated(error)) return
+      call check_scene_grid(scene, 5, 2, 2, error)
+   end subroutine test_grid_annulus
+
+   subroutine test_grid_octant(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      call load('example/scenes/lame_sphere.nml', scene, error)
+      if (allocated(error)) return
+      call check_scene_grid(scene, 3, 1, 2, error)
+   end subroutine test_grid_octant
+
+   !> The grid of a quarter/octant model against brute force: every leaf's
+   !> class agrees with samples of the level set on a 6^dim lattice in its box
+   !> (inside: no sample outside; cut: found so by the certified ranges, and
+   !> only the curved shapes 1..ncurved may cut it — the symmetry planes lie on
+   !> grid planes and must never produce a cut).
+   subroutine check_scene_grid(scene, level, refine, ncurved, error)
+      type(scene_type), intent(in) :: scene
+      integer, intent(in) :: level, refine, ncurved
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type), allocatable :: bodies(:)
+      type(grid_type) :: grid
+      real(wp) :: lo(3), hi(3), x(3), t(3)
+      integer :: leaf, list(8), n, k, dim, ncut
+      character(len=80) :: msg
+
+      call build_bodies(scene, bodies, error)
+      if (allocated(error)) return
+      dim = scene%dim
+      call grid%build(bodies(1), dim, scene%box_min, scene%box_size, level, refine, error)
+      if (allocated(error)) return
+      ncut = 0
+      do leaf = 1, grid%n_leaves
+         call grid%leaf_box(leaf, lo(1:dim), hi(1:dim))
+         if (grid%leaf_class(leaf) == cell_cut) then
+            ncut = ncut + 1
+            call bodies(1)%active_shapes(lo(1:dim), hi(1:dim), list, n)
+            write (msg, '("leaf ",i0," is cut by a symmetry plane")') leaf
+            call check(error, n > 0 .and. all(list(1:n) <= ncurved), trim(msg))
+            if (allocated(error)) return
+            cycle
+         end if
+         do k = 0, 6**dim - 1
+            t(1:dim) = real(mod([(k/6**(n - 1), n = 1, dim)], 6), wp)/5.0_wp
+            x(1:dim) = lo(1:dim) + t(1:dim)*(hi(1:dim) - lo(1:dim))
+            write (msg, '("internal leaf ",i0," has a sample outside the body")') leaf
+            call check(error, bodies(1)%phi(x(1:dim)) <= 1.0e-12_wp*scene%box_size, trim(msg))
+            if (allocated(error)) return
+         end do
+      end do
+      call check(error, ncut > 0 .and. ncut == sum(grid%n_cut), 'cut leaves counted')
+   end subroutine check_scene_grid
 
 end module sprc_test_model
