@@ -14,6 +14,7 @@ program sprc_unit_tests
    use sprc_test_grid, only: collect_grid
    use sprc_test_model, only: collect_model
    use sprc_test_quadrature, only: collect_quadrature
+   use sprc_test_recovery, only: collect_recovery
    implicit none
 
    type(testsuite_type), allocatable :: suites(:)
@@ -30,7 +31,8 @@ program sprc_unit_tests
       new_testsuite('geometry', collect_geometry), &
       new_testsuite('grid', collect_grid), &
       new_testsuite('model', collect_model), &
-      new_testsuite('quadrature', collect_quadrature) &
+      new_testsuite('quadrature', collect_quadrature), &
+      new_testsuite('recovery', collect_recovery) &
       ]
 
    call get_arg(1, suite_name)
