@@ -54,7 +54,7 @@ module sprc_fem_linear_solver
       !> (MATLAB's threshold too) accepts every cond_1 below 4.5e15. Costs
       !> about five solves; set 0 to skip the check.
       real(wp) :: rcond_tol = epsilon(1.0_wp)
-      contains
+   contains
       !> `factorize(a, error)`: factor `a`, replacing any previous factor.
       procedure :: factorize
       procedure, private :: solve_one, solve_many
