@@ -17,6 +17,7 @@ module sprc_core_lapack
    public :: dgesvd, dgelsd, dsyev
    public :: dgemm, dgemv, dsyrk, dlamch
    public :: lapack_info_error
+   public :: dlacn2
 
    interface
       subroutine dgesv(n, nrhs, a, lda, ipiv, b, ldb, info)
@@ -211,6 +212,17 @@ module sprc_core_lapack
          character(len=1), intent(in) :: cmach
          real(dp) :: r
       end function dlamch
+   end interface
+
+   interface
+      !> Hager/Higham 1-norm estimator by reverse communication: on each return
+      !> with kase = 1 (2) overwrite x by A^-1 x (A^-T x) and call again.
+      subroutine dlacn2(n, v, x, isgn, est, kase, isave)
+         import :: dp
+         integer, intent(in) :: n
+         real(dp), intent(inout) :: v(*), x(*), est
+         integer, intent(inout) :: isgn(*), kase, isave(3)
+      end subroutine dlacn2
    end interface
 
 contains

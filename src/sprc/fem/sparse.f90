@@ -1,0 +1,477 @@
+!> Sparse matrices for assembly and direct solves: a growable triplet list
+!> (`coo_type`) that finite elements add to, and compressed sparse rows
+!> (`csr_type`) that the solvers read.
+!>
+!> The COO -> CSR conversion sums duplicates in insertion order, so the same
+!> sequence of `add` calls gives a bit-identical matrix on every run and with
+!> any thread count. It is O(nnz + nrows + ncols): a stable counting sort by
+!> row, duplicates merged through a column marker, then a sort of each row's
+!> distinct columns (rows are short: at most 81 entries for Q1 elasticity).
+module sprc_fem_sparse
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use sprc_core_kinds, only: wp, i8
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_out_of_memory
+   implicit none
+   private
+
+   public :: coo_type, csr_type, csr_validate
+
+   !> Capacity of a `coo_type` whose first `add` finds no storage.
+   integer(i8), parameter :: min_capacity = 64
+
+   !> Growable list of (row, column, value) triplets of an `nrows` x `ncols`
+   !> matrix, indices 1-based. Duplicates are kept and summed by `to_csr`.
+   type :: coo_type
+      !> Dimensions, fixed by `init`.
+      integer :: nrows = 0, ncols = 0
+      !> Number of triplets stored (duplicates counted).
+      integer(i8) :: nnz = 0
+      !> Triplets 1..nnz; the arrays may be longer (capacity).
+      integer, allocatable :: row(:), col(:)
+      real(wp), allocatable :: val(:)
+   contains
+      procedure :: init => coo_init
+      procedure :: reserve => coo_reserve
+      procedure, private :: coo_add_entry, coo_add_block, coo_add_square_block
+      !> `add(i, j, v, error)`, `add(rows, cols, block, error)` or `add(dofs, block, error)`.
+      generic :: add => coo_add_entry, coo_add_block, coo_add_square_block
+      procedure :: clear => coo_clear
+      procedure :: to_csr => coo_to_csr
+   end type coo_type
+
+   !> Compressed sparse rows, 1-based: row `i` holds `col(k), val(k)` for
+   !> `k = rowptr(i) .. rowptr(i+1)-1`, columns strictly increasing.
+   type :: csr_type
+      integer :: nrows = 0, ncols = 0
+      !> Row starts, size nrows+1, `rowptr(1) = 1`; 64-bit so nnz may pass 2**31.
+      integer(i8), allocatable :: rowptr(:)
+      integer, allocatable :: col(:)
+      real(wp), allocatable :: val(:)
+   contains
+      procedure :: nnz => csr_nnz
+      procedure :: matvec => csr_matvec
+      procedure :: norm1 => csr_norm1
+   end type csr_type
+
+contains
+
+   !> Empty the list and fix the dimensions; `capacity` triplets are reserved
+   !> (an estimate of the final count saves regrowth).
+   subroutine coo_init(self, nrows, ncols, error, capacity)
+      class(coo_type), intent(inout) :: self
+      integer, intent(in) :: nrows, ncols
+      type(error_type), allocatable, intent(out) :: error
+      integer(i8), intent(in), optional :: capacity
+      character(len=64) :: buf
+
+      if (nrows < 0 .or. ncols < 0) then
+         write (buf, '(i0," x ",i0)') nrows, ncols
+         call fatal_error(error, 'coo_type%init: negative dimensions '//trim(buf), stat_invalid_input)
+         return
+      end if
+      call self%clear()
+      self%nrows = nrows
+      self%ncols = ncols
+      if (present(capacity)) call self%reserve(capacity, error)
+   end subroutine coo_init
+
+   !> Make room for at least `capacity` triplets in total, keeping the stored ones.
+   subroutine coo_reserve(self, capacity, error)
+      class(coo_type), intent(inout) :: self
+      integer(i8), intent(in) :: capacity
+      type(error_type), allocatable, intent(out) :: error
+      integer, allocatable :: irow(:), icol(:)
+      real(wp), allocatable :: v(:)
+      integer :: stat
+
+      if (allocated(self%val)) then
+         if (size(self%val, kind=i8) >= capacity) return
+      end if
+      if (capacity <= 0) return
+      allocate (irow(capacity), icol(capacity), v(capacity), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, 'coo_type%reserve: cannot allocate the triplet list', stat_out_of_memory)
+         return
+      end if
+      if (self%nnz > 0) then
+         irow(1:self%nnz) = self%row(1:self%nnz)
+         icol(1:self%nnz) = self%col(1:self%nnz)
+         v(1:self%nnz) = self%val(1:self%nnz)
+      end if
+      call move_alloc(irow, self%row)
+      call move_alloc(icol, self%col)
+      call move_alloc(v, self%val)
+   end subroutine coo_reserve
+
+   !> Drop all triplets and storage; the dimensions become 0 x 0.
+   subroutine coo_clear(self)
+      class(coo_type), intent(inout) :: self
+      if (allocated(self%row)) deallocate (self%row)
+      if (allocated(self%col)) deallocate (self%col)
+      if (allocated(self%val)) deallocate (self%val)
+      self%nnz = 0
+      self%nrows = 0
+      self%ncols = 0
+   end subroutine coo_clear
+
+   !> Room for `extra` more triplets, doubling the capacity so that n adds cost O(n).
+   subroutine coo_grow(self, extra, error)
+      class(coo_type), intent(inout) :: self
+      integer(i8), intent(in) :: extra
+      type(error_type), allocatable, intent(out) :: error
+      integer(i8) :: have
+
+      have = 0
+      if (allocated(self%val)) have = size(self%val, kind=i8)
+      if (self%nnz + extra <= have) return
+      call self%reserve(max(self%nnz + extra, 2*have, min_capacity), error)
+   end subroutine coo_grow
+
+   !> Add one triplet A(i, j) += v.
+   subroutine coo_add_entry(self, i, j, v, error)
+      class(coo_type), intent(inout) :: self
+      integer, intent(in) :: i, j
+      real(wp), intent(in) :: v
+      type(error_type), allocatable, intent(out) :: error
+
+      call check_indices(self, [i], [j], error)
+      if (allocated(error)) return
+      call check_finite([i], [j], reshape([v], [1, 1]), error)
+      if (allocated(error)) return
+      call coo_grow(self, 1_i8, error)
+      if (allocated(error)) return
+      self%nnz = self%nnz + 1
+      self%row(self%nnz) = i
+      self%col(self%nnz) = j
+      self%val(self%nnz) = v
+   end subroutine coo_add_entry
+
+   !> Add an element block: A(rows(a), cols(b)) += block(a, b). Nothing is added
+   !> when any index or value is rejected. Triplets go in column-major order of
+   !> `block`, which fixes the summation order of duplicates.
+   subroutine coo_add_block(self, rows, cols, block, error)
+      class(coo_type), intent(inout) :: self
+      integer, intent(in) :: rows(:), cols(:)
+      real(wp), intent(in) :: block(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: a, b
+      integer(i8) :: k
+      character(len=96) :: buf
+
+      if (size(block, 1) /= size(rows) .or. size(block, 2) /= size(cols)) then
+         write (buf, '(i0," x ",i0," block for ",i0," rows and ",i0," columns")') &
+            size(block, 1), size(block, 2), size(rows), size(cols)
+         call fatal_error(error, 'coo_type%add: '//trim(buf), stat_invalid_input)
+         return
+      end if
+      call check_indices(self, rows, cols, error)
+      if (allocated(error)) return
+      call check_finite(rows, cols, block, error)
+      if (allocated(error)) return
+      call coo_grow(self, size(block, kind=i8), error)
+      if (allocated(error)) return
+      k = self%nnz
+      do b = 1, size(cols)
+         do a = 1, size(rows)
+            k = k + 1
+            self%row(k) = rows(a)
+            self%col(k) = cols(b)
+            self%val(k) = block(a, b)
+         end do
+      end do
+      self%nnz = k
+   end subroutine coo_add_block
+
+   !> Add a square element block on the same rows and columns: A(dofs, dofs) += block.
+   subroutine coo_add_square_block(self, dofs, block, error)
+      class(coo_type), intent(inout) :: self
+      integer, intent(in) :: dofs(:)
+      real(wp), intent(in) :: block(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      call coo_add_block(self, dofs, dofs, block, error)
+   end subroutine coo_add_square_block
+
+   subroutine check_indices(self, rows, cols, error)
+      type(coo_type), intent(in) :: self
+      integer, intent(in) :: rows(:), cols(:)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=96) :: buf
+      integer :: k
+
+      do k = 1, size(rows)
+         if (rows(k) < 1 .or. rows(k) > self%nrows) then
+            write (buf, '("row index ",i0," outside 1..",i0)') rows(k), self%nrows
+            call fatal_error(error, 'coo_type%add: '//trim(buf), stat_invalid_input)
+            return
+         end if
+      end do
+      do k = 1, size(cols)
+         if (cols(k) < 1 .or. cols(k) > self%ncols) then
+            write (buf, '("column index ",i0," outside 1..",i0)') cols(k), self%ncols
+            call fatal_error(error, 'coo_type%add: '//trim(buf), stat_invalid_input)
+            return
+         end if
+      end do
+   end subroutine check_indices
+
+   subroutine check_finite(rows, cols, block, error)
+      integer, intent(in) :: rows(:), cols(:)
+      real(wp), intent(in) :: block(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: a, b
+      character(len=96) :: buf
+
+      do b = 1, size(block, 2)
+         do a = 1, size(block, 1)
+            if (ieee_is_finite(block(a, b))) cycle
+            write (buf, '("value for (",i0,", ",i0,") is not finite (NaN or Inf)")') rows(a), cols(b)
+            call fatal_error(error, 'coo_type%add: '//trim(buf), stat_invalid_input)
+            return
+         end do
+      end do
+   end subroutine check_finite
+
+   !> Convert to CSR, summing duplicates in insertion order; entries that sum
+   !> to zero are kept (the pattern does not depend on values).
+   subroutine coo_to_csr(self, a, error)
+      class(coo_type), intent(in) :: self
+      type(csr_type), intent(out) :: a
+      type(error_type), allocatable, intent(out) :: error
+      integer(i8), allocatable :: next(:), marker(:)
+      integer, allocatable :: tcol(:)
+      real(wp), allocatable :: tval(:)
+      integer(i8) :: k, p, q, rowstart, nnz
+      integer :: i, j, stat
+
+      a%nrows = self%nrows
+      a%ncols = self%ncols
+      allocate (a%rowptr(self%nrows + 1), next(self%nrows + 1), marker(self%ncols), &
+         tcol(self%nnz), tval(self%nnz), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, 'coo_type%to_csr: cannot allocate work arrays', stat_out_of_memory)
+         return
+      end if
+
+      ! Stable counting sort by row: within a row, triplets keep insertion order.
+      next = 0
+      do k = 1, self%nnz
+         next(self%row(k) + 1) = next(self%row(k) + 1) + 1
+      end do
+      next(1) = 1
+      do i = 1, self%nrows
+         next(i + 1) = next(i + 1) + next(i)
+      end do
+      a%rowptr = next
+      do k = 1, self%nnz
+         i = self%row(k)
+         tcol(next(i)) = self%col(k)
+         tval(next(i)) = self%val(k)
+         next(i) = next(i) + 1
+      end do
+
+      ! Merge duplicates in place: marker(j) is where column j of the current
+      ! row was written; positions grow across rows, so no reset is needed.
+      marker = 0
+      q = 0
+      do i = 1, self%nrows
+         rowstart = q + 1
+         do p = a%rowptr(i), a%rowptr(i + 1) - 1
+            j = tcol(p)
+            if (marker(j) >= rowstart) then
+               tval(marker(j)) = tval(marker(j)) + tval(p)
+            else
+               q = q + 1
+               marker(j) = q
+               tcol(q) = j
+               tval(q) = tval(p)
+            end if
+         end do
+         a%rowptr(i) = rowstart
+         call sort_row(tcol(rowstart:q), tval(rowstart:q))
+      end do
+      a%rowptr(self%nrows + 1) = q + 1
+      nnz = q
+      deallocate (next, marker)
+
+      allocate (a%col(nnz), a%val(nnz), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, 'coo_type%to_csr: cannot allocate the CSR matrix', stat_out_of_memory)
+         return
+      end if
+      a%col = tcol(1:nnz)
+      a%val = tval(1:nnz)
+   end subroutine coo_to_csr
+
+   !> Sort distinct columns ascending, carrying the values: insertion sort for
+   !> the short rows of finite elements, heap sort beyond.
+   subroutine sort_row(col, val)
+      integer, intent(inout) :: col(:)
+      real(wp), intent(inout) :: val(:)
+      integer, parameter :: short = 32
+      integer :: m, k, c
+      real(wp) :: v
+
+      if (size(col) > short) then
+         call heap_sort(col, val)
+         return
+      end if
+      do k = 2, size(col)
+         c = col(k)
+         v = val(k)
+         m = k - 1
+         do while (m >= 1)
+            if (col(m) <= c) exit
+            col(m + 1) = col(m)
+            val(m + 1) = val(m)
+            m = m - 1
+         end do
+         col(m + 1) = c
+         val(m + 1) = v
+      end do
+   end subroutine sort_row
+
+   subroutine heap_sort(col, val)
+      integer, intent(inout) :: col(:)
+      real(wp), intent(inout) :: val(:)
+      integer :: n, k
+
+      n = size(col)
+      do k = n/2, 1, -1
+         call sift_down(col, val, k, n)
+      end do
+      do k = n, 2, -1
+         call swap(col, val, 1, k)
+         call sift_down(col, val, 1, k - 1)
+      end do
+   end subroutine heap_sort
+
+   subroutine sift_down(col, val, first, last)
+      integer, intent(inout) :: col(:)
+      real(wp), intent(inout) :: val(:)
+      integer, intent(in) :: first, last
+      integer :: root, child
+
+      root = first
+      do while (2*root <= last)
+         child = 2*root
+         if (child < last) then
+            if (col(child + 1) > col(child)) child = child + 1
+         end if
+         if (col(root) >= col(child)) return
+         call swap(col, val, root, child)
+         root = child
+      end do
+   end subroutine sift_down
+
+   subroutine swap(col, val, i, j)
+      integer, intent(inout) :: col(:)
+      real(wp), intent(inout) :: val(:)
+      integer, intent(in) :: i, j
+      integer :: c
+      real(wp) :: v
+      c = col(i); col(i) = col(j); col(j) = c
+      v = val(i); val(i) = val(j); val(j) = v
+   end subroutine swap
+
+   !> Number of stored entries.
+   pure function csr_nnz(self) result(nnz)
+      class(csr_type), intent(in) :: self
+      integer(i8) :: nnz
+      nnz = 0
+      if (allocated(self%rowptr)) nnz = self%rowptr(self%nrows + 1) - 1
+   end function csr_nnz
+
+   !> y = A x.
+   subroutine csr_matvec(self, x, y, error)
+      class(csr_type), intent(in) :: self
+      real(wp), intent(in) :: x(:)
+      real(wp), intent(out) :: y(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: i
+      integer(i8) :: k
+      real(wp) :: s
+      character(len=96) :: buf
+
+      if (size(x) /= self%ncols .or. size(y) /= self%nrows) then
+         write (buf, '(i0," x ",i0," matrix, x of size ",i0,", y of size ",i0)') &
+            self%nrows, self%ncols, size(x), size(y)
+         call fatal_error(error, 'csr_type%matvec: '//trim(buf), stat_invalid_input)
+         return
+      end if
+      do i = 1, self%nrows
+         s = 0.0_wp
+         do k = self%rowptr(i), self%rowptr(i + 1) - 1
+            s = s + self%val(k)*x(self%col(k))
+         end do
+         y(i) = s
+      end do
+   end subroutine csr_matvec
+
+   !> Matrix 1-norm: the largest column sum of magnitudes (0 for an empty matrix).
+   function csr_norm1(self) result(norm)
+      class(csr_type), intent(in) :: self
+      real(wp) :: norm
+      real(wp), allocatable :: colsum(:)
+      integer(i8) :: k
+
+      allocate (colsum(self%ncols))
+      colsum = 0.0_wp
+      do k = 1, self%nnz()
+         colsum(self%col(k)) = colsum(self%col(k)) + abs(self%val(k))
+      end do
+      norm = 0.0_wp
+      if (self%ncols > 0) norm = maxval(colsum)
+   end function csr_norm1
+
+   !> Check the CSR invariants the solvers rely on: array sizes, `rowptr`
+   !> non-decreasing from 1, columns in range and strictly increasing in each
+   !> row, values finite. `who` names the caller in the message.
+   subroutine csr_validate(a, who, error)
+      type(csr_type), intent(in) :: a
+      character(len=*), intent(in) :: who
+      type(error_type), allocatable, intent(out) :: error
+      integer :: i
+      integer(i8) :: k, nnz
+      character(len=128) :: buf
+
+      if (a%nrows < 0 .or. a%ncols < 0) then
+         call fatal_error(error, who//': matrix with negative dimensions', stat_invalid_input)
+         return
+      end if
+      if (.not. (allocated(a%rowptr) .and. allocated(a%col) .and. allocated(a%val))) then
+         call fatal_error(error, who//': matrix arrays not allocated', stat_invalid_input)
+         return
+      end if
+      if (size(a%rowptr, kind=i8) /= a%nrows + 1_i8) then
+         call fatal_error(error, who//': rowptr must have nrows+1 entries', stat_invalid_input)
+         return
+      end if
+      nnz = a%rowptr(a%nrows + 1) - 1
+      if (a%rowptr(1) /= 1 .or. nnz > size(a%col, kind=i8) .or. nnz > size(a%val, kind=i8)) then
+         call fatal_error(error, who//': rowptr(1) must be 1 and rowptr(nrows+1)-1 at most size(col)', &
+            stat_invalid_input)
+         return
+      end if
+      do i = 1, a%nrows
+         if (a%rowptr(i + 1) < a%rowptr(i)) then
+            write (buf, '("rowptr decreases at row ",i0)') i
+            call fatal_error(error, who//': '//trim(buf), stat_invalid_input)
+            return
+         end if
+         do k = a%rowptr(i), a%rowptr(i + 1) - 1
+            if (a%col(k) < 1 .or. a%col(k) > a%ncols) then
+               write (buf, '("column ",i0," in row ",i0," outside 1..",i0)') a%col(k), i, a%ncols
+            else if (k > a%rowptr(i) .and. a%col(k) <= a%col(max(k - 1, 1_i8))) then
+               write (buf, '("columns of row ",i0," not strictly increasing")') i
+            else if (.not. ieee_is_finite(a%val(k))) then
+               write (buf, '("value in row ",i0,", column ",i0," is not finite")') i, a%col(k)
+            else
+               cycle
+            end if
+            call fatal_error(error, who//': '//trim(buf), stat_invalid_input)
+            return
+         end do
+      end do
+   end subroutine csr_validate
+
+end module sprc_fem_sparse
