@@ -41,6 +41,40 @@ static int report(int status, char *msg, int64_t len, const char *fmt, ...)
     return status;
 }
 
+/* ------------------------------------------------------- BLAS thread count
+ *
+ * OpenBLAS splits its level-2/3 work across threads in ways that change the
+ * rounding: the same factorization run with 1 or 2 BLAS threads differs in
+ * the last bits. sprc promises the same bits for any thread count, so every
+ * factorization and solve runs its BLAS in one thread; sprc's own
+ * parallelism is OpenMP over elements and patches. The OpenBLAS controls
+ * are weak references: with another BLAS they are absent and nothing is done.
+ */
+extern int openblas_get_num_threads(void) __attribute__((weak));
+extern void openblas_set_num_threads(int) __attribute__((weak));
+
+int sprc_blas_get_threads(void)
+{
+    return openblas_get_num_threads ? openblas_get_num_threads() : 0;
+}
+
+void sprc_blas_set_threads(int n)
+{
+    if (openblas_set_num_threads && n > 0) openblas_set_num_threads(n);
+}
+
+static int blas_serial_begin(void)
+{
+    int n = sprc_blas_get_threads();
+    if (n > 1) sprc_blas_set_threads(1);
+    return n;
+}
+
+static void blas_serial_end(int n)
+{
+    if (n > 1) sprc_blas_set_threads(n);
+}
+
 /* ------------------------------------------------------------------ CHOLMOD */
 
 typedef struct {
@@ -82,7 +116,7 @@ static int cholmod_failure(const cholmod_common *c, char *msg, int64_t len, cons
  * CSR holds; the strict upper triangle is ignored. Read as compressed
  * columns, that lower triangle of rows is the upper triangle of columns
  * (stype = +1), CHOLMOD's preferred input, with no transpose. */
-int sprc_cholmod_factorize(void *handle, int64_t n, const int64_t *rowptr, const int *col,
+static int sprc_cholmod_factorize_serial(void *handle, int64_t n, const int64_t *rowptr, const int *col,
                            const double *val, int64_t *factor_nnz, int64_t *peak_bytes,
                            double *pivot_ratio, char *msg, int64_t len)
 {
@@ -140,7 +174,7 @@ int sprc_cholmod_factorize(void *handle, int64_t n, const int64_t *rowptr, const
     return SPRC_OK;
 }
 
-int sprc_cholmod_solve(void *handle, int64_t n, int64_t nrhs, const double *b, double *x,
+static int sprc_cholmod_solve_serial(void *handle, int64_t n, int64_t nrhs, const double *b, double *x,
                        char *msg, int64_t len)
 {
     sprc_cholmod *s = handle;
@@ -218,7 +252,7 @@ static int umfpack_failure(SuiteSparse_long status, char *msg, int64_t len, cons
 
 /* The CSR is kept (0-based, 64-bit) because solves refine iteratively
  * against A. UMFPACK factors the column form, A^T; solve picks the system. */
-int sprc_umfpack_factorize(void *handle, int64_t n, const int64_t *rowptr, const int *col,
+static int sprc_umfpack_factorize_serial(void *handle, int64_t n, const int64_t *rowptr, const int *col,
                            const double *val, int64_t *factor_nnz, int64_t *peak_bytes,
                            double *pivot_ratio, char *msg, int64_t len)
 {
@@ -260,7 +294,7 @@ int sprc_umfpack_factorize(void *handle, int64_t n, const int64_t *rowptr, const
     return SPRC_OK;
 }
 
-int sprc_umfpack_solve(void *handle, int64_t n, int64_t nrhs, int transposed, const double *b,
+static int sprc_umfpack_solve_serial(void *handle, int64_t n, int64_t nrhs, int transposed, const double *b,
                        double *x, char *msg, int64_t len)
 {
     sprc_umfpack *s = handle;
@@ -276,4 +310,46 @@ int sprc_umfpack_solve(void *handle, int64_t n, int64_t nrhs, int transposed, co
         if (status != UMFPACK_OK) return umfpack_failure(status, msg, len, "solve");
     }
     return SPRC_OK;
+}
+
+/* ------------------------------------------- entry points: BLAS in one thread */
+
+int sprc_cholmod_factorize(void *handle, int64_t n, const int64_t *rowptr, const int *col,
+                           const double *val, int64_t *factor_nnz, int64_t *peak_bytes,
+                           double *pivot_ratio, char *msg, int64_t len)
+{
+    int saved = blas_serial_begin();
+    int status = sprc_cholmod_factorize_serial(handle, n, rowptr, col, val, factor_nnz, peak_bytes,
+                                               pivot_ratio, msg, len);
+    blas_serial_end(saved);
+    return status;
+}
+
+int sprc_cholmod_solve(void *handle, int64_t n, int64_t nrhs, const double *b, double *x,
+                       char *msg, int64_t len)
+{
+    int saved = blas_serial_begin();
+    int status = sprc_cholmod_solve_serial(handle, n, nrhs, b, x, msg, len);
+    blas_serial_end(saved);
+    return status;
+}
+
+int sprc_umfpack_factorize(void *handle, int64_t n, const int64_t *rowptr, const int *col,
+                           const double *val, int64_t *factor_nnz, int64_t *peak_bytes,
+                           double *pivot_ratio, char *msg, int64_t len)
+{
+    int saved = blas_serial_begin();
+    int status = sprc_umfpack_factorize_serial(handle, n, rowptr, col, val, factor_nnz, peak_bytes,
+                                               pivot_ratio, msg, len);
+    blas_serial_end(saved);
+    return status;
+}
+
+int sprc_umfpack_solve(void *handle, int64_t n, int64_t nrhs, int transposed, const double *b,
+                       double *x, char *msg, int64_t len)
+{
+    int saved = blas_serial_begin();
+    int status = sprc_umfpack_solve_serial(handle, n, nrhs, transposed, b, x, msg, len);
+    blas_serial_end(saved);
+    return status;
 }

@@ -57,7 +57,8 @@ contains
          new_unittest('rcond_vs_dense', test_rcond_vs_dense), &
          new_unittest('rcond_diagonal', test_rcond_diagonal), &
          new_unittest('destroy_refactorize', test_destroy_refactorize), &
-         new_unittest('zero_size_solve', test_zero_size_solve) &
+         new_unittest('zero_size_solve', test_zero_size_solve), &
+         new_unittest('same_bits_any_blas_threads', test_blas_threads_bits) &
          ]
    end subroutine collect_sparse
 
@@ -1160,5 +1161,48 @@ contains
          node_number = node_number*n + idx(d)
       end do
    end function node_number
+
+   !> Factorize and solve a 3D elasticity system with OpenBLAS set to 2 threads
+   !> and to 1: the solutions must agree bit for bit (the solvers run their
+   !> BLAS in one thread). Without OpenBLAS there is nothing to vary: the test
+   !> then only checks that the control reports 0.
+   subroutine test_blas_threads_bits(error)
+      use sprc_fem_linear_solver, only: blas_threads, set_blas_threads
+      type(error_type), allocatable, intent(out) :: error
+      type(cholmod_solver_type) :: chol
+      type(umfpack_solver_type) :: lu
+      type(csr_type) :: a
+      real(wp), allocatable :: b(:), x1(:), x2(:), y1(:), y2(:)
+      integer :: saved
+
+      saved = blas_threads()
+      if (saved == 0) return
+      call elasticity(3, 12, .true., a, error)
+      if (allocated(error)) return
+      allocate (b(a%nrows), x1(a%nrows), x2(a%nrows), y1(a%nrows), y2(a%nrows))
+      b = 1.0_wp
+      call set_blas_threads(2)
+      call solve_both(x1, y1, error)
+      if (allocated(error)) return
+      call check(error, blas_threads(), 2, 'the solvers restore the caller''s thread count')
+      if (allocated(error)) return
+      call set_blas_threads(1)
+      call solve_both(x2, y2, error)
+      call set_blas_threads(saved)
+      if (allocated(error)) return
+      call check(error, all(x1 == x2) .and. all(y1 == y2), 'identical bits with 1 and 2 BLAS threads')
+   contains
+      subroutine solve_both(x, y, error)
+         real(wp), intent(out) :: x(:), y(:)
+         type(error_type), allocatable, intent(out) :: error
+         call chol%factorize(a, error)
+         if (allocated(error)) return
+         call chol%solve(b, x, error)
+         if (allocated(error)) return
+         call lu%factorize(a, error)
+         if (allocated(error)) return
+         call lu%solve(b, y, error)
+      end subroutine solve_both
+   end subroutine test_blas_threads_bits
 
 end module sprc_test_sparse

@@ -11,7 +11,7 @@
 !> Objects own C memory through a handle: call `destroy` when done, and do not
 !> copy a factorized solver by assignment (both copies would share one factor).
 module sprc_fem_linear_solver
-   use, intrinsic :: iso_c_binding, only: c_char, c_null_char
+   use, intrinsic :: iso_c_binding, only: c_char, c_null_char, c_int
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular, &
       & stat_not_positive_definite, stat_out_of_memory, stat_internal
@@ -20,7 +20,7 @@ module sprc_fem_linear_solver
    implicit none
    private
 
-   public :: linear_solver_type, backend_error, message_length
+   public :: linear_solver_type, backend_error, message_length, blas_threads, set_blas_threads
 
    !> Length of the message buffer the C shim fills.
    integer, parameter :: message_length = 512
@@ -75,6 +75,22 @@ module sprc_fem_linear_solver
       !> Back end: release C resources; must accept an object that has none.
       procedure(destroy_interface), deferred :: destroy_backend
    end type linear_solver_type
+
+   interface
+      !> OpenBLAS's thread count; 0 with a BLAS that has no such control.
+      !> Factorizations and solves always run their BLAS in one thread (the C
+      !> shim says why: identical bits for any thread count).
+      function blas_threads() result(n) bind(C, name='sprc_blas_get_threads')
+         import :: c_int
+         integer(c_int) :: n
+      end function blas_threads
+
+      !> Set OpenBLAS's thread count for BLAS calls outside the sparse solvers.
+      subroutine set_blas_threads(n) bind(C, name='sprc_blas_set_threads')
+         import :: c_int
+         integer(c_int), value :: n
+      end subroutine set_blas_threads
+   end interface
 
    abstract interface
       subroutine factorize_interface(self, a, error)
