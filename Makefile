@@ -14,7 +14,7 @@ all: build
 help:
 	@echo "make run     install what is missing, build (release) and run the driver on its default scene"
 	@echo "make test    install what is missing and run the whole test suite"
-	@echo "make bench   benchmarks (sparse direct solvers)"
+	@echo "make bench   benchmarks (sparse direct solvers, grid build)"
 	@echo "make build   build the release profile"
 	@echo "make clean   remove build outputs"
 
@@ -32,6 +32,7 @@ test: deps
 
 bench: deps
 	@tools/bench-sparse
+	$(FPM) run --profile release --example bench_grid
 
 clean:
 	$(FPM) clean --all 2>/dev/null || rm -rf build
