@@ -15,6 +15,8 @@ program sprc_unit_tests
    use sprc_test_model, only: collect_model
    use sprc_test_quadrature, only: collect_quadrature
    use sprc_test_recovery, only: collect_recovery
+   use sprc_test_report, only: collect_report
+   use sprc_test_output, only: collect_output
    implicit none
 
    type(testsuite_type), allocatable :: suites(:)
@@ -32,7 +34,9 @@ program sprc_unit_tests
       new_testsuite('grid', collect_grid), &
       new_testsuite('model', collect_model), &
       new_testsuite('quadrature', collect_quadrature), &
-      new_testsuite('recovery', collect_recovery) &
+      new_testsuite('recovery', collect_recovery), &
+      new_testsuite('report', collect_report), &
+      new_testsuite('output', collect_output) &
       ]
 
    call get_arg(1, suite_name)
