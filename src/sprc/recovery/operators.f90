@@ -152,29 +152,31 @@ contains
 
    !> Incompatibility operator on Voigt strains with engineering shears:
    !> equation r is sum_e sum_m op(r, e, m) d2_m eps_e = 0, with m the second-derivative
-   !> index. Equations: 2D S_33; 3D S_11, S_22, S_33, S_12, S_23, S_13 of
-   !> S_ij = e_ikm e_jln eps_kl,mn (tensor strains eps_kl = gamma_kl/2 for k /= l).
+   !> index. Equations: components of S_ij = e_ikm e_jln eps_kl,mn (tensor strains
+   !> eps_kl = gamma_kl/2 for k /= l): 2D S_33 (eq. 44); 3D S_33, S_11, S_22, -2 S_23, -2 S_13,
+   !> -2 S_12, which is row by row the operator L' of eq. 57.
    pure subroutine incompatibility_operator(dim, op)
       integer, intent(in) :: dim
       !> op(1:ncompat, 1:nstress, 1:nhess)
       real(wp), intent(out) :: op(:, :, :)
       integer :: r, i, j, k, l, m, n, nr
-      real(wp) :: f
+      real(wp) :: f, s
+      ! Component (i, j) of S and its factor per equation, in the seed's order and scaling
+      ! of eq. 57 (row 1 is S_33, the 2D equation 44; rows 4-6 are -2 S_23, -2 S_13, -2 S_12).
+      integer, parameter :: eq57_pairs(2, 6) = reshape([3, 3, 1, 1, 2, 2, 2, 3, 1, 3, 1, 2], [2, 6])
+      real(wp), parameter :: eq57_factor(6) = [1.0_wp, 1.0_wp, 1.0_wp, -2.0_wp, -2.0_wp, -2.0_wp]
 
       op = 0.0_wp
       nr = ncompat_equations(dim)
       do r = 1, nr
-         if (dim == 2) then
-            i = 3
-            j = 3
-         else
-            call voigt_pair(3, r, i, j)
-         end if
+         i = eq57_pairs(1, r)
+         j = eq57_pairs(2, r)
+         s = eq57_factor(r)
          do k = 1, dim
             do m = 1, dim
                do l = 1, dim
                   do n = 1, dim
-                     f = real(levi(i, k, m)*levi(j, l, n), wp)
+                     f = s*real(levi(i, k, m)*levi(j, l, n), wp)
                      if (f == 0.0_wp) cycle
                      if (k /= l) f = 0.5_wp*f
                      op(r, voigt_index(dim, k, l), hess_index(dim, m, n)) = &

@@ -269,67 +269,68 @@ contains
       ns = voigt_size(patch%analysis)
       if (ns == 0) then
          write (buf, '(i0)') patch%analysis
-         call fail('analysis = '//trim(buf)//' is not plane_stress, plane_strain or solid')
+         call fail(error, 'analysis = '//trim(buf)//' is not plane_stress, plane_strain or solid')
          return
       end if
       if (.not. ((d == 2 .and. patch%analysis /= solid) .or. (d == 3 .and. patch%analysis == solid))) then
          write (buf, '("dim = ",i0," does not match analysis ",i0)') d, patch%analysis
-         call fail(trim(buf))
+         call fail(error, trim(buf))
          return
       end if
       call check_material(patch%young, patch%poisson, 'patch', error)
       if (allocated(error)) return
       if (.not. (patch%h > 0.0_wp .and. patch%h <= huge(1.0_wp))) then
          write (buf, '(es12.4)') patch%h
-         call fail('h = '//trim(adjustl(buf))//' must be finite and > 0')
+         call fail(error, 'h = '//trim(adjustl(buf))//' must be finite and > 0')
          return
       end if
       if (.not. all(abs(patch%x0(1:d)) <= huge(1.0_wp))) then
-         call fail('x0 is not finite')
+         call fail(error, 'x0 is not finite')
          return
       end if
       if (.not. all(abs(patch%body_force(1:d)) <= huge(1.0_wp))) then
-         call fail('body_force is not finite')
+         call fail(error, 'body_force is not finite')
          return
       end if
       if (patch%npoints < 1) then
-         call fail('no integration points (npoints < 1)')
+         call fail(error, 'no integration points (npoints < 1)')
          return
       end if
       if (.not. allocated(patch%w)) then
-         call fail('point arrays are not allocated (use patch_reserve or patch_add_point)')
+         call fail(error, 'point arrays are not allocated (use patch_reserve or patch_add_point)')
          return
       end if
       if (patch%npoints > size(patch%w) .or. patch%npoints > size(patch%x, 2) .or. &
          & patch%npoints > size(patch%stress, 2) .or. size(patch%x, 1) < d .or. size(patch%stress, 1) < ns) then
          write (buf, '("npoints = ",i0," exceeds the point arrays (w has ",i0,")")') patch%npoints, size(patch%w)
-         call fail(trim(buf))
+         call fail(error, trim(buf))
          return
       end if
       do i = 1, patch%npoints
          if (.not. all(abs(patch%x(1:d, i)) <= huge(1.0_wp))) then
             write (buf, '("x(:, ",i0,") is not finite")') i
-            call fail(trim(buf))
+            call fail(error, trim(buf))
             return
          end if
          if (.not. (patch%w(i) > 0.0_wp .and. patch%w(i) <= huge(1.0_wp))) then
             write (buf, '("w(",i0,") = ",es12.4," must be finite and > 0")') i, patch%w(i)
-            call fail(trim(buf))
+            call fail(error, trim(buf))
             return
          end if
          if (.not. all(abs(patch%stress(1:ns, i)) <= huge(1.0_wp))) then
             write (buf, '("stress(:, ",i0,") is not finite (NaN or Inf)")') i
-            call fail(trim(buf))
+            call fail(error, trim(buf))
             return
          end if
       end do
       call check_boundary(patch, error)
-   contains
-      pure subroutine fail(message)
-         character(len=*), intent(in) :: message
-         call fatal_error(error, 'patch: '//message, stat_invalid_input)
-      end subroutine fail
    end subroutine check_patch
+
+   pure subroutine fail(error, message)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), intent(in) :: message
+      call fatal_error(error, 'patch: '//message, stat_invalid_input)
+   end subroutine fail
 
    pure subroutine check_boundary(patch, error)
       type(patch_type), intent(in) :: patch

@@ -160,7 +160,7 @@ contains
       allocate (ws%pw(max(cp, 1), cnt), ws%qr(max(cp, 1), cnt), ws%rhs(max(cp, 1), 6))
       allocate (ws%mp(cnt, cnt), ws%hmat(cnt, 6))
       allocate (ws%blk(ws%cap_mr, cn), ws%brhs(ws%cap_mr), ws%tmp(3*cnt, cn))
-      allocate (ws%estack(max(3*cb, 1), cn), ws%erhs(max(3*cb, 1)))
+      allocate (ws%estack(max(3*cb, 1), cn), ws%erhs(max(3*cb, 3*cnt)))
       allocate (ws%cq(cn, ws%cap_mq), ws%c(4*cn, cn), ws%lam(4*cn))
       allocate (ws%kkt(2*cn, 2*cn), ws%sol(2*cn), ws%dscale(2*cn))
       allocate (ws%tau(max(ws%cap_mq, cnt)), ws%jpvt(max(ws%cap_mq, cnt)), ws%ipiv(2*cn))
