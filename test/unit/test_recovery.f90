@@ -75,6 +75,7 @@ contains
          new_unittest('exact_3d_traction', test_exact_3d_traction), &
          new_unittest('exact_3d_symmetry', test_exact_3d_symmetry), &
          new_unittest('exact_3d_mixed', test_exact_3d_mixed), &
+         new_unittest('exact_2d_unstructured_valence', test_exact_unstructured), &
          new_unittest('known_ranks', test_known_ranks), &
          new_unittest('noisy_constraints_exact', test_noisy), &
          new_unittest('scaling_invariance', test_scaling), &
@@ -764,6 +765,87 @@ contains
          if (allocated(error)) return
       end do
    end subroutine test_exact_3d_mixed
+
+   !> Unstructured 2D vertex patches: valence 3, 5 and 6 (quads (centre, spoke k, outer k,
+   !> spoke k+1) with perturbed radii and angles), p = 1 and 2, internal; SPR and SPR-C
+   !> reproduce the exact field and SPR-C's residuals are at round-off.
+   subroutine test_exact_unstructured(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(field_t) :: f
+      type(frame_t) :: fr
+      type(patch_type) :: patch
+      type(recovery_workspace_type) :: ws
+      type(recovered_patch_type) :: rec
+      integer(i8) :: st
+      integer :: nv, p, k, g1, g2, a, method
+      real(wp) :: spoke(2, 0:6), outer(2, 0:6), ang, xi(3), wt(3), crn(2, 4), nsh(4), dxi(2, 4), y(3), jac(2, 2)
+      real(wp) :: x(3), sig(6), relerr, req, rcomp, rtr, rsym
+      real(wp), parameter :: pi = 3.14159265358979324_wp
+      integer, parameter :: valence(3) = [3, 5, 6]
+      character(len=40) :: tag
+
+      fr%r = rotation(2, 0.2_wp, 0.0_wp, 0.0_wp)
+      fr%x0 = [5.0_wp, -3.0_wp, 0.0_wp]
+      do a = 1, size(valence)
+         nv = valence(a)
+         do p = 1, 2
+            write (tag, '(" (valence ",i0,", p ",i0,")")') nv, p
+            st = 2024_i8 + 10*nv + p
+            call make_field(2, p, .false., st, f)
+            do k = 0, nv - 1
+               ang = 2*pi*(k + 0.15_wp*urand(st))/nv
+               spoke(:, k) = (1.0_wp + 0.2_wp*urand(st))*[cos(ang), sin(ang)]
+               ang = 2*pi*(k + 0.5_wp + 0.1_wp*urand(st))/nv
+               outer(:, k) = (1.4_wp + 0.2_wp*urand(st))*[cos(ang), sin(ang)]
+            end do
+            ! Valence 3: the outer node must stay inside the angle for a convex quad.
+            if (nv == 3) outer = 0.9_wp*outer
+            spoke(:, nv) = spoke(:, 0)
+            call patch_reset(patch, 2, plane_stress, 70.0_wp, 0.33_wp, fr%x0(1:2), 1.5_wp)
+            patch%body_force(1:2) = matmul(fr%r(1:2, 1:2), f%b(1:2))
+            call gauss(p + 1, xi, wt)
+            do k = 0, nv - 1
+               crn(:, 1) = 0.0_wp
+               crn(:, 2) = spoke(:, k)
+               crn(:, 3) = outer(:, k)
+               crn(:, 4) = spoke(:, k + 1)
+               do g2 = 1, p + 1
+                  do g1 = 1, p + 1
+                     nsh = 0.25_wp*[(1 - xi(g1))*(1 - xi(g2)), (1 + xi(g1))*(1 - xi(g2)), &
+                        & (1 + xi(g1))*(1 + xi(g2)), (1 - xi(g1))*(1 + xi(g2))]
+                     dxi(1, :) = 0.25_wp*[-(1 - xi(g2)), (1 - xi(g2)), (1 + xi(g2)), -(1 + xi(g2))]
+                     dxi(2, :) = 0.25_wp*[-(1 - xi(g1)), -(1 + xi(g1)), (1 + xi(g1)), (1 - xi(g1))]
+                     y = 0.0_wp
+                     y(1:2) = matmul(crn, nsh)
+                     jac = matmul(crn, transpose(dxi))
+                     if (jac(1, 1)*jac(2, 2) - jac(1, 2)*jac(2, 1) <= 0.0_wp) then
+                        call test_failed(error, 'test setup: inverted quad'//tag)
+                        return
+                     end if
+                     x = phys(fr, y)
+                     call eval_field(f, fr, x, sig)
+                     call patch_add_point(patch, x(1:2), wt(g1)*wt(g2)*(jac(1, 1)*jac(2, 2) - jac(1, 2)*jac(2, 1)), &
+                        & sig(1:3))
+                  end do
+               end do
+            end do
+            do method = 1, 2
+               if (method == 1) then
+                  call recover_spr(patch, p, ws, rec, error)
+               else
+                  call recover_sprc(patch, p, ws, rec, error)
+               end if
+               if (allocated(error)) return
+               call reproduction_error(rec, f, fr, st, relerr)
+               call check(error, relerr <= tol_exact, 'exact field reproduced'//tag)
+               if (allocated(error)) return
+            end do
+            call residuals(patch, rec, fr, st, req, rcomp, rtr, rsym)
+            call check(error, max(req, rcomp) <= tol_exact, 'SPR-C residuals at round-off'//tag)
+            if (allocated(error)) return
+         end do
+      end do
+   end subroutine test_exact_unstructured
 
    !> Ranks of the constraint blocks. Hand reasoning (b constant, points unisolvent):
    !> - equilibrium: A -> div sigma* maps onto vector polynomials of degree p-1 (sigma_xx alone
