@@ -9,8 +9,11 @@
 !> depend only on (dim, degree) and are rebuilt only when these change: keep one
 !> workspace per (dim, degree) in a loop that mixes them.
 !>
-!> No module state: workspaces are independent objects, safe to use one per
-!> thread (`!$omp parallel private(ws)`).
+!> No module state: workspaces are independent objects, one per thread. Declare
+!> the thread's workspace inside the parallel region (a `block` construct, or a
+!> local variable of a procedure called there), or call `workspace_init` on a
+!> `private` copy first: gfortran does not apply default initialisation to
+!> OpenMP private copies, and a garbage capacity would be trusted.
 module sprc_recovery_workspace
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
@@ -22,7 +25,7 @@ module sprc_recovery_workspace
    implicit none
    private
 
-   public :: recovery_workspace_type, workspace_reserve, workspace_tic, workspace_toc
+   public :: recovery_workspace_type, workspace_init, workspace_reserve, workspace_tic, workspace_toc
 
    !> Work arrays of the patch solves (components are internal to sprc_recovery; public only
    !> so that the solve module can reach them without accessor overhead).
@@ -72,6 +75,13 @@ module sprc_recovery_workspace
    end type recovery_workspace_type
 
 contains
+
+   !> Reset a workspace to its empty default state (frees its storage). Needed only for
+   !> copies whose default initialisation is not guaranteed (OpenMP `private`).
+   pure subroutine workspace_init(ws)
+      type(recovery_workspace_type), intent(out) :: ws
+      ws%dim = 0
+   end subroutine workspace_init
 
    !> Prepare `ws` for a patch of `npoints` integration and `nbpoints` boundary points with a
    !> basis of `degree` in `dim`: rebuilds basis and operators if (dim, degree) changed, grows
