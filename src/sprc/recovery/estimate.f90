@@ -1,0 +1,160 @@
+!> Evaluation of recovered patch polynomials, the polynomial-union field of an
+!> element (seed eq. 102) and the Zienkiewicz-Zhu element error integral (eq. 1).
+!> Mesh-agnostic: the caller supplies points, shape-function values and weights.
+!> All procedures are pure and allocate nothing.
+module sprc_recovery_estimate
+   use sprc_core_kinds, only: wp
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
+   use sprc_core_material, only: voigt_size, compliance_matrix
+   use sprc_core_poly, only: poly_exponents_2d, poly_exponents_3d
+   use sprc_recovery_patch, only: recovered_patch_type
+   implicit none
+   private
+
+   public :: eval_recovered, eval_union, zz_error_integral
+
+contains
+
+   !> sigma*(x) = P((x - x0)/h) A of one recovered patch; sigma(1:nstress) is written.
+   pure subroutine eval_recovered(rec, x, sigma, error)
+      type(recovered_patch_type), intent(in) :: rec
+      !> Physical point x(1:dim).
+      real(wp), intent(in) :: x(:)
+      real(wp), intent(out) :: sigma(:)
+      type(error_type), allocatable, intent(out) :: error
+
+      call check_rec(rec, size(x), size(sigma), 'eval_recovered', error)
+      if (allocated(error)) return
+      call eval_unchecked(rec, x, sigma)
+   end subroutine eval_recovered
+
+   pure subroutine eval_unchecked(rec, x, sigma)
+      type(recovered_patch_type), intent(in) :: rec
+      real(wp), intent(in) :: x(:)
+      real(wp), intent(out) :: sigma(:)
+      real(wp) :: s(3), p
+      integer :: i, e(3)
+
+      s = 0.0_wp
+      s(1:rec%dim) = (x(1:rec%dim) - rec%x0(1:rec%dim))/rec%h
+      sigma(1:rec%nstress) = 0.0_wp
+      do i = 1, rec%nterms
+         if (rec%dim == 2) then
+            e = poly_exponents_2d(:, i)
+         else
+            e = poly_exponents_3d(:, i)
+         end if
+         p = s(1)**e(1)*s(2)**e(2)*s(3)**e(3)
+         sigma(1:rec%nstress) = sigma(1:rec%nstress) + p*rec%coef(i, 1:rec%nstress)
+      end do
+   end subroutine eval_unchecked
+
+   pure subroutine check_rec(rec, nx, nsig, context, error)
+      type(recovered_patch_type), intent(in) :: rec
+      integer, intent(in) :: nx, nsig
+      character(len=*), intent(in) :: context
+      type(error_type), allocatable, intent(out) :: error
+      character(len=96) :: buf
+
+      if ((rec%dim /= 2 .and. rec%dim /= 3) .or. rec%nterms < 1 .or. rec%nstress < 3 .or. &
+         & .not. (rec%h > 0.0_wp)) then
+         call fatal_error(error, context//': recovered patch is empty (not produced by a successful solve)', &
+            & stat_invalid_input)
+      else if (nx < rec%dim .or. nsig < rec%nstress) then
+         write (buf, '("x has ",i0," entries (need ",i0,"), sigma ",i0," (need ",i0,")")') nx, rec%dim, nsig, &
+            & rec%nstress
+         call fatal_error(error, context//': '//trim(buf), stat_invalid_input)
+      end if
+   end subroutine check_rec
+
+   !> Polynomial union (seed eq. 102) at a point x of an element:
+   !> sigma*(x) = sum_J shape_values(J) sigma*_J(x), with sigma*_J the recovered polynomial of
+   !> the patch of the element's vertex J and shape_values(J) = N_J(x) its (linear) shape
+   !> function at x. The nodal interpolation (eq. 101) is the same sum with each sigma*_J
+   !> evaluated at its own node; the producer does that from `eval_recovered`.
+   pure subroutine eval_union(recs, shape_values, x, sigma, error)
+      type(recovered_patch_type), intent(in) :: recs(:)
+      real(wp), intent(in) :: shape_values(:)
+      real(wp), intent(in) :: x(:)
+      real(wp), intent(out) :: sigma(:)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: sj(6)
+      integer :: j, ns
+      character(len=80) :: buf
+
+      if (size(recs) /= size(shape_values) .or. size(recs) < 1) then
+         write (buf, '(i0," patches and ",i0," shape-function values")') size(recs), size(shape_values)
+         call fatal_error(error, 'eval_union: '//trim(buf)//' (need the same, >= 1)', stat_invalid_input)
+         return
+      end if
+      do j = 1, size(recs)
+         call check_rec(recs(j), size(x), size(sigma), 'eval_union', error)
+         if (allocated(error)) return
+         if (recs(j)%dim /= recs(1)%dim) then
+            call fatal_error(error, 'eval_union: patches of different dimensions', stat_invalid_input)
+            return
+         end if
+      end do
+      if (.not. all(abs(shape_values) <= huge(1.0_wp))) then
+         call fatal_error(error, 'eval_union: shape_values are not finite', stat_invalid_input)
+         return
+      end if
+      ns = recs(1)%nstress
+      sigma(1:ns) = 0.0_wp
+      do j = 1, size(recs)
+         call eval_unchecked(recs(j), x, sj)
+         sigma(1:ns) = sigma(1:ns) + shape_values(j)*sj(1:ns)
+      end do
+   end subroutine eval_union
+
+   !> ZZ error integral of one element: err2 = sum_i w_i (s*_i - s_h,i)^T D^-1 (s*_i - s_h,i),
+   !> the square of the energy norm of the estimated error (seed eq. 1), with w_i = weight*|J|
+   !> and D^-1 the closed-form compliance of `analysis`.
+   pure subroutine zz_error_integral(analysis, young, poisson, w, sigma_star, sigma_h, err2, error)
+      integer, intent(in) :: analysis
+      real(wp), intent(in) :: young, poisson
+      !> Quadrature weights times |J|, w(npoints) >= 0.
+      real(wp), intent(in) :: w(:)
+      !> Recovered and FE stresses, Voigt, (nstress, npoints).
+      real(wp), intent(in) :: sigma_star(:, :), sigma_h(:, :)
+      real(wp), intent(out) :: err2
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: cmat(6, 6), diff(6)
+      integer :: i, ns
+      character(len=96) :: buf
+
+      err2 = 0.0_wp
+      ns = voigt_size(analysis)
+      if (ns > 0) then
+         call compliance_matrix(analysis, young, poisson, cmat(1:ns, 1:ns), error)
+      else
+         call compliance_matrix(analysis, young, poisson, cmat(1:3, 1:3), error)
+      end if
+      if (allocated(error)) then
+         error%message = 'zz_error_integral: '//error%message
+         return
+      end if
+      if (size(sigma_star, 1) /= ns .or. size(sigma_h, 1) /= ns .or. size(sigma_star, 2) /= size(w) .or. &
+         & size(sigma_h, 2) /= size(w)) then
+         write (buf, '("shapes w(",i0,"), sigma_star(",i0,",",i0,"), sigma_h(",i0,",",i0,"); nstress = ",i0)') &
+            & size(w), shape(sigma_star), shape(sigma_h), ns
+         call fatal_error(error, 'zz_error_integral: '//trim(buf), stat_invalid_input)
+         return
+      end if
+      do i = 1, size(w)
+         if (.not. (w(i) >= 0.0_wp .and. w(i) <= huge(1.0_wp))) then
+            write (buf, '("w(",i0,") = ",es12.4," must be finite and >= 0")') i, w(i)
+            call fatal_error(error, 'zz_error_integral: '//trim(buf), stat_invalid_input)
+            return
+         end if
+         diff(1:ns) = sigma_star(:, i) - sigma_h(:, i)
+         if (.not. all(abs(diff(1:ns)) <= huge(1.0_wp))) then
+            write (buf, '("stresses at point ",i0," are not finite")') i
+            call fatal_error(error, 'zz_error_integral: '//trim(buf), stat_invalid_input)
+            return
+         end if
+         err2 = err2 + w(i)*dot_product(diff(1:ns), matmul(cmat(1:ns, 1:ns), diff(1:ns)))
+      end do
+   end subroutine zz_error_integral
+
+end module sprc_recovery_estimate

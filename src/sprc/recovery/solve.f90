@@ -1,0 +1,588 @@
+!> SPR and SPR-C patch solves (seed eqs. 8-11, 19-24, 35-42, 44-62, 77-80, 88-94, 99-100).
+!>
+!> Both fit sigma*(x) = P(s) A, s = (x - x0)/h, with the complete polynomial of degree p
+!> in patch-scaled coordinates (sprc_core_poly's term order).
+!>
+!> - `recover_spr` (Zienkiewicz-Zhu 1992): unweighted least squares per component at the
+!>   patch's integration points. Solved by QR with column pivoting of the design matrix
+!>   P (npoints x nterms), not by normal equations: the pivoted QR is needed anyway for the
+!>   rank decision, and it solves with cond(P) instead of cond(P)^2, for the same O(m n^2)
+!>   cost; all components are right-hand sides of one factorisation.
+!> - `recover_sprc`: all components at once, integral least squares with the weights w|J|
+!>   (normalised by their sum, which leaves the minimiser unchanged), plus equality
+!>   constraints by Lagrange multipliers:
+!>   (a) internal equilibrium in least-squares form (eq. 42):
+!>       sum_j w_j T'(s_j)^T T'(s_j) A = -h sum_j w_j T'(s_j)^T b, with T'(s) = L^T P(s).
+!>       Because L^T P(s) A = (I_dim x p(s)) B A with B the exact coefficient-space divergence
+!>       built from the derivative matrices, the sums are B^T (I x Mp) B and
+!>       B^T (b x Mp(:,1)) with Mp the one-component Gram matrix: no per-point work.
+!>       (The factor h: derivatives in s are h times physical ones.)
+!>   (b) compatibility for p >= 2, exact: all coefficients of L'C P(s) A vanish (operators
+!>       module), from the compliance (plane stress, reduced plane strain, solid).
+!>   (c) traction equilibrium in least-squares form (eq. 80) over the boundary points of
+!>       kind traction: sum_j bw_j E_j^T E_j A = sum_j bw_j E_j^T t_j, E_j = G(n_j) P(s_j).
+!>   (d) symmetry, exact: for each symmetry plane of the patch (its symmetry points grouped by
+!>       normal and offset) and each unit tangent t of the plane, n^T sigma*(s) t = 0 at the
+!>       principal lattice of degree p on the plane, which is unisolvent for the degree-p
+!>       restriction of sigma* to the plane, so the shear vanishes on the whole plane.
+!>   Each block's rows are rank-reduced by QR with column pivoting (dgeqp3 on the transposed
+!>   rows): rows jpvt(1:r) are kept, r = #{k : |R_kk| > recovery_rank_tol |R_11|}. The kept
+!>   rows of all blocks are stacked, normalised to unit length and reduced once more the same
+!>   way (blocks can depend on each other, e.g. traction and symmetry rows at a corner).
+!>   The KKT system [M C^T; C 0][A; lambda] = [H; Lambda], M = I_ns x Mp, is scaled
+!>   symmetrically (A rows/columns by 1/sqrt(M_ii), lambda rows/columns by the inverse norm of
+!>   the scaled constraint row) and solved by dsysv. Without constraint rows SPR-C is the
+!>   weighted QR least squares (as SPR with weights).
+!>
+!> Rank tolerance: `recovery_rank_tol` = 1e-10, relative to the largest pivot. Exactly dependent
+!> rows and basis columns leave pivots at round-off (~1e-16 relative); a discarded pivot above
+!> `recovery_bite_ratio` = 1e-12 means the tolerance, not exact dependence, decided a rank:
+!> the result reports it (`tolerance_bites`, `max_dropped_ratio`).
+!>
+!> Rank-deficient patches (the contract with the producer): if the (weighted) basis matrix at
+!> the integration points has rank < nterms (too few points, or points on a line / plane), the
+!> solves return an error with stat = stat_singular naming the rank, and set
+!> rec%basis_rank. The core has no mesh and cannot grow the patch: the producer adds
+!> neighbouring elements (seed Figure 15) and calls again. SPR-C requires the full rank too,
+!> even where constraints would fix the missing directions, so that its M is positive definite.
+!>
+!> Thread safety: no module state; everything a solve writes is in its arguments. Use one
+!> workspace per thread. The solves are not `pure` only because LAPACK externals are not.
+module sprc_recovery_solve
+   use sprc_core_kinds, only: wp
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular
+   use sprc_core_lapack, only: dgeqp3, dormqr, dtrtrs, dsysv, dsyrk, dgemm, dgemv, lapack_info_error
+   use sprc_core_material, only: compliance_matrix
+   use sprc_core_poly, only: poly_max_degree
+   use sprc_recovery_patch, only: patch_type, recovered_patch_type, check_patch, dominant_boundary_kind, &
+      & boundary_traction, boundary_symmetry, boundary_contact, boundary_none, &
+      & kind_equilibrium, kind_compatibility, kind_traction, kind_symmetry
+   use sprc_recovery_operators, only: traction_operator, shear_operator, plane_tangents, compatibility_rows, &
+      & ncompat_equations
+   use sprc_recovery_workspace, only: recovery_workspace_type, workspace_reserve, workspace_tic, workspace_toc
+   implicit none
+   private
+
+   public :: recover_spr, recover_sprc, recovery_rank_tol, recovery_bite_ratio
+
+   !> Relative tolerance of every rank decision (pivoted QR): |R_kk| > tol |R_11| counts.
+   real(wp), parameter :: recovery_rank_tol = 1.0e-10_wp
+   !> A discarded pivot above this ratio means the tolerance decided the rank.
+   real(wp), parameter :: recovery_bite_ratio = 1.0e-12_wp
+   !> Two symmetry points lie on the same plane if normals and offsets (scaled) agree to this.
+   real(wp), parameter :: plane_tol = 1.0e-8_wp
+
+contains
+
+   !> SPR (Zienkiewicz-Zhu 1992): per-component least squares of the FE stresses at the
+   !> integration points with the complete basis of degree `degree` (0..3). Weights are not
+   !> used. Errors: invalid patch (stat_invalid_input), rank-deficient patch (stat_singular).
+   subroutine recover_spr(patch, degree, ws, rec, error)
+      type(patch_type), intent(in) :: patch
+      integer, intent(in) :: degree
+      type(recovery_workspace_type), intent(inout) :: ws
+      type(recovered_patch_type), intent(out) :: rec
+      type(error_type), allocatable, intent(out) :: error
+
+      call prepare(patch, degree, ws, rec, .false., 'recover_spr', error)
+      if (allocated(error)) return
+      call qr_least_squares(patch, ws, rec, .false., 'recover_spr', error)
+   end subroutine recover_spr
+
+   !> SPR-C: integral least squares with the constraints switched on in `patch`
+   !> (use_equilibrium, use_compatibility, use_boundary, all_boundary_kinds); see the module
+   !> documentation. Errors: invalid patch (stat_invalid_input), rank-deficient patch or
+   !> singular KKT system (stat_singular), contact boundaries (stat_invalid_input: not yet).
+   subroutine recover_sprc(patch, degree, ws, rec, error)
+      type(patch_type), intent(in) :: patch
+      integer, intent(in) :: degree
+      type(recovery_workspace_type), intent(inout) :: ws
+      type(recovered_patch_type), intent(out) :: rec
+      type(error_type), allocatable, intent(out) :: error
+      integer :: mc
+
+      call prepare(patch, degree, ws, rec, .true., 'recover_sprc', error)
+      if (allocated(error)) return
+      call gram(ws, patch%npoints)
+      mc = 0
+      if (patch%use_equilibrium) call equilibrium_block(patch, ws, rec, mc, error)
+      if (allocated(error)) return
+      if (patch%use_compatibility .and. degree >= 2) call compatibility_block(patch, ws, rec, mc, error)
+      if (allocated(error)) return
+      if (patch%use_boundary) call boundary_blocks(patch, ws, rec, mc, error)
+      if (allocated(error)) return
+      if (mc > 0) then
+         call select_stacked(ws, mc, rec, error)
+         if (allocated(error)) return
+      end if
+      rec%rank_total = mc
+      if (mc == 0) then
+         call qr_least_squares(patch, ws, rec, .true., 'recover_sprc', error)
+      else
+         call solve_kkt(patch, ws, mc, rec, error)
+      end if
+   end subroutine recover_sprc
+
+   !> Validate, reserve, scale the points, fill the (weighted) design matrix and decide its rank.
+   subroutine prepare(patch, degree, ws, rec, weighted, context, error)
+      type(patch_type), intent(in) :: patch
+      integer, intent(in) :: degree
+      type(recovery_workspace_type), intent(inout) :: ws
+      type(recovered_patch_type), intent(inout) :: rec
+      logical, intent(in) :: weighted
+      character(len=*), intent(in) :: context
+      type(error_type), allocatable, intent(out) :: error
+      integer :: i, np, nt, info, r
+      real(wp) :: wsum
+      character(len=160) :: buf
+
+      if (degree < 0 .or. degree > poly_max_degree) then
+         write (buf, '("degree = ",i0," is not in 0..",i0)') degree, poly_max_degree
+         call fatal_error(error, context//': '//trim(buf), stat_invalid_input)
+         return
+      end if
+      call check_patch(patch, error)
+      if (allocated(error)) then
+         error%message = context//': '//error%message
+         return
+      end if
+      np = patch%npoints
+      call workspace_reserve(ws, patch%dim, degree, np, patch%nbpoints, error)
+      if (allocated(error)) return
+      nt = ws%nt
+      rec%dim = patch%dim
+      rec%nstress = ws%ns
+      rec%degree = degree
+      rec%nterms = nt
+      rec%x0 = patch%x0
+      rec%h = patch%h
+
+      do i = 1, np
+         ws%s(1:patch%dim, i) = (patch%x(1:patch%dim, i) - patch%x0(1:patch%dim))/patch%h
+      end do
+      call ws%basis%eval_points(ws%s(1:patch%dim, 1:np), ws%pw)
+      if (weighted) then
+         wsum = sum(patch%w(1:np))
+         ws%wn(1:np) = sqrt(patch%w(1:np)/wsum)
+         do i = 1, nt
+            ws%pw(1:np, i) = ws%wn(1:np)*ws%pw(1:np, i)
+         end do
+      else
+         ws%wn(1:np) = 1.0_wp
+      end if
+
+      ws%qr(1:np, 1:nt) = ws%pw(1:np, 1:nt)
+      ws%jpvt(1:nt) = 0
+      call workspace_tic(ws)
+      call dgeqp3(np, nt, ws%qr, size(ws%qr, 1), ws%jpvt, ws%tau, ws%work, size(ws%work), info)
+      call workspace_toc(ws)
+      if (info /= 0) then
+         call lapack_info_error('dgeqp3', info, context//' (basis rank)', error)
+         return
+      end if
+      r = diag_rank(ws%qr, min(np, nt))
+      rec%basis_rank = r
+      if (r < min(np, nt)) call note_dropped(rec, abs(ws%qr(r + 1, r + 1))/abs(ws%qr(1, 1)))
+      if (r < nt) then
+         write (buf, '("patch rank deficient: basis matrix rank ",i0," < ",i0," terms (degree ",i0,", ",i0, &
+            & " points); too few or aligned points: expand the patch")') r, nt, degree, np
+         call fatal_error(error, context//': '//trim(buf), stat_singular)
+      end if
+   end subroutine prepare
+
+   !> Rank from the diagonal of a pivoted-QR R: |R_kk| > tol |R_11|.
+   pure integer function diag_rank(a, k) result(r)
+      real(wp), intent(in) :: a(:, :)
+      integer, intent(in) :: k
+      integer :: i
+
+      r = 0
+      if (k < 1) return
+      if (.not. (abs(a(1, 1)) > 0.0_wp)) return
+      do i = 1, k
+         if (abs(a(i, i)) > recovery_rank_tol*abs(a(1, 1))) r = i
+      end do
+   end function diag_rank
+
+   pure subroutine note_dropped(rec, ratio)
+      type(recovered_patch_type), intent(inout) :: rec
+      real(wp), intent(in) :: ratio
+      rec%max_dropped_ratio = max(rec%max_dropped_ratio, ratio)
+      rec%tolerance_bites = rec%max_dropped_ratio > recovery_bite_ratio
+   end subroutine note_dropped
+
+   !> Least squares by the pivoted QR already in ws%qr: A = Pi R^-1 Q^T (sqrt(w) sigma).
+   subroutine qr_least_squares(patch, ws, rec, weighted, context, error)
+      type(patch_type), intent(in) :: patch
+      type(recovery_workspace_type), intent(inout) :: ws
+      type(recovered_patch_type), intent(inout) :: rec
+      logical, intent(in) :: weighted
+      character(len=*), intent(in) :: context
+      type(error_type), allocatable, intent(out) :: error
+      integer :: np, nt, ns, c, info
+
+      np = patch%npoints
+      nt = ws%nt
+      ns = ws%ns
+      do c = 1, ns
+         ws%rhs(1:np, c) = patch%stress(c, 1:np)
+         if (weighted) ws%rhs(1:np, c) = ws%wn(1:np)*ws%rhs(1:np, c)
+      end do
+      call workspace_tic(ws)
+      call dormqr('L', 'T', np, ns, nt, ws%qr, size(ws%qr, 1), ws%tau, ws%rhs, size(ws%rhs, 1), &
+         & ws%work, size(ws%work), info)
+      if (info == 0) call dtrtrs('U', 'N', 'N', nt, ns, ws%qr, size(ws%qr, 1), ws%rhs, size(ws%rhs, 1), info)
+      call workspace_toc(ws)
+      if (info /= 0) then
+         call lapack_info_error('dormqr/dtrtrs', info, context//' (least squares)', error)
+         return
+      end if
+      rec%coef = 0.0_wp
+      rec%coef(ws%jpvt(1:nt), 1:ns) = ws%rhs(1:nt, 1:ns)
+   end subroutine qr_least_squares
+
+   !> Mp = P^T W P of one component (full symmetric).
+   subroutine gram(ws, np)
+      type(recovery_workspace_type), intent(inout) :: ws
+      integer, intent(in) :: np
+      integer :: i, nt
+
+      nt = ws%nt
+      call workspace_tic(ws)
+      call dsyrk('U', 'T', nt, np, 1.0_wp, ws%pw, size(ws%pw, 1), 0.0_wp, ws%mp, size(ws%mp, 1))
+      call workspace_toc(ws)
+      do i = 1, nt
+         ws%mp(i + 1:nt, i) = ws%mp(i, i + 1:nt)
+      end do
+   end subroutine gram
+
+   !> (a) internal equilibrium, least-squares form: rows B^T (I x Mp) B, rhs -h B^T (b x Mp(:,1)).
+   subroutine equilibrium_block(patch, ws, rec, mc, error)
+      type(patch_type), intent(in) :: patch
+      type(recovery_workspace_type), intent(inout) :: ws
+      type(recovered_patch_type), intent(inout) :: rec
+      integer, intent(inout) :: mc
+      type(error_type), allocatable, intent(out) :: error
+      integer :: i, nt, n, d
+
+      nt = ws%nt
+      n = ws%n
+      d = patch%dim
+      call workspace_tic(ws)
+      do i = 1, d
+         call dgemm('N', 'N', nt, n, nt, 1.0_wp, ws%mp, size(ws%mp, 1), ws%bdiv((i - 1)*nt + 1, 1), &
+            & size(ws%bdiv, 1), 0.0_wp, ws%tmp((i - 1)*nt + 1, 1), size(ws%tmp, 1))
+      end do
+      call dgemm('T', 'N', n, n, d*nt, 1.0_wp, ws%bdiv, size(ws%bdiv, 1), ws%tmp, size(ws%tmp, 1), &
+         & 0.0_wp, ws%blk, size(ws%blk, 1))
+      do i = 1, d
+         ws%erhs((i - 1)*nt + 1:i*nt) = -patch%h*patch%body_force(i)*ws%mp(1:nt, 1)
+      end do
+      call dgemv('T', d*nt, n, 1.0_wp, ws%bdiv, size(ws%bdiv, 1), ws%erhs, 1, 0.0_wp, ws%brhs, 1)
+      call workspace_toc(ws)
+      call select_block(ws, n, kind_equilibrium, rec, mc, error)
+   end subroutine equilibrium_block
+
+   !> (b) compatibility, exact: coefficient rows of L'C P A (compliance times E, which only scales).
+   subroutine compatibility_block(patch, ws, rec, mc, error)
+      type(patch_type), intent(in) :: patch
+      type(recovery_workspace_type), intent(inout) :: ws
+      type(recovered_patch_type), intent(inout) :: rec
+      integer, intent(inout) :: mc
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: cmat(6, 6)
+      integer :: m, ns
+
+      ns = ws%ns
+      call compliance_matrix(patch%analysis, patch%young, patch%poisson, cmat(1:ns, 1:ns), error)
+      if (allocated(error)) return
+      cmat(1:ns, 1:ns) = patch%young*cmat(1:ns, 1:ns)
+      m = ncompat_equations(patch%dim)*ws%nt
+      call compatibility_rows(patch%dim, ws%nt, ws%incomp, cmat(1:ns, 1:ns), ws%d2, ws%blk(1:m, 1:ws%n))
+      ws%brhs(1:m) = 0.0_wp
+      call select_block(ws, m, kind_compatibility, rec, mc, error)
+   end subroutine compatibility_block
+
+   !> (c), (d): boundary constraints of the dominant kind (or of every kind present).
+   subroutine boundary_blocks(patch, ws, rec, mc, error)
+      type(patch_type), intent(in) :: patch
+      type(recovery_workspace_type), intent(inout) :: ws
+      type(recovered_patch_type), intent(inout) :: rec
+      integer, intent(inout) :: mc
+      type(error_type), allocatable, intent(out) :: error
+      integer :: kind
+
+      kind = dominant_boundary_kind(patch)
+      rec%boundary_kind = kind
+      if (kind == boundary_none) return
+      if (any(patch%bkind(1:patch%nbpoints) == boundary_contact)) then
+         call fatal_error(error, 'recover_sprc: contact boundary points are not supported yet', stat_invalid_input)
+         return
+      end if
+      if (kind == boundary_traction .or. patch%all_boundary_kinds) then
+         call traction_block(patch, ws, rec, mc, error)
+         if (allocated(error)) return
+      end if
+      if (kind == boundary_symmetry .or. patch%all_boundary_kinds) then
+         call symmetry_block(patch, ws, rec, mc, error)
+      end if
+   end subroutine boundary_blocks
+
+   !> (c) traction equilibrium, least-squares form (eq. 80) with weights bw / sum(bw).
+   subroutine traction_block(patch, ws, rec, mc, error)
+      type(patch_type), intent(in) :: patch
+      type(recovery_workspace_type), intent(inout) :: ws
+      type(recovered_patch_type), intent(inout) :: rec
+      integer, intent(inout) :: mc
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: g(3, 6), p(20), s(3), bsum, sq
+      integer :: j, i, c, d, nt, n, m
+
+      d = patch%dim
+      nt = ws%nt
+      n = ws%n
+      bsum = 0.0_wp
+      do j = 1, patch%nbpoints
+         if (patch%bkind(j) == boundary_traction) bsum = bsum + patch%bw(j)
+      end do
+      if (.not. (bsum > 0.0_wp)) return
+      m = 0
+      do j = 1, patch%nbpoints
+         if (patch%bkind(j) /= boundary_traction .or. patch%bw(j) == 0.0_wp) cycle
+         sq = sqrt(patch%bw(j)/bsum)
+         s(1:d) = (patch%bx(1:d, j) - patch%x0(1:d))/patch%h
+         call ws%basis%eval(s(1:d), p)
+         call traction_operator(d, patch%bn(1:d, j), g)
+         do i = 1, d
+            m = m + 1
+            do c = 1, ws%ns
+               ws%estack(m, (c - 1)*nt + 1:c*nt) = (sq*g(i, c))*p(1:nt)
+            end do
+            ws%erhs(m) = sq*patch%btraction(i, j)
+         end do
+      end do
+      call workspace_tic(ws)
+      call dsyrk('U', 'T', n, m, 1.0_wp, ws%estack, size(ws%estack, 1), 0.0_wp, ws%blk, size(ws%blk, 1))
+      call dgemv('T', m, n, 1.0_wp, ws%estack, size(ws%estack, 1), ws%erhs, 1, 0.0_wp, ws%brhs, 1)
+      call workspace_toc(ws)
+      do i = 1, n
+         ws%blk(i + 1:n, i) = ws%blk(i, i + 1:n)
+      end do
+      call select_block(ws, n, kind_traction, rec, mc, error)
+   end subroutine traction_block
+
+   !> (d) symmetry, exact: zero shear n^T sigma* t on each symmetry plane, imposed at the
+   !> principal lattice of degree p on the plane (unisolvent for the restriction).
+   subroutine symmetry_block(patch, ws, rec, mc, error)
+      type(patch_type), intent(in) :: patch
+      type(recovery_workspace_type), intent(inout) :: ws
+      type(recovered_patch_type), intent(inout) :: rec
+      integer, intent(inout) :: mc
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: pn(3, 3), pd(3), s(3), nrm(3), off, t(3, 2), g(6), p(20), base(3), alpha, beta
+      integer :: nplanes, j, k, q, i1, i2, c, d, nt, m, deg, ntan
+      character(len=80) :: buf
+
+      d = patch%dim
+      nt = ws%nt
+      deg = ws%degree
+      nplanes = 0
+      do j = 1, patch%nbpoints
+         if (patch%bkind(j) /= boundary_symmetry) cycle
+         nrm(1:d) = patch%bn(1:d, j)
+         s(1:d) = (patch%bx(1:d, j) - patch%x0(1:d))/patch%h
+         off = dot_product(nrm(1:d), s(1:d))
+         if (any([(maxval(abs(pn(1:d, k) - nrm(1:d))) <= plane_tol .and. abs(pd(k) - off) <= plane_tol, &
+            & k=1, nplanes)])) cycle
+         if (nplanes == 3) then
+            write (buf, '("symmetry point ",i0," lies on a 4th plane")') j
+            call fatal_error(error, 'recover_sprc: '//trim(buf)// &
+               & ' (at most 3 symmetry planes per patch; symmetry boundaries must be planes)', stat_invalid_input)
+            return
+         end if
+         nplanes = nplanes + 1
+         pn(1:d, nplanes) = nrm(1:d)
+         pd(nplanes) = off
+      end do
+      m = 0
+      ntan = d - 1
+      do k = 1, nplanes
+         call plane_tangents(d, pn(:, k), t)
+         base(1:d) = pd(k)*pn(1:d, k)
+         do i1 = 0, deg
+            do i2 = 0, merge(0, deg - i1, d == 2)
+               alpha = 0.0_wp
+               beta = 0.0_wp
+               if (deg > 0) then
+                  alpha = real(i1, wp)/real(deg, wp)
+                  beta = real(i2, wp)/real(deg, wp)
+               end if
+               s(1:d) = base(1:d) + alpha*t(1:d, 1) + beta*t(1:d, 2)
+               call ws%basis%eval(s(1:d), p)
+               do q = 1, ntan
+                  call shear_operator(d, pn(:, k), t(:, q), g)
+                  m = m + 1
+                  do c = 1, ws%ns
+                     ws%blk(m, (c - 1)*nt + 1:c*nt) = g(c)*p(1:nt)
+                  end do
+                  ws%brhs(m) = 0.0_wp
+               end do
+            end do
+         end do
+      end do
+      call select_block(ws, m, kind_symmetry, rec, mc, error)
+   end subroutine symmetry_block
+
+   !> Keep the rank-revealing rows of the block ws%blk(1:m, 1:n) / ws%brhs(1:m): dgeqp3 on the
+   !> transposed rows; rows jpvt(1:r) (in their original order) go to ws%c / ws%lam after mc.
+   subroutine select_block(ws, m, kind, rec, mc, error)
+      type(recovery_workspace_type), intent(inout) :: ws
+      integer, intent(in) :: m, kind
+      type(recovered_patch_type), intent(inout) :: rec
+      integer, intent(inout) :: mc
+      type(error_type), allocatable, intent(out) :: error
+      integer :: n, r, k, i
+
+      rec%rows(kind) = rec%rows(kind) + m
+      if (m == 0) return
+      n = ws%n
+      ws%cq(1:n, 1:m) = transpose(ws%blk(1:m, 1:n))
+      call pivoted_rank(ws, n, m, rec, r, error)
+      if (allocated(error)) return
+      call sort_int(ws%jpvt(1:r))
+      do k = 1, r
+         i = ws%jpvt(k)
+         ws%c(mc + k, 1:n) = ws%blk(i, 1:n)
+         ws%lam(mc + k) = ws%brhs(i)
+      end do
+      mc = mc + r
+      rec%ranks(kind) = rec%ranks(kind) + r
+   end subroutine select_block
+
+   !> Final rank selection over the stacked kept rows (normalised to unit length).
+   subroutine select_stacked(ws, mc, rec, error)
+      type(recovery_workspace_type), intent(inout) :: ws
+      integer, intent(inout) :: mc
+      type(recovered_patch_type), intent(inout) :: rec
+      type(error_type), allocatable, intent(out) :: error
+      integer :: n, r, k, i
+      real(wp) :: nrm
+
+      n = ws%n
+      do k = 1, mc
+         nrm = sqrt(sum(ws%c(k, 1:n)**2))
+         ws%cq(1:n, k) = ws%c(k, 1:n)/nrm
+      end do
+      call pivoted_rank(ws, n, mc, rec, r, error)
+      if (allocated(error)) return
+      if (r == mc) return
+      call sort_int(ws%jpvt(1:r))
+      do k = 1, r
+         i = ws%jpvt(k)
+         ws%c(k, 1:n) = ws%c(i, 1:n)
+         ws%lam(k) = ws%lam(i)
+      end do
+      mc = r
+   end subroutine select_stacked
+
+   !> Pivoted QR of ws%cq(1:n, 1:m); rank r from its diagonal; pivots in ws%jpvt(1:m).
+   subroutine pivoted_rank(ws, n, m, rec, r, error)
+      type(recovery_workspace_type), intent(inout) :: ws
+      integer, intent(in) :: n, m
+      type(recovered_patch_type), intent(inout) :: rec
+      integer, intent(out) :: r
+      type(error_type), allocatable, intent(out) :: error
+      integer :: info
+
+      ws%jpvt(1:m) = 0
+      call workspace_tic(ws)
+      call dgeqp3(n, m, ws%cq, size(ws%cq, 1), ws%jpvt, ws%tau, ws%work, size(ws%work), info)
+      call workspace_toc(ws)
+      r = 0
+      if (info /= 0) then
+         call lapack_info_error('dgeqp3', info, 'recover_sprc (constraint rank)', error)
+         return
+      end if
+      r = diag_rank(ws%cq, min(n, m))
+      if (r < min(n, m) .and. r > 0) call note_dropped(rec, abs(ws%cq(r + 1, r + 1))/abs(ws%cq(1, 1)))
+   end subroutine pivoted_rank
+
+   pure subroutine sort_int(a)
+      integer, intent(inout) :: a(:)
+      integer :: i, j, v
+      do i = 2, size(a)
+         v = a(i)
+         j = i - 1
+         do while (j >= 1)
+            if (a(j) <= v) exit
+            a(j + 1) = a(j)
+            j = j - 1
+         end do
+         a(j + 1) = v
+      end do
+   end subroutine sort_int
+
+   !> Scaled KKT solve [M C^T; C 0][A; lambda] = [H; Lambda] with dsysv.
+   subroutine solve_kkt(patch, ws, mc, rec, error)
+      type(patch_type), intent(in) :: patch
+      type(recovery_workspace_type), intent(inout) :: ws
+      integer, intent(in) :: mc
+      type(recovered_patch_type), intent(inout) :: rec
+      type(error_type), allocatable, intent(out) :: error
+      integer :: np, nt, ns, n, nk, c, k, i, info, lk
+      real(wp) :: nrm
+
+      np = patch%npoints
+      nt = ws%nt
+      ns = ws%ns
+      n = ws%n
+      nk = n + mc
+      lk = size(ws%kkt, 1)
+      do c = 1, ns
+         ws%rhs(1:np, c) = ws%wn(1:np)*patch%stress(c, 1:np)
+      end do
+      call workspace_tic(ws)
+      call dgemm('T', 'N', nt, ns, np, 1.0_wp, ws%pw, size(ws%pw, 1), ws%rhs, size(ws%rhs, 1), 0.0_wp, &
+         & ws%hmat, size(ws%hmat, 1))
+      call workspace_toc(ws)
+
+      ! Symmetric scaling: unknowns by 1/sqrt(Mp_kk), multipliers by 1/|scaled row|.
+      do c = 1, ns
+         do k = 1, nt
+            ws%dscale((c - 1)*nt + k) = 1.0_wp/sqrt(ws%mp(k, k))
+         end do
+      end do
+      do i = 1, mc
+         nrm = sqrt(sum((ws%c(i, 1:n)*ws%dscale(1:n))**2))
+         ws%dscale(n + i) = 1.0_wp/nrm
+      end do
+      ws%kkt(1:nk, 1:nk) = 0.0_wp
+      do c = 1, ns
+         do k = 1, nt
+            ws%kkt((c - 1)*nt + 1:c*nt, (c - 1)*nt + k) = ws%mp(1:nt, k)
+         end do
+         ws%sol((c - 1)*nt + 1:c*nt) = ws%hmat(1:nt, c)
+      end do
+      do k = 1, n
+         ws%kkt(k, n + 1:nk) = ws%c(1:mc, k)
+         ws%kkt(n + 1:nk, k) = ws%c(1:mc, k)
+      end do
+      ws%sol(n + 1:nk) = ws%lam(1:mc)
+      do k = 1, nk
+         ws%kkt(1:nk, k) = ws%kkt(1:nk, k)*(ws%dscale(1:nk)*ws%dscale(k))
+      end do
+      ws%sol(1:nk) = ws%sol(1:nk)*ws%dscale(1:nk)
+      call workspace_tic(ws)
+      call dsysv('U', nk, 1, ws%kkt, lk, ws%ipiv, ws%sol, lk, ws%work, size(ws%work), info)
+      call workspace_toc(ws)
+      if (info /= 0) then
+         call lapack_info_error('dsysv', info, 'recover_sprc (KKT system)', error)
+         return
+      end if
+      rec%coef = 0.0_wp
+      do c = 1, ns
+         rec%coef(1:nt, c) = ws%sol((c - 1)*nt + 1:c*nt)*ws%dscale((c - 1)*nt + 1:c*nt)
+      end do
+   end subroutine solve_kkt
+
+end module sprc_recovery_solve

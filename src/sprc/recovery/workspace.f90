@@ -1,0 +1,214 @@
+!> Per-thread work storage of the SPR / SPR-C patch solves.
+!>
+!> One `recovery_workspace_type` per thread holds every work array and the
+!> LAPACK workspace. `workspace_reserve` (called by the solves) grows the arrays
+!> only when a patch needs more than the current capacity, and queries the
+!> optimal LAPACK `lwork` only then (once per size class), so a patch loop
+!> allocates nothing once its largest patch has been seen. The polynomial basis,
+!> its derivative matrices and the divergence and incompatibility operators
+!> depend only on (dim, degree) and are rebuilt only when these change: keep one
+!> workspace per (dim, degree) in a loop that mixes them.
+!>
+!> No module state: workspaces are independent objects, one per thread. Declare
+!> the thread's workspace inside the parallel region (a `block` construct, or a
+!> local variable of a procedure called there), or call `workspace_init` on a
+!> `private` copy first: gfortran does not apply default initialisation to
+!> OpenMP private copies, and a garbage capacity would be trusted.
+module sprc_recovery_workspace
+   use sprc_core_kinds, only: wp
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
+   use sprc_core_lapack, only: dgeqp3, dormqr, dsysv, lapack_info_error
+   use sprc_core_poly, only: poly_basis_type, new_poly_basis, poly_nterms, poly_max_degree
+   use sprc_core_timer, only: wall_time
+   use sprc_recovery_operators, only: divergence_operator, incompatibility_operator, ncompat_equations, &
+      & hess_index, voigt_pair
+   implicit none
+   private
+
+   public :: recovery_workspace_type, workspace_init, workspace_reserve, workspace_tic, workspace_toc
+
+   !> Work arrays of the patch solves (components are internal to sprc_recovery; public only
+   !> so that the solve module can reach them without accessor overhead).
+   type :: recovery_workspace_type
+      !> Dimension and degree the basis and operators are built for.
+      integer :: dim = 0, degree = -1
+      !> Terms, stress components, unknowns nt*ns.
+      integer :: nt = 0, ns = 0, n = 0
+      !> Polynomial basis of (dim, degree).
+      type(poly_basis_type) :: basis
+      !> Derivative matrices d/ds_k, dmat(nt, nt, dim); second-derivative matrices d2(nt, nt, nhess).
+      real(wp), allocatable :: dmat(:, :, :), d2(:, :, :)
+      !> Coefficient-space divergence operator bdiv(dim*nt, n).
+      real(wp), allocatable :: bdiv(:, :)
+      !> Incompatibility operator on strains, incomp(ncompat, ns, nhess).
+      real(wp), allocatable :: incomp(:, :, :)
+      !> Capacities: integration points, boundary points, unknowns, block rows, QR columns.
+      integer :: cap_p = 0, cap_b = 0, cap_n = 0, cap_mr = 0, cap_mq = 0, cap_nt = 0
+      !> Scaled point coordinates s(3, cap_p) and normalised weights wn(cap_p).
+      real(wp), allocatable :: s(:, :), wn(:)
+      !> (Weighted) design matrix pw(cap_p, cap_nt), its QR copy, right-hand sides rhs(cap_p, 6).
+      real(wp), allocatable :: pw(:, :), qr(:, :), rhs(:, :)
+      !> Gram matrix of one component mp(cap_nt, cap_nt) and H = P^T W sigma, hmat(cap_nt, 6).
+      real(wp), allocatable :: mp(:, :), hmat(:, :)
+      !> One constraint block blk(cap_mr, cap_n) with right-hand side brhs(cap_mr).
+      real(wp), allocatable :: blk(:, :), brhs(:)
+      !> (I x Mp) B, tmp(3*cap_nt, cap_n).
+      real(wp), allocatable :: tmp(:, :)
+      !> Weighted traction operator rows estack(3*cap_b, cap_n) and data erhs(3*cap_b).
+      real(wp), allocatable :: estack(:, :), erhs(:)
+      !> Transposed rows for the pivoted QR, cq(cap_n, cap_mq).
+      real(wp), allocatable :: cq(:, :)
+      !> Accepted constraint rows c(4*cap_n, cap_n) and right-hand side lam(4*cap_n).
+      real(wp), allocatable :: c(:, :), lam(:)
+      !> KKT matrix kkt(2*cap_n, 2*cap_n), solution sol and symmetric scaling dscale.
+      real(wp), allocatable :: kkt(:, :), sol(:), dscale(:)
+      !> Householder scalars and pivots.
+      real(wp), allocatable :: tau(:)
+      integer, allocatable :: jpvt(:), ipiv(:)
+      !> LAPACK workspace, lwork = size(work).
+      real(wp), allocatable :: work(:)
+      !> If true, the solves accumulate the wall time spent inside LAPACK/BLAS calls.
+      logical :: timing = .false.
+      !> Seconds spent in LAPACK/BLAS (only if `timing`).
+      real(wp) :: lapack_seconds = 0.0_wp
+      real(wp) :: t0 = 0.0_wp
+   end type recovery_workspace_type
+
+contains
+
+   !> Reset a workspace to its empty default state (frees its storage). Needed only for
+   !> copies whose default initialisation is not guaranteed (OpenMP `private`).
+   pure subroutine workspace_init(ws)
+      type(recovery_workspace_type), intent(out) :: ws
+      ws%dim = 0
+   end subroutine workspace_init
+
+   !> Prepare `ws` for a patch of `npoints` integration and `nbpoints` boundary points with a
+   !> basis of `degree` in `dim`: rebuilds basis and operators if (dim, degree) changed, grows
+   !> arrays only beyond the current capacity (then re-queries lwork).
+   subroutine workspace_reserve(ws, dim, degree, npoints, nbpoints, error)
+      type(recovery_workspace_type), intent(inout) :: ws
+      integer, intent(in) :: dim, degree, npoints, nbpoints
+      type(error_type), allocatable, intent(out) :: error
+      character(len=64) :: buf
+
+      if ((dim /= 2 .and. dim /= 3) .or. degree < 0 .or. degree > poly_max_degree) then
+         write (buf, '("dim = ",i0,", degree = ",i0)') dim, degree
+         call fatal_error(error, 'recovery workspace: unsupported '//trim(buf)// &
+            & ' (dim 2 or 3, degree 0..3)', stat_invalid_input)
+         return
+      end if
+      if (npoints < 0 .or. nbpoints < 0) then
+         call fatal_error(error, 'recovery workspace: negative point count', stat_invalid_input)
+         return
+      end if
+      if (dim /= ws%dim .or. degree /= ws%degree) then
+         call build_operators(ws, dim, degree, error)
+         if (allocated(error)) return
+      end if
+      if (npoints > ws%cap_p .or. nbpoints > ws%cap_b .or. ws%n > ws%cap_n .or. ws%nt > ws%cap_nt) then
+         call grow(ws, max(npoints, ws%cap_p), max(nbpoints, ws%cap_b), max(ws%n, ws%cap_n), &
+            & max(ws%nt, ws%cap_nt), error)
+      end if
+   end subroutine workspace_reserve
+
+   subroutine build_operators(ws, dim, degree, error)
+      type(recovery_workspace_type), intent(inout) :: ws
+      integer, intent(in) :: dim, degree
+      type(error_type), allocatable, intent(out) :: error
+      integer :: k, m, a, b, nt, nh
+
+      call new_poly_basis(ws%basis, dim, degree, error)
+      if (allocated(error)) return
+      nt = poly_nterms(dim, degree)
+      nh = merge(3, 6, dim == 2)
+      ws%dim = dim
+      ws%degree = degree
+      ws%nt = nt
+      ws%ns = nh
+      ws%n = nt*nh
+      if (allocated(ws%dmat)) deallocate (ws%dmat, ws%d2, ws%bdiv, ws%incomp)
+      allocate (ws%dmat(nt, nt, dim), ws%d2(nt, nt, nh), ws%bdiv(dim*nt, ws%n))
+      allocate (ws%incomp(ncompat_equations(dim), nh, nh))
+      do k = 1, dim
+         call ws%basis%derivative_matrix(k, ws%dmat(:, :, k), error)
+         if (allocated(error)) return
+      end do
+      do m = 1, nh
+         call voigt_pair(dim, m, a, b)
+         if (hess_index(dim, a, b) /= m) then
+            call fatal_error(error, 'recovery workspace: second-derivative order mismatch', stat_invalid_input)
+            return
+         end if
+         ws%d2(:, :, m) = matmul(ws%dmat(:, :, a), ws%dmat(:, :, b))
+      end do
+      call divergence_operator(dim, nt, ws%dmat, ws%bdiv)
+      call incompatibility_operator(dim, ws%incomp)
+   end subroutine build_operators
+
+   subroutine grow(ws, cp, cb, cn, cnt, error)
+      type(recovery_workspace_type), intent(inout) :: ws
+      integer, intent(in) :: cp, cb, cn, cnt
+      type(error_type), allocatable, intent(out) :: error
+      integer :: info, lw
+      real(wp) :: q(1)
+
+      ws%cap_p = cp
+      ws%cap_b = cb
+      ws%cap_n = cn
+      ws%cap_nt = cnt
+      ! Largest block: n Gram rows, 6 compatibility equations x nt, or symmetry rows
+      ! (2 tangents x 10 lattice points x 3 planes).
+      ws%cap_mr = max(cn, 6*cnt, 60)
+      ws%cap_mq = max(ws%cap_mr, 4*cn)
+      if (allocated(ws%s)) then
+         deallocate (ws%s, ws%wn, ws%pw, ws%qr, ws%rhs, ws%mp, ws%hmat, ws%blk, ws%brhs, ws%tmp)
+         deallocate (ws%estack, ws%erhs, ws%cq, ws%c, ws%lam, ws%kkt, ws%sol, ws%dscale)
+         deallocate (ws%tau, ws%jpvt, ws%ipiv, ws%work)
+      end if
+      allocate (ws%s(3, max(cp, 1)), ws%wn(max(cp, 1)))
+      allocate (ws%pw(max(cp, 1), cnt), ws%qr(max(cp, 1), cnt), ws%rhs(max(cp, 1), 6))
+      allocate (ws%mp(cnt, cnt), ws%hmat(cnt, 6))
+      allocate (ws%blk(ws%cap_mr, cn), ws%brhs(ws%cap_mr), ws%tmp(3*cnt, cn))
+      allocate (ws%estack(max(3*cb, 1), cn), ws%erhs(max(3*cb, 3*cnt)))
+      allocate (ws%cq(cn, ws%cap_mq), ws%c(4*cn, cn), ws%lam(4*cn))
+      allocate (ws%kkt(2*cn, 2*cn), ws%sol(2*cn), ws%dscale(2*cn))
+      allocate (ws%tau(max(ws%cap_mq, cnt)), ws%jpvt(max(ws%cap_mq, cnt)), ws%ipiv(2*cn))
+
+      ! Workspace queries for the largest problem of each LAPACK call.
+      lw = 1
+      call dgeqp3(size(ws%qr, 1), cnt, ws%qr, size(ws%qr, 1), ws%jpvt, ws%tau, q, -1, info)
+      call check_query('dgeqp3')
+      call dgeqp3(cn, ws%cap_mq, ws%cq, cn, ws%jpvt, ws%tau, q, -1, info)
+      call check_query('dgeqp3')
+      call dormqr('L', 'T', size(ws%qr, 1), 6, cnt, ws%qr, size(ws%qr, 1), ws%tau, ws%rhs, size(ws%rhs, 1), &
+         & q, -1, info)
+      call check_query('dormqr')
+      call dsysv('U', 2*cn, 1, ws%kkt, 2*cn, ws%ipiv, ws%sol, 2*cn, q, -1, info)
+      call check_query('dsysv')
+      allocate (ws%work(lw))
+   contains
+      subroutine check_query(name)
+         character(len=*), intent(in) :: name
+         if (allocated(error)) return
+         if (info /= 0) then
+            call lapack_info_error(name, info, 'recovery workspace query', error)
+            return
+         end if
+         lw = max(lw, int(q(1)), 3*max(cn, ws%cap_mq) + 1)
+      end subroutine check_query
+   end subroutine grow
+
+   !> Start timing a LAPACK/BLAS call (no-op unless ws%timing).
+   subroutine workspace_tic(ws)
+      type(recovery_workspace_type), intent(inout) :: ws
+      if (ws%timing) ws%t0 = wall_time()
+   end subroutine workspace_tic
+
+   !> Stop timing a LAPACK/BLAS call and accumulate into ws%lapack_seconds.
+   subroutine workspace_toc(ws)
+      type(recovery_workspace_type), intent(inout) :: ws
+      if (ws%timing) ws%lapack_seconds = ws%lapack_seconds + (wall_time() - ws%t0)
+   end subroutine workspace_toc
+
+end module sprc_recovery_workspace
