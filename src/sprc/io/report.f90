@@ -249,7 +249,7 @@ contains
       real(wp) :: a
 
       a = abs(x)
-      if (a == 0.0_wp) then
+      if (a <= 0.0_wp) then
          s = '0'
          return
       end if
