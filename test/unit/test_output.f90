@@ -324,6 +324,9 @@ contains
       if (allocated(error)) return
       call check(error, count_sub(text, 'GeometryType="XYZ"'), 2, 'XYZ geometry')
       if (allocated(error)) return
+      call check(error, index(text, '<Time Value="0"/>') < index(text, '<Time Value="3"/>'), &
+         'levels in time order though written 3 then 0')
+      if (allocated(error)) return
       call check(error, index(text, 'Name="sigma_sprc_xz"') > 0, 'sixth Voigt component')
       if (allocated(error)) return
       call check(error, index(text, 'Dimensions="45 3" NumberType="Float" Precision="8" Format="HDF">'// &

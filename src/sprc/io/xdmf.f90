@@ -16,7 +16,9 @@
 !>
 !> **XDMF** (version 3.0, also read by ParaView's legacy XDMF reader): one
 !> temporal collection whose Time is the level, so ParaView's time control
-!> steps through the levels; one Uniform grid per level. Geometry is XY or
+!> steps through the levels; one Uniform grid per level, in level order.
+!> (Checked by hand with VTK 9.7's vtkXdmfReader: cell types, named
+!> component scalars, the displacement as active vectors, hex27 volumes.) Geometry is XY or
 !> XYZ. Topology types: Quadrilateral, Quadrilateral_9, Hexahedron,
 !> Hexahedron_27. Attributes: Scalar, Vector (3 components), and for named
 !> components one Scalar per component, `<name>_<component>`, cut out of the
@@ -216,13 +218,18 @@ contains
       character(len=*), intent(in) :: h5_name
       type(xdmf_grid_type), intent(in) :: grids(:)
       character(len=:), allocatable :: text
-      integer :: g
+      integer :: g, k
+      logical :: done(size(grids))
 
       text = '<?xml version="1.0" encoding="UTF-8"?>'//nl//'<!DOCTYPE Xdmf SYSTEM "Xdmf.dtd" []>'//nl// &
          '<Xdmf xmlns:xi="http://www.w3.org/2001/XInclude" Version="3.0">'//nl// &
          ' <Domain>'//nl// &
          '  <Grid Name="levels" GridType="Collection" CollectionType="Temporal">'//nl
-      do g = 1, size(grids)
+      ! Grids in increasing level (= time) order, whatever order they were written in.
+      done = .false.
+      do k = 1, size(grids)
+         g = minloc(grids%level, dim=1, mask=.not. done)
+         done(g) = .true.
          text = text//grid_text(escape(h5_name), grids(g))
       end do
       text = text//'  </Grid>'//nl//' </Domain>'//nl//'</Xdmf>'//nl
