@@ -1,0 +1,513 @@
+!> The study report (SCENE.md "Report"): one row per level, printed as a
+!> fixed-width table and written as a CSV file whose reals round-trip bit for
+!> bit; a CSV reader for tests and comparisons. The SVG plot of the same rows
+!> is `sprc_io_svg`.
+!>
+!> A real cell that does not apply (no exact solution, recovery not run) is
+!> *empty*: it holds a quiet NaN (`report_empty`) and `is_empty` is true for
+!> it. Every NaN counts as empty, so no writer ever prints "NaN": an empty cell
+!> is an empty string in the CSV and blanks in the table.
+module sprc_io_report
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_is_finite
+   use sprc_core_kinds, only: wp, i8
+   use sprc_core_error, only: error_type, fatal_error, stat_io, stat_invalid_input
+   implicit none
+   private
+
+   public :: report_row_type, report_table, write_report_csv, read_report_csv
+   public :: report_column, report_empty, is_empty
+   public :: n_report_columns, report_columns, report_csv_header
+
+   !> Number of contract columns.
+   integer, parameter :: n_report_columns = 19
+
+   !> Column names, in the contract's order.
+   character(len=12), parameter :: report_columns(n_report_columns) = [character(len=12) :: &
+      & 'level', 'h', 'elements', 'cut_elements', 'dofs', 't_mesh', 't_quadrature', 't_assembly', &
+      & 't_solve', 't_recovery', 't_estimate', 't_total', 'err_fe', 'err_spr', 'err_sprc', &
+      & 'eta_spr', 'eta_sprc', 'theta_spr', 'theta_sprc']
+
+   !> The CSV header line, exactly as SCENE.md states it.
+   character(len=*), parameter :: report_csv_header = 'level,h,elements,cut_elements,dofs,t_mesh,'// &
+      & 't_quadrature,t_assembly,t_solve,t_recovery,t_estimate,t_total,err_fe,err_spr,err_sprc,'// &
+      & 'eta_spr,eta_sprc,theta_spr,theta_sprc'
+
+   !> The value of an empty real cell: the default quiet NaN (bits 0x7FF8000000000000).
+   real(wp), parameter :: report_empty = transfer(9221120237041090560_i8, 1.0_wp)
+
+   !> How each column is formatted in the table.
+   integer, parameter :: kind_integer = 1, kind_sig3 = 2, kind_error = 3
+   integer, parameter :: column_kind(n_report_columns) = [kind_integer, kind_sig3, kind_integer, &
+      & kind_integer, kind_integer, kind_sig3, kind_sig3, kind_sig3, kind_sig3, kind_sig3, kind_sig3, &
+      & kind_sig3, kind_error, kind_error, kind_error, kind_error, kind_error, kind_sig3, kind_sig3]
+
+   !> One level of a study. Times are wall-clock seconds for that level alone;
+   !> errors and estimates are relative, in the energy norm (SCENE.md).
+   !> Real components start empty: set only those that apply.
+   type :: report_row_type
+      integer :: level = 0
+      !> Element size of the level.
+      real(wp) :: h = report_empty
+      !> Active elements, of which cut by the boundary; degrees of freedom.
+      integer(i8) :: elements = 0, cut_elements = 0, dofs = 0
+      real(wp) :: t_mesh = report_empty, t_quadrature = report_empty, t_assembly = report_empty
+      real(wp) :: t_solve = report_empty, t_recovery = report_empty, t_estimate = report_empty
+      real(wp) :: t_total = report_empty
+      !> Exact relative errors of the FE, SPR and SPR-C stresses.
+      real(wp) :: err_fe = report_empty, err_spr = report_empty, err_sprc = report_empty
+      !> Estimated relative errors (ZZ with the SPR / SPR-C field).
+      real(wp) :: eta_spr = report_empty, eta_sprc = report_empty
+      !> Global effectivity indices.
+      real(wp) :: theta_spr = report_empty, theta_sprc = report_empty
+   end type report_row_type
+
+contains
+
+   !> True when `x` is an empty cell (any NaN).
+   elemental logical function is_empty(x)
+      real(wp), intent(in) :: x
+      is_empty = ieee_is_nan(x)
+   end function is_empty
+
+   !> The values of column `name` over `rows` (integers converted to real;
+   !> empty cells stay empty). An unknown name gives all-empty values.
+   pure function report_column(rows, name) result(values)
+      type(report_row_type), intent(in) :: rows(:)
+      character(len=*), intent(in) :: name
+      real(wp) :: values(size(rows))
+      integer :: i, j
+
+      values = report_empty
+      j = findloc(report_columns, name, dim=1)
+      if (j == 0) return
+      do i = 1, size(rows)
+         values(i) = row_values(rows(i), j)
+      end do
+   end function report_column
+
+   !> Column j of a row as a real.
+   pure real(wp) function row_values(row, j) result(x)
+      type(report_row_type), intent(in) :: row
+      integer, intent(in) :: j
+
+      select case (j)
+      case (1); x = real(row%level, wp)
+      case (2); x = row%h
+      case (3); x = real(row%elements, wp)
+      case (4); x = real(row%cut_elements, wp)
+      case (5); x = real(row%dofs, wp)
+      case (6); x = row%t_mesh
+      case (7); x = row%t_quadrature
+      case (8); x = row%t_assembly
+      case (9); x = row%t_solve
+      case (10); x = row%t_recovery
+      case (11); x = row%t_estimate
+      case (12); x = row%t_total
+      case (13); x = row%err_fe
+      case (14); x = row%err_spr
+      case (15); x = row%err_sprc
+      case (16); x = row%eta_spr
+      case (17); x = row%eta_sprc
+      case (18); x = row%theta_spr
+      case default; x = row%theta_sprc
+      end select
+   end function row_values
+
+   !> Set real column j of a row (j is never an integer column here).
+   pure subroutine set_real(row, j, x)
+      type(report_row_type), intent(inout) :: row
+      integer, intent(in) :: j
+      real(wp), intent(in) :: x
+
+      select case (j)
+      case (2); row%h = x
+      case (6); row%t_mesh = x
+      case (7); row%t_quadrature = x
+      case (8); row%t_assembly = x
+      case (9); row%t_solve = x
+      case (10); row%t_recovery = x
+      case (11); row%t_estimate = x
+      case (12); row%t_total = x
+      case (13); row%err_fe = x
+      case (14); row%err_spr = x
+      case (15); row%err_sprc = x
+      case (16); row%eta_spr = x
+      case (17); row%eta_sprc = x
+      case (18); row%theta_spr = x
+      case (19); row%theta_sprc = x
+      end select
+   end subroutine set_real
+
+   !> Set integer column j of a row.
+   pure subroutine set_integer(row, j, n)
+      type(report_row_type), intent(inout) :: row
+      integer, intent(in) :: j
+      integer(i8), intent(in) :: n
+
+      select case (j)
+      case (1); row%level = int(n)
+      case (3); row%elements = n
+      case (4); row%cut_elements = n
+      case (5); row%dofs = n
+      end select
+   end subroutine set_integer
+
+   !> Integer column j of a row.
+   pure integer(i8) function row_integer(row, j) result(n)
+      type(report_row_type), intent(in) :: row
+      integer, intent(in) :: j
+
+      select case (j)
+      case (1); n = int(row%level, i8)
+      case (3); n = row%elements
+      case (4); n = row%cut_elements
+      case default; n = row%dofs
+      end select
+   end function row_integer
+
+   !> The report as a fixed-width table: a header, a rule, one line per row,
+   !> each line ended by a newline (trailing blanks dropped). Columns are right-aligned to a common
+   !> width; times, h and theta have 3 significant digits, errors and
+   !> estimates es notation; empty cells are blank.
+   function report_table(rows) result(table)
+      type(report_row_type), intent(in) :: rows(:)
+      character(len=:), allocatable :: table
+      type :: cell_type
+         character(len=:), allocatable :: s
+      end type cell_type
+      type(cell_type) :: cells(n_report_columns, size(rows))
+      integer :: width(n_report_columns), i, j
+      character(len=:), allocatable :: line
+      character, parameter :: nl = new_line('a')
+
+      do j = 1, n_report_columns
+         width(j) = len_trim(report_columns(j))
+         do i = 1, size(rows)
+            cells(j, i)%s = table_cell(rows(i), j)
+            width(j) = max(width(j), len(cells(j, i)%s))
+         end do
+      end do
+
+      line = ''
+      do j = 1, n_report_columns
+         line = line//'  '//right(trim(report_columns(j)), width(j))
+      end do
+      table = line(3:)//nl
+      line = ''
+      do j = 1, n_report_columns
+         line = line//'  '//repeat('-', width(j))
+      end do
+      table = table//line(3:)//nl
+      do i = 1, size(rows)
+         line = ''
+         do j = 1, n_report_columns
+            line = line//'  '//right(cells(j, i)%s, width(j))
+         end do
+         table = table//trim(line(3:))//nl
+      end do
+   end function report_table
+
+   !> `s` right-aligned in a field of `w` characters.
+   pure function right(s, w) result(r)
+      character(len=*), intent(in) :: s
+      integer, intent(in) :: w
+      character(len=max(w, len(s))) :: r
+      r = repeat(' ', max(0, w - len(s)))//s
+   end function right
+
+   !> Table text of column j of a row.
+   function table_cell(row, j) result(s)
+      type(report_row_type), intent(in) :: row
+      integer, intent(in) :: j
+      character(len=:), allocatable :: s
+      character(len=32) :: buf
+      real(wp) :: x
+
+      if (column_kind(j) == kind_integer) then
+         write (buf, '(i0)') row_integer(row, j)
+         s = trim(buf)
+         return
+      end if
+      x = row_values(row, j)
+      if (is_empty(x)) then
+         s = ''
+      else if (column_kind(j) == kind_error) then
+         write (buf, '(es10.3)') x
+         s = trim(adjustl(buf))
+      else
+         s = sig3(x)
+      end if
+   end function table_cell
+
+   !> `x` with 3 significant digits: fixed point for 1e-4 <= |x| < 1e6
+   !> ("0.00123", "1.23", "123", "12346"), es notation outside.
+   function sig3(x) result(s)
+      real(wp), intent(in) :: x
+      character(len=:), allocatable :: s
+      character(len=32) :: buf, fmt
+      integer :: d, decimals
+      real(wp) :: a
+
+      a = abs(x)
+      if (a <= 0.0_wp) then
+         s = '0'
+         return
+      end if
+      if (.not. ieee_is_finite(x)) then
+         write (buf, '(es10.2)') x
+         s = trim(adjustl(buf))
+         return
+      end if
+      d = floor(log10(a))
+      ! Rounding to 3 digits may carry into the next decade (9.996 -> 10.0).
+      if (d >= -4 .and. d <= 5) then
+         if (anint(a*10.0_wp**(2 - d)) >= 1000.0_wp) d = d + 1
+      end if
+      if (d < -4 .or. d > 5) then
+         write (buf, '(es9.2)') x
+      else if (d >= 2) then
+         write (buf, '(i0)') nint(x, i8)
+      else
+         decimals = 2 - d
+         write (fmt, '("(f0.",i0,")")') decimals
+         write (buf, fmt) x
+      end if
+      s = leading_zero(trim(adjustl(buf)))
+   end function sig3
+
+   !> Add the zero some compilers omit before the decimal point (".5" -> "0.5").
+   pure function leading_zero(t) result(s)
+      character(len=*), intent(in) :: t
+      character(len=:), allocatable :: s
+      s = t
+      if (len(t) == 0) return
+      if (t(1:1) == '.') then
+         s = '0'//t
+      else if (len(t) > 1) then
+         if (t(1:2) == '-.') s = '-0'//t(2:)
+      end if
+   end function leading_zero
+
+   !> CSV text of column j of a row: integers plain, reals with 17
+   !> significant digits and a 3-digit exponent (read back bit for bit, by
+   !> Fortran and by Python's float), empty cells empty.
+   function csv_cell(row, j) result(s)
+      type(report_row_type), intent(in) :: row
+      integer, intent(in) :: j
+      character(len=:), allocatable :: s
+      character(len=32) :: buf
+      real(wp) :: x
+
+      if (column_kind(j) == kind_integer) then
+         write (buf, '(i0)') row_integer(row, j)
+      else
+         x = row_values(row, j)
+         if (is_empty(x)) then
+            s = ''
+            return
+         end if
+         write (buf, '(es25.16e3)') x
+      end if
+      s = trim(adjustl(buf))
+   end function csv_cell
+
+   !> Write `rows` as CSV to `path` (replacing it): the contract header, then
+   !> one line per row. Fails with stat_io naming the path.
+   subroutine write_report_csv(path, rows, error)
+      character(len=*), intent(in) :: path
+      type(report_row_type), intent(in) :: rows(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: unit, stat, i, j
+      character(len=256) :: msg
+      character(len=:), allocatable :: line
+
+      open (newunit=unit, file=path, status='replace', action='write', form='formatted', &
+         iostat=stat, iomsg=msg)
+      if (stat /= 0) then
+         call fatal_error(error, 'report CSV: cannot open "'//path//'" for writing: '//trim(msg), stat_io)
+         return
+      end if
+      write (unit, '(a)', iostat=stat, iomsg=msg) report_csv_header
+      do i = 1, size(rows)
+         if (stat /= 0) exit
+         line = csv_cell(rows(i), 1)
+         do j = 2, n_report_columns
+            line = line//','//csv_cell(rows(i), j)
+         end do
+         write (unit, '(a)', iostat=stat, iomsg=msg) line
+      end do
+      if (stat /= 0) then
+         close (unit)
+         call fatal_error(error, 'report CSV: cannot write "'//path//'": '//trim(msg), stat_io)
+         return
+      end if
+      close (unit, iostat=stat, iomsg=msg)
+      if (stat /= 0) call fatal_error(error, 'report CSV: cannot close "'//path//'": '//trim(msg), stat_io)
+   end subroutine write_report_csv
+
+   !> Read a report CSV written by `write_report_csv` (or by anything that
+   !> follows the contract). The header must start with the contract columns
+   !> in order; further columns are ignored. Empty real cells become empty;
+   !> "NaN" is refused (the contract never writes it). A missing file is
+   !> stat_io; a malformed line is stat_invalid_input naming path and line.
+   subroutine read_report_csv(path, rows, error)
+      character(len=*), intent(in) :: path
+      type(report_row_type), allocatable, intent(out) :: rows(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: unit, stat, nline
+      character(len=256) :: msg
+      character(len=:), allocatable :: line
+      type(report_row_type) :: row
+      type(report_row_type), allocatable :: buffer(:)
+      integer :: nrows
+
+      allocate (rows(0))
+      open (newunit=unit, file=path, status='old', action='read', form='formatted', iostat=stat, iomsg=msg)
+      if (stat /= 0) then
+         call fatal_error(error, 'report CSV: cannot open "'//path//'" for reading: '//trim(msg), stat_io)
+         return
+      end if
+      call read_line(unit, line, stat)
+      if (stat /= 0) then
+         close (unit)
+         call fatal_error(error, 'report CSV "'//path//'": no header line', stat_invalid_input)
+         return
+      end if
+      call check_header(line, path, error)
+      if (allocated(error)) then
+         close (unit)
+         return
+      end if
+      allocate (buffer(16))
+      nrows = 0
+      nline = 1
+      do
+         call read_line(unit, line, stat)
+         if (stat /= 0) exit
+         nline = nline + 1
+         if (len_trim(line) == 0) cycle
+         call parse_row(line, path, nline, row, error)
+         if (allocated(error)) exit
+         if (nrows == size(buffer)) buffer = [buffer, buffer]
+         nrows = nrows + 1
+         buffer(nrows) = row
+      end do
+      close (unit)
+      if (allocated(error)) return
+      if (.not. is_iostat_end(stat)) then
+         call fatal_error(error, 'report CSV "'//path//'": read error after line '//itoa(nline), stat_io)
+         return
+      end if
+      rows = buffer(:nrows)
+   end subroutine read_report_csv
+
+   !> Check that a header line starts with the contract columns.
+   subroutine check_header(line, path, error)
+      character(len=*), intent(in) :: line, path
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: field
+      integer :: pos, j
+
+      pos = 1
+      do j = 1, n_report_columns
+         call next_field(line, pos, field)
+         if (field /= trim(report_columns(j))) then
+            call fatal_error(error, 'report CSV "'//path//'": header column '//itoa(j)//' is "'//field// &
+               '", expected "'//trim(report_columns(j))//'"', stat_invalid_input)
+            return
+         end if
+      end do
+   end subroutine check_header
+
+   !> Parse one data line into a row.
+   subroutine parse_row(line, path, nline, row, error)
+      character(len=*), intent(in) :: line, path
+      integer, intent(in) :: nline
+      type(report_row_type), intent(out) :: row
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: field
+      character(len=64) :: buf
+      integer :: pos, j, stat
+      integer(i8) :: n
+      real(wp) :: x
+
+      pos = 1
+      do j = 1, n_report_columns
+         if (pos > len(line) + 1) then
+            call fatal_error(error, 'report CSV "'//path//'" line '//itoa(nline)//': '//itoa(j - 1)// &
+               ' columns, expected '//itoa(n_report_columns), stat_invalid_input)
+            return
+         end if
+         call next_field(line, pos, field)
+         stat = 0
+         if (len(field) > len(buf)) stat = 1
+         buf = field
+         if (column_kind(j) == kind_integer) then
+            if (len(field) == 0) stat = 1
+            if (stat == 0) read (buf, '(i64)', iostat=stat) n
+            if (stat == 0) call set_integer(row, j, n)
+         else if (len(field) > 0) then
+            if (stat == 0) read (buf, '(f64.0)', iostat=stat) x
+            if (stat == 0 .and. ieee_is_nan(x)) stat = 1
+            if (stat == 0) call set_real(row, j, x)
+         end if
+         if (stat /= 0) then
+            call fatal_error(error, 'report CSV "'//path//'" line '//itoa(nline)//': column '// &
+               trim(report_columns(j))//' has bad value "'//field//'"', stat_invalid_input)
+            return
+         end if
+      end do
+   end subroutine parse_row
+
+   !> The comma-separated field starting at `pos`, blanks trimmed; `pos`
+   !> moves past the comma (to len(line)+2 after the last field).
+   subroutine next_field(line, pos, field)
+      character(len=*), intent(in) :: line
+      integer, intent(inout) :: pos
+      character(len=:), allocatable, intent(out) :: field
+      integer :: last
+
+      if (pos > len(line)) then
+         field = ''
+         pos = len(line) + 2
+         return
+      end if
+      last = index(line(pos:), ',')
+      if (last == 0) then
+         field = trim(adjustl(line(pos:)))
+         pos = len(line) + 2
+      else
+         field = trim(adjustl(line(pos:pos + last - 2)))
+         pos = pos + last
+      end if
+   end subroutine next_field
+
+   !> Read one line of any length; a trailing carriage return is dropped.
+   subroutine read_line(unit, line, stat)
+      integer, intent(in) :: unit
+      character(len=:), allocatable, intent(out) :: line
+      integer, intent(out) :: stat
+      character(len=512) :: buf
+      integer :: n
+
+      line = ''
+      do
+         read (unit, '(a)', advance='no', iostat=stat, size=n) buf
+         line = line//buf(:n)
+         if (stat /= 0) exit
+      end do
+      if (is_iostat_eor(stat)) stat = 0
+      if (stat == 0 .and. len(line) > 0) then
+         if (line(len(line):) == achar(13)) line = line(:len(line) - 1)
+      end if
+   end subroutine read_line
+
+   pure function itoa(i) result(s)
+      integer, intent(in) :: i
+      character(len=:), allocatable :: s
+      character(len=16) :: buf
+      write (buf, '(i0)') i
+      s = trim(buf)
+   end function itoa
+
+end module sprc_io_report
