@@ -601,9 +601,9 @@ contains
          do i = k0, k0 + nk - 1
             p = rule%poly(:, i)
             if (depends_on(p, k)) then
-               call restrict(p, k, lo(k), c)
+               call face_restriction(ctx, body, p, rule%owner(i), k, lo(k), c)
                call push_poly(rule, c, 0, 0)
-               call restrict(p, k, hi(k), c)
+               call face_restriction(ctx, body, p, rule%owner(i), k, hi(k), c)
                call push_poly(rule, c, 0, 0)
             else
                call push_poly(rule, p, 0, 0)
@@ -644,6 +644,35 @@ contains
       end if
       rule%np = k0 - 1
    end subroutine reduce
+
+   !> Restriction of quadric p (of shape `owner`, 0 if derived) to y_k = v.
+   !> For a curved shape it is rebuilt from the shape around the face point,
+   !> x_k = center_k + half_k v: the constant term is then formed without
+   !> cancellation ((|d| - r)(|d| + r) and the like), which keeps the split
+   !> points of near-tangent restrictions (a sliver cut, a pole near a face)
+   !> accurate to a few ulps instead of eps * h^2 / (their small value).
+   pure subroutine face_restriction(ctx, body, p, owner, k, v, c)
+      type(context_type), intent(in) :: ctx
+      class(body_type), intent(in) :: body
+      real(wp), intent(in) :: p(0:), v
+      integer, intent(in) :: owner, k
+      real(wp), intent(out) :: c(0:)
+      real(wp) :: center(3), half(3), polys(0:ncoef - 1, max_shape_quadrics)
+      integer :: n
+
+      if (owner > 0) then
+         if (body%shapes(owner)%kind /= shape_box .and. body%shapes(owner)%kind /= shape_halfspace) then
+            center = ctx%center
+            half = ctx%half
+            center(k) = ctx%center(k) + ctx%half(k)*v
+            half(k) = 0.0_wp
+            call shape_quadrics(body%shapes(owner), center, half, center, center, 0.0_wp, polys, n)
+            c(0:ncoef - 1) = polys(:, 1)
+            return
+         end if
+      end if
+      call restrict(p, k, v, c)
+   end subroutine face_restriction
 
    !> Height direction among the free ones. Valid: every quadric either free
    !> of y_k (not allowed where `require`) or with dp/dy_k of one strict sign

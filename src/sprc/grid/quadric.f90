@@ -73,11 +73,14 @@ contains
 
    !> Enclosure [pmin, pmax] of p over the box [lo, hi]: in centered form each
    !> g_i t_i + A_ii t_i^2 has its exact range, the mixed terms their interval
-   !> bound; widened by a few ulps of the terms so that it is certified.
+   !> bound (exact for separable quadrics). Not widened for rounding: a zero
+   !> set touching the box only within a few ulps (a tangency at a point or
+   !> along a line, e.g. a sphere's pole on a cell face) must count as not
+   !> crossing it, and one missed by rounding has a measure of a few ulps.
    pure subroutine quadric_range(p, lo, hi, pmin, pmax)
       real(wp), intent(in) :: p(0:), lo(3), hi(3)
       real(wp), intent(out) :: pmin, pmax
-      real(wp) :: mid(3), r(3), g(3), f0, a, e1, e2, vmin, vmax, t, cross, mag
+      real(wp) :: mid(3), r(3), g(3), f0, a, e1, e2, vmin, vmax, t, cross
       integer :: i, j
 
       mid = 0.5_wp*(lo + hi)
@@ -86,7 +89,6 @@ contains
       g = quadric_gradient(p, mid)
       pmin = f0
       pmax = f0
-      mag = abs(f0)
       do i = 1, 3
          a = p(iq(i, i))
          e1 = -g(i)*r(i) + a*r(i)**2
@@ -102,18 +104,14 @@ contains
          end if
          pmin = pmin + vmin
          pmax = pmax + vmax
-         mag = mag + abs(g(i))*r(i) + abs(a)*r(i)**2
       end do
       do i = 1, 2
          do j = i + 1, 3
             cross = abs(p(iq(i, j)))*r(i)*r(j)
             pmin = pmin - cross
             pmax = pmax + cross
-            mag = mag + cross
          end do
       end do
-      pmin = pmin - 8.0_wp*epsilon(1.0_wp)*mag
-      pmax = pmax + 8.0_wp*epsilon(1.0_wp)*mag
    end subroutine quadric_range
 
    !> Range [dmin, dmax] of dp/dy_k over the box [lo, hi] (affine: exact, widened by a few ulps).
