@@ -63,7 +63,8 @@ contains
          new_unittest('rigid_modes', test_rigid_modes), &
          new_unittest('bad_inputs', test_bad_inputs), &
          new_unittest('umfpack_fallback', test_umfpack_fallback), &
-         new_unittest('threads', test_threads) &
+         new_unittest('threads', test_threads), &
+         new_unittest('queries_and_api_errors', test_queries) &
          ]
    end subroutine collect_fem
 
@@ -823,6 +824,118 @@ contains
       if (allocated(error)) return
       call check(error, index(problem%solver_note, 'not positive definite') > 0, 'note: '//problem%solver_note)
    end subroutine test_umfpack_fallback
+
+   !> Post-processing queries on a patch solution (stress is exact for a
+   !> linear field: stress_at, element_points, element weights sum to the
+   !> body's area), and the API's error paths.
+   subroutine test_queries(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: body
+      type(poly_field_type) :: field
+      type(elasticity_problem_type) :: problem, fresh
+      type(error_type), allocatable :: e
+      real(wp), allocatable :: x(:, :), w(:), sigma(:, :), ee(:)
+      real(wp) :: s(3), sx(3), area, err, nfe, nex
+      integer :: i
+
+      call new_poly_field(field, plane_strain, [0.01_wp, -0.02_wp], &
+         & reshape([0.003_wp, -0.001_wp, 0.002_wp, 0.004_wp], [2, 2]), error=error)
+      if (allocated(error)) return
+      call polygon_2d(body, error)
+      if (allocated(error)) return
+      call run_patch(body, [new_fe_bc(1, bc_exact_traction), new_fe_bc(2, bc_exact_displacement), &
+         & new_fe_bc(3, bc_exact_traction)], field, 2, 3, 1, 1.0e-10_wp, 'queries', error, problem_out=problem)
+      if (allocated(error)) return
+      call problem%stress_at([0.1_wp, -0.2_wp], s, error)
+      if (allocated(error)) return
+      call field%stress([0.1_wp, -0.2_wp], sx)
+      call check(error, maxval(abs(s - sx)), 0.0_wp, 1.0e-10_wp*maxval(abs(sx)), 'stress_at')
+      if (allocated(error)) return
+      area = 0.0_wp
+      do i = 1, problem%grid%n_leaves
+         call problem%element_points(i, x, w, sigma)
+         area = area + sum(w)
+         if (size(w) > 0) then
+            call field%stress(x(:, 1), sx)
+            call check(error, maxval(abs(sigma(:, 1) - sx)), 0.0_wp, 1.0e-10_wp*maxval(abs(sx)), 'element_points')
+            if (allocated(error)) return
+         end if
+      end do
+      call check(error, area, polygon_area(), 1.0e-12_wp, 'sum of element weights = area', rel=.true.)
+      if (allocated(error)) return
+
+      call problem%stress_at([5.0_wp, 0.0_wp], s, e)
+      call check(error, allocated(e), 'stress_at outside the grid rejected')
+      if (allocated(error)) return
+      call problem%stress_at([0.0_wp, 0.0_wp, 0.0_wp], s, e)
+      call check(error, allocated(e), 'stress_at with 3 coordinates rejected')
+      if (allocated(error)) return
+      call fresh%solve(e)
+      call check(error, allocated(e), 'solve before setup rejected')
+      if (allocated(error)) return
+      call fresh%energy_error(err, ee, nfe, nex, e)
+      call check(error, allocated(e), 'energy_error before solve rejected')
+      if (allocated(error)) return
+      call fresh%scaled_rcond(err, e)
+      call check(error, allocated(e), 'scaled_rcond before assembly rejected')
+      if (allocated(error)) return
+      call fresh%stress_at([0.0_wp, 0.0_wp], s, e)
+      call check(error, allocated(e), 'stress_at before solve rejected')
+      if (allocated(error)) return
+      call solve_on_grid(fresh, body, [-1.0_wp, -1.0_wp], 2.0_wp, 2, 0, 1, plane_strain, young, poisson, &
+         & [0.0_wp, 0.0_wp], [new_fe_bc(2, bc_displacement, vector=[0.0_wp, 0.0_wp])], e)
+      if (allocated(e)) then
+         call test_failed(error, 'plain displacement problem: '//e%message)
+         return
+      end if
+      call fresh%energy_error(err, ee, nfe, nex, e)
+      call check(error, allocated(e), 'energy_error without an exact solution rejected')
+      if (allocated(error)) return
+      call check(error, index(e%message, 'no exact solution') > 0, e%message)
+      if (allocated(error)) return
+      call solve_on_grid(fresh, body, [-1.0_wp, -1.0_wp], 2.0_wp, 2, 0, 1, plane_strain, young, poisson, &
+         & [0.0_wp, 0.0_wp], [new_fe_bc(2, bc_displacement, vector=[0.0_wp, 0.0_wp])], e, eta=1.5_wp)
+      call check(error, allocated(e), 'eta = 1.5 rejected')
+      if (allocated(error)) return
+      call solve_on_grid(fresh, body, [-1.0_wp, -1.0_wp], 2.0_wp, 2, 0, 1, plane_strain, young, poisson, &
+         & [0.0_wp, 0.0_wp], [new_fe_bc(2, bc_displacement, vector=[0.0_wp, 0.0_wp])], e, gamma=-1.0_wp)
+      call check(error, allocated(e), 'gamma = -1 rejected')
+
+   contains
+
+      !> Area of the box clipped by the two halfspaces n.(x - p) <= 0 (Sutherland-Hodgman, shoelace).
+      real(wp) function polygon_area() result(a)
+         real(wp) :: v(2, 16), u(2, 16), pt(2, 2), nr(2, 2), f0, f1
+         integer :: n, m, k, c
+         pt = reshape([0.3_wp, 0.2_wp, -0.4_wp, 0.1_wp], [2, 2])
+         nr = reshape([0.6_wp, 0.8_wp, -0.8_wp, 0.6_wp], [2, 2])
+         v(:, 1:4) = reshape([-0.83_wp, -0.77_wp, 0.79_wp, -0.77_wp, 0.79_wp, 0.81_wp, -0.83_wp, 0.81_wp], [2, 4])
+         n = 4
+         do c = 1, 2
+            m = 0
+            do k = 1, n
+               f0 = dot_product(nr(:, c), v(:, k) - pt(:, c))
+               f1 = dot_product(nr(:, c), v(:, mod(k, n) + 1) - pt(:, c))
+               if (f0 <= 0.0_wp) then
+                  m = m + 1
+                  u(:, m) = v(:, k)
+               end if
+               if ((f0 < 0.0_wp .and. f1 > 0.0_wp) .or. (f0 > 0.0_wp .and. f1 < 0.0_wp)) then
+                  m = m + 1
+                  u(:, m) = v(:, k) + f0/(f0 - f1)*(v(:, mod(k, n) + 1) - v(:, k))
+               end if
+            end do
+            n = m
+            v(:, 1:n) = u(:, 1:n)
+         end do
+         a = 0.0_wp
+         do k = 1, n
+            a = a + v(1, k)*v(2, mod(k, n) + 1) - v(1, mod(k, n) + 1)*v(2, k)
+         end do
+         a = 0.5_wp*abs(a)
+      end function polygon_area
+
+   end subroutine test_queries
 
    !> Same displacement bits with 1 and 2 OpenMP threads (parallel quadrature
    !> and element matrices, serial insertion).
