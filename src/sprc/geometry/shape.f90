@@ -19,6 +19,12 @@
 !> ulps of the coordinate magnitude). It is exact (attained) for every kind:
 !> each bound is phi evaluated at a point of the box where the extremum is
 !> attained, found from the shape's analytic structure, never by sampling.
+!>
+!> `gradient_range` gives a certified enclosure of one component of the
+!> gradient over a box (what a height-direction test needs): exact for the
+!> disk/sphere, ellipse/ellipsoid, halfspace and axis-parallel cylinder; a
+!> sound over-estimate for an oblique cylinder and for the box (whose gradient
+!> takes the values -1, 0, 1).
 module sprc_geometry_shape
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use sprc_core_kinds, only: wp
@@ -72,6 +78,7 @@ module sprc_geometry_shape
       procedure :: phi => shape_phi
       procedure :: gradient => shape_gradient
       procedure :: phi_range => shape_phi_range
+      procedure :: gradient_range => shape_gradient_range
    end type shape_type
 
 contains
@@ -419,6 +426,134 @@ contains
          fmax = huge(1.0_wp)
       end select
    end subroutine shape_phi_range
+
+   !> Certified enclosure [gmin, gmax] of the k-th gradient component over the
+   !> box [lo, hi] (size dim, lo <= hi, 1 <= k <= dim); see the module notes.
+   !> - sphere: g_k = t/sqrt(t^2 + s^2) with t = x_k - c_k and s the distance of
+   !>   the other coordinates to the center's: increasing in t, decreasing in
+   !>   s for t > 0 and increasing for t < 0, so each bound takes t at a face
+   !>   and s at its nearest or farthest value (exact); [-1, 1] if the center
+   !>   lies in the box (every direction is a limit there);
+   !> - ellipsoid: affine in x_k; halfspace: constant;
+   !> - cylinder along a coordinate axis: the disk rule in the normal plane
+   !>   (exact); oblique: numerator range over denominator range, clipped to
+   !>   [-1, 1] (sound);
+   !> - box: -1 possible only in the lower half along k, +1 only in the
+   !>   upper half, 0 wherever another face may win (sound).
+   pure subroutine shape_gradient_range(self, lo, hi, k, gmin, gmax)
+      class(shape_type), intent(in) :: self
+      real(wp), intent(in) :: lo(:), hi(:)
+      integer, intent(in) :: k
+      real(wp), intent(out) :: gmin, gmax
+      real(wp) :: s, nlo, nhi, dmin, dmax, far(3)
+      logical :: other(3)
+      integer :: d, i, corner
+
+      d = self%dim
+      select case (self%kind)
+      case (shape_disk, shape_sphere)
+         other = .true.
+         other(k) = .false.
+         call round_gradient_range(self%center, lo, hi, k, other(1:d), gmin, gmax)
+      case (shape_ellipse, shape_ellipsoid)
+         s = 2.0_wp*ellipsoid_factor(self)/self%semi_axes(k)**2
+         gmin = s*(lo(k) - self%center(k))
+         gmax = s*(hi(k) - self%center(k))
+      case (shape_halfspace)
+         gmin = self%normal(k)
+         gmax = self%normal(k)
+      case (shape_cylinder)
+         if (count(self%axis == 0.0_wp) == 2) then
+            ! axis along a coordinate direction: phi is the disk's in the normal plane
+            other = self%axis == 0.0_wp
+            if (.not. other(k)) then
+               gmin = 0.0_wp
+               gmax = 0.0_wp
+               return
+            end if
+            other(k) = .false.
+            call round_gradient_range(self%point, lo, hi, k, other, gmin, gmax)
+            return
+         end if
+         ! numerator e_k.P(x - p) is affine: its range is attained at corners
+         nlo = huge(1.0_wp)
+         nhi = -huge(1.0_wp)
+         do corner = 0, 7
+            do i = 1, 3
+               far(i) = merge(hi(i), lo(i), btest(corner, i - 1))
+            end do
+            s = perpendicular_component(self%axis, far - self%point, k)
+            nlo = min(nlo, s)
+            nhi = max(nhi, s)
+         end do
+         dmin = line_box_distance(self%point, self%axis, lo(1:3), hi(1:3))
+         dmax = -huge(1.0_wp)
+         do corner = 0, 7
+            do i = 1, 3
+               far(i) = merge(hi(i), lo(i), btest(corner, i - 1))
+            end do
+            dmax = max(dmax, norm2(perpendicular(self%axis, far - self%point)))
+         end do
+         gmin = -1.0_wp
+         gmax = 1.0_wp
+         if (dmin > 0.0_wp) then
+            gmin = max(-1.0_wp, min(nlo/dmin, nlo/dmax))
+            gmax = min(1.0_wp, max(nhi/dmin, nhi/dmax))
+         end if
+      case (shape_box)
+         s = 0.5_wp*(self%lower(k) + self%upper(k))
+         gmin = merge(-1.0_wp, 0.0_wp, lo(k) < s)
+         gmax = merge(1.0_wp, 0.0_wp, hi(k) > s)
+      case default
+         gmin = 0.0_wp
+         gmax = 0.0_wp
+      end select
+   end subroutine shape_gradient_range
+
+   !> Range of (x_k - c_k)/|x_J - c_J| over the box, J = {k} and the dims marked in `other`.
+   pure subroutine round_gradient_range(c, lo, hi, k, other, gmin, gmax)
+      real(wp), intent(in) :: c(:), lo(:), hi(:)
+      integer, intent(in) :: k
+      logical, intent(in) :: other(:)
+      real(wp), intent(out) :: gmin, gmax
+      real(wp) :: near2, far2, nearest
+      integer :: i
+
+      near2 = 0.0_wp
+      far2 = 0.0_wp
+      do i = 1, size(other)
+         if (.not. other(i)) cycle
+         nearest = min(max(c(i), lo(i)), hi(i)) - c(i)
+         near2 = near2 + nearest**2
+         far2 = far2 + max(abs(lo(i) - c(i)), abs(hi(i) - c(i)))**2
+      end do
+      if (near2 == 0.0_wp .and. lo(k) <= c(k) .and. c(k) <= hi(k)) then
+         gmin = -1.0_wp
+         gmax = 1.0_wp
+         return
+      end if
+      gmax = ratio(hi(k) - c(k), near2, far2)
+      gmin = -ratio(c(k) - lo(k), near2, far2)
+   contains
+      !> Largest t/sqrt(t^2 + s^2) at this t over s^2 in [near2, far2].
+      pure real(wp) function ratio(t, near2, far2) result(r)
+         real(wp), intent(in) :: t, near2, far2
+         if (t > 0.0_wp) then
+            r = t/sqrt(t*t + near2)
+         else if (t < 0.0_wp) then
+            r = t/sqrt(t*t + far2)
+         else
+            r = 0.0_wp
+         end if
+      end function ratio
+   end subroutine round_gradient_range
+
+   !> k-th component of v normal to the unit vector a.
+   pure real(wp) function perpendicular_component(a, v, k) result(w)
+      real(wp), intent(in) :: a(3), v(3)
+      integer, intent(in) :: k
+      w = v(k) - dot_product(v, a)*a(k)
+   end function perpendicular_component
 
    ! ------------------------------------------------------------ helpers
 

@@ -1,0 +1,320 @@
+!> Dofs of the FE space and the transformation u = T ubar from the reduced
+!> unknowns ubar to the displacement components of all nodes.
+!>
+!> T is built per node (scalar, applied per component) from two sources, then
+!> restricted per component:
+!> 1. hanging nodes (`sprc_grid_hanging`): u_h = sum_k c_k u_k over free nodes;
+!> 2. cell aggregation (`sprc_fem_aggregation`): a free node that no
+!>    well-posed cell uses (directly or as a hanging-node master) is an
+!>    "outlaw"; it takes the value of its root cell's polynomial,
+!>    u_i = sum_j N_j^root(x_i) u_j over the root's nodes (themselves expanded
+!>    by 1, whose masters all belong to well-posed cells). The outlaw's root is
+!>    the root of the lowest-numbered cell containing it.
+!> The free nodes that remain are the masters, numbered in node order.
+!> 3. strong zero components: component c of a node lying on a plane
+!>    x_c = const listed by the caller (a symmetry plane on grid planes) is
+!>    zero. Its row of T is empty, and a master's component on such a plane
+!>    is not an unknown.
+!> The reduced dofs are the remaining (master, component) pairs, numbered
+!> master by master. T reproduces every field whose components are linear
+!> (hanging and aggregation constraints interpolate polynomials exactly), up
+!> to the zeroed components.
+!>
+!> Element matrices are reduced element by element: `element_map` gives the
+!> element's reduced dofs and the dense block T_e (rows: local dofs, node-major).
+module sprc_fem_constraints
+   use sprc_core_kinds, only: wp
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_internal
+   use sprc_grid_tree, only: grid_type
+   use sprc_grid_nodes, only: grid_nodes_type, element_shape
+   use sprc_grid_hanging, only: hanging_type
+   implicit none
+   private
+
+   public :: constraint_type
+
+   !> u = T ubar (module notes).
+   type :: constraint_type
+      integer :: dim = 0
+      !> Nodes (rows of the node-level T), masters (its columns), reduced dofs.
+      integer :: n_nodes = 0, n_masters = 0, n_dofs = 0
+      !> Free nodes constrained by aggregation (outlaws).
+      integer :: n_outlaw = 0
+      !> Node-level T in CSR over master numbers: row i is t_col/t_val(t_ptr(i) : t_ptr(i+1)-1).
+      integer, allocatable :: t_ptr(:), t_col(:)
+      real(wp), allocatable :: t_val(:)
+      !> Node of each master (n_masters).
+      integer, allocatable :: master_node(:)
+      !> Reduced dof of component c of master m, 0 when that component is zero (dim, n_masters).
+      integer, allocatable :: dof(:, :)
+      !> Component c of node i is zero (strong symmetry) (dim, n_nodes).
+      logical, allocatable :: zero(:, :)
+   contains
+      procedure :: build => constraints_build
+      procedure :: element_map
+      procedure :: expand
+      procedure :: restrict_field
+   end type constraint_type
+
+contains
+
+   !> Build T for `nodes` on `grid` with hanging constraints `hanging`, cell roots
+   !> `root` (root(e) = e: well-posed) and strong zero planes: component
+   !> plane_axis(k) is zero on the nodes with |x(plane_axis(k)) - plane_coord(k)| <= tol.
+   subroutine constraints_build(self, grid, nodes, hanging, root, plane_axis, plane_coord, tol, error)
+      class(constraint_type), intent(out) :: self
+      type(grid_type), intent(in) :: grid
+      type(grid_nodes_type), intent(in) :: nodes
+      type(hanging_type), intent(in) :: hanging
+      integer, intent(in) :: root(:), plane_axis(:)
+      real(wp), intent(in) :: plane_coord(:), tol
+      type(error_type), allocatable, intent(out) :: error
+      logical, allocatable :: supported(:)
+      integer, allocatable :: master_of(:), a_ptr(:), a_col(:), marker(:), row_col(:)
+      real(wp), allocatable :: a_val(:), acc(:)
+      integer :: d, e, j, k, i, m, c, nfree, p, q, nrow, r, na, nt
+      real(wp) :: lo(3), hi(3), xi(3), shape(27)
+
+      d = nodes%dim
+      if (size(root) /= nodes%n_elements .or. hanging%n_all /= nodes%n_nodes) then
+         call fatal_error(error, 'constraints: root or hanging data do not match the nodes', stat_invalid_input)
+         return
+      end if
+      self%dim = d
+      self%n_nodes = nodes%n_nodes
+      nfree = hanging%n_free
+
+      ! Free nodes used by a well-posed cell.
+      allocate (supported(nfree))
+      supported = .false.
+      do e = 1, nodes%n_elements
+         if (root(e) /= e) cycle
+         do j = 1, nodes%nodes_per_element
+            i = nodes%connectivity(j, e)
+            supported(hanging%t_col(hanging%t_ptr(i):hanging%t_ptr(i + 1) - 1)) = .true.
+         end do
+      end do
+      allocate (master_of(nfree))
+      m = 0
+      do k = 1, nfree
+         master_of(k) = 0
+         if (.not. supported(k)) cycle
+         m = m + 1
+         master_of(k) = m
+      end do
+      self%n_masters = m
+      allocate (self%master_node(m))
+      do k = 1, nfree
+         if (master_of(k) > 0) self%master_node(master_of(k)) = hanging%free_node(k)
+      end do
+      self%n_outlaw = nfree - m
+
+      ! Outlaw rows A(k, :) over masters: the root polynomial at the outlaw's position.
+      allocate (a_ptr(nfree + 1), marker(m), acc(m), row_col(m))
+      marker = 0
+      allocate (a_col(16), a_val(16))
+      na = 0
+      a_ptr(1) = 1
+      do k = 1, nfree
+         nrow = 0
+         if (.not. supported(k)) then
+            i = hanging%free_node(k)
+            e = nodes%node_element(nodes%node_element_ptr(i))
+            r = root(e)
+            call grid%leaf_box(r, lo(1:d), hi(1:d))
+            xi(1:d) = (nodes%x(:, i) - lo(1:d))/(hi(1:d) - lo(1:d))
+            call element_shape(d, nodes%degree, xi(1:d), shape)
+            do j = 1, nodes%nodes_per_element
+               p = nodes%connectivity(j, r)
+               do q = hanging%t_ptr(p), hanging%t_ptr(p + 1) - 1
+                  c = master_of(hanging%t_col(q))
+                  if (c == 0) then
+                     call fatal_error(error, 'constraints: a well-posed cell uses an unsupported node', &
+                        & stat_internal)
+                     return
+                  end if
+                  call accumulate(c, shape(j)*hanging%t_val(q))
+               end do
+            end do
+         end if
+         call flush_row(a_col, a_val, na)
+         a_ptr(k + 1) = na + 1
+      end do
+
+      ! Node rows: hanging rows with outlaws replaced by their A rows.
+      nt = 0
+      allocate (self%t_ptr(self%n_nodes + 1), self%t_col(size(hanging%t_col) + 16), &
+         & self%t_val(size(hanging%t_col) + 16))
+      self%t_ptr(1) = 1
+      do i = 1, self%n_nodes
+         nrow = 0
+         do q = hanging%t_ptr(i), hanging%t_ptr(i + 1) - 1
+            k = hanging%t_col(q)
+            if (master_of(k) > 0) then
+               call accumulate(master_of(k), hanging%t_val(q))
+            else
+               do p = a_ptr(k), a_ptr(k + 1) - 1
+                  call accumulate(a_col(p), hanging%t_val(q)*a_val(p))
+               end do
+            end if
+         end do
+         call flush_row(self%t_col, self%t_val, nt)
+         self%t_ptr(i + 1) = nt + 1
+      end do
+      self%t_col = self%t_col(1:nt)
+      self%t_val = self%t_val(1:nt)
+
+      ! Strong zero components and the reduced dof numbers.
+      allocate (self%zero(d, self%n_nodes), self%dof(d, m))
+      self%zero = .false.
+      do k = 1, size(plane_axis)
+         do i = 1, self%n_nodes
+            if (abs(nodes%x(plane_axis(k), i) - plane_coord(k)) <= tol) self%zero(plane_axis(k), i) = .true.
+         end do
+      end do
+      self%n_dofs = 0
+      do j = 1, m
+         do c = 1, d
+            self%dof(c, j) = 0
+            if (self%zero(c, self%master_node(j))) cycle
+            self%n_dofs = self%n_dofs + 1
+            self%dof(c, j) = self%n_dofs
+         end do
+      end do
+
+   contains
+
+      subroutine accumulate(col, val)
+         integer, intent(in) :: col
+         real(wp), intent(in) :: val
+         if (marker(col) == 0) then
+            nrow = nrow + 1
+            row_col(nrow) = col
+            marker(col) = nrow
+            acc(nrow) = 0.0_wp
+         end if
+         acc(marker(col)) = acc(marker(col)) + val
+      end subroutine accumulate
+
+      !> Append the accumulated row (columns ascending, exact zeros dropped) and reset the marker.
+      subroutine flush_row(cols, vals, count)
+         integer, allocatable, intent(inout) :: cols(:)
+         real(wp), allocatable, intent(inout) :: vals(:)
+         integer, intent(inout) :: count
+         integer :: a, b, tc
+         real(wp) :: tv
+         do a = 2, nrow
+            tc = row_col(a)
+            tv = acc(a)
+            b = a - 1
+            do while (b >= 1)
+               if (row_col(b) <= tc) exit
+               row_col(b + 1) = row_col(b)
+               acc(b + 1) = acc(b)
+               b = b - 1
+            end do
+            row_col(b + 1) = tc
+            acc(b + 1) = tv
+         end do
+         do a = 1, nrow
+            marker(row_col(a)) = 0
+         end do
+         if (count + nrow > size(cols)) then
+            cols = [cols, spread(0, 1, max(count + nrow, 2*size(cols)) - size(cols))]
+            vals = [vals, spread(0.0_wp, 1, size(cols) - size(vals))]
+         end if
+         do a = 1, nrow
+            if (acc(a) == 0.0_wp) cycle
+            count = count + 1
+            cols(count) = row_col(a)
+            vals(count) = acc(a)
+         end do
+         nrow = 0
+      end subroutine flush_row
+
+   end subroutine constraints_build
+
+   !> Reduced dofs dofs(1:m) (ascending) of an element with nodes `conn` and the
+   !> block tmat(1:dim*size(conn), 1:m) with u_e = tmat ubar(dofs). `dofs` and
+   !> `tmat` must be large enough (size(dofs) >= number of distinct dofs).
+   pure subroutine element_map(self, conn, dofs, tmat, m)
+      class(constraint_type), intent(in) :: self
+      integer, intent(in) :: conn(:)
+      integer, intent(out) :: dofs(:)
+      real(wp), intent(out) :: tmat(:, :)
+      integer, intent(out) :: m
+      integer :: j, c, q, g, a, b, d, row, pos
+
+      d = self%dim
+      m = 0
+      do j = 1, size(conn)
+         do q = self%t_ptr(conn(j)), self%t_ptr(conn(j) + 1) - 1
+            do c = 1, d
+               if (self%zero(c, conn(j))) cycle
+               g = self%dof(c, self%t_col(q))
+               if (g == 0) cycle
+               if (any(dofs(1:m) == g)) cycle
+               m = m + 1
+               dofs(m) = g
+            end do
+         end do
+      end do
+      ! ascending order, so the element's entries reach the COO in a fixed order
+      do a = 2, m
+         g = dofs(a)
+         b = a - 1
+         do while (b >= 1)
+            if (dofs(b) <= g) exit
+            dofs(b + 1) = dofs(b)
+            b = b - 1
+         end do
+         dofs(b + 1) = g
+      end do
+      tmat(1:d*size(conn), 1:m) = 0.0_wp
+      do j = 1, size(conn)
+         do c = 1, d
+            if (self%zero(c, conn(j))) cycle
+            row = (j - 1)*d + c
+            do q = self%t_ptr(conn(j)), self%t_ptr(conn(j) + 1) - 1
+               g = self%dof(c, self%t_col(q))
+               if (g == 0) cycle
+               pos = findloc(dofs(1:m), g, 1)
+               tmat(row, pos) = tmat(row, pos) + self%t_val(q)
+            end do
+         end do
+      end do
+   end subroutine element_map
+
+   !> u(dim, n_nodes) = T ubar(n_dofs).
+   pure subroutine expand(self, ubar, u)
+      class(constraint_type), intent(in) :: self
+      real(wp), intent(in) :: ubar(:)
+      real(wp), intent(out) :: u(:, :)
+      integer :: i, c, q, g
+      do i = 1, self%n_nodes
+         do c = 1, self%dim
+            u(c, i) = 0.0_wp
+            if (self%zero(c, i)) cycle
+            do q = self%t_ptr(i), self%t_ptr(i + 1) - 1
+               g = self%dof(c, self%t_col(q))
+               if (g > 0) u(c, i) = u(c, i) + self%t_val(q)*ubar(g)
+            end do
+         end do
+      end do
+   end subroutine expand
+
+   !> ubar(n_dofs) holding the nodal field u(dim, n_nodes) at the masters (the
+   !> reduced representation of a field T reproduces; zeroed components dropped).
+   pure subroutine restrict_field(self, u, ubar)
+      class(constraint_type), intent(in) :: self
+      real(wp), intent(in) :: u(:, :)
+      real(wp), intent(out) :: ubar(:)
+      integer :: j, c
+      do j = 1, self%n_masters
+         do c = 1, self%dim
+            if (self%dof(c, j) > 0) ubar(self%dof(c, j)) = u(c, self%master_node(j))
+         end do
+      end do
+   end subroutine restrict_field
+
+end module sprc_fem_constraints

@@ -1,0 +1,152 @@
+!> Q1 / Q2 Lagrange elements on axis-aligned boxes (the grid's cells).
+!>
+!> A cell [lo, hi] is mapped from the reference cube by x = lo + (hi - lo) xi,
+!> so the Jacobian is the constant diagonal diag(hi - lo): gradients are the
+!> reference gradients divided by the edge lengths, with no inversion. Shape
+!> functions are tensor products of 1D Lagrange polynomials on equispaced
+!> nodes, and the local node order is `sprc_grid_nodes`' VTK order
+!> (`element_node_index`). Points outside the box are allowed: the element's
+!> polynomial is then extrapolated (what cell aggregation needs).
+!>
+!> Local dofs are node-major: dof (j - 1) dim + c is component c of node j.
+!> Voigt order 2D (xx, yy, xy), 3D (xx, yy, zz, xy, yz, xz) with engineering
+!> shear strains, as in `sprc_core_material`.
+!>
+!> Everything here is pure and allocation-free apart from automatic arrays
+!> sized by the element, so it may be called from OpenMP threads.
+module sprc_fem_element
+   use sprc_core_kinds, only: wp
+   use sprc_core_lapack, only: dgemm
+   use sprc_grid_nodes, only: element_node_index
+   implicit none
+   private
+
+   public :: shape_functions, strain_matrix, traction_matrix, displacement_matrix
+   public :: add_stiffness, element_stress
+
+contains
+
+   !> Values n(nen) and physical gradients dndx(dim, nen) of the Q`degree`
+   !> shape functions of the box [lo, hi] at the point x (size dim each).
+   pure subroutine shape_functions(dim, degree, lo, hi, x, n, dndx)
+      integer, intent(in) :: dim, degree
+      real(wp), intent(in) :: lo(:), hi(:), x(:)
+      real(wp), intent(out) :: n(:), dndx(:, :)
+      real(wp) :: l(0:2, 3), dl(0:2, 3), width(3)
+      integer :: idx(dim, (degree + 1)**dim)
+      integer :: j, k, m
+
+      do k = 1, dim
+         width(k) = hi(k) - lo(k)
+         call lagrange_1d(degree, (x(k) - lo(k))/width(k), l(:, k), dl(:, k))
+      end do
+      idx = element_node_index(dim, degree)
+      do j = 1, size(idx, 2)
+         n(j) = 1.0_wp
+         do k = 1, dim
+            n(j) = n(j)*l(idx(k, j), k)
+            dndx(k, j) = dl(idx(k, j), k)/width(k)
+            do m = 1, dim
+               if (m /= k) dndx(k, j) = dndx(k, j)*l(idx(m, j), m)
+            end do
+         end do
+      end do
+   end subroutine shape_functions
+
+   !> 1D Lagrange basis of degree 1 or 2 on the equispaced nodes of [0, 1] and its derivative.
+   pure subroutine lagrange_1d(degree, t, l, dl)
+      integer, intent(in) :: degree
+      real(wp), intent(in) :: t
+      real(wp), intent(out) :: l(0:2), dl(0:2)
+      if (degree == 1) then
+         l = [1.0_wp - t, t, 0.0_wp]
+         dl = [-1.0_wp, 1.0_wp, 0.0_wp]
+      else
+         l = [(2.0_wp*t - 1.0_wp)*(t - 1.0_wp), 4.0_wp*t*(1.0_wp - t), t*(2.0_wp*t - 1.0_wp)]
+         dl = [4.0_wp*t - 3.0_wp, 4.0_wp - 8.0_wp*t, 4.0_wp*t - 1.0_wp]
+      end if
+   end subroutine lagrange_1d
+
+   !> Strain-displacement matrix b(nstress, dim*nen): eps = b u_e.
+   pure subroutine strain_matrix(dim, dndx, b)
+      integer, intent(in) :: dim
+      real(wp), intent(in) :: dndx(:, :)
+      real(wp), intent(out) :: b(:, :)
+      integer :: j, c
+
+      b = 0.0_wp
+      do j = 1, size(dndx, 2)
+         c = (j - 1)*dim
+         b(1, c + 1) = dndx(1, j)
+         b(2, c + 2) = dndx(2, j)
+         if (dim == 2) then
+            b(3, c + 1) = dndx(2, j)
+            b(3, c + 2) = dndx(1, j)
+         else
+            b(3, c + 3) = dndx(3, j)
+            b(4, c + 1) = dndx(2, j)
+            b(4, c + 2) = dndx(1, j)
+            b(5, c + 2) = dndx(3, j)
+            b(5, c + 3) = dndx(2, j)
+            b(6, c + 1) = dndx(3, j)
+            b(6, c + 3) = dndx(1, j)
+         end if
+      end do
+   end subroutine strain_matrix
+
+   !> Matrix tn(dim, nstress) with t = tn sigma = sigma n for the unit normal n.
+   pure subroutine traction_matrix(dim, n, tn)
+      integer, intent(in) :: dim
+      real(wp), intent(in) :: n(:)
+      real(wp), intent(out) :: tn(:, :)
+      tn = 0.0_wp
+      if (dim == 2) then
+         tn(1, 1) = n(1); tn(1, 3) = n(2)
+         tn(2, 2) = n(2); tn(2, 3) = n(1)
+      else
+         tn(1, 1) = n(1); tn(1, 4) = n(2); tn(1, 6) = n(3)
+         tn(2, 2) = n(2); tn(2, 4) = n(1); tn(2, 5) = n(3)
+         tn(3, 3) = n(3); tn(3, 5) = n(2); tn(3, 6) = n(1)
+      end if
+   end subroutine traction_matrix
+
+   !> Displacement interpolation matrix nm(dim, dim*nen): u = nm u_e.
+   pure subroutine displacement_matrix(dim, n, nm)
+      integer, intent(in) :: dim
+      real(wp), intent(in) :: n(:)
+      real(wp), intent(out) :: nm(:, :)
+      integer :: j, c
+      nm = 0.0_wp
+      do j = 1, size(n)
+         do c = 1, dim
+            nm(c, (j - 1)*dim + c) = n(j)
+         end do
+      end do
+   end subroutine displacement_matrix
+
+   !> ke += w b^T d b, with db = d b (nstress, ndof) supplied by the caller
+   !> (it is also what a Nitsche term or a stress needs).
+   subroutine add_stiffness(b, db, w, ke)
+      real(wp), intent(in) :: b(:, :), db(:, :), w
+      real(wp), intent(inout) :: ke(:, :)
+      integer :: ns, ndof
+      ns = size(b, 1)
+      ndof = size(b, 2)
+      call dgemm('T', 'N', ndof, ndof, ns, w, b, ns, db, ns, 1.0_wp, ke, size(ke, 1))
+   end subroutine add_stiffness
+
+   !> Stress sigma(nstress) = d b u_e at a point of the box [lo, hi] from the
+   !> element's nodal displacements ue(dim*nen), node-major.
+   pure subroutine element_stress(dim, degree, d, lo, hi, x, ue, sigma)
+      integer, intent(in) :: dim, degree
+      real(wp), intent(in) :: d(:, :), lo(:), hi(:), x(:), ue(:)
+      real(wp), intent(out) :: sigma(:)
+      real(wp) :: n((degree + 1)**dim), dndx(dim, (degree + 1)**dim)
+      real(wp) :: b(size(d, 1), dim*(degree + 1)**dim)
+
+      call shape_functions(dim, degree, lo, hi, x, n, dndx)
+      call strain_matrix(dim, dndx, b)
+      sigma = matmul(d, matmul(b, ue))
+   end subroutine element_stress
+
+end module sprc_fem_element

@@ -1,0 +1,940 @@
+!> Linear elasticity on one body's cut Cartesian grid: Q1 / Q2 elements,
+!> immersed boundary conditions, small-cut robustness, sparse direct solve and
+!> the post-processing the recovery and the report need.
+!>
+!> Use:
+!> ```
+!> call problem%setup(body, grid, nodes, hanging, quad, analysis, young, poisson, &
+!>                    body_force, bcs, error [, exact] [, eta] [, gamma])
+!> call problem%solve(error)
+!> ! problem%u(dim, n_nodes), problem%stress_at(x, sigma, error),
+!> ! problem%element_points(e, x, w, sigma), problem%energy_error(...),
+!> ! problem%t_quadrature, t_assembly, t_solve
+!> ```
+!> The inputs are plain data: the body (geometry), its grid, Q`degree` nodes
+!> and hanging-node constraints built on that grid, the cut-cell quadrature
+!> settings, the material, a constant body force, boundary conditions by shape
+!> index (`sprc_fem_bc`) and optionally an exact solution (for exact_* kinds
+!> and for `energy_error`). The problem keeps copies of what it needs.
+!>
+!> Formulation. Find u_h in V_h = {T ubar} with
+!>   a(u, v) + N(u, v) = l(v) for all v in V_h,
+!>   a(u, v) = int_Omega eps(v)^T D eps(u),  l(v) = int_Omega v.b + int_GN v.t,
+!> where Omega is the true (curved) domain integrated by the cut-cell
+!> quadrature and GN the Neumann surfaces (free, pressure t = -p n, traction,
+!> exact traction sigma_ex n). Dirichlet (u = g: displacement, exact
+!> displacement; P = I) and weak symmetry (u.n = 0 with zero shear: P = n n^T,
+!> g = 0) surfaces add the symmetric Nitsche terms
+!>   N(u, v) = -int_GD (v.P sigma(u)n + u.P sigma(v)n) + int_GD (gamma dmax/h) u.P v,
+!>   l(v)   += -int_GD g.P sigma(v)n + int_GD (gamma dmax/h) g.P v,
+!> with h the cell size and dmax the largest diagonal entry of D (the
+!> material's stiffness scale, 1.35 E for nu = 0.3 in plane strain). Symmetry
+!> on a halfspace with an axis normal lying on grid planes (no cell straddles
+!> it: every quarter / octant scene) is strong: u_k = 0 at the nodes on the
+!> plane, and its surface points add nothing (zero shear is natural).
+!>
+!> Penalty. Coercivity of a + N needs gamma dmax/h > 2 sup ||sigma(v)n||^2_GD /
+!> a(v, v) over V_h, i.e. gamma > 2 C_I with the trace-inverse constant C_I of
+!> h ||sigma(v) n||^2_{Gamma ∩ A} <= C_I dmax a_A(v, v) on an aggregate A.
+!> Aggregation makes C_I independent of the cut (the function on a small cell
+!> is the root cell's polynomial, whose trace anywhere within a few cell sizes
+!> is bounded by its energy on the root cell); for Q_p on a cell C_I is about
+!> (p + 1)^2 times a small geometric factor (surface measure per cell up to
+!> ~sqrt(dim) h^(dim-1), extrapolation over one cell). `default_gamma` =
+!> 10 (p + 1)^2 (40 for Q1, 90 for Q2) leaves a margin of 2 or more over that;
+!> if the system still comes out indefinite CHOLMOD says so and UMFPACK
+!> solves it (`solver_note`).
+!>
+!> Small cut cells: cell aggregation (`sprc_fem_aggregation`, threshold `eta`)
+!> through the constraint machinery (`sprc_fem_constraints`).
+!>
+!> Determinism: quadrature and element matrices are computed in parallel
+!> (OpenMP), in chunks of elements, and inserted into the COO list serially
+!> in element order; reductions (norms, errors) are summed serially in
+!> element order. The bits do not depend on the thread count.
+module sprc_fem_problem
+   use sprc_core_kinds, only: wp
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular, &
+      & stat_not_positive_definite
+   use sprc_core_lapack, only: dgemm, dsyev
+   use sprc_core_material, only: plane_stress, plane_strain, solid, voigt_size, analysis_name, &
+      & material_matrix, compliance_matrix
+   use sprc_core_timer, only: timer_type
+   use sprc_geometry_body, only: body_type
+   use sprc_geometry_shape, only: shape_halfspace
+   use sprc_geometry_region, only: cell_inside
+   use sprc_grid_tree, only: grid_type
+   use sprc_grid_nodes, only: grid_nodes_type
+   use sprc_grid_hanging, only: hanging_type
+   use sprc_grid_quadrature, only: cut_quadrature_type, cell_rule_type, cell_rule, new_cut_quadrature, &
+      & default_points
+   use sprc_exact_solution, only: exact_solution_type
+   use sprc_fem_sparse, only: coo_type, csr_type
+   use sprc_fem_cholmod, only: cholmod_solver_type
+   use sprc_fem_umfpack, only: umfpack_solver_type
+   use sprc_fem_element, only: shape_functions, strain_matrix, traction_matrix, displacement_matrix, &
+      & add_stiffness, element_stress
+   use sprc_fem_bc, only: fe_bc_type, check_bcs, bc_free, bc_pressure, bc_traction, bc_displacement, &
+      & bc_symmetry, bc_exact_traction, bc_exact_displacement
+   use sprc_fem_aggregation, only: aggregate_cells, default_eta
+   use sprc_fem_constraints, only: constraint_type
+   implicit none
+   private
+
+   public :: elasticity_problem_type, default_gamma, rigid_tol, solve_on_grid
+
+   !> Elements per chunk of the parallel assembly (bounds the buffer of reduced matrices).
+   integer, parameter :: chunk_size = 256
+
+   !> A rigid-body mode whose normalised energy (module notes of `check_rigid_modes`)
+   !> is below this is free. Free modes give round-off, ~1e-15; the weakest
+   !> restraint (one Nitsche point or one zeroed node row on a 1e6-node grid)
+   !> gives >= ~1e-7.
+   real(wp), parameter :: rigid_tol = 1.0e-10_wp
+
+   !> Quadrature of one element while the rules are computed in parallel.
+   type :: rule_store_type
+      integer :: nvol = 0, nsurf = 0
+      real(wp), allocatable :: x(:, :), w(:), sx(:, :), sw(:), sn(:, :)
+      integer, allocatable :: ss(:)
+   end type rule_store_type
+
+   !> The FE problem of one body (module notes).
+   type :: elasticity_problem_type
+      !> Dimension, element degree, analysis kind, Voigt size, nodes per element.
+      integer :: dim = 0, degree = 0, analysis = 0, nstress = 0, nen = 0
+      real(wp) :: young = 0.0_wp, poisson = 0.0_wp
+      !> Material matrix, compliance, largest diagonal entry of d.
+      real(wp) :: d(6, 6) = 0.0_wp, compliance(6, 6) = 0.0_wp, dmax = 0.0_wp
+      real(wp) :: body_force(3) = 0.0_wp
+      !> Aggregation threshold and Nitsche penalty factor in use.
+      real(wp) :: eta = 0.0_wp, gamma = 0.0_wp
+      type(grid_type) :: grid
+      type(grid_nodes_type) :: nodes
+      type(fe_bc_type), allocatable :: bcs(:)
+      class(exact_solution_type), allocatable :: exact
+      !> Condition index of each shape (0: free surface); shape symmetry imposed strongly.
+      integer, allocatable :: bc_of_shape(:)
+      logical, allocatable :: strong_shape(:)
+      !> Volume points of element e: vol_x(:, vol_ptr(e) : vol_ptr(e+1)-1), weights w|J| in vol_w.
+      integer, allocatable :: vol_ptr(:)
+      real(wp), allocatable :: vol_x(:, :), vol_w(:)
+      !> Surface points: coordinates, weights, unit outward normals, shape index.
+      integer, allocatable :: surf_ptr(:)
+      real(wp), allocatable :: surf_x(:, :), surf_w(:), surf_n(:, :)
+      integer, allocatable :: surf_shape(:)
+      !> Volume fraction of each element and its aggregation root (root(e) = e: well posed).
+      real(wp), allocatable :: fraction(:)
+      integer, allocatable :: root(:)
+      !> Cut elements and aggregated (ill-posed) elements.
+      integer :: n_cut = 0, n_aggregated = 0
+      !> u = T ubar.
+      type(constraint_type) :: constraints
+      !> Reduced stiffness and load.
+      type(csr_type) :: k
+      real(wp), allocatable :: f(:)
+      !> Reduced solution and nodal displacements (dim, n_nodes).
+      real(wp), allocatable :: ubar(:), u(:, :)
+      logical :: solved = .false.
+      !> 'cholmod' or 'umfpack'; why the fallback was taken ('' if not).
+      character(len=:), allocatable :: solver_name, solver_note
+      !> Reciprocal 1-norm condition estimate of the reduced stiffness (from the solver).
+      real(wp) :: rcond = -1.0_wp
+      !> Wall-clock seconds of the phases.
+      real(wp) :: t_quadrature = 0.0_wp, t_assembly = 0.0_wp, t_solve = 0.0_wp
+   contains
+      procedure :: setup => problem_setup
+      procedure :: solve => problem_solve
+      procedure :: n_dofs
+      procedure :: element_box
+      procedure :: element_displacements
+      procedure :: stress_in_element
+      procedure :: stress_at
+      procedure :: element_points
+      procedure :: energy_error
+      procedure :: scaled_rcond
+   end type elasticity_problem_type
+
+contains
+
+   !> Default Nitsche penalty factor for degree p: 10 (p + 1)^2 (module notes).
+   pure real(wp) function default_gamma(degree)
+      integer, intent(in) :: degree
+      default_gamma = 10.0_wp*real((degree + 1)**2, wp)
+   end function default_gamma
+
+   !> Convenience: build the grid of `body` (uniform `level`, `refine_boundary`
+   !> extra levels on cut cells), its Q`degree` nodes and hanging constraints,
+   !> the cut quadrature (`points` per direction, default `default_points`),
+   !> then `setup` and `solve` the problem. `t_mesh` (optional) gets the grid,
+   !> node and constraint build time.
+   subroutine solve_on_grid(problem, body, box_min, box_size, level, refine_boundary, degree, analysis, young, &
+         & poisson, body_force, bcs, error, exact, points, eta, gamma, t_mesh)
+      type(elasticity_problem_type), intent(out) :: problem
+      type(body_type), intent(in) :: body
+      real(wp), intent(in) :: box_min(:), box_size
+      integer, intent(in) :: level, refine_boundary, degree, analysis
+      real(wp), intent(in) :: young, poisson, body_force(:)
+      type(fe_bc_type), intent(in) :: bcs(:)
+      type(error_type), allocatable, intent(out) :: error
+      class(exact_solution_type), intent(in), optional :: exact
+      integer, intent(in), optional :: points
+      real(wp), intent(in), optional :: eta, gamma
+      real(wp), intent(out), optional :: t_mesh
+      type(grid_type) :: grid
+      type(grid_nodes_type) :: nodes
+      type(hanging_type) :: hanging
+      type(cut_quadrature_type) :: quad
+      type(timer_type) :: timer
+      integer :: q
+
+      call timer%start()
+      call grid%build(body, body%dim, box_min, box_size, level, refine_boundary, error)
+      if (allocated(error)) return
+      call nodes%build(grid, degree, error)
+      if (allocated(error)) return
+      call hanging%build(grid, nodes, error)
+      if (allocated(error)) return
+      call timer%stop()
+      if (present(t_mesh)) t_mesh = timer%elapsed
+      q = default_points(degree)
+      if (present(points)) q = points
+      call new_cut_quadrature(quad, body%dim, q, error)
+      if (allocated(error)) return
+      call problem%setup(body, grid, nodes, hanging, quad, analysis, young, poisson, body_force, bcs, error, &
+         & exact, eta, gamma)
+      if (allocated(error)) return
+      call problem%solve(error)
+   end subroutine solve_on_grid
+
+   !> Prepare the problem: validate, integrate (t_quadrature), aggregate small
+   !> cells and build T (t_assembly). `body_force` has dim entries; `eta`
+   !> defaults to `default_eta`, `gamma` to `default_gamma(degree)`.
+   subroutine problem_setup(self, body, grid, nodes, hanging, quad, analysis, young, poisson, body_force, bcs, &
+         & error, exact, eta, gamma)
+      class(elasticity_problem_type), intent(out) :: self
+      type(body_type), intent(in) :: body
+      type(grid_type), intent(in) :: grid
+      type(grid_nodes_type), intent(in) :: nodes
+      type(hanging_type), intent(in) :: hanging
+      type(cut_quadrature_type), intent(in) :: quad
+      integer, intent(in) :: analysis
+      real(wp), intent(in) :: young, poisson, body_force(:)
+      type(fe_bc_type), intent(in) :: bcs(:)
+      type(error_type), allocatable, intent(out) :: error
+      class(exact_solution_type), intent(in), optional :: exact
+      real(wp), intent(in), optional :: eta, gamma
+      type(timer_type) :: timer
+      integer, allocatable :: plane_axis(:)
+      real(wp), allocatable :: plane_coord(:)
+      integer :: i
+
+      call check_inputs(body, grid, nodes, hanging, quad, analysis, body_force, error)
+      if (allocated(error)) return
+      call check_bcs(bcs, body%nshape, grid%dim, present(exact), error)
+      if (allocated(error)) return
+      if (present(exact)) then
+         call check_exact(exact, analysis, young, poisson, error)
+         if (allocated(error)) return
+         allocate (self%exact, source=exact)
+      end if
+      self%dim = grid%dim
+      self%degree = nodes%degree
+      self%analysis = analysis
+      self%nstress = voigt_size(analysis)
+      self%nen = nodes%nodes_per_element
+      self%young = young
+      self%poisson = poisson
+      call material_matrix(analysis, young, poisson, self%d(1:self%nstress, 1:self%nstress), error)
+      if (allocated(error)) return
+      call compliance_matrix(analysis, young, poisson, self%compliance(1:self%nstress, 1:self%nstress), error)
+      if (allocated(error)) return
+      self%dmax = 0.0_wp
+      do i = 1, self%nstress
+         self%dmax = max(self%dmax, self%d(i, i))
+      end do
+      self%body_force(1:self%dim) = body_force
+      self%eta = default_eta
+      if (present(eta)) self%eta = eta
+      self%gamma = default_gamma(self%degree)
+      if (present(gamma)) self%gamma = gamma
+      if (.not. (self%eta >= 0.0_wp .and. self%eta <= 1.0_wp)) then
+         call fatal_error(error, 'elasticity setup: eta must lie in [0, 1]', stat_invalid_input)
+         return
+      end if
+      if (.not. (self%gamma > 0.0_wp .and. self%gamma < huge(1.0_wp))) then
+         call fatal_error(error, 'elasticity setup: gamma must be finite and > 0', stat_invalid_input)
+         return
+      end if
+      self%grid = grid
+      self%nodes = nodes
+      self%bcs = bcs
+      call classify_bcs(self, body, plane_axis, plane_coord)
+
+      call timer%start()
+      call integrate(self, body, quad, error)
+      call timer%stop()
+      self%t_quadrature = timer%elapsed
+      if (allocated(error)) return
+
+      call timer%reset()
+      call timer%start()
+      call aggregate_cells(grid, grid%leaf_class == cell_inside, self%fraction, self%eta, self%root, error)
+      if (.not. allocated(error)) then
+         self%n_aggregated = count(self%root /= [(i, i = 1, grid%n_leaves)])
+         call self%constraints%build(grid, nodes, hanging, self%root, plane_axis, plane_coord, &
+            & plane_tol(grid), error)
+      end if
+      call timer%stop()
+      self%t_assembly = timer%elapsed
+   end subroutine problem_setup
+
+   pure real(wp) function plane_tol(grid)
+      type(grid_type), intent(in) :: grid
+      plane_tol = 1.0e-12_wp*(grid%box_size + maxval(abs(grid%box_min)))
+   end function plane_tol
+
+   subroutine check_inputs(body, grid, nodes, hanging, quad, analysis, body_force, error)
+      type(body_type), intent(in) :: body
+      type(grid_type), intent(in) :: grid
+      type(grid_nodes_type), intent(in) :: nodes
+      type(hanging_type), intent(in) :: hanging
+      type(cut_quadrature_type), intent(in) :: quad
+      integer, intent(in) :: analysis
+      real(wp), intent(in) :: body_force(:)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=200) :: buf
+
+      if (grid%dim /= 2 .and. grid%dim /= 3) then
+         call fatal_error(error, 'elasticity setup: the grid is not built', stat_invalid_input)
+      else if (grid%n_leaves == 0) then
+         call fatal_error(error, 'elasticity setup: the grid has no active cells (the body misses the box)', &
+            & stat_invalid_input)
+      else if (nodes%dim /= grid%dim .or. nodes%n_elements /= grid%n_leaves .or. &
+         & nodes%lattice_level /= grid%max_level + 1) then
+         call fatal_error(error, 'elasticity setup: the nodes were not built on this grid', stat_invalid_input)
+      else if (hanging%n_all /= nodes%n_nodes .or. .not. allocated(hanging%t_ptr)) then
+         call fatal_error(error, 'elasticity setup: the hanging-node constraints were not built on these nodes', &
+            & stat_invalid_input)
+      else if (body%dim /= grid%dim .or. quad%dim /= grid%dim) then
+         write (buf, '("elasticity setup: dimensions differ: grid ",i0,", body ",i0,", quadrature ",i0)') &
+            & grid%dim, body%dim, quad%dim
+         call fatal_error(error, trim(buf), stat_invalid_input)
+      else if ((grid%dim == 2 .and. analysis /= plane_stress .and. analysis /= plane_strain) .or. &
+         & (grid%dim == 3 .and. analysis /= solid)) then
+         write (buf, '("elasticity setup: analysis ",i0," (",a,") does not fit dimension ",i0)') analysis, &
+            & analysis_name(analysis), grid%dim
+         call fatal_error(error, trim(buf), stat_invalid_input)
+      else if (size(body_force) /= grid%dim) then
+         write (buf, '("elasticity setup: body_force has ",i0," values, expected ",i0)') size(body_force), grid%dim
+         call fatal_error(error, trim(buf), stat_invalid_input)
+      else if (.not. all(abs(body_force) <= huge(1.0_wp))) then
+         call fatal_error(error, 'elasticity setup: body_force must be finite', stat_invalid_input)
+      end if
+   end subroutine check_inputs
+
+   !> The exact solution must describe this problem: same analysis and material.
+   subroutine check_exact(exact, analysis, young, poisson, error)
+      class(exact_solution_type), intent(in) :: exact
+      integer, intent(in) :: analysis
+      real(wp), intent(in) :: young, poisson
+      type(error_type), allocatable, intent(out) :: error
+      character(len=200) :: buf
+
+      if (exact%analysis /= analysis) then
+         call fatal_error(error, 'elasticity setup: the exact solution is for '//analysis_name(exact%analysis)// &
+            & ', the analysis is '//analysis_name(analysis), stat_invalid_input)
+      else if (abs(exact%young - young) > 1.0e-12_wp*abs(young) .or. &
+         & abs(exact%poisson - poisson) > 1.0e-12_wp) then
+         write (buf, '("elasticity setup: the exact solution has young = ",es12.5,", poisson = ",f8.5, &
+            & "; the problem ",es12.5,", ",f8.5)') exact%young, exact%poisson, young, poisson
+         call fatal_error(error, trim(buf), stat_invalid_input)
+      end if
+   end subroutine check_exact
+
+   !> Condition of each shape, and the strong symmetry planes: a symmetry
+   !> halfspace with an axis normal that no cell straddles.
+   subroutine classify_bcs(self, body, plane_axis, plane_coord)
+      type(elasticity_problem_type), intent(inout) :: self
+      type(body_type), intent(in) :: body
+      integer, allocatable, intent(out) :: plane_axis(:)
+      real(wp), allocatable, intent(out) :: plane_coord(:)
+      integer :: i, s, a, e, d
+      real(wp) :: p, tol, lo(3), hi(3)
+      logical :: straddled
+
+      d = self%dim
+      allocate (self%bc_of_shape(body%nshape), self%strong_shape(body%nshape), plane_axis(0), plane_coord(0))
+      self%bc_of_shape = 0
+      self%strong_shape = .false.
+      tol = plane_tol(self%grid)
+      do i = 1, size(self%bcs)
+         s = self%bcs(i)%shape
+         self%bc_of_shape(s) = i
+         if (self%bcs(i)%kind /= bc_symmetry .or. body%shapes(s)%kind /= shape_halfspace) cycle
+         a = maxloc(abs(body%shapes(s)%normal(1:d)), 1)
+         if (abs(abs(body%shapes(s)%normal(a)) - 1.0_wp) > 1.0e-12_wp) cycle
+         p = body%shapes(s)%point(a)
+         straddled = .false.
+         do e = 1, self%grid%n_leaves
+            call self%grid%leaf_box(e, lo(1:d), hi(1:d))
+            if (lo(a) < p - tol .and. hi(a) > p + tol) then
+               straddled = .true.
+               exit
+            end if
+         end do
+         if (straddled) cycle
+         self%strong_shape(s) = .true.
+         plane_axis = [plane_axis, a]
+         plane_coord = [plane_coord, p]
+      end do
+   end subroutine classify_bcs
+
+   !> Cut-cell quadrature of every element (parallel, one rule object per
+   !> thread), concatenated in element order; volume fractions.
+   subroutine integrate(self, body, quad, error)
+      type(elasticity_problem_type), intent(inout) :: self
+      type(body_type), intent(in) :: body
+      type(cut_quadrature_type), intent(in) :: quad
+      type(error_type), allocatable, intent(out) :: error
+      type(rule_store_type), allocatable :: store(:)
+      type(cell_rule_type) :: rule
+      type(error_type), allocatable :: cell_error
+      logical, allocatable :: failed(:)
+      integer :: e, n, d, nv, ns, iv, is
+      real(wp) :: lo(3), hi(3)
+
+      n = self%grid%n_leaves
+      d = self%dim
+      allocate (store(n), failed(n))
+      failed = .false.
+      !$omp parallel do schedule(dynamic, 16) default(shared) private(e, rule, cell_error, lo, hi)
+      do e = 1, n
+         call self%grid%leaf_box(e, lo(1:d), hi(1:d))
+         call cell_rule(quad, body, lo(1:d), hi(1:d), rule, cell_error)
+         if (allocated(cell_error)) then
+            failed(e) = .true.
+            cycle
+         end if
+         store(e)%nvol = rule%nvol
+         store(e)%nsurf = rule%nsurf
+         store(e)%x = rule%vol_x(1:d, 1:rule%nvol)
+         store(e)%w = rule%vol_w(1:rule%nvol)
+         store(e)%sx = rule%surf_x(1:d, 1:rule%nsurf)
+         store(e)%sw = rule%surf_w(1:rule%nsurf)
+         store(e)%sn = rule%surf_n(1:d, 1:rule%nsurf)
+         store(e)%ss = rule%surf_shape(1:rule%nsurf)
+      end do
+      !$omp end parallel do
+      if (any(failed)) then
+         e = findloc(failed, .true., 1)
+         call self%grid%leaf_box(e, lo(1:d), hi(1:d))
+         call cell_rule(quad, body, lo(1:d), hi(1:d), rule, error)
+         return
+      end if
+
+      nv = sum(store%nvol)
+      ns = sum(store%nsurf)
+      allocate (self%vol_ptr(n + 1), self%surf_ptr(n + 1), self%vol_x(d, nv), self%vol_w(nv), &
+         & self%surf_x(d, ns), self%surf_w(ns), self%surf_n(d, ns), self%surf_shape(ns), self%fraction(n))
+      iv = 0
+      is = 0
+      do e = 1, n
+         self%vol_ptr(e) = iv + 1
+         self%surf_ptr(e) = is + 1
+         self%vol_x(:, iv + 1:iv + store(e)%nvol) = store(e)%x
+         self%vol_w(iv + 1:iv + store(e)%nvol) = store(e)%w
+         self%surf_x(:, is + 1:is + store(e)%nsurf) = store(e)%sx
+         self%surf_w(is + 1:is + store(e)%nsurf) = store(e)%sw
+         self%surf_n(:, is + 1:is + store(e)%nsurf) = store(e)%sn
+         self%surf_shape(is + 1:is + store(e)%nsurf) = store(e)%ss
+         iv = iv + store(e)%nvol
+         is = is + store(e)%nsurf
+         call self%grid%leaf_box(e, lo(1:d), hi(1:d))
+         self%fraction(e) = sum(store(e)%w)/product(hi(1:d) - lo(1:d))
+      end do
+      self%vol_ptr(n + 1) = iv + 1
+      self%surf_ptr(n + 1) = is + 1
+      self%n_cut = count(self%grid%leaf_class /= cell_inside)
+   end subroutine integrate
+
+   !> Number of reduced unknowns.
+   pure integer function n_dofs(self)
+      class(elasticity_problem_type), intent(in) :: self
+      n_dofs = self%constraints%n_dofs
+   end function n_dofs
+
+   !> Box [lo, hi] (size dim) of element e.
+   pure subroutine element_box(self, e, lo, hi)
+      class(elasticity_problem_type), intent(in) :: self
+      integer, intent(in) :: e
+      real(wp), intent(out) :: lo(:), hi(:)
+      call self%grid%leaf_box(e, lo, hi)
+   end subroutine element_box
+
+   !> Assemble (t_assembly), check rigid-body modes, factorize and solve
+   !> (t_solve), and expand the nodal displacements `u`.
+   subroutine problem_solve(self, error)
+      class(elasticity_problem_type), intent(inout) :: self
+      type(error_type), allocatable, intent(out) :: error
+      type(timer_type) :: timer
+
+      if (.not. allocated(self%root)) then
+         call fatal_error(error, 'elasticity solve: setup was not called or failed', stat_invalid_input)
+         return
+      end if
+      self%solved = .false.
+      call timer%start()
+      call assemble(self, error)
+      call timer%stop()
+      self%t_assembly = self%t_assembly + timer%elapsed
+      if (allocated(error)) return
+
+      call timer%reset()
+      call timer%start()
+      call check_rigid_modes(self, error)
+      if (.not. allocated(error)) call factor_and_solve(self, error)
+      call timer%stop()
+      self%t_solve = timer%elapsed
+      if (allocated(error)) return
+      allocate (self%u(self%dim, self%nodes%n_nodes))
+      call self%constraints%expand(self%ubar, self%u)
+      self%solved = .true.
+   end subroutine problem_solve
+
+   !> K and f: element systems in parallel chunks, reduced by T_e, inserted in element order.
+   subroutine assemble(self, error)
+      type(elasticity_problem_type), intent(inout) :: self
+      type(error_type), allocatable, intent(out) :: error
+      type(coo_type) :: coo
+      integer, allocatable :: mdof(:), dofs(:, :), offset(:)
+      real(wp), allocatable :: kbuf(:), fbuf(:, :)
+      integer :: nel, nd, maxm, c0, c1, e, m, k0
+
+      nel = self%grid%n_leaves
+      nd = self%dim*self%nen
+      ! distinct reduced dofs of each element (bounds the buffers)
+      allocate (mdof(nel))
+      block
+         integer, allocatable :: dtmp(:)
+         real(wp), allocatable :: ttmp(:, :)
+         allocate (dtmp(nd*32), ttmp(nd, nd*32))
+         do e = 1, nel
+            call self%constraints%element_map(self%nodes%connectivity(:, e), dtmp, ttmp, mdof(e))
+         end do
+      end block
+      maxm = maxval(mdof)
+      call coo%init(self%constraints%n_dofs, self%constraints%n_dofs, error, &
+         & capacity=sum(int(mdof, kind(coo%nnz))**2))
+      if (allocated(error)) return
+      allocate (self%f(self%constraints%n_dofs))
+      self%f = 0.0_wp
+      allocate (dofs(maxm, chunk_size), fbuf(maxm, chunk_size), offset(chunk_size + 1))
+      do c0 = 1, nel, chunk_size
+         c1 = min(nel, c0 + chunk_size - 1)
+         offset(1) = 1
+         do e = c0, c1
+            offset(e - c0 + 2) = offset(e - c0 + 1) + mdof(e)**2
+         end do
+         if (allocated(kbuf)) then
+            if (size(kbuf) < offset(c1 - c0 + 2)) deallocate (kbuf)
+         end if
+         if (.not. allocated(kbuf)) allocate (kbuf(offset(c1 - c0 + 2)))
+         !$omp parallel do schedule(dynamic, 4) default(shared) private(e, k0, m)
+         do e = c0, c1
+            k0 = offset(e - c0 + 1)
+            call reduced_element_system(self, e, maxm, dofs(:, e - c0 + 1), m, &
+               & kbuf(k0:k0 + mdof(e)**2 - 1), fbuf(:, e - c0 + 1))
+         end do
+         !$omp end parallel do
+         do e = c0, c1
+            m = mdof(e)
+            k0 = offset(e - c0 + 1)
+            call coo%add(dofs(1:m, e - c0 + 1), reshape(kbuf(k0:k0 + m*m - 1), [m, m]), error)
+            if (allocated(error)) return
+            self%f(dofs(1:m, e - c0 + 1)) = self%f(dofs(1:m, e - c0 + 1)) + fbuf(1:m, e - c0 + 1)
+         end do
+      end do
+      call coo%to_csr(self%k, error)
+   end subroutine assemble
+
+   !> Reduced system of element e: kr = T_e^T k_e T_e (m x m, column-major in
+   !> kr), fr = T_e^T f_e, on the reduced dofs dofs(1:m).
+   subroutine reduced_element_system(self, e, maxm, dofs, m, kr, fr)
+      type(elasticity_problem_type), intent(in) :: self
+      integer, intent(in) :: e, maxm
+      integer, intent(out) :: dofs(:), m
+      real(wp), intent(out) :: kr(:), fr(:)
+      real(wp) :: ke(self%dim*self%nen, self%dim*self%nen), fe(self%dim*self%nen)
+      real(wp) :: tmat(self%dim*self%nen, maxm), kt(self%dim*self%nen, maxm)
+      integer :: nd
+
+      nd = self%dim*self%nen
+      call element_system(self, e, ke, fe)
+      call self%constraints%element_map(self%nodes%connectivity(:, e), dofs, tmat, m)
+      if (m == 0) return
+      call dgemm('N', 'N', nd, m, nd, 1.0_wp, ke, nd, tmat, nd, 0.0_wp, kt, nd)
+      call dgemm('T', 'N', m, m, nd, 1.0_wp, tmat, nd, kt, nd, 0.0_wp, kr, m)
+      fr(1:m) = matmul(fe, tmat(:, 1:m))
+   end subroutine reduced_element_system
+
+   !> Unreduced stiffness ke and load fe of element e: volume terms, Neumann
+   !> loads and Nitsche terms of its surface points.
+   subroutine element_system(self, e, ke, fe)
+      type(elasticity_problem_type), intent(in) :: self
+      integer, intent(in) :: e
+      real(wp), intent(out) :: ke(:, :), fe(:)
+      integer :: d, ns, nd, q, c, ib, kind
+      real(wp) :: lo(3), hi(3), h, pen, t(3), g(3), p(3, 3)
+      real(wp) :: n(self%nen), dndx(self%dim, self%nen)
+      real(wp) :: b(self%nstress, self%dim*self%nen), db(self%nstress, self%dim*self%nen)
+      real(wp) :: nm(self%dim, self%dim*self%nen), tn(self%dim, self%nstress), s(self%dim, self%dim*self%nen)
+
+      d = self%dim
+      ns = self%nstress
+      nd = d*self%nen
+      call self%grid%leaf_box(e, lo(1:d), hi(1:d))
+      h = minval(hi(1:d) - lo(1:d))
+      pen = self%gamma*self%dmax/h
+      ke = 0.0_wp
+      fe = 0.0_wp
+      do q = self%vol_ptr(e), self%vol_ptr(e + 1) - 1
+         call shape_functions(d, self%degree, lo(1:d), hi(1:d), self%vol_x(:, q), n, dndx)
+         call strain_matrix(d, dndx, b)
+         db = matmul(self%d(1:ns, 1:ns), b)
+         call add_stiffness(b, db, self%vol_w(q), ke)
+         do c = 1, d
+            fe(c:nd:d) = fe(c:nd:d) + self%vol_w(q)*self%body_force(c)*n
+         end do
+      end do
+      do q = self%surf_ptr(e), self%surf_ptr(e + 1) - 1
+         ib = self%bc_of_shape(self%surf_shape(q))
+         kind = bc_free
+         if (ib > 0) kind = self%bcs(ib)%kind
+         if (kind == bc_free) cycle
+         if (kind == bc_symmetry .and. self%strong_shape(self%surf_shape(q))) cycle
+         associate (x => self%surf_x(:, q), nrm => self%surf_n(:, q), w => self%surf_w(q))
+            call shape_functions(d, self%degree, lo(1:d), hi(1:d), x, n, dndx)
+            select case (kind)
+            case (bc_pressure, bc_traction, bc_exact_traction)
+               select case (kind)
+               case (bc_pressure)
+                  t(1:d) = -self%bcs(ib)%value*nrm
+               case (bc_traction)
+                  t(1:d) = self%bcs(ib)%vector
+               case default
+                  call self%exact%traction(x, nrm, t(1:d))
+               end select
+               do c = 1, d
+                  fe(c:nd:d) = fe(c:nd:d) + w*t(c)*n
+               end do
+            case default
+               ! Nitsche: P = I (displacement) or n n^T (symmetry), data g.
+               g = 0.0_wp
+               if (kind == bc_symmetry) then
+                  p(1:d, 1:d) = spread(nrm, 2, d)*spread(nrm, 1, d)
+               else
+                  p = 0.0_wp
+                  do c = 1, d
+                     p(c, c) = 1.0_wp
+                  end do
+                  if (kind == bc_displacement) then
+                     g(1:d) = self%bcs(ib)%vector
+                  else
+                     call self%exact%displacement(x, g(1:d))
+                  end if
+               end if
+               call strain_matrix(d, dndx, b)
+               call displacement_matrix(d, n, nm)
+               call traction_matrix(d, nrm, tn)
+               s = matmul(tn, matmul(self%d(1:ns, 1:ns), b))
+               s = matmul(p(1:d, 1:d), s)
+               ke = ke - w*(matmul(transpose(nm), s) + matmul(transpose(s), nm)) &
+                  & + (w*pen)*matmul(transpose(nm), matmul(p(1:d, 1:d), nm))
+               fe = fe - w*matmul(g(1:d), s) + (w*pen)*matmul(matmul(p(1:d, 1:d), g(1:d)), nm)
+            end select
+         end associate
+      end do
+   end subroutine element_system
+
+   !> Rigid-body modes the conditions leave free. The 3 (2D) / 6 (3D) modes
+   !> r_i (translations; rotations about the grid box centre, scaled by 1/box
+   !> size so all have unit magnitude) are taken to the reduced space
+   !> (restrict_field: nodal values at the masters, zeroed components
+   !> dropped), and G = R^T K R is normalised by the diagonal energies
+   !> s_i = sum_j K_jj R_ji^2. An eigenvalue of the normalised G below
+   !> `rigid_tol` is a motion the system does not resist.
+   subroutine check_rigid_modes(self, error)
+      type(elasticity_problem_type), intent(inout) :: self
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: names2(3) = [character(len=16) :: 'translation x', 'translation y', &
+         & 'rotation about z']
+      character(len=*), parameter :: names3(6) = [character(len=16) :: 'translation x', 'translation y', &
+         & 'translation z', 'rotation about x', 'rotation about y', 'rotation about z']
+      real(wp), allocatable :: field(:, :), r(:, :), kr(:, :), diag(:), work(:)
+      real(wp) :: g(6, 6), s(6), lam(6), xc(3), y(3)
+      integer :: nm, i, j, nn, nd, info, d
+      integer(kind(self%k%rowptr)) :: q
+      character(len=:), allocatable :: what
+
+      d = self%dim
+      nm = merge(3, 6, d == 2)
+      nd = self%constraints%n_dofs
+      nn = self%nodes%n_nodes
+      if (nd == 0) then
+         call fatal_error(error, 'elasticity solve: no unknowns are left (every dof is constrained)', &
+            & stat_invalid_input)
+         return
+      end if
+      xc(1:d) = self%grid%box_min(1:d) + 0.5_wp*self%grid%box_size
+      allocate (field(d, nn), r(nd, nm), kr(nd, nm), diag(nd))
+      do i = 1, nm
+         do j = 1, nn
+            y(1:d) = (self%nodes%x(:, j) - xc(1:d))/self%grid%box_size
+            field(:, j) = 0.0_wp
+            if (i <= d) then
+               field(i, j) = 1.0_wp
+            else if (d == 2) then
+               field(:, j) = [-y(2), y(1)]
+            else if (i == 4) then
+               field(:, j) = [0.0_wp, -y(3), y(2)]
+            else if (i == 5) then
+               field(:, j) = [y(3), 0.0_wp, -y(1)]
+            else
+               field(:, j) = [-y(2), y(1), 0.0_wp]
+            end if
+         end do
+         call self%constraints%restrict_field(field, r(:, i))
+         call self%k%matvec(r(:, i), kr(:, i), error)
+         if (allocated(error)) return
+      end do
+      diag = 0.0_wp
+      do i = 1, nd
+         do q = self%k%rowptr(i), self%k%rowptr(i + 1) - 1
+            if (self%k%col(q) == i) diag(i) = self%k%val(q)
+         end do
+      end do
+      do i = 1, nm
+         s(i) = sum(diag*r(:, i)**2)
+      end do
+      do j = 1, nm
+         do i = 1, nm
+            g(i, j) = dot_product(r(:, i), kr(:, j))/sqrt(max(s(i)*s(j), tiny(1.0_wp)))
+         end do
+      end do
+      g(1:nm, 1:nm) = 0.5_wp*(g(1:nm, 1:nm) + transpose(g(1:nm, 1:nm)))
+      allocate (work(64))
+      call dsyev('V', 'U', nm, g, 6, lam, work, size(work), info)
+      if (info /= 0) return
+      if (lam(1) >= rigid_tol) return
+      what = ''
+      do j = 1, nm
+         if (lam(j) >= rigid_tol) exit
+         do i = 1, nm
+            if (abs(g(i, j)) < 0.2_wp*maxval(abs(g(1:nm, j)))) cycle
+            if (len(what) > 0) what = what//', '
+            if (d == 2) then
+               what = what//trim(names2(i))
+            else
+               what = what//trim(names3(i))
+            end if
+         end do
+         what = what//';'
+      end do
+      call fatal_error(error, 'the boundary conditions leave rigid-body motion free: '// &
+         & what(1:len(what) - 1)//' (add displacement or symmetry conditions that restrain it)', stat_singular)
+   end subroutine check_rigid_modes
+
+   !> CHOLMOD, or UMFPACK when CHOLMOD finds K not positive definite.
+   subroutine factor_and_solve(self, error)
+      type(elasticity_problem_type), intent(inout) :: self
+      type(error_type), allocatable, intent(out) :: error
+      type(cholmod_solver_type) :: chol
+      type(umfpack_solver_type) :: lu
+
+      allocate (self%ubar(self%constraints%n_dofs))
+      self%solver_name = 'cholmod'
+      self%solver_note = ''
+      call chol%factorize(self%k, error)
+      if (.not. allocated(error)) then
+         self%rcond = chol%rcond_estimate
+         call chol%solve(self%f, self%ubar, error)
+         call chol%destroy()
+         return
+      end if
+      call chol%destroy()
+      if (error%stat /= stat_not_positive_definite) then
+         error%message = 'elasticity solve: '//error%message
+         return
+      end if
+      self%solver_name = 'umfpack'
+      self%solver_note = 'CHOLMOD found the stiffness not positive definite ('//error%message// &
+         & '); solved by UMFPACK (LU). Raise gamma for an SPD system.'
+      deallocate (error)
+      call lu%factorize(self%k, error)
+      if (.not. allocated(error)) then
+         self%rcond = lu%rcond_estimate
+         call lu%solve(self%f, self%ubar, error)
+      end if
+      call lu%destroy()
+      if (allocated(error)) error%message = 'elasticity solve (UMFPACK fallback): '//error%message
+   end subroutine factor_and_solve
+
+   !> Nodal displacements ue(dim*nen) of element e, node-major.
+   pure subroutine element_displacements(self, e, ue)
+      class(elasticity_problem_type), intent(in) :: self
+      integer, intent(in) :: e
+      real(wp), intent(out) :: ue(:)
+      integer :: j
+      do j = 1, self%nen
+         ue((j - 1)*self%dim + 1:j*self%dim) = self%u(:, self%nodes%connectivity(j, e))
+      end do
+   end subroutine element_displacements
+
+   !> FE stress sigma(nstress) of element e at the point x (any point; the
+   !> element's polynomial is used, extrapolated outside its box). After solve.
+   pure subroutine stress_in_element(self, e, x, sigma)
+      class(elasticity_problem_type), intent(in) :: self
+      integer, intent(in) :: e
+      real(wp), intent(in) :: x(:)
+      real(wp), intent(out) :: sigma(:)
+      real(wp) :: ue(self%dim*self%nen), lo(3), hi(3)
+      call self%element_displacements(e, ue)
+      call self%grid%leaf_box(e, lo(1:self%dim), hi(1:self%dim))
+      call element_stress(self%dim, self%degree, self%d(1:self%nstress, 1:self%nstress), lo(1:self%dim), &
+         & hi(1:self%dim), x, ue, sigma)
+   end subroutine stress_in_element
+
+   !> FE stress at the point x, in the element that contains it (on a shared
+   !> face: the element on the upper side). Error if no active element holds x.
+   subroutine stress_at(self, x, sigma, error)
+      class(elasticity_problem_type), intent(in) :: self
+      real(wp), intent(in) :: x(:)
+      real(wp), intent(out) :: sigma(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: e
+      character(len=160) :: buf
+
+      if (.not. self%solved) then
+         call fatal_error(error, 'stress_at: the problem is not solved', stat_invalid_input)
+         return
+      end if
+      if (size(x) /= self%dim .or. size(sigma) /= self%nstress) then
+         write (buf, '("stress_at: x has ",i0," values and sigma ",i0,", expected ",i0," and ",i0)') &
+            & size(x), size(sigma), self%dim, self%nstress
+         call fatal_error(error, trim(buf), stat_invalid_input)
+         return
+      end if
+      e = self%grid%locate_point(x)
+      if (e == 0) then
+         call fatal_error(error, 'stress_at: the point lies in no active element', stat_invalid_input)
+         return
+      end if
+      call self%stress_in_element(e, x, sigma)
+   end subroutine stress_at
+
+   !> The volume integration points of element e (what a recovery patch
+   !> needs): x(dim, n), weights w(n) (w |J| over the cut domain) and FE
+   !> stresses sigma(nstress, n). After solve.
+   pure subroutine element_points(self, e, x, w, sigma)
+      class(elasticity_problem_type), intent(in) :: self
+      integer, intent(in) :: e
+      real(wp), allocatable, intent(out) :: x(:, :), w(:), sigma(:, :)
+      integer :: q, q0, q1
+      q0 = self%vol_ptr(e)
+      q1 = self%vol_ptr(e + 1) - 1
+      x = self%vol_x(:, q0:q1)
+      w = self%vol_w(q0:q1)
+      allocate (sigma(self%nstress, q1 - q0 + 1))
+      do q = q0, q1
+         call self%stress_in_element(e, self%vol_x(:, q), sigma(:, q - q0 + 1))
+      end do
+   end subroutine element_points
+
+   !> Energy norms over the true domain (cut-cell volume rules), with
+   !> ||s||_E^2 = int s^T D^-1 s: err_fe = ||sigma_ex - sigma_h||_E / ||sigma_ex||_E,
+   !> element_error(e) = ||sigma_ex - sigma_h||_E on element e, norm_fe = ||sigma_h||_E,
+   !> norm_exact = ||sigma_ex||_E. Needs the exact solution given to setup.
+   subroutine energy_error(self, err_fe, element_error, norm_fe, norm_exact, error)
+      class(elasticity_problem_type), intent(in) :: self
+      real(wp), intent(out) :: err_fe
+      real(wp), allocatable, intent(out) :: element_error(:)
+      real(wp), intent(out) :: norm_fe, norm_exact
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: parts(:, :)
+      real(wp) :: sh(6), se(6), c(6, 6), de(6)
+      integer :: e, q, ns, nel
+
+      err_fe = 0.0_wp
+      norm_fe = 0.0_wp
+      norm_exact = 0.0_wp
+      if (.not. self%solved) then
+         call fatal_error(error, 'energy_error: the problem is not solved', stat_invalid_input)
+         return
+      end if
+      if (.not. allocated(self%exact)) then
+         call fatal_error(error, 'energy_error: no exact solution was given to setup', stat_invalid_input)
+         return
+      end if
+      ns = self%nstress
+      nel = self%grid%n_leaves
+      c = self%compliance
+      allocate (parts(3, nel))
+      !$omp parallel do schedule(dynamic, 16) default(shared) private(e, q, sh, se, de)
+      do e = 1, nel
+         parts(:, e) = 0.0_wp
+         do q = self%vol_ptr(e), self%vol_ptr(e + 1) - 1
+            call self%stress_in_element(e, self%vol_x(:, q), sh(1:ns))
+            call self%exact%stress(self%vol_x(:, q), se(1:ns))
+            de(1:ns) = se(1:ns) - sh(1:ns)
+            parts(1, e) = parts(1, e) + self%vol_w(q)*dot_product(de(1:ns), matmul(c(1:ns, 1:ns), de(1:ns)))
+            parts(2, e) = parts(2, e) + self%vol_w(q)*dot_product(sh(1:ns), matmul(c(1:ns, 1:ns), sh(1:ns)))
+            parts(3, e) = parts(3, e) + self%vol_w(q)*dot_product(se(1:ns), matmul(c(1:ns, 1:ns), se(1:ns)))
+         end do
+      end do
+      !$omp end parallel do
+      element_error = sqrt(parts(1, :))
+      norm_fe = sqrt(sum(parts(2, :)))
+      norm_exact = sqrt(sum(parts(3, :)))
+      err_fe = sqrt(sum(parts(1, :)))/max(norm_exact, tiny(1.0_wp))
+   end subroutine energy_error
+
+   !> Reciprocal 1-norm condition estimate of the diagonally scaled reduced
+   !> stiffness S^-1/2 K S^-1/2 (S = diag K): one extra factorization, for
+   !> studies of the conditioning. After solve (or assembly).
+   subroutine scaled_rcond(self, value, error)
+      class(elasticity_problem_type), intent(in) :: self
+      real(wp), intent(out) :: value
+      type(error_type), allocatable, intent(out) :: error
+      type(csr_type) :: a
+      type(cholmod_solver_type) :: chol
+      real(wp), allocatable :: scale(:)
+      integer :: i
+      integer(kind(self%k%rowptr)) :: q
+
+      value = 0.0_wp
+      if (.not. allocated(self%k%rowptr)) then
+         call fatal_error(error, 'scaled_rcond: the stiffness is not assembled', stat_invalid_input)
+         return
+      end if
+      a = self%k
+      allocate (scale(a%nrows))
+      scale = 0.0_wp
+      do i = 1, a%nrows
+         do q = a%rowptr(i), a%rowptr(i + 1) - 1
+            if (a%col(q) == i .and. a%val(q) > 0.0_wp) scale(i) = 1.0_wp/sqrt(a%val(q))
+         end do
+      end do
+      do i = 1, a%nrows
+         do q = a%rowptr(i), a%rowptr(i + 1) - 1
+            a%val(q) = a%val(q)*scale(i)*scale(a%col(q))
+         end do
+      end do
+      chol%rcond_tol = 0.0_wp
+      call chol%factorize(a, error)
+      if (allocated(error)) return
+      call chol%rcond(a, value, error)
+      call chol%destroy()
+   end subroutine scaled_rcond
+
+end module sprc_fem_problem

@@ -1,0 +1,1034 @@
+!> Quadrature of grid cells on the true curved geometry of a body: tensor
+!> Gauss-Legendre for inside cells, and for cut cells a volume rule for
+!> cell ∩ body and a surface rule for the body's boundary inside the cell,
+!> with exact unit outward normals and the shape index (hence the surface
+!> name) at every surface point. All weights are positive.
+!>
+!> Method (Saye 2015, SIAM J. Sci. Comput. 37(2):A993, dimension reduction):
+!> the active shapes of the cell become quadrics in reference coordinates
+!> (sprc_grid_quadric). On a box with a set of quadrics:
+!> 1. quadrics of one sign over the box are dropped; none left: tensor Gauss;
+!> 2. a height direction k is sought such that every quadric either does not
+!>    involve y_k or has dp/dy_k certified nonzero over the box (so a height
+!>    line meets each surface at most once), and every pair of surfaces that
+!>    both involve y_k has a crossing quadric (one of them a plane, or both
+!>    with proportional quadratic parts such as two spheres; CSG edges and
+!>    corners are thus resolved exactly);
+!> 3. the base (the box without direction k) gets the restrictions of the
+!>    quadrics to the two faces y_k = lo, hi, the quadrics free of y_k, and
+!>    the crossing quadrics; its rule comes from the same algorithm one
+!>    dimension lower. On a base piece between these zero sets the roots
+!>    along height lines are smooth, so Gauss points integrate accurately;
+!> 4. each base point is lifted: the roots of the quadrics on its height line
+!>    (closed-form, cancellation-free) split it into pieces; at the top level
+!>    a piece belongs to the body if the body's level set is negative at its
+!>    midpoint (exact CSG membership), gets q Gauss points if so, and a root
+!>    where membership changes is a surface point with weight
+!>    w_base / |n_k| (n the exact outward normal from body%outward_normal).
+!> Where no height direction exists (near-tangency, a turning point in the
+!> box, two non-proportional quadrics meeting) the box is split in 2^m halves
+!> (the fallback), up to max_depth times; beyond that the best direction is
+!> used as is (counted in `nunresolved`).
+!>
+!> Boundaries on grid planes. A halfspace with an axis normal, or a box face,
+!> lying on a cell face (within the body's snapping tolerance) is never a cut
+!> shape of either neighbour. Its part on the face enters the surface rule of
+!> the cell on the body side only: a face point is a boundary point of this
+!> cell if the body is inside just on the cell side and outside just across,
+!> which is decided by CSG membership with the coinciding shape's sign
+!> replaced by its one-sided value. The face part is itself a (dim-1)
+!> dimensional cut quadrature. `boundary_face_rule` gives only these points
+!> (for a cell classified inside); `cut_cell_rule` and `cell_rule` include them.
+!>
+!> Points per direction: `default_points(order)` = order + 2 (3 for Q1, 4 for
+!> Q2): exact for the stiffness, load and mass integrands of a full cell (degree
+!> <= 2p per direction needs p + 1), one more for error norms of non-polynomial
+!> exact solutions; on cut cells the geometry is then integrated to order
+!> 2q >= 6, above the FE convergence order. Any q in 1..max_gauss_points may be
+!> set instead (the `--points` option).
+!>
+!> No module state; every procedure is pure. A `cell_rule_type` holds the
+!> result and its own work arrays, grown on demand and reused across cells:
+!> use one per thread.
+module sprc_grid_quadrature
+   use sprc_core_kinds, only: wp
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
+   use sprc_core_gauss, only: max_gauss_points, gauss_legendre_nodes
+   use sprc_geometry_region, only: cell_outside, cell_inside, cell_cut
+   use sprc_geometry_shape, only: shape_halfspace, shape_box
+   use sprc_geometry_body, only: body_type, csg_add, csg_intersect, snap_tolerance
+   use sprc_grid_quadric, only: ncoef, max_shape_quadrics, quadric_eval, quadric_range, derivative_range, &
+      & quadric_gradient, depends_on, restrict, line_coefficients, quadratic_roots, shape_quadrics, crossing
+   implicit none
+   private
+
+   public :: cut_quadrature_type, new_cut_quadrature, default_points, default_max_depth, default_min_ratio
+   public :: cell_rule_type, cell_rule, cut_cell_rule, boundary_face_rule
+
+   !> Settings of the cut-cell quadrature: immutable once built, share it between threads.
+   type :: cut_quadrature_type
+      !> Space dimension, 2 or 3.
+      integer :: dim = 0
+      !> Gauss points per direction (per piece).
+      integer :: q = 0
+      !> Subdivision levels allowed before a box is integrated unresolved.
+      integer :: max_depth = 0
+      !> Strength of a height direction: min |dp/dy_k| over the box must be at
+      !> least min_ratio times its variation over the box (module notes).
+      real(wp) :: min_ratio = 0.0_wp
+      !> Gauss nodes on [0, 1] and weights summing to 1.
+      real(wp) :: node(max_gauss_points) = 0.0_wp
+      real(wp) :: weight(max_gauss_points) = 0.0_wp
+   end type cut_quadrature_type
+
+   !> The quadrature of one cell. Result arrays are valid in 1:nvol and
+   !> 1:nsurf; they and the private work arrays keep their capacity between
+   !> calls.
+   type :: cell_rule_type
+      !> Space dimension.
+      integer :: dim = 0
+      !> Class of the cell (cell_inside, cell_cut, cell_outside) as used.
+      integer :: cls = cell_outside
+      !> Volume points: coordinates (3, :) (dim used) and weights (|J| included).
+      integer :: nvol = 0
+      real(wp), allocatable :: vol_x(:, :), vol_w(:)
+      !> Surface points: coordinates, weights (surface measure), unit outward
+      !> normals (3, :), and the body's shape index of the surface.
+      integer :: nsurf = 0
+      real(wp), allocatable :: surf_x(:, :), surf_w(:), surf_n(:, :)
+      integer, allocatable :: surf_shape(:)
+      !> Boxes subdivided (fallback) while building this rule.
+      integer :: nsplit = 0
+      !> Boxes integrated at max_depth without a valid height direction.
+      integer :: nunresolved = 0
+      real(wp), allocatable, private :: sy(:, :), sw(:)
+      integer, private :: ns = 0
+      real(wp), allocatable, private :: poly(:, :)
+      integer, allocatable, private :: owner(:), tag(:)
+      integer, private :: np = 0
+   end type cell_rule_type
+
+   !> Default strength of a height direction (module notes, `min_ratio`).
+   real(wp), parameter :: default_min_ratio = 3.0_wp
+
+   !> What the top level of the reduction produces.
+   type :: context_type
+      integer :: dim = 0
+      real(wp) :: center(3) = 0.0_wp, half(3) = 0.0_wp
+      !> 0: cell volume and surface; else the shape on the cell face being integrated.
+      integer :: face_shape = 0
+      integer :: face_dim = 0
+      !> +1: the cell's upper face along face_dim, -1: the lower one.
+      real(wp) :: face_side = 0.0_wp
+      !> The coinciding shape's inside lies on the cell side of the face.
+      logical :: cell_side_inside = .false.
+   end type context_type
+
+contains
+
+   ! ------------------------------------------------------------ settings
+
+   !> Gauss points per direction for FE order p (1 or 2): p + 2 (module notes).
+   pure integer function default_points(order) result(q)
+      integer, intent(in) :: order
+      q = max(order, 1) + 2
+   end function default_points
+
+   !> Default subdivision depth: 20 in 2D (a box 1e-6 of the cell), 10 in 3D.
+   pure integer function default_max_depth(dim) result(depth)
+      integer, intent(in) :: dim
+      depth = merge(20, 10, dim == 2)
+   end function default_max_depth
+
+   !> Settings for dimension dim (2 or 3) with q points per direction
+   !> (1..max_gauss_points) and optionally a subdivision depth (0..30).
+   pure subroutine new_cut_quadrature(self, dim, q, error, max_depth, min_ratio)
+      type(cut_quadrature_type), intent(out) :: self
+      integer, intent(in) :: dim, q
+      type(error_type), allocatable, intent(out) :: error
+      integer, intent(in), optional :: max_depth
+      real(wp), intent(in), optional :: min_ratio
+      real(wp) :: t(max_gauss_points), w(max_gauss_points)
+
+      if (dim /= 2 .and. dim /= 3) then
+         call fatal_error(error, 'new_cut_quadrature: dim = '//int_str(dim)//', expected 2 or 3', stat_invalid_input)
+         return
+      end if
+      if (q < 1 .or. q > max_gauss_points) then
+         call fatal_error(error, 'new_cut_quadrature: q = '//int_str(q)//' points, expected 1 to '// &
+            & int_str(max_gauss_points), stat_invalid_input)
+         return
+      end if
+      self%max_depth = default_max_depth(dim)
+      if (present(max_depth)) then
+         if (max_depth < 0 .or. max_depth > 30) then
+            call fatal_error(error, 'new_cut_quadrature: max_depth = '//int_str(max_depth)// &
+               & ', expected 0 to 30', stat_invalid_input)
+            return
+         end if
+         self%max_depth = max_depth
+      end if
+      self%min_ratio = default_min_ratio
+      if (present(min_ratio)) then
+         if (.not. (min_ratio >= 0.0_wp .and. min_ratio <= 100.0_wp)) then
+            call fatal_error(error, 'new_cut_quadrature: min_ratio = '//real_str(min_ratio)// &
+               & ', expected 0 to 100', stat_invalid_input)
+            return
+         end if
+         self%min_ratio = min_ratio
+      end if
+      call gauss_legendre_nodes(q, t, w)
+      self%dim = dim
+      self%q = q
+      self%node(1:q) = 0.5_wp*(t(1:q) + 1.0_wp)
+      self%weight(1:q) = 0.5_wp*w(1:q)
+   end subroutine new_cut_quadrature
+
+   ! ------------------------------------------------------------ entry points
+
+   !> The rule of any cell [lo, hi]: classified by body%classify_box; inside:
+   !> tensor Gauss plus boundary faces on grid planes; cut: `cut_cell_rule`;
+   !> outside: empty.
+   pure subroutine cell_rule(quad, body, lo, hi, rule, error)
+      type(cut_quadrature_type), intent(in) :: quad
+      class(body_type), intent(in) :: body
+      real(wp), intent(in) :: lo(:), hi(:)
+      type(cell_rule_type), intent(inout) :: rule
+      type(error_type), allocatable, intent(out) :: error
+
+      call check_input(quad, body, lo, hi, 'cell_rule', error)
+      if (allocated(error)) return
+      call reset(rule, quad%dim)
+      rule%cls = body%classify_box(lo, hi)
+      select case (rule%cls)
+      case (cell_inside)
+         call tensor_volume(quad, lo, hi, rule)
+         call add_face_parts(quad, body, lo, hi, rule)
+      case (cell_cut)
+         call cut_rule(quad, body, lo, hi, rule)
+      end select
+   end subroutine cell_rule
+
+   !> Volume and surface rule of a cell [lo, hi] treated as cut (whatever its
+   !> class; an inside cell gives the tensor rule the long way), including the
+   !> boundary parts on its faces that it owns.
+   pure subroutine cut_cell_rule(quad, body, lo, hi, rule, error)
+      type(cut_quadrature_type), intent(in) :: quad
+      class(body_type), intent(in) :: body
+      real(wp), intent(in) :: lo(:), hi(:)
+      type(cell_rule_type), intent(inout) :: rule
+      type(error_type), allocatable, intent(out) :: error
+
+      call check_input(quad, body, lo, hi, 'cut_cell_rule', error)
+      if (allocated(error)) return
+      call reset(rule, quad%dim)
+      rule%cls = cell_cut
+      call cut_rule(quad, body, lo, hi, rule)
+   end subroutine cut_cell_rule
+
+   !> Only the surface points of boundary parts lying on the faces of the cell
+   !> [lo, hi] that this cell owns (module notes); nvol = 0. For a cell
+   !> classified inside, whose volume rule is the tensor rule.
+   pure subroutine boundary_face_rule(quad, body, lo, hi, rule, error)
+      type(cut_quadrature_type), intent(in) :: quad
+      class(body_type), intent(in) :: body
+      real(wp), intent(in) :: lo(:), hi(:)
+      type(cell_rule_type), intent(inout) :: rule
+      type(error_type), allocatable, intent(out) :: error
+
+      call check_input(quad, body, lo, hi, 'boundary_face_rule', error)
+      if (allocated(error)) return
+      call reset(rule, quad%dim)
+      rule%cls = body%classify_box(lo, hi)
+      call add_face_parts(quad, body, lo, hi, rule)
+   end subroutine boundary_face_rule
+
+   pure subroutine check_input(quad, body, lo, hi, where, error)
+      type(cut_quadrature_type), intent(in) :: quad
+      class(body_type), intent(in) :: body
+      real(wp), intent(in) :: lo(:), hi(:)
+      character(len=*), intent(in) :: where
+      type(error_type), allocatable, intent(out) :: error
+      integer :: i
+
+      if (quad%dim == 0) then
+         call fatal_error(error, where//': quadrature settings not built (new_cut_quadrature)', stat_invalid_input)
+         return
+      end if
+      if (body%nshape == 0 .or. body%dim /= quad%dim) then
+         call fatal_error(error, where//': body has dimension '//int_str(body%dim)//' and '// &
+            & int_str(body%nshape)//' shapes, the quadrature dimension '//int_str(quad%dim), stat_invalid_input)
+         return
+      end if
+      if (size(lo) /= quad%dim .or. size(hi) /= quad%dim) then
+         call fatal_error(error, where//': lo and hi have '//int_str(size(lo))//' and '//int_str(size(hi))// &
+            & ' values, expected '//int_str(quad%dim), stat_invalid_input)
+         return
+      end if
+      do i = 1, quad%dim
+         if (.not. (lo(i) < hi(i) .and. abs(hi(i) - lo(i)) < huge(1.0_wp))) then
+            call fatal_error(error, where//': cell extent lo('//int_str(i)//') < hi('//int_str(i)// &
+               & ') violated or not finite', stat_invalid_input)
+            return
+         end if
+      end do
+   end subroutine check_input
+
+   pure subroutine reset(rule, dim)
+      type(cell_rule_type), intent(inout) :: rule
+      integer, intent(in) :: dim
+      rule%dim = dim
+      rule%cls = cell_outside
+      rule%nvol = 0
+      rule%nsurf = 0
+      rule%nsplit = 0
+      rule%nunresolved = 0
+      rule%ns = 0
+      rule%np = 0
+      if (.not. allocated(rule%vol_x)) then
+         allocate (rule%vol_x(3, 64), rule%vol_w(64))
+         allocate (rule%surf_x(3, 32), rule%surf_w(32), rule%surf_n(3, 32), rule%surf_shape(32))
+         allocate (rule%sy(3, 64), rule%sw(64), rule%poly(0:ncoef - 1, 16), rule%owner(16), rule%tag(16))
+      end if
+   end subroutine reset
+
+   !> Tensor rule of the whole cell.
+   pure subroutine tensor_volume(quad, lo, hi, rule)
+      type(cut_quadrature_type), intent(in) :: quad
+      real(wp), intent(in) :: lo(:), hi(:)
+      type(cell_rule_type), intent(inout) :: rule
+      real(wp) :: x(3), w
+      integer :: ipt, i, d, idx
+
+      do ipt = 1, quad%q**quad%dim
+         i = ipt - 1
+         w = 1.0_wp
+         x = 0.0_wp
+         do d = 1, quad%dim
+            idx = mod(i, quad%q) + 1
+            i = i/quad%q
+            x(d) = lo(d) + (hi(d) - lo(d))*quad%node(idx)
+            w = w*(hi(d) - lo(d))*quad%weight(idx)
+         end do
+         call push_volume(rule, x, w)
+      end do
+   end subroutine tensor_volume
+
+   !> Cut rule proper: the active shapes' quadrics on the cell, then the faces.
+   pure subroutine cut_rule(quad, body, lo, hi, rule)
+      type(cut_quadrature_type), intent(in) :: quad
+      class(body_type), intent(in) :: body
+      real(wp), intent(in) :: lo(:), hi(:)
+      type(cell_rule_type), intent(inout) :: rule
+      type(context_type) :: ctx
+      real(wp) :: ylo(3), yhi(3)
+      integer :: list(body%nshape), n, i, dim
+      logical :: free(3)
+
+      dim = quad%dim
+      call new_context(ctx, dim, lo, hi)
+      call body%active_shapes(lo, hi, list, n)
+      do i = 1, n
+         call add_shape_quadrics(body, list(i), ctx, lo, hi, rule)
+      end do
+      ylo = 0.0_wp
+      yhi = 0.0_wp
+      ylo(1:dim) = -1.0_wp
+      yhi(1:dim) = 1.0_wp
+      free = .false.
+      free(1:dim) = .true.
+      call reduce(ctx, quad, body, rule, ylo, yhi, free, 1, rule%np, .true., 0, 0)
+      rule%np = 0
+      call add_face_parts(quad, body, lo, hi, rule)
+   end subroutine cut_rule
+
+   pure subroutine new_context(ctx, dim, lo, hi)
+      type(context_type), intent(out) :: ctx
+      integer, intent(in) :: dim
+      real(wp), intent(in) :: lo(:), hi(:)
+      ctx%dim = dim
+      ctx%center(1:dim) = 0.5_wp*(lo(1:dim) + hi(1:dim))
+      ctx%half(1:dim) = 0.5_wp*(hi(1:dim) - lo(1:dim))
+   end subroutine new_context
+
+   !> Push the quadrics of shape s for the x-box [lo, hi] (owner s).
+   pure subroutine add_shape_quadrics(body, s, ctx, lo, hi, rule)
+      class(body_type), intent(in) :: body
+      integer, intent(in) :: s
+      type(context_type), intent(in) :: ctx
+      real(wp), intent(in) :: lo(:), hi(:)
+      type(cell_rule_type), intent(inout) :: rule
+      real(wp) :: polys(0:ncoef - 1, max_shape_quadrics), xlo(3), xhi(3), tol
+      integer :: n, j
+
+      xlo = 0.0_wp
+      xhi = 0.0_wp
+      xlo(1:ctx%dim) = lo(1:ctx%dim)
+      xhi(1:ctx%dim) = hi(1:ctx%dim)
+      tol = snap_tolerance(body%shapes(s), lo, hi)
+      call shape_quadrics(body%shapes(s), ctx%center, ctx%half, xlo, xhi, tol, polys, n)
+      do j = 1, n
+         call push_poly(rule, polys(:, j), s, rule%np + 1)
+      end do
+   end subroutine add_shape_quadrics
+
+   ! ------------------------------------------------------------ faces on grid planes
+
+   !> For each face of the cell and each shape whose surface lies on that face
+   !> plane, the face part where this cell is on the body side (module notes).
+   pure subroutine add_face_parts(quad, body, lo, hi, rule)
+      type(cut_quadrature_type), intent(in) :: quad
+      class(body_type), intent(in) :: body
+      real(wp), intent(in) :: lo(:), hi(:)
+      type(cell_rule_type), intent(inout) :: rule
+      type(context_type) :: ctx
+      real(wp) :: flo(quad%dim), fhi(quad%dim), ylo(3), yhi(3), xf, side
+      integer :: classes(body%nshape), m, iside, s, i, dim
+      logical :: free(3), on, inside_on_cell_side
+
+      dim = quad%dim
+      do m = 1, dim
+         do iside = 1, 2
+            side = merge(-1.0_wp, 1.0_wp, iside == 1)
+            xf = merge(lo(m), hi(m), iside == 1)
+            flo = lo
+            fhi = hi
+            flo(m) = xf
+            fhi(m) = xf
+            do s = 1, body%nshape
+               call on_face_plane(body, s, m, side, xf, flo, fhi, on, inside_on_cell_side)
+               if (.not. on) cycle
+               call new_context(ctx, dim, lo, hi)
+               ctx%face_shape = s
+               ctx%face_dim = m
+               ctx%face_side = side
+               ctx%cell_side_inside = inside_on_cell_side
+               call body%shape_classes(flo, fhi, classes)
+               rule%np = 0
+               do i = 1, body%nshape
+                  if (i == s) then
+                     if (body%shapes(s)%kind == shape_box) call add_shape_quadrics(body, s, ctx, flo, fhi, rule)
+                  else if (classes(i) == cell_cut) then
+                     call add_shape_quadrics(body, i, ctx, flo, fhi, rule)
+                  end if
+               end do
+               ylo = 0.0_wp
+               yhi = 0.0_wp
+               ylo(1:dim) = -1.0_wp
+               yhi(1:dim) = 1.0_wp
+               ylo(m) = side
+               yhi(m) = side
+               free = .false.
+               free(1:dim) = .true.
+               free(m) = .false.
+               call reduce(ctx, quad, body, rule, ylo, yhi, free, 1, rule%np, .true., -1, 0)
+               rule%np = 0
+            end do
+         end do
+      end do
+   end subroutine add_face_parts
+
+   !> True if shape s's surface lies on the plane x_m = xf (the cell face
+   !> [flo, fhi] on `side`): a halfspace with normal +-e_m, or a box face,
+   !> within the snapping tolerance. inside_on_cell_side: the shape's inside
+   !> lies on the cell side of the plane.
+   pure subroutine on_face_plane(body, s, m, side, xf, flo, fhi, on, inside_on_cell_side)
+      class(body_type), intent(in) :: body
+      integer, intent(in) :: s, m
+      real(wp), intent(in) :: side, xf, flo(:), fhi(:)
+      logical, intent(out) :: on, inside_on_cell_side
+      real(wp) :: tol
+      integer :: i
+
+      on = .false.
+      inside_on_cell_side = .false.
+      tol = snap_tolerance(body%shapes(s), flo, fhi)
+      associate (sh => body%shapes(s))
+         select case (sh%kind)
+         case (shape_halfspace)
+            do i = 1, body%dim
+               if (i /= m .and. sh%normal(i) /= 0.0_wp) return
+            end do
+            on = abs(sh%point(m) - xf) <= tol
+            inside_on_cell_side = sh%normal(m)*side > 0.0_wp
+         case (shape_box)
+            if (abs(sh%upper(m) - xf) <= tol) then
+               on = .true.
+               inside_on_cell_side = side > 0.0_wp
+            else if (abs(sh%lower(m) - xf) <= tol) then
+               on = .true.
+               inside_on_cell_side = side < 0.0_wp
+            end if
+         end select
+      end associate
+   end subroutine on_face_plane
+
+   !> Body membership just on one side of the face plane at x (on the plane).
+   pure logical function face_member(ctx, body, x, cell_side) result(inside)
+      type(context_type), intent(in) :: ctx
+      class(body_type), intent(in) :: body
+      real(wp), intent(in) :: x(:)
+      logical, intent(in) :: cell_side
+      real(wp) :: v, xm(size(x))
+      integer :: s, m
+
+      s = ctx%face_shape
+      m = ctx%face_dim
+      if (cell_side .eqv. ctx%cell_side_inside) then
+         ! on the shape's inner side of the plane
+         if (body%shapes(s)%kind == shape_box) then
+            ! the other faces decide: phi with x_m moved to the box's mid-plane
+            xm = x
+            xm(m) = 0.5_wp*(body%shapes(s)%lower(m) + body%shapes(s)%upper(m))
+            v = body%shapes(s)%phi(xm)
+         else
+            v = -1.0_wp
+         end if
+      else
+         v = 1.0_wp
+      end if
+      inside = csg_phi(body, x, s, v) < 0.0_wp
+   end function face_member
+
+   !> The body's level set at x with shape s's value replaced by v.
+   pure real(wp) function csg_phi(body, x, s, v) result(f)
+      class(body_type), intent(in) :: body
+      real(wp), intent(in) :: x(:), v
+      integer, intent(in) :: s
+      real(wp) :: g
+      integer :: k
+
+      do k = 1, body%nshape
+         if (k == s) then
+            g = v
+         else
+            g = body%shapes(k)%phi(x)
+         end if
+         if (k == 1) then
+            f = g
+         else if (body%ops(k) == csg_add) then
+            f = min(f, g)
+         else if (body%ops(k) == csg_intersect) then
+            f = max(f, g)
+         else
+            f = max(f, -g)
+         end if
+      end do
+   end function csg_phi
+
+   ! ------------------------------------------------------------ dimension reduction
+
+   !> Rule of the y-box [lo, hi] over its free dimensions for the quadrics
+   !> rule%poly(:, p0:p0+np-1). Below the top: push base points (y, weight in
+   !> y measure) onto the stack. At the top, `want` says what to emit: -1 the
+   !> volume only (a face part), 0 volume and every surface, t > 0 only the
+   !> surface of the top-level quadric tagged t.
+   recursive pure subroutine reduce(ctx, quad, body, rule, lo, hi, free, p0, np, top, want, depth)
+      type(context_type), intent(in) :: ctx
+      type(cut_quadrature_type), intent(in) :: quad
+      class(body_type), intent(in) :: body
+      type(cell_rule_type), intent(inout) :: rule
+      real(wp), intent(in) :: lo(3), hi(3)
+      logical, intent(in) :: free(3)
+      integer, intent(in) :: p0, np, want, depth
+      logical, intent(in) :: top
+      real(wp) :: pmin, pmax, p(0:ncoef - 1), c(0:ncoef - 1), clo(3), chi(3)
+      integer :: k0, nk, i, j, k, m, s0, s1, b0, nnew, child, bit, d, status, owner, tag
+      logical :: resolved, base_free(3), require(np)
+
+      k0 = rule%np + 1
+      do i = p0, p0 + np - 1
+         p = rule%poly(:, i)
+         call quadric_range(p, lo, hi, pmin, pmax)
+         ! owner and tag by value: push_poly may reallocate the arrays they live in
+         owner = rule%owner(i)
+         tag = rule%tag(i)
+         if (pmin < 0.0_wp .and. pmax > 0.0_wp) call push_poly(rule, p, owner, tag)
+      end do
+      nk = rule%np - k0 + 1
+      m = count(free)
+      if (top .and. want > 0) then
+         ! only the surface tagged `want`: nothing to do where it is not
+         if (.not. any(rule%tag(k0:k0 + nk - 1) == want)) then
+            rule%np = k0 - 1
+            return
+         end if
+      end if
+
+      if (nk == 0) then
+         call tensor_piece(ctx, quad, body, rule, lo, hi, free, top)
+         rule%np = k0 - 1
+         return
+      end if
+
+      ! the surfaces wanted at the top must be crossed by the height lines
+      require(1:nk) = top .and. want >= 0
+      if (top .and. want > 0) require(1:nk) = rule%tag(k0:k0 + nk - 1) == want
+      call choose_direction(rule%poly(:, k0:k0 + nk - 1), require(1:nk), lo, hi, free, quad%min_ratio, k, resolved)
+      if (.not. resolved .and. top .and. want == 0) then
+         ! walls parallel to some direction: volume now, their surfaces in own passes
+         require(1:nk) = .false.
+         call choose_direction(rule%poly(:, k0:k0 + nk - 1), require(1:nk), lo, hi, free, quad%min_ratio, k, &
+            & resolved)
+      end if
+      if (.not. resolved .and. depth < quad%max_depth) then
+         rule%nsplit = rule%nsplit + 1
+         do child = 0, 2**m - 1
+            clo = lo
+            chi = hi
+            bit = 0
+            do d = 1, 3
+               if (.not. free(d)) cycle
+               if (btest(child, bit)) then
+                  clo(d) = 0.5_wp*(lo(d) + hi(d))
+               else
+                  chi(d) = 0.5_wp*(lo(d) + hi(d))
+               end if
+               bit = bit + 1
+            end do
+            call reduce(ctx, quad, body, rule, clo, chi, free, k0, nk, top, want, depth + 1)
+         end do
+         rule%np = k0 - 1
+         return
+      end if
+      if (.not. resolved) rule%nunresolved = rule%nunresolved + 1
+
+      s0 = rule%ns
+      if (m == 1) then
+         call push_point(rule, 0.5_wp*(lo + hi), 1.0_wp)
+      else
+         b0 = rule%np + 1
+         do i = k0, k0 + nk - 1
+            p = rule%poly(:, i)
+            if (depends_on(p, k)) then
+               call face_restriction(ctx, body, p, rule%owner(i), k, lo(k), c)
+               call push_poly(rule, c, 0, 0)
+               call face_restriction(ctx, body, p, rule%owner(i), k, hi(k), c)
+               call push_poly(rule, c, 0, 0)
+            else
+               call push_poly(rule, p, 0, 0)
+            end if
+         end do
+         do i = k0, k0 + nk - 1
+            if (.not. depends_on(rule%poly(:, i), k)) cycle
+            do j = i + 1, k0 + nk - 1
+               if (.not. depends_on(rule%poly(:, j), k)) cycle
+               p = rule%poly(:, i)
+               call crossing(p, rule%poly(:, j), k, c, status)
+               if (status == 1) call push_poly(rule, c, 0, 0)
+            end do
+         end do
+         base_free = free
+         base_free(k) = .false.
+         call reduce(ctx, quad, body, rule, lo, hi, base_free, b0, rule%np - b0 + 1, .false., 0, depth)
+         rule%np = b0 - 1
+      end if
+      s1 = rule%ns
+      do i = s0 + 1, s1
+         call lift(ctx, quad, body, rule, i, k, lo(k), hi(k), k0, nk, free, top, want)
+      end do
+      if (top) then
+         rule%ns = s0
+         if (want == 0) then
+            do i = k0, k0 + nk - 1
+               tag = rule%tag(i)
+               if (depends_on(rule%poly(:, i), k) .or. tag == 0) cycle
+               call reduce(ctx, quad, body, rule, lo, hi, free, k0, nk, .true., tag, depth)
+            end do
+         end if
+      else
+         nnew = rule%ns - s1
+         rule%sy(:, s0 + 1:s0 + nnew) = rule%sy(:, s1 + 1:s1 + nnew)
+         rule%sw(s0 + 1:s0 + nnew) = rule%sw(s1 + 1:s1 + nnew)
+         rule%ns = s0 + nnew
+      end if
+      rule%np = k0 - 1
+   end subroutine reduce
+
+   !> Restriction of quadric p (of shape `owner`, 0 if derived) to y_k = v.
+   !> For a curved shape it is rebuilt from the shape around the face point,
+   !> x_k = center_k + half_k v: the constant term is then formed without
+   !> cancellation ((|d| - r)(|d| + r) and the like), which keeps the split
+   !> points of near-tangent restrictions (a sliver cut, a pole near a face)
+   !> accurate to a few ulps instead of eps * h^2 / (their small value).
+   pure subroutine face_restriction(ctx, body, p, owner, k, v, c)
+      type(context_type), intent(in) :: ctx
+      class(body_type), intent(in) :: body
+      real(wp), intent(in) :: p(0:), v
+      integer, intent(in) :: owner, k
+      real(wp), intent(out) :: c(0:)
+      real(wp) :: center(3), half(3), polys(0:ncoef - 1, max_shape_quadrics)
+      integer :: n
+
+      if (owner > 0) then
+         if (body%shapes(owner)%kind /= shape_box .and. body%shapes(owner)%kind /= shape_halfspace) then
+            center = ctx%center
+            half = ctx%half
+            center(k) = ctx%center(k) + ctx%half(k)*v
+            half(k) = 0.0_wp
+            call shape_quadrics(body%shapes(owner), center, half, center, center, 0.0_wp, polys, n)
+            c(0:ncoef - 1) = polys(:, 1)
+            return
+         end if
+      end if
+      call restrict(p, k, v, c)
+   end subroutine face_restriction
+
+   !> Height direction among the free ones. Valid: every quadric either free
+   !> of y_k (not allowed where `require`) or with dp/dy_k of one strict sign
+   !> over the box and |dp/dy_k| >= min_ratio * (its variation over the box),
+   !> which keeps the turning points of the height function at least min_ratio
+   !> box widths away; and every pair involving y_k with a crossing quadric.
+   !> Among valid ones the largest min |dp/dy_k|/|grad p| at the box center.
+   !> A single free dimension is always resolved (all roots on a line are
+   !> found). If none is valid: resolved = .false. and k is the direction with
+   !> the best score.
+   pure subroutine choose_direction(polys, require, lo, hi, free, min_ratio, k, resolved)
+      real(wp), intent(in) :: polys(0:, :), lo(3), hi(3), min_ratio
+      logical, intent(in) :: require(:), free(3)
+      integer, intent(out) :: k
+      logical, intent(out) :: resolved
+      real(wp) :: score, best_valid, best_any, dmin, dmax, g(3), mid(3), c(0:ncoef - 1)
+      integer :: d, i, j, status
+      logical :: valid
+
+      mid = 0.5_wp*(lo + hi)
+      best_valid = -1.0_wp
+      best_any = -1.0_wp
+      k = 0
+      resolved = .false.
+      do d = 1, 3
+         if (.not. free(d)) cycle
+         if (count(free) == 1) then
+            k = d
+            resolved = .true.
+            return
+         end if
+         valid = .true.
+         score = 1.0_wp
+         do i = 1, size(polys, 2)
+            if (.not. depends_on(polys(:, i), d)) then
+               if (require(i)) then
+                  valid = .false.
+                  score = 0.0_wp
+               end if
+               cycle
+            end if
+            g = quadric_gradient(polys(:, i), mid)
+            if (norm2(g) > 0.0_wp) score = min(score, abs(g(d))/norm2(g))
+            call derivative_range(polys(:, i), d, lo, hi, dmin, dmax)
+            if (dmin > 0.0_wp) then
+               if (dmin < min_ratio*(dmax - dmin)) valid = .false.
+            else if (dmax < 0.0_wp) then
+               if (-dmax < min_ratio*(dmax - dmin)) valid = .false.
+            else
+               valid = .false.
+            end if
+         end do
+         if (score > best_any) then
+            best_any = score
+            if (best_valid < 0.0_wp) k = d
+         end if
+         if (.not. valid .or. score <= best_valid) cycle
+         pairs: do i = 1, size(polys, 2)
+            if (.not. depends_on(polys(:, i), d)) cycle
+            do j = i + 1, size(polys, 2)
+               if (.not. depends_on(polys(:, j), d)) cycle
+               call crossing(polys(:, i), polys(:, j), d, c, status)
+               if (status < 0) then
+                  valid = .false.
+                  exit pairs
+               end if
+            end do
+         end do pairs
+         if (.not. valid) cycle
+         best_valid = score
+         k = d
+         resolved = .true.
+      end do
+   end subroutine choose_direction
+
+   !> A box with no surface in it: at the top, all of it or nothing by the
+   !> membership at its center; below, its tensor rule onto the stack.
+   pure subroutine tensor_piece(ctx, quad, body, rule, lo, hi, free, top)
+      type(context_type), intent(in) :: ctx
+      type(cut_quadrature_type), intent(in) :: quad
+      class(body_type), intent(in) :: body
+      type(cell_rule_type), intent(inout) :: rule
+      real(wp), intent(in) :: lo(3), hi(3)
+      logical, intent(in) :: free(3)
+      logical, intent(in) :: top
+      real(wp) :: y(3), w
+      integer :: ipt, i, d, idx, m
+
+      if (top) then
+         if (.not. member(ctx, body, 0.5_wp*(lo + hi))) return
+      end if
+      m = count(free)
+      do ipt = 1, quad%q**m
+         i = ipt - 1
+         w = 1.0_wp
+         y = 0.5_wp*(lo + hi)
+         do d = 1, 3
+            if (.not. free(d)) cycle
+            idx = mod(i, quad%q) + 1
+            i = i/quad%q
+            y(d) = lo(d) + (hi(d) - lo(d))*quad%node(idx)
+            w = w*(hi(d) - lo(d))*quad%weight(idx)
+         end do
+         if (top) then
+            call emit_volume(ctx, rule, y, w, free)
+         else
+            call push_point(rule, y, w)
+         end if
+      end do
+   end subroutine tensor_piece
+
+   !> Lift base point number ip along y_k over [a, b] through the quadrics
+   !> rule%poly(:, k0:k0+nk-1) (see the module notes, step 4).
+   pure subroutine lift(ctx, quad, body, rule, ip, k, a, b, k0, nk, free, top, want)
+      type(context_type), intent(in) :: ctx
+      type(cut_quadrature_type), intent(in) :: quad
+      class(body_type), intent(in) :: body
+      type(cell_rule_type), intent(inout) :: rule
+      integer, intent(in) :: ip, k, k0, nk, want
+      real(wp), intent(in) :: a, b
+      logical, intent(in) :: free(3), top
+      real(wp) :: y(3), ym(3), wb, t(0:2*nk + 1), roots(2), ca, cb, cc, len, key
+      integer :: rown(0:2*nk + 1), nr, i, j, n, g, okey, owner
+      logical :: inside, prev_in, have_prev
+
+      y = rule%sy(:, ip)
+      wb = rule%sw(ip)
+      nr = 0
+      do i = k0, k0 + nk - 1
+         if (.not. depends_on(rule%poly(:, i), k)) cycle
+         call line_coefficients(rule%poly(:, i), k, y, ca, cb, cc)
+         call quadratic_roots(ca, cb, cc, roots, n)
+         do j = 1, n
+            if (roots(j) > a .and. roots(j) < b) then
+               nr = nr + 1
+               t(nr) = roots(j)
+               rown(nr) = i
+            end if
+         end do
+      end do
+      ! insertion sort of the roots with their owners
+      do i = 2, nr
+         key = t(i)
+         okey = rown(i)
+         j = i - 1
+         do while (j >= 1)
+            if (t(j) <= key) exit
+            t(j + 1) = t(j)
+            rown(j + 1) = rown(j)
+            j = j - 1
+         end do
+         t(j + 1) = key
+         rown(j + 1) = okey
+      end do
+      t(0) = a
+      t(nr + 1) = b
+      rown(0) = 0
+
+      have_prev = .false.
+      prev_in = .false.
+      do j = 0, nr
+         len = t(j + 1) - t(j)
+         if (.not. len > 0.0_wp) cycle
+         if (top) then
+            ym = y
+            ym(k) = t(j) + 0.5_wp*len
+            inside = member(ctx, body, ym)
+            if (have_prev .and. (inside .neqv. prev_in) .and. want >= 0) then
+               if (want == 0 .or. rule%tag(rown(j)) == want) then
+                  ym(k) = t(j)
+                  owner = rule%owner(rown(j))
+                  call emit_surface(ctx, body, rule, ym, wb, k, free, owner)
+               end if
+            end if
+            have_prev = .true.
+            prev_in = inside
+            if (.not. inside .or. want > 0) cycle
+         end if
+         do g = 1, quad%q
+            ym = y
+            ym(k) = t(j) + len*quad%node(g)
+            if (top) then
+               call emit_volume(ctx, rule, ym, wb*len*quad%weight(g), free)
+            else
+               call push_point(rule, ym, wb*len*quad%weight(g))
+            end if
+         end do
+      end do
+   end subroutine lift
+
+   !> Membership of the reference point y at the top level.
+   pure logical function member(ctx, body, y) result(inside)
+      type(context_type), intent(in) :: ctx
+      class(body_type), intent(in) :: body
+      real(wp), intent(in) :: y(3)
+      real(wp) :: x(ctx%dim)
+
+      x = ctx%center(1:ctx%dim) + ctx%half(1:ctx%dim)*y(1:ctx%dim)
+      if (ctx%face_shape == 0) then
+         inside = body%phi(x) < 0.0_wp
+      else
+         inside = face_member(ctx, body, x, .true.)
+         if (inside) inside = .not. face_member(ctx, body, x, .false.)
+      end if
+   end function member
+
+   !> A top-level volume point (y-measure weight w): a volume point of the
+   !> cell, or in face mode a surface point on the face.
+   pure subroutine emit_volume(ctx, rule, y, w, free)
+      type(context_type), intent(in) :: ctx
+      type(cell_rule_type), intent(inout) :: rule
+      real(wp), intent(in) :: y(3), w
+      logical, intent(in) :: free(3)
+      real(wp) :: x(3), n(3)
+
+      x = 0.0_wp
+      x(1:ctx%dim) = ctx%center(1:ctx%dim) + ctx%half(1:ctx%dim)*y(1:ctx%dim)
+      if (ctx%face_shape == 0) then
+         call push_volume(rule, x, w*product(ctx%half, mask=free))
+      else
+         n = 0.0_wp
+         n(ctx%face_dim) = ctx%face_side
+         call push_surface(rule, x, w*product(ctx%half, mask=free), n, ctx%face_shape)
+      end if
+   end subroutine emit_volume
+
+   !> A surface point at y on shape s seen along y_k, base weight wb (y measure).
+   pure subroutine emit_surface(ctx, body, rule, y, wb, k, free, s)
+      type(context_type), intent(in) :: ctx
+      class(body_type), intent(in) :: body
+      type(cell_rule_type), intent(inout) :: rule
+      real(wp), intent(in) :: y(3), wb
+      integer, intent(in) :: k, s
+      logical, intent(in) :: free(3)
+      real(wp) :: x(3), n(3), jac
+      logical :: base(3)
+
+      x = 0.0_wp
+      n = 0.0_wp
+      x(1:ctx%dim) = ctx%center(1:ctx%dim) + ctx%half(1:ctx%dim)*y(1:ctx%dim)
+      call body%outward_normal(x(1:ctx%dim), s, n)
+      ! n_k = 0 only on an unresolved box: a point of zero measure
+      if (.not. abs(n(k)) > 1.0e-12_wp) return
+      base = free
+      base(k) = .false.
+      jac = product(ctx%half, mask=base)
+      call push_surface(rule, x, wb*jac/abs(n(k)), n, s)
+   end subroutine emit_surface
+
+   ! ------------------------------------------------------------ growing arrays
+
+   !> Push a quadric with its shape (owner, 0 for a derived one) and its tag
+   !> (1, 2, ... for the top-level quadrics of a cell, 0 for derived ones).
+   pure subroutine push_poly(rule, p, owner, tag)
+      type(cell_rule_type), intent(inout) :: rule
+      real(wp), intent(in) :: p(0:)
+      integer, intent(in) :: owner, tag
+      real(wp), allocatable :: tp(:, :)
+      integer, allocatable :: to(:), tt(:)
+      integer :: cap
+
+      cap = size(rule%poly, 2)
+      if (rule%np == cap) then
+         allocate (tp(0:ncoef - 1, 2*cap), to(2*cap), tt(2*cap))
+         tp(:, 1:cap) = rule%poly
+         to(1:cap) = rule%owner
+         tt(1:cap) = rule%tag
+         call move_alloc(tp, rule%poly)
+         call move_alloc(to, rule%owner)
+         call move_alloc(tt, rule%tag)
+      end if
+      rule%np = rule%np + 1
+      rule%poly(:, rule%np) = p(0:ncoef - 1)
+      rule%owner(rule%np) = owner
+      rule%tag(rule%np) = tag
+   end subroutine push_poly
+
+   pure subroutine push_point(rule, y, w)
+      type(cell_rule_type), intent(inout) :: rule
+      real(wp), intent(in) :: y(3), w
+      real(wp), allocatable :: ty(:, :), tw(:)
+      integer :: cap
+
+      cap = size(rule%sw)
+      if (rule%ns == cap) then
+         allocate (ty(3, 2*cap), tw(2*cap))
+         ty(:, 1:cap) = rule%sy
+         tw(1:cap) = rule%sw
+         call move_alloc(ty, rule%sy)
+         call move_alloc(tw, rule%sw)
+      end if
+      rule%ns = rule%ns + 1
+      rule%sy(:, rule%ns) = y
+      rule%sw(rule%ns) = w
+   end subroutine push_point
+
+   pure subroutine push_volume(rule, x, w)
+      type(cell_rule_type), intent(inout) :: rule
+      real(wp), intent(in) :: x(3), w
+      real(wp), allocatable :: tx(:, :), tw(:)
+      integer :: cap
+
+      cap = size(rule%vol_w)
+      if (rule%nvol == cap) then
+         allocate (tx(3, 2*cap), tw(2*cap))
+         tx(:, 1:cap) = rule%vol_x
+         tw(1:cap) = rule%vol_w
+         call move_alloc(tx, rule%vol_x)
+         call move_alloc(tw, rule%vol_w)
+      end if
+      rule%nvol = rule%nvol + 1
+      rule%vol_x(:, rule%nvol) = x
+      rule%vol_w(rule%nvol) = w
+   end subroutine push_volume
+
+   pure subroutine push_surface(rule, x, w, n, s)
+      type(cell_rule_type), intent(inout) :: rule
+      real(wp), intent(in) :: x(3), w, n(3)
+      integer, intent(in) :: s
+      real(wp), allocatable :: tx(:, :), tw(:), tn(:, :)
+      integer, allocatable :: ts(:)
+      integer :: cap
+
+      cap = size(rule%surf_w)
+      if (rule%nsurf == cap) then
+         allocate (tx(3, 2*cap), tw(2*cap), tn(3, 2*cap), ts(2*cap))
+         tx(:, 1:cap) = rule%surf_x
+         tw(1:cap) = rule%surf_w
+         tn(:, 1:cap) = rule%surf_n
+         ts(1:cap) = rule%surf_shape
+         call move_alloc(tx, rule%surf_x)
+         call move_alloc(tw, rule%surf_w)
+         call move_alloc(tn, rule%surf_n)
+         call move_alloc(ts, rule%surf_shape)
+      end if
+      rule%nsurf = rule%nsurf + 1
+      rule%surf_x(:, rule%nsurf) = x
+      rule%surf_w(rule%nsurf) = w
+      rule%surf_n(:, rule%nsurf) = n
+      rule%surf_shape(rule%nsurf) = s
+   end subroutine push_surface
+
+   pure function real_str(x) result(s)
+      real(wp), intent(in) :: x
+      character(len=:), allocatable :: s
+      character(len=32) :: buf
+      write (buf, '(g0)') x
+      s = trim(adjustl(buf))
+   end function real_str
+
+   pure function int_str(i) result(s)
+      integer, intent(in) :: i
+      character(len=:), allocatable :: s
+      character(len=16) :: buf
+      write (buf, '(i0)') i
+      s = trim(buf)
+   end function int_str
+
+end module sprc_grid_quadrature
