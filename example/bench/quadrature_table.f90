@@ -89,10 +89,11 @@ contains
       type(cut_quadrature_type) :: quad
       type(cell_rule_type) :: rule
       type(error_type), allocatable :: error
-      real(wp) :: lo(3), hi(3), h
+      real(wp) :: lo(3), hi(3), h, cellsum(4), comp(4), t
       integer :: n, dim, cell, idx, d, i
 
       dim = body%dim
+      comp = 0.0_wp
       call new_cut_quadrature(quad, dim, q, error, min_ratio=ratio)
       if (allocated(error)) error stop 'new_cut_quadrature'
       n = 2**level
@@ -115,13 +116,26 @@ contains
             if (rule%nsplit > 0) nsplitcells = nsplitcells + 1
             nfallback = nfallback + rule%nunresolved
          end if
+         cellsum = 0.0_wp
          do i = 1, rule%nvol
-            got(1) = got(1) + rule%vol_w(i)
-            got(3) = got(3) + rule%vol_w(i)*rule%vol_x(1, i)
-            got(4) = got(4) + rule%vol_w(i)*rule%vol_x(1, i)**2
+            cellsum(1) = cellsum(1) + rule%vol_w(i)
+            cellsum(3) = cellsum(3) + rule%vol_w(i)*rule%vol_x(1, i)
+            cellsum(4) = cellsum(4) + rule%vol_w(i)*rule%vol_x(1, i)**2
          end do
-         got(2) = got(2) + sum(rule%surf_w(1:rule%nsurf))
+         cellsum(2) = sum(rule%surf_w(1:rule%nsurf))
+         ! compensated (Neumaier) sum over up to 2^18 cells: the naive sum's
+         ! round-off (~1e-11 at level 6) would mask the quadrature error
+         do i = 1, 4
+            t = got(i) + cellsum(i)
+            if (abs(got(i)) >= abs(cellsum(i))) then
+               comp(i) = comp(i) + ((got(i) - t) + cellsum(i))
+            else
+               comp(i) = comp(i) + ((cellsum(i) - t) + got(i))
+            end if
+            got(i) = t
+         end do
       end do
+      got = got + comp
    end subroutine integrate
 
    !> Time cut_cell_rule over the cut cells of a level (repeated to >= 0.5 s).

@@ -13,22 +13,36 @@
 !>    line meets each surface at most once), and every pair of surfaces that
 !>    both involve y_k has a crossing quadric (one of them a plane, or both
 !>    with proportional quadratic parts such as two spheres; CSG edges and
-!>    corners are thus resolved exactly);
+!>    corners are thus resolved exactly). Beyond Saye's condition the
+!>    direction must be strong: min |dp/dy_k| >= min_ratio * (variation of
+!>    dp/dy_k over the box), which keeps the turning points of the height
+!>    function (its square-root singularities) at least min_ratio box widths
+!>    away, so Gauss converges like rho^(-2q) with rho >= 13.9 for the
+!>    default min_ratio = 3 (about 1e-13 relative at q = 6 on any level);
 !> 3. the base (the box without direction k) gets the restrictions of the
-!>    quadrics to the two faces y_k = lo, hi, the quadrics free of y_k, and
-!>    the crossing quadrics; its rule comes from the same algorithm one
-!>    dimension lower. On a base piece between these zero sets the roots
-!>    along height lines are smooth, so Gauss points integrate accurately;
+!>    quadrics to the two faces y_k = lo, hi (rebuilt from the shape there,
+!>    without cancellation), the quadrics free of y_k, and the crossing
+!>    quadrics; its rule comes from the same algorithm one dimension lower.
+!>    On a base piece between these zero sets the roots along height lines
+!>    are smooth, so Gauss points integrate accurately;
 !> 4. each base point is lifted: the roots of the quadrics on its height line
 !>    (closed-form, cancellation-free) split it into pieces; at the top level
 !>    a piece belongs to the body if the body's level set is negative at its
 !>    midpoint (exact CSG membership), gets q Gauss points if so, and a root
 !>    where membership changes is a surface point with weight
 !>    w_base / |n_k| (n the exact outward normal from body%outward_normal).
-!> Where no height direction exists (near-tangency, a turning point in the
-!> box, two non-proportional quadrics meeting) the box is split in 2^m halves
-!> (the fallback), up to max_depth times; beyond that the best direction is
-!> used as is (counted in `nunresolved`).
+!> A surface free of y_k (a wall parallel to the height lines, e.g. a
+!> z-cylinder next to a z-cap) is met by no height line: the volume pass may
+!> still use k, and each such surface gets its own pass with a direction
+!> that crosses it (and no volume points).
+!> Fallback: where no valid height direction exists (a turning point in or
+!> near the box, near-tangency, two non-proportional quadrics meeting, such
+!> as a sphere and a cylinder, or two derived conics in a 3D base where a
+!> CSG edge crosses a cell face) the box is split into its 2^m halves, up to
+!> max_depth times (20 in 2D, 10 in 3D); beyond that the best direction is
+!> used as is on a box 2^-max_depth of the cell wide (counted in
+!> `nunresolved`; its error is bounded by that box's measure). `nsplit`
+!> counts the subdivisions of a cell.
 !>
 !> Boundaries on grid planes. A halfspace with an axis normal, or a box face,
 !> lying on a cell face (within the body's snapping tolerance) is never a cut
@@ -57,7 +71,7 @@ module sprc_grid_quadrature
    use sprc_geometry_region, only: cell_outside, cell_inside, cell_cut
    use sprc_geometry_shape, only: shape_halfspace, shape_box
    use sprc_geometry_body, only: body_type, csg_add, csg_intersect, snap_tolerance
-   use sprc_grid_quadric, only: ncoef, max_shape_quadrics, quadric_eval, quadric_range, derivative_range, &
+   use sprc_grid_quadric, only: ncoef, max_shape_quadrics, quadric_range, derivative_range, &
       & quadric_gradient, depends_on, restrict, line_coefficients, quadratic_roots, shape_quadrics, crossing
    implicit none
    private
@@ -141,7 +155,9 @@ contains
    end function default_max_depth
 
    !> Settings for dimension dim (2 or 3) with q points per direction
-   !> (1..max_gauss_points) and optionally a subdivision depth (0..30).
+   !> (1..max_gauss_points), optionally a subdivision depth (0..30, default
+   !> `default_max_depth(dim)`) and a height-direction strength min_ratio
+   !> (0..100, default `default_min_ratio` = 3; 0 is Saye's plain condition).
    pure subroutine new_cut_quadrature(self, dim, q, error, max_depth, min_ratio)
       type(cut_quadrature_type), intent(out) :: self
       integer, intent(in) :: dim, q
