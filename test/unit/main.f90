@@ -17,6 +17,7 @@ program sprc_unit_tests
    use sprc_test_recovery, only: collect_recovery
    use sprc_test_report, only: collect_report
    use sprc_test_output, only: collect_output
+   use sprc_test_patches, only: collect_patches
    implicit none
 
    type(testsuite_type), allocatable :: suites(:)
@@ -36,6 +37,7 @@ program sprc_unit_tests
       new_testsuite('quadrature', collect_quadrature), &
       new_testsuite('recovery', collect_recovery), &
       new_testsuite('report', collect_report), &
+      new_testsuite('patches', collect_patches), &
       new_testsuite('output', collect_output) &
       ]
 

@@ -38,17 +38,21 @@
 !> patches needed it.
 !>
 !> Parallelism and determinism: the patch loop is OpenMP-parallel, each thread owns a
-!> patch object, a recovery workspace, an element list and an element stamp array, all
-!> grown only when a larger patch comes (nothing is allocated per patch once capacities
-!> are reached). Every patch is independent and its elements and points are gathered in
-!> a fixed order, and results are stored per patch: the bits do not depend on the thread
-!> count or schedule. Errors inside the loop are recorded per patch; after the loop the
-!> first failing patch (lowest node) is solved again serially for its message.
+!> patch object, a recovery workspace, an element list and an element stamp array. LAPACK
+!> results depend on the workspace's capacities (leading dimensions, lwork and with it
+!> blocked or unblocked code paths), so every thread reserves the same capacity before the
+!> loop, that of the largest unexpanded patch, and never grows it: a patch that outgrows it
+!> (only possible after expansion) is solved in a second workspace reset to that patch's
+!> own size. Results then depend on the patch alone, elements and points are gathered in a
+!> fixed order, and results are stored per patch: the bits do not depend on the thread
+!> count or schedule. Nothing is allocated per patch except for such outgrown expanded
+!> patches. Errors inside the loop are recorded per patch; after the loop the first
+!> failing patch (lowest node) is solved again serially for its message.
 module sprc_grid_patches
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular
    use sprc_core_material, only: plane_stress, plane_strain, solid, voigt_size, check_material
-   use sprc_core_poly, only: poly_max_degree
+   use sprc_core_poly, only: poly_max_degree, poly_nterms
    use sprc_core_timer, only: wall_time
    use sprc_exact_solution, only: exact_solution_type
    use sprc_grid_tree, only: grid_type
@@ -56,7 +60,7 @@ module sprc_grid_patches
    use sprc_grid_hanging, only: hanging_type
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reset, patch_reserve, &
       & boundary_traction, boundary_symmetry
-   use sprc_recovery_workspace, only: recovery_workspace_type
+   use sprc_recovery_workspace, only: recovery_workspace_type, workspace_reserve, workspace_init
    use sprc_recovery_solve, only: recover_spr, recover_sprc
    use sprc_grid_recovered_field, only: recovered_field_type, method_spr, method_sprc, build_field
    implicit none
@@ -98,7 +102,8 @@ module sprc_grid_patches
    !> Per-thread storage of the patch loop.
    type :: scratch_type
       type(patch_type) :: patch
-      type(recovery_workspace_type) :: ws
+      !> Workspace of the common capacity (same in every thread) and one for larger patches.
+      type(recovery_workspace_type) :: ws, ws_big
       !> Elements of the current patch (1:nlist) and a stamp per element (= the patch's node).
       integer, allocatable :: list(:), stamp(:)
       integer :: nlist = 0
@@ -137,7 +142,7 @@ contains
       !> Expansion rounds allowed per patch (>= 0; default `default_max_rounds`).
       integer, intent(in), optional :: max_rounds
       integer, allocatable :: status(:)
-      integer :: rounds_limit, ip, e
+      integer :: rounds_limit, ip, e, cap(2)
       real(wp) :: t0
       character(len=80) :: buf
 
@@ -162,16 +167,17 @@ contains
       allocate (field%recs(field%n_patches), field%patch_rounds(field%n_patches), &
          & field%patch_elements(field%n_patches), status(field%n_patches))
 
+      cap = initial_capacity(input, nodes, method, degree)
+
       !$omp parallel default(shared)
-      call patch_loop(input, nodes, field, method, degree, rounds_limit, status, exact)
+      call patch_loop(input, nodes, field, method, degree, rounds_limit, cap, status, exact)
       !$omp end parallel
 
       if (any(status /= 0)) then
          ip = findloc(status /= 0, .true., dim=1)
          block
             type(scratch_type) :: sc
-            allocate (sc%list(16), sc%stamp(nodes%n_elements))
-            sc%stamp = 0
+            call init_scratch(sc, nodes, degree, cap)
             call recover_patch(input, nodes, field%elem_lo, field%elem_hi, field%patch_node(ip), field%nstress, &
                & method, degree, rounds_limit, sc, field%recs(ip), field%patch_rounds(ip), field%patch_elements(ip), &
                & error, exact)
@@ -240,19 +246,18 @@ contains
 
    !> One thread's share of the patch loop (called inside the parallel region: its locals
    !> are the thread's own, default-initialised).
-   subroutine patch_loop(input, nodes, field, method, degree, rounds_limit, status, exact)
+   subroutine patch_loop(input, nodes, field, method, degree, rounds_limit, cap, status, exact)
       type(recovery_input_type), intent(in) :: input
       type(grid_nodes_type), intent(in) :: nodes
       type(recovered_field_type), intent(inout) :: field
-      integer, intent(in) :: method, degree, rounds_limit
+      integer, intent(in) :: method, degree, rounds_limit, cap(2)
       integer, intent(inout) :: status(:)
       class(exact_solution_type), intent(in), optional :: exact
       type(scratch_type) :: sc
       type(error_type), allocatable :: err
       integer :: ip
 
-      allocate (sc%list(64), sc%stamp(nodes%n_elements))
-      sc%stamp = 0
+      call init_scratch(sc, nodes, degree, cap)
       !$omp do schedule(dynamic, 16)
       do ip = 1, field%n_patches
          call recover_patch(input, nodes, field%elem_lo, field%elem_hi, field%patch_node(ip), field%nstress, &
@@ -263,6 +268,45 @@ contains
       end do
       !$omp end do
    end subroutine patch_loop
+
+   !> Points and boundary points of the largest unexpanded patch (at least 4 nterms points:
+   !> the LAPACK workspace queries need room for a full basis).
+   function initial_capacity(input, nodes, method, degree) result(cap)
+      type(recovery_input_type), intent(in) :: input
+      type(grid_nodes_type), intent(in) :: nodes
+      integer, intent(in) :: method, degree
+      integer :: cap(2)
+      integer :: n, k, e, np, nb
+
+      cap = [4*poly_nterms(nodes%dim, degree), 0]
+      do n = 1, nodes%n_nodes
+         np = 0
+         nb = 0
+         do k = nodes%node_element_ptr(n), nodes%node_element_ptr(n + 1) - 1
+            e = nodes%node_element(k)
+            np = np + input%elem_ptr(e + 1) - input%elem_ptr(e)
+            if (method == method_sprc) nb = nb + input%belem_ptr(e + 1) - input%belem_ptr(e)
+         end do
+         cap = max(cap, [np, nb])
+      end do
+   end function initial_capacity
+
+   !> Thread storage. The LAPACK results depend on the workspace's capacities (leading
+   !> dimensions, lwork and with it blocked or unblocked code), so every thread reserves the
+   !> same capacity `cap` once, and a patch that outgrows it (only after expansion) is
+   !> solved in `ws_big`, reset to that patch's own size: results depend on the patch only.
+   subroutine init_scratch(sc, nodes, degree, cap)
+      type(scratch_type), intent(inout) :: sc
+      type(grid_nodes_type), intent(in) :: nodes
+      integer, intent(in) :: degree, cap(2)
+      type(error_type), allocatable :: err
+
+      allocate (sc%list(64), sc%stamp(nodes%n_elements))
+      sc%stamp = 0
+      ! Cannot fail: dim and degree were validated.
+      call workspace_reserve(sc%ws, nodes%dim, degree, cap(1), cap(2), err)
+      call patch_reserve(sc%patch, cap(1), cap(2))
+   end subroutine init_scratch
 
    !> Gather, solve, and expand while the basis lacks rank.
    subroutine recover_patch(input, nodes, elem_lo, elem_hi, n, ns, method, degree, rounds_limit, sc, rec, rounds, &
@@ -296,10 +340,11 @@ contains
          nel = sc%nlist
          call fill_patch(input, nodes, elem_lo, elem_hi, n, ns, method, sc, exact)
          if (sc%patch%npoints == 0) cycle
-         if (method == method_spr) then
-            call recover_spr(sc%patch, degree, sc%ws, rec, error)
+         if (sc%patch%npoints <= sc%ws%cap_p .and. sc%patch%nbpoints <= sc%ws%cap_b) then
+            call solve(sc%ws)
          else
-            call recover_sprc(sc%patch, degree, sc%ws, rec, error)
+            call workspace_init(sc%ws_big)
+            call solve(sc%ws_big)
          end if
          if (.not. allocated(error)) return
          if (error%stat /= stat_singular) exit
@@ -314,6 +359,15 @@ contains
       else
          error%message = 'recover_grid: '//trim(buf)//'): '//error%message
       end if
+   contains
+      subroutine solve(ws)
+         type(recovery_workspace_type), intent(inout) :: ws
+         if (method == method_spr) then
+            call recover_spr(sc%patch, degree, ws, rec, error)
+         else
+            call recover_sprc(sc%patch, degree, ws, rec, error)
+         end if
+      end subroutine solve
    end subroutine recover_patch
 
    subroutine list_add(sc, e, tag)

@@ -11,8 +11,10 @@
 !> - err_ex = ||sigma_ex - sigma_h||_E, theta = err / err_ex  (effectivity index),
 !> - max_boundary_node_error: the largest |sigma*(x_J) - sigma_ex(x_J)| (Euclidean norm of
 !>   the Voigt difference) over the boundary vertex nodes J, the vertices with a patch of
-!>   elements that have boundary points (nodes just outside the body included: the exact
-!>   solution is evaluated there by its formula's continuation); and the same over the
+!>   elements that have boundary points, restricted to `node_inside` if given (without it,
+!>   nodes just outside the body count too: there the exact solution is its formula's
+!>   continuation and sigma* an extrapolation from the cut pieces, which for noisy data can
+!>   be far off); and the same over the
 !>   boundary points themselves (max_boundary_point_error), where the field is the
 !>   method's interpolation in the point's element.
 !> sigma* is the method's field (nodal for SPR, union for SPR-C) at the same points as
@@ -56,12 +58,14 @@ contains
    !> ZZ estimate of `field` against the FE stresses of `input` (the same input the field was
    !> recovered from), and with `exact` the error norms. Errors: input and field disagree
    !> (stat_invalid_input), exact solution of another dimension.
-   subroutine estimate_error(input, field, est, error, exact)
+   subroutine estimate_error(input, field, est, error, exact, node_inside)
       type(recovery_input_type), intent(in) :: input
       type(recovered_field_type), intent(in) :: field
       type(zz_estimate_type), intent(out) :: est
       type(error_type), allocatable, intent(out) :: error
       class(exact_solution_type), intent(in), optional :: exact
+      !> Nodes inside or on the body (n_nodes), for max_boundary_node_error.
+      logical, intent(in), optional :: node_inside(:)
       real(wp), allocatable :: sex(:, :), zero(:, :)
       real(wp) :: t0
       integer :: ne, ns, np, e, a, b, maxpts
@@ -69,6 +73,12 @@ contains
       t0 = wall_time()
       call check_consistent(input, field, error, exact)
       if (allocated(error)) return
+      if (present(node_inside)) then
+         if (size(node_inside) /= field%n_nodes) then
+            call fatal_error(error, 'estimate_error: node_inside must have n_nodes entries', stat_invalid_input)
+            return
+         end if
+      end if
       ne = field%n_elements
       ns = field%nstress
       np = size(input%w)
@@ -100,7 +110,7 @@ contains
       est%eta = 0.0_wp
       if (est%norm_h**2 + est%err**2 > 0.0_wp) est%eta = est%err/sqrt(est%norm_h**2 + est%err**2)
       if (est%has_exact) then
-         call exact_norms(input, field, est, sex, zero, exact)
+         call exact_norms(input, field, est, sex, zero, exact, node_inside)
       end if
       est%t_estimate = field%t_field + (wall_time() - t0)
    end subroutine estimate_error
@@ -136,12 +146,13 @@ contains
          & est%sigma_star(:, a:b), est%elem_err_star2(e), err)
    end subroutine element_terms
 
-   subroutine exact_norms(input, field, est, sex, zero, exact)
+   subroutine exact_norms(input, field, est, sex, zero, exact, node_inside)
       type(recovery_input_type), intent(in) :: input
       type(recovered_field_type), intent(in) :: field
       type(zz_estimate_type), intent(inout) :: est
       real(wp), intent(in) :: sex(:, :), zero(:, :)
       class(exact_solution_type), intent(in) :: exact
+      logical, intent(in), optional :: node_inside(:)
       type(error_type), allocatable :: err
       logical, allocatable :: bnode(:)
       real(wp) :: s(6), sx(6), nex2
@@ -178,6 +189,7 @@ contains
          end do
       end do
       bnode = bnode .and. field%patch_of_node > 0
+      if (present(node_inside)) bnode = bnode .and. node_inside
       est%n_boundary_nodes = count(bnode)
       est%max_boundary_node_error = 0.0_wp
       do n = 1, field%n_nodes
