@@ -50,7 +50,7 @@
 !> failing patch (lowest node) is solved again serially for its message.
 module sprc_grid_patches
    use sprc_core_kinds, only: wp
-   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular, stat_internal
    use sprc_core_material, only: plane_stress, plane_strain, solid, voigt_size, check_material
    use sprc_core_poly, only: poly_max_degree, poly_nterms
    use sprc_core_timer, only: wall_time
@@ -184,7 +184,7 @@ contains
          end block
          if (.not. allocated(error)) then
             write (buf, '("patch ",i0," failed in the parallel loop but not serially")') ip
-            call fatal_error(error, 'recover_grid: '//trim(buf), stat_invalid_input)
+            call fatal_error(error, 'recover_grid: '//trim(buf), stat_internal)
          end if
          return
       end if
