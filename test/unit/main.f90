@@ -18,6 +18,7 @@ program sprc_unit_tests
    use sprc_test_report, only: collect_report
    use sprc_test_output, only: collect_output
    use sprc_test_fem, only: collect_fem
+   use sprc_test_patches, only: collect_patches
    implicit none
 
    type(testsuite_type), allocatable :: suites(:)
@@ -37,6 +38,7 @@ program sprc_unit_tests
       new_testsuite('quadrature', collect_quadrature), &
       new_testsuite('recovery', collect_recovery), &
       new_testsuite('report', collect_report), &
+      new_testsuite('patches', collect_patches), &
       new_testsuite('output', collect_output), &
       new_testsuite('fem', collect_fem) &
       ]

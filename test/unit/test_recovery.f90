@@ -32,7 +32,7 @@ module sprc_test_recovery
       & patch_add_boundary_point, boundary_traction, boundary_symmetry, boundary_contact, boundary_none, &
       & dominant_boundary_kind, kind_equilibrium, kind_compatibility, kind_traction, kind_symmetry
    use sprc_recovery_operators, only: incompatibility_operator
-   use sprc_recovery_workspace, only: recovery_workspace_type
+   use sprc_recovery_workspace, only: recovery_workspace_type, workspace_init, workspace_reserve
    use sprc_recovery_solve, only: recover_spr, recover_sprc
    use sprc_recovery_estimate, only: eval_recovered, eval_union, zz_error_integral
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type
@@ -84,7 +84,8 @@ contains
          new_unittest('workspace_reuse', test_workspace_reuse), &
          new_unittest('thread_safety_bitwise', test_threads), &
          new_unittest('union_and_zz', test_union_zz), &
-         new_unittest('error_paths', test_errors) &
+         new_unittest('error_paths', test_errors), &
+         new_unittest('reserve_fewer_points_than_terms', test_reserve_few_points) &
          ]
    end subroutine collect_recovery
 
@@ -1376,5 +1377,14 @@ contains
       real(wp) :: x
       x = ieee_value(1.0_wp, ieee_quiet_nan)
    end function ieee_nan
+
+   !> A first patch with fewer points than basis terms (3D, degree 2: 10 terms,
+   !> 2 points) must size the workspace without LAPACK rejecting the query.
+   subroutine test_reserve_few_points(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(recovery_workspace_type) :: ws
+      call workspace_init(ws)
+      call workspace_reserve(ws, 3, 2, 2, 0, error)
+   end subroutine test_reserve_few_points
 
 end module sprc_test_recovery

@@ -167,7 +167,9 @@ contains
          deallocate (ws%tau, ws%jpvt, ws%ipiv, ws%work)
       end if
       allocate (ws%s(3, max(cp, 1)), ws%wn(max(cp, 1)))
-      allocate (ws%pw(max(cp, 1), cnt), ws%qr(max(cp, 1), cnt), ws%rhs(max(cp, 1), 6))
+      ! At least cnt rows: the dormqr query needs m >= k even for a patch with
+      ! fewer points than basis terms (that patch is then reported rank deficient).
+      allocate (ws%pw(max(cp, cnt), cnt), ws%qr(max(cp, cnt), cnt), ws%rhs(max(cp, cnt), 6))
       allocate (ws%mp(cnt, cnt), ws%hmat(cnt, 6))
       allocate (ws%blk(ws%cap_mr, cn), ws%brhs(ws%cap_mr), ws%tmp(3*cnt, cn))
       allocate (ws%estack(max(3*cb, 1), cn), ws%erhs(max(3*cb, 3*cnt)))
