@@ -82,9 +82,7 @@ contains
       if (allocated(error)) call fail(2, error%message)
       call study_levels(scene, cli%levels, levels, error)
       if (allocated(error)) call fail(2, error%message)
-      write (error_unit, '(a)') 'sprc mesh: cell counts only; the measure and boundary_measure keys '// &
-         'arrive with the cut-cell quadrature'
-      call mesh_study(scene, levels, rows, error)
+      call mesh_study(scene, levels, cli%points, rows, error)
       if (allocated(error)) call fail(1, error%message)
       do i = 1, size(rows)
          write (output_unit, '(a)') format_mesh_row(rows(i))

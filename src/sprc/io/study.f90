@@ -6,6 +6,8 @@ module sprc_io_study
    use sprc_core_timer, only: timer_type
    use sprc_geometry_body, only: body_type
    use sprc_grid_tree, only: grid_type
+   use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature, cell_rule_type, cell_rule, &
+      & default_points
    use sprc_io_scene, only: scene_type
    use sprc_io_model, only: build_bodies
    implicit none
@@ -20,8 +22,13 @@ module sprc_io_study
       !> Leaves of each class, summed over all levels of the grid; external
       !> cells coarser than `level` count as the level-`level` cells they cover.
       integer(i8) :: internal = 0, cut = 0, external = 0
-      !> Seconds to build, classify and balance the grid.
-      real(wp) :: t_mesh = 0.0_wp
+      !> Area (2D) / volume (3D) of the body and length / area of its boundary,
+      !> summed from the cut-cell quadrature.
+      real(wp) :: measure = 0.0_wp, boundary_measure = 0.0_wp
+      !> Gauss points per direction used.
+      integer :: points = 0
+      !> Seconds to build, classify and balance the grid, and to build the rules.
+      real(wp) :: t_mesh = 0.0_wp, t_quadrature = 0.0_wp
    end type mesh_row_type
 
 contains
@@ -52,18 +59,23 @@ contains
       levels = override
    end subroutine study_levels
 
-   !> Build each body's grid at each level and count its cells.
-   subroutine mesh_study(scene, levels, rows, error)
+   !> Build each body's grid at each level, count its cells and integrate its
+   !> measure and boundary measure with `points` Gauss points per direction
+   !> (0: the default for the scene's FE order).
+   subroutine mesh_study(scene, levels, points, rows, error)
       type(scene_type), intent(in) :: scene
-      integer, intent(in) :: levels(:)
+      integer, intent(in) :: levels(:), points
       type(mesh_row_type), allocatable, intent(out) :: rows(:)
       type(error_type), allocatable, intent(out) :: error
       type(body_type), allocatable :: bodies(:)
       type(grid_type) :: grid
       type(timer_type) :: timer
+      type(cut_quadrature_type) :: quad
       integer :: l, b, k
 
       call build_bodies(scene, bodies, error)
+      if (allocated(error)) return
+      call new_cut_quadrature(quad, scene%dim, merge(points, default_points(scene%order), points > 0), error)
       if (allocated(error)) return
       allocate (rows(size(levels)*size(bodies)))
       k = 0
@@ -85,19 +97,75 @@ contains
             rows(k)%cut = sum(grid%n_cut)
             rows(k)%external = sum(grid%n_outside)
             rows(k)%t_mesh = timer%elapsed
+            rows(k)%points = quad%q
+            call timer%reset()
+            call timer%start()
+            call integrate_measures(grid, bodies(b), quad, rows(k)%measure, rows(k)%boundary_measure, error)
+            call timer%stop()
+            rows(k)%t_quadrature = timer%elapsed
+            if (allocated(error)) return
          end do
       end do
    end subroutine mesh_study
+
+   !> Sum of the volume and surface weights of every active cell's rule, in
+   !> leaf order with compensated (Neumaier) sums, so that the printed 15
+   !> digits are the quadrature's, not the summation's.
+   subroutine integrate_measures(grid, body, quad, measure, boundary_measure, error)
+      type(grid_type), intent(in) :: grid
+      type(body_type), intent(in) :: body
+      type(cut_quadrature_type), intent(in) :: quad
+      real(wp), intent(out) :: measure, boundary_measure
+      type(error_type), allocatable, intent(out) :: error
+      type(cell_rule_type) :: rule
+      real(wp) :: lo(3), hi(3), vol(2), surf(2)
+      integer :: leaf, d
+
+      d = grid%dim
+      vol = 0.0_wp
+      surf = 0.0_wp
+      do leaf = 1, grid%n_leaves
+         call grid%leaf_box(leaf, lo(1:d), hi(1:d))
+         call cell_rule(quad, body, lo(1:d), hi(1:d), rule, error)
+         if (allocated(error)) return
+         call neumaier_add(vol, rule%vol_w(1:rule%nvol))
+         call neumaier_add(surf, rule%surf_w(1:rule%nsurf))
+      end do
+      measure = vol(1) + vol(2)
+      boundary_measure = surf(1) + surf(2)
+   end subroutine integrate_measures
+
+   !> acc = (sum, compensation) += values, Neumaier's variant of Kahan summation.
+   pure subroutine neumaier_add(acc, values)
+      real(wp), intent(inout) :: acc(2)
+      real(wp), intent(in) :: values(:)
+      real(wp) :: t
+      integer :: i
+      do i = 1, size(values)
+         t = acc(1) + values(i)
+         if (abs(acc(1)) >= abs(values(i))) then
+            acc(2) = acc(2) + ((acc(1) - t) + values(i))
+         else
+            acc(2) = acc(2) + ((values(i) - t) + acc(1))
+         end if
+         acc(1) = t
+      end do
+   end subroutine neumaier_add
 
    !> `level=4 body=cylinder internal=1234 cut=210 external=604 ...` (SCENE.md).
    function format_mesh_row(row) result(line)
       type(mesh_row_type), intent(in) :: row
       character(len=:), allocatable :: line
-      character(len=32) :: t
+      character(len=32) :: t, tq, m, bm
 
       write (t, '(es10.3)') row%t_mesh
+      write (tq, '(es10.3)') row%t_quadrature
+      write (m, '(es24.16)') row%measure
+      write (bm, '(es24.16)') row%boundary_measure
       line = 'level='//itoa(row%level)//' body='//row%body//' internal='//itoa8(row%internal)// &
-         ' cut='//itoa8(row%cut)//' external='//itoa8(row%external)//' t_mesh='//trim(adjustl(t))
+         ' cut='//itoa8(row%cut)//' external='//itoa8(row%external)//' measure='//trim(adjustl(m))// &
+         ' boundary_measure='//trim(adjustl(bm))//' points='//itoa(row%points)//' t_mesh='//trim(adjustl(t))// &
+         ' t_quadrature='//trim(adjustl(tq))
    end function format_mesh_row
 
    pure function itoa(i) result(s)
