@@ -2,10 +2,15 @@
 !> (0 success, 2 bad input, 1 numerical failure or a capability not yet available).
 program sprc_main
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
-   use sprc_core_error, only: error_type
+   use omp_lib, only: omp_set_num_threads
+   use sprc_core_error, only: error_type, stat_invalid_input, stat_io
    use sprc_version, only: sprc_version_string
    use sprc_io_scene, only: scene_type, read_scene, read_scene_text, scene_summary, default_scene_text
    use sprc_io_study, only: mesh_row_type, mesh_study, format_mesh_row, study_levels
+   use sprc_io_run, only: run_model_type, prepare_run, run_level
+   use sprc_io_report, only: report_row_type, report_table, write_report_csv
+   use sprc_io_svg, only: write_report_svg
+   use sprc_io_hdf5, only: h5_output_type
    use sprc_app_cli, only: cli_type, parse_cli, usage_text
    implicit none
 
@@ -23,41 +28,102 @@ program sprc_main
    case ('version')
       write (output_unit, '(a)') 'sprc '//sprc_version_string
    case ('default')
-      call run_default()
+      call run_default(cli)
    case ('check')
       call check_scene(cli%scene_path)
    case ('mesh')
       call mesh_scene(cli)
    case ('run')
-      call check_scene_quietly(cli%scene_path)
-      call fail(1, 'sprc '//cli%command//': '//not_yet())
+      call run_scene_file(cli)
    end select
 
 contains
 
-   !> What this version can and cannot do, stated plainly (issue: never pretend).
-   function not_yet() result(text)
-      character(len=:), allocatable :: text
-      text = 'this version ('//sprc_version_string//') reads and validates scenes and builds their '// &
-         'grids (sprc mesh); the cut-cell quadrature, FE solve, SPR/SPR-C recovery and the error '// &
-         'report are not implemented yet'
-   end function not_yet
-
-   subroutine run_default()
+   !> `sprc` with no arguments: the built-in default scene (Lame cylinder study).
+   subroutine run_default(cli)
+      type(cli_type), intent(in) :: cli
       type(scene_type) :: scene
       type(error_type), allocatable :: error
 
-      write (output_unit, '(a)') 'sprc '//sprc_version_string
-      write (output_unit, '(a)') 'Can do now:    sprc check SCENE.nml (read and validate a scene, '// &
-         'list what it switches on and off), sprc mesh SCENE.nml (grid cell counts per level), '// &
-         '--help, --version.'
-      write (output_unit, '(a)') 'Cannot do yet: sprc run and this default study: '//not_yet()//'.'
-      write (output_unit, '(a)') 'The built-in default scene (example/scenes/lame_cylinder.nml) validates as:'
-      write (output_unit, '(a)') ''
       call read_scene_text(default_scene_text(), '<built-in default scene>', scene, error)
       if (allocated(error)) call fail(1, 'built-in default scene: '//error%message)
-      write (output_unit, '(a)') scene_summary(scene)
+      write (error_unit, '(a)') 'sprc: running the built-in default scene (example/scenes/lame_cylinder.nml); '// &
+         'sprc --help lists the commands'
+      call run_study(scene, cli)
    end subroutine run_default
+
+   subroutine run_scene_file(cli)
+      type(cli_type), intent(in) :: cli
+      type(scene_type) :: scene
+      type(error_type), allocatable :: error
+
+      call read_scene(cli%scene_path, scene, error)
+      if (allocated(error)) call fail(2, error%message)
+      call run_study(scene, cli)
+   end subroutine run_scene_file
+
+   !> One analysis per level; the report on standard output and, with an
+   !> output prefix, PREFIX.csv, .svg, .h5 and .xdmf.
+   subroutine run_study(scene, cli)
+      type(scene_type), intent(in) :: scene
+      type(cli_type), intent(in) :: cli
+      type(run_model_type) :: model
+      type(report_row_type), allocatable :: rows(:)
+      type(h5_output_type) :: h5
+      type(error_type), allocatable :: error
+      character(len=:), allocatable :: prefix
+      integer, allocatable :: levels(:)
+      integer :: i
+
+      call study_levels(scene, cli%levels, levels, error)
+      if (allocated(error)) call fail(2, error%message)
+      call prepare_run(scene, cli%points, model, error)
+      if (allocated(error)) call fail_with(error)
+      if (cli%threads > 0) call omp_set_num_threads(cli%threads)
+      prefix = scene%output
+      if (len(cli%output) > 0) prefix = cli%output
+      if (len(prefix) > 0) then
+         call make_parent_directory(prefix)
+         call h5%create(prefix//'.h5', error)
+         if (allocated(error)) call fail_with(error)
+      end if
+      allocate (rows(size(levels)))
+      do i = 1, size(levels)
+         if (.not. cli%quiet) write (error_unit, '(a,i0,a,i0,a,i0,a)') 'sprc: level ', levels(i), &
+            ' (', i, ' of ', size(levels), ')'
+         call run_level(scene, model, levels(i), rows(i), error, h5)
+         if (allocated(error)) call fail_with(error)
+         if (.not. cli%quiet) write (error_unit, '(a,i0,a,f0.3,a)') 'sprc: level ', levels(i), ' done in ', &
+            rows(i)%t_total, ' s'
+      end do
+      write (output_unit, '(a)') scene%title
+      write (output_unit, '(a)', advance='no') report_table(rows)
+      if (len(prefix) == 0) return
+      call write_report_csv(prefix//'.csv', rows, error)
+      if (.not. allocated(error)) call write_report_svg(prefix//'.svg', rows, scene%title, error)
+      if (.not. allocated(error)) call h5%close(error)
+      if (.not. allocated(error)) call h5%write_xdmf(prefix//'.xdmf', error)
+      if (allocated(error)) call fail_with(error)
+      if (.not. cli%quiet) write (error_unit, '(a)') 'sprc: wrote '//prefix//'.csv, .svg, .h5, .xdmf'
+   end subroutine run_study
+
+   !> mkdir -p of the directory part of an output prefix (the library does no
+   !> file-system management); a path with quotes is left to fail on open.
+   subroutine make_parent_directory(prefix)
+      character(len=*), intent(in) :: prefix
+      integer :: slash, stat
+      slash = index(prefix, '/', back=.true.)
+      if (slash <= 1) return
+      if (scan(prefix, '"''`$\') > 0) return
+      call execute_command_line('mkdir -p -- "'//prefix(1:slash - 1)//'"', exitstat=stat)
+   end subroutine make_parent_directory
+
+   !> Exit 2 for bad input or an unwritable file, 1 for everything else.
+   subroutine fail_with(error)
+      type(error_type), intent(in) :: error
+      if (error%stat == stat_invalid_input .or. error%stat == stat_io) call fail(2, error%message)
+      call fail(1, error%message)
+   end subroutine fail_with
 
    subroutine check_scene(path)
       character(len=*), intent(in) :: path
@@ -89,14 +155,6 @@ contains
       end do
    end subroutine mesh_scene
 
-   subroutine check_scene_quietly(path)
-      character(len=*), intent(in) :: path
-      type(scene_type) :: scene
-      type(error_type), allocatable :: error
-
-      call read_scene(path, scene, error)
-      if (allocated(error)) call fail(2, error%message)
-   end subroutine check_scene_quietly
 
    subroutine fail(status, text)
       integer, intent(in) :: status
