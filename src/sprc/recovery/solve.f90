@@ -64,7 +64,7 @@ module sprc_recovery_solve
    private
 
    public :: recover_spr, recover_sprc, recovery_rank_tol, recovery_bite_ratio, traction_rank_tol
-   public :: flat_traction_rank
+   public :: flat_traction_rank, traction_reach
 
    !> Relative tolerance of every rank decision (pivoted QR): |R_kk| > tol |R_11| counts.
    real(wp), parameter :: recovery_rank_tol = 1.0e-10_wp
@@ -72,6 +72,8 @@ module sprc_recovery_solve
    real(wp), parameter :: recovery_bite_ratio = 1.0e-12_wp
    !> Relative pivot tolerance of the traction rows (QR of the weighted E, module notes).
    real(wp), parameter :: traction_rank_tol = 1.0e-8_wp
+   !> Traction rows only for patches with a traction point within traction_reach h of the node.
+   real(wp), parameter :: traction_reach = 0.1_wp
    !> Two traction points of one piece belong to one face if their normals' cosine exceeds this.
    real(wp), parameter :: face_cos = 0.25_wp
    !> Two symmetry points lie on the same plane if normals and offsets (scaled) agree to this.
@@ -329,7 +331,7 @@ contains
          call fatal_error(error, 'recover_sprc: contact boundary points are not supported yet', stat_invalid_input)
          return
       end if
-      if (kind == boundary_traction .or. patch%all_boundary_kinds) then
+      if ((kind == boundary_traction .or. patch%all_boundary_kinds) .and. traction_near_node(patch)) then
          call traction_block(patch, ws, rec, mc, error)
          if (allocated(error)) return
       end if
@@ -433,6 +435,29 @@ contains
          end if
       end do
    end subroutine traction_faces
+
+   !> True if the patch node lies on the traction boundary up to traction_reach h: its distance
+   !> to the tangent plane at the nearest traction point (module notes).
+   pure logical function traction_near_node(patch) result(near)
+      type(patch_type), intent(in) :: patch
+      integer :: j, jn, d
+      real(wp) :: dist, dmin
+
+      d = patch%dim
+      jn = 0
+      dmin = huge(1.0_wp)
+      do j = 1, patch%nbpoints
+         if (patch%bkind(j) /= boundary_traction .or. .not. (patch%bw(j) > 0.0_wp)) cycle
+         dist = norm2(patch%bx(1:d, j) - patch%x0(1:d))
+         if (dist < dmin) then
+            dmin = dist
+            jn = j
+         end if
+      end do
+      near = .false.
+      if (jn > 0) near = abs(dot_product(patch%bn(1:d, jn), patch%x0(1:d) - patch%bx(1:d, jn))) <= &
+         & traction_reach*patch%h
+   end function traction_near_node
 
    !> Rank of the traction rows of degree-`degree` stresses on a flat boundary piece: dim
    !> components, each a polynomial of degree p in dim - 1 variables, dim C(p + dim - 1, dim - 1).
