@@ -19,8 +19,21 @@
 !>       (The factor h: derivatives in s are h times physical ones.)
 !>   (b) compatibility for p >= 2, exact: all coefficients of L'C P(s) A vanish (operators
 !>       module), from the compliance (plane stress, reduced plane strain, solid).
-!>   (c) traction equilibrium in least-squares form (eq. 80) over the boundary points of
-!>       kind traction: sum_j bw_j E_j^T E_j A = sum_j bw_j E_j^T t_j, E_j = G(n_j) P(s_j).
+!>   (c) traction equilibrium, least-squares form (eq. 80), only for patches whose node lies on
+!>       the traction boundary: within traction_reach h (0.1) of the tangent plane at the
+!>       nearest traction point. (The seed's boundary patches are those of boundary nodes; on
+!>       a cut grid, the traction rows of a patch whose node is a cell or more away from the
+!>       boundary pin the polynomial far from the node, and measured on Lame / Kirsch / sphere
+!>       FE solutions SPR-C then lost to SPR at several levels; reach 0.2 was worse than 0.1.)
+!>       Per boundary face (traction points grouped by piece `bpiece`, and within a piece by
+!>       normal, so box corners give separate faces), E = rows sqrt(bw_j) G(n_j) P(s_j) is
+!>       factored by QR with column pivoting, E Pi = Q R, and eq. 80, E^T E A = E^T t, becomes
+!>       R Pi^T A = Q^T t. The leading rows of R with |R_kk| > traction_rank_tol |R_11|
+!>       (1e-8: a ratio of E, not of the squared E^T E) are kept, at most the rank of the
+!>       rows on a flat face, dim C(p + dim - 1, dim - 1) (`flat_traction_rank`). On a curved
+!>       face the further rows (pivots of the order of the curvature) would pin a degree-p
+!>       polynomial to the traction of a curved arc and ignore the interior data; rows of
+!>       E^T E with pivots 1e-10 carried their data only to ~1e-6 (round-off amplification).
 !>   (d) symmetry, exact: for each symmetry plane of the patch (its symmetry points grouped by
 !>       normal and offset) and each unit tangent t of the plane, n^T sigma*(s) t = 0 at the
 !>       principal lattice of degree p on the plane, which is unisolvent for the degree-p
@@ -34,7 +47,8 @@
 !>   the scaled constraint row) and solved by dsysv. Without constraint rows SPR-C is the
 !>   weighted QR least squares (as SPR with weights).
 !>
-!> Rank tolerance: `recovery_rank_tol` = 1e-10, relative to the largest pivot. Exactly dependent
+!> Rank tolerance: `recovery_rank_tol` = 1e-10, relative to the largest pivot (traction rows:
+!> traction_rank_tol, see (c)). Exactly dependent
 !> rows and basis columns leave pivots at round-off (~1e-16 relative); a discarded pivot above
 !> `recovery_bite_ratio` = 1e-12 means the tolerance, not exact dependence, decided a rank:
 !> the result reports it (`tolerance_bites`, `max_dropped_ratio`).
