@@ -745,7 +745,7 @@ contains
    !> strong symmetry): err_sprc < err_spr < err_fe (energy norm; measured 5.4e-3, 9.5e-3,
    !> 3.4e-2), SPR-C's largest stress error at boundary vertex nodes inside the body at most
    !> half SPR's (measured 0.042 vs 0.102) and its effectivity within 5% of 1 (measured 0.997).
-   !> With the earlier traction block SPR-C had 6.2e-3 and 0.040 here but was worse than SPR
+   !> With traction rows in every patch touching the boundary SPR-C had 6.2e-3 and 0.040 here but lost to SPR
    !> at levels 3 and 4; see example/bench/recovery_study.f90 for the whole table.
    subroutine test_lame_fe(error)
       type(error_type), allocatable, intent(out) :: error
