@@ -1298,6 +1298,11 @@ contains
       call expect('bkind(2)')
       if (allocated(error)) return
       patch = good
+      patch%bpiece(2) = 0
+      call recover_sprc(patch, 1, ws, rec, err)
+      call expect('bpiece(2)')
+      if (allocated(error)) return
+      patch = good
       do i = 1, patch%nbpoints
          if (patch%bkind(i) == boundary_traction) patch%btraction(1, i) = nan
       end do

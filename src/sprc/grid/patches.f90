@@ -448,6 +448,7 @@ contains
                p%bw(p%nbpoints) = input%bw(k)
                p%bn(1:d, p%nbpoints) = input%bn(:, k)
                p%bkind(p%nbpoints) = kind
+               p%bpiece(p%nbpoints) = input%bshape(k)
                p%btraction(1:d, p%nbpoints) = t(1:d)
             end do
          end do

@@ -9,7 +9,8 @@
 !>   s = (x - x0)/h; h is e.g. the largest distance from x0 to a patch node),
 !> - integration points: coordinates, weight*|J| and the FE stress (Voigt),
 !> - boundary quadrature points: coordinates, weight*|J|, outward unit normal,
-!>   boundary kind and, for traction boundaries, the prescribed traction,
+!>   boundary kind, the boundary piece it lies on (e.g. the shape index; default 1)
+!>   and, for traction boundaries, the prescribed traction,
 !> - a constant body force (zero unless set),
 !> - which constraint kinds SPR-C applies.
 !>
@@ -17,7 +18,8 @@
 !> `patch_add_boundary_point` grow them (doubling) only when a larger patch
 !> comes, so a patch loop with one patch object per thread allocates nothing
 !> once the largest patch has been seen. Arrays may also be filled directly:
-!> set the leading columns and `npoints` / `nbpoints` (after `patch_reserve`).
+!> set the leading columns and `npoints` / `nbpoints` (after `patch_reserve`; `bpiece`
+!> is 1 in newly grown storage but keeps old values in reused storage: set it too).
 !>
 !> Symmetry boundaries are planes: the symmetry points of a patch are grouped
 !> into (at most three) planes by their normal and offset, and SPR-C imposes
@@ -79,6 +81,9 @@ module sprc_recovery_patch
       real(wp), allocatable :: bn(:, :)
       !> Boundary kind of point j (boundary_traction, boundary_symmetry, boundary_contact).
       integer, allocatable :: bkind(:)
+      !> Boundary piece of point j (>= 1): the surface it lies on, e.g. the shape index. SPR-C
+      !> bounds the traction constraint rank per piece (sprc_recovery_solve).
+      integer, allocatable :: bpiece(:)
       !> Prescribed traction vector t(1:dim, j) (traction points only; ignored otherwise).
       real(wp), allocatable :: btraction(:, :)
       !> Constant body force per unit volume, b(1:dim); equilibrium is div sigma + b = 0.
@@ -158,6 +163,7 @@ contains
       if (.not. allocated(patch%w)) then
          allocate (patch%x(3, 0), patch%w(0), patch%stress(6, 0))
          allocate (patch%bx(3, 0), patch%bw(0), patch%bn(3, 0), patch%bkind(0), patch%btraction(3, 0))
+         allocate (patch%bpiece(0))
       end if
       if (npoints > size(patch%w)) then
          call grow2(patch%x, npoints)
@@ -169,7 +175,8 @@ contains
          call grow1(patch%bw, nbpoints)
          call grow2(patch%bn, nbpoints)
          call grow2(patch%btraction, nbpoints)
-         call grow1i(patch%bkind, nbpoints)
+         call grow1i(patch%bkind, nbpoints, boundary_none)
+         call grow1i(patch%bpiece, nbpoints, 1)
       end if
    end subroutine patch_reserve
 
@@ -190,12 +197,13 @@ contains
    end subroutine patch_add_point
 
    !> Append a boundary point (coordinates, weight*|J|, outward unit normal, kind,
-   !> and the prescribed traction for traction points).
-   pure subroutine patch_add_boundary_point(patch, x, w, normal, kind, traction)
+   !> the prescribed traction for traction points, and the boundary piece, default 1).
+   pure subroutine patch_add_boundary_point(patch, x, w, normal, kind, traction, piece)
       type(patch_type), intent(inout) :: patch
       real(wp), intent(in) :: x(:), w, normal(:)
       integer, intent(in) :: kind
       real(wp), intent(in), optional :: traction(:)
+      integer, intent(in), optional :: piece
       integer :: j
 
       call patch_reserve(patch, 0, max(patch%nbpoints + 1, 2*patch%nbpoints))
@@ -208,6 +216,8 @@ contains
       patch%bkind(j) = kind
       patch%btraction(:, j) = 0.0_wp
       if (present(traction)) patch%btraction(1:size(traction), j) = traction
+      patch%bpiece(j) = 1
+      if (present(piece)) patch%bpiece(j) = piece
       patch%nbpoints = j
    end subroutine patch_add_boundary_point
 
@@ -345,13 +355,15 @@ contains
          return
       end if
       if (patch%nbpoints == 0) return
-      if (.not. allocated(patch%bw)) then
-         call fatal_error(error, 'patch: boundary arrays are not allocated', stat_invalid_input)
+      if (.not. (allocated(patch%bw) .and. allocated(patch%bx) .and. allocated(patch%bn) .and. &
+         & allocated(patch%bkind) .and. allocated(patch%btraction) .and. allocated(patch%bpiece))) then
+         call fatal_error(error, 'patch: boundary arrays are not allocated (use patch_reserve)', stat_invalid_input)
          return
       end if
       if (patch%nbpoints > size(patch%bw) .or. patch%nbpoints > size(patch%bx, 2) .or. &
          & patch%nbpoints > size(patch%bn, 2) .or. patch%nbpoints > size(patch%bkind) .or. &
-         & patch%nbpoints > size(patch%btraction, 2) .or. size(patch%bx, 1) < d .or. &
+         & patch%nbpoints > size(patch%btraction, 2) .or. patch%nbpoints > size(patch%bpiece) .or. &
+         & size(patch%bx, 1) < d .or. &
          & size(patch%bn, 1) < d .or. size(patch%btraction, 1) < d) then
          write (buf, '("nbpoints = ",i0," exceeds the boundary arrays (bw has ",i0,")")') &
             & patch%nbpoints, size(patch%bw)
@@ -369,6 +381,8 @@ contains
             write (buf, '("bn(:, ",i0,") has length ",es12.4,", expected a unit normal")') j, nrm
          else if (patch%bkind(j) < boundary_traction .or. patch%bkind(j) > boundary_contact) then
             write (buf, '("bkind(",i0,") = ",i0," is not traction=1, symmetry=2 or contact=3")') j, patch%bkind(j)
+         else if (patch%bpiece(j) < 1) then
+            write (buf, '("bpiece(",i0,") = ",i0," must be >= 1")') j, patch%bpiece(j)
          else if (patch%bkind(j) == boundary_traction .and. &
             & .not. all(abs(patch%btraction(1:d, j)) <= huge(1.0_wp))) then
             write (buf, '("btraction(:, ",i0,") is not finite")') j
@@ -390,12 +404,12 @@ contains
       call move_alloc(tmp, a)
    end subroutine grow1
 
-   pure subroutine grow1i(a, n)
+   pure subroutine grow1i(a, n, fill)
       integer, allocatable, intent(inout) :: a(:)
-      integer, intent(in) :: n
+      integer, intent(in) :: n, fill
       integer, allocatable :: tmp(:)
       allocate (tmp(n))
-      tmp = boundary_none
+      tmp = fill
       tmp(1:size(a)) = a
       call move_alloc(tmp, a)
    end subroutine grow1i

@@ -19,8 +19,21 @@
 !>       (The factor h: derivatives in s are h times physical ones.)
 !>   (b) compatibility for p >= 2, exact: all coefficients of L'C P(s) A vanish (operators
 !>       module), from the compliance (plane stress, reduced plane strain, solid).
-!>   (c) traction equilibrium in least-squares form (eq. 80) over the boundary points of
-!>       kind traction: sum_j bw_j E_j^T E_j A = sum_j bw_j E_j^T t_j, E_j = G(n_j) P(s_j).
+!>   (c) traction equilibrium, least-squares form (eq. 80), only for patches whose node lies on
+!>       the traction boundary: within traction_reach h (0.1) of the tangent plane at the
+!>       nearest traction point. (The seed's boundary patches are those of boundary nodes; on
+!>       a cut grid, the traction rows of a patch whose node is a cell or more away from the
+!>       boundary pin the polynomial far from the node, and measured on Lame / Kirsch / sphere
+!>       FE solutions SPR-C then lost to SPR at several levels; reach 0.2 was worse than 0.1.)
+!>       Per boundary face (traction points grouped by piece `bpiece`, and within a piece by
+!>       normal, so box corners give separate faces), E = rows sqrt(bw_j) G(n_j) P(s_j) is
+!>       factored by QR with column pivoting, E Pi = Q R, and eq. 80, E^T E A = E^T t, becomes
+!>       R Pi^T A = Q^T t. The leading rows of R with |R_kk| > traction_rank_tol |R_11|
+!>       (1e-8: a ratio of E, not of the squared E^T E) are kept, at most the rank of the
+!>       rows on a flat face, dim C(p + dim - 1, dim - 1) (`flat_traction_rank`). On a curved
+!>       face the further rows (pivots of the order of the curvature) would pin a degree-p
+!>       polynomial to the traction of a curved arc and ignore the interior data; rows of
+!>       E^T E with pivots 1e-10 carried their data only to ~1e-6 (round-off amplification).
 !>   (d) symmetry, exact: for each symmetry plane of the patch (its symmetry points grouped by
 !>       normal and offset) and each unit tangent t of the plane, n^T sigma*(s) t = 0 at the
 !>       principal lattice of degree p on the plane, which is unisolvent for the degree-p
@@ -34,7 +47,8 @@
 !>   the scaled constraint row) and solved by dsysv. Without constraint rows SPR-C is the
 !>   weighted QR least squares (as SPR with weights).
 !>
-!> Rank tolerance: `recovery_rank_tol` = 1e-10, relative to the largest pivot. Exactly dependent
+!> Rank tolerance: `recovery_rank_tol` = 1e-10, relative to the largest pivot (traction rows:
+!> traction_rank_tol, see (c)). Exactly dependent
 !> rows and basis columns leave pivots at round-off (~1e-16 relative); a discarded pivot above
 !> `recovery_bite_ratio` = 1e-12 means the tolerance, not exact dependence, decided a rank:
 !> the result reports it (`tolerance_bites`, `max_dropped_ratio`).
@@ -63,12 +77,19 @@ module sprc_recovery_solve
    implicit none
    private
 
-   public :: recover_spr, recover_sprc, recovery_rank_tol, recovery_bite_ratio
+   public :: recover_spr, recover_sprc, recovery_rank_tol, recovery_bite_ratio, traction_rank_tol
+   public :: flat_traction_rank, traction_reach
 
    !> Relative tolerance of every rank decision (pivoted QR): |R_kk| > tol |R_11| counts.
    real(wp), parameter :: recovery_rank_tol = 1.0e-10_wp
    !> A discarded pivot above this ratio means the tolerance decided the rank.
    real(wp), parameter :: recovery_bite_ratio = 1.0e-12_wp
+   !> Relative pivot tolerance of the traction rows (QR of the weighted E, module notes).
+   real(wp), parameter :: traction_rank_tol = 1.0e-8_wp
+   !> Traction rows only for patches with a traction point within traction_reach h of the node.
+   real(wp), parameter :: traction_reach = 0.1_wp
+   !> Two traction points of one piece belong to one face if their normals' cosine exceeds this.
+   real(wp), parameter :: face_cos = 0.25_wp
    !> Two symmetry points lie on the same plane if normals and offsets (scaled) agree to this.
    real(wp), parameter :: plane_tol = 1.0e-8_wp
 
@@ -190,17 +211,22 @@ contains
       end if
    end subroutine prepare
 
-   !> Rank from the diagonal of a pivoted-QR R: |R_kk| > tol |R_11|.
-   pure integer function diag_rank(a, k) result(r)
+   !> Rank from the diagonal of a pivoted-QR R: |R_kk| > tol |R_11| (tol: recovery_rank_tol
+   !> unless given).
+   pure integer function diag_rank(a, k, tol) result(r)
       real(wp), intent(in) :: a(:, :)
       integer, intent(in) :: k
+      real(wp), intent(in), optional :: tol
+      real(wp) :: t
       integer :: i
 
+      t = recovery_rank_tol
+      if (present(tol)) t = tol
       r = 0
       if (k < 1) return
       if (.not. (abs(a(1, 1)) > 0.0_wp)) return
       do i = 1, k
-         if (abs(a(i, i)) > recovery_rank_tol*abs(a(1, 1))) r = i
+         if (abs(a(i, i)) > t*abs(a(1, 1))) r = i
       end do
    end function diag_rank
 
@@ -319,7 +345,7 @@ contains
          call fatal_error(error, 'recover_sprc: contact boundary points are not supported yet', stat_invalid_input)
          return
       end if
-      if (kind == boundary_traction .or. patch%all_boundary_kinds) then
+      if ((kind == boundary_traction .or. patch%all_boundary_kinds) .and. traction_near_node(patch)) then
          call traction_block(patch, ws, rec, mc, error)
          if (allocated(error)) return
       end if
@@ -328,7 +354,10 @@ contains
       end if
    end subroutine boundary_blocks
 
-   !> (c) traction equilibrium, least-squares form (eq. 80) with weights bw / sum(bw).
+   !> (c) traction equilibrium, least-squares form (eq. 80), per boundary face (module notes):
+   !> QR with column pivoting of the face's weighted rows sqrt(bw_j) E_j, E_j = G(n_j) P(s_j):
+   !> E Pi = Q R, and eq. 80 (E^T E A = E^T t) is R Pi^T A = Q^T t. The leading rows of R whose
+   !> pivots pass traction_rank_tol, at most the flat-boundary rank, become constraints.
    subroutine traction_block(patch, ws, rec, mc, error)
       type(patch_type), intent(in) :: patch
       type(recovery_workspace_type), intent(inout) :: ws
@@ -336,40 +365,124 @@ contains
       integer, intent(inout) :: mc
       type(error_type), allocatable, intent(out) :: error
       real(wp) :: g(3, 6), p(20), s(3), bsum, sq
-      integer :: j, i, c, d, nt, n, m
+      integer :: nfaces, f, j, i, k, c, d, nt, n, m, r, cap, kmax, info, lde
 
       d = patch%dim
       nt = ws%nt
       n = ws%n
-      bsum = 0.0_wp
-      do j = 1, patch%nbpoints
-         if (patch%bkind(j) == boundary_traction) bsum = bsum + patch%bw(j)
-      end do
-      if (.not. (bsum > 0.0_wp)) return
-      m = 0
-      do j = 1, patch%nbpoints
-         if (patch%bkind(j) /= boundary_traction .or. patch%bw(j) == 0.0_wp) cycle
-         sq = sqrt(patch%bw(j)/bsum)
-         s(1:d) = (patch%bx(1:d, j) - patch%x0(1:d))/patch%h
-         call ws%basis%eval(s(1:d), p)
-         call traction_operator(d, patch%bn(1:d, j), g)
-         do i = 1, d
-            m = m + 1
-            do c = 1, ws%ns
-               ws%estack(m, (c - 1)*nt + 1:c*nt) = (sq*g(i, c))*p(1:nt)
-            end do
-            ws%erhs(m) = sq*patch%btraction(i, j)
+      lde = size(ws%estack, 1)
+      cap = flat_traction_rank(d, ws%degree)
+      call traction_faces(patch, ws, nfaces)
+      do f = 1, nfaces
+         bsum = 0.0_wp
+         do j = 1, patch%nbpoints
+            if (ws%bface(j) == f) bsum = bsum + patch%bw(j)
          end do
+         m = 0
+         do j = 1, patch%nbpoints
+            if (ws%bface(j) /= f) cycle
+            sq = sqrt(patch%bw(j)/bsum)
+            s(1:d) = (patch%bx(1:d, j) - patch%x0(1:d))/patch%h
+            call ws%basis%eval(s(1:d), p)
+            call traction_operator(d, patch%bn(1:d, j), g)
+            do i = 1, d
+               m = m + 1
+               do c = 1, ws%ns
+                  ws%estack(m, (c - 1)*nt + 1:c*nt) = (sq*g(i, c))*p(1:nt)
+               end do
+               ws%erhs(m) = sq*patch%btraction(i, j)
+            end do
+         end do
+         rec%rows(kind_traction) = rec%rows(kind_traction) + m
+         kmax = min(m, n)
+         ws%jpvt(1:n) = 0
+         call workspace_tic(ws)
+         call dgeqp3(m, n, ws%estack, lde, ws%jpvt, ws%tau, ws%work, size(ws%work), info)
+         if (info == 0) call dormqr('L', 'T', m, 1, kmax, ws%estack, lde, ws%tau, ws%erhs, size(ws%erhs), &
+            & ws%work, size(ws%work), info)
+         call workspace_toc(ws)
+         if (info /= 0) then
+            call lapack_info_error('dgeqp3/dormqr', info, 'recover_sprc (traction rows)', error)
+            return
+         end if
+         r = diag_rank(ws%estack, kmax, traction_rank_tol)
+         if (r < min(kmax, cap) .and. r > 0) &
+            & call note_dropped(rec, abs(ws%estack(r + 1, r + 1))/abs(ws%estack(1, 1)))
+         r = min(r, cap)
+         do k = 1, r
+            ws%c(mc + k, 1:n) = 0.0_wp
+            ws%c(mc + k, ws%jpvt(k:n)) = ws%estack(k, k:n)
+            ws%lam(mc + k) = ws%erhs(k)
+         end do
+         mc = mc + r
+         rec%ranks(kind_traction) = rec%ranks(kind_traction) + r
       end do
-      call workspace_tic(ws)
-      call dsyrk('U', 'T', n, m, 1.0_wp, ws%estack, size(ws%estack, 1), 0.0_wp, ws%blk, size(ws%blk, 1))
-      call dgemv('T', m, n, 1.0_wp, ws%estack, size(ws%estack, 1), ws%erhs, 1, 0.0_wp, ws%brhs, 1)
-      call workspace_toc(ws)
-      do i = 1, n
-         ws%blk(i + 1:n, i) = ws%blk(i, i + 1:n)
-      end do
-      call select_block(ws, n, kind_traction, rec, mc, error)
    end subroutine traction_block
+
+   !> Traction faces of a patch: its traction points with weight > 0 grouped by boundary piece and,
+   !> within a piece, by normal (a point joins the first face of its piece whose first normal
+   !> makes an angle below acos(face_cos) with its own; corners of a box are separate faces).
+   !> ws%bface(j) = face of point j (0: none).
+   pure subroutine traction_faces(patch, ws, nfaces)
+      type(patch_type), intent(in) :: patch
+      type(recovery_workspace_type), intent(inout) :: ws
+      integer, intent(out) :: nfaces
+      integer :: j, f, q, d
+
+      d = patch%dim
+      nfaces = 0
+      do j = 1, patch%nbpoints
+         ws%bface(j) = 0
+         if (patch%bkind(j) /= boundary_traction .or. .not. (patch%bw(j) > 0.0_wp)) cycle
+         do f = 1, nfaces
+            q = ws%bfirst(f)
+            if (patch%bpiece(q) == patch%bpiece(j) .and. &
+               & dot_product(patch%bn(1:d, q), patch%bn(1:d, j)) > face_cos) then
+               ws%bface(j) = f
+               exit
+            end if
+         end do
+         if (ws%bface(j) == 0) then
+            nfaces = nfaces + 1
+            ws%bfirst(nfaces) = j
+            ws%bface(j) = nfaces
+         end if
+      end do
+   end subroutine traction_faces
+
+   !> True if the patch node lies on the traction boundary up to traction_reach h: its distance
+   !> to the tangent plane at the nearest traction point (module notes).
+   pure logical function traction_near_node(patch) result(near)
+      type(patch_type), intent(in) :: patch
+      integer :: j, jn, d
+      real(wp) :: dist, dmin
+
+      d = patch%dim
+      jn = 0
+      dmin = huge(1.0_wp)
+      do j = 1, patch%nbpoints
+         if (patch%bkind(j) /= boundary_traction .or. .not. (patch%bw(j) > 0.0_wp)) cycle
+         dist = norm2(patch%bx(1:d, j) - patch%x0(1:d))
+         if (dist < dmin) then
+            dmin = dist
+            jn = j
+         end if
+      end do
+      near = .false.
+      if (jn > 0) near = abs(dot_product(patch%bn(1:d, jn), patch%x0(1:d) - patch%bx(1:d, jn))) <= &
+         & traction_reach*patch%h
+   end function traction_near_node
+
+   !> Rank of the traction rows of degree-`degree` stresses on a flat boundary piece: dim
+   !> components, each a polynomial of degree p in dim - 1 variables, dim C(p + dim - 1, dim - 1).
+   pure integer function flat_traction_rank(dim, degree) result(r)
+      integer, intent(in) :: dim, degree
+      if (dim == 2) then
+         r = 2*(degree + 1)
+      else
+         r = 3*((degree + 1)*(degree + 2))/2
+      end if
+   end function flat_traction_rank
 
    !> (d) symmetry, exact: zero shear n^T sigma* t on each symmetry plane, imposed at the
    !> principal lattice of degree p on the plane (unisolvent for the restriction).

@@ -56,9 +56,11 @@ module sprc_recovery_workspace
       real(wp), allocatable :: tmp(:, :)
       !> Weighted traction operator rows estack(3*cap_b, cap_n) and data erhs(3*cap_b).
       real(wp), allocatable :: estack(:, :), erhs(:)
+      !> Traction face of each boundary point bface(cap_b) and the first point of each face bfirst(cap_b).
+      integer, allocatable :: bface(:), bfirst(:)
       !> Transposed rows for the pivoted QR, cq(cap_n, cap_mq).
       real(wp), allocatable :: cq(:, :)
-      !> Accepted constraint rows c(4*cap_n, cap_n) and right-hand side lam(4*cap_n).
+      !> Accepted constraint rows c(cap_mq, cap_n) and right-hand side lam(cap_mq).
       real(wp), allocatable :: c(:, :), lam(:)
       !> KKT matrix kkt(2*cap_n, 2*cap_n), solution sol and symmetric scaling dscale.
       real(wp), allocatable :: kkt(:, :), sol(:), dscale(:)
@@ -160,10 +162,12 @@ contains
       ! Largest block: n Gram rows, 6 compatibility equations x nt, or symmetry rows
       ! (2 tangents x 10 lattice points x 3 planes).
       ws%cap_mr = max(cn, 6*cnt, 60)
-      ws%cap_mq = max(ws%cap_mr, 4*cn)
+      ! Accepted rows before the stacked selection: equilibrium, compatibility and symmetry
+      ! at most cn each, traction at most one per traction row (3 per boundary point).
+      ws%cap_mq = max(ws%cap_mr, 4*cn, 3*cn + 3*cb)
       if (allocated(ws%s)) then
          deallocate (ws%s, ws%wn, ws%pw, ws%qr, ws%rhs, ws%mp, ws%hmat, ws%blk, ws%brhs, ws%tmp)
-         deallocate (ws%estack, ws%erhs, ws%cq, ws%c, ws%lam, ws%kkt, ws%sol, ws%dscale)
+         deallocate (ws%estack, ws%erhs, ws%cq, ws%c, ws%lam, ws%kkt, ws%sol, ws%dscale, ws%bface, ws%bfirst)
          deallocate (ws%tau, ws%jpvt, ws%ipiv, ws%work)
       end if
       allocate (ws%s(3, max(cp, 1)), ws%wn(max(cp, 1)))
@@ -173,7 +177,8 @@ contains
       allocate (ws%mp(cnt, cnt), ws%hmat(cnt, 6))
       allocate (ws%blk(ws%cap_mr, cn), ws%brhs(ws%cap_mr), ws%tmp(3*cnt, cn))
       allocate (ws%estack(max(3*cb, 1), cn), ws%erhs(max(3*cb, 3*cnt)))
-      allocate (ws%cq(cn, ws%cap_mq), ws%c(4*cn, cn), ws%lam(4*cn))
+      allocate (ws%cq(cn, ws%cap_mq), ws%c(ws%cap_mq, cn), ws%lam(ws%cap_mq))
+      allocate (ws%bface(max(cb, 1)), ws%bfirst(max(cb, 1)))
       allocate (ws%kkt(2*cn, 2*cn), ws%sol(2*cn), ws%dscale(2*cn))
       allocate (ws%tau(max(ws%cap_mq, cnt)), ws%jpvt(max(ws%cap_mq, cnt)), ws%ipiv(2*cn))
 
@@ -183,6 +188,11 @@ contains
       call check_query('dgeqp3')
       call dgeqp3(cn, ws%cap_mq, ws%cq, cn, ws%jpvt, ws%tau, q, -1, info)
       call check_query('dgeqp3')
+      call dgeqp3(size(ws%estack, 1), cn, ws%estack, size(ws%estack, 1), ws%jpvt, ws%tau, q, -1, info)
+      call check_query('dgeqp3')
+      call dormqr('L', 'T', size(ws%estack, 1), 1, min(size(ws%estack, 1), cn), ws%estack, size(ws%estack, 1), &
+         & ws%tau, ws%erhs, size(ws%erhs), q, -1, info)
+      call check_query('dormqr')
       call dormqr('L', 'T', size(ws%qr, 1), 6, cnt, ws%qr, size(ws%qr, 1), ws%tau, ws%rhs, size(ws%rhs, 1), &
          & q, -1, info)
       call check_query('dormqr')
