@@ -164,7 +164,7 @@ contains
       if (allocated(error)) return
       call check(error, s%analysis, 'plane_stress', 'analysis')
       if (allocated(error)) return
-      call check(error, size(s%levels) == 4 .and. all(s%levels == [3, 4, 5, 6]), 'levels 3..6')
+      call check(error, size(s%levels) == 4 .and. all(s%levels == [4, 5, 6, 7]), 'levels 4..7')
       if (allocated(error)) return
       call check(error, s%exact%kind, 'kirsch', 'exact kind')
       if (allocated(error)) return
