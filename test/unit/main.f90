@@ -19,6 +19,7 @@ program sprc_unit_tests
    use sprc_test_output, only: collect_output
    use sprc_test_fem, only: collect_fem
    use sprc_test_patches, only: collect_patches
+   use sprc_test_mesh_recovery, only: collect_mesh_recovery
    implicit none
 
    type(testsuite_type), allocatable :: suites(:)
@@ -40,7 +41,8 @@ program sprc_unit_tests
       new_testsuite('report', collect_report), &
       new_testsuite('patches', collect_patches), &
       new_testsuite('output', collect_output), &
-      new_testsuite('fem', collect_fem) &
+      new_testsuite('fem', collect_fem), &
+      new_testsuite('mesh_recovery', collect_mesh_recovery) &
       ]
 
    call get_arg(1, suite_name)
