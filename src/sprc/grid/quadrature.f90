@@ -969,40 +969,35 @@ contains
    pure subroutine push_point(rule, y, w)
       type(cell_rule_type), intent(inout) :: rule
       real(wp), intent(in) :: y(3), w
-      real(wp), allocatable :: ty(:, :), tw(:)
-      integer :: cap
-
-      cap = size(rule%sw)
-      if (rule%ns == cap) then
-         allocate (ty(3, 2*cap), tw(2*cap))
-         ty(:, 1:cap) = rule%sy
-         tw(1:cap) = rule%sw
-         call move_alloc(ty, rule%sy)
-         call move_alloc(tw, rule%sw)
-      end if
-      rule%ns = rule%ns + 1
-      rule%sy(:, rule%ns) = y
-      rule%sw(rule%ns) = w
+      call push_weighted(rule%sy, rule%sw, rule%ns, y, w)
    end subroutine push_point
 
    pure subroutine push_volume(rule, x, w)
       type(cell_rule_type), intent(inout) :: rule
       real(wp), intent(in) :: x(3), w
+      call push_weighted(rule%vol_x, rule%vol_w, rule%nvol, x, w)
+   end subroutine push_volume
+
+   !> Append (x, w) to a point list of n entries, doubling its capacity when full.
+   pure subroutine push_weighted(xs, ws, n, x, w)
+      real(wp), allocatable, intent(inout) :: xs(:, :), ws(:)
+      integer, intent(inout) :: n
+      real(wp), intent(in) :: x(3), w
       real(wp), allocatable :: tx(:, :), tw(:)
       integer :: cap
 
-      cap = size(rule%vol_w)
-      if (rule%nvol == cap) then
+      cap = size(ws)
+      if (n == cap) then
          allocate (tx(3, 2*cap), tw(2*cap))
-         tx(:, 1:cap) = rule%vol_x
-         tw(1:cap) = rule%vol_w
-         call move_alloc(tx, rule%vol_x)
-         call move_alloc(tw, rule%vol_w)
+         tx(:, 1:cap) = xs
+         tw(1:cap) = ws
+         call move_alloc(tx, xs)
+         call move_alloc(tw, ws)
       end if
-      rule%nvol = rule%nvol + 1
-      rule%vol_x(:, rule%nvol) = x
-      rule%vol_w(rule%nvol) = w
-   end subroutine push_volume
+      n = n + 1
+      xs(:, n) = x
+      ws(n) = w
+   end subroutine push_weighted
 
    pure subroutine push_surface(rule, x, w, n, s)
       type(cell_rule_type), intent(inout) :: rule
