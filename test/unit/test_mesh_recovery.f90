@@ -26,6 +26,7 @@ module sprc_test_mesh_recovery
       & mesh_method_sprc, facet_traction, facet_symmetry, facet_free, elem_tri3, elem_quad4, elem_tet4, elem_hex8, &
       & elem_quad9, elem_hex27
    use sprc_legacy, only: sprc_recover_mesh
+   use sprc_recovery_mesh_element, only: facet_points
    !$ use omp_lib, only: omp_get_max_threads, omp_set_num_threads
    implicit none
    private
@@ -68,6 +69,7 @@ contains
          new_unittest('quadratic_quad9', test_quadratic_quad9), &
          new_unittest('quadratic_hex27', test_quadratic_hex27), &
          new_unittest('eval_points', test_eval_points), &
+         new_unittest('facet_quadrature', test_facet_quadrature), &
          new_unittest('traction_facets', test_traction_facets), &
          new_unittest('symmetry_facets', test_symmetry_facets), &
          new_unittest('symmetry_facets_3d', test_symmetry_facets_3d), &
@@ -598,6 +600,57 @@ contains
       call expect(error, stat_invalid_input, 'is in no element')
    end subroutine test_eval_points
 
+   !> Facet quadrature against hand values: length / area (sum of w|J|), unit normals
+   !> perpendicular to the facet, and the first moment (centroid) of each facet; line2,
+   !> line3, tri3, quad4, quad9 (a rectangle in the plane x = 1 with its VTK node order).
+   subroutine test_facet_quadrature(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: x(3, 9), w(9), nrm(3, 9), xf(3, 9)
+      integer :: nq
+
+      xf(1:2, 1:3) = reshape([0.0_wp, 0.0_wp, 3.0_wp, 4.0_wp, 1.5_wp, 2.0_wp], [2, 3])
+      call facet_points(2, 2, xf(1:2, 1:2), nq, x, w, nrm)
+      call check_facet(nq, 2, 5.0_wp, [1.5_wp, 2.0_wp, 0.0_wp], [0.8_wp, -0.6_wp, 0.0_wp], 'line2')
+      if (allocated(error)) return
+      call facet_points(2, 3, xf(1:2, 1:3), nq, x, w, nrm)
+      call check_facet(nq, 3, 5.0_wp, [1.5_wp, 2.0_wp, 0.0_wp], [0.8_wp, -0.6_wp, 0.0_wp], 'line3')
+      if (allocated(error)) return
+      xf(:, 1:3) = reshape([0.0_wp, 0.0_wp, 1.0_wp, 2.0_wp, 0.0_wp, 1.0_wp, 0.0_wp, 3.0_wp, 1.0_wp], [3, 3])
+      call facet_points(3, 3, xf(:, 1:3), nq, x, w, nrm)
+      call check_facet(nq, 3, 3.0_wp, [2.0_wp/3, 1.0_wp, 1.0_wp], [0.0_wp, 0.0_wp, 1.0_wp], 'tri3')
+      if (allocated(error)) return
+      ! Rectangle y in [0, 2], z in [0, 1] at x = 1, VTK quad9 order in (y, z).
+      xf(1, 1:9) = 1.0_wp
+      xf(2, 1:9) = [0.0_wp, 2.0_wp, 2.0_wp, 0.0_wp, 1.0_wp, 2.0_wp, 1.0_wp, 0.0_wp, 1.0_wp]
+      xf(3, 1:9) = [0.0_wp, 0.0_wp, 1.0_wp, 1.0_wp, 0.0_wp, 0.5_wp, 1.0_wp, 0.5_wp, 0.5_wp]
+      call facet_points(3, 4, xf(:, 1:4), nq, x, w, nrm)
+      call check_facet(nq, 4, 2.0_wp, [1.0_wp, 1.0_wp, 0.5_wp], [1.0_wp, 0.0_wp, 0.0_wp], 'quad4')
+      if (allocated(error)) return
+      call facet_points(3, 9, xf(:, 1:9), nq, x, w, nrm)
+      call check_facet(nq, 9, 2.0_wp, [1.0_wp, 1.0_wp, 0.5_wp], [1.0_wp, 0.0_wp, 0.0_wp], 'quad9')
+   contains
+      subroutine check_facet(nq_got, nq_want, measure, centroid, normal, label)
+         integer, intent(in) :: nq_got, nq_want
+         real(wp), intent(in) :: measure, centroid(3), normal(3)
+         character(len=*), intent(in) :: label
+         integer :: q, d
+         d = merge(2, 3, label(1:4) == 'line')
+         call check(error, nq_got, nq_want, label//': points')
+         if (allocated(error)) return
+         call check(error, sum(w(1:nq_got)), measure, 1.0e-14_wp, label//': measure', rel=.true.)
+         if (allocated(error)) return
+         do q = 1, d
+            call check(error, sum(w(1:nq_got)*x(q, 1:nq_got))/measure, centroid(q), 1.0e-14_wp, label//': centroid')
+            if (allocated(error)) return
+         end do
+         do q = 1, nq_got
+            ! The sign is the producer's business: |n . normal| = 1.
+            call check(error, abs(dot_product(nrm(1:d, q), normal(1:d))), 1.0_wp, 1.0e-14_wp, label//': normal')
+            if (allocated(error)) return
+         end do
+      end subroutine check_facet
+   end subroutine test_facet_quadrature
+
    !> Traction facets on x = 0 and x = 1 (constant exact traction): exact data stays exact;
    !> noisy data: SPR-C's nodal stresses on those sides satisfy sigma n = t, SPR's do not.
    subroutine test_traction_facets(error)
@@ -629,6 +682,13 @@ contains
       call check(error, nodal_error(c, res) <= tol, 'exact data with traction facets stays exact')
       if (allocated(error)) return
       call check(error, res%eta <= tol, 'exact data: eta ~ 0')
+      if (allocated(error)) return
+      ! Normals are oriented away from the owning element: the facets' node order is free.
+      call recover_on_mesh(2, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
+         & mesh_method_sprc, res, error, body_force=c%body(1:2), facet_nodes=fn(2:1:-1, :), facet_kind=fk, &
+         & facet_traction=ft)
+      if (allocated(error)) return
+      call check(error, nodal_error(c, res) <= tol, 'reversed facet node order: still exact')
       if (allocated(error)) return
 
       call build_case(c, elem_quad4, 4, f_traction, 0.3_wp)
