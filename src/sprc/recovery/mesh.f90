@@ -20,8 +20,8 @@
 !> (sprc_recovery_mesh_element) get normals oriented away from that element's vertex centroid,
 !> so the caller's facet node order does not matter for the orientation. Boundary
 !> constraints apply only where the caller gives facets: a surface without facets is not
-!> constrained. SPR ignores facets (they are validated all the same). All traction and free facets form boundary piece 1 and all symmetry facets
-!> piece 2: the recovery core separates faces within a piece by their normals (box corners)
+!> constrained. SPR ignores facets (they are validated all the same). All traction and free
+!> facets form boundary piece 1 and all symmetry facets piece 2: the recovery core separates faces within a piece by their normals (box corners)
 !> and symmetry points into planes, and caps the traction rank per flat face.
 !>
 !> Patches: one per vertex node (a node in a vertex position of some element), holding the
