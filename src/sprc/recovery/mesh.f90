@@ -21,8 +21,9 @@
 !> so the caller's facet node order does not matter for the orientation. Boundary
 !> constraints apply only where the caller gives facets: a surface without facets is not
 !> constrained. SPR ignores facets (they are validated all the same). All traction and free
-!> facets form boundary piece 1 and all symmetry facets piece 2: the recovery core separates faces within a piece by their normals (box corners)
-!> and symmetry points into planes, and caps the traction rank per flat face.
+!> facets form boundary piece 1 and all symmetry facets piece 2: the recovery core
+!> separates faces within a piece by their normals (box corners) and symmetry points into
+!> planes, and caps the traction rank per flat face.
 !>
 !> Patches: one per vertex node (a node in a vertex position of some element), holding the
 !> elements that contain the node (in element order); x0 = the node, h = the largest
