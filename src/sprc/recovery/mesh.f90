@@ -1,0 +1,801 @@
+!> SPR / SPR-C recovery and the ZZ estimate on a caller's own unstructured mesh (seed
+!> eqs. 1, 8-11, 19-24, 99-102; Figure 15 for patch expansion). For legacy FE codes: the
+!> mesh is plain arrays, the result one object (`mesh_recovery_type`, opaque to bindings).
+!>
+!> Input (`recover_on_mesh`): nodes(dim, nnode); one element type for the whole mesh
+!> (sprc_recovery_mesh_element: tri3, quad4, quad9, tet4, hex8, hex27; VTK codes and VTK node
+!> order) with connectivity(nen, nelem) of 1-based node indices; per element ngp
+!> integration points with physical coordinates gp(dim, ngp, nelem), weights times |J|
+!> gw(ngp, nelem) > 0 and FE stresses gs(nstress, ngp, nelem) (Voigt: 2D xx, yy, xy; 3D
+!> xx, yy, zz, xy, yz, xz); analysis (plane_stress 1, plane_strain 2, solid 3), E, nu;
+!> method (mesh_method_spr 1, mesh_method_sprc 2); optionally a constant body force
+!> (div sigma + b = 0) and boundary facets. Every point must lie in its element (checked by
+!> the inverse isoparametric map, tolerance 1e-6 in reference coordinates).
+!>
+!> Facets: facet_nodes(nfn, nfacet) (a side of an element: line2 / line3 in 2D, tri3 /
+!> quad4 / quad9 faces in 3D, nfn fixed by the element type, VTK order for the quadratic
+!> ones), facet_kind(nfacet) (facet_traction 1 with the constant vector facet_traction(:, f);
+!> facet_symmetry 2; facet_free 3 = traction zero). A facet belongs to exactly one element,
+!> the one holding all its nodes (else an error: not a boundary facet). Its quadrature points
+!> (sprc_recovery_mesh_element) get normals oriented away from that element's vertex centroid,
+!> so the caller's facet node order does not matter for the orientation. Boundary
+!> constraints apply only where the caller gives facets: a surface without facets is not
+!> constrained. SPR ignores facets (they are validated all the same). All traction and free
+!> facets form boundary piece 1 and all symmetry facets piece 2: the recovery core
+!> separates faces within a piece by their normals (box corners) and symmetry points into
+!> planes, and caps the traction rank per flat face.
+!>
+!> Patches: one per vertex node (a node in a vertex position of some element), holding the
+!> elements that contain the node (in element order); x0 = the node, h = the largest
+!> distance from x0 to a node of those elements. SPR-C adds the boundary points of facets
+!> owned by those elements. A patch whose basis matrix lacks rank is expanded by one ring
+!> (every element sharing a node with the patch) up to `max_rounds` times (default
+!> mesh_default_max_rounds = 3), as on the grid (sprc_grid_patches). Degree p: the element
+!> degree (1 for tri3, quad4, tet4, hex8; 2 for quad9, hex27) unless `degree` is given.
+!>
+!> Output fields:
+!> - nodal(nstress, nnode): at a vertex node its patch polynomial at the node (SPR and SPR-C
+!>   alike: the union equals it there); at a mid-side / face / centre node of quad9 / hex27
+!>   the union (eq. 102) at the node in its first element (the linear vertex partition of
+!>   unity restricted to a shared side is the same in both elements). Nodes referenced by
+!>   no element get zero.
+!> - the recovered field sigma*(x): SPR the nodal interpolation sum_a N_a(xi) nodal(:, a)
+!>   with the element's own shape functions (eq. 101); SPR-C the union
+!>   sum_J Nv_J(xi) sigma*_J(x) over the element's vertices (eq. 102).
+!> - elem_err(e) = sqrt(sum_i gw (s* - s_h)^T D^-1 (s* - s_h)) over the caller's points of e,
+!>   elem_norm_h(e) the same of s_h; err = sqrt(sum elem_err^2), norm_h likewise,
+!>   eta = err / sqrt(norm_h^2 + err^2).
+!> Evaluation at points (`mesh_recovery_eval`): with the element of each point given, one
+!> inverse map per point; otherwise a search over the elements whose bounding box holds the
+!> point, one inverse map per candidate: O(nelem) box tests per point (no spatial index).
+!>
+!> Parallelism and determinism as in sprc_grid_patches: every thread reserves the same
+!> workspace capacity (the largest unexpanded patch) before the OpenMP patch loop, outgrown
+!> expanded patches get a workspace of their own size, results are stored per patch: the
+!> bits do not depend on the thread count.
+module sprc_recovery_mesh
+   use sprc_core_kinds, only: wp
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular, stat_internal, &
+      & stat_not_converged
+   use sprc_core_material, only: voigt_size
+   use sprc_core_poly, only: poly_nterms
+   use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reset, patch_reserve, &
+      & boundary_traction, boundary_symmetry
+   use sprc_recovery_workspace, only: recovery_workspace_type, workspace_reserve, workspace_init
+   use sprc_recovery_solve, only: recover_spr, recover_sprc
+   use sprc_recovery_estimate, only: eval_recovered, zz_error_integral
+   use sprc_recovery_mesh_element, only: elem_tri3, elem_quad4, elem_tet4, elem_hex8, elem_quad9, elem_hex27, &
+      & element_dim, element_nodes, element_vertices, element_degree, element_facet_nodes, element_shape, &
+      & element_vertex_shape, element_node_xi, element_inside, element_inverse_map, element_name, &
+      & facet_points, facet_npoints, max_facet_points, max_element_nodes
+   use sprc_recovery_mesh_check, only: check_mesh_options, check_mesh_arrays, check_mesh_facets, itoa, rtoa, &
+      & mesh_method_spr, mesh_method_sprc, facet_traction, facet_symmetry, facet_free
+   implicit none
+   private
+
+   public :: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, mesh_default_max_rounds
+   public :: mesh_method_spr, mesh_method_sprc, facet_traction, facet_symmetry, facet_free
+   public :: elem_tri3, elem_quad4, elem_tet4, elem_hex8, elem_quad9, elem_hex27
+
+   !> Default limit of expansion rounds per patch.
+   integer, parameter :: mesh_default_max_rounds = 3
+   !> Tolerance (reference coordinates) for a point to count as inside an element.
+   real(wp), parameter :: inside_tol = 1.0e-6_wp
+
+   !> Result of `recover_on_mesh` (module notes). Components are public plain data.
+   type :: mesh_recovery_type
+      !> Dimension, analysis, element type, method, patch degree, stress components.
+      integer :: dim = 0, analysis = 0, element_type = 0, method = 0, degree = 0, nstress = 0
+      !> Nodes, elements, nodes and vertices per element.
+      integer :: nnode = 0, nelem = 0, nen = 0, nvertex = 0
+      real(wp) :: young = 0.0_wp, poisson = 0.0_wp
+      !> Copy of the mesh: nodes x(dim, nnode), connectivity(nen, nelem), element boxes.
+      real(wp), allocatable :: x(:, :), box_lo(:, :), box_hi(:, :)
+      integer, allocatable :: connectivity(:, :)
+      !> Patches: node of each (ascending), patch of each node (0: none), recovered polynomials,
+      !> expansion rounds and final element count of each.
+      integer :: n_patches = 0
+      integer, allocatable :: patch_node(:), patch_of_node(:), patch_rounds(:), patch_elements(:)
+      type(recovered_patch_type), allocatable :: recs(:)
+      !> Patches expanded, most rounds used, patches where the rank tolerance decided a rank,
+      !> boundary quadrature points generated from the facets.
+      integer :: n_expanded = 0, max_rounds_used = 0, n_tolerance_bites = 0, n_boundary_points = 0
+      !> Recovered nodal stresses (nstress, nnode).
+      real(wp), allocatable :: nodal(:, :)
+      !> Per element: ZZ error and FE stress energy norm (not squared).
+      real(wp), allocatable :: elem_err(:), elem_norm_h(:)
+      !> Global ZZ estimate, FE stress norm, estimated relative error.
+      real(wp) :: err = 0.0_wp, norm_h = 0.0_wp, eta = 0.0_wp
+   end type mesh_recovery_type
+
+   !> Mesh data of one recovery: node -> element CSR and boundary points per element (CSR).
+   type :: topology_type
+      integer, allocatable :: ne_ptr(:), ne_list(:)
+      integer, allocatable :: bptr(:), bkind(:), bpiece(:)
+      real(wp), allocatable :: bx(:, :), bw(:), bn(:, :), bt(:, :)
+      real(wp) :: body_force(3) = 0.0_wp
+   end type topology_type
+
+   !> Per-thread storage of the patch loop.
+   type :: scratch_type
+      type(patch_type) :: patch
+      type(recovery_workspace_type) :: ws, ws_big
+      integer, allocatable :: list(:), stamp(:)
+      integer :: nlist = 0
+   end type scratch_type
+
+contains
+
+   !> Recover the stresses of a caller's mesh and estimate the error (module notes). Errors
+   !> name the argument and index: invalid input (stat_invalid_input), a point whose
+   !> inverse map does not converge (stat_not_converged), a patch still rank deficient after
+   !> `max_rounds` expansions (stat_singular, naming the node).
+   subroutine recover_on_mesh(dim, analysis, nodes, element_type, connectivity, gp, gw, gs, young, poisson, method, &
+         & result, error, body_force, facet_nodes, facet_kind, facet_traction, degree, max_rounds)
+      integer, intent(in) :: dim, analysis
+      !> Node coordinates (dim, nnode).
+      real(wp), intent(in) :: nodes(:, :)
+      integer, intent(in) :: element_type
+      !> Element nodes (nen, nelem), 1-based, VTK order.
+      integer, intent(in) :: connectivity(:, :)
+      !> Integration points (dim, ngp, nelem), weight*|J| (ngp, nelem), FE stress (nstress, ngp, nelem).
+      real(wp), intent(in) :: gp(:, :, :), gw(:, :), gs(:, :, :)
+      real(wp), intent(in) :: young, poisson
+      integer, intent(in) :: method
+      type(mesh_recovery_type), intent(out) :: result
+      type(error_type), allocatable, intent(out) :: error
+      !> Constant body force (dim).
+      real(wp), intent(in), optional :: body_force(:)
+      !> Boundary facets (nfn, nfacet), their kinds (nfacet) and tractions (dim, nfacet).
+      integer, intent(in), optional :: facet_nodes(:, :), facet_kind(:)
+      real(wp), intent(in), optional :: facet_traction(:, :)
+      !> Patch polynomial degree (1..3; default the element degree); expansion rounds (>= 0).
+      integer, intent(in), optional :: degree, max_rounds
+      type(topology_type) :: topo
+      real(wp), allocatable :: xi(:, :, :)
+      integer :: deg, rounds
+
+      deg = element_degree(element_type)
+      if (present(degree)) deg = degree
+      rounds = mesh_default_max_rounds
+      if (present(max_rounds)) rounds = max_rounds
+      call check_mesh_options(dim, analysis, element_type, method, deg, rounds, young, poisson, error)
+      if (allocated(error)) return
+      call check_mesh_arrays(dim, analysis, nodes, element_type, connectivity, gp, gw, gs, error, body_force)
+      if (allocated(error)) return
+      call check_mesh_facets(dim, element_type, size(nodes, 2), error, facet_nodes, facet_kind, facet_traction)
+      if (allocated(error)) return
+
+      call init_result(result, dim, analysis, element_type, method, deg, young, poisson, nodes, connectivity)
+      call node_elements(result, topo)
+      if (present(body_force)) topo%body_force(1:dim) = body_force
+      call point_coordinates(result, gp, xi, error)
+      if (allocated(error)) return
+      call boundary_points(result, topo, error, facet_nodes, facet_kind, facet_traction)
+      if (allocated(error)) return
+      call recover_patches(result, topo, gp, gw, gs, rounds, error)
+      if (allocated(error)) return
+      call nodal_values(result, topo)
+      call estimate(result, gp, gw, gs, xi, error)
+   end subroutine recover_on_mesh
+
+   subroutine init_result(r, dim, analysis, element_type, method, deg, young, poisson, nodes, connectivity)
+      type(mesh_recovery_type), intent(inout) :: r
+      integer, intent(in) :: dim, analysis, element_type, method, deg
+      real(wp), intent(in) :: young, poisson, nodes(:, :)
+      integer, intent(in) :: connectivity(:, :)
+      integer :: e
+
+      r%dim = dim
+      r%analysis = analysis
+      r%element_type = element_type
+      r%method = method
+      r%degree = deg
+      r%nstress = voigt_size(analysis)
+      r%nnode = size(nodes, 2)
+      r%nelem = size(connectivity, 2)
+      r%nen = element_nodes(element_type)
+      r%nvertex = element_vertices(element_type)
+      r%young = young
+      r%poisson = poisson
+      r%x = nodes
+      r%connectivity = connectivity
+      allocate (r%box_lo(dim, r%nelem), r%box_hi(dim, r%nelem))
+      do e = 1, r%nelem
+         r%box_lo(:, e) = minval(nodes(:, connectivity(:, e)), dim=2)
+         r%box_hi(:, e) = maxval(nodes(:, connectivity(:, e)), dim=2)
+      end do
+   end subroutine init_result
+
+   !> Node -> element CSR (elements ascending per node); patches at the vertex nodes.
+   subroutine node_elements(r, topo)
+      type(mesh_recovery_type), intent(inout) :: r
+      type(topology_type), intent(inout) :: topo
+      integer, allocatable :: fill(:)
+      logical, allocatable :: vertex(:)
+      integer :: e, a, n
+
+      allocate (topo%ne_ptr(r%nnode + 1), fill(r%nnode), vertex(r%nnode))
+      fill = 0
+      do e = 1, r%nelem
+         fill(r%connectivity(:, e)) = fill(r%connectivity(:, e)) + 1
+      end do
+      topo%ne_ptr(1) = 1
+      do n = 1, r%nnode
+         topo%ne_ptr(n + 1) = topo%ne_ptr(n) + fill(n)
+      end do
+      allocate (topo%ne_list(topo%ne_ptr(r%nnode + 1) - 1))
+      fill = 0
+      do e = 1, r%nelem
+         do a = 1, r%nen
+            n = r%connectivity(a, e)
+            topo%ne_list(topo%ne_ptr(n) + fill(n)) = e
+            fill(n) = fill(n) + 1
+         end do
+      end do
+      vertex = .false.
+      do e = 1, r%nelem
+         vertex(r%connectivity(1:r%nvertex, e)) = .true.
+      end do
+      r%n_patches = count(vertex)
+      allocate (r%patch_node(r%n_patches), r%patch_of_node(r%nnode))
+      r%patch_of_node = 0
+      r%n_patches = 0
+      do n = 1, r%nnode
+         if (.not. vertex(n)) cycle
+         r%n_patches = r%n_patches + 1
+         r%patch_node(r%n_patches) = n
+         r%patch_of_node(n) = r%n_patches
+      end do
+   end subroutine node_elements
+
+   !> Reference coordinates of every integration point in its element.
+   subroutine point_coordinates(r, gp, xi, error)
+      type(mesh_recovery_type), intent(in) :: r
+      real(wp), intent(in) :: gp(:, :, :)
+      real(wp), allocatable, intent(out) :: xi(:, :, :)
+      type(error_type), allocatable, intent(out) :: error
+      logical :: ok
+      integer :: e, i
+
+      allocate (xi(r%dim, size(gp, 2), r%nelem))
+      do e = 1, r%nelem
+         do i = 1, size(gp, 2)
+            call element_inverse_map(r%element_type, r%x(:, r%connectivity(:, e)), gp(:, i, e), xi(:, i, e), ok)
+            if (.not. ok) then
+               call fatal_error(error, 'recover_on_mesh: the inverse map of gp(:, '//itoa(i)//', '//itoa(e)// &
+                  & ') did not converge (distorted or inverted element '//itoa(e)//'?)', stat_not_converged)
+               return
+            end if
+            if (.not. element_inside(r%element_type, xi(:, i, e), inside_tol)) then
+               call fatal_error(error, 'recover_on_mesh: gp(:, '//itoa(i)//', '//itoa(e)//') is not inside element '// &
+                  & itoa(e)//' (reference coordinates '//vec_str(xi(:, i, e))//')', stat_invalid_input)
+               return
+            end if
+         end do
+      end do
+   end subroutine point_coordinates
+
+   !> Quadrature points of the facets, gathered per owning element (CSR), normals outward.
+   subroutine boundary_points(r, topo, error, facet_nodes, facet_kind, facet_traction_value)
+      type(mesh_recovery_type), intent(inout) :: r
+      type(topology_type), intent(inout) :: topo
+      type(error_type), allocatable, intent(out) :: error
+      integer, intent(in), optional :: facet_nodes(:, :), facet_kind(:)
+      real(wp), intent(in), optional :: facet_traction_value(:, :)
+      integer, allocatable :: owner(:), fill(:)
+      real(wp) :: xq(3, max_facet_points), wq(max_facet_points), nq(3, max_facet_points), c(3)
+      integer :: nf, nfn, f, e, q, nq_f, k, d
+
+      d = r%dim
+      nf = 0
+      if (present(facet_nodes)) nf = size(facet_nodes, 2)
+      nfn = element_facet_nodes(r%element_type)
+      allocate (owner(nf), fill(r%nelem), topo%bptr(r%nelem + 1))
+      fill = 0
+      do f = 1, nf
+         call facet_owner(r, topo, facet_nodes(:, f), f, owner(f), error)
+         if (allocated(error)) return
+         fill(owner(f)) = fill(owner(f)) + 1
+      end do
+      nq_f = facet_npoints(nfn)
+      topo%bptr(1) = 1
+      do e = 1, r%nelem
+         topo%bptr(e + 1) = topo%bptr(e) + nq_f*fill(e)
+      end do
+      k = topo%bptr(r%nelem + 1) - 1
+      if (nf == 0) k = 0
+      r%n_boundary_points = k
+      allocate (topo%bx(d, k), topo%bw(k), topo%bn(d, k), topo%bt(d, k), topo%bkind(k), topo%bpiece(k))
+      fill = 0
+      do f = 1, nf
+         e = owner(f)
+         call facet_points(d, nfn, r%x(:, facet_nodes(:, f)), nq_f, xq, wq, nq)
+         if (.not. all(wq(1:nq_f) > 0.0_wp)) then
+            call fatal_error(error, 'recover_on_mesh: facet '//itoa(f)//' is degenerate (zero length or area)', &
+               & stat_invalid_input)
+            return
+         end if
+         c(1:d) = sum(r%x(:, r%connectivity(1:r%nvertex, e)), dim=2)/real(r%nvertex, wp)
+         do q = 1, nq_f
+            k = topo%bptr(e) + fill(e)
+            fill(e) = fill(e) + 1
+            topo%bx(:, k) = xq(1:d, q)
+            topo%bw(k) = wq(q)
+            topo%bn(:, k) = nq(1:d, q)
+            if (dot_product(xq(1:d, q) - c(1:d), nq(1:d, q)) < 0.0_wp) topo%bn(:, k) = -nq(1:d, q)
+            topo%bt(:, k) = 0.0_wp
+            select case (facet_kind(f))
+            case (facet_traction)
+               topo%bkind(k) = boundary_traction
+               topo%bt(:, k) = facet_traction_value(:, f)
+               topo%bpiece(k) = 1
+            case (facet_free)
+               topo%bkind(k) = boundary_traction
+               topo%bpiece(k) = 1
+            case default
+               topo%bkind(k) = boundary_symmetry
+               topo%bpiece(k) = 2
+            end select
+         end do
+      end do
+   end subroutine boundary_points
+
+   !> The one element holding every node of a facet.
+   subroutine facet_owner(r, topo, fnodes, f, owner, error)
+      type(mesh_recovery_type), intent(in) :: r
+      type(topology_type), intent(in) :: topo
+      integer, intent(in) :: fnodes(:), f
+      integer, intent(out) :: owner
+      type(error_type), allocatable, intent(out) :: error
+      integer :: k, e, a
+
+      owner = 0
+      do k = topo%ne_ptr(fnodes(1)), topo%ne_ptr(fnodes(1) + 1) - 1
+         e = topo%ne_list(k)
+         if (.not. all([(any(r%connectivity(:, e) == fnodes(a)), a=1, size(fnodes))])) cycle
+         if (owner /= 0) then
+            call fatal_error(error, 'recover_on_mesh: facet '//itoa(f)//' is shared by elements '//itoa(owner)// &
+               & ' and '//itoa(e)//': not a boundary facet', stat_invalid_input)
+            return
+         end if
+         owner = e
+      end do
+      if (owner == 0) call fatal_error(error, 'recover_on_mesh: facet '//itoa(f)//' (nodes '//ivec_str(fnodes)// &
+         & ') is not a side of any element', stat_invalid_input)
+   end subroutine facet_owner
+
+   !> The OpenMP patch loop, then the first failing patch serially for its message.
+   subroutine recover_patches(r, topo, gp, gw, gs, rounds, error)
+      type(mesh_recovery_type), intent(inout) :: r
+      type(topology_type), intent(in) :: topo
+      real(wp), intent(in) :: gp(:, :, :), gw(:, :), gs(:, :, :)
+      integer, intent(in) :: rounds
+      type(error_type), allocatable, intent(out) :: error
+      integer, allocatable :: status(:)
+      integer :: cap(2), ip
+
+      allocate (r%recs(r%n_patches), r%patch_rounds(r%n_patches), r%patch_elements(r%n_patches))
+      allocate (status(r%n_patches))
+      cap = initial_capacity(r, topo, size(gp, 2))
+      !$omp parallel default(shared)
+      call patch_loop(r, topo, gp, gw, gs, rounds, cap, status)
+      !$omp end parallel
+      if (any(status /= 0)) then
+         ip = findloc(status /= 0, .true., dim=1)
+         block
+            type(scratch_type) :: sc
+            call init_scratch(sc, r, cap)
+            call recover_patch(r, topo, gp, gw, gs, r%patch_node(ip), rounds, sc, r%recs(ip), r%patch_rounds(ip), &
+               & r%patch_elements(ip), error)
+         end block
+         if (.not. allocated(error)) call fatal_error(error, 'recover_on_mesh: patch '//itoa(ip)// &
+            & ' failed in the parallel loop but not serially', stat_internal)
+         return
+      end if
+      r%n_expanded = count(r%patch_rounds > 0)
+      r%max_rounds_used = 0
+      if (r%n_patches > 0) r%max_rounds_used = maxval(r%patch_rounds)
+      r%n_tolerance_bites = count(r%recs%tolerance_bites)
+   end subroutine recover_patches
+
+   subroutine patch_loop(r, topo, gp, gw, gs, rounds, cap, status)
+      type(mesh_recovery_type), intent(inout) :: r
+      type(topology_type), intent(in) :: topo
+      real(wp), intent(in) :: gp(:, :, :), gw(:, :), gs(:, :, :)
+      integer, intent(in) :: rounds, cap(2)
+      integer, intent(inout) :: status(:)
+      type(scratch_type) :: sc
+      type(error_type), allocatable :: err
+      integer :: ip
+
+      call init_scratch(sc, r, cap)
+      !$omp do schedule(dynamic, 16)
+      do ip = 1, r%n_patches
+         call recover_patch(r, topo, gp, gw, gs, r%patch_node(ip), rounds, sc, r%recs(ip), r%patch_rounds(ip), &
+            & r%patch_elements(ip), err)
+         status(ip) = 0
+         if (allocated(err)) status(ip) = err%stat
+      end do
+      !$omp end do
+   end subroutine patch_loop
+
+   !> Points and boundary points of the largest unexpanded patch (at least 4 nterms points).
+   pure function initial_capacity(r, topo, ngp) result(cap)
+      type(mesh_recovery_type), intent(in) :: r
+      type(topology_type), intent(in) :: topo
+      integer, intent(in) :: ngp
+      integer :: cap(2)
+      integer :: ip, n, k, nb
+
+      cap = [4*poly_nterms(r%dim, r%degree), 0]
+      do ip = 1, r%n_patches
+         n = r%patch_node(ip)
+         nb = 0
+         do k = topo%ne_ptr(n), topo%ne_ptr(n + 1) - 1
+            nb = nb + topo%bptr(topo%ne_list(k) + 1) - topo%bptr(topo%ne_list(k))
+         end do
+         if (r%method /= mesh_method_sprc) nb = 0
+         cap = max(cap, [ngp*(topo%ne_ptr(n + 1) - topo%ne_ptr(n)), nb])
+      end do
+   end function initial_capacity
+
+   !> Thread storage of the common capacity (LAPACK results depend on it: module notes).
+   subroutine init_scratch(sc, r, cap)
+      type(scratch_type), intent(inout) :: sc
+      type(mesh_recovery_type), intent(in) :: r
+      integer, intent(in) :: cap(2)
+      type(error_type), allocatable :: err
+
+      call workspace_init(sc%ws)
+      call workspace_init(sc%ws_big)
+      allocate (sc%list(64), sc%stamp(r%nelem))
+      sc%stamp = 0
+      ! Cannot fail: dim and degree were validated.
+      call workspace_reserve(sc%ws, r%dim, r%degree, cap(1), cap(2), err)
+      call patch_reserve(sc%patch, cap(1), cap(2))
+   end subroutine init_scratch
+
+   !> Gather, solve, and expand while the basis lacks rank.
+   subroutine recover_patch(r, topo, gp, gw, gs, n, rounds_limit, sc, rec, rounds, nel, error)
+      type(mesh_recovery_type), intent(in) :: r
+      type(topology_type), intent(in) :: topo
+      real(wp), intent(in) :: gp(:, :, :), gw(:, :), gs(:, :, :)
+      integer, intent(in) :: n, rounds_limit
+      type(scratch_type), intent(inout) :: sc
+      type(recovered_patch_type), intent(out) :: rec
+      integer, intent(out) :: rounds, nel
+      type(error_type), allocatable, intent(out) :: error
+      integer :: k, round, nprev
+
+      sc%nlist = 0
+      do k = topo%ne_ptr(n), topo%ne_ptr(n + 1) - 1
+         call list_add(sc, topo%ne_list(k), n)
+      end do
+      rounds = 0
+      do round = 0, rounds_limit
+         if (round > 0) then
+            nprev = sc%nlist
+            call expand(r, topo, sc, n)
+            if (sc%nlist == nprev) exit
+            rounds = round
+         end if
+         call fill_patch(r, topo, gp, gw, gs, n, sc)
+         if (sc%patch%npoints <= sc%ws%cap_p .and. sc%patch%nbpoints <= sc%ws%cap_b) then
+            call solve(sc%ws)
+         else
+            call workspace_init(sc%ws_big)
+            call solve(sc%ws_big)
+         end if
+         if (.not. allocated(error)) exit
+         if (error%stat /= stat_singular) exit
+      end do
+      nel = sc%nlist
+      if (.not. allocated(error)) return
+      if (error%stat == stat_singular) then
+         error%message = 'recover_on_mesh: patch of node '//itoa(n)//' at '//vec_str(r%x(:, n))//', '//itoa(nel)// &
+            & ' elements after '//itoa(rounds)//' expansion rounds: '//error%message
+      else
+         error%message = 'recover_on_mesh: patch of node '//itoa(n)//': '//error%message
+      end if
+   contains
+      subroutine solve(ws)
+         type(recovery_workspace_type), intent(inout) :: ws
+         if (r%method == mesh_method_spr) then
+            call recover_spr(sc%patch, r%degree, ws, rec, error)
+         else
+            call recover_sprc(sc%patch, r%degree, ws, rec, error)
+         end if
+      end subroutine solve
+   end subroutine recover_patch
+
+   subroutine list_add(sc, e, tag)
+      type(scratch_type), intent(inout) :: sc
+      integer, intent(in) :: e, tag
+      integer, allocatable :: tmp(:)
+
+      if (sc%stamp(e) == tag) return
+      sc%stamp(e) = tag
+      if (sc%nlist == size(sc%list)) then
+         allocate (tmp(2*size(sc%list)))
+         tmp(1:sc%nlist) = sc%list(1:sc%nlist)
+         call move_alloc(tmp, sc%list)
+      end if
+      sc%nlist = sc%nlist + 1
+      sc%list(sc%nlist) = e
+   end subroutine list_add
+
+   !> One ring: every element sharing a node with the patch, in list and node order.
+   subroutine expand(r, topo, sc, tag)
+      type(mesh_recovery_type), intent(in) :: r
+      type(topology_type), intent(in) :: topo
+      type(scratch_type), intent(inout) :: sc
+      integer, intent(in) :: tag
+      integer :: i, j, k, m, n0
+
+      n0 = sc%nlist
+      do i = 1, n0
+         do j = 1, r%nen
+            m = r%connectivity(j, sc%list(i))
+            do k = topo%ne_ptr(m), topo%ne_ptr(m + 1) - 1
+               call list_add(sc, topo%ne_list(k), tag)
+            end do
+         end do
+      end do
+   end subroutine expand
+
+   !> The patch of node n over the listed elements (storage reused).
+   subroutine fill_patch(r, topo, gp, gw, gs, n, sc)
+      type(mesh_recovery_type), intent(in) :: r
+      type(topology_type), intent(in) :: topo
+      real(wp), intent(in) :: gp(:, :, :), gw(:, :), gs(:, :, :)
+      integer, intent(in) :: n
+      type(scratch_type), intent(inout) :: sc
+      real(wp) :: h
+      integer :: d, i, e, k, a, np, nb, ngp, ns
+
+      d = r%dim
+      ns = r%nstress
+      ngp = size(gp, 2)
+      h = 0.0_wp
+      nb = 0
+      do i = 1, sc%nlist
+         e = sc%list(i)
+         do a = 1, r%nen
+            h = max(h, sqrt(sum((r%x(:, r%connectivity(a, e)) - r%x(:, n))**2)))
+         end do
+         if (r%method == mesh_method_sprc) nb = nb + topo%bptr(e + 1) - topo%bptr(e)
+      end do
+      np = ngp*sc%nlist
+      associate (p => sc%patch)
+         call patch_reset(p, d, r%analysis, r%young, r%poisson, r%x(:, n), h)
+         call patch_reserve(p, np, nb)
+         p%body_force(1:d) = topo%body_force(1:d)
+         do i = 1, sc%nlist
+            e = sc%list(i)
+            p%x(1:d, p%npoints + 1:p%npoints + ngp) = gp(:, :, e)
+            p%w(p%npoints + 1:p%npoints + ngp) = gw(:, e)
+            p%stress(1:ns, p%npoints + 1:p%npoints + ngp) = gs(:, :, e)
+            p%npoints = p%npoints + ngp
+            if (r%method /= mesh_method_sprc) cycle
+            do k = topo%bptr(e), topo%bptr(e + 1) - 1
+               p%nbpoints = p%nbpoints + 1
+               p%bx(1:d, p%nbpoints) = topo%bx(:, k)
+               p%bw(p%nbpoints) = topo%bw(k)
+               p%bn(1:d, p%nbpoints) = topo%bn(:, k)
+               p%bkind(p%nbpoints) = topo%bkind(k)
+               p%bpiece(p%nbpoints) = topo%bpiece(k)
+               p%btraction(1:d, p%nbpoints) = topo%bt(:, k)
+            end do
+         end do
+      end associate
+   end subroutine fill_patch
+
+   !> Nodal stresses: patch value at vertex nodes, the union elsewhere (module notes).
+   subroutine nodal_values(r, topo)
+      type(mesh_recovery_type), intent(inout) :: r
+      type(topology_type), intent(in) :: topo
+      real(wp) :: xi(3)
+      integer :: n, e, a
+
+      allocate (r%nodal(r%nstress, r%nnode))
+      r%nodal = 0.0_wp
+      do n = 1, r%nnode
+         if (r%patch_of_node(n) > 0) then
+            call eval_patch(r, r%patch_of_node(n), r%x(:, n), r%nodal(:, n))
+         else if (topo%ne_ptr(n + 1) > topo%ne_ptr(n)) then
+            e = topo%ne_list(topo%ne_ptr(n))
+            a = findloc(r%connectivity(:, e), n, dim=1)
+            call element_node_xi(r%element_type, a, xi)
+            call union_at(r, e, xi, r%x(:, n), r%nodal(:, n))
+         end if
+      end do
+   end subroutine nodal_values
+
+   subroutine eval_patch(r, ip, x, sigma)
+      type(mesh_recovery_type), intent(in) :: r
+      integer, intent(in) :: ip
+      real(wp), intent(in) :: x(:)
+      real(wp), intent(out) :: sigma(:)
+      type(error_type), allocatable :: err
+      ! Cannot fail: the patch was recovered and the sizes are the result's own.
+      call eval_recovered(r%recs(ip), x, sigma, err)
+   end subroutine eval_patch
+
+   !> Union (eq. 102) at reference point xi / physical point x of element e.
+   subroutine union_at(r, e, xi, x, sigma)
+      type(mesh_recovery_type), intent(in) :: r
+      integer, intent(in) :: e
+      real(wp), intent(in) :: xi(:), x(:)
+      real(wp), intent(out) :: sigma(:)
+      real(wp) :: nv(8), sj(6)
+      integer :: j
+
+      call element_vertex_shape(r%element_type, xi, nv)
+      sigma(1:r%nstress) = 0.0_wp
+      do j = 1, r%nvertex
+         call eval_patch(r, r%patch_of_node(r%connectivity(j, e)), x, sj)
+         sigma(1:r%nstress) = sigma(1:r%nstress) + nv(j)*sj(1:r%nstress)
+      end do
+   end subroutine union_at
+
+   !> The method's field at reference point xi / physical point x of element e.
+   subroutine field_at(r, e, xi, x, sigma)
+      type(mesh_recovery_type), intent(in) :: r
+      integer, intent(in) :: e
+      real(wp), intent(in) :: xi(:), x(:)
+      real(wp), intent(out) :: sigma(:)
+      real(wp) :: n(max_element_nodes)
+
+      if (r%method == mesh_method_sprc) then
+         call union_at(r, e, xi, x, sigma)
+      else
+         call element_shape(r%element_type, xi, n)
+         sigma(1:r%nstress) = matmul(r%nodal(:, r%connectivity(:, e)), n(1:r%nen))
+      end if
+   end subroutine field_at
+
+   !> ZZ estimate at the caller's points (module notes).
+   subroutine estimate(r, gp, gw, gs, xi, error)
+      type(mesh_recovery_type), intent(inout) :: r
+      real(wp), intent(in) :: gp(:, :, :), gw(:, :), gs(:, :, :), xi(:, :, :)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: sstar(:, :), zero(:, :)
+      real(wp) :: e2, h2
+      integer :: e, i, ngp
+
+      ngp = size(gp, 2)
+      allocate (sstar(r%nstress, ngp), zero(r%nstress, ngp), r%elem_err(r%nelem), r%elem_norm_h(r%nelem))
+      zero = 0.0_wp
+      do e = 1, r%nelem
+         do i = 1, ngp
+            call field_at(r, e, xi(:, i, e), gp(:, i, e), sstar(:, i))
+         end do
+         call zz_error_integral(r%analysis, r%young, r%poisson, gw(:, e), sstar, gs(:, :, e), e2, error)
+         if (allocated(error)) return
+         call zz_error_integral(r%analysis, r%young, r%poisson, gw(:, e), zero, gs(:, :, e), h2, error)
+         if (allocated(error)) return
+         r%elem_err(e) = sqrt(e2)
+         r%elem_norm_h(e) = sqrt(h2)
+      end do
+      r%err = sqrt(sum(r%elem_err**2))
+      r%norm_h = sqrt(sum(r%elem_norm_h**2))
+      r%eta = 0.0_wp
+      if (r%norm_h**2 + r%err**2 > 0.0_wp) r%eta = r%err/sqrt(r%norm_h**2 + r%err**2)
+   end subroutine estimate
+
+   !> The recovered field sigma(nstress, npts) at points x(dim, npts) (SPR: nodal
+   !> interpolation; SPR-C: union). elem(i) in 1..nelem names the element of point i (the
+   !> point must lie in it); elem(i) = 0 or no `elem`: the element is searched (module
+   !> notes: O(nelem) per point). Errors: result not built, shapes, non-finite points, an
+   !> element out of range, a point in no element (stat_invalid_input).
+   subroutine mesh_recovery_eval(result, x, sigma, error, elem)
+      type(mesh_recovery_type), intent(in) :: result
+      real(wp), intent(in) :: x(:, :)
+      real(wp), intent(out) :: sigma(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      integer, intent(in), optional :: elem(:)
+      real(wp) :: xi(3)
+      integer :: i, e, npts
+
+      npts = size(x, 2)
+      if (.not. allocated(result%nodal)) then
+         call fail('the result is not built (recover_on_mesh did not succeed)')
+      else if (size(x, 1) /= result%dim .or. size(sigma, 1) /= result%nstress .or. size(sigma, 2) /= npts) then
+         call fail('x has shape ('//itoa(size(x, 1))//', '//itoa(npts)//'), sigma ('//itoa(size(sigma, 1))//', '// &
+            & itoa(size(sigma, 2))//'); need ('//itoa(result%dim)//', npts) and ('//itoa(result%nstress)//', npts)')
+      end if
+      if (allocated(error)) return
+      if (present(elem)) then
+         if (size(elem) /= npts) call fail('elem has '//itoa(size(elem))//' entries, x '//itoa(npts)//' points')
+         if (allocated(error)) return
+      end if
+      do i = 1, npts
+         if (.not. all(abs(x(:, i)) <= huge(1.0_wp))) then
+            call fail('x(:, '//itoa(i)//') is not finite')
+            return
+         end if
+         e = 0
+         if (present(elem)) e = elem(i)
+         if (e < 0 .or. e > result%nelem) then
+            call fail('elem('//itoa(i)//') = '//itoa(e)//' is not 0 (search) or an element in 1..'// &
+               & itoa(result%nelem))
+            return
+         end if
+         if (e > 0) then
+            if (.not. in_element(result, e, x(:, i), xi)) then
+               call fail('x(:, '//itoa(i)//') = '//vec_str(x(:, i))//' is not in element '//itoa(e))
+               return
+            end if
+         else
+            e = locate(result, x(:, i), xi)
+            if (e == 0) then
+               call fail('x(:, '//itoa(i)//') = '//vec_str(x(:, i))//' is in no element')
+               return
+            end if
+         end if
+         call field_at(result, e, xi, x(:, i), sigma(:, i))
+      end do
+   contains
+      subroutine fail(message)
+         character(len=*), intent(in) :: message
+         call fatal_error(error, 'mesh_recovery_eval: '//message, stat_invalid_input)
+      end subroutine fail
+   end subroutine mesh_recovery_eval
+
+   !> True (and the reference coordinates) if x lies in element e.
+   logical function in_element(r, e, x, xi)
+      type(mesh_recovery_type), intent(in) :: r
+      integer, intent(in) :: e
+      real(wp), intent(in) :: x(:)
+      real(wp), intent(out) :: xi(:)
+      logical :: ok
+
+      call element_inverse_map(r%element_type, r%x(:, r%connectivity(:, e)), x, xi, ok)
+      in_element = ok
+      if (ok) in_element = element_inside(r%element_type, xi, inside_tol)
+   end function in_element
+
+   !> The first element (lowest index) holding x, 0 if none.
+   integer function locate(r, x, xi) result(found)
+      type(mesh_recovery_type), intent(in) :: r
+      real(wp), intent(in) :: x(:)
+      real(wp), intent(out) :: xi(:)
+      real(wp) :: pad
+      integer :: e
+
+      found = 0
+      do e = 1, r%nelem
+         pad = inside_tol*maxval(r%box_hi(:, e) - r%box_lo(:, e))
+         if (any(x(1:r%dim) < r%box_lo(:, e) - pad) .or. any(x(1:r%dim) > r%box_hi(:, e) + pad)) cycle
+         if (in_element(r, e, x, xi)) then
+            found = e
+            return
+         end if
+      end do
+   end function locate
+
+   pure function vec_str(v) result(s)
+      real(wp), intent(in) :: v(:)
+      character(len=:), allocatable :: s
+      integer :: i
+      s = '('
+      do i = 1, size(v)
+         s = s//rtoa(v(i))
+         if (i < size(v)) s = s//', '
+      end do
+      s = s//')'
+   end function vec_str
+
+   pure function ivec_str(v) result(s)
+      integer, intent(in) :: v(:)
+      character(len=:), allocatable :: s
+      integer :: i
+      s = ''
+      do i = 1, size(v)
+         s = s//itoa(v(i))
+         if (i < size(v)) s = s//' '
+      end do
+   end function ivec_str
+
+end module sprc_recovery_mesh

@@ -1,0 +1,409 @@
+!> Element library for recovery on a caller's unstructured mesh: shape functions,
+!> vertex partition of unity, reference node positions, the isoparametric map and its
+!> inverse, and facet quadrature (points, weight*|J|, unit normal).
+!>
+!> Element type codes are the VTK cell type ids (part of the C API; never renumber),
+!> and local node order is VTK's:
+!> - tri3  (VTK_TRIANGLE = 5): (0,0) (1,0) (0,1) on the unit triangle;
+!> - quad4 (VTK_QUAD = 9): (0,0) (1,0) (1,1) (0,1) on [0,1]^2;
+!> - tet4  (VTK_TETRA = 10): (0,0,0) (1,0,0) (0,1,0) (0,0,1) on the unit tetrahedron;
+!> - hex8  (VTK_HEXAHEDRON = 12): bottom face z=0 as quad4, then the top face z=1;
+!> - quad9 (VTK_BIQUADRATIC_QUAD = 28): corners as quad4, edge midpoints of y=0, x=1, y=1,
+!>   x=0, then the centre;
+!> - hex27 (VTK_TRIQUADRATIC_HEXAHEDRON = 29): corners as hex8; edge midpoints of the bottom
+!>   face (as quad9's 4..7), of the top face, then of the vertical edges above corners 0..3;
+!>   face centres x=0, x=1, y=0, y=1, z=0, z=1; the centre.
+!> The vertices are the first 2^dim (dim+1 for simplices) nodes; the vertex partition of
+!> unity (for the polynomial union, seed eq. 102) is the linear element on them (quad4 for
+!> quad9, hex8 for hex27).
+!>
+!> Facets (boundary pieces the caller names by their nodes) by their node count:
+!> 2D: 2 nodes line2, 3 nodes line3 (VTK_QUADRATIC_EDGE: the two ends, then the midpoint);
+!> 3D: 3 nodes tri3, 4 nodes quad4, 9 nodes quad9 (VTK orders as above). Facet quadrature:
+!> Gauss 2 (line2) or 3 (line3) points, the 3-point degree-2 rule on triangles, 2x2 (quad4)
+!> or 3x3 (quad9) Gauss. The normal returned here follows the facet's parametrisation
+!> ((dy, -dx) of the tangent in 2D, t1 x t2 in 3D); the producer orients it.
+module sprc_recovery_mesh_element
+   use sprc_core_kinds, only: wp
+   use sprc_core_gauss, only: gauss_legendre_nodes
+   implicit none
+   private
+
+   public :: elem_tri3, elem_quad4, elem_tet4, elem_hex8, elem_quad9, elem_hex27
+   public :: element_known, element_name, element_dim, element_nodes, element_vertices, element_degree
+   public :: element_facet_nodes, element_simplex
+   public :: element_shape, element_vertex_shape, element_node_xi, element_center_xi, element_inside
+   public :: element_map, element_inverse_map, max_element_nodes
+   public :: facet_points, facet_npoints, max_facet_points, max_facet_nodes
+
+   !> Element type codes (VTK cell type ids).
+   integer, parameter :: elem_tri3 = 5, elem_quad4 = 9, elem_tet4 = 10, elem_hex8 = 12
+   integer, parameter :: elem_quad9 = 28, elem_hex27 = 29
+   !> Largest node counts of an element and of a facet, largest facet quadrature.
+   integer, parameter :: max_element_nodes = 27, max_facet_nodes = 9, max_facet_points = 9
+
+   integer, parameter :: idx1(1, 2) = reshape([0, 1], [1, 2])
+   integer, parameter :: idx1q(1, 3) = reshape([0, 2, 1], [1, 3])
+   integer, parameter :: quad4(2, 4) = reshape([0, 0, 1, 0, 1, 1, 0, 1], [2, 4])
+   integer, parameter :: quad9(2, 9) = reshape([0, 0, 2, 0, 2, 2, 0, 2, 1, 0, 2, 1, 1, 2, 0, 1, 1, 1], [2, 9])
+   integer, parameter :: hex8(3, 8) = reshape([0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, &
+      & 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1], [3, 8])
+   integer, parameter :: hex27(3, 27) = reshape([ &
+      & 0, 0, 0, 2, 0, 0, 2, 2, 0, 0, 2, 0, 0, 0, 2, 2, 0, 2, 2, 2, 2, 0, 2, 2, &
+      & 1, 0, 0, 2, 1, 0, 1, 2, 0, 0, 1, 0, &
+      & 1, 0, 2, 2, 1, 2, 1, 2, 2, 0, 1, 2, &
+      & 0, 0, 1, 2, 0, 1, 2, 2, 1, 0, 2, 1, &
+      & 0, 1, 1, 2, 1, 1, 1, 0, 1, 1, 2, 1, 1, 1, 0, 1, 1, 2, &
+      & 1, 1, 1], [3, 27])
+
+contains
+
+   !> True for a supported element type code.
+   pure logical function element_known(etype)
+      integer, intent(in) :: etype
+      element_known = any(etype == [elem_tri3, elem_quad4, elem_tet4, elem_hex8, elem_quad9, elem_hex27])
+   end function element_known
+
+   !> Name of an element type, for messages ('unknown' otherwise).
+   pure function element_name(etype) result(name)
+      integer, intent(in) :: etype
+      character(len=:), allocatable :: name
+      select case (etype)
+      case (elem_tri3); name = 'tri3'
+      case (elem_quad4); name = 'quad4'
+      case (elem_tet4); name = 'tet4'
+      case (elem_hex8); name = 'hex8'
+      case (elem_quad9); name = 'quad9'
+      case (elem_hex27); name = 'hex27'
+      case default; name = 'unknown'
+      end select
+   end function element_name
+
+   !> Space dimension of an element type (0 if unknown).
+   pure integer function element_dim(etype)
+      integer, intent(in) :: etype
+      select case (etype)
+      case (elem_tri3, elem_quad4, elem_quad9); element_dim = 2
+      case (elem_tet4, elem_hex8, elem_hex27); element_dim = 3
+      case default; element_dim = 0
+      end select
+   end function element_dim
+
+   !> Nodes per element (0 if unknown).
+   pure integer function element_nodes(etype)
+      integer, intent(in) :: etype
+      select case (etype)
+      case (elem_tri3); element_nodes = 3
+      case (elem_quad4, elem_tet4); element_nodes = 4
+      case (elem_hex8); element_nodes = 8
+      case (elem_quad9); element_nodes = 9
+      case (elem_hex27); element_nodes = 27
+      case default; element_nodes = 0
+      end select
+   end function element_nodes
+
+   !> Vertex nodes per element: the leading local nodes (0 if unknown).
+   pure integer function element_vertices(etype)
+      integer, intent(in) :: etype
+      select case (etype)
+      case (elem_tri3); element_vertices = 3
+      case (elem_quad4, elem_quad9, elem_tet4); element_vertices = 4
+      case (elem_hex8, elem_hex27); element_vertices = 8
+      case default; element_vertices = 0
+      end select
+   end function element_vertices
+
+   !> Polynomial degree of the element (1 or 2; 0 if unknown): the default recovery degree p.
+   pure integer function element_degree(etype)
+      integer, intent(in) :: etype
+      select case (etype)
+      case (elem_tri3, elem_quad4, elem_tet4, elem_hex8); element_degree = 1
+      case (elem_quad9, elem_hex27); element_degree = 2
+      case default; element_degree = 0
+      end select
+   end function element_degree
+
+   !> Nodes of one facet of the element type (line2 2, line3 3, tri3 3, quad4 4, quad9 9).
+   pure integer function element_facet_nodes(etype)
+      integer, intent(in) :: etype
+      select case (etype)
+      case (elem_tri3, elem_quad4); element_facet_nodes = 2
+      case (elem_quad9, elem_tet4); element_facet_nodes = 3
+      case (elem_hex8); element_facet_nodes = 4
+      case (elem_hex27); element_facet_nodes = 9
+      case default; element_facet_nodes = 0
+      end select
+   end function element_facet_nodes
+
+   !> True for the simplices (tri3, tet4).
+   pure logical function element_simplex(etype)
+      integer, intent(in) :: etype
+      element_simplex = etype == elem_tri3 .or. etype == elem_tet4
+   end function element_simplex
+
+   !> Shape functions n(1:nen) and optionally their reference derivatives dn(1:dim, 1:nen)
+   !> at the reference point xi(1:dim) (the element type must be known).
+   pure subroutine element_shape(etype, xi, n, dn)
+      integer, intent(in) :: etype
+      real(wp), intent(in) :: xi(:)
+      real(wp), intent(out) :: n(:)
+      real(wp), intent(out), optional :: dn(:, :)
+      real(wp) :: d(3, max_element_nodes)
+
+      select case (etype)
+      case (elem_tri3, elem_tet4)
+         call simplex_shape(element_dim(etype), xi, n, d)
+      case (elem_quad4); call tensor_shape(quad4, 1, xi, n, d)
+      case (elem_quad9); call tensor_shape(quad9, 2, xi, n, d)
+      case (elem_hex8); call tensor_shape(hex8, 1, xi, n, d)
+      case (elem_hex27); call tensor_shape(hex27, 2, xi, n, d)
+      end select
+      if (present(dn)) dn(1:element_dim(etype), 1:element_nodes(etype)) = &
+         & d(1:element_dim(etype), 1:element_nodes(etype))
+   end subroutine element_shape
+
+   !> Vertex partition of unity nv(1:nvertex) at xi: the linear element on the vertices.
+   pure subroutine element_vertex_shape(etype, xi, nv)
+      integer, intent(in) :: etype
+      real(wp), intent(in) :: xi(:)
+      real(wp), intent(out) :: nv(:)
+      real(wp) :: d(3, max_element_nodes)
+
+      select case (etype)
+      case (elem_tri3, elem_tet4)
+         call simplex_shape(element_dim(etype), xi, nv, d)
+      case (elem_quad4, elem_quad9); call tensor_shape(quad4, 1, xi, nv, d)
+      case (elem_hex8, elem_hex27); call tensor_shape(hex8, 1, xi, nv, d)
+      end select
+   end subroutine element_vertex_shape
+
+   !> Reference coordinates xi(1:dim) of local node j.
+   pure subroutine element_node_xi(etype, j, xi)
+      integer, intent(in) :: etype, j
+      real(wp), intent(out) :: xi(:)
+      integer :: d
+
+      d = element_dim(etype)
+      select case (etype)
+      case (elem_tri3, elem_tet4)
+         xi(1:d) = 0.0_wp
+         if (j > 1) xi(j - 1) = 1.0_wp
+      case (elem_quad4); xi(1:2) = real(quad4(:, j), wp)
+      case (elem_quad9); xi(1:2) = 0.5_wp*real(quad9(:, j), wp)
+      case (elem_hex8); xi(1:3) = real(hex8(:, j), wp)
+      case (elem_hex27); xi(1:3) = 0.5_wp*real(hex27(:, j), wp)
+      end select
+   end subroutine element_node_xi
+
+   !> Reference centroid.
+   pure subroutine element_center_xi(etype, xi)
+      integer, intent(in) :: etype
+      real(wp), intent(out) :: xi(:)
+      integer :: d
+      d = element_dim(etype)
+      xi(1:d) = merge(1.0_wp/real(d + 1, wp), 0.5_wp, element_simplex(etype))
+   end subroutine element_center_xi
+
+   !> True if xi lies in the reference element, enlarged by tol.
+   pure logical function element_inside(etype, xi, tol)
+      integer, intent(in) :: etype
+      real(wp), intent(in) :: xi(:), tol
+      integer :: d
+      d = element_dim(etype)
+      if (element_simplex(etype)) then
+         element_inside = all(xi(1:d) >= -tol) .and. sum(xi(1:d)) <= 1.0_wp + tol
+      else
+         element_inside = all(xi(1:d) >= -tol) .and. all(xi(1:d) <= 1.0_wp + tol)
+      end if
+   end function element_inside
+
+   !> Physical point x(1:dim) of reference point xi; xe(1:dim, 1:nen) are the element's nodes.
+   pure subroutine element_map(etype, xe, xi, x)
+      integer, intent(in) :: etype
+      real(wp), intent(in) :: xe(:, :), xi(:)
+      real(wp), intent(out) :: x(:)
+      real(wp) :: n(max_element_nodes)
+      integer :: d, nen
+
+      d = element_dim(etype)
+      nen = element_nodes(etype)
+      call element_shape(etype, xi, n)
+      x(1:d) = matmul(xe(1:d, 1:nen), n(1:nen))
+   end subroutine element_map
+
+   !> Reference coordinates xi of the physical point x by Newton's method on the
+   !> isoparametric map, started at the centroid; converged = the last step is below
+   !> 1e-13 (reference units) within 50 steps. Affine elements converge in one step.
+   !> The small Jacobian is inverted by its adjugate (2x2, 3x3).
+   pure subroutine element_inverse_map(etype, xe, x, xi, converged)
+      integer, intent(in) :: etype
+      real(wp), intent(in) :: xe(:, :), x(:)
+      real(wp), intent(out) :: xi(:)
+      logical, intent(out) :: converged
+      real(wp) :: n(max_element_nodes), dn(3, max_element_nodes), jac(3, 3), inv(3, 3), r(3), step(3), det
+      integer :: d, nen, it
+
+      d = element_dim(etype)
+      nen = element_nodes(etype)
+      call element_center_xi(etype, xi)
+      converged = .false.
+      do it = 1, 50
+         call element_shape(etype, xi, n, dn)
+         r(1:d) = x(1:d) - matmul(xe(1:d, 1:nen), n(1:nen))
+         jac(1:d, 1:d) = matmul(xe(1:d, 1:nen), transpose(dn(1:d, 1:nen)))
+         call small_inverse(d, jac, inv, det)
+         if (.not. (abs(det) > 0.0_wp)) return
+         step(1:d) = matmul(inv(1:d, 1:d), r(1:d))
+         if (.not. all(abs(step(1:d)) <= 1.0e3_wp)) return
+         xi(1:d) = xi(1:d) + step(1:d)
+         if (maxval(abs(step(1:d))) < 1.0e-13_wp) then
+            converged = .true.
+            return
+         end if
+      end do
+   end subroutine element_inverse_map
+
+   !> Number of quadrature points of a facet of `nfn` nodes (line2 2, line3 3, tri3 3,
+   !> quad4 2x2, quad9 3x3: one per node, as it happens).
+   pure integer function facet_npoints(nfn)
+      integer, intent(in) :: nfn
+      facet_npoints = nfn
+   end function facet_npoints
+
+   !> Quadrature of one facet of `nfn` nodes xf(1:dim, 1:nfn) in `dim` space dimensions:
+   !> nq points x(1:dim, q), weights w(q) = weight*|J| and unit normals nrm(1:dim, q) of the
+   !> facet's parametrisation (not oriented). A degenerate facet gives w = 0 and nrm = 0.
+   pure subroutine facet_points(dim, nfn, xf, nq, x, w, nrm)
+      integer, intent(in) :: dim, nfn
+      real(wp), intent(in) :: xf(:, :)
+      integer, intent(out) :: nq
+      real(wp), intent(out) :: x(:, :), w(:), nrm(:, :)
+      real(wp) :: gx(3), gw(3), xir(2, max_facet_points), wr(max_facet_points)
+      real(wp) :: n(max_facet_nodes), d(3, max_element_nodes), t(3, 2), v(3), a
+      integer :: ng, i, j, q
+
+      if (dim == 3 .and. nfn == 3) then
+         nq = 3
+         xir(:, 1:3) = reshape([1.0_wp/6, 1.0_wp/6, 2.0_wp/3, 1.0_wp/6, 1.0_wp/6, 2.0_wp/3], [2, 3])
+         wr(1:3) = 1.0_wp/6
+      else
+         ng = merge(3, 2, nfn == 3 .or. nfn == 9)
+         call gauss_legendre_nodes(ng, gx, gw)
+         gx(1:ng) = 0.5_wp*(gx(1:ng) + 1.0_wp)
+         gw(1:ng) = 0.5_wp*gw(1:ng)
+         if (dim == 2) then
+            nq = ng
+            xir(1, 1:ng) = gx(1:ng)
+            xir(2, 1:ng) = 0.0_wp
+            wr(1:ng) = gw(1:ng)
+         else
+            nq = 0
+            do j = 1, ng
+               do i = 1, ng
+                  nq = nq + 1
+                  xir(:, nq) = [gx(i), gx(j)]
+                  wr(nq) = gw(i)*gw(j)
+               end do
+            end do
+         end if
+      end if
+      do q = 1, nq
+         select case (10*dim + nfn)
+         case (22); call tensor_shape(idx1, 1, xir(:, q), n, d)
+         case (23); call tensor_shape(idx1q, 2, xir(:, q), n, d)
+         case (33); call simplex_shape(2, xir(:, q), n, d)
+         case (34); call tensor_shape(quad4, 1, xir(:, q), n, d)
+         case default; call tensor_shape(quad9, 2, xir(:, q), n, d)
+         end select
+         x(1:dim, q) = matmul(xf(1:dim, 1:nfn), n(1:nfn))
+         t(1:dim, 1:dim - 1) = matmul(xf(1:dim, 1:nfn), transpose(d(1:dim - 1, 1:nfn)))
+         if (dim == 2) then
+            v(1:2) = [t(2, 1), -t(1, 1)]
+         else
+            v = [t(2, 1)*t(3, 2) - t(3, 1)*t(2, 2), t(3, 1)*t(1, 2) - t(1, 1)*t(3, 2), &
+               & t(1, 1)*t(2, 2) - t(2, 1)*t(1, 2)]
+         end if
+         a = sqrt(sum(v(1:dim)**2))
+         w(q) = wr(q)*a
+         nrm(1:dim, q) = 0.0_wp
+         if (a > 0.0_wp) nrm(1:dim, q) = v(1:dim)/a
+      end do
+   end subroutine facet_points
+
+   !> Linear simplex shape functions in rdim reference dimensions (unit simplex).
+   pure subroutine simplex_shape(rdim, xi, n, d)
+      integer, intent(in) :: rdim
+      real(wp), intent(in) :: xi(:)
+      real(wp), intent(out) :: n(:), d(:, :)
+      integer :: k
+
+      n(1) = 1.0_wp - sum(xi(1:rdim))
+      n(2:rdim + 1) = xi(1:rdim)
+      d(1:rdim, 1:rdim + 1) = 0.0_wp
+      d(1:rdim, 1) = -1.0_wp
+      do k = 1, rdim
+         d(k, k + 1) = 1.0_wp
+      end do
+   end subroutine simplex_shape
+
+   !> Tensor Lagrange shape functions of degree deg on [0,1]^rdim, node j at idx(:, j)/deg.
+   pure subroutine tensor_shape(idx, deg, xi, n, d)
+      integer, intent(in) :: idx(:, :), deg
+      real(wp), intent(in) :: xi(:)
+      real(wp), intent(out) :: n(:), d(:, :)
+      real(wp) :: l(0:2, 3), dl(0:2, 3)
+      integer :: j, k, m, rdim
+
+      rdim = size(idx, 1)
+      do k = 1, rdim
+         call lagrange_1d(deg, xi(k), l(:, k), dl(:, k))
+      end do
+      do j = 1, size(idx, 2)
+         n(j) = product([(l(idx(k, j), k), k=1, rdim)])
+         do m = 1, rdim
+            d(m, j) = product([(merge(dl(idx(k, j), k), l(idx(k, j), k), k == m), k=1, rdim)])
+         end do
+      end do
+   end subroutine tensor_shape
+
+   !> 1D Lagrange basis of degree 1 or 2 on equispaced nodes of [0, 1], with derivatives.
+   pure subroutine lagrange_1d(deg, t, l, dl)
+      integer, intent(in) :: deg
+      real(wp), intent(in) :: t
+      real(wp), intent(out) :: l(0:2), dl(0:2)
+      if (deg == 1) then
+         l = [1.0_wp - t, t, 0.0_wp]
+         dl = [-1.0_wp, 1.0_wp, 0.0_wp]
+      else
+         l = [(2.0_wp*t - 1.0_wp)*(t - 1.0_wp), 4.0_wp*t*(1.0_wp - t), t*(2.0_wp*t - 1.0_wp)]
+         dl = [4.0_wp*t - 3.0_wp, 4.0_wp - 8.0_wp*t, 4.0_wp*t - 1.0_wp]
+      end if
+   end subroutine lagrange_1d
+
+   !> Inverse of a 2x2 or 3x3 matrix by its adjugate, and the determinant (inv undefined if 0).
+   pure subroutine small_inverse(d, a, inv, det)
+      integer, intent(in) :: d
+      real(wp), intent(in) :: a(3, 3)
+      real(wp), intent(out) :: inv(3, 3), det
+
+      if (d == 2) then
+         det = a(1, 1)*a(2, 2) - a(1, 2)*a(2, 1)
+         if (.not. (abs(det) > 0.0_wp)) return
+         inv(1:2, 1:2) = reshape([a(2, 2), -a(2, 1), -a(1, 2), a(1, 1)], [2, 2])/det
+      else
+         inv(1, 1) = a(2, 2)*a(3, 3) - a(2, 3)*a(3, 2)
+         inv(1, 2) = a(1, 3)*a(3, 2) - a(1, 2)*a(3, 3)
+         inv(1, 3) = a(1, 2)*a(2, 3) - a(1, 3)*a(2, 2)
+         inv(2, 1) = a(2, 3)*a(3, 1) - a(2, 1)*a(3, 3)
+         inv(2, 2) = a(1, 1)*a(3, 3) - a(1, 3)*a(3, 1)
+         inv(2, 3) = a(1, 3)*a(2, 1) - a(1, 1)*a(2, 3)
+         inv(3, 1) = a(2, 1)*a(3, 2) - a(2, 2)*a(3, 1)
+         inv(3, 2) = a(1, 2)*a(3, 1) - a(1, 1)*a(3, 2)
+         inv(3, 3) = a(1, 1)*a(2, 2) - a(1, 2)*a(2, 1)
+         det = a(1, 1)*inv(1, 1) + a(1, 2)*inv(2, 1) + a(1, 3)*inv(3, 1)
+         if (.not. (abs(det) > 0.0_wp)) return
+         inv = inv/det
+      end if
+   end subroutine small_inverse
+
+end module sprc_recovery_mesh_element
