@@ -7,7 +7,19 @@ export PATH := $(CURDIR)/.venv/bin:$(PATH)
 FPM ?= fpm
 PROFILE ?= release
 
-.PHONY: all deps build run test bench clean help
+# Shared library and install (make lib, make install PREFIX=...). fpm 0.12's
+# shared-library link drops the HDF5 -L path, so libsprc.so is linked here
+# from the static archive fpm builds (its objects are compiled with -fPIC).
+LIBDIR := build/lib
+PREFIX ?= /usr/local
+VERSION := $(shell sed -n 's/^version *= *"\(.*\)"/\1/p' fpm.toml)
+HDF5_LDIR := $(shell pkg-config --libs-only-L hdf5 2>/dev/null || echo -L/usr/lib/x86_64-linux-gnu/hdf5/serial)
+# Everything libsprc needs at link time: HDF5 (Fortran), SuiteSparse,
+# LAPACK/BLAS (fpm.toml's link list), the gfortran and OpenMP run times.
+DEP_LIBS := $(HDF5_LDIR) -lhdf5_fortran -lhdf5 -lcholmod -lumfpack -lsuitesparseconfig -llapack -lblas \
+            -lgfortran -lgomp -lm
+
+.PHONY: all deps build run test bench clean help lib install
 
 all: build
 
@@ -16,6 +28,8 @@ help:
 	@echo "make test    install what is missing and run the whole test suite"
 	@echo "make bench   benchmarks (sparse direct solvers, grid build)"
 	@echo "make build   build the release profile"
+	@echo "make lib     build/lib/libsprc.so and libsprc.a, Fortran modules in build/lib/mod"
+	@echo "make install PREFIX=DIR   lib, include (sprc.h, modules in include/sprc), pkg-config, bin/sprc"
 	@echo "make clean   remove build outputs"
 
 deps:
@@ -33,6 +47,52 @@ test: deps
 bench: deps
 	@tools/bench-sparse
 	$(FPM) run --profile release --example bench_grid
+
+# fpm names its build directories by hashes: remove every archive, build the
+# profile verbosely and take the archive and module directory from the one
+# `ar` line that recreates it.
+lib: deps
+	@mkdir -p $(LIBDIR)
+	@rm -rf $(LIBDIR)/mod build/gfortran_*/sprc/libsprc.a
+	@$(FPM) build --profile $(PROFILE) --no-prune --verbose >$(LIBDIR)/fpm-build.log 2>&1 \
+	  || { tail -n 40 $(LIBDIR)/fpm-build.log; exit 1; }
+	@set -e; \
+	arline=$$(grep -E '^ *\+ ar -rs .*/libsprc\.a ' $(LIBDIR)/fpm-build.log | tail -n 1); \
+	archive=$$(awk '{print $$4}' <<<"$$arline"); \
+	obj=$$(grep -oE '[^ ]+/src_sprc\.f90\.o' <<<"$$arline"); \
+	if [ -z "$$archive" ] || [ -z "$$obj" ]; then echo "make lib: no archive in $(LIBDIR)/fpm-build.log"; exit 1; fi; \
+	moddir=$$(dirname "$$(dirname "$$obj")"); \
+	cp "$$archive" $(LIBDIR)/libsprc.a; \
+	mkdir -p $(LIBDIR)/mod; \
+	for m in $$(grep -rhiE '^[[:space:]]*module[[:space:]]+[a-z0-9_]+[[:space:]]*(!.*)?$$' src \
+	            | awk '{print tolower($$2)}'); do cp "$$moddir/$$m.mod" $(LIBDIR)/mod/; done; \
+	gcc -shared -Wl,-soname,libsprc.so -o $(LIBDIR)/libsprc.so \
+	  -Wl,--whole-archive $(LIBDIR)/libsprc.a -Wl,--no-whole-archive $(DEP_LIBS) -Wl,--no-undefined; \
+	$(FPM) run --profile $(PROFILE) --runner echo sprc 2>/dev/null | tail -n 1 >$(LIBDIR)/driver-path; \
+	echo "make lib: $(LIBDIR)/libsprc.so, $(LIBDIR)/libsprc.a, $(LIBDIR)/mod ($(PROFILE))"
+
+install: lib
+	@set -e; \
+	prefix=$(abspath $(PREFIX)); \
+	install -d "$(DESTDIR)$$prefix"/{bin,lib/pkgconfig,include/sprc}; \
+	install -m 755 "$$(cat $(LIBDIR)/driver-path)" "$(DESTDIR)$$prefix/bin/sprc"; \
+	install -m 755 $(LIBDIR)/libsprc.so "$(DESTDIR)$$prefix/lib/"; \
+	install -m 644 $(LIBDIR)/libsprc.a "$(DESTDIR)$$prefix/lib/"; \
+	install -m 644 include/sprc.h "$(DESTDIR)$$prefix/include/"; \
+	install -m 644 $(LIBDIR)/mod/*.mod "$(DESTDIR)$$prefix/include/sprc/"; \
+	{ echo "prefix=$$prefix"; \
+	  echo 'libdir=$${prefix}/lib'; \
+	  echo 'includedir=$${prefix}/include'; \
+	  echo 'moddir=$${includedir}/sprc'; \
+	  echo; \
+	  echo 'Name: sprc'; \
+	  echo 'Description: SPR / SPR-C stress recovery and ZZ error estimation on cut Cartesian grids'; \
+	  echo 'Version: $(VERSION)'; \
+	  echo 'Cflags: -I$${includedir} -I$${moddir}'; \
+	  echo 'Libs: -L$${libdir} -Wl,-rpath,$${libdir} -lsprc'; \
+	  echo 'Libs.private: $(DEP_LIBS)'; \
+	} >"$(DESTDIR)$$prefix/lib/pkgconfig/sprc.pc"; \
+	echo "make install: installed into $(DESTDIR)$$prefix"
 
 clean:
 	$(FPM) clean --all 2>/dev/null || rm -rf build
