@@ -128,7 +128,7 @@ contains
       d = grid%dim
       p = nodes%degree
       nen = nodes%nodes_per_element
-      idx = element_node_index(d, p)
+      allocate (idx, source=element_node_index(d, p))
       call side_tables(d, p, idx, dir, ndir, side_nodes, n_side)
       allocate (shape(nen), hanging(nodes%n_nodes), owner(nodes%n_nodes))
       hanging = .false.

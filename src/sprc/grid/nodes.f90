@@ -137,7 +137,7 @@ contains
       end if
       d = grid%dim
       nen = nodes_per_element(d, degree)
-      idx = element_node_index(d, degree)
+      allocate (idx, source=element_node_index(d, degree))
       self%dim = d
       self%degree = degree
       self%nodes_per_element = nen
