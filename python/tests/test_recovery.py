@@ -338,6 +338,20 @@ def test_library_errors_raise_sprc_error(quad):
         call(quad, boundary={"nodes": [[0, 8]], "kind": "free"})
 
 
+def test_thin_layer_reports_unknown_element_code(quad):
+    """Names are checked in Python; a raw code the C API does not know (through
+    sprc.library, the 1:1 layer) comes back as SprcError naming it."""
+    import ctypes
+    d = ctypes.POINTER(ctypes.c_double)
+    arrays = [np.ascontiguousarray(quad[k], dtype=float) for k in ("nodes", "gauss_points", "gauss_weights",
+                                                                   "gauss_stress")]
+    conn = np.ascontiguousarray(quad["elements"], dtype=np.intc)
+    x, gp, gw, gs = (a.ctypes.data_as(d) for a in arrays)
+    with pytest.raises(sprc.SprcError, match="element_type = 99 is unknown"):
+        sprc.library.recover(2, 1, 9, x, 99, 4, 4, conn.ctypes.data_as(ctypes.POINTER(ctypes.c_int)), 4, gp, gw, gs,
+                             1000.0, 0.3, 2, None, 0, 2, None, None, None)
+
+
 def test_evaluate_errors(quad):
     rec = call(quad)
     with pytest.raises(sprc.SprcError, match="is in no element"):
