@@ -114,6 +114,97 @@ void sprc_get_report_values(sprc_error error, sprc_report report, const char *co
 /* Free *report and set it to NULL. */
 void sprc_delete_report(sprc_report *report);
 
+/* ------------------------------------------------- recovery on your mesh */
+
+/* SPR / SPR-C stress recovery and the ZZ error estimate on a caller's own
+ * mesh (one element type for the whole mesh, VTK node order), from the FE
+ * stresses at the integration points. */
+
+/* Element types (VTK cell type ids). */
+#define SPRC_TRI3 5
+#define SPRC_QUAD4 9
+#define SPRC_TET4 10
+#define SPRC_HEX8 12
+#define SPRC_QUAD9 28
+#define SPRC_HEX27 29
+
+/* Analyses: nstress = 3 in 2D (xx, yy, xy), 6 in 3D (xx, yy, zz, xy, yz, xz). */
+#define SPRC_PLANE_STRESS 1
+#define SPRC_PLANE_STRAIN 2
+#define SPRC_SOLID 3
+
+/* Recovery methods. */
+#define SPRC_METHOD_SPR 1
+#define SPRC_METHOD_SPRC 2
+
+/* Boundary facet kinds: a constant traction given per facet, a symmetry
+ * plane (zero shear), a free surface (zero traction). */
+#define SPRC_FACET_TRACTION 1
+#define SPRC_FACET_SYMMETRY 2
+#define SPRC_FACET_FREE 3
+
+typedef struct _sprc_recovery *sprc_recovery;
+
+/* Recover the stresses of a mesh and estimate the error. Shapes in C order:
+ *   nodes          [nnode][dim]
+ *   connectivity   [nelem][nen]       0-based node indices, VTK order
+ *                                     (nen: tri3 3, quad4 4, quad9 9, tet4 4,
+ *                                     hex8 8, hex27 27)
+ *   gauss_points   [nelem][ngp][dim]  physical coordinates, inside the element
+ *   gauss_weights  [nelem][ngp]       weight times |J|, > 0
+ *   gauss_stress   [nelem][ngp][nstress]  FE stresses (Voigt, see above)
+ *   body_force     [dim] or NULL      constant body force b (div sigma + b = 0)
+ *   facet_nodes    [nfacet][facet_nnode]  0-based; a side of one element
+ *                                     (line2 / line3 in 2D, tri3 / quad4 /
+ *                                     quad9 faces in 3D); NULL with nfacet = 0
+ *   facet_kind     [nfacet]           SPRC_FACET_*
+ *   facet_traction [nfacet][dim] or NULL  (needed if a facet is a traction one)
+ * dim 2 or 3; analysis SPRC_PLANE_STRESS / SPRC_PLANE_STRAIN in 2D,
+ * SPRC_SOLID in 3D; method SPRC_METHOD_SPR or SPRC_METHOD_SPRC (SPR ignores
+ * the facets once validated). The patch degree is the element's (1, or 2
+ * for quad9 and hex27). Boundary constraints apply only on the facets given.
+ * Returns a new recovery (free it with sprc_delete_recovery) or NULL with
+ * the error set: SPRC_STAT_INVALID_INPUT for a bad size, code, NULL array,
+ * index out of range, non-finite value, point outside its element;
+ * SPRC_STAT_SINGULAR for a patch that stays rank deficient;
+ * SPRC_STAT_NOT_CONVERGED for a point whose inverse map fails. Sizes,
+ * NULL pointers and 0-based indices are checked at the C boundary and named
+ * in C notation (connectivity[e][a]); values checked deeper in the library
+ * are named in its Fortran notation, 1-based and column-major:
+ * gp(:, q, e) is gauss_points[e-1][q-1], element e is element e-1 here. */
+sprc_recovery sprc_recover(sprc_error error, int dim, int analysis, int nnode, const double *nodes,
+                           int element_type, int nen, int nelem, const int *connectivity, int ngp,
+                           const double *gauss_points, const double *gauss_weights, const double *gauss_stress,
+                           double young, double poisson, int method, const double *body_force, int nfacet,
+                           int facet_nnode, const int *facet_nodes, const int *facet_kind,
+                           const double *facet_traction);
+
+/* Recovered stresses at the nodes into out[nnode][nstress]; n must equal
+ * nnode (nodes of no element get zero). On error out is left unchanged. */
+void sprc_get_recovery_nodal_stress(sprc_error error, sprc_recovery recovery, double *out, int n);
+
+/* ZZ error of each element (energy norm of sigma* - sigma_h over its
+ * integration points) into out[nelem]; nelem must equal the element count. */
+void sprc_get_recovery_element_error(sprc_error error, sprc_recovery recovery, double *out, int nelem);
+
+/* Global ZZ estimate sqrt(sum of squared element errors); NaN on error. */
+double sprc_get_recovery_global_error(sprc_error error, sprc_recovery recovery);
+
+/* Estimated relative error err / sqrt(||sigma_h||^2 + err^2); NaN on error. */
+double sprc_get_recovery_eta(sprc_error error, sprc_recovery recovery);
+
+/* The recovered field sigma* at points[npts][dim] into stress[npts][nstress].
+ * elements[npts] names the element of each point (0-based; -1 searches for
+ * it); elements = NULL searches for every point (O(nelem) per point). A
+ * point in no element (or not in the one named) is an error, its message
+ * in the library's 1-based notation (x(:, i) is points[i-1]); on error the
+ * contents of stress are unspecified. npts = 0 does nothing. */
+void sprc_eval_recovery(sprc_error error, sprc_recovery recovery, int npts, const double *points,
+                        const int *elements, double *stress);
+
+/* Free *recovery and set it to NULL. */
+void sprc_delete_recovery(sprc_recovery *recovery);
+
 #ifdef __cplusplus
 }
 #endif

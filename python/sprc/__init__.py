@@ -1,6 +1,7 @@
 """sprc for Python: SPR / SPR-C stress recovery and ZZ error estimation on
-cut Cartesian grids, through libsprc's C API (ctypes, no compiled
-extension). See :mod:`sprc.library` for how libsprc.so is found.
+cut Cartesian grids, and on your own mesh (:func:`recover`), through
+libsprc's C API (ctypes, no compiled extension). See :mod:`sprc.library`
+for how libsprc.so is found.
 
 >>> import sprc
 >>> rows = sprc.run_scene("example/scenes/lame_cylinder.nml", levels=[3, 4])
@@ -16,8 +17,9 @@ import numpy as np
 
 from . import library
 from .library import SprcError
+from .recovery import Recovery, recover
 
-__all__ = ["__version__", "SprcError", "get_version", "run_scene", "INTEGER_COLUMNS"]
+__all__ = ["__version__", "SprcError", "get_version", "run_scene", "recover", "Recovery", "INTEGER_COLUMNS"]
 
 __version__ = "0.1.0"
 

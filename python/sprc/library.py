@@ -107,6 +107,7 @@ get_error = _prototype("sprc_get_error", None, _handle, ctypes.c_char_p, _c_int_
 clear_error = _prototype("sprc_clear_error", None, _handle)
 delete_error = _prototype("sprc_delete_error", None, ctypes.POINTER(_handle))
 delete_report = _prototype("sprc_delete_report", None, ctypes.POINTER(_handle))
+delete_recovery = _prototype("sprc_delete_recovery", None, ctypes.POINTER(_handle))
 
 
 def error_message(handle, size=4096):
@@ -159,3 +160,20 @@ def get_report_values(report, column, nrows):
     values = np.empty(nrows, dtype=np.float64)
     _get_report_values(report, column.encode(), values.ctypes.data_as(_c_double_p), nrows)
     return values
+
+recover = error_check(_prototype(
+    "sprc_recover", _handle, _handle,
+    ctypes.c_int, ctypes.c_int, ctypes.c_int, _c_double_p,                  # dim, analysis, nnode, nodes
+    ctypes.c_int, ctypes.c_int, ctypes.c_int, _c_int_p,                     # element_type, nen, nelem, connectivity
+    ctypes.c_int, _c_double_p, _c_double_p, _c_double_p,                    # ngp, points, weights, stress
+    ctypes.c_double, ctypes.c_double, ctypes.c_int, _c_double_p,            # young, poisson, method, body_force
+    ctypes.c_int, ctypes.c_int, _c_int_p, _c_int_p, _c_double_p))           # facets
+get_recovery_nodal_stress = error_check(_prototype("sprc_get_recovery_nodal_stress", None, _handle, _handle,
+                                                   _c_double_p, ctypes.c_int))
+get_recovery_element_error = error_check(_prototype("sprc_get_recovery_element_error", None, _handle, _handle,
+                                                    _c_double_p, ctypes.c_int))
+get_recovery_global_error = error_check(_prototype("sprc_get_recovery_global_error", ctypes.c_double, _handle,
+                                                   _handle))
+get_recovery_eta = error_check(_prototype("sprc_get_recovery_eta", ctypes.c_double, _handle, _handle))
+eval_recovery = error_check(_prototype("sprc_eval_recovery", None, _handle, _handle, ctypes.c_int, _c_double_p,
+                                       _c_int_p, _c_double_p))

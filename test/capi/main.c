@@ -238,6 +238,357 @@ static void test_run_invalid_scene(void) {
   PASS();
 }
 
+/* ------------------------------------------------ recovery on a C mesh */
+
+/* A distorted M x M quad4 mesh of [0,1]^2: interior nodes moved by 0.2 of a
+ * cell (sides stay straight), 2x2 Gauss points mapped bilinearly, weights
+ * times |J|, and the FE stresses of an exact field at the points. */
+#define M 4
+#define NNODE ((M + 1) * (M + 1))
+#define NELEM (M * M)
+#define NGP 4
+
+typedef struct {
+  double nodes[NNODE][2];
+  int conn[NELEM][4];
+  double gp[NELEM][NGP][2], gw[NELEM][NGP], gs[NELEM][NGP][3];
+  double body[2];
+  int field;
+} quad_mesh;
+
+/* field 0: a linear field (body force b = -div sigma = (-2.25, 2.5));
+ * field 1: sigma_xx, sigma_xy depend on x only, so the sides x = 0 and
+ * x = 1 carry constant tractions (b = (-2, 2)). */
+static void exact_stress(int field, const double *x, double *s) {
+  double a = x[0], b = x[1];
+  if (field == 0) {
+    s[0] = 1.0 + 2 * a + 3 * b;
+    s[1] = -2.0 + 0.5 * a - b;
+    s[2] = 0.7 - 1.5 * a + 0.25 * b;
+  } else {
+    s[0] = 1.0 + 2 * a;
+    s[1] = -2.0 + 0.5 * a - b;
+    s[2] = 0.5 - a;
+  }
+}
+
+static void build_quad_mesh(quad_mesh *m, int field) {
+  const double g = 0.5 / sqrt(3.0);
+  const double xi[NGP][2] = {{0.5 - g, 0.5 - g}, {0.5 + g, 0.5 - g}, {0.5 + g, 0.5 + g}, {0.5 - g, 0.5 + g}};
+  int i, j, e, q, a;
+  for (j = 0; j <= M; j++) {
+    for (i = 0; i <= M; i++) {
+      double *x = m->nodes[i + (M + 1) * j];
+      x[0] = (double)i / M;
+      x[1] = (double)j / M;
+      if (i > 0 && i < M) x[0] += 0.2 / M * sin(1.7 * i + 2.3 * j + 1.0);
+      if (j > 0 && j < M) x[1] += 0.2 / M * sin(1.7 * i + 2.3 * j + 2.0);
+    }
+  }
+  for (j = 0; j < M; j++) {
+    for (i = 0; i < M; i++) {
+      int n = i + (M + 1) * j;
+      e = i + M * j;
+      m->conn[e][0] = n;
+      m->conn[e][1] = n + 1;
+      m->conn[e][2] = n + M + 2;
+      m->conn[e][3] = n + M + 1;
+    }
+  }
+  for (e = 0; e < NELEM; e++) {
+    for (q = 0; q < NGP; q++) {
+      double r = xi[q][0], t = xi[q][1];
+      double shp[4] = {(1 - r) * (1 - t), r * (1 - t), r * t, (1 - r) * t};
+      double dr[4] = {-(1 - t), 1 - t, t, -t}, dt[4] = {-(1 - r), -r, r, 1 - r};
+      double jac[2][2] = {{0, 0}, {0, 0}};
+      m->gp[e][q][0] = m->gp[e][q][1] = 0.0;
+      for (a = 0; a < 4; a++) {
+        const double *x = m->nodes[m->conn[e][a]];
+        m->gp[e][q][0] += shp[a] * x[0];
+        m->gp[e][q][1] += shp[a] * x[1];
+        jac[0][0] += dr[a] * x[0];
+        jac[0][1] += dt[a] * x[0];
+        jac[1][0] += dr[a] * x[1];
+        jac[1][1] += dt[a] * x[1];
+      }
+      m->gw[e][q] = 0.25 * fabs(jac[0][0] * jac[1][1] - jac[0][1] * jac[1][0]);
+      exact_stress(field, m->gp[e][q], m->gs[e][q]);
+    }
+  }
+  m->field = field;
+  m->body[0] = field == 0 ? -2.25 : -2.0;
+  m->body[1] = field == 0 ? 2.5 : 2.0;
+}
+
+/* sprc_recover on the mesh with the given method and no facets. */
+static sprc_recovery recover_quad_mesh(sprc_error err, const quad_mesh *m, int method) {
+  return sprc_recover(err, 2, SPRC_PLANE_STRESS, NNODE, &m->nodes[0][0], SPRC_QUAD4, 4, NELEM, &m->conn[0][0], NGP,
+                      &m->gp[0][0][0], &m->gw[0][0], &m->gs[0][0][0], 1000.0, 0.3, method, m->body, 0, 2, NULL,
+                      NULL, NULL);
+}
+
+/* Largest |nodal - exact| over the nodes. */
+static double nodal_deviation(const quad_mesh *m, double nodal[NNODE][3]) {
+  double dev = 0.0, s[3];
+  int n, k;
+  for (n = 0; n < NNODE; n++) {
+    exact_stress(m->field, m->nodes[n], s);
+    for (k = 0; k < 3; k++) dev = fmax(dev, fabs(nodal[n][k] - s[k]));
+  }
+  return dev;
+}
+
+static void test_recovery_null_handles(void) {
+  const char *name = "recovery_null_handles";
+  static quad_mesh m;
+  double out[NNODE][3], e[NELEM], pts[1][2] = {{0.5, 0.5}}, s[1][3] = {{7.0, 7.0, 7.0}};
+  sprc_recovery rec = NULL;
+  sprc_error err = sprc_new_error();
+  build_quad_mesh(&m, 0);
+  out[0][0] = e[0] = 7.0;
+  /* No error handle: nothing happens, failure values come back. */
+  CHECK(recover_quad_mesh(NULL, &m, SPRC_METHOD_SPRC) == NULL, "sprc_recover without error handle");
+  CHECK(isnan(sprc_get_recovery_global_error(NULL, rec)), "global error without error handle is not NaN");
+  CHECK(isnan(sprc_get_recovery_eta(NULL, rec)), "eta without error handle is not NaN");
+  sprc_get_recovery_nodal_stress(NULL, rec, &out[0][0], NNODE);
+  sprc_get_recovery_element_error(NULL, rec, e, NELEM);
+  sprc_eval_recovery(NULL, rec, 1, &pts[0][0], NULL, &s[0][0]);
+  CHECK(out[0][0] == 7.0 && e[0] == 7.0 && s[0][0] == 7.0, "output written without error handle");
+  /* A NULL recovery handle is an error naming the entry. */
+  CHECK(isnan(sprc_get_recovery_global_error(err, NULL)), "global error of NULL is not NaN");
+  CHECK(has_error(err, "sprc_get_recovery_global_error: the recovery handle is NULL"), "global error: no error");
+  CHECK(isnan(sprc_get_recovery_eta(err, NULL)), "eta of NULL is not NaN");
+  CHECK(has_error(err, "sprc_get_recovery_eta: the recovery handle is NULL"), "eta: no error");
+  sprc_get_recovery_nodal_stress(err, NULL, &out[0][0], NNODE);
+  CHECK(has_error(err, "recovery handle is NULL"), "nodal stress: no error for NULL");
+  sprc_get_recovery_element_error(err, NULL, e, NELEM);
+  CHECK(has_error(err, "recovery handle is NULL"), "element error: no error for NULL");
+  sprc_eval_recovery(err, NULL, 1, &pts[0][0], NULL, &s[0][0]);
+  CHECK(has_error(err, "recovery handle is NULL"), "eval: no error for NULL");
+  CHECK(out[0][0] == 7.0 && e[0] == 7.0 && s[0][0] == 7.0, "output written for a NULL recovery");
+  sprc_delete_recovery(&rec);
+  sprc_delete_recovery(NULL);
+  sprc_delete_error(&err);
+  PASS();
+}
+
+/* Every size, code and pointer of sprc_recover, wrong one at a time. */
+static void test_recovery_bad_input(void) {
+  const char *name = "recovery_bad_input";
+  static quad_mesh m, bad;
+  const double *x = &m.nodes[0][0], *gp = &m.gp[0][0][0], *gw = &m.gw[0][0], *gs = &m.gs[0][0][0];
+  const int *c = &m.conn[0][0];
+  int fn[2][2] = {{0, 1}, {1, 2}}, fk[2] = {SPRC_FACET_FREE, SPRC_FACET_TRACTION}, fk_bad[2] = {3, 9};
+  double ft[2][2] = {{0, 0}, {0, 0}};
+  sprc_error err = sprc_new_error();
+  build_quad_mesh(&m, 0);
+#define RECOVER_FAILS(text, ...)                                                                  \
+  do {                                                                                            \
+    sprc_recovery r_ = sprc_recover(err, __VA_ARGS__);                                            \
+    CHECK(r_ == NULL, "a recovery came back for bad input: " text);                               \
+    CHECK(sprc_get_error_status(err) == SPRC_STAT_INVALID_INPUT, "not invalid input: " text);    \
+    CHECK(has_error(err, text), "no error saying: " text);                                        \
+  } while (0)
+  RECOVER_FAILS("dim = 4", 4, 1, NNODE, x, 9, 4, NELEM, c, NGP, gp, gw, gs, 1e3, 0.3, 2, NULL, 0, 2, NULL, NULL, NULL);
+  RECOVER_FAILS("analysis = 7", 2, 7, NNODE, x, 9, 4, NELEM, c, NGP, gp, gw, gs, 1e3, 0.3, 2, NULL, 0, 2, NULL, NULL,
+                NULL);
+  RECOVER_FAILS("element_type = 99", 2, 1, NNODE, x, 99, 4, NELEM, c, NGP, gp, gw, gs, 1e3, 0.3, 2, NULL, 0, 2, NULL,
+                NULL, NULL);
+  RECOVER_FAILS("nen = 3", 2, 1, NNODE, x, 9, 3, NELEM, c, NGP, gp, gw, gs, 1e3, 0.3, 2, NULL, 0, 2, NULL, NULL, NULL);
+  RECOVER_FAILS("nnode = 0", 2, 1, 0, x, 9, 4, NELEM, c, NGP, gp, gw, gs, 1e3, 0.3, 2, NULL, 0, 2, NULL, NULL, NULL);
+  RECOVER_FAILS("nelem = -1", 2, 1, NNODE, x, 9, 4, -1, c, NGP, gp, gw, gs, 1e3, 0.3, 2, NULL, 0, 2, NULL, NULL, NULL);
+  RECOVER_FAILS("ngp = 0", 2, 1, NNODE, x, 9, 4, NELEM, c, 0, gp, gw, gs, 1e3, 0.3, 2, NULL, 0, 2, NULL, NULL, NULL);
+  RECOVER_FAILS("nodes is NULL", 2, 1, NNODE, NULL, 9, 4, NELEM, c, NGP, gp, gw, gs, 1e3, 0.3, 2, NULL, 0, 2, NULL,
+                NULL, NULL);
+  RECOVER_FAILS("connectivity is NULL", 2, 1, NNODE, x, 9, 4, NELEM, NULL, NGP, gp, gw, gs, 1e3, 0.3, 2, NULL, 0, 2,
+                NULL, NULL, NULL);
+  RECOVER_FAILS("gauss_points is NULL", 2, 1, NNODE, x, 9, 4, NELEM, c, NGP, NULL, gw, gs, 1e3, 0.3, 2, NULL, 0, 2,
+                NULL, NULL, NULL);
+  RECOVER_FAILS("gauss_weights is NULL", 2, 1, NNODE, x, 9, 4, NELEM, c, NGP, gp, NULL, gs, 1e3, 0.3, 2, NULL, 0, 2,
+                NULL, NULL, NULL);
+  RECOVER_FAILS("gauss_stress is NULL", 2, 1, NNODE, x, 9, 4, NELEM, c, NGP, gp, gw, NULL, 1e3, 0.3, 2, NULL, 0, 2,
+                NULL, NULL, NULL);
+  RECOVER_FAILS("nfacet = -1", 2, 1, NNODE, x, 9, 4, NELEM, c, NGP, gp, gw, gs, 1e3, 0.3, 2, NULL, -1, 2, NULL, NULL,
+                NULL);
+  RECOVER_FAILS("facet_nodes or facet_kind is NULL", 2, 1, NNODE, x, 9, 4, NELEM, c, NGP, gp, gw, gs, 1e3, 0.3, 2,
+                NULL, 2, 2, NULL, fk, NULL);
+  RECOVER_FAILS("facet_nodes or facet_kind is NULL", 2, 1, NNODE, x, 9, 4, NELEM, c, NGP, gp, gw, gs, 1e3, 0.3, 2,
+                NULL, 2, 2, &fn[0][0], NULL, NULL);
+  RECOVER_FAILS("facet_nnode = 3", 2, 1, NNODE, x, 9, 4, NELEM, c, NGP, gp, gw, gs, 1e3, 0.3, 2, NULL, 2, 3,
+                &fn[0][0], fk, NULL);
+  /* Codes and values the library checks, reported through the C API. */
+  RECOVER_FAILS("method = 5", 2, 1, NNODE, x, 9, 4, NELEM, c, NGP, gp, gw, gs, 1e3, 0.3, 5, NULL, 0, 2, NULL, NULL,
+                NULL);
+  RECOVER_FAILS("analysis = 3 does not fit dim = 2", 2, 3, NNODE, x, 9, 4, NELEM, c, NGP, gp, gw, gs, 1e3, 0.3, 2,
+                NULL, 0, 2, NULL, NULL, NULL);
+  RECOVER_FAILS("poisson", 2, 1, NNODE, x, 9, 4, NELEM, c, NGP, gp, gw, gs, 1e3, 0.5, 2, NULL, 0, 2, NULL, NULL, NULL);
+  RECOVER_FAILS("facet_kind(2) = 9", 2, 1, NNODE, x, 9, 4, NELEM, c, NGP, gp, gw, gs, 1e3, 0.3, 2, NULL, 2, 2,
+                &fn[0][0], fk_bad, &ft[0][0]);
+  RECOVER_FAILS("kind traction but facet_traction is not given", 2, 1, NNODE, x, 9, 4, NELEM, c, NGP, gp, gw, gs, 1e3,
+                0.3, 2, NULL, 2, 2, &fn[0][0], fk, NULL);
+  /* 0-based indices: range-checked and named as the caller wrote them. */
+  bad = m;
+  bad.conn[3][2] = NNODE;
+  RECOVER_FAILS("connectivity[3][2] = 25 is not a node in 0..24", 2, 1, NNODE, x, 9, 4, NELEM, &bad.conn[0][0], NGP,
+                gp, gw, gs, 1e3, 0.3, 2, NULL, 0, 2, NULL, NULL, NULL);
+  bad.conn[3][2] = -1;
+  RECOVER_FAILS("connectivity[3][2] = -1", 2, 1, NNODE, x, 9, 4, NELEM, &bad.conn[0][0], NGP, gp, gw, gs, 1e3, 0.3, 2,
+                NULL, 0, 2, NULL, NULL, NULL);
+  fn[1][0] = -3;
+  RECOVER_FAILS("facet_nodes[1][0] = -3", 2, 1, NNODE, x, 9, 4, NELEM, c, NGP, gp, gw, gs, 1e3, 0.3, 2, NULL, 2, 2,
+                &fn[0][0], fk, &ft[0][0]);
+  fn[1][0] = 1;
+  /* Non-finite data and a point outside its element. */
+  bad = m;
+  bad.gs[5][1][2] = NAN;
+  RECOVER_FAILS("not finite", 2, 1, NNODE, x, 9, 4, NELEM, c, NGP, gp, gw, &bad.gs[0][0][0], 1e3, 0.3, 2, NULL, 0, 2,
+                NULL, NULL, NULL);
+  bad = m;
+  bad.gp[2][0][0] = 5.0;
+  RECOVER_FAILS("not in", 2, 1, NNODE, x, 9, 4, NELEM, c, NGP, &bad.gp[0][0][0], gw, gs, 1e3, 0.3, 2, NULL, 0, 2, NULL,
+                NULL, NULL);
+#undef RECOVER_FAILS
+  sprc_delete_error(&err);
+  PASS();
+}
+
+/* Wrong sizes and pointers of the getters and of sprc_eval_recovery. */
+static void test_recovery_bad_output(void) {
+  const char *name = "recovery_bad_output";
+  static quad_mesh m;
+  double out[NNODE][3], e[NELEM], pts[2][2] = {{0.5, 0.5}, {3.0, 0.5}}, s[2][3];
+  int el[2] = {0, NELEM}, el_neg[1] = {-2};
+  sprc_error err = sprc_new_error();
+  sprc_recovery rec;
+  build_quad_mesh(&m, 0);
+  rec = recover_quad_mesh(err, &m, SPRC_METHOD_SPRC);
+  CHECK(rec != NULL && sprc_check_error(err) == 0, "recovery of the quad4 mesh failed");
+  out[0][0] = e[0] = 7.0;
+  sprc_get_recovery_nodal_stress(err, rec, &out[0][0], NNODE - 1);
+  CHECK(has_error(err, "n = 24 but the recovery has nnode = 25"), "nodal stress: no error for n = nnode - 1");
+  sprc_get_recovery_nodal_stress(err, rec, &out[0][0], NNODE + 1);
+  CHECK(has_error(err, "n = 26"), "nodal stress: no error for n = nnode + 1");
+  sprc_get_recovery_nodal_stress(err, rec, NULL, NNODE);
+  CHECK(has_error(err, "out is NULL"), "nodal stress: no error for NULL out");
+  sprc_get_recovery_element_error(err, rec, e, NELEM + 1);
+  CHECK(has_error(err, "nelem = 16"), "element error: no error for a wrong nelem");
+  sprc_get_recovery_element_error(err, rec, NULL, NELEM);
+  CHECK(has_error(err, "out is NULL"), "element error: no error for NULL out");
+  CHECK(out[0][0] == 7.0 && e[0] == 7.0, "output written despite an error");
+  sprc_eval_recovery(err, rec, -1, &pts[0][0], NULL, &s[0][0]);
+  CHECK(has_error(err, "npts = -1"), "eval: no error for npts = -1");
+  sprc_eval_recovery(err, rec, 0, NULL, NULL, NULL);
+  CHECK(sprc_check_error(err) == 0, "eval: npts = 0 with NULL arrays is an error");
+  sprc_eval_recovery(err, rec, 1, NULL, NULL, &s[0][0]);
+  CHECK(has_error(err, "points or stress is NULL"), "eval: no error for NULL points");
+  sprc_eval_recovery(err, rec, 1, &pts[0][0], NULL, NULL);
+  CHECK(has_error(err, "points or stress is NULL"), "eval: no error for NULL stress");
+  sprc_eval_recovery(err, rec, 2, &pts[0][0], el, &s[0][0]);
+  CHECK(has_error(err, "elements[1] = 16 is not -1 (search) or an element in 0..15"), "eval: element 16 accepted");
+  sprc_eval_recovery(err, rec, 1, &pts[0][0], el_neg, &s[0][0]);
+  CHECK(has_error(err, "elements[0] = -2"), "eval: element -2 accepted");
+  sprc_eval_recovery(err, rec, 2, &pts[0][0], NULL, &s[0][0]);
+  CHECK(has_error(err, "is in no element"), "eval: no error for a point outside the mesh");
+  sprc_delete_recovery(&rec);
+  CHECK(rec == NULL, "sprc_delete_recovery did not null the handle");
+  sprc_delete_error(&err);
+  PASS();
+}
+
+/* An equilibrated linear field is in the span of both recoveries: the nodal
+ * stresses, the field at points and the estimate are exact up to round-off
+ * (patch least-squares solves of size <= 20 on scaled coordinates: 1e-10 of
+ * the field's magnitude ~ 5 leaves a wide margin over ~1e-14). */
+static void test_recovery_linear_quad4(void) {
+  const char *name = "recovery_linear_quad4";
+  static quad_mesh m;
+  double nodal[NNODE][3], e[NELEM], pts[3][2] = {{0.31, 0.47}, {0.9, 0.12}, {0.05, 0.95}}, s[3][3], ex[3];
+  int el[3] = {-1, -1, -1}, method, i, k, found;
+  sprc_error err = sprc_new_error();
+  build_quad_mesh(&m, 0);
+  for (method = SPRC_METHOD_SPR; method <= SPRC_METHOD_SPRC; method++) {
+    sprc_recovery rec = recover_quad_mesh(err, &m, method);
+    CHECK(rec != NULL && sprc_check_error(err) == 0, "recovery of the quad4 mesh failed");
+    sprc_get_recovery_nodal_stress(err, rec, &nodal[0][0], NNODE);
+    CHECK(nodal_deviation(&m, nodal) <= 5e-10, "nodal stresses deviate from the exact field by more than 1e-10");
+    sprc_get_recovery_element_error(err, rec, e, NELEM);
+    for (i = 0; i < NELEM; i++) CHECK(e[i] >= 0.0 && e[i] <= 1e-10, "an element error is not ~ 0");
+    CHECK(sprc_get_recovery_global_error(err, rec) <= 1e-10, "global error is not ~ 0");
+    CHECK(sprc_get_recovery_eta(err, rec) <= 1e-10, "eta is not ~ 0");
+    /* With the elements searched, then named (found by searching first). */
+    sprc_eval_recovery(err, rec, 3, &pts[0][0], NULL, &s[0][0]);
+    CHECK(sprc_check_error(err) == 0, "eval with search failed");
+    for (i = 0; i < 3; i++) {
+      exact_stress(0, pts[i], ex);
+      for (k = 0; k < 3; k++) CHECK(fabs(s[i][k] - ex[k]) <= 5e-10, "field at a point is not exact");
+    }
+    for (i = 0; i < 3; i++) {
+      for (found = 0; found < NELEM; found++) {
+        int one[1] = {found};
+        sprc_eval_recovery(err, rec, 1, pts[i], one, s[i]);
+        if (sprc_check_error(err) == 0) break;
+        sprc_clear_error(err);
+      }
+      CHECK(found < NELEM, "no element holds a point inside the mesh");
+      el[i] = found;
+    }
+    sprc_eval_recovery(err, rec, 3, &pts[0][0], el, &s[0][0]);
+    CHECK(sprc_check_error(err) == 0, "eval with named elements failed");
+    for (i = 0; i < 3; i++) {
+      exact_stress(0, pts[i], ex);
+      for (k = 0; k < 3; k++) CHECK(fabs(s[i][k] - ex[k]) <= 5e-10, "field at a point (element named) is not exact");
+    }
+    el[0] = (el[0] + 1) % NELEM;
+    sprc_eval_recovery(err, rec, 3, &pts[0][0], el, &s[0][0]);
+    CHECK(has_error(err, "is not in element"), "a point in the wrong element: no error");
+    sprc_delete_recovery(&rec);
+  }
+  sprc_delete_error(&err);
+  PASS();
+}
+
+/* SPR-C with traction facets on x = 0 and x = 1 (0-based facet nodes in C
+ * order, constant tractions sigma n): still exact, and the facets reach the
+ * library (a traction that contradicts the field makes the estimate > 0). */
+static void test_recovery_facets(void) {
+  const char *name = "recovery_traction_facets";
+  static quad_mesh m;
+  int fn[2 * M][2], fk[2 * M], j;
+  double ft[2 * M][2], nodal[NNODE][3], eta;
+  sprc_error err = sprc_new_error();
+  sprc_recovery rec;
+  build_quad_mesh(&m, 1);
+  for (j = 0; j < M; j++) {
+    fn[j][0] = (M + 1) * j; /* x = 0: t = -(sigma_xx, sigma_xy) = -(1, 0.5) */
+    fn[j][1] = (M + 1) * (j + 1);
+    ft[j][0] = -1.0;
+    ft[j][1] = -0.5;
+    fn[M + j][0] = (M + 1) * (j + 1) + M; /* x = 1: t = (3, -0.5), nodes in either order */
+    fn[M + j][1] = (M + 1) * j + M;
+    ft[M + j][0] = 3.0;
+    ft[M + j][1] = -0.5;
+    fk[j] = fk[M + j] = SPRC_FACET_TRACTION;
+  }
+  rec = sprc_recover(err, 2, SPRC_PLANE_STRAIN, NNODE, &m.nodes[0][0], SPRC_QUAD4, 4, NELEM, &m.conn[0][0], NGP,
+                     &m.gp[0][0][0], &m.gw[0][0], &m.gs[0][0][0], 1000.0, 0.3, SPRC_METHOD_SPRC, m.body, 2 * M, 2,
+                     &fn[0][0], fk, &ft[0][0]);
+  CHECK(rec != NULL, "recovery with traction facets failed");
+  sprc_get_recovery_nodal_stress(err, rec, &nodal[0][0], NNODE);
+  CHECK(nodal_deviation(&m, nodal) <= 5e-10, "nodal stresses with facets are not exact");
+  CHECK(sprc_get_recovery_eta(err, rec) <= 1e-10, "eta with consistent facets is not ~ 0");
+  sprc_delete_recovery(&rec);
+  for (j = 0; j < M; j++) ft[j][0] = 0.0; /* wrong traction on x = 0 */
+  rec = sprc_recover(err, 2, SPRC_PLANE_STRAIN, NNODE, &m.nodes[0][0], SPRC_QUAD4, 4, NELEM, &m.conn[0][0], NGP,
+                     &m.gp[0][0][0], &m.gw[0][0], &m.gs[0][0][0], 1000.0, 0.3, SPRC_METHOD_SPRC, m.body, 2 * M, 2,
+                     &fn[0][0], fk, &ft[0][0]);
+  CHECK(rec != NULL, "recovery with a wrong traction failed");
+  eta = sprc_get_recovery_eta(err, rec);
+  CHECK(eta > 1e-3, "a traction contradicting the field left the estimate ~ 0");
+  sprc_delete_recovery(&rec);
+  sprc_delete_error(&err);
+  PASS();
+}
+
 int main(int argc, char **argv) {
   if (argc > 1) root = argv[1];
   test_version();
@@ -248,6 +599,11 @@ int main(int argc, char **argv) {
   test_run_bad_arguments();
   test_run_lame();
   test_run_invalid_scene();
+  test_recovery_null_handles();
+  test_recovery_bad_input();
+  test_recovery_bad_output();
+  test_recovery_linear_quad4();
+  test_recovery_facets();
   printf("%d passed, %d failed\n", passed, failed);
   return failed == 0 ? 0 : 1;
 }
