@@ -6,6 +6,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "sprc.h"
 
@@ -590,7 +591,14 @@ static void test_recovery_facets(void) {
 }
 
 int main(int argc, char **argv) {
-  if (argc > 1) root = argv[1];
+  /* `fpm test -- SUITE` passes the unit tests' suite name to every test
+     program: take argv[1] as the root only if it holds example/scenes. */
+  if (argc > 1) {
+    char probe[4096];
+    struct stat st;
+    snprintf(probe, sizeof probe, "%s/example/scenes", argv[1]);
+    if (stat(probe, &st) == 0 && S_ISDIR(st.st_mode)) root = argv[1];
+  }
   test_version();
   test_error_lifecycle();
   test_null_error_handle();
