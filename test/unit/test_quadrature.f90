@@ -62,6 +62,7 @@ contains
          new_unittest('faces_on_grid_planes', test_grid_faces), &
          new_unittest('degenerate_tiny_cut', test_tiny_cut), &
          new_unittest('degenerate_nodes_and_tangency', test_nodes_tangency), &
+         new_unittest('degenerate_offcentre_tangent_hole', test_offcentre_tangent), &
          new_unittest('degenerate_csg_corners', test_csg_corners), &
          new_unittest('inside_outside_cells', test_inside_outside), &
          new_unittest('reuse_is_deterministic', test_reuse), &
@@ -663,6 +664,42 @@ contains
          if (allocated(error)) return
       end do
    end subroutine test_nodes_tangency
+
+   !> A disk with an off-centre hole whose circle is tangent to the grid line
+   !> x = 0.625 from inside a cell (levels 3-5), away from any node: the face
+   !> restriction there has a double root, which rounding once split into two
+   !> roots ~1e-9 apart and lost the arc between them (5e-9 of the boundary
+   !> length, whatever q). Boundary length and the closure sum w n = 0 to 1e-12.
+   subroutine test_offcentre_tangent(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: body
+      type(shape_type) :: s
+      type(grid_sums_type) :: sums
+      real(wp), parameter :: c_out(2) = [0.55_wp, 0.525_wp], r_out = 0.385_wp, c_in(2) = [0.51_wp, 0.55_wp]
+      real(wp) :: r_in
+      integer :: level
+
+      r_in = 0.625_wp - c_in(1)
+      call new_body(body, 'holed')
+      call new_disk(s, 'outer', c_out, r_out, error)
+      if (allocated(error)) return
+      call body%add_shape(csg_add, s, error)
+      if (allocated(error)) return
+      call new_disk(s, 'hole', c_in, r_in, error)
+      if (allocated(error)) return
+      call body%add_shape(csg_subtract, s, error)
+      if (allocated(error)) return
+      do level = 3, 5
+         call integrate_grid(body, level, 6, sums, error)
+         if (allocated(error)) return
+         call check_sane(sums, 'off-centre tangent hole', error)
+         if (allocated(error)) return
+         call check(error, sums%m(1), pi*(r_out**2 - r_in**2), tol2d, 'area', rel=.true.)
+         if (allocated(error)) return
+         call check(error, sums%m(2), 2.0_wp*pi*(r_out + r_in), tol2d, 'boundary length', rel=.true.)
+         if (allocated(error)) return
+      end do
+   end subroutine test_offcentre_tangent
 
    !> CSG edges and corners inside cells: a disk cut by an oblique plane (a
    !> circular segment), the union of two overlapping disks (corners where the

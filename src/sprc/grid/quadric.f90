@@ -223,7 +223,8 @@ contains
 
    !> Real roots of a t^2 + b t + c (n = 0, 1 or 2 of them in t(1:n)), by the
    !> cancellation-free pair q/a, c/q with q = -(b + sign(b) sqrt(b^2 - 4ac))/2.
-   !> A negative discriminant is no root (a tangency, measure zero).
+   !> A negative discriminant is no root (a tangency, measure zero); one at
+   !> rounding level is one double root.
    pure subroutine quadratic_roots(a, b, c, t, n)
       real(wp), intent(in) :: a, b, c
       real(wp), intent(out) :: t(2)
@@ -241,6 +242,15 @@ contains
       end if
       disc = b*b - 4.0_wp*a*c
       if (disc < 0.0_wp) return
+      ! A discriminant at the rounding level of its terms is a double root (a
+      ! surface tangent to a face): two roots sqrt(disc)/|a| apart would open a
+      ! sliver of base between them whose height lines all lose their root to
+      ! rounding. Roots closer than ~4e-8 of the reference interval merge.
+      if (disc <= 16.0_wp*epsilon(1.0_wp)*max(b*b, 4.0_wp*abs(a)*max(abs(a), abs(b), abs(c)))) then
+         n = 1
+         t(1) = -b/(2.0_wp*a)
+         return
+      end if
       q = -0.5_wp*(b + sign(sqrt(disc), b))
       if (q == 0.0_wp) then
          ! b = 0 and c = 0: a double root at 0
