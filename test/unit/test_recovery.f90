@@ -85,7 +85,8 @@ contains
          new_unittest('thread_safety_bitwise', test_threads), &
          new_unittest('union_and_zz', test_union_zz), &
          new_unittest('error_paths', test_errors), &
-         new_unittest('reserve_fewer_points_than_terms', test_reserve_few_points) &
+         new_unittest('reserve_fewer_points_than_terms', test_reserve_few_points), &
+         new_unittest('traction_weight_focus', test_traction_focus) &
          ]
    end subroutine collect_recovery
 
@@ -915,6 +916,57 @@ contains
 
    !> A noisy, non-equilibrated field: SPR-C still satisfies every imposed constraint to
    !> round-off, while SPR does not satisfy equilibrium (so the test can tell them apart).
+   !> Traction rows weighted by (1 - rho)^4 (solve.f90 notes (c)): on the straight face y = 0
+   !> of a 2D p = 1 patch with zero volume stress and a prescribed normal traction
+   !> t = (0, -g(x)), g(x) = x^2 + x^3/2 (not linear: p = 1 cannot match it), the flat-rank
+   !> rows make the traction of sigma* the weighted least-squares line of g with weights
+   !> bw_j (1 - |x_j|/h)^4, and equilibrium (sigma_yy,y = 0) carries it into the patch:
+   !> sigma*_yy(x, y) = a + b x, with (a, b) from the 2 x 2 normal equations here.
+   subroutine test_traction_focus(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(patch_type) :: patch
+      type(recovery_workspace_type) :: ws
+      type(recovered_patch_type) :: rec
+      real(wp) :: xi(3), wt(3), x, y, f, g, nm(2, 2), rhs(2), det, a, b, sig(3)
+      integer :: i, j, k, cell
+
+      call gauss(3, xi, wt)
+      call patch_reset(patch, 2, plane_stress, 1000.0_wp, 0.3_wp, [0.0_wp, 0.0_wp], 1.0_wp)
+      nm = 0.0_wp
+      rhs = 0.0_wp
+      do cell = 0, 1
+         do i = 1, 3
+            x = cell - 1 + 0.5_wp*(xi(i) + 1.0_wp)
+            do j = 1, 3
+               y = 0.5_wp*(xi(j) + 1.0_wp)
+               call patch_add_point(patch, [x, y], 0.25_wp*wt(i)*wt(j), [0.0_wp, 0.0_wp, 0.0_wp])
+            end do
+            g = x**2 + 0.5_wp*x**3
+            call patch_add_boundary_point(patch, [x, 0.0_wp], 0.5_wp*wt(i), [0.0_wp, -1.0_wp], &
+               & boundary_traction, [0.0_wp, -g])
+            f = 0.5_wp*wt(i)*(1.0_wp - abs(x))**4
+            nm = nm + f*reshape([1.0_wp, x, x, x*x], [2, 2])
+            rhs = rhs + f*g*[1.0_wp, x]
+         end do
+      end do
+      det = nm(1, 1)*nm(2, 2) - nm(1, 2)*nm(2, 1)
+      a = (nm(2, 2)*rhs(1) - nm(1, 2)*rhs(2))/det
+      b = (nm(1, 1)*rhs(2) - nm(2, 1)*rhs(1))/det
+      call recover_sprc(patch, 1, ws, rec, error)
+      if (allocated(error)) return
+      call check(error, rec%ranks(kind_traction) == 4, 'flat-face traction rank 4')
+      if (allocated(error)) return
+      do k = 1, 3
+         x = -0.7_wp + 0.6_wp*k
+         call eval_recovered(rec, [x, 0.4_wp], sig, error)
+         if (allocated(error)) return
+         call check(error, abs(sig(2) - (a + b*x)) <= 1.0e-10_wp*abs(a), 'sigma_yy is the focused fit of g')
+         if (allocated(error)) return
+         call check(error, abs(sig(3)) <= 1.0e-10_wp*abs(a), 'sigma_xy vanishes')
+         if (allocated(error)) return
+      end do
+   end subroutine test_traction_focus
+
    subroutine test_noisy(error)
       type(error_type), allocatable, intent(out) :: error
       type(field_t) :: f
