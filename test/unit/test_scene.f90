@@ -6,7 +6,7 @@ module sprc_test_scene
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, stat_invalid_input, stat_io, stat_unsupported
    use sprc_io_namelist, only: read_text_file
-   use sprc_io_scene, only: scene_type, read_scene, read_scene_text, default_scene_text, scene_summary
+   use sprc_io_scene, only: scene_type, read_scene, read_scene_text, default_scene_text, scene_summary, recovery_degree
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed
    implicit none
    private
@@ -210,6 +210,10 @@ contains
       if (allocated(error)) return
       call check(error, s%recovery, 'both', 'recovery default')
       if (allocated(error)) return
+      call check(error, s%recovery_degree, 'p', 'recovery_degree default')
+      if (allocated(error)) return
+      call check(error, recovery_degree(s), s%order, 'recovery degree is the FE order by default')
+      if (allocated(error)) return
       call check(error, s%output, '', 'output default')
       if (allocated(error)) return
       call check(error, size(s%bodies(1)%body_force), 2, 'body_force size')
@@ -273,6 +277,13 @@ contains
       call read_ok(text, s, error)
       if (allocated(error)) return
       call check(error, s%analysis//' '//s%recovery, 'plane_stress spr', 'choices stored in lower case')
+      if (allocated(error)) return
+      text = replaced(minimal, 'box_size=4', "box_size=4 order=2 recovery_degree='P+1'")
+      call read_ok(text, s, error)
+      if (allocated(error)) return
+      call check(error, recovery_degree(s), 3, "recovery_degree = 'p+1' with order 2")
+      if (allocated(error)) return
+      call check(error, index(scene_summary(s), 'recovery_degree = 3') > 0, 'summary shows the recovery degree')
    end subroutine test_case
 
    subroutine test_summary_order1(error)

@@ -25,7 +25,7 @@ module sprc_io_run
    use sprc_grid_recovered_estimate, only: zz_estimate_type, estimate_error
    use sprc_fem_bc, only: fe_bc_type, new_fe_bc, bc_kind_from_name
    use sprc_fem_problem, only: elasticity_problem_type
-   use sprc_io_scene, only: scene_type
+   use sprc_io_scene, only: scene_type, recovery_degree
    use sprc_io_model, only: build_bodies, build_exact, analysis_kind
    use sprc_io_report, only: report_row_type
    use sprc_io_hdf5, only: h5_output_type
@@ -165,7 +165,8 @@ contains
       end if
       do m = 1, 2
          if (.not. done(m)) cycle
-         call recover_and_estimate(model, input, grid, nodes, hanging, m, scene%order, field(m), est(m), error)
+         call recover_and_estimate(model, input, grid, nodes, hanging, m, recovery_degree(scene), field(m), est(m), &
+            & error)
          if (allocated(error)) return
          row%t_recovery = row%t_recovery + field(m)%t_recovery
          row%t_estimate = row%t_estimate + est(m)%t_estimate
@@ -179,7 +180,7 @@ contains
       end if
    end subroutine run_level
 
-   !> Recovery and estimate with one method (1 SPR, 2 SPR-C) at the FE degree.
+   !> Recovery and estimate with one method (1 SPR, 2 SPR-C) at the patch degree `degree`.
    subroutine recover_and_estimate(model, input, grid, nodes, hanging, m, degree, field, est, error)
       type(run_model_type), intent(in) :: model
       type(recovery_input_type), intent(in) :: input

@@ -12,7 +12,7 @@ module sprc_io_scene
    private
 
    public :: scene_type, body_type, shape_type, bc_type, exact_type, contact_type
-   public :: read_scene, read_scene_text, default_scene_text, scene_summary
+   public :: read_scene, read_scene_text, default_scene_text, scene_summary, recovery_degree
 
    !> One elastic body.
    type :: body_type
@@ -122,6 +122,8 @@ module sprc_io_scene
       real(wp) :: box_size = 0.0_wp
       !> 'none' | 'spr' | 'sprc' | 'both'.
       character(len=:), allocatable :: recovery
+      !> Patch polynomial degree of SPR and SPR-C: 'p' (the FE degree) or 'p+1'.
+      character(len=:), allocatable :: recovery_degree
       !> Prefix of the files written; '' writes none.
       character(len=:), allocatable :: output
       type(body_type), allocatable :: bodies(:)
@@ -134,7 +136,7 @@ module sprc_io_scene
    character(len=*), parameter :: known_groups(6) = [character(len=7) :: 'scene', 'body', 'shape', 'bc', &
       & 'exact', 'contact']
    character(len=*), parameter :: scene_keys = 'title analysis order levels refine_boundary box_min box_size '// &
-      & 'recovery output'
+      & 'recovery recovery_degree output'
    character(len=*), parameter :: body_keys = 'name young poisson body_force'
    character(len=*), parameter :: shape_fields = 'center radius semi_axes lower upper point normal axis'
    character(len=*), parameter :: shape_keys = 'body op kind name '//shape_fields
@@ -146,6 +148,7 @@ module sprc_io_scene
 
    character(len=*), parameter :: analyses = 'plane_stress plane_strain solid'
    character(len=*), parameter :: recoveries = 'none spr sprc both'
+   character(len=*), parameter :: recovery_degrees = 'p p+1'
    character(len=*), parameter :: ops = 'add subtract intersect'
    character(len=*), parameter :: shape_kinds = 'disk sphere ellipse ellipsoid box halfspace cylinder'
    character(len=*), parameter :: bc_types = 'free pressure traction displacement symmetry exact_traction '// &
@@ -312,6 +315,9 @@ contains
          if (allocated(error)) return
          scene%recovery = 'both'
          call get_choice(g, 'recovery', recoveries, .false., scene%recovery, error)
+         if (allocated(error)) return
+         scene%recovery_degree = 'p'
+         call get_choice(g, 'recovery_degree', recovery_degrees, .false., scene%recovery_degree, error)
          if (allocated(error)) return
          scene%output = ''
          call nml_get(g, 'output', scene%output, found, error)
@@ -920,6 +926,7 @@ contains
       text = text//'  box_min         = '//real_list(scene%box_min)//nl
       text = text//'  box_size        = '//real_text(scene%box_size)//nl
       text = text//'  recovery        = '//scene%recovery//nl
+      text = text//'  recovery_degree = '//int_text(recovery_degree(scene))//nl
       text = text//"  output          = '"//scene%output//"'"//nl
       do i = 1, size(scene%bodies)
          associate (b => scene%bodies(i))
@@ -1196,6 +1203,15 @@ contains
          if (text(i:i) >= 'A' .and. text(i:i) <= 'Z') low(i:i) = achar(iachar(text(i:i)) + 32)
       end do
    end function lower
+
+   !> Patch polynomial degree of the scene's recoveries: the FE order, plus one with
+   !> recovery_degree = 'p+1'.
+   pure integer function recovery_degree(scene)
+      type(scene_type), intent(in) :: scene
+      recovery_degree = scene%order
+      if (.not. allocated(scene%recovery_degree)) return
+      if (scene%recovery_degree == 'p+1') recovery_degree = scene%order + 1
+   end function recovery_degree
 
    pure function int_text(i) result(text)
       integer, intent(in) :: i
