@@ -2,8 +2,12 @@
 !> degree 1 and 2, on synthetic vertex patches (2^dim cells of (p+1)^dim Gauss points
 !> each, jittered; half of the patches carry a traction boundary with (p+1)^(dim-1)
 !> points per boundary face). Prints per-thread rates, the rate of an OpenMP loop over
-!> all threads, and the share of time spent inside LAPACK/BLAS (timed around each call
-!> in a separate single-thread run).
+!> all threads, and, from a separate single-thread run with ws%timing on: the share of time
+!> spent inside LAPACK/BLAS (timed around each call), the mean nominal LAPACK/BLAS flops per
+!> patch (LAWN 41 leading terms, sprc_recovery_flops; hand-written loops not included), the
+!> rate achieved inside LAPACK/BLAS (those flops / the time inside), and the mean hand count
+!> of forming the design matrix (the one counted hand-written loop, not in flops/patch).
+!> Patches that fail (rank deficient) are in the means: their calls up to the failure count.
 !>
 !> Run: fpm run --profile release --example bench_recovery
 program bench_recovery
@@ -24,7 +28,8 @@ program bench_recovery
    nthreads = 1
    !$ nthreads = omp_get_max_threads()
    write (*, '(a,i0)') 'bench_recovery: synthetic vertex patches; OpenMP threads: ', nthreads
-   write (*, '(a)') ' dim  p  method  points  bpoints  patches/s/thread  patches/s (all threads)  LAPACK share'
+   write (*, '(a)') ' dim  p  method  points  bpoints  patches/s/thread  patches/s (all threads)  LAPACK share'// &
+      & '  flops/patch  LAPACK GFLOP/s  design flops/patch'
    do dim = 2, 3
       do p = 1, 2
          do method = 1, 2
@@ -43,8 +48,8 @@ contains
       type(recovered_patch_type) :: rec
       type(error_type), allocatable :: error
       integer(i8) :: st
-      integer :: i, k, nrep, nfail
-      real(wp) :: t0, t1, serial, parallel, share
+      integer :: i, k, nrep, nfail, ntimed
+      real(wp) :: t0, t1, serial, parallel, share, flops, gflops, design
 
       allocate (patches(npatch), recs(npatch))
       st = 17_i8
@@ -83,12 +88,19 @@ contains
 
       ws%timing = .true.
       ws%lapack_seconds = 0.0_wp
+      ws%flops = 0
+      ws%design_flops = 0
+      ntimed = max(1, nrep/4)
       t0 = wall_time()
-      call sweep(patches, recs, dim, p, method, max(1, nrep/4), ws, nfail)
+      call sweep(patches, recs, dim, p, method, ntimed, ws, nfail)
       share = ws%lapack_seconds/(wall_time() - t0)
+      flops = real(ws%flops, wp)/(real(npatch, wp)*ntimed)
+      design = real(ws%design_flops, wp)/(real(npatch, wp)*ntimed)
+      gflops = 1.0e-9_wp*real(ws%flops, wp)/max(ws%lapack_seconds, tiny(1.0_wp))
 
-      write (*, '(i4,i3,2x,a6,i8,i9,f18.0,f25.0,f12.1,"%",a,i0)') dim, p, merge('SPR   ', 'SPR-C ', method == 1), &
-         & patches(1)%npoints, patches(2)%nbpoints, serial, parallel, 100.0_wp*share, '  failed: ', nfail
+      write (*, '(i4,i3,2x,a6,i8,i9,f18.0,f25.0,f13.1,"%",f13.0,f16.2,f20.0,a,i0)') dim, p, &
+         & merge('SPR   ', 'SPR-C ', method == 1), patches(1)%npoints, patches(2)%nbpoints, serial, parallel, &
+         & 100.0_wp*share, flops, gflops, design, '  failed: ', nfail
    end subroutine run
 
    subroutine sweep(patches, recs, dim, p, method, nrep, ws, nfail)

@@ -34,6 +34,8 @@ module sprc_test_recovery
    use sprc_recovery_operators, only: incompatibility_operator
    use sprc_recovery_workspace, only: recovery_workspace_type, workspace_init, workspace_reserve
    use sprc_recovery_solve, only: recover_spr, recover_sprc
+   use sprc_recovery_flops, only: flops_gemm, flops_gemv, flops_syrk, flops_geqrf, flops_ormqr_left, flops_trtrs, &
+      & flops_sysv, design_matrix_flops
    use sprc_recovery_estimate, only: eval_recovered, eval_union, zz_error_integral
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type
    implicit none
@@ -86,7 +88,10 @@ contains
          new_unittest('union_and_zz', test_union_zz), &
          new_unittest('error_paths', test_errors), &
          new_unittest('reserve_fewer_points_than_terms', test_reserve_few_points), &
-         new_unittest('traction_weight_focus', test_traction_focus) &
+         new_unittest('traction_weight_focus', test_traction_focus), &
+         new_unittest('flop_formulas', test_flop_formulas), &
+         new_unittest('flop_count_spr', test_flop_count_spr), &
+         new_unittest('flop_count_sprc', test_flop_count_sprc) &
          ]
    end subroutine collect_recovery
 
@@ -1443,5 +1448,117 @@ contains
       call workspace_init(ws)
       call workspace_reserve(ws, 3, 2, 2, 0, error)
    end subroutine test_reserve_few_points
+
+   ! ------------------------------------------------------------------ flop counts
+
+   !> The LAWN 41 leading-term formulas against counts worked out by hand, both QR shapes and
+   !> both roundings of the thirds (n^3 = 1 and 2 mod 3).
+   subroutine test_flop_formulas(error)
+      type(error_type), allocatable, intent(out) :: error
+      call check(error, flops_gemm(2, 3, 4), 48_i8, 'dgemm 2x3x4')
+      if (allocated(error)) return
+      call check(error, flops_gemv(5, 7), 70_i8, 'dgemv 5x7')
+      if (allocated(error)) return
+      call check(error, flops_syrk(3, 12), 144_i8, 'dsyrk n=3 k=12: 12*3*4')
+      if (allocated(error)) return
+      call check(error, flops_geqrf(12, 3), 198_i8, 'dgeqrf 12x3: 216-18')
+      if (allocated(error)) return
+      call check(error, flops_geqrf(3, 12), 198_i8, 'dgeqrf 3x12 (m < n form)')
+      if (allocated(error)) return
+      call check(error, flops_geqrf(10, 4), 277_i8, 'dgeqrf 10x4: 320-42.67')
+      if (allocated(error)) return
+      call check(error, flops_geqrf(10, 5), 417_i8, 'dgeqrf 10x5: 500-83.33')
+      if (allocated(error)) return
+      call check(error, flops_ormqr_left(12, 3, 3), 378_i8, 'dormqr 12x3, k=3: 432-54')
+      if (allocated(error)) return
+      call check(error, flops_trtrs(3, 3), 27_i8, 'dtrtrs 3, nrhs 3')
+      if (allocated(error)) return
+      call check(error, flops_sysv(10, 1), 533_i8, 'dsysv 10: 333.33+200')
+      if (allocated(error)) return
+      call check(error, flops_sysv(11, 1), 686_i8, 'dsysv 11: 443.67+242')
+      if (allocated(error)) return
+      call check(error, design_matrix_flops(3, 5, 4, .true.), 30_i8 + 15_i8 + 15_i8 + 20_i8, &
+         & 'design matrix 3D, 5 points, 4 terms, weighted')
+   end subroutine test_flop_formulas
+
+   !> 2D, seven scattered points, unit weights, arbitrary stresses (no exact field needed:
+   !> the counts depend on sizes and ranks only).
+   subroutine flop_patch(patch)
+      type(patch_type), intent(inout) :: patch
+      real(wp), parameter :: x(2, 7) = reshape([0.0_wp, 0.0_wp, 0.5_wp, 0.1_wp, -0.4_wp, 0.3_wp, &
+         & 0.2_wp, -0.6_wp, -0.3_wp, -0.2_wp, 0.7_wp, 0.6_wp, -0.6_wp, 0.5_wp], [2, 7])
+      integer :: i
+
+      call patch_reset(patch, 2, plane_stress, 1.0_wp, 0.3_wp, [0.0_wp, 0.0_wp], 1.0_wp)
+      do i = 1, size(x, 2)
+         call patch_add_point(patch, x(:, i), 1.0_wp, [real(i, wp), 1.0_wp - i, 0.5_wp*i])
+      end do
+   end subroutine flop_patch
+
+   !> SPR, 2D p=1: nothing counted with timing off; with timing on, exactly its three calls
+   !> dgeqp3(np, nt), dormqr(np x ns, nt reflectors), dtrtrs(nt, ns), written out here from
+   !> the sizes (nt = 3 makes 2 nt^3 / 3 exact), and twice that after a second solve.
+   subroutine test_flop_count_spr(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(patch_type) :: patch
+      type(recovery_workspace_type) :: ws
+      type(recovered_patch_type) :: rec
+      integer(i8) :: np, expected
+      integer(i8), parameter :: nt = 3, ns = 3
+
+      call flop_patch(patch)
+      call recover_spr(patch, 1, ws, rec, error)
+      if (allocated(error)) return
+      call check(error, ws%flops == 0 .and. ws%design_flops == 0 .and. ws%lapack_seconds == 0.0_wp, &
+         & 'nothing counted with timing off')
+      if (allocated(error)) return
+      np = patch%npoints
+      expected = (2*np*nt**2 - 2*nt**3/3) + (4*np*ns*nt - 2*ns*nt**2) + nt**2*ns
+      ws%timing = .true.
+      call recover_spr(patch, 1, ws, rec, error)
+      if (allocated(error)) return
+      call check(error, ws%flops, expected, 'SPR 2D p=1 LAPACK flops')
+      if (allocated(error)) return
+      ! Unweighted: point scaling 2 dim np, basis recurrence np (nt - 1).
+      call check(error, ws%design_flops, 2*2*np + np*(nt - 1), 'SPR 2D p=1 design-matrix flops')
+      if (allocated(error)) return
+      call recover_spr(patch, 1, ws, rec, error)
+      if (allocated(error)) return
+      call check(error, ws%flops, 2*expected, 'SPR flops accumulate over solves')
+   end subroutine test_flop_count_spr
+
+   !> SPR-C, 2D p=1, interior patch (equilibrium only; no compatibility below p=2): its
+   !> calls with their sizes, written out here; the kept-row counts come from the result
+   !> (equilibrium rank 2 for linear stresses in 2D, checked first).
+   subroutine test_flop_count_sprc(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(patch_type) :: patch
+      type(recovery_workspace_type) :: ws
+      type(recovered_patch_type) :: rec
+      integer(i8) :: np, mr, mc, nk, expected
+      integer(i8), parameter :: d = 2, nt = 3, ns = 3, n = nt*ns
+
+      call flop_patch(patch)
+      ws%timing = .true.
+      call recover_sprc(patch, 1, ws, rec, error)
+      if (allocated(error)) return
+      call check(error, rec%ranks(kind_equilibrium) == 2 .and. rec%rank_total == 2, 'equilibrium rank 2')
+      if (allocated(error)) return
+      np = patch%npoints
+      mr = rec%ranks(kind_equilibrium)
+      mc = rec%rank_total
+      nk = n + mc
+      expected = (2*np*nt**2 - 2*nt**3/3) &             ! dgeqp3 of the design matrix
+         & + np*nt*(nt + 1) &                          ! dsyrk: Mp
+         & + d*2*nt*n*nt + 2*n*n*(d*nt) + 2*(d*nt)*n & ! dgemm x d, dgemm, dgemv: equilibrium
+         & + (2*n**3 - 2*n**3/3) &                     ! dgeqp3 of the n x n equilibrium rows
+         & + nint(2.0_wp*n*mr**2 - 2.0_wp*mr**3/3.0_wp, i8) & ! dgeqp3 of the stacked rows
+         & + 2*nt*ns*np &                              ! dgemm: H
+         & + nint(real(nk, wp)**3/3.0_wp, i8) + 2*nk**2  ! dsysv of the KKT system
+      call check(error, ws%flops, expected, 'SPR-C 2D p=1 LAPACK flops')
+      if (allocated(error)) return
+      ! Weighted: scaling 2 dim np, recurrence np (nt - 1), weights 3 np, row scaling np nt.
+      call check(error, ws%design_flops, 2*d*np + np*(nt - 1) + 3*np + np*nt, 'SPR-C design-matrix flops')
+   end subroutine test_flop_count_sprc
 
 end module sprc_test_recovery

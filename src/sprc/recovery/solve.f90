@@ -67,6 +67,12 @@
 !> neighbouring elements (seed Figure 15) and calls again. SPR-C requires the full rank too,
 !> even where constraints would fix the missing directions, so that its M is positive definite.
 !>
+!> Timing (ws%timing): each LAPACK/BLAS call adds its wall time to ws%lapack_seconds and its
+!> nominal flop count (sprc_recovery_flops, from the sizes passed) to ws%flops, also when it
+!> returns info /= 0 (the patch then fails). The one hand-written loop counted is forming the
+!> design matrix (ws%design_flops); the others (constraint rows, KKT assembly and scaling,
+!> row norms) are not counted.
+!>
 !> Thread safety: no module state; everything a solve writes is in its arguments. Use one
 !> workspace per thread. The solves are not `pure` only because LAPACK externals are not.
 module sprc_recovery_solve
@@ -81,6 +87,8 @@ module sprc_recovery_solve
    use sprc_recovery_operators, only: traction_operator, shear_operator, plane_tangents, compatibility_rows, &
       & ncompat_equations
    use sprc_recovery_workspace, only: recovery_workspace_type, workspace_reserve, workspace_tic, workspace_toc
+   use sprc_recovery_flops, only: flops_gemm, flops_gemv, flops_syrk, flops_geqrf, flops_ormqr_left, flops_trtrs, &
+      & flops_sysv, design_matrix_flops
    implicit none
    private
 
@@ -200,12 +208,13 @@ contains
       else
          ws%wn(1:np) = 1.0_wp
       end if
+      if (ws%timing) ws%design_flops = ws%design_flops + design_matrix_flops(patch%dim, np, nt, weighted)
 
       ws%qr(1:np, 1:nt) = ws%pw(1:np, 1:nt)
       ws%jpvt(1:nt) = 0
       call workspace_tic(ws)
       call dgeqp3(np, nt, ws%qr, size(ws%qr, 1), ws%jpvt, ws%tau, ws%work, size(ws%work), info)
-      call workspace_toc(ws)
+      call workspace_toc(ws, flops_geqrf(np, nt))
       if (info /= 0) then
          call lapack_info_error('dgeqp3', info, context//' (basis rank)', error)
          return
@@ -267,7 +276,7 @@ contains
       call dormqr('L', 'T', np, ns, nt, ws%qr, size(ws%qr, 1), ws%tau, ws%rhs, size(ws%rhs, 1), &
          & ws%work, size(ws%work), info)
       if (info == 0) call dtrtrs('U', 'N', 'N', nt, ns, ws%qr, size(ws%qr, 1), ws%rhs, size(ws%rhs, 1), info)
-      call workspace_toc(ws)
+      call workspace_toc(ws, flops_ormqr_left(np, ns, nt) + flops_trtrs(nt, ns))
       if (info /= 0) then
          call lapack_info_error('dormqr/dtrtrs', info, context//' (least squares)', error)
          return
@@ -285,7 +294,7 @@ contains
       nt = ws%nt
       call workspace_tic(ws)
       call dsyrk('U', 'T', nt, np, 1.0_wp, ws%pw, size(ws%pw, 1), 0.0_wp, ws%mp, size(ws%mp, 1))
-      call workspace_toc(ws)
+      call workspace_toc(ws, flops_syrk(nt, np))
       do i = 1, nt
          ws%mp(i + 1:nt, i) = ws%mp(i, i + 1:nt)
       end do
@@ -314,7 +323,7 @@ contains
          ws%erhs((i - 1)*nt + 1:i*nt) = -patch%h*patch%body_force(i)*ws%mp(1:nt, 1)
       end do
       call dgemv('T', d*nt, n, 1.0_wp, ws%bdiv, size(ws%bdiv, 1), ws%erhs, 1, 0.0_wp, ws%brhs, 1)
-      call workspace_toc(ws)
+      call workspace_toc(ws, d*flops_gemm(nt, n, nt) + flops_gemm(n, n, d*nt) + flops_gemv(d*nt, n))
       call select_block(ws, n, kind_equilibrium, rec, mc, error)
    end subroutine equilibrium_block
 
@@ -417,7 +426,7 @@ contains
          call dgeqp3(m, n, ws%estack, lde, ws%jpvt, ws%tau, ws%work, size(ws%work), info)
          if (info == 0) call dormqr('L', 'T', m, 1, kmax, ws%estack, lde, ws%tau, ws%erhs, size(ws%erhs), &
             & ws%work, size(ws%work), info)
-         call workspace_toc(ws)
+         call workspace_toc(ws, flops_geqrf(m, n) + flops_ormqr_left(m, 1, kmax))
          if (info /= 0) then
             call lapack_info_error('dgeqp3/dormqr', info, 'recover_sprc (traction rows)', error)
             return
@@ -632,7 +641,7 @@ contains
       ws%jpvt(1:m) = 0
       call workspace_tic(ws)
       call dgeqp3(n, m, ws%cq, size(ws%cq, 1), ws%jpvt, ws%tau, ws%work, size(ws%work), info)
-      call workspace_toc(ws)
+      call workspace_toc(ws, flops_geqrf(n, m))
       r = 0
       if (info /= 0) then
          call lapack_info_error('dgeqp3', info, 'recover_sprc (constraint rank)', error)
@@ -679,7 +688,7 @@ contains
       call workspace_tic(ws)
       call dgemm('T', 'N', nt, ns, np, 1.0_wp, ws%pw, size(ws%pw, 1), ws%rhs, size(ws%rhs, 1), 0.0_wp, &
          & ws%hmat, size(ws%hmat, 1))
-      call workspace_toc(ws)
+      call workspace_toc(ws, flops_gemm(nt, ns, np))
 
       ! Symmetric scaling: unknowns by 1/sqrt(Mp_kk), multipliers by 1/|scaled row|.
       do c = 1, ns
@@ -709,7 +718,7 @@ contains
       ws%sol(1:nk) = ws%sol(1:nk)*ws%dscale(1:nk)
       call workspace_tic(ws)
       call dsysv('U', nk, 1, ws%kkt, lk, ws%ipiv, ws%sol, lk, ws%work, size(ws%work), info)
-      call workspace_toc(ws)
+      call workspace_toc(ws, flops_sysv(nk, 1))
       if (info /= 0) then
          call lapack_info_error('dsysv', info, 'recover_sprc (KKT system)', error)
          return

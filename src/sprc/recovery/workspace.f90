@@ -15,7 +15,7 @@
 !> `private` copy first: gfortran does not apply default initialisation to
 !> OpenMP private copies, and a garbage capacity would be trusted.
 module sprc_recovery_workspace
-   use sprc_core_kinds, only: wp
+   use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_lapack, only: dgeqp3, dormqr, dsysv, lapack_info_error
    use sprc_core_poly, only: poly_basis_type, new_poly_basis, poly_nterms, poly_max_degree
@@ -69,10 +69,17 @@ module sprc_recovery_workspace
       integer, allocatable :: jpvt(:), ipiv(:)
       !> LAPACK workspace, lwork = size(work).
       real(wp), allocatable :: work(:)
-      !> If true, the solves accumulate the wall time spent inside LAPACK/BLAS calls.
+      !> If true, the solves accumulate the wall time spent inside LAPACK/BLAS calls and
+      !> their nominal flop counts.
       logical :: timing = .false.
       !> Seconds spent in LAPACK/BLAS (only if `timing`).
       real(wp) :: lapack_seconds = 0.0_wp
+      !> Nominal flops of those LAPACK/BLAS calls (only if `timing`; LAWN 41 leading terms,
+      !> sprc_recovery_flops). Hand-written loops are not in it.
+      integer(i8) :: flops = 0
+      !> Hand count of forming the design matrix at the integration points, the one counted
+      !> hand-written loop (only if `timing`; `design_matrix_flops`), kept apart from `flops`.
+      integer(i8) :: design_flops = 0
       real(wp) :: t0 = 0.0_wp
    end type recovery_workspace_type
 
@@ -217,10 +224,15 @@ contains
       if (ws%timing) ws%t0 = wall_time()
    end subroutine workspace_tic
 
-   !> Stop timing a LAPACK/BLAS call and accumulate into ws%lapack_seconds.
-   subroutine workspace_toc(ws)
+   !> Stop timing a LAPACK/BLAS call and accumulate into ws%lapack_seconds, and the call's
+   !> nominal flop count `flops` (sprc_recovery_flops; the sum if the tic/toc pair encloses
+   !> several calls) into ws%flops.
+   subroutine workspace_toc(ws, flops)
       type(recovery_workspace_type), intent(inout) :: ws
-      if (ws%timing) ws%lapack_seconds = ws%lapack_seconds + (wall_time() - ws%t0)
+      integer(i8), intent(in), optional :: flops
+      if (.not. ws%timing) return
+      ws%lapack_seconds = ws%lapack_seconds + (wall_time() - ws%t0)
+      if (present(flops)) ws%flops = ws%flops + flops
    end subroutine workspace_toc
 
 end module sprc_recovery_workspace
