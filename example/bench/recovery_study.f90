@@ -11,10 +11,11 @@
 !> theta = ||s* - s_h|| / ||s_ex - s_h||, and the largest nodal stress error (Euclidean,
 !> Voigt) over the boundary vertex nodes inside or on the body, SPR and SPR-C; then the
 !> acceptance checks. Run:
-!>   fpm run --profile release --example recovery_study [-- [+1] [sprc+1] lame1 lame2 kirsch1 kirsch2 sphere]
+!>   fpm run --profile release --example recovery_study [-- [+1] [sprc+1 | p+1] lame1 lame2 kirsch1 kirsch2 sphere]
 !> Options (apply to the cases named after them): `+1` adds one level past the scene's finest
 !> (the checks then judge that level: is a criterion met asymptotically?); `sprc+1` recovers
-!> with SPR-C at degree p + 1 (SPR stays at p), the DESIGN's optional recovery degree.
+!> with SPR-C at degree p + 1 (SPR stays at p), `p+1` both methods (the scene key
+!> recovery_degree = 'p+1'), the DESIGN's optional recovery degree.
 program recovery_study
    use, intrinsic :: iso_fortran_env, only: output_unit
    use sprc_core_kinds, only: wp
@@ -45,7 +46,7 @@ program recovery_study
    character(len=16) :: arg
    integer :: i, nfail
    !> Options: levels past the scene's finest, SPR-C degree increment over p.
-   integer :: extra_levels = 0, sprc_plus = 0
+   integer :: extra_levels = 0, sprc_plus = 0, spr_plus = 0
 
    nfail = 0
    if (command_argument_count() == 0) then
@@ -62,6 +63,9 @@ program recovery_study
             extra_levels = 1
          case ('sprc+1')
             sprc_plus = 1
+         case ('p+1')
+            sprc_plus = 1
+            spr_plus = 1
          case default
             call run_case(trim(arg))
          end select
@@ -224,7 +228,7 @@ contains
       real(wp) :: err(3, 0:8), eta(0:8), theta(2, 0:8), bnode(2, 0:8), rate(3)
       integer :: level, m, n, bites, rdeg(2)
 
-      rdeg = [degree, degree + sprc_plus]
+      rdeg = [degree + spr_plus, degree + sprc_plus]
       write (output_unit, '(/,a," Q",i0,", recovery degree ",i0," (SPR), ",i0," (SPR-C)")') title, degree, rdeg
       write (output_unit, '(a3,3a10,3a6,a9,2a7,2a10,a6)') 'lvl', 'err_fe', 'err_spr', 'err_sprc', 'r_fe', 'r_spr', &
          & 'r_sprc', 'eta_c', 'th_spr', 'th_sprc', 'bn_spr', 'bn_sprc', 'bites'
