@@ -40,6 +40,7 @@ module sprc_test_patches
    use sprc_fem_bc, only: fe_bc_type, new_fe_bc, fe_pressure => bc_pressure, fe_symmetry => bc_symmetry
    use sprc_fem_problem, only: elasticity_problem_type, solve_on_grid
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type
+   use sprc_core_blas_threads, only: blas_threads, set_blas_threads
    !$ use omp_lib, only: omp_get_max_threads, omp_set_num_threads
    implicit none
    private
@@ -924,7 +925,7 @@ contains
       type(lame_cylinder_type) :: lame
       type(recovered_field_type) :: field(2)
       type(zz_estimate_type) :: est(2)
-      integer :: nt, k, nthreads0
+      integer :: nt, k, nthreads0, blas0
 
       call quarter_annulus(pb%body, error)
       if (allocated(error)) return
@@ -937,14 +938,20 @@ contains
       pb%input%bc_pressure(2) = 1.0_wp
       nthreads0 = 1
       !$ nthreads0 = omp_get_max_threads()
+      ! A caller's OpenBLAS pool of 2: the patch loop runs BLAS in one thread and restores it.
+      blas0 = blas_threads()
+      if (blas0 > 0) call set_blas_threads(2)
       do nt = 1, 2
          !$ call omp_set_num_threads(nt)
          call recover_grid(pb%input, pb%grid, pb%nodes, pb%hanging, method_sprc, 2, field(nt), error)
+         if (allocated(error)) exit
+         if (blas0 > 0 .and. blas_threads() /= 2) call test_failed(error, 'recover_grid did not restore the BLAS threads')
          if (allocated(error)) exit
          call estimate_error(pb%input, field(nt), est(nt), error, lame)
          if (allocated(error)) exit
       end do
       !$ call omp_set_num_threads(nthreads0)
+      if (blas0 > 0) call set_blas_threads(blas0)
       if (allocated(error)) return
       do k = 1, field(1)%n_patches
          if (any(field(1)%recs(k)%coef /= field(2)%recs(k)%coef)) then

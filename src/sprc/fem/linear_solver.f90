@@ -16,6 +16,7 @@ module sprc_fem_linear_solver
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular, &
       & stat_not_positive_definite, stat_out_of_memory, stat_internal
    use sprc_core_lapack, only: dlacn2
+   use sprc_core_blas_threads, only: blas_threads, set_blas_threads
    use sprc_fem_sparse, only: csr_type, csr_validate
    implicit none
    private
@@ -76,21 +77,6 @@ module sprc_fem_linear_solver
       procedure(destroy_interface), deferred :: destroy_backend
    end type linear_solver_type
 
-   interface
-      !> OpenBLAS's thread count; 0 with a BLAS that has no such control.
-      !> Factorizations and solves always run their BLAS in one thread (the C
-      !> shim says why: identical bits for any thread count).
-      function blas_threads() result(n) bind(C, name='sprc_blas_get_threads')
-         import :: c_int
-         integer(c_int) :: n
-      end function blas_threads
-
-      !> Set OpenBLAS's thread count for BLAS calls outside the sparse solvers.
-      subroutine set_blas_threads(n) bind(C, name='sprc_blas_set_threads')
-         import :: c_int
-         integer(c_int), value :: n
-      end subroutine set_blas_threads
-   end interface
 
    abstract interface
       subroutine factorize_interface(self, a, error)

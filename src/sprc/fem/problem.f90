@@ -57,6 +57,7 @@ module sprc_fem_problem
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular, &
       & stat_not_positive_definite
    use sprc_core_lapack, only: dgemm, dsyev
+   use sprc_core_blas_threads, only: blas_serial_begin, blas_serial_end
    use sprc_core_material, only: plane_stress, plane_strain, solid, voigt_size, analysis_name, &
       & material_matrix, compliance_matrix
    use sprc_core_timer, only: timer_type
@@ -509,7 +510,7 @@ contains
       type(coo_type) :: coo
       integer, allocatable :: mdof(:), dofs(:, :), offset(:)
       real(wp), allocatable :: kbuf(:), fbuf(:, :)
-      integer :: nel, nd, maxm, c0, c1, e, m, k0
+      integer :: nel, nd, maxm, c0, c1, e, m, k0, saved_blas
 
       nel = self%grid%n_leaves
       nd = self%dim*self%nen
@@ -530,6 +531,8 @@ contains
       allocate (self%f(self%constraints%n_dofs))
       self%f = 0.0_wp
       allocate (dofs(maxm, chunk_size), fbuf(maxm, chunk_size), offset(chunk_size + 1))
+      ! Small dgemm calls from every thread: OpenBLAS in one thread (sprc_core_blas_threads).
+      saved_blas = blas_serial_begin()
       do c0 = 1, nel, chunk_size
          c1 = min(nel, c0 + chunk_size - 1)
          offset(1) = 1
@@ -551,10 +554,13 @@ contains
             m = mdof(e)
             k0 = offset(e - c0 + 1)
             call coo%add(dofs(1:m, e - c0 + 1), reshape(kbuf(k0:k0 + m*m - 1), [m, m]), error)
-            if (allocated(error)) return
+            if (allocated(error)) exit
             self%f(dofs(1:m, e - c0 + 1)) = self%f(dofs(1:m, e - c0 + 1)) + fbuf(1:m, e - c0 + 1)
          end do
+         if (allocated(error)) exit
       end do
+      call blas_serial_end(saved_blas)
+      if (allocated(error)) return
       call coo%to_csr(self%k, error)
    end subroutine assemble
 

@@ -54,6 +54,7 @@ module sprc_grid_patches
    use sprc_core_material, only: plane_stress, plane_strain, solid, voigt_size, check_material
    use sprc_core_poly, only: poly_max_degree, poly_nterms
    use sprc_core_timer, only: wall_time
+   use sprc_core_blas_threads, only: blas_serial_begin, blas_serial_end
    use sprc_exact_solution, only: exact_solution_type
    use sprc_grid_tree, only: grid_type
    use sprc_grid_nodes, only: grid_nodes_type
@@ -142,7 +143,7 @@ contains
       !> Expansion rounds allowed per patch (>= 0; default `default_max_rounds`).
       integer, intent(in), optional :: max_rounds
       integer, allocatable :: status(:)
-      integer :: rounds_limit, ip, e, cap(2)
+      integer :: rounds_limit, ip, e, cap(2), saved_blas
       real(wp) :: t0
       character(len=80) :: buf
 
@@ -169,9 +170,12 @@ contains
 
       cap = initial_capacity(input, nodes, method, degree)
 
+      ! Small LAPACK calls from every thread: OpenBLAS in one thread (sprc_core_blas_threads).
+      saved_blas = blas_serial_begin()
       !$omp parallel default(shared)
       call patch_loop(input, nodes, field, method, degree, rounds_limit, cap, status, exact)
       !$omp end parallel
+      call blas_serial_end(saved_blas)
 
       if (any(status /= 0)) then
          ip = findloc(status /= 0, .true., dim=1)

@@ -59,6 +59,7 @@ module sprc_recovery_mesh
       & stat_not_converged
    use sprc_core_material, only: voigt_size
    use sprc_core_poly, only: poly_nterms
+   use sprc_core_blas_threads, only: blas_serial_begin, blas_serial_end
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reset, patch_reserve, &
       & boundary_traction, boundary_symmetry
    use sprc_recovery_workspace, only: recovery_workspace_type, workspace_reserve, workspace_init
@@ -373,14 +374,17 @@ contains
       integer, intent(in) :: rounds
       type(error_type), allocatable, intent(out) :: error
       integer, allocatable :: status(:)
-      integer :: cap(2), ip
+      integer :: cap(2), ip, saved_blas
 
       allocate (r%recs(r%n_patches), r%patch_rounds(r%n_patches), r%patch_elements(r%n_patches))
       allocate (status(r%n_patches))
       cap = initial_capacity(r, topo, size(gp, 2))
+      ! Small LAPACK calls from every thread: OpenBLAS in one thread (sprc_core_blas_threads).
+      saved_blas = blas_serial_begin()
       !$omp parallel default(shared)
       call patch_loop(r, topo, gp, gw, gs, rounds, cap, status)
       !$omp end parallel
+      call blas_serial_end(saved_blas)
       if (any(status /= 0)) then
          ip = findloc(status /= 0, .true., dim=1)
          block
