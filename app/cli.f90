@@ -101,6 +101,11 @@ contains
       call get_arg(i, value)
       select case (arg)
       case ('--output')
+         ! A blank prefix would write files named " .csv" etc.: a quoting mistake, not a wish.
+         if (len(value) > 0 .and. len_trim(value) == 0) then
+            message = 'sprc '//cli%command//': --output "'//value//'" is blank; give a file prefix'
+            return
+         end if
          cli%output = value
       case ('--threads')
          call parse_positive(arg, value, 4096, cli%threads, message)
