@@ -1,7 +1,7 @@
 !> Accuracy study of SPR and SPR-C on real FE solutions (the acceptance table of the
 !> recovery): for the Lame quarter cylinder (plane strain, Q1 levels 3..6, Q2 3..5), the
 !> Kirsch quarter plate (plane stress, Q1 / Q2 levels 3..7) and the Lame sphere octant
-!> (Q1 levels 2..4) it solves the FE problem (solve_on_grid), builds the recovery input
+!> (Q1 levels 2..5) it solves the FE problem (solve_on_grid), builds the recovery input
 !> from the problem's volume points (element_points) and surface points (the shape index
 !> of each point selects its recovery kind: pressure / free (traction 0) / exact traction /
 !> symmetry from the FE conditions; Dirichlet surfaces none), recovers with SPR and SPR-C
@@ -88,7 +88,7 @@ contains
             & merge(1, 2, name == 'kirsch1'), plane_stress, 3, 7 + extra_levels)
       case ('sphere')
          call sphere_body()
-         call study('Lame sphere solid', sphere, [0.0_wp, 0.0_wp, 0.0_wp], 25.0_wp, 1, solid, 2, 4 + extra_levels)
+         call study('Lame sphere solid', sphere, [0.0_wp, 0.0_wp, 0.0_wp], 25.0_wp, 1, solid, 2, 5 + extra_levels)
       case default
          write (output_unit, '(a)') 'unknown case '//name//' (lame1 lame2 kirsch1 kirsch2 sphere)'
       end select
