@@ -15,6 +15,7 @@ program bench_recovery
    use sprc_core_error, only: error_type
    use sprc_core_material, only: plane_stress, solid
    use sprc_core_timer, only: wall_time
+   use sprc_core_blas_threads, only: blas_serial_begin, blas_serial_end
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reset, patch_add_point, &
       & patch_add_boundary_point, boundary_traction
    use sprc_recovery_workspace, only: recovery_workspace_type, workspace_init
@@ -23,11 +24,14 @@ program bench_recovery
    implicit none
 
    integer, parameter :: npatch = 64
-   integer :: dim, p, method, nthreads
+   integer :: dim, p, method, nthreads, saved_blas
 
    nthreads = 1
    !$ nthreads = omp_get_max_threads()
    write (*, '(a,i0)') 'bench_recovery: synthetic vertex patches; OpenMP threads: ', nthreads
+   ! OpenBLAS in one thread throughout, as in the library's own patch loops
+   ! (sprc_core_blas_threads: concurrent small calls with a pool of 2+ spin in the kernel).
+   saved_blas = blas_serial_begin()
    write (*, '(a)') ' dim  p  method  points  bpoints  patches/s/thread  patches/s (all threads)  LAPACK share'// &
       & '  flops/patch  LAPACK GFLOP/s  design flops/patch'
    do dim = 2, 3
@@ -37,6 +41,7 @@ program bench_recovery
          end do
       end do
    end do
+   call blas_serial_end(saved_blas)
 
 contains
 

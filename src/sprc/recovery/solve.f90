@@ -74,7 +74,11 @@
 !> row norms) are not counted.
 !>
 !> Thread safety: no module state; everything a solve writes is in its arguments. Use one
-!> workspace per thread. The solves are not `pure` only because LAPACK externals are not.
+!> workspace per thread. A caller that runs the solves from its own threads should run
+!> OpenBLAS in one thread meanwhile (`sprc_core_blas_threads`: blas_serial_begin / _end), as
+!> sprc's own patch loops do: concurrent small calls with an OpenBLAS pool of 2 or more
+!> spin in the kernel (bench_recovery, 3D p = 2 SPR-C over 2 threads: 1.7e3 against
+!> 7.6e3 patches/s). The solves are not `pure` only because LAPACK externals are not.
 module sprc_recovery_solve
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular
