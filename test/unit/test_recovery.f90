@@ -89,6 +89,7 @@ contains
          new_unittest('error_paths', test_errors), &
          new_unittest('reserve_fewer_points_than_terms', test_reserve_few_points), &
          new_unittest('traction_weight_focus', test_traction_focus), &
+         new_unittest('traction_rank_curved_face', test_traction_curved_rank), &
          new_unittest('flop_formulas', test_flop_formulas), &
          new_unittest('flop_count_spr', test_flop_count_spr), &
          new_unittest('flop_count_sprc', test_flop_count_sprc) &
@@ -971,6 +972,52 @@ contains
          if (allocated(error)) return
       end do
    end subroutine test_traction_focus
+
+   !> Traction rank cap (solve.f90 notes (c)): on a curved face (an arc) the traction is
+   !> matched up to degree p - 1 along it, 2 (p - 1 + 1) rows in 2D: 2 for p = 1, 4 for p = 2;
+   !> on a flat face of the same patch size, the full 4 and 6 (known_ranks has more).
+   subroutine test_traction_curved_rank(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(patch_type) :: patch
+      type(recovery_workspace_type) :: ws
+      type(recovered_patch_type) :: rec
+      real(wp) :: xi(3), wt(3), x, y, th, n(2)
+      integer :: i, j, p, k, curved
+      character(len=40) :: tag
+
+      call gauss(3, xi, wt)
+      do curved = 0, 1
+         do p = 1, 2
+            call patch_reset(patch, 2, plane_stress, 1000.0_wp, 0.3_wp, [0.0_wp, 0.0_wp], 1.0_wp)
+            do i = 1, 3
+               do j = 1, 3
+                  do k = 0, 1
+                     x = k - 1 + 0.5_wp*(xi(i) + 1.0_wp)
+                     y = -0.5_wp*(xi(j) + 1.0_wp)
+                     call patch_add_point(patch, [x, y], 0.25_wp*wt(i)*wt(j), [0.1_wp*x, 0.2_wp*y, 0.0_wp])
+                  end do
+               end do
+            end do
+            do k = -4, 4
+               th = 0.1_wp*k
+               if (curved == 1) then
+                  ! Arc of radius 2 through the node, centre (0, -2), outward normals.
+                  n = [sin(th), cos(th)]
+                  call patch_add_boundary_point(patch, 2.0_wp*n - [0.0_wp, 2.0_wp], 0.2_wp, n, &
+                     & boundary_traction, [0.0_wp, 0.0_wp])
+               else
+                  call patch_add_boundary_point(patch, [2.0_wp*th, 0.0_wp], 0.2_wp, [0.0_wp, 1.0_wp], &
+                     & boundary_traction, [0.0_wp, 0.0_wp])
+               end if
+            end do
+            write (tag, '(" (p ",i0,", curved ",i0,")")') p, curved
+            call recover_sprc(patch, p, ws, rec, error)
+            if (allocated(error)) return
+            call check(error, rec%ranks(kind_traction), merge(2*p, 2*(p + 1), curved == 1), 'traction rank'//tag)
+            if (allocated(error)) return
+         end do
+      end do
+   end subroutine test_traction_curved_rank
 
    subroutine test_noisy(error)
       type(error_type), allocatable, intent(out) :: error
