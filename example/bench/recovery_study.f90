@@ -278,6 +278,11 @@ contains
       call report(ok, 'err_sprc < err_spr < err_fe at every level >= 3')
       rate = log(err(3, l1 - 1)/err(3, l1))/log(2.0_wp)
       call report(rate >= real(degree, wp) + 0.5_wp, 'err_sprc rate (last two levels) >= p + 0.5')
+      ! Least-squares slope of -log2(err_sprc) over the last three levels: (e1 - e3) / 2 in log2.
+      ! Per-level rates on cut grids oscillate with the cut configuration; this one less so.
+      if (l1 - 2 >= l0) write (output_unit, '(a4,2x,a,f5.2)') 'info', &
+         & 'err_sprc slope over the last three levels (least squares): ', &
+         & log(err(3, l1 - 2)/err(3, l1))/log(2.0_wp)/2.0_wp
       call report(theta(2, l1) >= 0.95_wp .and. theta(2, l1) <= 1.05_wp, 'theta_sprc in [0.95, 1.05] (finest)')
       call report(bnode(2, l1) <= 0.5_wp*bnode(1, l1), 'boundary-node error SPR-C <= SPR / 2 (finest)')
    end subroutine acceptance
