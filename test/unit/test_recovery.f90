@@ -92,7 +92,8 @@ contains
          new_unittest('traction_rank_curved_face', test_traction_curved_rank), &
          new_unittest('flop_formulas', test_flop_formulas), &
          new_unittest('flop_count_spr', test_flop_count_spr), &
-         new_unittest('flop_count_sprc', test_flop_count_sprc) &
+         new_unittest('flop_count_sprc', test_flop_count_sprc), &
+         new_unittest('flop_count_sprc_traction', test_flop_count_traction) &
          ]
    end subroutine collect_recovery
 
@@ -1607,5 +1608,44 @@ contains
       ! Weighted: scaling 2 dim np, recurrence np (nt - 1), weights 3 np, row scaling np nt.
       call check(error, ws%design_flops, 2*d*np + np*(nt - 1) + 3*np + np*nt, 'SPR-C design-matrix flops')
    end subroutine test_flop_count_sprc
+
+   !> SPR-C 2D p=1 with one straight traction face of nb points through the node: on top of
+   !> the equilibrium-only count (test above), the face's dgeqp3(2 nb, n) and dormqr(2 nb x 1,
+   !> min(2 nb, n) reflectors), a stacked reduction of mr = 2 + 4 rows instead of 2, and a
+   !> larger KKT system. The difference between the two solves is written out from the sizes.
+   subroutine test_flop_count_traction(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(patch_type) :: patch
+      type(recovery_workspace_type) :: ws0, ws1
+      type(recovered_patch_type) :: rec0, rec1
+      integer(i8) :: m, k, mr0, mr1, nk0, nk1, expected
+      integer(i8), parameter :: n = 9, nb = 5
+      integer :: j
+
+      call flop_patch(patch)
+      ws0%timing = .true.
+      call recover_sprc(patch, 1, ws0, rec0, error)
+      if (allocated(error)) return
+      do j = 1, int(nb)
+         call patch_add_boundary_point(patch, [-0.8_wp + 0.4_wp*(j - 1), 0.0_wp], 0.4_wp, [0.0_wp, -1.0_wp], &
+            & boundary_traction, [0.0_wp, 0.1_wp*j])
+      end do
+      ws1%timing = .true.
+      call recover_sprc(patch, 1, ws1, rec1, error)
+      if (allocated(error)) return
+      call check(error, rec1%ranks(kind_traction) == 4 .and. rec1%rank_total == 6, 'traction rank 4 of 6 in all')
+      if (allocated(error)) return
+      m = 2*nb
+      k = min(m, n)
+      mr0 = rec0%rank_total
+      mr1 = rec1%rank_total
+      nk0 = n + mr0
+      nk1 = n + mr1
+      expected = ws0%flops &
+         & + (6*max(m, n)*min(m, n)**2 - 2*min(m, n)**3 + 1)/3 + (4*m*k - 2*k**2) & ! the face
+         & + ((6*n*mr1**2 - 2*mr1**3 + 1)/3 - (6*n*mr0**2 - 2*mr0**3 + 1)/3) &        ! stacked rows
+         & + ((nk1**3 + 1)/3 + 2*nk1**2) - ((nk0**3 + 1)/3 + 2*nk0**2)                ! KKT dsysv
+      call check(error, ws1%flops, expected, 'SPR-C 2D p=1 flops with a traction face')
+   end subroutine test_flop_count_traction
 
 end module sprc_test_recovery
