@@ -221,6 +221,16 @@ def test_equilibrated_field_recovered_exactly(etype, m, field, method):
     assert np.abs(rec.evaluate(pts[0]) - want[0]).max() <= TOL * case["scale"]
 
 
+@pytest.mark.parametrize("method", ["spr", "sprc"])
+def test_degree_p_plus_1(method):
+    """degree='p+1': a quadratic equilibrated field on a distorted quad4 mesh is
+    recovered exactly by quadratic patches (1e-10), while the element's degree
+    (linear patches) cannot represent it."""
+    case = build_case("quad4", 4, "quadratic")
+    assert nodal_deviation(case, recover(case, method=method, degree="p+1")) <= TOL
+    assert nodal_deviation(case, recover(case, method=method)) > 1e-3
+
+
 def test_inexact_data_gives_positive_estimate():
     """The estimate is not trivially zero: a perturbed field gives eta in (0, 1)
     and element errors that sum in squares to the global error."""
@@ -291,6 +301,7 @@ def call(case, **changes):
     (dict(gauss_stress="abc"), "gauss_stress must be an array of numbers"),
     (dict(analysis="plane"), "analysis = 'plane'"),
     (dict(method="zz"), "method = 'zz'"),
+    (dict(degree="p+2"), "degree = 'p+2'"),
     (dict(body_force=[1.0, 2.0, 3.0]), "body_force has shape [3], need [2]"),
     (dict(boundary={"nodes": [[0, 1]], "kind": "glued"}), "boundary kind = 'glued'"),
     (dict(boundary={"nodes": [[0, 1, 2]], "kind": "free"}), "has shape [1, 3], need [*, 2]"),

@@ -548,6 +548,26 @@ static void test_recovery_linear_quad4(void) {
   PASS();
 }
 
+/* SPRC_RECOVERY_P_PLUS_1 OR-ed into the method: quadratic patches on quad4
+ * still reproduce the linear field; an unknown flag bit is refused. */
+static void test_recovery_degree_flag(void) {
+  const char *name = "recovery_degree_flag";
+  static quad_mesh m;
+  double nodal[NNODE][3];
+  sprc_error err = sprc_new_error();
+  sprc_recovery rec;
+  build_quad_mesh(&m, 0);
+  rec = recover_quad_mesh(err, &m, SPRC_METHOD_SPRC | SPRC_RECOVERY_P_PLUS_1);
+  CHECK(rec != NULL && sprc_check_error(err) == 0, "recovery with SPRC_RECOVERY_P_PLUS_1 failed");
+  sprc_get_recovery_nodal_stress(err, rec, &nodal[0][0], NNODE);
+  CHECK(nodal_deviation(&m, nodal) <= 5e-10, "p+1 nodal stresses deviate from the linear field");
+  sprc_delete_recovery(&rec);
+  rec = recover_quad_mesh(err, &m, SPRC_METHOD_SPRC | 512);
+  CHECK(rec == NULL && has_error(err, "unknown flag bits"), "an unknown flag bit was accepted");
+  sprc_delete_error(&err);
+  PASS();
+}
+
 /* SPR-C with traction facets on x = 0 and x = 1 (0-based facet nodes in C
  * order, constant tractions sigma n): still exact, and the facets reach the
  * library (a traction that contradicts the field makes the estimate > 0). */
@@ -611,6 +631,7 @@ int main(int argc, char **argv) {
   test_recovery_bad_input();
   test_recovery_bad_output();
   test_recovery_linear_quad4();
+  test_recovery_degree_flag();
   test_recovery_facets();
   printf("%d passed, %d failed\n", passed, failed);
   return failed == 0 ? 0 : 1;

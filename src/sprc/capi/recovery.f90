@@ -13,7 +13,8 @@ module sprc_capi_recovery
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_out_of_memory
    use sprc_core_material, only: voigt_size
    use sprc_recovery_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval
-   use sprc_recovery_mesh_element, only: element_known, element_nodes, element_facet_nodes, element_name
+   use sprc_recovery_mesh_element, only: element_known, element_nodes, element_facet_nodes, element_name, &
+      & element_degree
    use sprc_capi_error, only: capi_error_type, get_capi_error, set_capi_error
    implicit none
    private
@@ -26,6 +27,10 @@ module sprc_capi_recovery
    type :: capi_recovery_type
       type(mesh_recovery_type) :: result
    end type capi_recovery_type
+
+   !> Flag OR-ed into `method` (sprc.h SPRC_RECOVERY_P_PLUS_1): patch degree one above the
+   !> element's; the low byte is the method proper.
+   integer(c_int), parameter :: flag_p_plus_1 = 256, method_mask = 255
 
    !> Sizes and codes of one `sprc_recover` call, checked before any array is touched.
    type :: mesh_sizes_type
@@ -55,13 +60,16 @@ contains
       real(wp), allocatable :: bf(:), ft(:, :)
       integer(c_int), pointer :: conn_c(:, :), fn_c(:, :), fk_c(:)
       integer, allocatable :: conn(:, :), fn(:, :), fk(:)
-      integer :: stat
+      integer :: stat, degree
 
       rech = c_null_ptr
       if (.not. get_capi_error(errh, err)) return
       sz = mesh_sizes_type(dim, analysis, nnode, element_type, nen, nelem, ngp, voigt_size(analysis), nfacet, &
          & facet_nnode)
       call check_sizes(sz, error)
+      if (.not. allocated(error) .and. iand(method, not(ior(method_mask, flag_p_plus_1))) /= 0) &
+         & call fail(error, 'sprc_recover: method = '//itoa(method)//' has unknown flag bits (the only flag is '// &
+         & 'SPRC_RECOVERY_P_PLUS_1 = 256)')
       if (.not. allocated(error)) call check_pointers(sz, nodes, connectivity, gauss_points, gauss_weights, &
          & gauss_stress, facet_nodes, facet_kind, error)
       if (allocated(error)) then
@@ -103,8 +111,11 @@ contains
          return
       end if
       ! Unallocated bf, fn, fk, ft reach the optional dummies as absent (F2008).
-      call recover_on_mesh(dim, analysis, x, element_type, conn, gp, gw, gs, young, poisson, method, rec%result, &
-         & error, body_force=bf, facet_nodes=fn, facet_kind=fk, facet_traction=ft)
+      degree = element_degree(element_type)
+      if (iand(method, flag_p_plus_1) /= 0) degree = degree + 1
+      call recover_on_mesh(dim, analysis, x, element_type, conn, gp, gw, gs, young, poisson, &
+         & int(iand(method, method_mask)), rec%result, error, body_force=bf, facet_nodes=fn, facet_kind=fk, &
+         & facet_traction=ft, degree=degree)
       if (allocated(error)) then
          deallocate (rec)
          call set_capi_error(err, error)
