@@ -77,7 +77,6 @@ module sprc_fem_linear_solver
       procedure(destroy_interface), deferred :: destroy_backend
    end type linear_solver_type
 
-
    abstract interface
       subroutine factorize_interface(self, a, error)
          import :: linear_solver_type, csr_type, error_type

@@ -396,9 +396,10 @@ contains
    end function traction_focus
 
    !> (c) traction equilibrium, least-squares form (eq. 80), per boundary face (module notes):
-   !> QR with column pivoting of the face's weighted rows sqrt(bw_j) E_j, E_j = G(n_j) P(s_j):
-   !> E Pi = Q R, and eq. 80 (E^T E A = E^T t) is R Pi^T A = Q^T t. The leading rows of R whose
-   !> pivots pass traction_rank_tol, at most the flat-boundary rank, become constraints.
+   !> QR with column pivoting of the face's weighted rows sqrt(bw_j f_j) E_j, E_j = G(n_j) P(s_j),
+   !> f_j = traction_focus: E Pi = Q R, and eq. 80 (E^T E A = E^T t) is R Pi^T A = Q^T t. The
+   !> leading rows of R whose pivots pass traction_rank_tol become constraints, at most the
+   !> flat-face rank of degree p (flat face) or p - 1 (curved face).
    subroutine traction_block(patch, ws, rec, mc, error)
       type(patch_type), intent(in) :: patch
       type(recovery_workspace_type), intent(inout) :: ws

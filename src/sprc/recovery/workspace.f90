@@ -229,10 +229,11 @@ contains
    !> several calls) into ws%flops.
    subroutine workspace_toc(ws, flops)
       type(recovery_workspace_type), intent(inout) :: ws
-      integer(i8), intent(in), optional :: flops
+      !> Required, so that a new LAPACK call site cannot leave the count out unnoticed.
+      integer(i8), intent(in) :: flops
       if (.not. ws%timing) return
       ws%lapack_seconds = ws%lapack_seconds + (wall_time() - ws%t0)
-      if (present(flops)) ws%flops = ws%flops + flops
+      ws%flops = ws%flops + flops
    end subroutine workspace_toc
 
 end module sprc_recovery_workspace
