@@ -32,6 +32,7 @@ module sprc_test_patches
    use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature, cell_rule_type, cell_rule
    use sprc_exact_solution, only: exact_solution_type, init_exact_solution
    use sprc_exact_lame, only: lame_cylinder_type, new_lame_cylinder
+   use sprc_recovery_solve, only: recovery_rank_tol
    use sprc_grid_patches, only: recovery_input_type, recover_grid, bc_none, bc_traction, bc_pressure, &
       & bc_exact_traction, bc_symmetry
    use sprc_grid_recovered_field, only: recovered_field_type, method_spr, method_sprc, interp_nodal, &
@@ -47,18 +48,21 @@ module sprc_test_patches
 
    public :: collect_patches
 
-   !> Reproduction tolerance relative to the largest stress: the patch solves are backward
-   !> stable with condition numbers ~1e2-1e4 in scaled coordinates, and the field sums a
-   !> handful of O(1) terms.
-   real(wp), parameter :: tol_exact = 1.0e-10_wp
+   !> Round-off tier of values that pass through the patch solves (QR, KKT by dsysv), relative
+   !> to the stress scale: sqrt(eps). The solves are backward stable, but the conditioning of a
+   !> patch system is not estimated (rank decisions keep pivots down to recovery_rank_tol, so
+   !> it is not bounded by a small number either); sqrt(eps) admits condition numbers up to
+   !> 1/sqrt(eps) ~ 7e7 and is still 1e5 below the errors a wrong constraint or basis makes.
+   real(wp), parameter :: tol_exact = sqrt(epsilon(1.0_wp))
    !> SPR-C with traction constraints on curved arcs, inside the body: the core's traction rows
    !> come from a QR of the weighted E per boundary face (pivots >= 1e-8 relative, at most the
    !> flat-boundary rank), so they carry their data to ~1e-14 (it was 3e-8 .. 1.2e-5 with the
    !> rank-reduced E^T E block).
    real(wp), parameter :: tol_curved = tol_exact
-   !> Nodes just outside the body (of cut elements): measured up to 5e-8 (3D Q2, SPR-C);
-   !> SPR stays at 1e-12.
-   real(wp), parameter :: tol_outside = 1.0e-6_wp
+   !> Nodes just outside the body (of cut elements): SPR-C keeps constraint rows down to pivot
+   !> ratios recovery_rank_tol, which carry their data to eps/recovery_rank_tol (2.2e-6);
+   !> measured up to 5e-8 (3D Q2, SPR-C); SPR stays at 1e-12.
+   real(wp), parameter :: tol_outside = epsilon(1.0_wp)/recovery_rank_tol
    !> The same with traction on the curved surfaces: the patch of an outside node farther than
    !> traction_reach h from the boundary's tangent plane gets no traction rows and extrapolates
    !> from small cut pieces with the equilibrium rows only; measured 1.2e-5.
