@@ -403,6 +403,18 @@ contains
       if (allocated(error)) return
       call check(error, index(summary, 'lower = 1.0, 0.1, upper = 3.0, 0.30000000000000004') > 0, &
          & '17 significant digits when needed')
+      if (allocated(error)) return
+      ! Three-digit exponents (the es descriptor's default width drops the 'E'),
+      ! down to the smallest subnormal.
+      text = replaced(minimal, 'young=1 poisson=0', 'young=1e-300 poisson=0 body_force=4.9e-324, -1.5e+300')
+      text = replaced(text, 'box_size=4', 'box_size=1e100')
+      call read_ok(text, s, error)
+      if (allocated(error)) return
+      summary = scene_summary(s)
+      call check(error, index(summary, 'young = 1.0e-300, poisson = 0.0, body_force = 5.0e-324, -1.5e300') > 0, &
+         & 'three-digit exponents in:'//nl//summary)
+      if (allocated(error)) return
+      call check(error, index(summary, 'box_size        = 1.0e100') > 0, 'box_size 1e100')
    end subroutine test_summary_reals
 
    subroutine test_contact(error)

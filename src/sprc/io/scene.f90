@@ -4,6 +4,7 @@
 !> Every error names the file, line, group, field and offending value, e.g.
 !> `scene.nml:7: &body: poisson = 0.5: must satisfy -1 < poisson < 0.5 ...`.
 module sprc_io_scene
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_unsupported
    use sprc_io_namelist, only: nml_group_type, parse_namelist, read_text_file, nml_get, nml_get_array, &
@@ -1242,7 +1243,8 @@ contains
    end function real_list
 
    !> Shortest decimal text that reads back as the same real: fixed notation
-   !> for moderate exponents (`1000.0`, `0.3`), else `2.5e-07` style.
+   !> for moderate exponents (`1000.0`, `0.3`), else `2.5e-7` style (`1.0e-300`);
+   !> `NaN`, `Infinity`, `-Infinity` for the non-finite values.
    function real_text(x) result(text)
       real(wp), intent(in) :: x
       character(len=:), allocatable :: text
@@ -1252,8 +1254,18 @@ contains
       real(wp) :: y
       integer :: d, ios, epos, e, n
 
+      if (ieee_is_nan(x)) then
+         text = 'NaN'
+         return
+      else if (.not. ieee_is_finite(x)) then
+         text = merge('-Infinity', ' Infinity', x < 0.0_wp)
+         text = trim(adjustl(text))
+         return
+      end if
+      ! Three exponent digits (e3): with the default width a three-digit
+      ! exponent is written without its 'E' (1.0+100).
       do d = 1, 17
-         write (fmt, '("(es40.",i0,")")') d - 1
+         write (fmt, '("(es40.",i0,"e3)")') d - 1
          write (buf, fmt) x
          read (buf, *, iostat=ios) y
          ! Bitwise identity is what 'reads back as the same real' means.
