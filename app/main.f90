@@ -6,6 +6,8 @@ program sprc_main
    use sprc_core_error, only: error_type, stat_invalid_input, stat_io
    use sprc_version, only: sprc_version_string
    use sprc_io_scene, only: scene_type, read_scene, read_scene_text, scene_summary, default_scene_text
+   use sprc_io_model, only: build_bodies
+   use sprc_geometry_body, only: body_type
    use sprc_io_study, only: mesh_row_type, mesh_study, format_mesh_row, study_levels
    use sprc_io_run, only: run_model_type, prepare_run, run_level
    use sprc_io_report, only: report_row_type, report_table, write_report_csv
@@ -128,10 +130,13 @@ contains
    subroutine check_scene(path)
       character(len=*), intent(in) :: path
       type(scene_type) :: scene
+      type(body_type), allocatable :: bodies(:)
       type(error_type), allocatable :: error
 
       call read_scene(path, scene, error)
       if (allocated(error)) call fail(2, error%message)
+      call build_bodies(scene, bodies, error)
+      if (allocated(error)) call fail_with(error)
       write (output_unit, '(a)') scene_summary(scene)
    end subroutine check_scene
 

@@ -1,7 +1,7 @@
 !> Tests of the scene -> geometry bodies and exact solution glue.
 module sprc_test_model
    use sprc_core_kinds, only: wp
-   use sprc_core_error, only: error_type
+   use sprc_core_error, only: error_type, stat_invalid_input
    use sprc_geometry_body, only: body_type
    use sprc_geometry_region, only: cell_inside, cell_outside, cell_cut
    use sprc_exact_solution, only: exact_solution_type
@@ -26,7 +26,8 @@ contains
          new_unittest('no_exact_group', test_no_exact), &
          new_unittest('facade_reexports', test_facade), &
          new_unittest('grid_quarter_annulus', test_grid_annulus), &
-         new_unittest('grid_sphere_octant', test_grid_octant) &
+         new_unittest('grid_sphere_octant', test_grid_octant), &
+         new_unittest('body_beyond_box', test_body_beyond_box) &
          ]
    end subroutine collect_model
 
@@ -65,6 +66,55 @@ contains
       if (allocated(error)) return
       call check(error, bodies(1)%classify_box([19.0_wp, 0.0_wp], [21.0_wp, 1.0_wp]), cell_cut, 'box on r = 20')
    end subroutine test_default_body
+
+   !> A body with material outside the box is an input error naming body and box (the grid
+   !> would clip it: box 15 around the radius-20 quarter cylinder gave area 203.9, not
+   !> 294.5); a body touching the box (quarter model on x = 0, y = 0; 3D octant; a disk
+   !> tangent to the box edge x = 25) is accepted.
+   subroutine test_body_beyond_box(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(body_type), allocatable :: bodies(:)
+      type(error_type), allocatable :: e
+      character(len=:), allocatable :: text
+
+      text = default_scene_text()
+      call read_scene_text(replaced(text, 'box_size = 25.0', 'box_size = 15.0'), 'small box', scene, error)
+      if (allocated(error)) return
+      call build_bodies(scene, bodies, e)
+      call check(error, allocated(e), 'box 15 around r = 20 rejected')
+      if (allocated(error)) return
+      call check(error, index(e%message, "body 'cylinder' extends beyond the scene's box 0..15 x 0..15") > 0 &
+         & .and. index(e%message, 'enlarge box_size') > 0, 'message names body, box and remedy: '//e%message)
+      if (allocated(error)) return
+      call check(error, e%stat, stat_invalid_input, 'status')
+      if (allocated(error)) return
+      ! r = 20 shifted to touch x = 25: tangent, no material beyond
+      call read_scene_text(replaced(replaced(text, 'center=0,0 radius=20', 'center=5,0 radius=20'), &
+         & "point=0,0 normal=-1,0", "point=5,0 normal=-1,0"), 'tangent', scene, error)
+      if (allocated(error)) return
+      call build_bodies(scene, bodies, error)
+      if (allocated(error)) return
+      call load('example/scenes/lame_sphere.nml', scene, error)
+      if (allocated(error)) return
+      call build_bodies(scene, bodies, error)
+      if (allocated(error)) return
+      call load('example/scenes/kirsch_plate.nml', scene, error)
+      if (allocated(error)) return
+      call build_bodies(scene, bodies, error)
+   end subroutine test_body_beyond_box
+
+   pure function replaced(text, old, new) result(out)
+      character(len=*), intent(in) :: text, old, new
+      character(len=:), allocatable :: out
+      integer :: i
+      i = index(text, old)
+      if (i == 0) then
+         out = text
+      else
+         out = text(1:i - 1)//new//text(i + len(old):)
+      end if
+   end function replaced
 
    !> t = sigma.n = -p_in n on the inner surface (n = (-1, 0) at (5, 0)): t = (1, 0).
    subroutine test_default_exact(error)

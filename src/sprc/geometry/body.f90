@@ -25,7 +25,7 @@ module sprc_geometry_body
    implicit none
    private
 
-   public :: body_type, new_body
+   public :: body_type, new_body, check_body_in_box
    public :: csg_add, csg_subtract, csg_intersect, csg_op_name, csg_op_from_name
    public :: snap_ulps, snap_tolerance
 
@@ -398,7 +398,135 @@ contains
       end do
    end subroutine unmasked_cuts
 
+   !> Error (stat_invalid_input) naming the body and the box when the body has material
+   !> outside the box [box_min, box_min + box_size]^dim: the grid would clip it silently.
+   !> Searches slabs of width box_size/16 outside each face for a part of the body (a
+   !> certified inside sub-box, or the centre of a cut one after `depth_limit` halvings
+   !> with phi below minus the snapping tolerance). A body that crosses a face has material
+   !> in the slab beyond it; one that only touches a face (a plane on the box boundary, a
+   !> circle tangent to it) has none. A piece entirely outside the box and the slabs is
+   !> not searched for.
+   subroutine check_body_in_box(self, box_min, box_size, error)
+      type(body_type), intent(in) :: self
+      real(wp), intent(in) :: box_min(:), box_size
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: depth_limit = 8
+      real(wp) :: lo(3), hi(3), x(3)
+      character(len=:), allocatable :: where
+      integer :: d, k, j, side
+      logical :: found
+
+      d = self%dim
+      if (d < 2 .or. size(box_min) < d) return
+      do k = 1, d
+         do side = 0, 1
+            lo(1:d) = box_min(1:d)
+            hi(1:d) = box_min(1:d) + box_size
+            if (side == 0) then
+               hi(k) = lo(k)
+               lo(k) = lo(k) - box_size/16.0_wp
+            else
+               lo(k) = hi(k)
+               hi(k) = hi(k) + box_size/16.0_wp
+            end if
+            call find_inside(self, lo(1:d), hi(1:d), depth_limit, found, x(1:d))
+            if (.not. found) cycle
+            where = real_str(box_min(1))//'..'//real_str(box_min(1) + box_size)
+            do j = 2, d
+               where = where//' x '//real_str(box_min(j))//'..'//real_str(box_min(j) + box_size)
+            end do
+            call fatal_error(error, "body '"//body_name(self)//"' extends beyond the scene's box "//where// &
+               & ' (box_min, box_size): it has material at ('//real_list(x(1:d))//'), which the grid would '// &
+               & 'cut off; enlarge box_size or move box_min so that the box holds the whole body', &
+               & stat_invalid_input)
+            return
+         end do
+      end do
+   end subroutine check_body_in_box
+
+   !> A point x of the body in the box [lo, hi], by bisection of the cut boxes (module
+   !> notes on the snapping tolerance).
+   recursive subroutine find_inside(self, lo, hi, depth, found, x)
+      type(body_type), intent(in) :: self
+      real(wp), intent(in) :: lo(:), hi(:)
+      integer, intent(in) :: depth
+      logical, intent(out) :: found
+      real(wp), intent(out) :: x(:)
+      real(wp) :: clo(size(lo)), chi(size(lo)), mid(size(lo))
+      integer :: child, k
+
+      x = 0.5_wp*(lo + hi)
+      found = .false.
+      select case (self%classify_box(lo, hi))
+      case (cell_inside)
+         found = .true.
+         return
+      case (cell_outside)
+         return
+      end select
+      if (depth == 0) then
+         found = self%phi(x) < -snap_ulps*epsilon(1.0_wp)*(maxval(abs(lo)) + maxval(abs(hi)))
+         return
+      end if
+      mid = x
+      do child = 0, 2**size(lo) - 1
+         do k = 1, size(lo)
+            if (btest(child, k - 1)) then
+               clo(k) = mid(k)
+               chi(k) = hi(k)
+            else
+               clo(k) = lo(k)
+               chi(k) = mid(k)
+            end if
+         end do
+         call find_inside(self, clo, chi, depth - 1, found, x)
+         if (found) return
+      end do
+   end subroutine find_inside
+
    ! ------------------------------------------------------------ text
+
+   !> Six significant digits, trailing zeros dropped: 15, -7.5, 0.125, 1.5e+20.
+   pure function real_str(v) result(s)
+      real(wp), intent(in) :: v
+      character(len=:), allocatable :: s
+      character(len=32) :: buf
+      integer :: n
+
+      if (v /= 0.0_wp .and. (abs(v) >= 1.0e6_wp .or. abs(v) < 1.0e-3_wp)) then
+         write (buf, '(es14.5e3)') v
+         buf = adjustl(buf)
+         n = index(buf, 'E')
+         s = strip_zeros(buf(1:n - 1))//'e'//buf(n + 1:len_trim(buf))
+      else
+         write (buf, '(f0.6)') v
+         ! f0 drops the zero before the point (.5, -.5)
+         if (buf(1:1) == '.') buf = '0'//buf
+         if (buf(1:2) == '-.') buf = '-0'//buf(2:)
+         s = strip_zeros(trim(buf))
+      end if
+   end function real_str
+
+   pure function strip_zeros(t) result(s)
+      character(len=*), intent(in) :: t
+      character(len=:), allocatable :: s
+      s = t
+      if (index(s, '.') == 0) return
+      do while (s(len(s):len(s)) == '0')
+         s = s(1:len(s) - 1)
+      end do
+      if (s(len(s):len(s)) == '.') s = s(1:len(s) - 1)
+   end function strip_zeros
+
+   pure function real_list(v) result(s)
+      real(wp), intent(in) :: v(:)
+      character(len=:), allocatable :: s
+      integer :: i
+      s = real_str(v(1))
+      do i = 2, size(v)
+         s = s//', '//real_str(v(i))
+      end do
+   end function real_list
 
    pure function body_name(self) result(name)
       type(body_type), intent(in) :: self

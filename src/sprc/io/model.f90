@@ -8,7 +8,7 @@ module sprc_io_model
    use sprc_core_material, only: plane_stress, plane_strain, solid
    use sprc_geometry_shape, only: geometry_shape => shape_type, new_disk, new_sphere, new_ellipse, &
       & new_ellipsoid, new_box, new_halfspace, new_cylinder
-   use sprc_geometry_body, only: geometry_body => body_type, new_body, csg_op_from_name
+   use sprc_geometry_body, only: geometry_body => body_type, new_body, csg_op_from_name, check_body_in_box
    use sprc_exact_solution, only: exact_solution_type
    use sprc_exact_lame, only: lame_cylinder_type, lame_sphere_type, new_lame_cylinder, new_lame_sphere
    use sprc_exact_kirsch, only: kirsch_type, new_kirsch
@@ -30,7 +30,8 @@ contains
       end select
    end function analysis_kind
 
-   !> One geometry body per `&body`, its shapes added in file order.
+   !> One geometry body per `&body`, its shapes added in file order; a body with
+   !> material outside the scene's box is an input error (the grid would clip it).
    subroutine build_bodies(scene, bodies, error)
       type(scene_type), intent(in) :: scene
       type(geometry_body), allocatable, intent(out) :: bodies(:)
@@ -52,6 +53,10 @@ contains
             error%message = '&shape '''//scene%shapes(s)%name//''': '//error%message
             return
          end if
+      end do
+      do b = 1, size(bodies)
+         call check_body_in_box(bodies(b), scene%box_min, scene%box_size, error)
+         if (allocated(error)) return
       end do
    end subroutine build_bodies
 
