@@ -2,6 +2,7 @@
 !> (0 success, 2 bad input, 1 numerical failure or a capability not yet available).
 program sprc_main
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
+   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
    use omp_lib, only: omp_set_num_threads
    use sprc_core_error, only: error_type, stat_invalid_input, stat_io
    use sprc_version, only: sprc_version_string
@@ -18,6 +19,20 @@ program sprc_main
 
    type(cli_type) :: cli
    character(len=:), allocatable :: message
+   !> Output prefix of the run in progress: its files are written as
+   !> PREFIX.EXT.partial and renamed when all are complete; `fail` removes them.
+   character(len=:), allocatable :: partial_prefix
+   !> The output files, in the order they are published.
+   character(len=*), parameter :: output_exts(4) = [character(len=5) :: '.csv', '.svg', '.h5', '.xdmf']
+   character(len=*), parameter :: partial = '.partial'
+
+   interface
+      !> C's rename(3) (stdio.h): replaces `new` atomically within a file system.
+      integer(c_int) function c_rename(old, new) bind(C, name='rename')
+         import :: c_int, c_char
+         character(kind=c_char), intent(in) :: old(*), new(*)
+      end function c_rename
+   end interface
 
    call parse_cli(cli, message)
    if (allocated(message)) call fail(2, message)
@@ -65,7 +80,9 @@ contains
    end subroutine run_scene_file
 
    !> One analysis per level; the report on standard output and, with an
-   !> output prefix, PREFIX.csv, .svg, .h5 and .xdmf.
+   !> output prefix, PREFIX.csv, .svg, .h5 and .xdmf: written under temporary
+   !> names and renamed when all four are complete, so a run that fails
+   !> leaves the results of an earlier run as they were.
    subroutine run_study(scene, cli)
       type(scene_type), intent(in) :: scene
       type(cli_type), intent(in) :: cli
@@ -86,7 +103,8 @@ contains
       if (len(cli%output) > 0) prefix = cli%output
       if (len(prefix) > 0) then
          call make_parent_directory(prefix)
-         call h5%create(prefix//'.h5', error)
+         partial_prefix = prefix
+         call h5%create(prefix//'.h5'//partial, error)
          if (allocated(error)) call fail_with(error)
       end if
       allocate (rows(size(levels)))
@@ -101,11 +119,18 @@ contains
       write (output_unit, '(a)') scene%title
       write (output_unit, '(a)', advance='no') report_table(rows)
       if (len(prefix) == 0) return
-      call write_report_csv(prefix//'.csv', rows, error)
-      if (.not. allocated(error)) call write_report_svg(prefix//'.svg', rows, scene%title, error)
+      call write_report_csv(prefix//'.csv'//partial, rows, error)
+      if (.not. allocated(error)) call write_report_svg(prefix//'.svg'//partial, rows, scene%title, error)
       if (.not. allocated(error)) call h5%close(error)
-      if (.not. allocated(error)) call h5%write_xdmf(prefix//'.xdmf', error)
+      if (.not. allocated(error)) call h5%write_xdmf(prefix//'.xdmf'//partial, error, data_path=prefix//'.h5')
       if (allocated(error)) call fail_with(error)
+      do i = 1, size(output_exts)
+         if (c_rename(prefix//trim(output_exts(i))//partial//c_null_char, &
+            & prefix//trim(output_exts(i))//c_null_char) /= 0) &
+            & call fail(2, 'cannot rename '//prefix//trim(output_exts(i))//partial//' to '// &
+            & prefix//trim(output_exts(i)))
+      end do
+      deallocate (partial_prefix)
       if (.not. cli%quiet) write (error_unit, '(a)') 'sprc: wrote '//prefix//'.csv, .svg, .h5, .xdmf'
    end subroutine run_study
 
@@ -164,8 +189,18 @@ contains
    subroutine fail(status, text)
       integer, intent(in) :: status
       character(len=*), intent(in) :: text
+      integer :: i, unit, stat
+      logical :: exists
       write (error_unit, '(a)') 'sprc: error: '//text
       flush (error_unit)
+      if (allocated(partial_prefix)) then
+         do i = 1, size(output_exts)
+            inquire (file=partial_prefix//trim(output_exts(i))//partial, exist=exists)
+            if (.not. exists) cycle
+            open (newunit=unit, file=partial_prefix//trim(output_exts(i))//partial, status='old', iostat=stat)
+            if (stat == 0) close (unit, status='delete', iostat=stat)
+         end do
+      end if
       ! `stop`, not `error stop`: gfortran prints a backtrace on error stop.
       select case (status)
       case (1)

@@ -403,17 +403,24 @@ contains
 
    !> Write the XDMF file `path` for everything written so far (usually after
    !> `close`). It must be in the HDF5 file's directory: it refers to the
-   !> HDF5 file by base name (PREFIX.xdmf next to PREFIX.h5).
-   subroutine h5_write_xdmf(self, path, error)
+   !> HDF5 file by base name (PREFIX.xdmf next to PREFIX.h5); `data_path` is the
+   !> name the HDF5 file will have when it differs from the one it was created
+   !> with (written under a temporary name, renamed when complete).
+   subroutine h5_write_xdmf(self, path, error, data_path)
       class(h5_output_type), intent(in) :: self
       character(len=*), intent(in) :: path
       type(error_type), allocatable, intent(out) :: error
+      character(len=*), intent(in), optional :: data_path
 
       if (.not. allocated(self%path)) then
          call fatal_error(error, 'XDMF "'//path//'": no HDF5 file was created', stat_invalid_input)
          return
       end if
-      call write_xdmf_file(path, self%path, self%grids(:self%n_grids), error)
+      if (present(data_path)) then
+         call write_xdmf_file(path, data_path, self%grids(:self%n_grids), error)
+      else
+         call write_xdmf_file(path, self%path, self%grids(:self%n_grids), error)
+      end if
    end subroutine h5_write_xdmf
 
    logical function h5_opened(self)
