@@ -678,10 +678,12 @@ contains
       character(len=*), parameter :: names3(6) = [character(len=16) :: 'translation x', 'translation y', &
          & 'translation z', 'rotation about x', 'rotation about y', 'rotation about z']
       real(wp), allocatable :: field(:, :), r(:, :), kr(:, :), diag(:), work(:)
-      real(wp) :: g(6, 6), s(6), lam(6), xc(3), y(3)
-      integer :: nm, i, j, nn, nd, info, d
+      real(wp) :: g(6, 6), s(6), lam(6), xc(3), y(3), kmax
+      integer :: nm, i, j, nn, nd, info, d, nfree
       integer(kind(self%k%rowptr)) :: q
+      logical :: involved(6)
       character(len=:), allocatable :: what
+      character(len=32) :: count
 
       d = self%dim
       nm = merge(3, 6, d == 2)
@@ -720,12 +722,18 @@ contains
             if (self%k%col(q) == i) diag(i) = self%k%val(q)
          end do
       end do
+      ! K scales with Young's modulus: divide by its largest diagonal entry so that
+      ! the energies neither overflow nor underflow for any representable E.
+      kmax = maxval(abs(diag))
+      if (.not. (kmax > 0.0_wp)) kmax = 1.0_wp
+      diag = diag/kmax
+      kr = kr/kmax
       do i = 1, nm
-         s(i) = sum(diag*r(:, i)**2)
+         s(i) = sqrt(max(sum(diag*r(:, i)**2), tiny(1.0_wp)))
       end do
       do j = 1, nm
          do i = 1, nm
-            g(i, j) = dot_product(r(:, i), kr(:, j))/sqrt(max(s(i)*s(j), tiny(1.0_wp)))
+            g(i, j) = dot_product(r(:, i), kr(:, j))/s(i)/s(j)
          end do
       end do
       g(1:nm, 1:nm) = 0.5_wp*(g(1:nm, 1:nm) + transpose(g(1:nm, 1:nm)))
@@ -733,22 +741,28 @@ contains
       call dsyev('V', 'U', nm, g, 6, lam, work, size(work), info)
       if (info /= 0) return
       if (lam(1) >= rigid_tol) return
-      what = ''
+      ! The free motions span the eigenvectors below rigid_tol; name every basic
+      ! motion with a significant share in one of them, once.
+      involved = .false.
+      nfree = 0
       do j = 1, nm
          if (lam(j) >= rigid_tol) exit
-         do i = 1, nm
-            if (abs(g(i, j)) < 0.2_wp*maxval(abs(g(1:nm, j)))) cycle
-            if (len(what) > 0) what = what//', '
-            if (d == 2) then
-               what = what//trim(names2(i))
-            else
-               what = what//trim(names3(i))
-            end if
-         end do
-         what = what//';'
+         nfree = nfree + 1
+         involved(1:nm) = involved(1:nm) .or. abs(g(1:nm, j)) >= 0.2_wp*maxval(abs(g(1:nm, j)))
       end do
-      call fatal_error(error, 'the boundary conditions leave rigid-body motion free: '// &
-         & what(1:len(what) - 1)//' (add displacement or symmetry conditions that restrain it)', stat_singular)
+      what = ''
+      do i = 1, nm
+         if (.not. involved(i)) cycle
+         if (len(what) > 0) what = what//', '
+         if (d == 2) then
+            what = what//trim(names2(i))
+         else
+            what = what//trim(names3(i))
+         end if
+      end do
+      write (count, '(i0," independent motion",a)') nfree, trim(merge('s', ' ', nfree > 1))
+      call fatal_error(error, 'the boundary conditions leave rigid-body motion free: '//what//' ('// &
+         & trim(count)//'); add displacement or symmetry conditions that restrain it', stat_singular)
    end subroutine check_rigid_modes
 
    !> CHOLMOD, or UMFPACK when CHOLMOD finds K not positive definite.

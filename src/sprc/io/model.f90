@@ -4,6 +4,7 @@
 !> The scene reader has already validated every field; errors here are the
 !> constructors' own checks, prefixed with the scene group they came from.
 module sprc_io_model
+   use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_unsupported
    use sprc_core_material, only: plane_stress, plane_strain, solid
    use sprc_geometry_shape, only: geometry_shape => shape_type, new_disk, new_sphere, new_ellipse, &
@@ -16,7 +17,17 @@ module sprc_io_model
    implicit none
    private
 
-   public :: build_bodies, build_exact, analysis_kind
+   public :: build_bodies, build_exact, analysis_kind, analysis_units, in_units
+
+   !> Units of an analysis: moduli divided by `modulus`, displacements by `strain`
+   !> (lengths unchanged), stresses and loads by modulus*strain. Both are powers of two, so
+   !> the scaling is exact; the stiffness, loads, displacements and energies of the scaled
+   !> problem are O(1) whatever the scale of Young's modulus (E = 1e300 with pressure 1 gave
+   !> energies that underflow; E = 1e308 a stiffness that overflows). Relative errors are
+   !> unchanged.
+   type, public :: analysis_units_type
+      real(wp) :: modulus = 1.0_wp, strain = 1.0_wp
+   end type analysis_units_type
 
 contains
 
@@ -29,6 +40,99 @@ contains
       case default; analysis_kind = solid
       end select
    end function analysis_kind
+
+   !> The units of `scene`: `modulus` within a factor 2 of the first body's Young's modulus,
+   !> `strain` within a factor 2 of the largest strain the data imply (1 if none): load / modulus (loads:
+   !> pressures, tractions, body force times box_size, the exact solution's pressures and
+   !> remote stress) or prescribed displacement / box_size. stat_invalid_input when that
+   !> strain is not representable (loads 1e300 times the modulus).
+   subroutine analysis_units(scene, units, error)
+      type(scene_type), intent(in) :: scene
+      type(analysis_units_type), intent(out) :: units
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: load, disp
+      integer :: i, k
+
+      if (size(scene%bodies) == 0) return
+      units%modulus = scale(1.0_wp, exponent(scene%bodies(1)%young) - 1)
+      load = 0.0_wp
+      disp = 0.0_wp
+      do i = 1, size(scene%bodies)
+         if (allocated(scene%bodies(i)%body_force)) &
+            & load = max(load, maxval([0.0_wp, abs(scene%bodies(i)%body_force)])*scene%box_size)
+      end do
+      do i = 1, size(scene%bcs)
+         load = max(load, abs(scene%bcs(i)%value))
+         if (.not. allocated(scene%bcs(i)%vector)) cycle
+         if (scene%bcs(i)%type == 'displacement') then
+            disp = max(disp, maxval([0.0_wp, abs(scene%bcs(i)%vector)])/scene%box_size)
+         else
+            load = max(load, maxval([0.0_wp, abs(scene%bcs(i)%vector)]))
+         end if
+      end do
+      if (scene%exact%present) load = max(load, abs(scene%exact%p_in), abs(scene%exact%p_out), &
+         & abs(scene%exact%s_inf))
+      k = -huge(1)
+      if (load > 0.0_wp) k = exponent(load) - exponent(units%modulus)
+      if (disp > 0.0_wp) k = max(k, exponent(disp))
+      if (k == -huge(1)) return
+      ! the strain unit itself must be a double (subnormal allowed: only the written
+      ! displacements and stresses lose digits then, not the analysis)
+      if (k >= maxexponent(1.0_wp) .or. k <= minexponent(1.0_wp) - digits(1.0_wp)) then
+         call fatal_error(error, "the loads (or prescribed displacements) imply strains of about 1e"// &
+            & int_text(nint(0.30103_wp*real(k, wp)))//" (load / young), beyond double precision: "// &
+            & "check the units of young and of the loads", stat_invalid_input)
+         return
+      end if
+      units%strain = scale(1.0_wp, k)
+   end subroutine analysis_units
+
+   !> The scene in `units` (analysis_units_type): moduli divided by units%modulus; body
+   !> forces, pressures, tractions and the exact solution's pressures and remote stress by
+   !> units%modulus*units%strain (in two steps, so no intermediate overflows); prescribed
+   !> displacements by units%strain. Poisson's ratios and lengths stay.
+   function in_units(scene, units) result(scaled)
+      type(scene_type), intent(in) :: scene
+      type(analysis_units_type), intent(in) :: units
+      type(scene_type) :: scaled
+      integer :: i
+
+      scaled = scene
+      do i = 1, size(scaled%bodies)
+         scaled%bodies(i)%young = scene%bodies(i)%young/units%modulus
+         if (allocated(scene%bodies(i)%body_force)) scaled%bodies(i)%body_force = stress(scene%bodies(i)%body_force)
+      end do
+      do i = 1, size(scaled%bcs)
+         scaled%bcs(i)%value = stress1(scene%bcs(i)%value)
+         if (.not. allocated(scene%bcs(i)%vector)) cycle
+         if (scene%bcs(i)%type == 'displacement') then
+            scaled%bcs(i)%vector = scene%bcs(i)%vector/units%strain
+         else
+            scaled%bcs(i)%vector = stress(scene%bcs(i)%vector)
+         end if
+      end do
+      scaled%exact%p_in = stress1(scene%exact%p_in)
+      scaled%exact%p_out = stress1(scene%exact%p_out)
+      scaled%exact%s_inf = stress1(scene%exact%s_inf)
+   contains
+      pure function stress(v) result(w)
+         real(wp), intent(in) :: v(:)
+         real(wp) :: w(size(v))
+         w = (v/units%modulus)/units%strain
+      end function stress
+      pure real(wp) function stress1(v)
+         real(wp), intent(in) :: v
+         stress1 = (v/units%modulus)/units%strain
+      end function stress1
+   end function in_units
+
+   pure function int_text(i) result(text)
+      integer, intent(in) :: i
+      character(len=:), allocatable :: text
+      character(len=16) :: buf
+      write (buf, '(i0)') i
+      text = trim(buf)
+   end function int_text
 
    !> One geometry body per `&body`, its shapes added in file order; a body with
    !> material outside the scene's box is an input error (the grid would clip it).

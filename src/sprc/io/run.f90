@@ -26,7 +26,7 @@ module sprc_io_run
    use sprc_fem_bc, only: fe_bc_type, new_fe_bc, bc_kind_from_name
    use sprc_fem_problem, only: elasticity_problem_type
    use sprc_io_scene, only: scene_type, recovery_degree
-   use sprc_io_model, only: build_bodies, build_exact, analysis_kind
+   use sprc_io_model, only: build_bodies, build_exact, analysis_kind, analysis_units_type, analysis_units, in_units
    use sprc_io_report, only: report_row_type
    use sprc_io_hdf5, only: h5_output_type
    use sprc_io_xdmf, only: cell_quad4, cell_quad9, cell_hex8, cell_hex27
@@ -44,6 +44,10 @@ module sprc_io_run
       !> Gauss points per direction of the cut-cell rules.
       integer :: points = 0
       logical :: run_spr = .false., run_sprc = .false.
+      !> The analysis runs in these units (sprc_io_model): the scaled modulus and body force.
+      type(analysis_units_type) :: units
+      real(wp) :: young = 0.0_wp
+      real(wp), allocatable :: body_force(:)
    end type run_model_type
 
 contains
@@ -56,6 +60,7 @@ contains
       type(run_model_type), intent(out) :: model
       type(error_type), allocatable, intent(out) :: error
       type(body_type), allocatable :: bodies(:)
+      type(scene_type) :: scaled
 
       if (size(scene%contacts) > 0) then
          call fatal_error(error, 'sprc run: &contact is not implemented in this version', stat_unsupported)
@@ -68,9 +73,14 @@ contains
       call build_bodies(scene, bodies, error)
       if (allocated(error)) return
       model%body = bodies(1)
-      call build_exact(scene, model%exact, error)
+      call analysis_units(scene, model%units, error)
       if (allocated(error)) return
-      call fe_conditions(scene, model%bcs)
+      scaled = in_units(scene, model%units)
+      model%young = scaled%bodies(1)%young
+      model%body_force = scaled%bodies(1)%body_force
+      call build_exact(scaled, model%exact, error)
+      if (allocated(error)) return
+      call fe_conditions(scaled, model%bcs)
       model%analysis = analysis_kind(scene)
       model%points = points
       if (points == 0) model%points = default_points(scene%order)
@@ -131,11 +141,11 @@ contains
       if (allocated(error)) return
       associate (mat => scene%bodies(1))
          if (allocated(model%exact)) then
-            call problem%setup(model%body, grid, nodes, hanging, quad, model%analysis, mat%young, mat%poisson, &
-               mat%body_force, model%bcs, error, exact=model%exact)
+            call problem%setup(model%body, grid, nodes, hanging, quad, model%analysis, model%young, mat%poisson, &
+               model%body_force, model%bcs, error, exact=model%exact)
          else
-            call problem%setup(model%body, grid, nodes, hanging, quad, model%analysis, mat%young, mat%poisson, &
-               mat%body_force, model%bcs, error)
+            call problem%setup(model%body, grid, nodes, hanging, quad, model%analysis, model%young, mat%poisson, &
+               model%body_force, model%bcs, error)
          end if
       end associate
       if (allocated(error)) return
@@ -176,7 +186,8 @@ contains
       call check_row(row, allocated(model%exact), done, error)
       if (allocated(error)) return
       if (present(h5)) then
-         if (h5%opened()) call write_fields(h5, level, scene, grid, nodes, problem, field, est, done, error)
+         if (h5%opened()) call write_fields(h5, level, scene, model%units, grid, nodes, problem, field, est, done, &
+            & error)
       end if
    end subroutine run_level
 
@@ -235,9 +246,9 @@ contains
       ne = problem%grid%n_leaves
       ns = voigt_size(model%analysis)
       input%analysis = model%analysis
-      input%young = scene%bodies(1)%young
+      input%young = model%young
       input%poisson = scene%bodies(1)%poisson
-      input%body_force(1:scene%dim) = scene%bodies(1)%body_force
+      input%body_force(1:scene%dim) = model%body_force
       input%elem_ptr = problem%vol_ptr
       input%x = problem%vol_x(1:scene%dim, :)
       input%w = problem%vol_w
@@ -301,11 +312,13 @@ contains
 
    !> The level's mesh and fields: displacement, FE nodal stresses (average of
    !> the elements at each node), recovered nodal stresses, element error
-   !> indicators (ZZ per method; exact where known) and cell class.
-   subroutine write_fields(h5, level, scene, grid, nodes, problem, field, est, done, error)
+   !> indicators (ZZ per method; exact where known) and cell class. The analysis ran in
+   !> `units`: the fields are written in the scene's units.
+   subroutine write_fields(h5, level, scene, units, grid, nodes, problem, field, est, done, error)
       type(h5_output_type), intent(inout) :: h5
       integer, intent(in) :: level
       type(scene_type), intent(in) :: scene
+      type(analysis_units_type), intent(in) :: units
       type(grid_type), intent(in) :: grid
       type(grid_nodes_type), intent(in) :: nodes
       type(elasticity_problem_type), intent(in) :: problem
@@ -316,7 +329,7 @@ contains
       character(len=2), parameter :: c2(3) = ['xx', 'yy', 'xy'], c3(6) = ['xx', 'yy', 'zz', 'xy', 'yz', 'xz']
       character(len=4), parameter :: method_name(2) = ['spr ', 'sprc']
       real(wp), allocatable :: sigma_fe(:, :), elem(:, :), element_error(:)
-      real(wp) :: err_fe, norm_fe, norm_exact
+      real(wp) :: err_fe, norm_fe, norm_exact, sunit, eunit
       integer, allocatable :: cls(:, :)
       integer :: cell_type, m
 
@@ -327,23 +340,26 @@ contains
       end if
       call h5%write_level(level, nodes%x, nodes%connectivity, cell_type, error)
       if (allocated(error)) return
-      call h5%write_node_field(level, 'displacement', problem%u, error)
+      ! stress unit modulus*strain; energy norm sqrt(sigma D^-1 sigma): sqrt(modulus)*strain
+      sunit = units%modulus*units%strain
+      eunit = sqrt(units%modulus)*units%strain
+      call h5%write_node_field(level, 'displacement', units%strain*problem%u, error)
       if (allocated(error)) return
       call nodal_fe_stress(problem, nodes, sigma_fe)
-      call write_stress(h5, level, 'sigma_fe', sigma_fe, error)
+      call write_stress(h5, level, 'sigma_fe', sunit*sigma_fe, error)
       if (allocated(error)) return
       do m = 1, 2
          if (.not. done(m)) cycle
-         call write_stress(h5, level, 'sigma_'//trim(method_name(m)), field(m)%nodal, error)
+         call write_stress(h5, level, 'sigma_'//trim(method_name(m)), sunit*field(m)%nodal, error)
          if (allocated(error)) return
-         elem = reshape(sqrt(est(m)%elem_err2), [1, size(est(m)%elem_err2)])
+         elem = reshape(eunit*sqrt(est(m)%elem_err2), [1, size(est(m)%elem_err2)])
          call h5%write_cell_field(level, 'zz_error_'//trim(method_name(m)), elem, error)
          if (allocated(error)) return
       end do
       if (problem%solved .and. allocated(problem%exact)) then
          call problem%energy_error(err_fe, element_error, norm_fe, norm_exact, error)
          if (allocated(error)) return
-         elem = reshape(element_error, [1, size(element_error)])
+         elem = reshape(eunit*element_error, [1, size(element_error)])
          call h5%write_cell_field(level, 'exact_error_fe', elem, error)
          if (allocated(error)) return
       end if
