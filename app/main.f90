@@ -93,6 +93,7 @@ contains
       character(len=:), allocatable :: prefix
       integer, allocatable :: levels(:)
       integer :: i
+      character(len=16) :: buf
 
       call study_levels(scene, cli%levels, levels, error)
       if (allocated(error)) call fail(2, error%message)
@@ -112,7 +113,11 @@ contains
          if (.not. cli%quiet) write (error_unit, '(a,i0,a,i0,a,i0,a)') 'sprc: level ', levels(i), &
             ' (', i, ' of ', size(levels), ')'
          call run_level(scene, model, levels(i), rows(i), error, h5)
-         if (allocated(error)) call fail_with(error)
+         if (allocated(error)) then
+            write (buf, '("level ",i0,":")') levels(i)
+            error%message = trim(buf)//' '//error%message
+            call fail_with(error)
+         end if
          if (.not. cli%quiet) write (error_unit, '(a,i0,a,f0.3,a)') 'sprc: level ', levels(i), ' done in ', &
             rows(i)%t_total, ' s'
       end do

@@ -47,7 +47,7 @@ contains
       integer :: e, n, d, k, first, last, nb, best, dir(3)
       real(wp) :: lo(3), hi(3), c(3), dist, best_dist
       logical :: changed
-      character(len=160) :: buf
+      character(len=400) :: buf
 
       n = grid%n_leaves
       d = grid%dim
@@ -89,8 +89,10 @@ contains
       end do
       do e = 1, n
          if (root(e) == 0) then
-            write (buf, '("cell aggregation: cut cell ",i0," (volume fraction ",es9.2,") has no path to a ", &
-               & "cell with volume fraction >= eta = ",f5.3)') e, fraction(e), eta
+            write (buf, '("the body (or a part of it) is too thin for cells of this size: no cell of that part ", &
+               & "is filled to ",i0,"% or more (cut cell ",i0," is filled to ",g0.2,"%), so the cut-cell ", &
+               & "method has no cell to extend its small cuts from; raise the level, or refine_boundary, so that ", &
+               & "the body spans whole cells")') nint(100*eta), e, 100*fraction(e)
             call fatal_error(error, trim(buf), stat_invalid_input)
             return
          end if

@@ -8,7 +8,7 @@
 module sprc_io_run
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use sprc_core_kinds, only: wp, i8
-   use sprc_core_error, only: error_type, fatal_error, stat_unsupported, stat_internal
+   use sprc_core_error, only: error_type, fatal_error, stat_unsupported, stat_internal, stat_invalid_input
    use sprc_core_timer, only: timer_type, wall_time
    use sprc_core_material, only: voigt_size
    use sprc_geometry_body, only: body_type
@@ -137,6 +137,12 @@ contains
       if (.not. allocated(error)) call hanging%build(grid, nodes, error)
       call t_mesh%stop()
       if (allocated(error)) return
+      if ((model%run_spr .or. model%run_sprc) .and. sum(grid%n_inside) + sum(grid%n_cut) < 2) then
+         call fatal_error(error, 'one cell holds the whole body at this level, so every recovery patch is that '// &
+            & 'one element: the recovered stress is the FE stress and the estimate (eta = 0) says nothing; '// &
+            & 'use a higher level (or a smaller box_size)', stat_invalid_input)
+         return
+      end if
       call new_cut_quadrature(quad, scene%dim, model%points, error)
       if (allocated(error)) return
       associate (mat => scene%bodies(1))
