@@ -7,7 +7,7 @@ program sprc_main
    use sprc_core_error, only: error_type, stat_invalid_input, stat_io
    use sprc_version, only: sprc_version_string
    use sprc_io_scene, only: scene_type, read_scene, read_scene_text, scene_summary, default_scene_text
-   use sprc_io_model, only: build_bodies
+   use sprc_io_model, only: build_bodies, scene_warnings
    use sprc_geometry_body, only: body_type
    use sprc_io_study, only: mesh_row_type, mesh_study, format_mesh_row, study_levels
    use sprc_io_run, only: run_model_type, prepare_run, run_level
@@ -99,6 +99,7 @@ contains
       if (allocated(error)) call fail(2, error%message)
       call prepare_run(scene, cli%points, model, error)
       if (allocated(error)) call fail_with(error)
+      call print_warnings(scene_warnings(scene, [model%body]))
       if (cli%threads > 0) call omp_set_num_threads(cli%threads)
       prefix = scene%output
       if (len(cli%output) > 0) prefix = cli%output
@@ -167,6 +168,7 @@ contains
       if (allocated(error)) call fail(2, error%message)
       call build_bodies(scene, bodies, error)
       if (allocated(error)) call fail_with(error)
+      call print_warnings(scene_warnings(scene, bodies))
       write (output_unit, '(a)') scene_summary(scene)
    end subroutine check_scene
 
@@ -190,6 +192,19 @@ contains
       end do
    end subroutine mesh_scene
 
+
+   !> Lines 'warning: ...' on standard error, each as 'sprc: warning: ...'.
+   subroutine print_warnings(text)
+      character(len=*), intent(in) :: text
+      integer :: start, nl
+      start = 1
+      do while (start <= len(text))
+         nl = index(text(start:), new_line('a'))
+         if (nl == 0) nl = len(text) - start + 2
+         write (error_unit, '(a)') 'sprc: '//text(start:start + nl - 2)
+         start = start + nl
+      end do
+   end subroutine print_warnings
 
    subroutine fail(status, text)
       integer, intent(in) :: status

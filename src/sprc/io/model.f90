@@ -13,11 +13,11 @@ module sprc_io_model
    use sprc_exact_solution, only: exact_solution_type
    use sprc_exact_lame, only: lame_cylinder_type, lame_sphere_type, new_lame_cylinder, new_lame_sphere
    use sprc_exact_kirsch, only: kirsch_type, new_kirsch
-   use sprc_io_scene, only: scene_type, shape_type
+   use sprc_io_scene, only: scene_type, shape_type, real_text
    implicit none
    private
 
-   public :: build_bodies, build_exact, analysis_kind, analysis_units, in_units
+   public :: build_bodies, build_exact, analysis_kind, analysis_units, in_units, scene_warnings
 
    !> Units of an analysis: moduli divided by `modulus`, displacements by `strain`
    !> (lengths unchanged), stresses and loads by modulus*strain. Both are powers of two, so
@@ -125,6 +125,99 @@ contains
          stress1 = (v/units%modulus)/units%strain
       end function stress1
    end function in_units
+
+   !> Valid but physically odd input, as lines 'warning: ...' ('' if none): no load at all
+   !> (u = 0: err_fe 1, eta 0, theta 0 mean nothing), and an &exact whose domain does not fit
+   !> the first body (its distances from the solution's centre, sampled on a lattice of
+   !> 64^2 / 32^3 points of the box, do not reach the solution's radii within two lattice
+   !> steps; the errors would compare with the solution of another problem).
+   function scene_warnings(scene, bodies) result(text)
+      type(scene_type), intent(in) :: scene
+      type(geometry_body), intent(in) :: bodies(:)
+      character(len=:), allocatable :: text
+      real(wp) :: load, r(2), step
+      integer :: i
+
+      text = ''
+      load = 0.0_wp
+      do i = 1, size(scene%bodies)
+         if (allocated(scene%bodies(i)%body_force)) load = max(load, maxval([0.0_wp, abs(scene%bodies(i)%body_force)]))
+      end do
+      do i = 1, size(scene%bcs)
+         select case (scene%bcs(i)%type)
+         case ('pressure')
+            load = max(load, abs(scene%bcs(i)%value))
+         case ('traction', 'displacement')
+            load = max(load, maxval([0.0_wp, abs(scene%bcs(i)%vector)]))
+         case ('exact_traction', 'exact_displacement')
+            load = max(load, abs(scene%exact%p_in), abs(scene%exact%p_out), abs(scene%exact%s_inf))
+         end select
+      end do
+      if (.not. (load > 0.0_wp) .and. size(scene%contacts) == 0) text = text//'warning: no load: every '// &
+         & 'pressure, traction, body force and prescribed displacement is zero, so the displacement is zero '// &
+         & 'and the errors and estimates mean nothing'//new_line('a')
+      if (.not. scene%exact%present .or. size(bodies) == 0) return
+      if (index(scene%exact%kind, 'hertz_') == 1) return
+      call distance_range(scene, bodies(1), scene%exact%center, r, step)
+      if (.not. (r(1) <= r(2))) then
+         text = text//"warning: &exact: the body '"//bodies(1)%name//"' has no material on the sampling lattice; "// &
+            & 'the exact solution is not checked against it'//new_line('a')
+         return
+      end if
+      select case (scene%exact%kind)
+      case ('lame_cylinder', 'lame_sphere')
+         if (abs(r(1) - scene%exact%r_in) <= 2*step .and. abs(r(2) - scene%exact%r_out) <= 2*step) return
+         text = text//"warning: &exact '"//scene%exact%kind//"' does not fit body '"//bodies(1)%name// &
+            & "': its material lies at distances "//real_text(rounded(r(1)))//' .. '//real_text(rounded(r(2)))// &
+            & ' from the centre, the solution holds for r_in .. r_out = '//real_text(scene%exact%r_in)//' .. '// &
+            & real_text(scene%exact%r_out)//'; check center, r_in and r_out'//new_line('a')
+      case ('kirsch')
+         if (abs(r(1) - scene%exact%radius) <= 2*step) return
+         text = text//"warning: &exact 'kirsch' does not fit body '"//bodies(1)%name// &
+            & "': its material comes no nearer than "//real_text(rounded(r(1)))//' to the centre, the hole radius is '// &
+            & real_text(scene%exact%radius)//'; check center and radius'//new_line('a')
+      end select
+   end function scene_warnings
+
+   !> Smallest and largest distance from `center` of the body's points among the centres
+   !> of a lattice of 64^2 (2D) or 32^3 (3D) cells of the box; r(1) > r(2) if none is in
+   !> the body. `step` is the lattice diagonal.
+   subroutine distance_range(scene, body, center, r, step)
+      type(scene_type), intent(in) :: scene
+      type(geometry_body), intent(in) :: body
+      real(wp), intent(in) :: center(:)
+      real(wp), intent(out) :: r(2), step
+      real(wp) :: x(3), h, dist
+      integer :: n, i, j, k, d, nk
+
+      d = scene%dim
+      n = merge(64, 32, d == 2)
+      nk = merge(1, n, d == 2)
+      h = scene%box_size/real(n, wp)
+      step = h*sqrt(real(d, wp))
+      r = [huge(1.0_wp), 0.0_wp]
+      do k = 1, nk
+         do j = 1, n
+            do i = 1, n
+               x = h*([real(i, wp), real(j, wp), real(k, wp)] - 0.5_wp)
+               x(1:d) = scene%box_min(1:d) + x(1:d)
+               if (.not. (body%phi(x(1:d)) < 0.0_wp)) cycle
+               dist = norm2(x(1:d) - center(1:d))
+               r = [min(r(1), dist), max(r(2), dist)]
+            end do
+         end do
+      end do
+   end subroutine distance_range
+
+   !> v to six significant digits (sampled distances: more digits would be noise).
+   pure real(wp) function rounded(v)
+      real(wp), intent(in) :: v
+      real(wp) :: unit
+      rounded = v
+      if (.not. (v > 0.0_wp)) return
+      unit = 10.0_wp**(floor(log10(v)) - 5)
+      rounded = anint(v/unit)*unit
+   end function rounded
 
    pure function int_text(i) result(text)
       integer, intent(in) :: i

@@ -13,7 +13,7 @@ module sprc_io_scene
    private
 
    public :: scene_type, body_type, shape_type, bc_type, exact_type, contact_type
-   public :: read_scene, read_scene_text, default_scene_text, scene_summary, recovery_degree
+   public :: read_scene, read_scene_text, default_scene_text, scene_summary, recovery_degree, real_text
 
    !> One elastic body.
    type :: body_type
