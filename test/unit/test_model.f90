@@ -1,12 +1,14 @@
 !> Tests of the scene -> geometry bodies and exact solution glue.
 module sprc_test_model
-   use sprc_core_kinds, only: wp
+   use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, stat_invalid_input
    use sprc_geometry_body, only: body_type
    use sprc_geometry_region, only: cell_inside, cell_outside, cell_cut
    use sprc_exact_solution, only: exact_solution_type
    use sprc_io_scene, only: scene_type, read_scene, read_scene_text, default_scene_text
    use sprc_io_model, only: build_bodies, build_exact
+   use sprc_io_budget, only: level_memory, check_level_memory
+   use sprc_core_memory, only: available_memory
    use sprc_grid_tree, only: grid_type
    use sprc_testsuite, only: unittest_type, new_unittest, check
    implicit none
@@ -27,7 +29,8 @@ contains
          new_unittest('facade_reexports', test_facade), &
          new_unittest('grid_quarter_annulus', test_grid_annulus), &
          new_unittest('grid_sphere_octant', test_grid_octant), &
-         new_unittest('body_beyond_box', test_body_beyond_box) &
+         new_unittest('body_beyond_box', test_body_beyond_box), &
+         new_unittest('level_memory_estimate', test_level_memory) &
          ]
    end subroutine collect_model
 
@@ -103,6 +106,57 @@ contains
       if (allocated(error)) return
       call build_bodies(scene, bodies, error)
    end subroutine test_body_beyond_box
+
+   !> The cell estimate of a level (sprc_io_budget) bounds the active cells of the grid
+   !> built at that level from above, within 1.5x (Lame sphere octant level 5, cylinder
+   !> quarter level 8 with refine_boundary 1); available_memory is known on Linux; a 3D
+   !> level 9 (1e8 cells, terabytes) is refused naming the estimate and what is available.
+   subroutine test_level_memory(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(body_type), allocatable :: bodies(:)
+      type(grid_type) :: grid
+      type(error_type), allocatable :: e
+      real(wp) :: cells, dofs, bytes, actual
+      integer(i8) :: avail
+      character(len=:), allocatable :: source
+      integer :: k
+
+      call available_memory(avail, source)
+      call check(error, avail > 0, 'available memory known on Linux, from '//source)
+      if (allocated(error)) return
+      do k = 1, 2
+         if (k == 1) then
+            call load('example/scenes/lame_sphere.nml', scene, error)
+         else
+            call read_scene_text(replaced(default_scene_text(), 'refine_boundary = 0', 'refine_boundary = 1'), &
+               & 'rb1', scene, error)
+         end if
+         if (allocated(error)) return
+         call build_bodies(scene, bodies, error)
+         if (allocated(error)) return
+         call level_memory(scene, bodies(1), merge(5, 8, k == 1), cells, dofs, bytes, error)
+         if (allocated(error)) return
+         call grid%build(bodies(1), scene%dim, scene%box_min, scene%box_size, merge(5, 8, k == 1), &
+            & scene%refine_boundary, error)
+         if (allocated(error)) return
+         actual = real(sum(grid%n_inside) + sum(grid%n_cut), wp)
+         call check(error, cells >= actual .and. cells <= 1.5_wp*actual, 'cell estimate within [1, 1.5] of the '// &
+            & 'grid''s active cells')
+         if (allocated(error)) return
+         call check(error, bytes > 0.0_wp, 'positive estimate')
+         if (allocated(error)) return
+      end do
+      call load('example/scenes/lame_sphere.nml', scene, error)
+      if (allocated(error)) return
+      call build_bodies(scene, bodies, error)
+      if (allocated(error)) return
+      call check_level_memory(scene, bodies(1), 9, e)
+      call check(error, allocated(e), '3D level 9 refused')
+      if (allocated(error)) return
+      call check(error, index(e%message, 'needs about') > 0 .and. index(e%message, 'is available') > 0 .and. &
+         & index(e%message, 'use a lower level') > 0, 'message: '//e%message)
+   end subroutine test_level_memory
 
    pure function replaced(text, old, new) result(out)
       character(len=*), intent(in) :: text, old, new

@@ -27,6 +27,7 @@ module sprc_io_run
    use sprc_fem_problem, only: elasticity_problem_type
    use sprc_io_scene, only: scene_type, recovery_degree
    use sprc_io_model, only: build_bodies, build_exact, analysis_kind, analysis_units_type, analysis_units, in_units
+   use sprc_io_budget, only: check_level_memory
    use sprc_io_report, only: report_row_type
    use sprc_io_hdf5, only: h5_output_type
    use sprc_io_xdmf, only: cell_quad4, cell_quad9, cell_hex8, cell_hex27
@@ -130,6 +131,8 @@ contains
       logical :: done(2)
       integer :: m
 
+      call check_level_memory(scene, model%body, level, error)
+      if (allocated(error)) return
       t_start = wall_time()
       call t_mesh%start()
       call grid%build(model%body, scene%dim, scene%box_min, scene%box_size, level, scene%refine_boundary, error)

@@ -1,0 +1,119 @@
+!> The memory a level of a study will need, estimated before its grid is built,
+!> and the refusal of a level that cannot fit (a 3D level 9 has 1.3e8 cells:
+!> building it ran out of memory in the middle of the grid).
+!>
+!> Cells: the body's grid at a coarse level c (6 in 2D, 4 in 3D, at most the
+!> level itself; 4096 cells at most) gives its inside and cut cells; each
+!> covers 2^(dim (level - c)) cells of the level, the cut ones
+!> 2^((dim - 1)(level - c)) cut cells, and refine_boundary splits each of
+!> those into 2^(dim refine_boundary). An upper estimate of the cells (the
+!> cut cells at level c count whole).
+!> Dofs: dim nodes per cell for Q1, dim 2^dim for Q2.
+!> Bytes: peak resident memory measured with the release build on the
+!> example scenes (Lame cylinder, Lame sphere; Q1, Q2): about 25 MB plus, in
+!> 2D, 2.3 kB per dof (Q1 level 8, 62k dofs: 171 MB; Q2 level 7, 63k dofs:
+!> 155 MB) and, in 3D, where the Cholesky factor fills more, 6 kB per dof at
+!> 4e3 dofs and 10 kB at 2.7e4 (Q1 levels 4, 5: 49 MB, 295 MB), i.e. growing
+!> as dofs^(1/3), and 1.2-1.75 times that for Q2 (levels 3, 4: 69 MB, 373 MB).
+!> The estimate below takes the upper figures: 32 MB + dofs * 2.5 kB (2D) or
+!> 10 kB (dofs / 3e4)^(1/3) (3D; times 1.75 for Q2).
+!> Under an address-space limit (ulimit -v) the virtual size counts, and
+!> OpenBLAS reserves a buffer of 128 MiB for each thread that calls it, when it
+!> first does (malloc(134221824) per thread, seen in a debugger); without that
+!> reserve a level that passed the check hung in OpenBLAS's retry loop of
+!> blas_memory_alloc (3D level 5 under ulimit -v 600000).
+module sprc_io_budget
+   !$ use omp_lib, only: omp_get_max_threads
+   use sprc_core_kinds, only: wp, i8
+   use sprc_core_error, only: error_type, fatal_error, stat_out_of_memory
+   use sprc_core_memory, only: available_memory
+   use sprc_geometry_body, only: body_type
+   use sprc_grid_tree, only: grid_type
+   use sprc_io_scene, only: scene_type
+   implicit none
+   private
+
+   public :: level_memory, check_level_memory
+
+   real(wp), parameter :: base_bytes = 32.0e6_wp, per_dof_2d = 2.5e3_wp, per_dof_3d = 1.0e4_wp, &
+      & dofs_3d = 3.0e4_wp, q2_factor_3d = 1.75_wp
+   !> Address space OpenBLAS reserves per calling thread (module notes).
+   real(wp), parameter :: blas_buffer_bytes = 134221824.0_wp
+
+contains
+
+   !> Estimated cells, dofs and peak bytes of `level` of the scene's study for `body`
+   !> (module notes).
+   subroutine level_memory(scene, body, level, cells, dofs, bytes, error)
+      type(scene_type), intent(in) :: scene
+      type(body_type), intent(in) :: body
+      integer, intent(in) :: level
+      real(wp), intent(out) :: cells, dofs, bytes
+      type(error_type), allocatable, intent(out) :: error
+      type(grid_type) :: grid
+      integer :: d, coarse, up
+      real(wp) :: active, cut, per_dof
+
+      cells = 0.0_wp
+      dofs = 0.0_wp
+      bytes = 0.0_wp
+      d = scene%dim
+      coarse = min(level, merge(6, 4, d == 2))
+      call grid%build(body, d, scene%box_min, scene%box_size, coarse, 0, error)
+      if (allocated(error)) return
+      active = real(sum(grid%n_inside) + sum(grid%n_cut), wp)
+      cut = real(sum(grid%n_cut), wp)
+      up = level - coarse
+      cells = active*2.0_wp**(d*up) + cut*2.0_wp**((d - 1)*up)*(2.0_wp**(d*scene%refine_boundary) - 1.0_wp)
+      dofs = real(d*scene%order**d, wp)*cells
+      if (d == 2) then
+         per_dof = per_dof_2d
+      else
+         per_dof = per_dof_3d*(dofs/dofs_3d)**(1.0_wp/3.0_wp)
+         if (scene%order == 2) per_dof = q2_factor_3d*per_dof
+      end if
+      bytes = base_bytes + dofs*per_dof
+   end subroutine level_memory
+
+   !> stat_out_of_memory when the estimate of `level` exceeds the memory this process
+   !> may still use (sprc_core_memory); the message names the estimate, what is available
+   !> and what bounds it.
+   subroutine check_level_memory(scene, body, level, error)
+      type(scene_type), intent(in) :: scene
+      type(body_type), intent(in) :: body
+      integer, intent(in) :: level
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: cells, dofs, bytes
+      integer(i8) :: avail
+      character(len=:), allocatable :: source
+      character(len=256) :: buf
+      integer :: threads
+
+      call level_memory(scene, body, level, cells, dofs, bytes, error)
+      if (allocated(error)) return
+      call available_memory(avail, source)
+      threads = 1
+      !$ threads = omp_get_max_threads()
+      if (source == 'ulimit -v') bytes = bytes + real(threads + 1, wp)*blas_buffer_bytes
+      if (avail < 0 .or. bytes <= real(avail, wp)) return
+      write (buf, '("needs about ",a," of memory (an estimate for ",es7.1," cells, ",es7.1, &
+         & " dofs), but ",a," is available (",a,"); use a lower level")') gigabytes(bytes), cells, dofs, &
+         & gigabytes(real(avail, wp)), source
+      call fatal_error(error, trim(buf), stat_out_of_memory)
+   end subroutine check_level_memory
+
+   pure function gigabytes(bytes) result(text)
+      real(wp), intent(in) :: bytes
+      character(len=:), allocatable :: text
+      character(len=24) :: buf
+      if (bytes < 1.0e9_wp) then
+         write (buf, '(i0," MB")') nint(bytes/1.0e6_wp)
+      else if (bytes < 1.0e6_wp*huge(1)) then
+         write (buf, '(f0.1," GB")') bytes/1.0e9_wp
+      else
+         write (buf, '(es8.1," GB")') bytes/1.0e9_wp
+      end if
+      text = trim(adjustl(buf))
+   end function gigabytes
+
+end module sprc_io_budget
