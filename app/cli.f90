@@ -106,6 +106,14 @@ contains
             message = 'sprc '//cli%command//': --output "'//value//'" is blank; give a file prefix'
             return
          end if
+         ! 'res/' would write the hidden files res/.csv, res/.h5, ...
+         if (len(value) > 0) then
+            if (value(len(value):) == '/') then
+               message = 'sprc '//cli%command//': --output "'//value//'" names a directory; give a file prefix '// &
+                  & 'such as "'//value//'name"'
+               return
+            end if
+         end if
          cli%output = value
       case ('--threads')
          call parse_positive(arg, value, 4096, cli%threads, message)

@@ -40,7 +40,8 @@ def run_scene(path, levels=None):
     columns are ``int``, the others ``float``; a cell that does not apply is
     ``None``. ``levels`` (a sequence of ints) overrides the scene's levels.
     Writes no files. Raises :class:`SprcError` with the library's message
-    when the scene cannot be read or run, ``ValueError`` for bad ``levels``.
+    when the scene cannot be read or run, ``ValueError`` for bad ``levels``
+    or a path with a NUL character.
     """
     if levels is None:
         lv, nlevels, lv_ptr = None, 0, None
@@ -51,7 +52,11 @@ def run_scene(path, levels=None):
         if not np.array_equal(lv, np.asarray(levels)):
             raise ValueError(f"levels must be integers, got {levels!r}")
         nlevels, lv_ptr = lv.size, lv.ctypes.data_as(ctypes.POINTER(ctypes.c_int))
-    report = ctypes.c_void_p(library.run_scene(os.fsencode(path), lv_ptr, nlevels))
+    encoded = os.fsencode(path)
+    if b"\0" in encoded:
+        # C would read the path up to the NUL: another file, silently.
+        raise ValueError(f"path contains a NUL character: {path!r}")
+    report = ctypes.c_void_p(library.run_scene(encoded, lv_ptr, nlevels))
     try:
         nrows = library.get_report_rows(report)
         ncols = library.get_report_columns(report)

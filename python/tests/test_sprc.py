@@ -170,3 +170,9 @@ def test_library_not_found_names_what_was_tried(tmp_path):
     out = subprocess.run([sys.executable, "-c", "import sprc"], env=env, capture_output=True, text=True)
     assert out.returncode != 0
     assert "libsprc.so not found" in out.stderr and "libnothing.so" in out.stderr
+
+
+def test_path_with_nul_is_refused(tmp_path):
+    # C would read the path up to the NUL and run another file, silently.
+    with pytest.raises(ValueError, match="NUL"):
+        sprc.run_scene(str(LAME) + "\0.ignored", levels=[3])

@@ -421,6 +421,12 @@ contains
       ! 5 columns x 3 rows x 2 panels of markers.
       call check(error, count_sub(text, 'class="point'), 30, 'markers')
       if (allocated(error)) return
+      ! err_fe is a wide pale band drawn first: eta_sprc on top of it (effectivity 1)
+      ! hid it when both were thin lines.
+      call check(error, index(text, 'class="line err_fe"') > 0 .and. &
+         & index(text, 'class="line err_fe"') < index(text, 'class="line eta_sprc"') .and. &
+         & count_sub(text, 'stroke-width="6" stroke-opacity="0.35"') == 3, 'err_fe band under the other lines')
+      if (allocated(error)) return
       call check(error, index(text, 'run time') > 0 .and. index(text, 'degrees of freedom') > 0 .and. &
          index(text, 'relative error') > 0, 'axis labels')
       if (allocated(error)) return

@@ -283,7 +283,8 @@ contains
       if (allocated(error)) return
       call check(error, recovery_degree(s), 3, "recovery_degree = 'p+1' with order 2")
       if (allocated(error)) return
-      call check(error, index(scene_summary(s), 'recovery_degree = 3') > 0, 'summary shows the recovery degree')
+      call check(error, index(scene_summary(s), "recovery_degree = 'p+1' (patch degree 3)") > 0, &
+         & 'summary shows the recovery degree keyword and the patch degree')
    end subroutine test_case
 
    subroutine test_summary_order1(error)

@@ -323,6 +323,14 @@ contains
          scene%output = ''
          call nml_get(g, 'output', scene%output, found, error)
          if (allocated(error)) return
+         if (len(scene%output) > 0) then
+            ! 'res/' would write the hidden files res/.csv, res/.h5, ...
+            if (scene%output(len(scene%output):) == '/') then
+               call nml_field_error(g, 'output', 'names a directory; give a file prefix such as '''// &
+                  & scene%output//'name''', error)
+               return
+            end if
+         end if
          call nml_check_consumed(g, error)
       end associate
    end subroutine read_scene_group
@@ -927,7 +935,8 @@ contains
       text = text//'  box_min         = '//real_list(scene%box_min)//nl
       text = text//'  box_size        = '//real_text(scene%box_size)//nl
       text = text//'  recovery        = '//scene%recovery//nl
-      text = text//'  recovery_degree = '//int_text(recovery_degree(scene))//nl
+      text = text//"  recovery_degree = '"//scene%recovery_degree//"' (patch degree "// &
+         & int_text(recovery_degree(scene))//')'//nl
       text = text//"  output          = '"//scene%output//"'"//nl
       do i = 1, size(scene%bodies)
          associate (b => scene%bodies(i))

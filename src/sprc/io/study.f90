@@ -51,7 +51,7 @@ contains
          if (override(i) < 0 .or. override(i) > top) then
             write (buf, '(i0)') override(i)
             call fatal_error(error, '--levels: level '//trim(buf)//' is out of range for a '// &
-               merge('2D', '3D', scene%dim == 2)//' scene (0..'//merge('14', '9 ', scene%dim == 2)//')', &
+               merge('2D', '3D', scene%dim == 2)//' scene (0..'//trim(merge('14', '9 ', scene%dim == 2))//')', &
                stat_invalid_input)
             return
          end if

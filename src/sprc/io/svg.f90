@@ -3,7 +3,9 @@
 !> with markers per column err_fe, err_spr, err_sprc, eta_spr, eta_sprc.
 !>
 !> Colours pair each estimate with its recovery: err_X solid with filled
-!> circles, eta_X dashed with open squares, same colour. Columns that are
+!> circles, eta_X dashed with open squares, same colour. err_fe, the reference,
+!> is a wide pale band drawn first, so that a line on it (eta_sprc when the
+!> effectivity is 1) stays visible and so does the band. Columns that are
 !> empty in every row are left out (also from the legend). A log axis cannot
 !> show empty cells or values <= 0: such points are skipped and listed in a
 !> comment in the file. A series with one point gets a marker, no line.
@@ -166,8 +168,7 @@ contains
                pts = pts//' '//num(xs(i))//','//num(ys(i))
             end do
             text = text//'<polyline class="line '//trim(series_name(k))//'" points="'//pts(2:)// &
-               '" fill="none" stroke="'//series_colour(k)//'" stroke-width="1.8"'// &
-               pick(series_estimate(k), ' stroke-dasharray="6,4"', '')//'/>'//nl
+               '" fill="none" stroke="'//series_colour(k)//'"'//series_stroke(k)//'/>'//nl
          end if
          do i = 1, m
             text = text//marker(k, xs(i), ys(i), 'point '//trim(series_name(k)))
@@ -262,11 +263,25 @@ contains
       if (series_estimate(k)) then
          text = '<rect class="'//class//'" x="'//num(x - 3.5_wp)//'" y="'//num(y - 3.5_wp)// &
             '" width="7" height="7" fill="white" stroke="'//series_colour(k)//'" stroke-width="1.5"/>'//nl
+      else if (k == 1) then
+         text = '<circle class="'//class//'" cx="'//num(x)//'" cy="'//num(y)//'" r="6" fill="'// &
+            series_colour(k)//'" fill-opacity="0.35"/>'//nl
       else
          text = '<circle class="'//class//'" cx="'//num(x)//'" cy="'//num(y)//'" r="4" fill="'// &
             series_colour(k)//'"/>'//nl
       end if
    end function marker
+
+   !> Stroke attributes of series k: err_fe (k = 1) a wide pale band, estimates dashed.
+   pure function series_stroke(k) result(text)
+      integer, intent(in) :: k
+      character(len=:), allocatable :: text
+      if (k == 1) then
+         text = ' stroke-width="6" stroke-opacity="0.35"'
+      else
+         text = ' stroke-width="1.8"'//pick(series_estimate(k), ' stroke-dasharray="6,4"', '')
+      end if
+   end function series_stroke
 
    !> One row of legend entries under the panels, centred.
    function legend(active) result(text)
@@ -282,8 +297,7 @@ contains
       do k = 1, n_series
          if (.not. active(k)) cycle
          text = text//'<line x1="'//num(x)//'" y1="'//num(y)//'" x2="'//num(x + 36)//'" y2="'//num(y)// &
-            '" stroke="'//series_colour(k)//'" stroke-width="1.8"'// &
-            pick(series_estimate(k), ' stroke-dasharray="6,4"', '')//'/>'//nl// &
+            '" stroke="'//series_colour(k)//'"'//series_stroke(k)//'/>'//nl// &
             marker(k, x + 18, y, 'legend')// &
             '<text x="'//num(x + 44)//'" y="'//num(y + 4)//'">'//trim(series_name(k))//'</text>'//nl
          x = x + entry_width
