@@ -162,6 +162,9 @@ module sprc_io_scene
    integer, parameter :: max_level_2d = 14, max_level_3d = 9
    integer, parameter :: max_refine_boundary = 6
 
+   !> Longest name of a body or shape: names are identifiers that messages quote
+   !> (a 100,000-character name was echoed whole in every message naming it).
+   integer, parameter :: max_name_length = 64
    character(len=*), parameter :: name_chars = &
       'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-.'
 
@@ -812,6 +815,9 @@ contains
          call nml_field_error(g, key, 'must not be empty', error)
       else if (verify(value, name_chars) /= 0) then
          call nml_field_error(g, key, 'may contain only letters, digits, ''_'', ''-'' and ''.''', error)
+      else if (len(value) > max_name_length) then
+         call nml_field_error(g, key, 'is '//int_text(len(value))//' characters long; names have at most '// &
+            & int_text(max_name_length), error)
       end if
    end subroutine get_name
 
