@@ -19,7 +19,7 @@ HDF5_LDIR := $(shell pkg-config --libs-only-L hdf5 2>/dev/null || echo -L/usr/li
 DEP_LIBS := $(HDF5_LDIR) -lhdf5_fortran -lhdf5 -lcholmod -lumfpack -lsuitesparseconfig -llapack -lblas \
             -lgfortran -lgomp -lm
 
-.PHONY: all deps build run test bench clean help lib install
+.PHONY: all deps build run test bench clean help lib install fuzz
 
 all: build
 
@@ -27,6 +27,7 @@ help:
 	@echo "make run     install what is missing, build (release) and run the driver on its default scene"
 	@echo "make test    install what is missing and run the whole test suite"
 	@echo "make bench   benchmarks (sparse direct solvers, grid build)"
+	@echo "make fuzz    5000 seeded mutants of the example scenes through sprc check and run (FUZZ_COUNT, FUZZ_SEED)"
 	@echo "make build   build the release profile"
 	@echo "make lib     build/lib/libsprc.so and libsprc.a, Fortran modules in build/lib/mod"
 	@echo "make install PREFIX=DIR   lib, include (sprc.h, modules in include/sprc), pkg-config, bin/sprc"
@@ -43,6 +44,13 @@ run: deps
 
 test: deps
 	@tools/run-tests
+
+# Long seeded fuzz of the scene input (make test runs 300 mutants, seed 1).
+FUZZ_COUNT ?= 5000
+FUZZ_SEED ?= 2
+fuzz: deps
+	$(FPM) build
+	@tools/fuzz-scenes --count $(FUZZ_COUNT) --seed $(FUZZ_SEED)
 
 bench: deps
 	@tools/bench-sparse
