@@ -13,7 +13,7 @@ module sprc_io_model
    use sprc_exact_solution, only: exact_solution_type
    use sprc_exact_lame, only: lame_cylinder_type, lame_sphere_type, new_lame_cylinder, new_lame_sphere
    use sprc_exact_kirsch, only: kirsch_type, new_kirsch
-   use sprc_io_scene, only: scene_type, shape_type, real_text
+   use sprc_io_scene, only: scene_type, shape_type, real_text, int_text
    implicit none
    private
 
@@ -218,14 +218,6 @@ contains
       unit = 10.0_wp**(floor(log10(v)) - 5)
       rounded = anint(v/unit)*unit
    end function rounded
-
-   pure function int_text(i) result(text)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: text
-      character(len=16) :: buf
-      write (buf, '(i0)') i
-      text = trim(buf)
-   end function int_text
 
    !> One geometry body per `&body`, its shapes added in file order; a body with
    !> material outside the scene's box is an input error (the grid would clip it).

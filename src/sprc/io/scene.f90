@@ -13,7 +13,7 @@ module sprc_io_scene
    private
 
    public :: scene_type, body_type, shape_type, bc_type, exact_type, contact_type
-   public :: read_scene, read_scene_text, default_scene_text, scene_summary, recovery_degree, real_text
+   public :: read_scene, read_scene_text, default_scene_text, scene_summary, recovery_degree, real_text, int_text
 
    !> One elastic body.
    type :: body_type
@@ -1229,6 +1229,7 @@ contains
       if (scene%recovery_degree == 'p+1') recovery_degree = scene%order + 1
    end function recovery_degree
 
+   !> Decimal text of an integer (no blanks).
    pure function int_text(i) result(text)
       integer, intent(in) :: i
       character(len=:), allocatable :: text
