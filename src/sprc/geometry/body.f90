@@ -436,7 +436,7 @@ contains
                where = where//' x '//real_str(box_min(j))//'..'//real_str(box_min(j) + box_size)
             end do
             call fatal_error(error, "body '"//body_name(self)//"' extends beyond the scene's box "//where// &
-               & ' (box_min, box_size): it has material at ('//real_list(x(1:d))//'), which the grid would '// &
+               & ' (&scene: box_min, box_size): it has material at ('//real_list(x(1:d))//'), which the grid would '// &
                & 'cut off; enlarge box_size or move box_min so that the box holds the whole body', &
                & stat_invalid_input)
             return
