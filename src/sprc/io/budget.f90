@@ -17,6 +17,10 @@
 !> as dofs^(1/3), and 1.2-1.75 times that for Q2 (levels 3, 4: 69 MB, 373 MB).
 !> The estimate below takes the upper figures: 32 MB + dofs * 2.5 kB (2D) or
 !> 10 kB (dofs / 3e4)^(1/3) (3D; times 1.75 for Q2).
+!> The grid and its quadrature alone (`sprc mesh`, `grid_only`): about 12 MB
+!> plus 105 bytes per active cell (sphere octant level 7: 5.1e5 cells, 66 MB;
+!> cylinder quarter level 10: 5.0e5 cells, 64 MB); the estimate takes 16 MB +
+!> 128 bytes per cell.
 !> Under an address-space limit (ulimit -v) the virtual size counts, and
 !> OpenBLAS reserves a buffer of 128 MiB for each thread that calls it, when it
 !> first does (malloc(134221824) per thread, seen in a debugger); without that
@@ -39,17 +43,20 @@ module sprc_io_budget
       & dofs_3d = 3.0e4_wp, q2_factor_3d = 1.75_wp
    !> Address space OpenBLAS reserves per calling thread (module notes).
    real(wp), parameter :: blas_buffer_bytes = 134221824.0_wp
+   !> Grid and quadrature only (module notes).
+   real(wp), parameter :: grid_base_bytes = 16.0e6_wp, per_cell_grid = 128.0_wp
 
 contains
 
    !> Estimated cells, dofs and peak bytes of `level` of the scene's study for `body`
-   !> (module notes).
-   subroutine level_memory(scene, body, level, cells, dofs, bytes, error)
+   !> (module notes); with `grid_only`, the bytes of the grid and its quadrature alone.
+   subroutine level_memory(scene, body, level, cells, dofs, bytes, error, grid_only)
       type(scene_type), intent(in) :: scene
       type(body_type), intent(in) :: body
       integer, intent(in) :: level
       real(wp), intent(out) :: cells, dofs, bytes
       type(error_type), allocatable, intent(out) :: error
+      logical, intent(in), optional :: grid_only
       type(grid_type) :: grid
       integer :: d, coarse, up
       real(wp) :: active, cut, per_dof
@@ -73,23 +80,28 @@ contains
          if (scene%order == 2) per_dof = q2_factor_3d*per_dof
       end if
       bytes = base_bytes + dofs*per_dof
+      if (present(grid_only)) then
+         if (grid_only) bytes = grid_base_bytes + per_cell_grid*cells
+      end if
    end subroutine level_memory
 
    !> stat_out_of_memory when the estimate of `level` exceeds the memory this process
    !> may still use (sprc_core_memory); the message names the estimate, what is available
    !> and what bounds it.
-   subroutine check_level_memory(scene, body, level, error)
+   subroutine check_level_memory(scene, body, level, error, grid_only)
       type(scene_type), intent(in) :: scene
       type(body_type), intent(in) :: body
       integer, intent(in) :: level
       type(error_type), allocatable, intent(out) :: error
+      !> Only the grid and its quadrature will be built (`sprc mesh`).
+      logical, intent(in), optional :: grid_only
       real(wp) :: cells, dofs, bytes
       integer(i8) :: avail
       character(len=:), allocatable :: source
       character(len=256) :: buf
       integer :: threads
 
-      call level_memory(scene, body, level, cells, dofs, bytes, error)
+      call level_memory(scene, body, level, cells, dofs, bytes, error, grid_only)
       if (allocated(error)) return
       call available_memory(avail, source)
       threads = 1

@@ -10,6 +10,7 @@ module sprc_io_study
       & default_points
    use sprc_io_scene, only: scene_type
    use sprc_io_model, only: build_bodies
+   use sprc_io_budget, only: check_level_memory
    implicit none
    private
 
@@ -82,11 +83,14 @@ contains
       do l = 1, size(levels)
          do b = 1, size(bodies)
             k = k + 1
-            call timer%reset()
-            call timer%start()
-            call grid%build(bodies(b), scene%dim, scene%box_min, scene%box_size, levels(l), &
-               scene%refine_boundary, error)
-            call timer%stop()
+            call check_level_memory(scene, bodies(b), levels(l), error, grid_only=.true.)
+            if (.not. allocated(error)) then
+               call timer%reset()
+               call timer%start()
+               call grid%build(bodies(b), scene%dim, scene%box_min, scene%box_size, levels(l), &
+                  scene%refine_boundary, error)
+               call timer%stop()
+            end if
             if (allocated(error)) then
                error%message = 'body '''//bodies(b)%name//''', level '//itoa(levels(l))//': '//error%message
                return
