@@ -5,6 +5,7 @@ program sprc_main
    use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
    use omp_lib, only: omp_set_num_threads, omp_get_max_threads
    use sprc_core_kinds, only: wp
+   use sprc_core_text, only: fixed_text
    use sprc_core_error, only: error_type, stat_invalid_input, stat_io
    use sprc_version, only: sprc_version_string
    use sprc_io_scene, only: scene_type, read_scene, read_scene_text, scene_summary, default_scene_text
@@ -136,7 +137,7 @@ contains
             call fail_with(error)
          end if
          if (.not. cli%quiet) write (error_unit, '(a,i0,a)') 'sprc: level ', levels(i), ' done in '// &
-            seconds_text(rows(i)%t_total)//' s'
+            fixed_text(rows(i)%t_total, 3)//' s'
       end do
       write (output_unit, '(a)') scene%title
       write (output_unit, '(a)', advance='no') report_table(rows)
@@ -208,16 +209,6 @@ contains
       end do
    end subroutine mesh_scene
 
-
-   !> Seconds with three decimals and the leading zero f0.3 drops (0.063, 12.345).
-   function seconds_text(t) result(text)
-      real(wp), intent(in) :: t
-      character(len=:), allocatable :: text
-      character(len=32) :: buf
-      write (buf, '(f0.3)') t
-      text = trim(adjustl(buf))
-      if (text(1:1) == '.') text = '0'//text
-   end function seconds_text
 
    !> Lines 'warning: ...' on standard error, each as 'sprc: warning: ...'.
    subroutine print_warnings(text)

@@ -5,6 +5,7 @@ module sprc_test_core
    use sprc_core_error, only: error_type, fatal_error, stat_name, stat_invalid_input, &
       & stat_singular, stat_not_positive_definite
    use sprc_core_timer, only: timer_type, wall_time
+   use sprc_core_text, only: fixed_text
    use sprc_core_lapack, only: dgesv, dgecon, dgetrf, dlange, dpotrf, dpotrs, dgeqp3, dgesvd, &
       & dgemm, dsyrk, dsysv, lapack_info_error
    use sprc_testsuite, only: unittest_type, new_unittest, check
@@ -27,6 +28,7 @@ contains
          new_unittest('dpotrf_spd_and_not', test_dpotrf), &
          new_unittest('dgeqp3_rank', test_dgeqp3_rank), &
          new_unittest('dgesvd_known', test_dgesvd), &
+         new_unittest('fixed_text_leading_zero', test_fixed_text), &
          new_unittest('dgemm_dsyrk', test_dgemm_dsyrk), &
          new_unittest('dsysv_indefinite', test_dsysv), &
          new_unittest('lapack_info_translation', test_info_translation) &
@@ -152,6 +154,18 @@ contains
       end do
       call check(error, rank, 2, 'numerical rank')
    end subroutine test_dgeqp3_rank
+
+   !> Fixed notation keeps the zero before the point that f0.d drops ('done in .063 s').
+   subroutine test_fixed_text(error)
+      type(error_type), allocatable, intent(out) :: error
+      call check(error, fixed_text(0.063_dp, 3), '0.063')
+      if (allocated(error)) return
+      call check(error, fixed_text(-0.5_dp, 2), '-0.50')
+      if (allocated(error)) return
+      call check(error, fixed_text(12.345_dp, 3), '12.345')
+      if (allocated(error)) return
+      call check(error, fixed_text(0.0_dp, 1), '0.0')
+   end subroutine test_fixed_text
 
    !> Singular values of [[3,0],[4,5]] are sqrt(45) and sqrt(5) (A^T A has eigenvalues 45 and 5).
    subroutine test_dgesvd(error)

@@ -19,6 +19,7 @@
 !> gives fmin = 0: outside.
 module sprc_geometry_body
    use sprc_core_kinds, only: wp
+   use sprc_core_text, only: fixed_text
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_geometry_region, only: region_type, cell_outside, cell_inside, cell_cut
    use sprc_geometry_shape, only: shape_type, shape_kind_name
@@ -499,11 +500,7 @@ contains
          n = index(buf, 'E')
          s = strip_zeros(buf(1:n - 1))//'e'//buf(n + 1:len_trim(buf))
       else
-         write (buf, '(f0.6)') v
-         ! f0 drops the zero before the point (.5, -.5)
-         if (buf(1:1) == '.') buf = '0'//buf
-         if (buf(1:2) == '-.') buf = '-0'//buf(2:)
-         s = strip_zeros(trim(buf))
+         s = strip_zeros(fixed_text(v, 6))
       end if
    end function real_str
 

@@ -10,6 +10,7 @@
 module sprc_io_report
    use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_is_finite
    use sprc_core_kinds, only: wp, i8
+   use sprc_core_text, only: fixed_text
    use sprc_core_error, only: error_type, fatal_error, stat_io, stat_invalid_input
    implicit none
    private
@@ -244,7 +245,7 @@ contains
    function sig3(x) result(s)
       real(wp), intent(in) :: x
       character(len=:), allocatable :: s
-      character(len=32) :: buf, fmt
+      character(len=32) :: buf
       integer :: d, decimals
       real(wp) :: a
 
@@ -265,28 +266,15 @@ contains
       end if
       if (d < -4 .or. d > 5) then
          write (buf, '(es9.2)') x
+         s = trim(adjustl(buf))
       else if (d >= 2) then
          write (buf, '(i0)') nint(x, i8)
+         s = trim(adjustl(buf))
       else
          decimals = 2 - d
-         write (fmt, '("(f0.",i0,")")') decimals
-         write (buf, fmt) x
+         s = fixed_text(x, decimals)
       end if
-      s = leading_zero(trim(adjustl(buf)))
    end function sig3
-
-   !> Add the zero some compilers omit before the decimal point (".5" -> "0.5").
-   pure function leading_zero(t) result(s)
-      character(len=*), intent(in) :: t
-      character(len=:), allocatable :: s
-      s = t
-      if (len(t) == 0) return
-      if (t(1:1) == '.') then
-         s = '0'//t
-      else if (len(t) > 1) then
-         if (t(1:2) == '-.') s = '-0'//t(2:)
-      end if
-   end function leading_zero
 
    !> CSV text of column j of a row: integers plain, reals with 17
    !> significant digits and a 3-digit exponent (read back bit for bit, by

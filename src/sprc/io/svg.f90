@@ -12,6 +12,7 @@
 !> No scripts, no external fonts or references (generic `sans-serif`).
 module sprc_io_svg
    use sprc_core_kinds, only: wp
+   use sprc_core_text, only: fixed_text
    use sprc_core_error, only: error_type, fatal_error, stat_io
    use sprc_io_report, only: report_row_type, report_column, is_empty
    implicit none
@@ -320,14 +321,7 @@ contains
    function num(v) result(s)
       real(wp), intent(in) :: v
       character(len=:), allocatable :: s
-      character(len=32) :: buf
-      write (buf, '(f0.2)') v
-      s = trim(adjustl(buf))
-      if (s(1:1) == '.') then
-         s = '0'//s
-      else if (len(s) > 1) then
-         if (s(1:2) == '-.') s = '-0'//s(2:)
-      end if
+      s = fixed_text(v, 2)
    end function num
 
    !> An integral value as text.
