@@ -80,6 +80,7 @@ contains
          new_unittest('thread_determinism', test_threads), &
          new_unittest('validation_errors', test_validation), &
          new_unittest('facet_errors', test_facet_errors), &
+         new_unittest('far_from_origin', test_far_from_origin), &
          new_unittest('legacy_wrapper', test_legacy) &
          ]
    end subroutine collect_mesh_recovery
@@ -1030,6 +1031,47 @@ contains
             & error, facet_nodes=fnodes, facet_kind=kinds, facet_traction=tr)
       end subroutine go
    end subroutine test_facet_errors
+
+
+   !> Elements small against their distance from the origin (issue 13, defect 1): the inverse
+   !> map's stopping test follows the map's round-off, so a unit quad4 shifted by 1000 and a
+   !> 4 x 4 grid of squares of side 0.01 at x = 10 (|x|/h = 1e3) are recovered, exactly for a
+   !> linear field, and their own integration points evaluate in their elements. The field is
+   !> the linear one of the unshifted mesh (linear in the moved coordinates too); the
+   !> tolerance is the file's, times |x|/h: the patch coordinates (x - x0)/h carry the
+   !> round-off of x, eps |x|/h relative.
+   subroutine test_far_from_origin(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(case_type) :: c
+      type(mesh_recovery_type) :: res
+      real(wp), allocatable :: x(:, :), gp(:, :, :)
+      real(wp) :: s(6), sp(3, 1)
+      integer :: k, n, e, i, method
+      real(wp), parameter :: side(2) = [1.0_wp, 0.01_wp], offset(2) = [1000.0_wp, 10.0_wp]
+
+      do k = 1, 2
+         call build_case(c, elem_quad4, merge(1, 4, k == 1), f_linear, 0.0_wp)
+         x = offset(k) + side(k)*c%x
+         gp = offset(k) + side(k)*c%gp
+         do method = mesh_method_spr, mesh_method_sprc
+            call recover_on_mesh(2, c%analysis, x, c%etype, c%conn, gp, c%gw*side(k)**2, c%gs, 1000.0_wp, 0.3_wp, &
+               & method, res, error, body_force=c%body(1:2)/side(k))
+            if (allocated(error)) return
+            do n = 1, size(c%x, 2)
+               call exact(f_linear, 2, c%x(:, n), s)
+               call check(error, maxval(abs(res%nodal(:, n) - s(1:3))) <= 1.0e3_wp*tol*c%scale, &
+                  & 'far from the origin: nodal stresses exact')
+               if (allocated(error)) return
+            end do
+            do e = 1, size(c%conn, 2)
+               do i = 1, size(gp, 2)
+                  call mesh_recovery_eval(res, gp(:, i:i, e), sp, error, [e])
+                  if (allocated(error)) return
+               end do
+            end do
+         end do
+      end do
+   end subroutine test_far_from_origin
 
    !> The legacy wrapper with plain double precision arrays: same nodal stresses as the
    !> modern call (free facets on y = 1 included), points evaluated, errors as stat/errmsg.

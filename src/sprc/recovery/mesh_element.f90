@@ -232,15 +232,20 @@ contains
    end subroutine element_map
 
    !> Reference coordinates xi of the physical point x by Newton's method on the
-   !> isoparametric map, started at the centroid; converged = the last step is below
-   !> 1e-13 (reference units) within 50 steps. Affine elements converge in one step.
-   !> The small Jacobian is inverted by its adjugate (2x2, 3x3).
+   !> isoparametric map, started at the centroid; converged = within 50 steps, the last step
+   !> is below 1e-13 (reference units) or below the round-off of the map itself: the
+   !> residual x - sum_a N_a x_a carries an error up to (nen + 2) eps (|x| + sum_a |N_a| |x_a|)
+   !> (a sum of nen + 1 products), which J^-1 turns into reference units. An element small
+   !> against its distance from the origin (|x|/h ~ 1e3 and more) sits there, far above
+   !> 1e-13. Affine elements converge in one or two steps. The small Jacobian is inverted
+   !> by its adjugate (2x2, 3x3).
    pure subroutine element_inverse_map(etype, xe, x, xi, converged)
       integer, intent(in) :: etype
       real(wp), intent(in) :: xe(:, :), x(:)
       real(wp), intent(out) :: xi(:)
       logical, intent(out) :: converged
       real(wp) :: n(max_element_nodes), dn(3, max_element_nodes), jac(3, 3), inv(3, 3), r(3), step(3), det
+      real(wp) :: map_size, floor
       integer :: d, nen, it
 
       d = element_dim(etype)
@@ -256,7 +261,9 @@ contains
          step(1:d) = matmul(inv(1:d, 1:d), r(1:d))
          if (.not. all(abs(step(1:d)) <= 1.0e3_wp)) return
          xi(1:d) = xi(1:d) + step(1:d)
-         if (maxval(abs(step(1:d))) < 1.0e-13_wp) then
+         map_size = maxval(abs(x(1:d))) + sum(abs(n(1:nen)))*maxval(abs(xe(1:d, 1:nen)))
+         floor = real(nen + 2, wp)*epsilon(1.0_wp)*map_size*maxval(sum(abs(inv(1:d, 1:d)), dim=2))
+         if (maxval(abs(step(1:d))) < max(1.0e-13_wp, floor)) then
             converged = .true.
             return
          end if
