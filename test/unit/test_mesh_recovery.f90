@@ -81,6 +81,7 @@ contains
          new_unittest('validation_errors', test_validation), &
          new_unittest('facet_errors', test_facet_errors), &
          new_unittest('far_from_origin', test_far_from_origin), &
+         new_unittest('huge_stresses', test_huge_stresses), &
          new_unittest('legacy_wrapper', test_legacy) &
          ]
    end subroutine collect_mesh_recovery
@@ -1032,6 +1033,38 @@ contains
       end subroutine go
    end subroutine test_facet_errors
 
+
+   !> Finite stresses of order 1e160 (issue 13, defect 2: their squares overflow): the
+   !> stresses times 2**532 (1.4e160) give the estimate of the unscaled ones times 2**532 and
+   !> the same eta, finite. A power of two scales every operation exactly; the tolerance
+   !> leaves room for LAPACK's own scaling decisions: 1e-12, eps times the patch condition
+   !> numbers (< 1e4, file notes).
+   subroutine test_huge_stresses(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(case_type) :: c
+      type(mesh_recovery_type) :: res0, res
+      real(wp), parameter :: big = 2.0_wp**532
+      integer :: method
+
+      call build_case(c, elem_quad4, 3, f_quadratic, 0.3_wp)
+      do method = mesh_method_spr, mesh_method_sprc
+         call recover_on_mesh(2, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, method, &
+            & res0, error)
+         if (allocated(error)) return
+         call recover_on_mesh(2, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, big*c%gs, 1000.0_wp, 0.3_wp, method, &
+            & res, error)
+         if (allocated(error)) return
+         call check(error, res%err/big, res0%err, 1.0e-12_wp, 'global error of huge stresses', rel=.true.)
+         if (allocated(error)) return
+         call check(error, res%norm_h/big, res0%norm_h, 1.0e-12_wp, 'norm of huge stresses', rel=.true.)
+         if (allocated(error)) return
+         call check(error, res%eta, res0%eta, 1.0e-12_wp, 'eta of huge stresses', rel=.true.)
+         if (allocated(error)) return
+         call check(error, maxval(abs(res%elem_err/big - res0%elem_err)) <= 1.0e-12_wp*maxval(res0%elem_err), &
+            & 'element errors of huge stresses')
+         if (allocated(error)) return
+      end do
+   end subroutine test_huge_stresses
 
    !> Elements small against their distance from the origin (issue 13, defect 1): the inverse
    !> map's stopping test follows the map's round-off, so a unit quad4 shifted by 1000 and a

@@ -11,7 +11,7 @@ module sprc_recovery_estimate
    implicit none
    private
 
-   public :: eval_recovered, eval_union, zz_error_integral
+   public :: eval_recovered, eval_union, zz_error_integral, zz_error_norm, scaled_norm, relative_error
 
 contains
 
@@ -109,7 +109,8 @@ contains
 
    !> ZZ error integral of one element: err2 = sum_i w_i (s*_i - s_h,i)^T D^-1 (s*_i - s_h,i),
    !> the square of the energy norm of the estimated error (seed eq. 1), with w_i = weight*|J|
-   !> and D^-1 the closed-form compliance of `analysis`.
+   !> and D^-1 the closed-form compliance of `analysis`. Overflows where the squared norm
+   !> does (stresses ~1e154 and more): `zz_error_norm` does not.
    pure subroutine zz_error_integral(analysis, young, poisson, w, sigma_star, sigma_h, err2, error)
       integer, intent(in) :: analysis
       real(wp), intent(in) :: young, poisson
@@ -119,11 +120,44 @@ contains
       real(wp), intent(in) :: sigma_star(:, :), sigma_h(:, :)
       real(wp), intent(out) :: err2
       type(error_type), allocatable, intent(out) :: error
-      real(wp) :: cmat(6, 6), diff(6)
+      real(wp) :: s, ssq
+
+      call scaled_integral(analysis, young, poisson, w, sigma_star, sigma_h, s, ssq, error)
+      err2 = ssq*s*s
+   end subroutine zz_error_integral
+
+   !> The energy norm err = sqrt(err2) of `zz_error_integral`, computed without overflow for
+   !> any finite stresses (issue 13: stresses ~1e160 gave NaN): the differences are scaled
+   !> by a power of two before squaring, so the result has the same bits as sqrt(err2)
+   !> wherever err2 does not overflow or underflow.
+   pure subroutine zz_error_norm(analysis, young, poisson, w, sigma_star, sigma_h, err, error)
+      integer, intent(in) :: analysis
+      real(wp), intent(in) :: young, poisson
+      real(wp), intent(in) :: w(:)
+      real(wp), intent(in) :: sigma_star(:, :), sigma_h(:, :)
+      real(wp), intent(out) :: err
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: s, ssq
+
+      call scaled_integral(analysis, young, poisson, w, sigma_star, sigma_h, s, ssq, error)
+      err = s*sqrt(ssq)
+   end subroutine zz_error_norm
+
+   !> err2 = s**2 * ssq with s a power of two near the largest stress difference (1 if all
+   !> differences vanish): scaling by a power of two is exact, squaring cannot overflow.
+   pure subroutine scaled_integral(analysis, young, poisson, w, sigma_star, sigma_h, s, ssq, error)
+      integer, intent(in) :: analysis
+      real(wp), intent(in) :: young, poisson
+      real(wp), intent(in) :: w(:)
+      real(wp), intent(in) :: sigma_star(:, :), sigma_h(:, :)
+      real(wp), intent(out) :: s, ssq
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: cmat(6, 6), diff(6), big
       integer :: i, ns
       character(len=96) :: buf
 
-      err2 = 0.0_wp
+      s = 1.0_wp
+      ssq = 0.0_wp
       ns = voigt_size(analysis)
       if (ns > 0) then
          call compliance_matrix(analysis, young, poisson, cmat(1:ns, 1:ns), error)
@@ -141,6 +175,7 @@ contains
          call fatal_error(error, 'zz_error_integral: '//trim(buf), stat_invalid_input)
          return
       end if
+      big = 0.0_wp
       do i = 1, size(w)
          if (.not. (w(i) >= 0.0_wp .and. w(i) <= huge(1.0_wp))) then
             write (buf, '("w(",i0,") = ",es12.4," must be finite and >= 0")') i, w(i)
@@ -153,8 +188,39 @@ contains
             call fatal_error(error, 'zz_error_integral: '//trim(buf), stat_invalid_input)
             return
          end if
-         err2 = err2 + w(i)*dot_product(diff(1:ns), matmul(cmat(1:ns, 1:ns), diff(1:ns)))
+         big = max(big, maxval(abs(diff(1:ns))))
       end do
-   end subroutine zz_error_integral
+      s = power_of_two(big)
+      do i = 1, size(w)
+         diff(1:ns) = (sigma_star(:, i) - sigma_h(:, i))/s
+         ssq = ssq + w(i)*dot_product(diff(1:ns), matmul(cmat(1:ns, 1:ns), diff(1:ns)))
+      end do
+   end subroutine scaled_integral
+
+   !> sqrt(sum(v**2)) without overflow or underflow; the same bits as that expression
+   !> wherever it neither overflows nor underflows (scaling by a power of two).
+   pure real(wp) function scaled_norm(v) result(r)
+      real(wp), intent(in) :: v(:)
+      real(wp) :: s
+      s = power_of_two(maxval(abs(v), mask=abs(v) <= huge(1.0_wp)))
+      r = s*sqrt(sum((v/s)**2))
+   end function scaled_norm
+
+   !> err / sqrt(norm**2 + err**2) (0 if both vanish) without overflow, same bits as that
+   !> expression where it does not overflow.
+   pure real(wp) function relative_error(err, norm) result(eta)
+      real(wp), intent(in) :: err, norm
+      real(wp) :: s
+      eta = 0.0_wp
+      s = power_of_two(max(abs(err), abs(norm)))
+      if ((norm/s)**2 + (err/s)**2 > 0.0_wp) eta = (err/s)/sqrt((norm/s)**2 + (err/s)**2)
+   end function relative_error
+
+   !> A power of two s with s <= x < 2 s for finite x > 0; 1 otherwise.
+   elemental real(wp) function power_of_two(x) result(s)
+      real(wp), intent(in) :: x
+      s = 1.0_wp
+      if (x > 0.0_wp .and. x <= huge(1.0_wp)) s = set_exponent(1.0_wp, exponent(x))
+   end function power_of_two
 
 end module sprc_recovery_estimate

@@ -44,7 +44,8 @@
 !>   sum_J Nv_J(xi) sigma*_J(x) over the element's vertices (eq. 102).
 !> - elem_err(e) = sqrt(sum_i gw (s* - s_h)^T D^-1 (s* - s_h)) over the caller's points of e,
 !>   elem_norm_h(e) the same of s_h; err = sqrt(sum elem_err^2), norm_h likewise,
-!>   eta = err / sqrt(norm_h^2 + err^2).
+!>   eta = err / sqrt(norm_h^2 + err^2); all scaled by powers of two before squaring, so
+!>   any finite stresses give finite results (same bits as the plain formulas otherwise).
 !> Evaluation at points (`mesh_recovery_eval`): with the element of each point given, one
 !> inverse map per point; otherwise a search over the elements whose bounding box holds the
 !> point, one inverse map per candidate: O(nelem) box tests per point (no spatial index).
@@ -64,7 +65,7 @@ module sprc_recovery_mesh
       & boundary_traction, boundary_symmetry
    use sprc_recovery_workspace, only: recovery_workspace_type, workspace_reserve, workspace_init
    use sprc_recovery_solve, only: recover_spr, recover_sprc
-   use sprc_recovery_estimate, only: eval_recovered, zz_error_integral
+   use sprc_recovery_estimate, only: eval_recovered, zz_error_norm, scaled_norm, relative_error
    use sprc_recovery_mesh_element, only: elem_tri3, elem_quad4, elem_tet4, elem_hex8, elem_quad9, elem_hex27, &
       & element_dim, element_nodes, element_vertices, element_degree, element_facet_nodes, element_shape, &
       & element_vertex_shape, element_node_xi, element_inside, element_inverse_map, element_name, &
@@ -665,7 +666,6 @@ contains
       real(wp), intent(in) :: gp(:, :, :), gw(:, :), gs(:, :, :), xi(:, :, :)
       type(error_type), allocatable, intent(out) :: error
       real(wp), allocatable :: sstar(:, :), zero(:, :)
-      real(wp) :: e2, h2
       integer :: e, i, ngp
 
       ngp = size(gp, 2)
@@ -675,17 +675,15 @@ contains
          do i = 1, ngp
             call field_at(r, e, xi(:, i, e), gp(:, i, e), sstar(:, i))
          end do
-         call zz_error_integral(r%analysis, r%young, r%poisson, gw(:, e), sstar, gs(:, :, e), e2, error)
+         call zz_error_norm(r%analysis, r%young, r%poisson, gw(:, e), sstar, gs(:, :, e), r%elem_err(e), error)
          if (allocated(error)) return
-         call zz_error_integral(r%analysis, r%young, r%poisson, gw(:, e), zero, gs(:, :, e), h2, error)
+         call zz_error_norm(r%analysis, r%young, r%poisson, gw(:, e), zero, gs(:, :, e), r%elem_norm_h(e), error)
          if (allocated(error)) return
-         r%elem_err(e) = sqrt(e2)
-         r%elem_norm_h(e) = sqrt(h2)
       end do
-      r%err = sqrt(sum(r%elem_err**2))
-      r%norm_h = sqrt(sum(r%elem_norm_h**2))
-      r%eta = 0.0_wp
-      if (r%norm_h**2 + r%err**2 > 0.0_wp) r%eta = r%err/sqrt(r%norm_h**2 + r%err**2)
+      ! Scaled sums: finite stresses never overflow to NaN (issue 13, defect 2).
+      r%err = scaled_norm(r%elem_err)
+      r%norm_h = scaled_norm(r%elem_norm_h)
+      r%eta = relative_error(r%err, r%norm_h)
    end subroutine estimate
 
    !> The recovered field sigma(nstress, npts) at points x(dim, npts) (SPR: nodal
