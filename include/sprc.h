@@ -141,10 +141,14 @@ void sprc_delete_report(sprc_report *report);
 #define SPRC_RECOVERY_P_PLUS_1 256
 
 /* Boundary facet kinds: a constant traction given per facet, a symmetry
- * plane (zero shear), a free surface (zero traction). */
+ * plane (zero shear), a free surface (zero traction), a pressure p
+ * (t = -p n with the facet's own outward normal at each of its points, so
+ * the traction turns along a curved facet; p is facet_traction[f][0], the
+ * other components are ignored). */
 #define SPRC_FACET_TRACTION 1
 #define SPRC_FACET_SYMMETRY 2
 #define SPRC_FACET_FREE 3
+#define SPRC_FACET_PRESSURE 4
 
 typedef struct _sprc_recovery *sprc_recovery;
 
@@ -161,7 +165,8 @@ typedef struct _sprc_recovery *sprc_recovery;
  *                                     (line2 / line3 in 2D, tri3 / quad4 /
  *                                     quad9 faces in 3D); NULL with nfacet = 0
  *   facet_kind     [nfacet]           SPRC_FACET_*
- *   facet_traction [nfacet][dim] or NULL  (needed if a facet is a traction one)
+ *   facet_traction [nfacet][dim] or NULL  (needed if a facet is a traction or
+ *                                     pressure one; pressure in [f][0])
  * dim 2 or 3; analysis SPRC_PLANE_STRESS / SPRC_PLANE_STRAIN in 2D,
  * SPRC_SOLID in 3D; method SPRC_METHOD_SPR or SPRC_METHOD_SPRC (SPR ignores
  * the facets once validated), optionally OR-ed with SPRC_RECOVERY_P_PLUS_1.
@@ -171,11 +176,11 @@ typedef struct _sprc_recovery *sprc_recovery;
  * the error set: SPRC_STAT_INVALID_INPUT for a bad size, code, NULL array,
  * index out of range, non-finite value, point outside its element;
  * SPRC_STAT_SINGULAR for a patch that stays rank deficient;
- * SPRC_STAT_NOT_CONVERGED for a point whose inverse map fails. Sizes,
- * NULL pointers and 0-based indices are checked at the C boundary and named
- * in C notation (connectivity[e][a]); values checked deeper in the library
- * are named in its Fortran notation, 1-based and column-major:
- * gp(:, q, e) is gauss_points[e-1][q-1], element e is element e-1 here. */
+ * SPRC_STAT_NOT_CONVERGED for a point whose inverse map fails. Duplicate
+ * nodes (two used nodes at the same point) and duplicate elements (the same
+ * vertices) are SPRC_STAT_INVALID_INPUT. Messages name entries, nodes,
+ * elements and facets as C does: 0-based, row-major, with the argument
+ * names above (gauss_weights[e][q], element e). */
 sprc_recovery sprc_recover(sprc_error error, int dim, int analysis, int nnode, const double *nodes,
                            int element_type, int nen, int nelem, const int *connectivity, int ngp,
                            const double *gauss_points, const double *gauss_weights, const double *gauss_stress,
@@ -200,9 +205,9 @@ double sprc_get_recovery_eta(sprc_error error, sprc_recovery recovery);
 /* The recovered field sigma* at points[npts][dim] into stress[npts][nstress].
  * elements[npts] names the element of each point (0-based; -1 searches for
  * it); elements = NULL searches for every point (O(nelem) per point). A
- * point in no element (or not in the one named) is an error, its message
- * in the library's 1-based notation (x(:, i) is points[i-1]); on error the
- * contents of stress are unspecified. npts = 0 does nothing. */
+ * point in no element (or not in the one named) is an error naming
+ * points[i] and the element 0-based; on error the contents of stress are
+ * unspecified. npts = 0 does nothing. */
 void sprc_eval_recovery(sprc_error error, sprc_recovery recovery, int npts, const double *points,
                         const int *elements, double *stress);
 

@@ -20,8 +20,8 @@ module sprc
    use sprc_io_scene, only: scene_type, read_scene, read_scene_text, scene_summary, default_scene_text
    use sprc_io_model, only: build_bodies, build_exact
    use sprc_recovery_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, mesh_method_spr, &
-      & mesh_method_sprc, facet_traction, facet_symmetry, facet_free, elem_tri3, elem_quad4, elem_tet4, elem_hex8, &
-      & elem_quad9, elem_hex27
+      & mesh_method_sprc, facet_traction, facet_symmetry, facet_free, facet_pressure, elem_tri3, elem_quad4, &
+      & elem_tet4, elem_hex8, elem_quad9, elem_hex27
    use sprc_io_study, only: mesh_row_type, mesh_study, format_mesh_row, study_levels
    use sprc_io_run, only: run_model_type, prepare_run, run_level
    use sprc_io_report, only: report_row_type, report_table, write_report_csv, read_report_csv, report_column, &

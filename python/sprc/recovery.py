@@ -31,7 +31,7 @@ METHODS = {"spr": 1, "sprc": 2}
 #: Patch degree: the element's, or one more (SPRC_RECOVERY_P_PLUS_1 OR-ed into the method).
 DEGREES = {"p": 0, "p+1": 256}
 #: Boundary facet kinds (SPRC_FACET_*).
-FACET_KINDS = {"traction": 1, "symmetry": 2, "free": 3}
+FACET_KINDS = {"traction": 1, "symmetry": 2, "free": 3, "pressure": 4}
 
 _INT_MIN, _INT_MAX = np.iinfo(np.intc).min, np.iinfo(np.intc).max
 _c_double_p = ctypes.POINTER(ctypes.c_double)
@@ -150,6 +150,11 @@ def _facets(boundary, dim, nfn):
             traction = np.asarray(traction, dtype=np.float64)
             if traction.shape == (dim,):
                 traction = np.broadcast_to(traction, (nf, dim))
+        pressure = boundary.get("pressure")
+        if pressure is not None:
+            if np.ndim(pressure) == 0:
+                pressure = np.full(nf, pressure, dtype=np.float64)
+            pressure = _doubles("boundary['pressure']", pressure, (nf,))
     else:
         try:
             facets = list(boundary)
@@ -168,6 +173,12 @@ def _facets(boundary, dim, nfn):
             for i, f in enumerate(facets):
                 if f.get("traction") is not None:
                     traction[i] = _doubles(f"boundary[{i}]['traction']", f["traction"], (dim,))
+        pressure = None
+        if any(f.get("pressure") is not None for f in facets):
+            pressure = np.zeros(nf)
+            for i, f in enumerate(facets):
+                if f.get("pressure") is not None:
+                    pressure[i] = _doubles(f"boundary[{i}]['pressure']", np.atleast_1d(f["pressure"]), (1,))[0]
     if len(kinds) != nf:
         raise ValueError(f"boundary has {nf} facets but {len(kinds)} kinds")
     codes = np.array([_code("boundary kind", k, FACET_KINDS) for k in kinds], dtype=np.intc)
@@ -175,6 +186,13 @@ def _facets(boundary, dim, nfn):
         traction = _doubles("boundary traction", traction, (nf, dim))
     if traction is None and (codes == FACET_KINDS["traction"]).any():
         raise ValueError("boundary has traction facets but no 'traction'")
+    is_pressure = codes == FACET_KINDS["pressure"]
+    if is_pressure.any():
+        if pressure is None:
+            raise ValueError("boundary has pressure facets but no 'pressure'")
+        # The C API takes a pressure facet's p in facet_traction[f][0].
+        traction = np.zeros((nf, dim)) if traction is None else traction.copy()
+        traction[is_pressure, 0] = pressure[is_pressure]
     return nodes, codes, traction
 
 
@@ -202,21 +220,28 @@ def recover(nodes, elements, element_type, gauss_points, gauss_weights, gauss_st
     boundary       boundary facets for SPR-C (SPR validates and ignores them):
                    either a dict of arrays
                        {"nodes": [nfacet, nfn] 0-based,
-                        "kind": "traction" | "symmetry" | "free" (or one per facet),
-                        "traction": [nfacet, dim] or [dim] for all (traction facets)}
+                        "kind": "traction" | "symmetry" | "free" | "pressure"
+                                (or one per facet),
+                        "traction": [nfacet, dim] or [dim] for all (traction facets),
+                        "pressure": [nfacet] or one value for all (pressure facets)}
                    or a list of facets
                        [{"nodes": [...], "kind": "traction", "traction": [tx, ty]},
+                        {"nodes": [...], "kind": "pressure", "pressure": p},
                         {"nodes": [...], "kind": "symmetry"}, ...].
                    A facet is a side of one element (nfn nodes: 2 for tri3 and
                    quad4, 3 for quad9 and tet4, 4 for hex8, 9 for hex27, VTK
-                   order); "free" means zero traction, "symmetry" zero shear.
-                   Only the facets given are constrained.
+                   order); "free" means zero traction, "symmetry" zero shear,
+                   "pressure" t = -p n with the facet's own outward normal at
+                   each of its points (right on curved facets, where the
+                   traction turns). Only the facets given are constrained.
 
     Returns a :class:`Recovery`. Raises ValueError for arrays of the wrong
     shape or type and unknown names, :class:`SprcError` with the library's
     message for what the library rejects (node indices out of range,
-    non-finite values, points outside their element, an invalid material, a
-    patch that stays rank deficient).
+    non-finite values, points outside their element, duplicate nodes or
+    elements, an invalid material, a patch that stays rank deficient); its
+    message names entries 0-based in C order with the C argument names
+    (``gauss_weights[e][q]``, ``connectivity[e][a]`` for ``elements[e, a]``).
     """
     etype, edim, nen, nfn = _code("element_type", element_type, ELEMENT_TYPES)
     x = _doubles("nodes", nodes, (None, edim))

@@ -272,6 +272,68 @@ def test_traction_boundary_both_forms():
     assert nodal_deviation(case, spr) <= TOL
 
 
+def test_pressure_on_curved_facets():
+    """Pressure facets (t = -p n with the facet's own normal at each point) on the
+    curved outer arc of a quarter annulus of quad9 (nodes on the circles): the
+    hydrostatic field -p I is recovered exactly by SPR-C, in both boundary forms;
+    the best constant traction per facet (the only way before) is not exact."""
+    m, p = 4, 3.0
+    case = build_case("quad9", m, "linear")
+    n = 2 * m + 1
+    r = 1.0 + np.arange(n) / (n - 1)
+    t = 0.5 * np.pi * np.arange(n) / (n - 1)
+    polar = np.array([[ri * np.cos(tj), ri * np.sin(tj)] for tj in t for ri in r])
+    # Rebuild points and weights on the curved mesh: the same isoparametric quad9 map.
+    case["nodes"] = polar
+    rx, rw = gauss_1d(3)
+    gp, gw = [], []
+    for el in case["elements"]:
+        xe = polar[el]
+        pts, wts = [], []
+        for j in range(3):
+            for i in range(3):
+                (li, di), (lj, dj) = lagrange(2, rx[i]), lagrange(2, rx[j])
+                val = np.zeros(len(el))
+                grad = np.zeros((len(el), 2))
+                for a, (u, v) in enumerate(VTK["quad9"]):
+                    val[a] = li[u] * lj[v]
+                    grad[a] = [di[u] * lj[v], li[u] * dj[v]]
+                pts.append(val @ xe)
+                wts.append(rw[i] * rw[j] * abs(np.linalg.det(xe.T @ grad)))
+        gp.append(pts)
+        gw.append(wts)
+    gp, gw = np.array(gp), np.array(gw)
+    gs = np.zeros(gp.shape[:2] + (3,))
+    gs[..., :2] = -p
+    outer = [[(n - 1) + n * 2 * k, (n - 1) + n * (2 * k + 2), (n - 1) + n * (2 * k + 1)] for k in range(m)]
+    args = (polar, case["elements"], "quad9", gp, gw, gs)
+    kw = dict(young=1000.0, poisson=0.3, analysis="plane_strain")
+    rec = sprc.recover(*args, **kw, boundary={"nodes": outer, "kind": "pressure", "pressure": p})
+    assert np.abs(rec.nodal_stress - [-p, -p, 0.0]).max() <= TOL * p
+    rec2 = sprc.recover(*args, **kw, boundary=[{"nodes": f, "kind": "pressure", "pressure": p} for f in outer])
+    assert np.array_equal(rec.nodal_stress, rec2.nodal_stress)
+    chord = np.array([polar[f[1]] - polar[f[0]] for f in outer])
+    normal = np.stack([chord[:, 1], -chord[:, 0]], axis=1) / np.linalg.norm(chord, axis=1)[:, None]
+    const = sprc.recover(*args, **kw, boundary={"nodes": outer, "kind": "traction", "traction": -p * normal})
+    assert np.abs(const.nodal_stress - [-p, -p, 0.0]).max() > 1e-6 * p
+    with pytest.raises(ValueError, match="no 'pressure'"):
+        sprc.recover(*args, **kw, boundary={"nodes": outer, "kind": "pressure"})
+
+
+def test_far_from_origin():
+    """Elements small against their distance from the origin (|x|/h = 1e5 here): the
+    inverse map stops at its own round-off; a linear field is recovered (tolerance
+    TOL times |x|/h, the round-off of the patch coordinates) and the points evaluate."""
+    case = build_case("quad4", 4, "linear")
+    side, shift = 1e-4, np.array([10.0, -5.0])
+    rec = sprc.recover(shift + side * case["nodes"], case["elements"], "quad4", shift + side * case["gauss_points"],
+                       side**2 * case["gauss_weights"], case["gauss_stress"], young=1000.0, poisson=0.3,
+                       body_force=case["body_force"] / side)
+    assert nodal_deviation(case, rec) <= 1e5 * TOL
+    pts = shift + side * case["gauss_points"].reshape(-1, 2)
+    rec.evaluate(pts, elements=np.repeat(np.arange(len(case["elements"])), 4))
+
+
 # ---------------------------------------------------------------- errors
 
 @pytest.fixture(scope="module")
@@ -329,16 +391,26 @@ def test_library_errors_raise_sprc_error(quad):
         call(quad, elements=bad)
     gs = quad["gauss_stress"].copy()
     gs[2, 1, 0] = np.nan
-    with pytest.raises(sprc.SprcError, match="not finite"):
+    with pytest.raises(sprc.SprcError, match=r"gauss_stress\[2\]\[1\] is not finite"):
         call(quad, gauss_stress=gs)
     gw = quad["gauss_weights"].copy()
-    gw[0, 0] = -1.0
-    with pytest.raises(sprc.SprcError, match="must be finite and > 0"):
+    gw[0, 2] = -1.0
+    # The caller's gw[0, 2], 0-based in C order (issue 13: it was named gw(3, 1)).
+    with pytest.raises(sprc.SprcError, match=r"gauss_weights\[0\]\[2\] = .* must be finite and > 0"):
         call(quad, gauss_weights=gw)
     gp = quad["gauss_points"].copy()
     gp[3, 0] = gp[0, 0]  # a point of element 0 given to element 3
-    with pytest.raises(sprc.SprcError, match="not inside element"):
+    with pytest.raises(sprc.SprcError, match=r"gauss_points\[3\]\[0\] is not inside element 3 "):
         call(quad, gauss_points=gp)
+    nodes = np.vstack([quad["nodes"], quad["nodes"][4]])  # node 9 at node 4, used by element 3
+    elements = quad["elements"].copy()
+    elements[3][elements[3] == 4] = 9
+    with pytest.raises(sprc.SprcError, match="nodes 4 and 9 are at the same point"):
+        call(quad, nodes=nodes, elements=elements)
+    elements = quad["elements"].copy()
+    elements[2] = elements[0][::-1]
+    with pytest.raises(sprc.SprcError, match="elements 0 and 2 have the same vertices"):
+        call(quad, elements=elements)
     with pytest.raises(sprc.SprcError, match="analysis = 3 does not fit dim = 2"):
         call(quad, analysis="solid")
     with pytest.raises(sprc.SprcError, match="poisson"):
@@ -365,8 +437,10 @@ def test_thin_layer_reports_unknown_element_code(quad):
 
 def test_evaluate_errors(quad):
     rec = call(quad)
-    with pytest.raises(sprc.SprcError, match="is in no element"):
-        rec.evaluate([[3.0, 3.0]])
+    with pytest.raises(sprc.SprcError, match=r"points\[1\] = .* is in no element"):
+        rec.evaluate([[0.5, 0.5], [3.0, 3.0]])
+    with pytest.raises(sprc.SprcError, match=r"points\[0\] = .* is not in element 3"):
+        rec.evaluate([[0.1, 0.1]], elements=[3])
     with pytest.raises(sprc.SprcError, match=r"elements\[0\] = 7 is not -1 \(search\) or an element in 0..3"):
         rec.evaluate([[0.5, 0.5]], elements=[7])
     with pytest.raises(ValueError, match=r"points has shape \[1, 3\], need \[\*, 2\]"):

@@ -6,7 +6,8 @@
 !>   quad9 = 28, hex27 = 29 (VTK node order, sprc_recovery_mesh_element);
 !> - analysis: plane stress = 1, plane strain = 2, solid (3D) = 3;
 !> - method: SPR = 1, SPR-C = 2;
-!> - facet kind: traction = 1 (value in ftrac), symmetry = 2, free = 3 (zero traction);
+!> - facet kind: traction = 1 (value in ftrac), symmetry = 2, free = 3 (zero traction),
+!>   pressure = 4 (p = ftrac(1, f), t = -p n with the facet's own normal at each point);
 !> - stat: 0 success, 1 invalid input, 2 singular (a patch stayed rank deficient),
 !>   4 not converged (an inverse map), 8 internal (sprc_core_error).
 !> On failure every output array is zero and errmsg holds the message (truncated to its

@@ -259,17 +259,21 @@ typedef struct {
 
 /* field 0: a linear field (body force b = -div sigma = (-2.25, 2.5));
  * field 1: sigma_xx, sigma_xy depend on x only, so the sides x = 0 and
- * x = 1 carry constant tractions (b = (-2, 2)). */
+ * x = 1 carry constant tractions (b = (-2, 2));
+ * field 2: hydrostatic sigma = -3 I, a pressure 3 on every side (b = 0). */
 static void exact_stress(int field, const double *x, double *s) {
   double a = x[0], b = x[1];
   if (field == 0) {
     s[0] = 1.0 + 2 * a + 3 * b;
     s[1] = -2.0 + 0.5 * a - b;
     s[2] = 0.7 - 1.5 * a + 0.25 * b;
-  } else {
+  } else if (field == 1) {
     s[0] = 1.0 + 2 * a;
     s[1] = -2.0 + 0.5 * a - b;
     s[2] = 0.5 - a;
+  } else {
+    s[0] = s[1] = -3.0;
+    s[2] = 0.0;
   }
 }
 
@@ -317,8 +321,8 @@ static void build_quad_mesh(quad_mesh *m, int field) {
     }
   }
   m->field = field;
-  m->body[0] = field == 0 ? -2.25 : -2.0;
-  m->body[1] = field == 0 ? 2.5 : 2.0;
+  m->body[0] = field == 0 ? -2.25 : field == 1 ? -2.0 : 0.0;
+  m->body[1] = field == 0 ? 2.5 : field == 1 ? 2.0 : 0.0;
 }
 
 /* sprc_recover on the mesh with the given method and no facets. */
@@ -423,7 +427,7 @@ static void test_recovery_bad_input(void) {
   RECOVER_FAILS("analysis = 3 does not fit dim = 2", 2, 3, NNODE, x, 9, 4, NELEM, c, NGP, gp, gw, gs, 1e3, 0.3, 2,
                 NULL, 0, 2, NULL, NULL, NULL);
   RECOVER_FAILS("poisson", 2, 1, NNODE, x, 9, 4, NELEM, c, NGP, gp, gw, gs, 1e3, 0.5, 2, NULL, 0, 2, NULL, NULL, NULL);
-  RECOVER_FAILS("facet_kind(2) = 9", 2, 1, NNODE, x, 9, 4, NELEM, c, NGP, gp, gw, gs, 1e3, 0.3, 2, NULL, 2, 2,
+  RECOVER_FAILS("facet_kind[1] = 9", 2, 1, NNODE, x, 9, 4, NELEM, c, NGP, gp, gw, gs, 1e3, 0.3, 2, NULL, 2, 2,
                 &fn[0][0], fk_bad, &ft[0][0]);
   RECOVER_FAILS("kind traction but facet_traction is not given", 2, 1, NNODE, x, 9, 4, NELEM, c, NGP, gp, gw, gs, 1e3,
                 0.3, 2, NULL, 2, 2, &fn[0][0], fk, NULL);
@@ -440,14 +444,24 @@ static void test_recovery_bad_input(void) {
                 &fn[0][0], fk, &ft[0][0]);
   fn[1][0] = 1;
   /* Non-finite data and a point outside its element. */
+  /* Named 0-based in C order with the C argument names, as the caller wrote them. */
   bad = m;
   bad.gs[5][1][2] = NAN;
-  RECOVER_FAILS("not finite", 2, 1, NNODE, x, 9, 4, NELEM, c, NGP, gp, gw, &bad.gs[0][0][0], 1e3, 0.3, 2, NULL, 0, 2,
-                NULL, NULL, NULL);
+  RECOVER_FAILS("gauss_stress[5][1] is not finite", 2, 1, NNODE, x, 9, 4, NELEM, c, NGP, gp, gw, &bad.gs[0][0][0], 1e3,
+                0.3, 2, NULL, 0, 2, NULL, NULL, NULL);
+  bad = m;
+  bad.gw[2][1] = -1.0;
+  RECOVER_FAILS("gauss_weights[2][1] = ", 2, 1, NNODE, x, 9, 4, NELEM, c, NGP, gp, &bad.gw[0][0], gs, 1e3, 0.3, 2, NULL,
+                0, 2, NULL, NULL, NULL);
   bad = m;
   bad.gp[2][0][0] = 5.0;
-  RECOVER_FAILS("not in", 2, 1, NNODE, x, 9, 4, NELEM, c, NGP, &bad.gp[0][0][0], gw, gs, 1e3, 0.3, 2, NULL, 0, 2, NULL,
-                NULL, NULL);
+  RECOVER_FAILS("gauss_points[2][0] is not inside element 2", 2, 1, NNODE, x, 9, 4, NELEM, c, NGP, &bad.gp[0][0][0],
+                gw, gs, 1e3, 0.3, 2, NULL, 0, 2, NULL, NULL, NULL);
+  /* Duplicate elements: element 5 repeats element 0's vertices. */
+  bad = m;
+  memcpy(bad.conn[5], bad.conn[0], sizeof bad.conn[0]);
+  RECOVER_FAILS("elements 0 and 5 have the same vertices", 2, 1, NNODE, x, 9, 4, NELEM, &bad.conn[0][0], NGP, gp, gw,
+                gs, 1e3, 0.3, 2, NULL, 0, 2, NULL, NULL, NULL);
 #undef RECOVER_FAILS
   sprc_delete_error(&err);
   PASS();
@@ -610,6 +624,48 @@ static void test_recovery_facets(void) {
   PASS();
 }
 
+/* SPR-C with SPRC_FACET_PRESSURE on all four sides (p in facet_traction[f][0],
+ * t = -p n with each facet's outward normal, whatever its node order) and the
+ * hydrostatic field -3 I: exact with p = 3; p = 2 contradicts the field. */
+static void test_recovery_pressure_facets(void) {
+  const char *name = "recovery_pressure_facets";
+  static quad_mesh m;
+  int fn[4 * M][2], fk[4 * M], j, k;
+  double ft[4 * M][2], nodal[NNODE][3], p;
+  sprc_error err = sprc_new_error();
+  sprc_recovery rec;
+  build_quad_mesh(&m, 2);
+  for (j = 0; j < M; j++) {
+    int side[4][2] = {{j, j + 1},                                   /* y = 0 */
+                      {(M + 1) * j + M, (M + 1) * (j + 1) + M},     /* x = 1 */
+                      {(M + 1) * M + j + 1, (M + 1) * M + j},       /* y = 1 */
+                      {(M + 1) * (j + 1), (M + 1) * j}};            /* x = 0 */
+    for (k = 0; k < 4; k++) {
+      fn[4 * j + k][0] = side[k][0];
+      fn[4 * j + k][1] = side[k][1];
+      fk[4 * j + k] = SPRC_FACET_PRESSURE;
+    }
+  }
+  for (p = 3.0; p >= 2.0; p -= 1.0) {
+    for (j = 0; j < 4 * M; j++) {
+      ft[j][0] = p;
+      ft[j][1] = NAN; /* ignored for a pressure facet */
+    }
+    rec = sprc_recover(err, 2, SPRC_PLANE_STRAIN, NNODE, &m.nodes[0][0], SPRC_QUAD4, 4, NELEM, &m.conn[0][0], NGP,
+                       &m.gp[0][0][0], &m.gw[0][0], &m.gs[0][0][0], 1000.0, 0.3, SPRC_METHOD_SPRC, m.body, 4 * M, 2,
+                       &fn[0][0], fk, &ft[0][0]);
+    CHECK(rec != NULL, "recovery with pressure facets failed");
+    sprc_get_recovery_nodal_stress(err, rec, &nodal[0][0], NNODE);
+    if (p == 3.0)
+      CHECK(nodal_deviation(&m, nodal) <= 5e-10, "pressure facets: the hydrostatic field is not exact");
+    else
+      CHECK(nodal_deviation(&m, nodal) > 1e-3, "a pressure contradicting the field left it exact");
+    sprc_delete_recovery(&rec);
+  }
+  sprc_delete_error(&err);
+  PASS();
+}
+
 int main(int argc, char **argv) {
   /* `fpm test -- SUITE` passes the unit tests' suite name to every test
      program: take argv[1] as the root only if it holds example/scenes. */
@@ -633,6 +689,7 @@ int main(int argc, char **argv) {
   test_recovery_linear_quad4();
   test_recovery_degree_flag();
   test_recovery_facets();
+  test_recovery_pressure_facets();
   printf("%d passed, %d failed\n", passed, failed);
   return failed == 0 ? 0 : 1;
 }

@@ -21,7 +21,7 @@ module sprc_test_mesh_recovery
    use sprc_core_error, only: stat_invalid_input, stat_singular
    use sprc_core_material, only: plane_stress, plane_strain, solid
    use sprc_recovery_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, mesh_method_spr, &
-      & mesh_method_sprc, facet_traction, facet_symmetry, facet_free, elem_tri3, elem_quad4, elem_tet4, elem_hex8, &
+      & mesh_method_sprc, facet_traction, facet_symmetry, facet_free, facet_pressure, elem_tri3, elem_quad4, elem_tet4, elem_hex8, &
       & elem_quad9, elem_hex27
    use sprc_legacy, only: sprc_recover_mesh
    use sprc_recovery_mesh_element, only: facet_points
@@ -82,6 +82,9 @@ contains
          new_unittest('facet_errors', test_facet_errors), &
          new_unittest('far_from_origin', test_far_from_origin), &
          new_unittest('huge_stresses', test_huge_stresses), &
+         new_unittest('pressure_facets', test_pressure_facets), &
+         new_unittest('duplicates', test_duplicates), &
+         new_unittest('c_index_messages', test_c_index_messages), &
          new_unittest('legacy_wrapper', test_legacy) &
          ]
    end subroutine collect_mesh_recovery
@@ -992,8 +995,8 @@ contains
       call build_case(c, elem_quad4, 2, f_linear, 0.0_wp)
       call side_facets(c, 1, 0, fn)
       ft = 0.0_wp
-      call go(fn, [1, 4], ft)
-      call expect(error, stat_invalid_input, 'facet_kind(2) = 4')
+      call go(fn, [1, 5], ft)
+      call expect(error, stat_invalid_input, 'facet_kind(2) = 5')
       if (allocated(error)) return
       call go(fn, [1, 2])
       call expect(error, stat_invalid_input, 'facet_traction is not given')
@@ -1065,6 +1068,122 @@ contains
          if (allocated(error)) return
       end do
    end subroutine test_huge_stresses
+
+   !> Pressure facets on a curved boundary (issue 13, defect 4): a quarter annulus
+   !> 1 <= r <= 2 of curved quad9 (nodes on the circles), line3 facets on r = 2 with a
+   !> pressure p, FE stresses the hydrostatic sigma = -p I, whose traction -p n turns along
+   !> each facet. With the pressure kind SPR-C recovers it exactly (round-off, the file's
+   !> tolerance); with the best constant traction per facet (-p times the chord's normal),
+   !> the only way before, the traction rows contradict the field and it is not (error above
+   !> 1e-6 p: the normal turns by pi/16 along a facet).
+   subroutine test_pressure_facets(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(case_type) :: c
+      type(mesh_recovery_type) :: res
+      integer, allocatable :: fn(:, :), fk(:)
+      real(wp), allocatable :: ft(:, :)
+      real(wp), parameter :: p = 3.0_wp, pi = acos(-1.0_wp)
+      real(wp) :: chord(2), s(3)
+      integer :: i, j, n, f, k
+
+      call build_case(c, elem_quad9, 4, f_linear, 0.0_wp)
+      n = c%q*c%m + 1
+      do j = 0, n - 1
+         do i = 0, n - 1
+            c%x(:, node_id(c, i, j, 0)) = (1.0_wp + real(i, wp)/(n - 1))* &
+               & [cos(0.5_wp*pi*j/(n - 1)), sin(0.5_wp*pi*j/(n - 1))]
+         end do
+      end do
+      deallocate (c%conn, c%gp, c%gw)
+      call build_cells(c, .false.)
+      c%gs = 0.0_wp
+      c%gs(1:2, :, :) = -p
+      call side_facets(c, 1, 1, fn)
+      allocate (fk(size(fn, 2)), ft(2, size(fn, 2)))
+      do k = 1, 2
+         fk = merge(facet_pressure, facet_traction, k == 1)
+         do f = 1, size(fn, 2)
+            chord = c%x(:, fn(2, f)) - c%x(:, fn(1, f))
+            ft(:, f) = merge([p, 0.0_wp], -p*[chord(2), -chord(1)]/norm2(chord), k == 1)
+         end do
+         call recover_on_mesh(2, plane_strain, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
+            & mesh_method_sprc, res, error, facet_nodes=fn, facet_kind=fk, facet_traction=ft)
+         if (allocated(error)) return
+         s = 0.0_wp
+         do i = 1, size(c%x, 2)
+            s = max(s, abs(res%nodal(:, i) - [-p, -p, 0.0_wp]))
+         end do
+         if (k == 1) then
+            call check(error, maxval(s) <= tol*p, 'pressure facets: the hydrostatic field is exact')
+         else
+            call check(error, maxval(s) > 1.0e-6_wp*p, 'constant tractions on curved facets: not exact')
+         end if
+         if (allocated(error)) return
+      end do
+   end subroutine test_pressure_facets
+
+   !> Duplicate nodes (two used nodes at one point) and duplicate elements (the same
+   !> vertices, here in another order) are input errors naming both (issue 13, defect 3).
+   subroutine test_duplicates(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(case_type) :: c
+      type(mesh_recovery_type) :: res
+      real(wp), allocatable :: x(:, :)
+      integer, allocatable :: conn(:, :)
+
+      call build_case(c, elem_quad4, 2, f_linear, 0.0_wp)
+      ! Node 10 at node 5 (the centre), used by element 4 instead of node 5.
+      x = reshape([c%x, c%x(:, 5)], [2, 10])
+      conn = c%conn
+      where (conn(:, 4) == 5) conn(:, 4) = 10
+      call recover_on_mesh(2, c%analysis, x, c%etype, conn, c%gp, c%gw, c%gs, 1.0e3_wp, 0.3_wp, 1, res, error)
+      call expect(error, stat_invalid_input, 'nodes 5 and 10 are at the same point')
+      if (allocated(error)) return
+      ! An unused node at the same point is harmless.
+      call recover_on_mesh(2, c%analysis, x, c%etype, c%conn, c%gp, c%gw, c%gs, 1.0e3_wp, 0.3_wp, 1, res, error)
+      if (allocated(error)) return
+      conn = c%conn
+      conn(:, 4) = cshift(c%conn(:, 1), 1)
+      call recover_on_mesh(2, c%analysis, c%x, c%etype, conn, c%gp, c%gw, c%gs, 1.0e3_wp, 0.3_wp, 1, res, error)
+      call expect(error, stat_invalid_input, 'elements 1 and 4 have the same vertices')
+   end subroutine test_duplicates
+
+   !> With c_indices (the C and Python entries) messages name entries 0-based in C order
+   !> with the C argument names (issue 13, defect 5): gw(2, 3) is gauss_weights[2][1].
+   subroutine test_c_index_messages(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(case_type) :: c
+      type(mesh_recovery_type) :: res
+      real(wp), allocatable :: gw(:, :), gp(:, :, :), x(:, :)
+      real(wp) :: sp(3, 1)
+
+      call build_case(c, elem_quad4, 2, f_linear, 0.0_wp)
+      gw = c%gw
+      gw(2, 3) = 0.0_wp
+      call recover_on_mesh(2, c%analysis, c%x, c%etype, c%conn, c%gp, gw, c%gs, 1.0e3_wp, 0.3_wp, 1, res, error, &
+         & c_indices=.true.)
+      call expect(error, stat_invalid_input, 'gauss_weights[2][1] = ')
+      if (allocated(error)) return
+      gp = c%gp
+      gp(:, 1, 1) = c%gp(:, 1, 4)
+      call recover_on_mesh(2, c%analysis, c%x, c%etype, c%conn, gp, c%gw, c%gs, 1.0e3_wp, 0.3_wp, 1, res, error, &
+         & c_indices=.true.)
+      call expect(error, stat_invalid_input, 'gauss_points[0][0] is not inside element 0')
+      if (allocated(error)) return
+      x = reshape([c%x, c%x(:, 5)], [2, 10])
+      call recover_on_mesh(2, c%analysis, x, c%etype, reshape([c%conn(:, 1:3), merge(10, c%conn(:, 4), &
+         & c%conn(:, 4) == 5)], [4, 4]), c%gp, c%gw, c%gs, 1.0e3_wp, 0.3_wp, 1, res, error, c_indices=.true.)
+      call expect(error, stat_invalid_input, 'nodes 4 and 9 are at the same point')
+      if (allocated(error)) return
+      call recover_on_mesh(2, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1.0e3_wp, 0.3_wp, 1, res, error, &
+         & c_indices=.true.)
+      if (allocated(error)) return
+      call mesh_recovery_eval(res, reshape([0.9_wp, 0.9_wp], [2, 1]), sp, error, [1])
+      call expect(error, stat_invalid_input, 'points[0] = ')
+      if (allocated(error)) return
+      call mesh_recovery_eval(res, reshape([0.9_wp, 0.9_wp], [2, 1]), sp, error, [1])
+      call expect(error, stat_invalid_input, 'is not in element 0')
+   end subroutine test_c_index_messages
 
    !> Elements small against their distance from the origin (issue 13, defect 1): the inverse
    !> map's stopping test follows the map's round-off, so a unit quad4 shifted by 1000 and a

@@ -4,8 +4,9 @@
 !> C arrays in row-major order are the Fortran column-major arrays with the
 !> same memory (`nodes[nnode][dim]` is `nodes(dim, nnode)`), so the real
 !> arrays are used in place; the 0-based indices (connectivity, facet nodes,
-!> point elements) are range-checked here and copied 1-based, so that a
-!> message names the index as the C caller wrote it.
+!> point elements) are range-checked here and copied 1-based. The library
+!> names entries in C notation (`c_indices`), so that every message names the
+!> index as the C caller wrote it.
 module sprc_capi_recovery
    use, intrinsic :: iso_c_binding, only: c_ptr, c_int, c_double, c_null_ptr, c_associated, c_f_pointer, c_loc
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
@@ -115,7 +116,7 @@ contains
       if (iand(method, flag_p_plus_1) /= 0) degree = degree + 1
       call recover_on_mesh(dim, analysis, x, element_type, conn, gp, gw, gs, young, poisson, &
          & int(iand(method, method_mask)), rec%result, error, body_force=bf, facet_nodes=fn, facet_kind=fk, &
-         & facet_traction=ft, degree=degree)
+         & facet_traction=ft, degree=degree, c_indices=.true.)
       if (allocated(error)) then
          deallocate (rec)
          call set_capi_error(err, error)

@@ -10,12 +10,15 @@
 !> xx, yy, zz, xy, yz, xz); analysis (plane_stress 1, plane_strain 2, solid 3), E, nu;
 !> method (mesh_method_spr 1, mesh_method_sprc 2); optionally a constant body force
 !> (div sigma + b = 0) and boundary facets. Every point must lie in its element (checked by
-!> the inverse isoparametric map, tolerance 1e-6 in reference coordinates).
+!> the inverse isoparametric map, tolerance 1e-6 in reference coordinates). Two used nodes
+!> at one point and two elements on the same vertices are input errors.
 !>
 !> Facets: facet_nodes(nfn, nfacet) (a side of an element: line2 / line3 in 2D, tri3 /
 !> quad4 / quad9 faces in 3D, nfn fixed by the element type, VTK order for the quadratic
 !> ones), facet_kind(nfacet) (facet_traction 1 with the constant vector facet_traction(:, f);
-!> facet_symmetry 2; facet_free 3 = traction zero). A facet belongs to exactly one element,
+!> facet_symmetry 2; facet_free 3 = traction zero; facet_pressure 4 with p = facet_traction(1, f):
+!> t = -p n with the facet's own outward normal at each of its points, so that the traction
+!> turns along a curved facet). A facet belongs to exactly one element,
 !> the one holding all its nodes (else an error: not a boundary facet). Its quadrature points
 !> (sprc_recovery_mesh_element) get normals oriented away from that element's vertex centroid,
 !> so the caller's facet node order does not matter for the orientation. Boundary
@@ -70,13 +73,14 @@ module sprc_recovery_mesh
       & element_dim, element_nodes, element_vertices, element_degree, element_facet_nodes, element_shape, &
       & element_vertex_shape, element_node_xi, element_inside, element_inverse_map, element_name, &
       & facet_points, facet_npoints, max_facet_points, max_element_nodes
-   use sprc_recovery_mesh_check, only: check_mesh_options, check_mesh_arrays, check_mesh_facets, itoa, rtoa, &
-      & mesh_method_spr, mesh_method_sprc, facet_traction, facet_symmetry, facet_free
+   use sprc_recovery_mesh_check, only: check_mesh_options, check_mesh_arrays, check_mesh_facets, &
+      & check_duplicate_nodes, check_duplicate_elements, itoa, vec_str, entry_name, index_name, &
+      & mesh_method_spr, mesh_method_sprc, facet_traction, facet_symmetry, facet_free, facet_pressure
    implicit none
    private
 
    public :: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, mesh_default_max_rounds
-   public :: mesh_method_spr, mesh_method_sprc, facet_traction, facet_symmetry, facet_free
+   public :: mesh_method_spr, mesh_method_sprc, facet_traction, facet_symmetry, facet_free, facet_pressure
    public :: elem_tri3, elem_quad4, elem_tet4, elem_hex8, elem_quad9, elem_hex27
 
    !> Default limit of expansion rounds per patch.
@@ -91,6 +95,8 @@ module sprc_recovery_mesh
       !> Nodes, elements, nodes and vertices per element.
       integer :: nnode = 0, nelem = 0, nen = 0, nvertex = 0
       real(wp) :: young = 0.0_wp, poisson = 0.0_wp
+      !> Messages name entries as C does (0-based, row-major; module sprc_recovery_mesh_check).
+      logical :: c_indices = .false.
       !> Copy of the mesh: nodes x(dim, nnode), connectivity(nen, nelem), element boxes.
       real(wp), allocatable :: x(:, :), box_lo(:, :), box_hi(:, :)
       integer, allocatable :: connectivity(:, :)
@@ -133,7 +139,7 @@ contains
    !> inverse map does not converge (stat_not_converged), a patch still rank deficient after
    !> `max_rounds` expansions (stat_singular, naming the node).
    subroutine recover_on_mesh(dim, analysis, nodes, element_type, connectivity, gp, gw, gs, young, poisson, method, &
-         & result, error, body_force, facet_nodes, facet_kind, facet_traction, degree, max_rounds)
+         & result, error, body_force, facet_nodes, facet_kind, facet_traction, degree, max_rounds, c_indices)
       integer, intent(in) :: dim, analysis
       !> Node coordinates (dim, nnode).
       real(wp), intent(in) :: nodes(:, :)
@@ -153,23 +159,34 @@ contains
       real(wp), intent(in), optional :: facet_traction(:, :)
       !> Patch polynomial degree (1..3; default the element degree); expansion rounds (>= 0).
       integer, intent(in), optional :: degree, max_rounds
+      !> Name array entries in messages as C does (the C and Python entries): 0-based,
+      !> row-major, C argument names (default false: Fortran's gw(i, e)).
+      logical, intent(in), optional :: c_indices
       type(topology_type) :: topo
       real(wp), allocatable :: xi(:, :, :)
       integer :: deg, rounds
+      logical :: ci
 
       deg = element_degree(element_type)
       if (present(degree)) deg = degree
       rounds = mesh_default_max_rounds
       if (present(max_rounds)) rounds = max_rounds
+      ci = .false.
+      if (present(c_indices)) ci = c_indices
       call check_mesh_options(dim, analysis, element_type, method, deg, rounds, young, poisson, error)
       if (allocated(error)) return
-      call check_mesh_arrays(dim, analysis, nodes, element_type, connectivity, gp, gw, gs, error, body_force)
+      call check_mesh_arrays(dim, analysis, nodes, element_type, connectivity, gp, gw, gs, ci, error, body_force)
       if (allocated(error)) return
-      call check_mesh_facets(dim, element_type, size(nodes, 2), error, facet_nodes, facet_kind, facet_traction)
+      call check_mesh_facets(dim, element_type, size(nodes, 2), ci, error, facet_nodes, facet_kind, facet_traction)
       if (allocated(error)) return
 
       call init_result(result, dim, analysis, element_type, method, deg, young, poisson, nodes, connectivity)
+      result%c_indices = ci
       call node_elements(result, topo)
+      call check_duplicate_nodes(nodes, topo%ne_ptr(2:) > topo%ne_ptr(:size(nodes, 2)), ci, error)
+      if (allocated(error)) return
+      call check_duplicate_elements(connectivity, result%nvertex, topo%ne_ptr, topo%ne_list, ci, error)
+      if (allocated(error)) return
       if (present(body_force)) topo%body_force(1:dim) = body_force
       call point_coordinates(result, gp, xi, error)
       if (allocated(error)) return
@@ -265,17 +282,25 @@ contains
          do i = 1, size(gp, 2)
             call element_inverse_map(r%element_type, r%x(:, r%connectivity(:, e)), gp(:, i, e), xi(:, i, e), ok)
             if (.not. ok) then
-               call fatal_error(error, 'recover_on_mesh: the inverse map of gp(:, '//itoa(i)//', '//itoa(e)// &
-                  & ') did not converge (distorted or inverted element '//itoa(e)//'?)', stat_not_converged)
+               call fatal_error(error, 'recover_on_mesh: the inverse map of '//point_name(i, e)// &
+                  & ' did not converge (distorted or inverted element '//index_name(r%c_indices, e)//'?)', &
+                  & stat_not_converged)
                return
             end if
             if (.not. element_inside(r%element_type, xi(:, i, e), inside_tol)) then
-               call fatal_error(error, 'recover_on_mesh: gp(:, '//itoa(i)//', '//itoa(e)//') is not inside element '// &
-                  & itoa(e)//' (reference coordinates '//vec_str(xi(:, i, e))//')', stat_invalid_input)
+               call fatal_error(error, 'recover_on_mesh: '//point_name(i, e)//' is not inside element '// &
+                  & index_name(r%c_indices, e)//' (reference coordinates '//vec_str(xi(:, i, e))//')', &
+                  & stat_invalid_input)
                return
             end if
          end do
       end do
+   contains
+      pure function point_name(i, e) result(s)
+         integer, intent(in) :: i, e
+         character(len=:), allocatable :: s
+         s = entry_name(r%c_indices, 'gp', 'gauss_points', [0, i, e])
+      end function point_name
    end subroutine point_coordinates
 
    !> Quadrature points of the facets, gathered per owning element (CSR), normals outward.
@@ -314,8 +339,8 @@ contains
          e = owner(f)
          call facet_points(d, nfn, r%x(:, facet_nodes(:, f)), nq_f, xq, wq, nq)
          if (.not. all(wq(1:nq_f) > 0.0_wp)) then
-            call fatal_error(error, 'recover_on_mesh: facet '//itoa(f)//' is degenerate (zero length or area)', &
-               & stat_invalid_input)
+            call fatal_error(error, 'recover_on_mesh: facet '//index_name(r%c_indices, f)// &
+               & ' is degenerate (zero length or area)', stat_invalid_input)
             return
          end if
          c(1:d) = sum(r%x(:, r%connectivity(1:r%nvertex, e)), dim=2)/real(r%nvertex, wp)
@@ -331,6 +356,11 @@ contains
             case (facet_traction)
                topo%bkind(k) = boundary_traction
                topo%bt(:, k) = facet_traction_value(:, f)
+               topo%bpiece(k) = 1
+            case (facet_pressure)
+               ! The facet's own outward normal at this point: the traction turns with it.
+               topo%bkind(k) = boundary_traction
+               topo%bt(:, k) = -facet_traction_value(1, f)*topo%bn(:, k)
                topo%bpiece(k) = 1
             case (facet_free)
                topo%bkind(k) = boundary_traction
@@ -357,14 +387,15 @@ contains
          e = topo%ne_list(k)
          if (.not. all([(any(r%connectivity(:, e) == fnodes(a)), a=1, size(fnodes))])) cycle
          if (owner /= 0) then
-            call fatal_error(error, 'recover_on_mesh: facet '//itoa(f)//' is shared by elements '//itoa(owner)// &
-               & ' and '//itoa(e)//': not a boundary facet', stat_invalid_input)
+            call fatal_error(error, 'recover_on_mesh: facet '//index_name(r%c_indices, f)//' is shared by elements '// &
+               & index_name(r%c_indices, owner)//' and '//index_name(r%c_indices, e)//': not a boundary facet', &
+               & stat_invalid_input)
             return
          end if
          owner = e
       end do
-      if (owner == 0) call fatal_error(error, 'recover_on_mesh: facet '//itoa(f)//' (nodes '//ivec_str(fnodes)// &
-         & ') is not a side of any element', stat_invalid_input)
+      if (owner == 0) call fatal_error(error, 'recover_on_mesh: facet '//index_name(r%c_indices, f)//' (nodes '// &
+         & ivec_str(r%c_indices, fnodes)//') is not a side of any element', stat_invalid_input)
    end subroutine facet_owner
 
    !> The OpenMP patch loop, then the first failing patch serially for its message.
@@ -498,10 +529,10 @@ contains
       nel = sc%nlist
       if (.not. allocated(error)) return
       if (error%stat == stat_singular) then
-         error%message = 'recover_on_mesh: patch of node '//itoa(n)//' at '//vec_str(r%x(:, n))//', '//itoa(nel)// &
-            & ' elements after '//itoa(rounds)//' expansion rounds: '//error%message
+         error%message = 'recover_on_mesh: patch of node '//index_name(r%c_indices, n)//' at '//vec_str(r%x(:, n))// &
+            & ', '//itoa(nel)//' elements after '//itoa(rounds)//' expansion rounds: '//error%message
       else
-         error%message = 'recover_on_mesh: patch of node '//itoa(n)//': '//error%message
+         error%message = 'recover_on_mesh: patch of node '//index_name(r%c_indices, n)//': '//error%message
       end if
    contains
       subroutine solve(ws)
@@ -714,25 +745,26 @@ contains
       end if
       do i = 1, npts
          if (.not. all(abs(x(:, i)) <= huge(1.0_wp))) then
-            call fail('x(:, '//itoa(i)//') is not finite')
+            call fail(point(i)//' is not finite')
             return
          end if
          e = 0
          if (present(elem)) e = elem(i)
          if (e < 0 .or. e > result%nelem) then
-            call fail('elem('//itoa(i)//') = '//itoa(e)//' is not 0 (search) or an element in 1..'// &
-               & itoa(result%nelem))
+            call fail(entry_name(result%c_indices, 'elem', 'elements', [i])//' = '//index_name(result%c_indices, e)// &
+               & ' is not '//index_name(result%c_indices, 0)//' (search) or an element in '// &
+               & index_name(result%c_indices, 1)//'..'//index_name(result%c_indices, result%nelem))
             return
          end if
          if (e > 0) then
             if (.not. in_element(result, e, x(:, i), xi)) then
-               call fail('x(:, '//itoa(i)//') = '//vec_str(x(:, i))//' is not in element '//itoa(e))
+               call fail(point(i)//' = '//vec_str(x(:, i))//' is not in element '//index_name(result%c_indices, e))
                return
             end if
          else
             e = locate(result, x(:, i), xi)
             if (e == 0) then
-               call fail('x(:, '//itoa(i)//') = '//vec_str(x(:, i))//' is in no element')
+               call fail(point(i)//' = '//vec_str(x(:, i))//' is in no element')
                return
             end if
          end if
@@ -743,6 +775,11 @@ contains
          character(len=*), intent(in) :: message
          call fatal_error(error, 'mesh_recovery_eval: '//message, stat_invalid_input)
       end subroutine fail
+      pure function point(i) result(s)
+         integer, intent(in) :: i
+         character(len=:), allocatable :: s
+         s = entry_name(result%c_indices, 'x', 'points', [0, i])
+      end function point
    end subroutine mesh_recovery_eval
 
    !> True (and the reference coordinates) if x lies in element e.
@@ -777,25 +814,14 @@ contains
       end do
    end function locate
 
-   pure function vec_str(v) result(s)
-      real(wp), intent(in) :: v(:)
-      character(len=:), allocatable :: s
-      integer :: i
-      s = '('
-      do i = 1, size(v)
-         s = s//rtoa(v(i))
-         if (i < size(v)) s = s//', '
-      end do
-      s = s//')'
-   end function vec_str
-
-   pure function ivec_str(v) result(s)
+   pure function ivec_str(c_indices, v) result(s)
+      logical, intent(in) :: c_indices
       integer, intent(in) :: v(:)
       character(len=:), allocatable :: s
       integer :: i
       s = ''
       do i = 1, size(v)
-         s = s//itoa(v(i))
+         s = s//index_name(c_indices, v(i))
          if (i < size(v)) s = s//' '
       end do
    end function ivec_str

@@ -3,9 +3,14 @@
 !> Every check names the argument, the index and the value, so that a legacy caller can
 !> find the offending entry: options and codes first, then shapes, then values (finite
 !> coordinates, connectivity in range without repeated nodes, positive finite weights,
-!> finite stresses, facet kinds and nodes, finite tractions and body force).
+!> finite stresses, facet kinds and nodes, finite tractions and body force), then
+!> duplicates (two used nodes at the same point, two elements on the same vertices).
+!>
+!> Indices in messages follow the caller's language (`c_indices`): Fortran's 1-based,
+!> column-major `gw(3, 1)`, or for the C and Python entries 0-based, row-major
+!> `gauss_weights[0][2]` with the C argument names (module procedure `entry_name`).
 module sprc_recovery_mesh_check
-   use sprc_core_kinds, only: wp
+   use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_material, only: plane_stress, plane_strain, solid, voigt_size, check_material
    use sprc_core_poly, only: poly_max_degree
@@ -14,14 +19,16 @@ module sprc_recovery_mesh_check
    implicit none
    private
 
-   public :: check_mesh_options, check_mesh_arrays, check_mesh_facets, itoa, rtoa
-   public :: mesh_method_spr, mesh_method_sprc, facet_traction, facet_symmetry, facet_free
+   public :: check_mesh_options, check_mesh_arrays, check_mesh_facets, check_duplicate_nodes, &
+      & check_duplicate_elements, itoa, rtoa, vec_str, entry_name, index_name
+   public :: mesh_method_spr, mesh_method_sprc, facet_traction, facet_symmetry, facet_free, facet_pressure
 
    !> Recovery methods (values are part of the C API; never renumber).
    integer, parameter :: mesh_method_spr = 1, mesh_method_sprc = 2
    !> Facet kinds (values are part of the C API; never renumber): prescribed traction
-   !> (its value per facet), symmetry plane (zero shear), free surface (zero traction).
-   integer, parameter :: facet_traction = 1, facet_symmetry = 2, facet_free = 3
+   !> (its value per facet), symmetry plane (zero shear), free surface (zero traction),
+   !> pressure p = facet_traction(1, f) (t = -p n with the facet's own normal at each point).
+   integer, parameter :: facet_traction = 1, facet_symmetry = 2, facet_free = 3, facet_pressure = 4
 
 contains
 
@@ -58,13 +65,15 @@ contains
    end subroutine check_mesh_options
 
    !> Shapes and values of nodes, connectivity, integration points, weights, stresses and
-   !> body force (options already checked).
-   pure subroutine check_mesh_arrays(dim, analysis, nodes, element_type, connectivity, gp, gw, gs, error, &
-         & body_force)
+   !> body force (options already checked). Shapes are named in Fortran order (the C entry
+   !> checks its own counts first); entries in the caller's convention (`c_indices`).
+   pure subroutine check_mesh_arrays(dim, analysis, nodes, element_type, connectivity, gp, gw, gs, c_indices, &
+         & error, body_force)
       integer, intent(in) :: dim, analysis, element_type
       real(wp), intent(in) :: nodes(:, :)
       integer, intent(in) :: connectivity(:, :)
       real(wp), intent(in) :: gp(:, :, :), gw(:, :), gs(:, :, :)
+      logical, intent(in) :: c_indices
       type(error_type), allocatable, intent(out) :: error
       real(wp), intent(in), optional :: body_force(:)
       integer :: nnode, nelem, nen, ngp, ns, e, a, b, i
@@ -100,45 +109,51 @@ contains
       end if
       do i = 1, nnode
          if (.not. all(abs(nodes(:, i)) <= huge(1.0_wp))) then
-            call fail(error, 'nodes(:, '//itoa(i)//') is not finite')
+            call fail(error, entry_name(c_indices, 'nodes', 'nodes', [0, i])//' is not finite')
             return
          end if
       end do
       do e = 1, nelem
          do a = 1, nen
             if (connectivity(a, e) < 1 .or. connectivity(a, e) > nnode) then
-               call fail(error, 'connectivity('//itoa(a)//', '//itoa(e)//') = '//itoa(connectivity(a, e))// &
-                  & ' is not a node in 1..'//itoa(nnode))
+               call fail(error, entry_name(c_indices, 'connectivity', 'connectivity', [a, e])//' = '// &
+                  & index_name(c_indices, connectivity(a, e))//' is not a node in '//index_name(c_indices, 1)// &
+                  & '..'//index_name(c_indices, nnode))
                return
             end if
             do b = 1, a - 1
                if (connectivity(b, e) == connectivity(a, e)) then
-                  call fail(error, 'element '//itoa(e)//' repeats node '//itoa(connectivity(a, e))// &
-                     & ' (local nodes '//itoa(b)//' and '//itoa(a)//')')
+                  call fail(error, 'element '//index_name(c_indices, e)//' repeats node '// &
+                     & index_name(c_indices, connectivity(a, e))//' (local nodes '//index_name(c_indices, b)// &
+                     & ' and '//index_name(c_indices, a)//')')
                   return
                end if
             end do
          end do
          do i = 1, ngp
             if (.not. all(abs(gp(:, i, e)) <= huge(1.0_wp))) then
-               call fail(error, 'gp(:, '//itoa(i)//', '//itoa(e)//') is not finite')
+               call fail(error, entry_name(c_indices, 'gp', 'gauss_points', [0, i, e])//' is not finite')
             else if (.not. (gw(i, e) > 0.0_wp .and. gw(i, e) <= huge(1.0_wp))) then
-               call fail(error, 'gw('//itoa(i)//', '//itoa(e)//') = '//rtoa(gw(i, e))//' must be finite and > 0')
+               call fail(error, entry_name(c_indices, 'gw', 'gauss_weights', [i, e])//' = '//rtoa(gw(i, e))// &
+                  & ' must be finite and > 0')
             else if (.not. all(abs(gs(:, i, e)) <= huge(1.0_wp))) then
-               call fail(error, 'gs(:, '//itoa(i)//', '//itoa(e)//') is not finite (NaN or Inf)')
+               call fail(error, entry_name(c_indices, 'gs', 'gauss_stress', [0, i, e])//' is not finite (NaN or Inf)')
             end if
             if (allocated(error)) return
          end do
       end do
    end subroutine check_mesh_arrays
 
-   !> Facet arrays: given together, shapes, kinds, node range, finite tractions.
-   pure subroutine check_mesh_facets(dim, element_type, nnode, error, facet_nodes, facet_kind, facet_traction_value)
+   !> Facet arrays: given together, shapes, kinds, node range, finite tractions (pressure
+   !> facets: the pressure facet_traction(1, f)).
+   pure subroutine check_mesh_facets(dim, element_type, nnode, c_indices, error, facet_nodes, facet_kind, &
+         & facet_traction_value)
       integer, intent(in) :: dim, element_type, nnode
+      logical, intent(in) :: c_indices
       type(error_type), allocatable, intent(out) :: error
       integer, intent(in), optional :: facet_nodes(:, :), facet_kind(:)
       real(wp), intent(in), optional :: facet_traction_value(:, :)
-      integer :: nf, nfn, f, a
+      integer :: nf, nfn, f, a, nval
 
       if (present(facet_nodes) .neqv. present(facet_kind)) then
          call fail(error, 'facet_nodes and facet_kind must be given together')
@@ -163,27 +178,152 @@ contains
       end if
       do f = 1, nf
          select case (facet_kind(f))
-         case (facet_traction)
+         case (facet_traction, facet_pressure)
+            nval = merge(dim, 1, facet_kind(f) == facet_traction)
             if (.not. present(facet_traction_value)) then
-               call fail(error, 'facet '//itoa(f)//' has kind traction but facet_traction is not given')
-            else if (.not. all(abs(facet_traction_value(:, f)) <= huge(1.0_wp))) then
-               call fail(error, 'facet_traction(:, '//itoa(f)//') is not finite')
+               call fail(error, 'facet '//index_name(c_indices, f)//' has kind '// &
+                  & trim(merge('traction', 'pressure', facet_kind(f) == facet_traction))// &
+                  & ' but facet_traction is not given')
+            else if (.not. all(abs(facet_traction_value(1:nval, f)) <= huge(1.0_wp))) then
+               call fail(error, entry_name(c_indices, 'facet_traction', 'facet_traction', [0, f])//' is not finite')
             end if
          case (facet_symmetry, facet_free)
          case default
-            call fail(error, 'facet_kind('//itoa(f)//') = '//itoa(facet_kind(f))// &
-               & ' is not traction = 1, symmetry = 2 or free = 3')
+            call fail(error, entry_name(c_indices, 'facet_kind', 'facet_kind', [f])//' = '//itoa(facet_kind(f))// &
+               & ' is not traction = 1, symmetry = 2, free = 3 or pressure = 4')
          end select
          if (allocated(error)) return
          do a = 1, nfn
             if (facet_nodes(a, f) < 1 .or. facet_nodes(a, f) > nnode) then
-               call fail(error, 'facet_nodes('//itoa(a)//', '//itoa(f)//') = '//itoa(facet_nodes(a, f))// &
-                  & ' is not a node in 1..'//itoa(nnode))
+               call fail(error, entry_name(c_indices, 'facet_nodes', 'facet_nodes', [a, f])//' = '// &
+                  & index_name(c_indices, facet_nodes(a, f))//' is not a node in '//index_name(c_indices, 1)//'..'// &
+                  & index_name(c_indices, nnode))
                return
             end if
          end do
       end do
    end subroutine check_mesh_facets
+
+   !> No two nodes used by elements at the same point (bitwise equal coordinates, -0 = +0):
+   !> such a mesh is not connected there, and its patches would silently stop at the seam.
+   !> A hash table of the used nodes: O(nnode) expected.
+   pure subroutine check_duplicate_nodes(nodes, used, c_indices, error)
+      real(wp), intent(in) :: nodes(:, :)
+      logical, intent(in) :: used(:)
+      logical, intent(in) :: c_indices
+      type(error_type), allocatable, intent(out) :: error
+      integer, allocatable :: table(:)
+      integer :: n, nslot, slot, m
+
+      ! A power of two at least twice the used nodes: short probe chains.
+      nslot = 4
+      do while (nslot < 2*count(used))
+         nslot = 2*nslot
+      end do
+      allocate (table(nslot))
+      table = 0
+      do n = 1, size(nodes, 2)
+         if (.not. used(n)) cycle
+         slot = int(iand(coordinate_hash(nodes(:, n)), int(nslot - 1, i8))) + 1
+         do
+            m = table(slot)
+            if (m == 0) exit
+            if (all(nodes(:, m) == nodes(:, n))) then
+               call fail(error, 'nodes '//index_name(c_indices, m)//' and '//index_name(c_indices, n)// &
+                  & ' are at the same point '//vec_str(nodes(:, n))//' (duplicate nodes: merge them; a crack or '// &
+                  & 'an interface is two meshes, recovered one at a time)')
+               return
+            end if
+            slot = mod(slot, nslot) + 1
+         end do
+         table(slot) = n
+      end do
+   end subroutine check_duplicate_nodes
+
+   !> No two elements on the same set of vertices (a repeated element would count its
+   !> points twice). Candidates share the first vertex: ne_ptr / ne_list is the node ->
+   !> element CSR (elements ascending per node); O(nelem) for bounded valence.
+   pure subroutine check_duplicate_elements(connectivity, nvertex, ne_ptr, ne_list, c_indices, error)
+      integer, intent(in) :: connectivity(:, :), nvertex, ne_ptr(:), ne_list(:)
+      logical, intent(in) :: c_indices
+      type(error_type), allocatable, intent(out) :: error
+      integer :: e, k, o, n, a
+
+      do e = 1, size(connectivity, 2)
+         n = connectivity(1, e)
+         do k = ne_ptr(n), ne_ptr(n + 1) - 1
+            o = ne_list(k)
+            if (o >= e) exit
+            if (all([(any(connectivity(1:nvertex, o) == connectivity(a, e)), a=1, nvertex)])) then
+               call fail(error, 'elements '//index_name(c_indices, o)//' and '//index_name(c_indices, e)// &
+                  & ' have the same vertices (duplicate elements)')
+               return
+            end if
+         end do
+      end do
+   end subroutine check_duplicate_elements
+
+   !> xorshift hash of the coordinates' bits (+0 for -0 so that equal points hash equal).
+   pure integer(i8) function coordinate_hash(x) result(h)
+      real(wp), intent(in) :: x(:)
+      integer :: i
+      h = 88172645463325252_i8
+      do i = 1, size(x)
+         h = ieor(h, transfer(x(i) + 0.0_wp, h))
+         h = ieor(h, shiftl(h, 13))
+         h = ieor(h, shiftr(h, 7))
+         h = ieor(h, shiftl(h, 17))
+      end do
+   end function coordinate_hash
+
+   !> An array entry as the caller writes it. idx are Fortran indices (1-based, 0 for a
+   !> whole dimension ':'): Fortran `fname(:, 3, 1)`; C (c_indices) `cname[0][2]`, the
+   !> indices reversed, 0-based, whole dimensions (the leading Fortran ones) left out.
+   pure function entry_name(c_indices, fname, cname, idx) result(s)
+      logical, intent(in) :: c_indices
+      character(len=*), intent(in) :: fname, cname
+      integer, intent(in) :: idx(:)
+      character(len=:), allocatable :: s
+      integer :: i
+
+      if (c_indices) then
+         s = cname
+         do i = size(idx), 1, -1
+            if (idx(i) > 0) s = s//'['//itoa(idx(i) - 1)//']'
+         end do
+      else
+         s = fname//'('
+         do i = 1, size(idx)
+            if (idx(i) > 0) then
+               s = s//itoa(idx(i))
+            else
+               s = s//':'
+            end if
+            if (i < size(idx)) s = s//', '
+         end do
+         s = s//')'
+      end if
+   end function entry_name
+
+   !> A 1-based index i (node, element, facet, point) as the caller counts it.
+   pure function index_name(c_indices, i) result(s)
+      logical, intent(in) :: c_indices
+      integer, intent(in) :: i
+      character(len=:), allocatable :: s
+      s = itoa(merge(i - 1, i, c_indices))
+   end function index_name
+
+   pure function vec_str(v) result(s)
+      real(wp), intent(in) :: v(:)
+      character(len=:), allocatable :: s
+      integer :: i
+      s = '('
+      do i = 1, size(v)
+         s = s//rtoa(v(i))
+         if (i < size(v)) s = s//', '
+      end do
+      s = s//')'
+   end function vec_str
 
    pure subroutine fail(error, message)
       type(error_type), allocatable, intent(out) :: error
