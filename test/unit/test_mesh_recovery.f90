@@ -25,6 +25,8 @@ module sprc_test_mesh_recovery
       & elem_quad9, elem_hex27
    use sprc_legacy, only: sprc_recover_mesh
    use sprc_recovery_mesh_element, only: facet_points
+   use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reset, patch_add_point
+   use sprc_recovery_patch_loop, only: patch_source_type, patch_loop_type, run_patch_loop, patch_capacity
    !$ use omp_lib, only: omp_get_max_threads, omp_set_num_threads
    implicit none
    private
@@ -60,6 +62,15 @@ module sprc_test_mesh_recovery
       & 0, 0, 1, 2, 0, 1, 2, 2, 1, 0, 2, 1, &
       & 0, 1, 1, 2, 1, 1, 1, 0, 1, 1, 2, 1, 1, 1, 0, 1, 1, 2, 1, 1, 1], [3, 27])
 
+   !> A test mesh as a source of patches for the shared patch loop (the plainest one:
+   !> the elements' points, h = 1).
+   type, extends(patch_source_type) :: case_source_type
+      type(case_type), pointer :: c => null()
+   contains
+      procedure :: fill => case_fill
+      procedure :: points_of => case_points_of
+   end type case_source_type
+
 contains
 
    subroutine collect_mesh_recovery(testsuite)
@@ -85,6 +96,7 @@ contains
          new_unittest('pressure_facets', test_pressure_facets), &
          new_unittest('duplicates', test_duplicates), &
          new_unittest('c_index_messages', test_c_index_messages), &
+         new_unittest('patch_loop_skip', test_patch_loop_skip), &
          new_unittest('legacy_wrapper', test_legacy) &
          ]
    end subroutine collect_mesh_recovery
@@ -1184,6 +1196,93 @@ contains
       call mesh_recovery_eval(res, reshape([0.9_wp, 0.9_wp], [2, 1]), sp, error, [1])
       call expect(error, stat_invalid_input, 'is not in element 0')
    end subroutine test_c_index_messages
+
+   subroutine case_fill(self, node, elements, patch)
+      class(case_source_type), intent(in) :: self
+      integer, intent(in) :: node, elements(:)
+      type(patch_type), intent(inout) :: patch
+      integer :: i, g
+      call patch_reset(patch, self%c%dim, self%c%analysis, 1000.0_wp, 0.3_wp, self%c%x(:, node), 1.0_wp)
+      do i = 1, size(elements)
+         do g = 1, size(self%c%gp, 2)
+            call patch_add_point(patch, self%c%gp(:, g, elements(i)), self%c%gw(g, elements(i)), &
+               & self%c%gs(:, g, elements(i)))
+         end do
+      end do
+   end subroutine case_fill
+
+   pure function case_points_of(self, e) result(counts)
+      class(case_source_type), intent(in) :: self
+      integer, intent(in) :: e
+      integer :: counts(2)
+      counts = [size(self%c%gp, 2) + 0*e, 0]
+   end function case_points_of
+
+   !> The shared patch loop (sprc_recovery_patch_loop) with patches left to another module
+   !> (contact): skipped patches stay empty with 0 rounds and elements, the others have the
+   !> bits of the loop without skips (results depend on the patch alone). The linear field
+   !> makes every solved patch exact (checked at its node: the file's tolerance).
+   subroutine test_patch_loop_skip(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(case_type), target :: c
+      type(case_source_type) :: src
+      type(patch_loop_type) :: opt
+      type(recovered_patch_type), allocatable :: recs(:), recs_skip(:)
+      integer, allocatable :: ne_ptr(:), ne_list(:), nodes(:), rounds(:), nel(:)
+      logical, allocatable :: skip(:)
+      integer :: n, e, a, failed, nn, ip
+      real(wp) :: s(6)
+
+      call build_case(c, elem_quad4, 3, f_linear, 0.2_wp)
+      c%gs = 0.0_wp
+      do e = 1, size(c%gp, 3)
+         do a = 1, size(c%gp, 2)
+            call exact(f_linear, 2, c%gp(:, a, e), s)
+            c%gs(:, a, e) = s(1:3)
+         end do
+      end do
+      src%c => c
+      nn = size(c%x, 2)
+      allocate (ne_ptr(nn + 1))
+      ne_ptr = 0
+      do e = 1, size(c%conn, 2)
+         ne_ptr(c%conn(:, e) + 1) = ne_ptr(c%conn(:, e) + 1) + 1
+      end do
+      ne_ptr(1) = 1
+      do n = 1, nn
+         ne_ptr(n + 1) = ne_ptr(n + 1) + ne_ptr(n)
+      end do
+      allocate (ne_list(ne_ptr(nn + 1) - 1), nodes(nn))
+      nodes = ne_ptr(1:nn)
+      do e = 1, size(c%conn, 2)
+         do a = 1, 4
+            ne_list(nodes(c%conn(a, e))) = e
+            nodes(c%conn(a, e)) = nodes(c%conn(a, e)) + 1
+         end do
+      end do
+      nodes = [(n, n=1, nn)]
+      opt = patch_loop_type(dim=2, degree=1, rounds_limit=2, sprc=.false.)
+      opt%cap = patch_capacity(src, 2, 1, ne_ptr, ne_list, nodes)
+      allocate (recs(nn), recs_skip(nn), rounds(nn), nel(nn), skip(nn))
+      call run_patch_loop(opt, src, ne_ptr, ne_list, c%conn, nodes, recs, rounds, nel, failed, error)
+      if (allocated(error)) return
+      skip = mod(nodes, 3) == 0
+      call run_patch_loop(opt, src, ne_ptr, ne_list, c%conn, nodes, recs_skip, rounds, nel, failed, error, skip)
+      if (allocated(error)) return
+      do ip = 1, nn
+         if (skip(ip)) then
+            call check(error, recs_skip(ip)%nterms == 0 .and. rounds(ip) == 0 .and. nel(ip) == 0, &
+               & 'a skipped patch stays empty')
+         else
+            call check(error, recs_skip(ip)%nterms == recs(ip)%nterms .and. &
+               & same(recs_skip(ip)%coef(1:3, 1:3), recs(ip)%coef(1:3, 1:3)), 'the other patches keep their bits')
+            if (allocated(error)) return
+            call exact(f_linear, 2, c%x(:, ip), s)
+            call check(error, maxval(abs(recs(ip)%coef(1, 1:3) - s(1:3))) <= tol*c%scale, 'patch exact at its node')
+         end if
+         if (allocated(error)) return
+      end do
+   end subroutine test_patch_loop_skip
 
    !> Elements small against their distance from the origin (issue 13, defect 1): the inverse
    !> map's stopping test follows the map's round-off, so a unit quad4 shifted by 1000 and a

@@ -37,32 +37,22 @@
 !> stat_singular naming the node. `field%patch_rounds`, `field%n_expanded` tell how many
 !> patches needed it.
 !>
-!> Parallelism and determinism: the patch loop is OpenMP-parallel, each thread owns a
-!> patch object, a recovery workspace, an element list and an element stamp array. LAPACK
-!> results depend on the workspace's capacities (leading dimensions, lwork and with it
-!> blocked or unblocked code paths), so every thread reserves the same capacity before the
-!> loop, that of the largest unexpanded patch, and never grows it: a patch that outgrows it
-!> (only possible after expansion) is solved in a second workspace reset to that patch's
-!> own size. Results then depend on the patch alone, elements and points are gathered in a
-!> fixed order, and results are stored per patch: the bits do not depend on the thread
-!> count or schedule. Nothing is allocated per patch except for such outgrown expanded
-!> patches. Errors inside the loop are recorded per patch; after the loop the first
-!> failing patch (lowest node) is solved again serially for its message.
+!> The loop itself (gathering, expansion, OpenMP, determinism) is the shared one of
+!> sprc_recovery_patch_loop; this module supplies the grid's patches (`grid_source_type`)
+!> and names a failing patch by its node. `skip_patch` leaves chosen patches to another
+!> module (contact recovers the patches it owns).
 module sprc_grid_patches
    use sprc_core_kinds, only: wp
-   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular, stat_internal
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular
    use sprc_core_material, only: plane_stress, plane_strain, solid, voigt_size, check_material
-   use sprc_core_poly, only: poly_max_degree, poly_nterms
+   use sprc_core_poly, only: poly_max_degree
    use sprc_core_timer, only: wall_time
-   use sprc_core_blas_threads, only: blas_serial_begin, blas_serial_end
    use sprc_exact_solution, only: exact_solution_type
    use sprc_grid_tree, only: grid_type
    use sprc_grid_nodes, only: grid_nodes_type
    use sprc_grid_hanging, only: hanging_type
-   use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reset, patch_reserve, &
-      & boundary_traction, boundary_symmetry
-   use sprc_recovery_workspace, only: recovery_workspace_type, workspace_reserve, workspace_init
-   use sprc_recovery_solve, only: recover_spr, recover_sprc
+   use sprc_recovery_patch, only: patch_type, patch_reset, patch_reserve, boundary_traction, boundary_symmetry
+   use sprc_recovery_patch_loop, only: patch_source_type, patch_loop_type, run_patch_loop, patch_capacity
    use sprc_grid_recovered_field, only: recovered_field_type, method_spr, method_sprc, build_field
    implicit none
    private
@@ -100,15 +90,19 @@ module sprc_grid_patches
       real(wp), allocatable :: bc_traction(:, :), bc_pressure(:)
    end type recovery_input_type
 
-   !> Per-thread storage of the patch loop.
-   type :: scratch_type
-      type(patch_type) :: patch
-      !> Workspace of the common capacity (same in every thread) and one for larger patches.
-      type(recovery_workspace_type) :: ws, ws_big
-      !> Elements of the current patch (1:nlist) and a stamp per element (= the patch's node).
-      integer, allocatable :: list(:), stamp(:)
-      integer :: nlist = 0
-   end type scratch_type
+   !> The grid as a source of patches (sprc_recovery_patch_loop): read-only views of the
+   !> input, the nodes, the leaf boxes and the exact solution.
+   type, extends(patch_source_type) :: grid_source_type
+      type(recovery_input_type), pointer :: input => null()
+      type(grid_nodes_type), pointer :: nodes => null()
+      real(wp), pointer :: elem_lo(:, :) => null(), elem_hi(:, :) => null()
+      class(exact_solution_type), pointer :: exact => null()
+      integer :: nstress = 0
+      logical :: sprc = .false.
+   contains
+      procedure :: fill => grid_fill
+      procedure :: points_of => grid_points_of
+   end type grid_source_type
 
 contains
 
@@ -132,20 +126,21 @@ contains
    !> invalid input (stat_invalid_input, naming the field and index), a patch still rank
    !> deficient after `max_rounds` expansions (stat_singular, naming the node).
    subroutine recover_grid(input, grid, nodes, hanging, method, degree, field, error, exact, max_rounds)
-      type(recovery_input_type), intent(in) :: input
+      type(recovery_input_type), intent(in), target :: input
       type(grid_type), intent(in) :: grid
-      type(grid_nodes_type), intent(in) :: nodes
+      type(grid_nodes_type), intent(in), target :: nodes
       type(hanging_type), intent(in) :: hanging
       integer, intent(in) :: method, degree
-      type(recovered_field_type), intent(out) :: field
+      type(recovered_field_type), intent(out), target :: field
       type(error_type), allocatable, intent(out) :: error
-      class(exact_solution_type), intent(in), optional :: exact
+      class(exact_solution_type), intent(in), optional, target :: exact
       !> Expansion rounds allowed per patch (>= 0; default `default_max_rounds`).
       integer, intent(in), optional :: max_rounds
-      integer, allocatable :: status(:)
-      integer :: rounds_limit, ip, e, cap(2), saved_blas
+      type(grid_source_type) :: src
+      type(patch_loop_type) :: opt
+      integer :: rounds_limit, ip, e, n
       real(wp) :: t0
-      character(len=80) :: buf
+      character(len=160) :: buf
 
       rounds_limit = default_max_rounds
       if (present(max_rounds)) rounds_limit = max_rounds
@@ -166,29 +161,31 @@ contains
       end do
       call number_patches(nodes, hanging, field)
       allocate (field%recs(field%n_patches), field%patch_rounds(field%n_patches), &
-         & field%patch_elements(field%n_patches), status(field%n_patches))
+         & field%patch_elements(field%n_patches))
 
-      cap = initial_capacity(input, nodes, method, degree)
-
-      ! Small LAPACK calls from every thread: OpenBLAS in one thread (sprc_core_blas_threads).
-      saved_blas = blas_serial_begin()
-      !$omp parallel default(shared)
-      call patch_loop(input, nodes, field, method, degree, rounds_limit, cap, status, exact)
-      !$omp end parallel
-      call blas_serial_end(saved_blas)
-
-      if (any(status /= 0)) then
-         ip = findloc(status /= 0, .true., dim=1)
-         block
-            type(scratch_type) :: sc
-            call init_scratch(sc, nodes, degree, cap)
-            call recover_patch(input, nodes, field%elem_lo, field%elem_hi, field%patch_node(ip), field%nstress, &
-               & method, degree, rounds_limit, sc, field%recs(ip), field%patch_rounds(ip), field%patch_elements(ip), &
-               & error, exact)
-         end block
-         if (.not. allocated(error)) then
-            write (buf, '("patch ",i0," failed in the parallel loop but not serially")') ip
-            call fatal_error(error, 'recover_grid: '//trim(buf), stat_internal)
+      src%input => input
+      src%nodes => nodes
+      src%elem_lo => field%elem_lo
+      src%elem_hi => field%elem_hi
+      if (present(exact)) src%exact => exact
+      src%nstress = field%nstress
+      src%sprc = method == method_sprc
+      opt = patch_loop_type(dim=grid%dim, degree=degree, rounds_limit=rounds_limit, sprc=src%sprc)
+      ! Over all nodes, hanging ones included: the capacity (and with it the bits) of before.
+      opt%cap = patch_capacity(src, grid%dim, degree, nodes%node_element_ptr, nodes%node_element, &
+         & [(n, n=1, nodes%n_nodes)])
+      call run_patch_loop(opt, src, nodes%node_element_ptr, nodes%node_element, nodes%connectivity, &
+         & field%patch_node, field%recs, field%patch_rounds, field%patch_elements, ip, error)
+      if (allocated(error)) then
+         if (ip == 0) return
+         n = field%patch_node(ip)
+         write (buf, '("patch of node ",i0," at (",3(es12.4,:,","))') n, nodes%x(:, n)
+         if (error%stat == stat_singular) then
+            write (buf, '(a,"), ",i0," elements after ",i0," expansion rounds: ")') trim(buf), &
+               & field%patch_elements(ip), field%patch_rounds(ip)
+            error%message = 'recover_grid: '//trim(buf)//error%message
+         else
+            error%message = 'recover_grid: '//trim(buf)//'): '//error%message
          end if
          return
       end if
@@ -248,216 +245,69 @@ contains
       end do
    end subroutine number_patches
 
-   !> One thread's share of the patch loop (called inside the parallel region: its locals
-   !> are the thread's own, default-initialised).
-   subroutine patch_loop(input, nodes, field, method, degree, rounds_limit, cap, status, exact)
-      type(recovery_input_type), intent(in) :: input
-      type(grid_nodes_type), intent(in) :: nodes
-      type(recovered_field_type), intent(inout) :: field
-      integer, intent(in) :: method, degree, rounds_limit, cap(2)
-      integer, intent(inout) :: status(:)
-      class(exact_solution_type), intent(in), optional :: exact
-      type(scratch_type) :: sc
-      type(error_type), allocatable :: err
-      integer :: ip
+   !> [volume points, boundary points] leaf e adds to a patch (boundary points of every
+   !> kind: the capacity of before).
+   pure function grid_points_of(self, e) result(counts)
+      class(grid_source_type), intent(in) :: self
+      integer, intent(in) :: e
+      integer :: counts(2)
 
-      call init_scratch(sc, nodes, degree, cap)
-      !$omp do schedule(dynamic, 16)
-      do ip = 1, field%n_patches
-         call recover_patch(input, nodes, field%elem_lo, field%elem_hi, field%patch_node(ip), field%nstress, &
-            & method, degree, rounds_limit, sc, field%recs(ip), field%patch_rounds(ip), field%patch_elements(ip), &
-            & err, exact)
-         status(ip) = 0
-         if (allocated(err)) status(ip) = err%stat
-      end do
-      !$omp end do
-   end subroutine patch_loop
+      counts = [self%input%elem_ptr(e + 1) - self%input%elem_ptr(e), 0]
+      if (self%sprc) counts(2) = self%input%belem_ptr(e + 1) - self%input%belem_ptr(e)
+   end function grid_points_of
 
-   !> Points and boundary points of the largest unexpanded patch (at least 4 nterms points:
-   !> the LAPACK workspace queries need room for a full basis).
-   function initial_capacity(input, nodes, method, degree) result(cap)
-      type(recovery_input_type), intent(in) :: input
-      type(grid_nodes_type), intent(in) :: nodes
-      integer, intent(in) :: method, degree
-      integer :: cap(2)
-      integer :: n, k, e, np, nb
+   !> The patch of node n over the listed leaves (storage reused).
+   subroutine grid_fill(self, node, elements, patch)
+      class(grid_source_type), intent(in) :: self
+      integer, intent(in) :: node, elements(:)
+      type(patch_type), intent(inout) :: patch
+      real(wp) :: x0(3), h, t(3)
+      integer :: d, i, e, k, np, nb, kind, ns
 
-      cap = [4*poly_nterms(nodes%dim, degree), 0]
-      do n = 1, nodes%n_nodes
+      associate (input => self%input, elem_lo => self%elem_lo, elem_hi => self%elem_hi)
+         d = self%nodes%dim
+         ns = self%nstress
+         x0 = 0.0_wp
+         x0(1:d) = self%nodes%x(:, node)
+         h = 0.0_wp
          np = 0
          nb = 0
-         do k = nodes%node_element_ptr(n), nodes%node_element_ptr(n + 1) - 1
-            e = nodes%node_element(k)
+         do i = 1, size(elements)
+            e = elements(i)
+            h = max(h, sqrt(sum(max(abs(elem_lo(:, e) - x0(1:d)), abs(elem_hi(:, e) - x0(1:d)))**2)))
             np = np + input%elem_ptr(e + 1) - input%elem_ptr(e)
-            if (method == method_sprc) nb = nb + input%belem_ptr(e + 1) - input%belem_ptr(e)
+            if (self%sprc) nb = nb + input%belem_ptr(e + 1) - input%belem_ptr(e)
          end do
-         cap = max(cap, [np, nb])
-      end do
-   end function initial_capacity
-
-   !> Thread storage. The LAPACK results depend on the workspace's capacities (leading
-   !> dimensions, lwork and with it blocked or unblocked code), so every thread reserves the
-   !> same capacity `cap` once, and a patch that outgrows it (only after expansion) is
-   !> solved in `ws_big`, reset to that patch's own size: results depend on the patch only.
-   subroutine init_scratch(sc, nodes, degree, cap)
-      type(scratch_type), intent(inout) :: sc
-      type(grid_nodes_type), intent(in) :: nodes
-      integer, intent(in) :: degree, cap(2)
-      type(error_type), allocatable :: err
-
-      allocate (sc%list(64), sc%stamp(nodes%n_elements))
-      sc%stamp = 0
-      ! Cannot fail: dim and degree were validated.
-      call workspace_reserve(sc%ws, nodes%dim, degree, cap(1), cap(2), err)
-      call patch_reserve(sc%patch, cap(1), cap(2))
-   end subroutine init_scratch
-
-   !> Gather, solve, and expand while the basis lacks rank.
-   subroutine recover_patch(input, nodes, elem_lo, elem_hi, n, ns, method, degree, rounds_limit, sc, rec, rounds, &
-         & nel, error, exact)
-      type(recovery_input_type), intent(in) :: input
-      type(grid_nodes_type), intent(in) :: nodes
-      real(wp), intent(in) :: elem_lo(:, :), elem_hi(:, :)
-      !> Patch node and number of stress components.
-      integer, intent(in) :: n, ns
-      integer, intent(in) :: method, degree, rounds_limit
-      type(scratch_type), intent(inout) :: sc
-      type(recovered_patch_type), intent(out) :: rec
-      integer, intent(out) :: rounds, nel
-      type(error_type), allocatable, intent(out) :: error
-      class(exact_solution_type), intent(in), optional :: exact
-      integer :: k, round, nprev
-      character(len=160) :: buf
-
-      sc%nlist = 0
-      do k = nodes%node_element_ptr(n), nodes%node_element_ptr(n + 1) - 1
-         call list_add(sc, nodes%node_element(k), n)
-      end do
-      rounds = 0
-      do round = 0, rounds_limit
-         if (round > 0) then
-            nprev = sc%nlist
-            call expand(nodes, sc, n)
-            if (sc%nlist == nprev) exit
-            rounds = round
-         end if
-         nel = sc%nlist
-         call fill_patch(input, nodes, elem_lo, elem_hi, n, ns, method, sc, exact)
-         if (sc%patch%npoints == 0) cycle
-         if (sc%patch%npoints <= sc%ws%cap_p .and. sc%patch%nbpoints <= sc%ws%cap_b) then
-            call solve(sc%ws)
-         else
-            call workspace_init(sc%ws_big)
-            call solve(sc%ws_big)
-         end if
-         if (.not. allocated(error)) return
-         if (error%stat /= stat_singular) exit
-      end do
-      nel = sc%nlist
-      write (buf, '("patch of node ",i0," at (",3(es12.4,:,","))') n, nodes%x(:, n)
-      if (.not. allocated(error)) then
-         call fatal_error(error, 'recover_grid: '//trim(buf)//'): no integration points', stat_singular)
-      else if (error%stat == stat_singular) then
-         write (buf, '(a,"), ",i0," elements after ",i0," expansion rounds: ")') trim(buf), nel, rounds
-         error%message = 'recover_grid: '//trim(buf)//error%message
-      else
-         error%message = 'recover_grid: '//trim(buf)//'): '//error%message
-      end if
-   contains
-      subroutine solve(ws)
-         type(recovery_workspace_type), intent(inout) :: ws
-         if (method == method_spr) then
-            call recover_spr(sc%patch, degree, ws, rec, error)
-         else
-            call recover_sprc(sc%patch, degree, ws, rec, error)
-         end if
-      end subroutine solve
-   end subroutine recover_patch
-
-   subroutine list_add(sc, e, tag)
-      type(scratch_type), intent(inout) :: sc
-      integer, intent(in) :: e, tag
-      integer, allocatable :: tmp(:)
-
-      if (sc%stamp(e) == tag) return
-      sc%stamp(e) = tag
-      if (sc%nlist == size(sc%list)) then
-         allocate (tmp(2*size(sc%list)))
-         tmp(1:sc%nlist) = sc%list(1:sc%nlist)
-         call move_alloc(tmp, sc%list)
-      end if
-      sc%nlist = sc%nlist + 1
-      sc%list(sc%nlist) = e
-   end subroutine list_add
-
-   !> One ring: every leaf sharing a node with the current patch, in list and node order.
-   subroutine expand(nodes, sc, tag)
-      type(grid_nodes_type), intent(in) :: nodes
-      type(scratch_type), intent(inout) :: sc
-      integer, intent(in) :: tag
-      integer :: i, j, k, m, n0
-
-      n0 = sc%nlist
-      do i = 1, n0
-         do j = 1, nodes%nodes_per_element
-            m = nodes%connectivity(j, sc%list(i))
-            do k = nodes%node_element_ptr(m), nodes%node_element_ptr(m + 1) - 1
-               call list_add(sc, nodes%node_element(k), tag)
-            end do
-         end do
-      end do
-   end subroutine expand
-
-   !> The patch of node n over the listed elements (storage reused).
-   subroutine fill_patch(input, nodes, elem_lo, elem_hi, n, ns, method, sc, exact)
-      type(recovery_input_type), intent(in) :: input
-      type(grid_nodes_type), intent(in) :: nodes
-      real(wp), intent(in) :: elem_lo(:, :), elem_hi(:, :)
-      integer, intent(in) :: n, ns, method
-      type(scratch_type), intent(inout) :: sc
-      class(exact_solution_type), intent(in), optional :: exact
-      real(wp) :: x0(3), h, t(3)
-      integer :: d, i, e, k, np, nb, kind
-
-      d = nodes%dim
-      x0 = 0.0_wp
-      x0(1:d) = nodes%x(:, n)
-      h = 0.0_wp
-      np = 0
-      nb = 0
-      do i = 1, sc%nlist
-         e = sc%list(i)
-         h = max(h, sqrt(sum(max(abs(elem_lo(:, e) - x0(1:d)), abs(elem_hi(:, e) - x0(1:d)))**2)))
-         np = np + input%elem_ptr(e + 1) - input%elem_ptr(e)
-         if (method == method_sprc) nb = nb + input%belem_ptr(e + 1) - input%belem_ptr(e)
-      end do
-      associate (p => sc%patch)
-         call patch_reset(p, d, input%analysis, input%young, input%poisson, x0(1:d), h)
-         call patch_reserve(p, np, nb)
-         p%body_force(1:d) = input%body_force(1:d)
-         do i = 1, sc%nlist
-            e = sc%list(i)
+         call patch_reset(patch, d, input%analysis, input%young, input%poisson, x0(1:d), h)
+         call patch_reserve(patch, np, nb)
+         patch%body_force(1:d) = input%body_force(1:d)
+         do i = 1, size(elements)
+            e = elements(i)
             do k = input%elem_ptr(e), input%elem_ptr(e + 1) - 1
-               p%npoints = p%npoints + 1
-               p%x(1:d, p%npoints) = input%x(:, k)
-               p%w(p%npoints) = input%w(k)
-               p%stress(1:ns, p%npoints) = input%stress(:, k)
+               patch%npoints = patch%npoints + 1
+               patch%x(1:d, patch%npoints) = input%x(:, k)
+               patch%w(patch%npoints) = input%w(k)
+               patch%stress(1:ns, patch%npoints) = input%stress(:, k)
             end do
-            if (method /= method_sprc) cycle
+            if (.not. self%sprc) cycle
             do k = input%belem_ptr(e), input%belem_ptr(e + 1) - 1
-               call boundary_data(input, k, d, kind, t, exact)
+               if (associated(self%exact)) then
+                  call boundary_data(input, k, d, kind, t, self%exact)
+               else
+                  call boundary_data(input, k, d, kind, t)
+               end if
                if (kind == 0) cycle
-               p%nbpoints = p%nbpoints + 1
-               p%bx(1:d, p%nbpoints) = input%bx(:, k)
-               p%bw(p%nbpoints) = input%bw(k)
-               p%bn(1:d, p%nbpoints) = input%bn(:, k)
-               p%bkind(p%nbpoints) = kind
-               p%bpiece(p%nbpoints) = input%bshape(k)
-               p%btraction(1:d, p%nbpoints) = t(1:d)
+               patch%nbpoints = patch%nbpoints + 1
+               patch%bx(1:d, patch%nbpoints) = input%bx(:, k)
+               patch%bw(patch%nbpoints) = input%bw(k)
+               patch%bn(1:d, patch%nbpoints) = input%bn(:, k)
+               patch%bkind(patch%nbpoints) = kind
+               patch%bpiece(patch%nbpoints) = input%bshape(k)
+               patch%btraction(1:d, patch%nbpoints) = t(1:d)
             end do
          end do
       end associate
-   end subroutine fill_patch
+   end subroutine grid_fill
 
    !> Recovery boundary kind (0: not constrained) and prescribed traction of boundary point k.
    pure subroutine boundary_data(input, k, d, kind, t, exact)

@@ -53,21 +53,16 @@
 !> inverse map per point; otherwise a search over the elements whose bounding box holds the
 !> point, one inverse map per candidate: O(nelem) box tests per point (no spatial index).
 !>
-!> Parallelism and determinism as in sprc_grid_patches: every thread reserves the same
-!> workspace capacity (the largest unexpanded patch) before the OpenMP patch loop, outgrown
-!> expanded patches get a workspace of their own size, results are stored per patch: the
-!> bits do not depend on the thread count.
+!> Parallelism and determinism: the patch loop is sprc_recovery_patch_loop's (shared with
+!> the grid); the bits do not depend on the thread count.
 module sprc_recovery_mesh
    use sprc_core_kinds, only: wp
-   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular, stat_internal, &
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular, &
       & stat_not_converged
    use sprc_core_material, only: voigt_size
-   use sprc_core_poly, only: poly_nterms
-   use sprc_core_blas_threads, only: blas_serial_begin, blas_serial_end
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reset, patch_reserve, &
       & boundary_traction, boundary_symmetry
-   use sprc_recovery_workspace, only: recovery_workspace_type, workspace_reserve, workspace_init
-   use sprc_recovery_solve, only: recover_spr, recover_sprc
+   use sprc_recovery_patch_loop, only: patch_source_type, patch_loop_type, run_patch_loop, patch_capacity
    use sprc_recovery_estimate, only: eval_recovered, zz_error_norm, scaled_norm, relative_error
    use sprc_recovery_mesh_element, only: elem_tri3, elem_quad4, elem_tet4, elem_hex8, elem_quad9, elem_hex27, &
       & element_dim, element_nodes, element_vertices, element_degree, element_facet_nodes, element_shape, &
@@ -124,13 +119,19 @@ module sprc_recovery_mesh
       real(wp) :: body_force(3) = 0.0_wp
    end type topology_type
 
-   !> Per-thread storage of the patch loop.
-   type :: scratch_type
-      type(patch_type) :: patch
-      type(recovery_workspace_type) :: ws, ws_big
-      integer, allocatable :: list(:), stamp(:)
-      integer :: nlist = 0
-   end type scratch_type
+   !> The caller's mesh as a source of patches (sprc_recovery_patch_loop): read-only views
+   !> of the result's copy of the mesh, the topology and the caller's point arrays.
+   type, extends(patch_source_type) :: mesh_source_type
+      integer :: dim = 0, analysis = 0, nstress = 0, nen = 0
+      logical :: sprc = .false.
+      real(wp) :: young = 0.0_wp, poisson = 0.0_wp
+      real(wp), pointer :: x(:, :) => null(), gp(:, :, :) => null(), gw(:, :) => null(), gs(:, :, :) => null()
+      integer, pointer :: connectivity(:, :) => null()
+      type(topology_type), pointer :: topo => null()
+   contains
+      procedure :: fill => mesh_fill
+      procedure :: points_of => mesh_points_of
+   end type mesh_source_type
 
 contains
 
@@ -147,10 +148,10 @@ contains
       !> Element nodes (nen, nelem), 1-based, VTK order.
       integer, intent(in) :: connectivity(:, :)
       !> Integration points (dim, ngp, nelem), weight*|J| (ngp, nelem), FE stress (nstress, ngp, nelem).
-      real(wp), intent(in) :: gp(:, :, :), gw(:, :), gs(:, :, :)
+      real(wp), intent(in), target :: gp(:, :, :), gw(:, :), gs(:, :, :)
       real(wp), intent(in) :: young, poisson
       integer, intent(in) :: method
-      type(mesh_recovery_type), intent(out) :: result
+      type(mesh_recovery_type), intent(out), target :: result
       type(error_type), allocatable, intent(out) :: error
       !> Constant body force (dim).
       real(wp), intent(in), optional :: body_force(:)
@@ -162,7 +163,7 @@ contains
       !> Name array entries in messages as C does (the C and Python entries): 0-based,
       !> row-major, C argument names (default false: Fortran's gw(i, e)).
       logical, intent(in), optional :: c_indices
-      type(topology_type) :: topo
+      type(topology_type), target :: topo
       real(wp), allocatable :: xi(:, :, :)
       integer :: deg, rounds
       logical :: ci
@@ -398,35 +399,46 @@ contains
          & ivec_str(r%c_indices, fnodes)//') is not a side of any element', stat_invalid_input)
    end subroutine facet_owner
 
-   !> The OpenMP patch loop, then the first failing patch serially for its message.
+   !> The shared patch loop (sprc_recovery_patch_loop) over the vertex nodes; a failing
+   !> patch is named by its node.
    subroutine recover_patches(r, topo, gp, gw, gs, rounds, error)
-      type(mesh_recovery_type), intent(inout) :: r
-      type(topology_type), intent(in) :: topo
-      real(wp), intent(in) :: gp(:, :, :), gw(:, :), gs(:, :, :)
+      type(mesh_recovery_type), intent(inout), target :: r
+      type(topology_type), intent(in), target :: topo
+      real(wp), intent(in), target :: gp(:, :, :), gw(:, :), gs(:, :, :)
       integer, intent(in) :: rounds
       type(error_type), allocatable, intent(out) :: error
-      integer, allocatable :: status(:)
-      integer :: cap(2), ip, saved_blas
+      type(mesh_source_type) :: src
+      type(patch_loop_type) :: opt
+      integer :: ip, n
 
+      src%dim = r%dim
+      src%analysis = r%analysis
+      src%nstress = r%nstress
+      src%nen = r%nen
+      src%sprc = r%method == mesh_method_sprc
+      src%young = r%young
+      src%poisson = r%poisson
+      src%x => r%x
+      src%connectivity => r%connectivity
+      src%topo => topo
+      src%gp => gp
+      src%gw => gw
+      src%gs => gs
+      opt = patch_loop_type(dim=r%dim, degree=r%degree, rounds_limit=rounds, sprc=src%sprc)
+      opt%cap = patch_capacity(src, r%dim, r%degree, topo%ne_ptr, topo%ne_list, r%patch_node)
       allocate (r%recs(r%n_patches), r%patch_rounds(r%n_patches), r%patch_elements(r%n_patches))
-      allocate (status(r%n_patches))
-      cap = initial_capacity(r, topo, size(gp, 2))
-      ! Small LAPACK calls from every thread: OpenBLAS in one thread (sprc_core_blas_threads).
-      saved_blas = blas_serial_begin()
-      !$omp parallel default(shared)
-      call patch_loop(r, topo, gp, gw, gs, rounds, cap, status)
-      !$omp end parallel
-      call blas_serial_end(saved_blas)
-      if (any(status /= 0)) then
-         ip = findloc(status /= 0, .true., dim=1)
-         block
-            type(scratch_type) :: sc
-            call init_scratch(sc, r, cap)
-            call recover_patch(r, topo, gp, gw, gs, r%patch_node(ip), rounds, sc, r%recs(ip), r%patch_rounds(ip), &
-               & r%patch_elements(ip), error)
-         end block
-         if (.not. allocated(error)) call fatal_error(error, 'recover_on_mesh: patch '//itoa(ip)// &
-            & ' failed in the parallel loop but not serially', stat_internal)
+      call run_patch_loop(opt, src, topo%ne_ptr, topo%ne_list, r%connectivity, r%patch_node, r%recs, &
+         & r%patch_rounds, r%patch_elements, ip, error)
+      if (allocated(error)) then
+         if (ip == 0) return
+         n = r%patch_node(ip)
+         if (error%stat == stat_singular) then
+            error%message = 'recover_on_mesh: patch of node '//index_name(r%c_indices, n)//' at '// &
+               & vec_str(r%x(:, n))//', '//itoa(r%patch_elements(ip))//' elements after '// &
+               & itoa(r%patch_rounds(ip))//' expansion rounds: '//error%message
+         else
+            error%message = 'recover_on_mesh: patch of node '//index_name(r%c_indices, n)//': '//error%message
+         end if
          return
       end if
       r%n_expanded = count(r%patch_rounds > 0)
@@ -435,197 +447,58 @@ contains
       r%n_tolerance_bites = count(r%recs%tolerance_bites)
    end subroutine recover_patches
 
-   subroutine patch_loop(r, topo, gp, gw, gs, rounds, cap, status)
-      type(mesh_recovery_type), intent(inout) :: r
-      type(topology_type), intent(in) :: topo
-      real(wp), intent(in) :: gp(:, :, :), gw(:, :), gs(:, :, :)
-      integer, intent(in) :: rounds, cap(2)
-      integer, intent(inout) :: status(:)
-      type(scratch_type) :: sc
-      type(error_type), allocatable :: err
-      integer :: ip
+   !> [volume points, boundary points] element e adds to a patch.
+   pure function mesh_points_of(self, e) result(counts)
+      class(mesh_source_type), intent(in) :: self
+      integer, intent(in) :: e
+      integer :: counts(2)
 
-      call init_scratch(sc, r, cap)
-      !$omp do schedule(dynamic, 16)
-      do ip = 1, r%n_patches
-         call recover_patch(r, topo, gp, gw, gs, r%patch_node(ip), rounds, sc, r%recs(ip), r%patch_rounds(ip), &
-            & r%patch_elements(ip), err)
-         status(ip) = 0
-         if (allocated(err)) status(ip) = err%stat
-      end do
-      !$omp end do
-   end subroutine patch_loop
-
-   !> Points and boundary points of the largest unexpanded patch (at least 4 nterms points).
-   pure function initial_capacity(r, topo, ngp) result(cap)
-      type(mesh_recovery_type), intent(in) :: r
-      type(topology_type), intent(in) :: topo
-      integer, intent(in) :: ngp
-      integer :: cap(2)
-      integer :: ip, n, k, nb
-
-      cap = [4*poly_nterms(r%dim, r%degree), 0]
-      do ip = 1, r%n_patches
-         n = r%patch_node(ip)
-         nb = 0
-         do k = topo%ne_ptr(n), topo%ne_ptr(n + 1) - 1
-            nb = nb + topo%bptr(topo%ne_list(k) + 1) - topo%bptr(topo%ne_list(k))
-         end do
-         if (r%method /= mesh_method_sprc) nb = 0
-         cap = max(cap, [ngp*(topo%ne_ptr(n + 1) - topo%ne_ptr(n)), nb])
-      end do
-   end function initial_capacity
-
-   !> Thread storage of the common capacity (LAPACK results depend on it: module notes).
-   subroutine init_scratch(sc, r, cap)
-      type(scratch_type), intent(inout) :: sc
-      type(mesh_recovery_type), intent(in) :: r
-      integer, intent(in) :: cap(2)
-      type(error_type), allocatable :: err
-
-      call workspace_init(sc%ws)
-      call workspace_init(sc%ws_big)
-      allocate (sc%list(64), sc%stamp(r%nelem))
-      sc%stamp = 0
-      ! Cannot fail: dim and degree were validated.
-      call workspace_reserve(sc%ws, r%dim, r%degree, cap(1), cap(2), err)
-      call patch_reserve(sc%patch, cap(1), cap(2))
-   end subroutine init_scratch
-
-   !> Gather, solve, and expand while the basis lacks rank.
-   subroutine recover_patch(r, topo, gp, gw, gs, n, rounds_limit, sc, rec, rounds, nel, error)
-      type(mesh_recovery_type), intent(in) :: r
-      type(topology_type), intent(in) :: topo
-      real(wp), intent(in) :: gp(:, :, :), gw(:, :), gs(:, :, :)
-      integer, intent(in) :: n, rounds_limit
-      type(scratch_type), intent(inout) :: sc
-      type(recovered_patch_type), intent(out) :: rec
-      integer, intent(out) :: rounds, nel
-      type(error_type), allocatable, intent(out) :: error
-      integer :: k, round, nprev
-
-      sc%nlist = 0
-      do k = topo%ne_ptr(n), topo%ne_ptr(n + 1) - 1
-         call list_add(sc, topo%ne_list(k), n)
-      end do
-      rounds = 0
-      do round = 0, rounds_limit
-         if (round > 0) then
-            nprev = sc%nlist
-            call expand(r, topo, sc, n)
-            if (sc%nlist == nprev) exit
-            rounds = round
-         end if
-         call fill_patch(r, topo, gp, gw, gs, n, sc)
-         if (sc%patch%npoints <= sc%ws%cap_p .and. sc%patch%nbpoints <= sc%ws%cap_b) then
-            call solve(sc%ws)
-         else
-            call workspace_init(sc%ws_big)
-            call solve(sc%ws_big)
-         end if
-         if (.not. allocated(error)) exit
-         if (error%stat /= stat_singular) exit
-      end do
-      nel = sc%nlist
-      if (.not. allocated(error)) return
-      if (error%stat == stat_singular) then
-         error%message = 'recover_on_mesh: patch of node '//index_name(r%c_indices, n)//' at '//vec_str(r%x(:, n))// &
-            & ', '//itoa(nel)//' elements after '//itoa(rounds)//' expansion rounds: '//error%message
-      else
-         error%message = 'recover_on_mesh: patch of node '//index_name(r%c_indices, n)//': '//error%message
-      end if
-   contains
-      subroutine solve(ws)
-         type(recovery_workspace_type), intent(inout) :: ws
-         if (r%method == mesh_method_spr) then
-            call recover_spr(sc%patch, r%degree, ws, rec, error)
-         else
-            call recover_sprc(sc%patch, r%degree, ws, rec, error)
-         end if
-      end subroutine solve
-   end subroutine recover_patch
-
-   subroutine list_add(sc, e, tag)
-      type(scratch_type), intent(inout) :: sc
-      integer, intent(in) :: e, tag
-      integer, allocatable :: tmp(:)
-
-      if (sc%stamp(e) == tag) return
-      sc%stamp(e) = tag
-      if (sc%nlist == size(sc%list)) then
-         allocate (tmp(2*size(sc%list)))
-         tmp(1:sc%nlist) = sc%list(1:sc%nlist)
-         call move_alloc(tmp, sc%list)
-      end if
-      sc%nlist = sc%nlist + 1
-      sc%list(sc%nlist) = e
-   end subroutine list_add
-
-   !> One ring: every element sharing a node with the patch, in list and node order.
-   subroutine expand(r, topo, sc, tag)
-      type(mesh_recovery_type), intent(in) :: r
-      type(topology_type), intent(in) :: topo
-      type(scratch_type), intent(inout) :: sc
-      integer, intent(in) :: tag
-      integer :: i, j, k, m, n0
-
-      n0 = sc%nlist
-      do i = 1, n0
-         do j = 1, r%nen
-            m = r%connectivity(j, sc%list(i))
-            do k = topo%ne_ptr(m), topo%ne_ptr(m + 1) - 1
-               call list_add(sc, topo%ne_list(k), tag)
-            end do
-         end do
-      end do
-   end subroutine expand
+      counts = [size(self%gp, 2), 0]
+      if (self%sprc) counts(2) = self%topo%bptr(e + 1) - self%topo%bptr(e)
+   end function mesh_points_of
 
    !> The patch of node n over the listed elements (storage reused).
-   subroutine fill_patch(r, topo, gp, gw, gs, n, sc)
-      type(mesh_recovery_type), intent(in) :: r
-      type(topology_type), intent(in) :: topo
-      real(wp), intent(in) :: gp(:, :, :), gw(:, :), gs(:, :, :)
-      integer, intent(in) :: n
-      type(scratch_type), intent(inout) :: sc
+   subroutine mesh_fill(self, node, elements, patch)
+      class(mesh_source_type), intent(in) :: self
+      integer, intent(in) :: node, elements(:)
+      type(patch_type), intent(inout) :: patch
       real(wp) :: h
       integer :: d, i, e, k, a, np, nb, ngp, ns
 
-      d = r%dim
-      ns = r%nstress
-      ngp = size(gp, 2)
+      d = self%dim
+      ns = self%nstress
+      ngp = size(self%gp, 2)
       h = 0.0_wp
       nb = 0
-      do i = 1, sc%nlist
-         e = sc%list(i)
-         do a = 1, r%nen
-            h = max(h, sqrt(sum((r%x(:, r%connectivity(a, e)) - r%x(:, n))**2)))
+      do i = 1, size(elements)
+         e = elements(i)
+         do a = 1, self%nen
+            h = max(h, sqrt(sum((self%x(:, self%connectivity(a, e)) - self%x(:, node))**2)))
          end do
-         if (r%method == mesh_method_sprc) nb = nb + topo%bptr(e + 1) - topo%bptr(e)
+         if (self%sprc) nb = nb + self%topo%bptr(e + 1) - self%topo%bptr(e)
       end do
-      np = ngp*sc%nlist
-      associate (p => sc%patch)
-         call patch_reset(p, d, r%analysis, r%young, r%poisson, r%x(:, n), h)
-         call patch_reserve(p, np, nb)
-         p%body_force(1:d) = topo%body_force(1:d)
-         do i = 1, sc%nlist
-            e = sc%list(i)
-            p%x(1:d, p%npoints + 1:p%npoints + ngp) = gp(:, :, e)
-            p%w(p%npoints + 1:p%npoints + ngp) = gw(:, e)
-            p%stress(1:ns, p%npoints + 1:p%npoints + ngp) = gs(:, :, e)
-            p%npoints = p%npoints + ngp
-            if (r%method /= mesh_method_sprc) cycle
-            do k = topo%bptr(e), topo%bptr(e + 1) - 1
-               p%nbpoints = p%nbpoints + 1
-               p%bx(1:d, p%nbpoints) = topo%bx(:, k)
-               p%bw(p%nbpoints) = topo%bw(k)
-               p%bn(1:d, p%nbpoints) = topo%bn(:, k)
-               p%bkind(p%nbpoints) = topo%bkind(k)
-               p%bpiece(p%nbpoints) = topo%bpiece(k)
-               p%btraction(1:d, p%nbpoints) = topo%bt(:, k)
-            end do
+      np = ngp*size(elements)
+      call patch_reset(patch, d, self%analysis, self%young, self%poisson, self%x(:, node), h)
+      call patch_reserve(patch, np, nb)
+      patch%body_force(1:d) = self%topo%body_force(1:d)
+      do i = 1, size(elements)
+         e = elements(i)
+         patch%x(1:d, patch%npoints + 1:patch%npoints + ngp) = self%gp(:, :, e)
+         patch%w(patch%npoints + 1:patch%npoints + ngp) = self%gw(:, e)
+         patch%stress(1:ns, patch%npoints + 1:patch%npoints + ngp) = self%gs(:, :, e)
+         patch%npoints = patch%npoints + ngp
+         if (.not. self%sprc) cycle
+         do k = self%topo%bptr(e), self%topo%bptr(e + 1) - 1
+            patch%nbpoints = patch%nbpoints + 1
+            patch%bx(1:d, patch%nbpoints) = self%topo%bx(:, k)
+            patch%bw(patch%nbpoints) = self%topo%bw(k)
+            patch%bn(1:d, patch%nbpoints) = self%topo%bn(:, k)
+            patch%bkind(patch%nbpoints) = self%topo%bkind(k)
+            patch%bpiece(patch%nbpoints) = self%topo%bpiece(k)
+            patch%btraction(1:d, patch%nbpoints) = self%topo%bt(:, k)
          end do
-      end associate
-   end subroutine fill_patch
+      end do
+   end subroutine mesh_fill
 
    !> Nodal stresses: patch value at vertex nodes, the union elsewhere (module notes).
    subroutine nodal_values(r, topo)
