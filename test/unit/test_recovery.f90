@@ -1293,6 +1293,7 @@ contains
       recs(1)%nterms = 3
       recs(1)%x0 = [1.0_wp, 0.0_wp, 0.0_wp]
       recs(1)%h = 2.0_wp
+      allocate (recs(1)%coef(3, 3))
       recs(1)%coef(1:3, 1) = [1.0_wp, 2.0_wp, 0.0_wp]
       recs(1)%coef(1:3, 2) = [3.0_wp, 0.0_wp, 0.0_wp]
       recs(1)%coef(1:3, 3) = [-1.0_wp, 0.0_wp, 0.0_wp]

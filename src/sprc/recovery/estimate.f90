@@ -11,7 +11,7 @@ module sprc_recovery_estimate
    implicit none
    private
 
-   public :: eval_recovered, eval_union, zz_error_integral, zz_error_norm, scaled_norm, relative_error
+   public :: eval_recovered, eval_union, zz_error_integral, zz_error_norm, energy_norms, scaled_norm, relative_error
 
 contains
 
@@ -152,7 +152,7 @@ contains
       real(wp), intent(in) :: sigma_star(:, :), sigma_h(:, :)
       real(wp), intent(out) :: s, ssq
       type(error_type), allocatable, intent(out) :: error
-      real(wp) :: cmat(6, 6), diff(6), big
+      real(wp) :: cmat(6, 6), diff(6)
       integer :: i, ns
       character(len=96) :: buf
 
@@ -175,7 +175,6 @@ contains
          call fatal_error(error, 'zz_error_integral: '//trim(buf), stat_invalid_input)
          return
       end if
-      big = 0.0_wp
       do i = 1, size(w)
          if (.not. (w(i) >= 0.0_wp .and. w(i) <= huge(1.0_wp))) then
             write (buf, '("w(",i0,") = ",es12.4," must be finite and >= 0")') i, w(i)
@@ -188,14 +187,53 @@ contains
             call fatal_error(error, 'zz_error_integral: '//trim(buf), stat_invalid_input)
             return
          end if
-         big = max(big, maxval(abs(diff(1:ns))))
+      end do
+      call scaled_sum(cmat(1:ns, 1:ns), w, sigma_h, s, ssq, sigma_star)
+   end subroutine scaled_integral
+
+   !> Both energy norms of one element for a validated caller (finite stresses, weights
+   !> >= 0) and its compliance cmat(nstress, nstress): err = ||s* - s_h||, norm_h = ||s_h||,
+   !> the bits of `zz_error_norm` (of s* and of a zero s*) without its checks and set-up.
+   pure subroutine energy_norms(cmat, w, sigma_star, sigma_h, err, norm_h)
+      real(wp), intent(in) :: cmat(:, :), w(:), sigma_star(:, :), sigma_h(:, :)
+      real(wp), intent(out) :: err, norm_h
+      real(wp) :: s, ssq
+
+      call scaled_sum(cmat, w, sigma_h, s, ssq, sigma_star)
+      err = s*sqrt(ssq)
+      call scaled_sum(cmat, w, sigma_h, s, ssq)
+      norm_h = s*sqrt(ssq)
+   end subroutine energy_norms
+
+   !> ssq = sum_i w_i d_i^T cmat d_i / s**2, d_i = a_i - b_i (a = 0 if absent), s the power
+   !> of two of the largest |d| (`power_of_two`).
+   pure subroutine scaled_sum(cmat, w, b, s, ssq, a)
+      real(wp), intent(in) :: cmat(:, :), w(:), b(:, :)
+      real(wp), intent(out) :: s, ssq
+      real(wp), intent(in), optional :: a(:, :)
+      real(wp) :: diff(6), big
+      integer :: i, ns
+
+      ns = size(cmat, 1)
+      big = 0.0_wp
+      do i = 1, size(w)
+         if (present(a)) then
+            big = max(big, maxval(abs(a(1:ns, i) - b(1:ns, i))))
+         else
+            big = max(big, maxval(abs(b(1:ns, i))))
+         end if
       end do
       s = power_of_two(big)
+      ssq = 0.0_wp
       do i = 1, size(w)
-         diff(1:ns) = (sigma_star(:, i) - sigma_h(:, i))/s
-         ssq = ssq + w(i)*dot_product(diff(1:ns), matmul(cmat(1:ns, 1:ns), diff(1:ns)))
+         if (present(a)) then
+            diff(1:ns) = (a(1:ns, i) - b(1:ns, i))/s
+         else
+            diff(1:ns) = (0.0_wp - b(1:ns, i))/s
+         end if
+         ssq = ssq + w(i)*dot_product(diff(1:ns), matmul(cmat, diff(1:ns)))
       end do
-   end subroutine scaled_integral
+   end subroutine scaled_sum
 
    !> sqrt(sum(v**2)) without overflow or underflow; the same bits as that expression
    !> wherever it neither overflows nor underflows (scaling by a power of two).

@@ -59,11 +59,12 @@ module sprc_recovery_mesh
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular, &
       & stat_not_converged
-   use sprc_core_material, only: voigt_size
+   use sprc_core_material, only: voigt_size, compliance_matrix
+   use sprc_core_timer, only: wall_time
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reset, patch_reserve, &
       & boundary_traction, boundary_symmetry
    use sprc_recovery_patch_loop, only: patch_source_type, patch_loop_type, run_patch_loop, patch_capacity
-   use sprc_recovery_estimate, only: eval_recovered, zz_error_norm, scaled_norm, relative_error
+   use sprc_recovery_estimate, only: eval_recovered, energy_norms, scaled_norm, relative_error
    use sprc_recovery_mesh_element, only: elem_tri3, elem_quad4, elem_tet4, elem_hex8, elem_quad9, elem_hex27, &
       & element_dim, element_nodes, element_vertices, element_degree, element_facet_nodes, element_shape, &
       & element_vertex_shape, element_node_xi, element_inside, element_inverse_map, element_name, &
@@ -109,6 +110,11 @@ module sprc_recovery_mesh
       real(wp), allocatable :: elem_err(:), elem_norm_h(:)
       !> Global ZZ estimate, FE stress norm, estimated relative error.
       real(wp) :: err = 0.0_wp, norm_h = 0.0_wp, eta = 0.0_wp
+      !> Wall times (s) of the phases: input checks; topology (node -> element lists,
+      !> duplicate checks, facet points); reference coordinates of the points; patch solves;
+      !> nodal values; ZZ estimate.
+      real(wp) :: t_check = 0.0_wp, t_topology = 0.0_wp, t_points = 0.0_wp, t_patches = 0.0_wp, &
+         & t_nodal = 0.0_wp, t_estimate = 0.0_wp
    end type mesh_recovery_type
 
    !> Mesh data of one recovery: node -> element CSR and boundary points per element (CSR).
@@ -167,6 +173,7 @@ contains
       real(wp), allocatable :: xi(:, :, :)
       integer :: deg, rounds
       logical :: ci
+      real(wp) :: t(0:6)
 
       deg = element_degree(element_type)
       if (present(degree)) deg = degree
@@ -174,12 +181,14 @@ contains
       if (present(max_rounds)) rounds = max_rounds
       ci = .false.
       if (present(c_indices)) ci = c_indices
+      t(0) = wall_time()
       call check_mesh_options(dim, analysis, element_type, method, deg, rounds, young, poisson, error)
       if (allocated(error)) return
       call check_mesh_arrays(dim, analysis, nodes, element_type, connectivity, gp, gw, gs, ci, error, body_force)
       if (allocated(error)) return
       call check_mesh_facets(dim, element_type, size(nodes, 2), ci, error, facet_nodes, facet_kind, facet_traction)
       if (allocated(error)) return
+      t(1) = wall_time()
 
       call init_result(result, dim, analysis, element_type, method, deg, young, poisson, nodes, connectivity)
       result%c_indices = ci
@@ -189,14 +198,25 @@ contains
       call check_duplicate_elements(connectivity, result%nvertex, topo%ne_ptr, topo%ne_list, ci, error)
       if (allocated(error)) return
       if (present(body_force)) topo%body_force(1:dim) = body_force
-      call point_coordinates(result, gp, xi, error)
-      if (allocated(error)) return
       call boundary_points(result, topo, error, facet_nodes, facet_kind, facet_traction)
       if (allocated(error)) return
+      t(2) = wall_time()
+      call point_coordinates(result, gp, xi, error)
+      if (allocated(error)) return
+      t(3) = wall_time()
       call recover_patches(result, topo, gp, gw, gs, rounds, error)
       if (allocated(error)) return
+      t(4) = wall_time()
       call nodal_values(result, topo)
+      t(5) = wall_time()
       call estimate(result, gp, gw, gs, xi, error)
+      t(6) = wall_time()
+      result%t_check = t(1) - t(0)
+      result%t_topology = t(2) - t(1)
+      result%t_points = t(3) - t(2)
+      result%t_patches = t(4) - t(3)
+      result%t_nodal = t(5) - t(4)
+      result%t_estimate = t(6) - t(5)
    end subroutine recover_on_mesh
 
    subroutine init_result(r, dim, analysis, element_type, method, deg, young, poisson, nodes, connectivity)
@@ -269,34 +289,69 @@ contains
       end do
    end subroutine node_elements
 
-   !> Reference coordinates of every integration point in its element.
+   !> Reference coordinates of every integration point in its element, computed once here
+   !> (the estimate reuses them). Newton starts from the point's coordinates in element 1
+   !> (a caller's rule is usually the same in every element: then one step confirms them),
+   !> from the centroid if that fails. OpenMP over elements; the guess does not depend on
+   !> the schedule, so neither do the bits. The first failing point (element order) is named.
    subroutine point_coordinates(r, gp, xi, error)
       type(mesh_recovery_type), intent(in) :: r
       real(wp), intent(in) :: gp(:, :, :)
       real(wp), allocatable, intent(out) :: xi(:, :, :)
       type(error_type), allocatable, intent(out) :: error
-      logical :: ok
-      integer :: e, i
+      real(wp), allocatable :: guess(:, :)
+      integer, allocatable :: bad(:)
+      integer :: e, i, ngp
 
-      allocate (xi(r%dim, size(gp, 2), r%nelem))
-      do e = 1, r%nelem
-         do i = 1, size(gp, 2)
-            call element_inverse_map(r%element_type, r%x(:, r%connectivity(:, e)), gp(:, i, e), xi(:, i, e), ok)
-            if (.not. ok) then
-               call fatal_error(error, 'recover_on_mesh: the inverse map of '//point_name(i, e)// &
-                  & ' did not converge (distorted or inverted element '//index_name(r%c_indices, e)//'?)', &
-                  & stat_not_converged)
-               return
-            end if
-            if (.not. element_inside(r%element_type, xi(:, i, e), inside_tol)) then
-               call fatal_error(error, 'recover_on_mesh: '//point_name(i, e)//' is not inside element '// &
-                  & index_name(r%c_indices, e)//' (reference coordinates '//vec_str(xi(:, i, e))//')', &
-                  & stat_invalid_input)
-               return
-            end if
-         end do
+      ngp = size(gp, 2)
+      allocate (xi(r%dim, ngp, r%nelem), bad(r%nelem), guess(r%dim, ngp))
+      bad(1) = map_element(1)
+      guess = xi(:, :, 1)
+      if (bad(1) /= 0) guess = 0.5_wp
+      !$omp parallel do schedule(static)
+      do e = 2, r%nelem
+         bad(e) = map_element(e, guess)
       end do
+      !$omp end parallel do
+      if (all(bad == 0)) return
+      e = findloc(bad /= 0, .true., dim=1)
+      i = abs(bad(e))
+      if (bad(e) < 0) then
+         call fatal_error(error, 'recover_on_mesh: the inverse map of '//point_name(i, e)// &
+            & ' did not converge (distorted or inverted element '//index_name(r%c_indices, e)//'?)', &
+            & stat_not_converged)
+      else
+         call fatal_error(error, 'recover_on_mesh: '//point_name(i, e)//' is not inside element '// &
+            & index_name(r%c_indices, e)//' (reference coordinates '//vec_str(xi(:, i, e))//')', &
+            & stat_invalid_input)
+      end if
    contains
+      !> 0, or -i (point i did not converge), or i (point i is outside).
+      integer function map_element(e, start) result(status)
+         integer, intent(in) :: e
+         real(wp), intent(in), optional :: start(:, :)
+         real(wp) :: xe(3, max_element_nodes)
+         logical :: ok
+         integer :: a, j
+
+         do a = 1, r%nen
+            xe(1:r%dim, a) = r%x(:, r%connectivity(a, e))
+         end do
+         status = 0
+         do j = 1, ngp
+            if (present(start)) then
+               call element_inverse_map(r%element_type, xe, gp(:, j, e), xi(:, j, e), ok, start(:, j))
+            else
+               call element_inverse_map(r%element_type, xe, gp(:, j, e), xi(:, j, e), ok)
+            end if
+            if (.not. ok) then
+               status = -j
+            else if (.not. element_inside(r%element_type, xi(:, j, e), inside_tol)) then
+               status = j
+            end if
+            if (status /= 0) return
+         end do
+      end function map_element
       pure function point_name(i, e) result(s)
          integer, intent(in) :: i, e
          character(len=:), allocatable :: s
@@ -555,39 +610,54 @@ contains
       real(wp), intent(in) :: xi(:), x(:)
       real(wp), intent(out) :: sigma(:)
       real(wp) :: n(max_element_nodes)
+      integer :: a
 
       if (r%method == mesh_method_sprc) then
          call union_at(r, e, xi, x, sigma)
       else
          call element_shape(r%element_type, xi, n)
-         sigma(1:r%nstress) = matmul(r%nodal(:, r%connectivity(:, e)), n(1:r%nen))
+         sigma(1:r%nstress) = 0.0_wp
+         do a = 1, r%nen
+            sigma(1:r%nstress) = sigma(1:r%nstress) + r%nodal(:, r%connectivity(a, e))*n(a)
+         end do
       end if
    end subroutine field_at
 
-   !> ZZ estimate at the caller's points (module notes).
+   !> ZZ estimate at the caller's points (module notes); OpenMP over elements, the sums in
+   !> element order (the bits do not depend on the thread count).
    subroutine estimate(r, gp, gw, gs, xi, error)
       type(mesh_recovery_type), intent(inout) :: r
       real(wp), intent(in) :: gp(:, :, :), gw(:, :), gs(:, :, :), xi(:, :, :)
       type(error_type), allocatable, intent(out) :: error
-      real(wp), allocatable :: sstar(:, :), zero(:, :)
-      integer :: e, i, ngp
+      real(wp), allocatable :: sstar(:, :)
+      real(wp) :: cmat(6, 6)
+      integer :: e, i, ngp, ns
 
       ngp = size(gp, 2)
-      allocate (sstar(r%nstress, ngp), zero(r%nstress, ngp), r%elem_err(r%nelem), r%elem_norm_h(r%nelem))
-      zero = 0.0_wp
+      ns = r%nstress
+      allocate (r%elem_err(r%nelem), r%elem_norm_h(r%nelem))
+      call compliance_matrix(r%analysis, r%young, r%poisson, cmat(1:ns, 1:ns), error)
+      if (allocated(error)) return
+      !$omp parallel default(shared) private(sstar, i)
+      allocate (sstar(ns, ngp))
+      !$omp do schedule(static)
       do e = 1, r%nelem
          do i = 1, ngp
             call field_at(r, e, xi(:, i, e), gp(:, i, e), sstar(:, i))
          end do
-         call zz_error_norm(r%analysis, r%young, r%poisson, gw(:, e), sstar, gs(:, :, e), r%elem_err(e), error)
-         if (allocated(error)) return
-         call zz_error_norm(r%analysis, r%young, r%poisson, gw(:, e), zero, gs(:, :, e), r%elem_norm_h(e), error)
-         if (allocated(error)) return
+         call energy_norms(cmat(1:ns, 1:ns), gw(:, e), sstar, gs(:, :, e), r%elem_err(e), r%elem_norm_h(e))
       end do
+      !$omp end do
+      !$omp end parallel
       ! Scaled sums: finite stresses never overflow to NaN (issue 13, defect 2).
       r%err = scaled_norm(r%elem_err)
       r%norm_h = scaled_norm(r%elem_norm_h)
       r%eta = relative_error(r%err, r%norm_h)
+      if (.not. (r%err <= huge(1.0_wp))) then
+         e = findloc(.not. (r%elem_err <= huge(1.0_wp)), .true., dim=1)
+         call fatal_error(error, 'recover_on_mesh: the recovered stress of element '//index_name(r%c_indices, e)// &
+            & ' is not finite (stresses near the overflow threshold?)', stat_invalid_input)
+      end if
    end subroutine estimate
 
    !> The recovered field sigma(nstress, npts) at points x(dim, npts) (SPR: nodal

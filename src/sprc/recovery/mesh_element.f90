@@ -239,10 +239,29 @@ contains
    !> against its distance from the origin (|x|/h ~ 1e3 and more) sits there, far above
    !> 1e-13. Affine elements converge in one or two steps. The small Jacobian is inverted
    !> by its adjugate (2x2, 3x3).
-   pure subroutine element_inverse_map(etype, xe, x, xi, converged)
+   !> With `guess` Newton starts there (a point's reference coordinates in a like element:
+   !> then one step confirms them) and falls back to the centroid if that fails.
+   pure subroutine element_inverse_map(etype, xe, x, xi, converged, guess)
       integer, intent(in) :: etype
       real(wp), intent(in) :: xe(:, :), x(:)
       real(wp), intent(out) :: xi(:)
+      logical, intent(out) :: converged
+      real(wp), intent(in), optional :: guess(:)
+
+      if (present(guess)) then
+         xi(1:element_dim(etype)) = guess(1:element_dim(etype))
+         call newton(etype, xe, x, xi, converged)
+         if (converged) return
+      end if
+      call element_center_xi(etype, xi)
+      call newton(etype, xe, x, xi, converged)
+   end subroutine element_inverse_map
+
+   !> Newton's iteration of `element_inverse_map` from xi.
+   pure subroutine newton(etype, xe, x, xi, converged)
+      integer, intent(in) :: etype
+      real(wp), intent(in) :: xe(:, :), x(:)
+      real(wp), intent(inout) :: xi(:)
       logical, intent(out) :: converged
       real(wp) :: n(max_element_nodes), dn(3, max_element_nodes), jac(3, 3), inv(3, 3), r(3), step(3), det
       real(wp) :: map_size, floor
@@ -250,7 +269,6 @@ contains
 
       d = element_dim(etype)
       nen = element_nodes(etype)
-      call element_center_xi(etype, xi)
       converged = .false.
       do it = 1, 50
          call element_shape(etype, xi, n, dn)
@@ -268,7 +286,7 @@ contains
             return
          end if
       end do
-   end subroutine element_inverse_map
+   end subroutine newton
 
    !> Number of quadrature points of a facet of `nfn` nodes (line2 2, line3 3, tri3 3,
    !> quad4 2x2, quad9 3x3: one per node, as it happens).
@@ -354,23 +372,38 @@ contains
    end subroutine simplex_shape
 
    !> Tensor Lagrange shape functions of degree deg on [0,1]^rdim, node j at idx(:, j)/deg.
+   !> Products written out per dimension (no temporaries: this runs per point).
    pure subroutine tensor_shape(idx, deg, xi, n, d)
       integer, intent(in) :: idx(:, :), deg
       real(wp), intent(in) :: xi(:)
       real(wp), intent(out) :: n(:), d(:, :)
       real(wp) :: l(0:2, 3), dl(0:2, 3)
-      integer :: j, k, m, rdim
+      integer :: j, k, rdim
 
       rdim = size(idx, 1)
       do k = 1, rdim
          call lagrange_1d(deg, xi(k), l(:, k), dl(:, k))
       end do
-      do j = 1, size(idx, 2)
-         n(j) = product([(l(idx(k, j), k), k=1, rdim)])
-         do m = 1, rdim
-            d(m, j) = product([(merge(dl(idx(k, j), k), l(idx(k, j), k), k == m), k=1, rdim)])
+      select case (rdim)
+      case (1)
+         do j = 1, size(idx, 2)
+            n(j) = l(idx(1, j), 1)
+            d(1, j) = dl(idx(1, j), 1)
          end do
-      end do
+      case (2)
+         do j = 1, size(idx, 2)
+            n(j) = l(idx(1, j), 1)*l(idx(2, j), 2)
+            d(1, j) = dl(idx(1, j), 1)*l(idx(2, j), 2)
+            d(2, j) = l(idx(1, j), 1)*dl(idx(2, j), 2)
+         end do
+      case default
+         do j = 1, size(idx, 2)
+            n(j) = l(idx(1, j), 1)*l(idx(2, j), 2)*l(idx(3, j), 3)
+            d(1, j) = dl(idx(1, j), 1)*l(idx(2, j), 2)*l(idx(3, j), 3)
+            d(2, j) = l(idx(1, j), 1)*dl(idx(2, j), 2)*l(idx(3, j), 3)
+            d(3, j) = l(idx(1, j), 1)*l(idx(2, j), 2)*dl(idx(3, j), 3)
+         end do
+      end select
    end subroutine tensor_shape
 
    !> 1D Lagrange basis of degree 1 or 2 on equispaced nodes of [0, 1], with derivatives.

@@ -28,7 +28,6 @@ module sprc_recovery_patch
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_material, only: plane_stress, plane_strain, solid, voigt_size, check_material
-   use sprc_core_poly, only: poly_max_terms
    implicit none
    private
 
@@ -107,8 +106,9 @@ module sprc_recovery_patch
       integer :: dim = 0, nstress = 0, degree = -1, nterms = 0
       !> Scaling of the polynomial: s = (x - x0)/h.
       real(wp) :: x0(3) = 0.0_wp, h = 1.0_wp
-      !> Coefficients A: coef(1:nterms, c) of stress component c, in sprc_core_poly's term order.
-      real(wp) :: coef(poly_max_terms, 6) = 0.0_wp
+      !> Coefficients A: coef(1:nterms, c) of stress component c, in sprc_core_poly's term order;
+      !> allocated (nterms, nstress) by a successful solve.
+      real(wp), allocatable :: coef(:, :)
       !> Rank of the (weighted) basis matrix at the integration points (= nterms on success).
       integer :: basis_rank = 0
       !> Per constraint kind (kind_equilibrium .. kind_symmetry): constraint rows generated

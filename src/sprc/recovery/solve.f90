@@ -296,7 +296,7 @@ contains
          call lapack_info_error('dormqr/dtrtrs', info, context//' (least squares)', error)
          return
       end if
-      rec%coef = 0.0_wp
+      call coef_storage(rec, nt, ns)
       rec%coef(ws%jpvt(1:nt), 1:ns) = ws%rhs(1:nt, 1:ns)
    end subroutine qr_least_squares
 
@@ -758,10 +758,22 @@ contains
          call lapack_info_error('dsysv', info, 'recover_sprc (KKT system)', error)
          return
       end if
-      rec%coef = 0.0_wp
+      call coef_storage(rec, nt, ns)
       do c = 1, ns
          rec%coef(1:nt, c) = ws%sol((c - 1)*nt + 1:c*nt)*ws%dscale((c - 1)*nt + 1:c*nt)
       end do
    end subroutine solve_kkt
+
+   !> rec%coef allocated (nterms, nstress) and zero: storage of the patch's own size, so
+   !> that a mesh of many patches holds only what its degree needs.
+   pure subroutine coef_storage(rec, nt, ns)
+      type(recovered_patch_type), intent(inout) :: rec
+      integer, intent(in) :: nt, ns
+      if (allocated(rec%coef)) then
+         if (any(shape(rec%coef) /= [nt, ns])) deallocate (rec%coef)
+      end if
+      if (.not. allocated(rec%coef)) allocate (rec%coef(nt, ns))
+      rec%coef = 0.0_wp
+   end subroutine coef_storage
 
 end module sprc_recovery_solve

@@ -1,0 +1,290 @@
+!> Benchmark of recovery + ZZ estimate on a caller's mesh (recover_on_mesh), per phase, with
+!> 1 and 2 OpenMP threads: a quarter annulus 5 <= r <= 20 of 512 x 512 = 262,144 quad4
+!> (plane strain) and a quarter of a thick cylinder of 48 x 48 x 46 = 105,984 hex8, each
+!> with 2^dim Gauss points per element and the Lame stresses (internal pressure 1) plus a
+!> smooth perturbation of 1 % as FE stresses. SPR without facets (as an estimator that knows
+!> no boundary); SPR-C with facets: pressure on the inner surface, symmetry on the planes of
+!> the quarter (and on the z planes of the hex mesh), free outer surface. Times are medians
+!> of `nrep` runs, in milliseconds; the last column is recovery + estimate (all phases).
+!>
+!> Run: fpm run --profile release --example bench_mesh_recovery [-- NREP [quad4|hex8 [spr|sprc]]]
+!> (the optional words restrict the runs to one mesh and one method).
+program bench_mesh_recovery
+   use sprc_core_kinds, only: wp
+   use sprc_core_error, only: error_type
+   use sprc_core_material, only: plane_strain, solid
+   use sprc_recovery_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_method_spr, mesh_method_sprc, &
+      & facet_pressure, facet_symmetry, facet_free, elem_quad4, elem_hex8
+   !$ use omp_lib, only: omp_set_num_threads, omp_get_max_threads
+   implicit none
+
+   type :: mesh_type
+      integer :: dim = 0, etype = 0, analysis = 0
+      real(wp), allocatable :: x(:, :), gp(:, :, :), gw(:, :), gs(:, :, :)
+      integer, allocatable :: conn(:, :), fn(:, :), fk(:)
+      real(wp), allocatable :: ft(:, :)
+   end type mesh_type
+
+   real(wp), parameter :: pi = acos(-1.0_wp), r_in = 5.0_wp, r_out = 20.0_wp, young = 1000.0_wp, nu = 0.3_wp
+   type(mesh_type) :: quad, hex
+   integer :: nrep, nmax
+   character(len=16) :: arg, only_mesh, only_method
+
+   nrep = 3
+   only_mesh = ''
+   only_method = ''
+   if (command_argument_count() > 0) then
+      call get_command_argument(1, arg)
+      read (arg, *) nrep
+   end if
+   if (command_argument_count() > 1) call get_command_argument(2, only_mesh)
+   if (command_argument_count() > 2) call get_command_argument(3, only_method)
+   nmax = 1
+   !$ nmax = omp_get_max_threads()
+   call annulus(512, 512, 0, quad)
+   call annulus(48, 48, 46, hex)
+   write (*, '(a,i0,a,i0,a)') 'bench_mesh_recovery: medians of ', nrep, ' runs, milliseconds; ', nmax, &
+      & ' threads available'
+   write (*, '(a)') 'mesh            elements  method  threads   check  topology  points  patches  nodal  '// &
+      & 'estimate   total'
+   call run(quad, 'quad4 annulus', mesh_method_spr)
+   call run(quad, 'quad4 annulus', mesh_method_sprc)
+   call run(hex, 'hex8 cylinder', mesh_method_spr)
+   call run(hex, 'hex8 cylinder', mesh_method_sprc)
+
+contains
+
+   !> Timings of one mesh and method with 1 and 2 threads.
+   subroutine run(m, label, method)
+      type(mesh_type), intent(in) :: m
+      character(len=*), intent(in) :: label
+      integer, intent(in) :: method
+      type(mesh_recovery_type) :: res
+      type(error_type), allocatable :: error
+      real(wp), allocatable :: t(:, :)
+      real(wp) :: med(7)
+      integer :: nt, k, i
+
+      if (len_trim(only_mesh) > 0 .and. index(label, trim(only_mesh)) == 0) return
+      if (len_trim(only_method) > 0 .and. trim(only_method) /= trim(merge('spr ', 'sprc', &
+         & method == mesh_method_spr))) return
+      allocate (t(7, nrep))
+      do nt = 1, min(2, nmax)
+         !$ call omp_set_num_threads(nt)
+         do k = 1, nrep
+            if (method == mesh_method_spr) then
+               call recover_on_mesh(m%dim, m%analysis, m%x, m%etype, m%conn, m%gp, m%gw, m%gs, young, nu, method, &
+                  & res, error)
+            else
+               call recover_on_mesh(m%dim, m%analysis, m%x, m%etype, m%conn, m%gp, m%gw, m%gs, young, nu, method, &
+                  & res, error, facet_nodes=m%fn, facet_kind=m%fk, facet_traction=m%ft)
+            end if
+            if (allocated(error)) then
+               write (*, '(a)') 'bench_mesh_recovery: '//error%message
+               stop 1
+            end if
+            t(:, k) = 1.0e3_wp*[res%t_check, res%t_topology, res%t_points, res%t_patches, res%t_nodal, &
+               & res%t_estimate, 0.0_wp]
+            t(7, k) = sum(t(1:6, k))
+         end do
+         do i = 1, 7
+            med(i) = median(t(i, :))
+         end do
+         write (*, '(a14,i10,2x,a6,i9,6f9.1,f9.1)') label, size(m%conn, 2), merge('spr   ', 'sprc  ', &
+            & method == mesh_method_spr), nt, med
+      end do
+      write (*, '(a,es10.3,a,es10.3)') '   global error ', res%err, ', eta ', res%eta
+   end subroutine run
+
+   real(wp) function median(v)
+      real(wp), intent(in) :: v(:)
+      real(wp) :: w(size(v)), s
+      integer :: i, j
+      w = v
+      do i = 2, size(w)
+         s = w(i)
+         j = i - 1
+         do while (j >= 1)
+            if (w(j) <= s) exit
+            w(j + 1) = w(j)
+            j = j - 1
+         end do
+         w(j + 1) = s
+      end do
+      median = w((size(w) + 1)/2)
+   end function median
+
+   !> Quarter annulus r_in <= r <= r_out of nr x nt quad4 (nz = 0) or, extruded over
+   !> 0 <= z <= 10 in nz layers, hex8; points, weights, Lame stresses and facets.
+   subroutine annulus(nr, nt, nz, m)
+      integer, intent(in) :: nr, nt, nz
+      type(mesh_type), intent(out) :: m
+      integer :: i, j, k, e, nl, nn, ne, ngp, a, g, d
+      real(wp) :: r, th, z, gx(2), xi(3), shp(8), dshp(3, 8), jac(3, 3), xe(3, 8)
+      integer, parameter :: corner(3, 8) = reshape([0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0, 0, 1, 1, 0, 1, 1, 1, 1, &
+         & 0, 1, 1], [3, 8])
+
+      d = merge(2, 3, nz == 0)
+      m%dim = d
+      m%etype = merge(elem_quad4, elem_hex8, d == 2)
+      m%analysis = merge(plane_strain, solid, d == 2)
+      nl = max(nz, 0) + 1
+      nn = (nr + 1)*(nt + 1)*nl
+      ne = nr*nt*max(nz, 1)
+      ngp = 2**d
+      allocate (m%x(d, nn), m%conn(2**d, ne), m%gp(d, ngp, ne), m%gw(ngp, ne), m%gs(3*(d - 1), ngp, ne))
+      do k = 0, nl - 1
+         do j = 0, nt
+            do i = 0, nr
+               r = r_in + (r_out - r_in)*i/nr
+               th = 0.5_wp*pi*j/nt
+               z = 10.0_wp*k/max(nz, 1)
+               m%x(1:2, lattice(nr, nt, i, j, k)) = [r*cos(th), r*sin(th)]
+               if (d == 3) m%x(3, lattice(nr, nt, i, j, k)) = z
+            end do
+         end do
+      end do
+      gx = 0.5_wp + [-0.5_wp, 0.5_wp]/sqrt(3.0_wp)
+      e = 0
+      do k = 0, max(nz, 1) - 1
+         do j = 0, nt - 1
+            do i = 0, nr - 1
+               e = e + 1
+               do a = 1, 2**d
+                  m%conn(a, e) = lattice(nr, nt, i + corner(1, a), j + corner(2, a), k + corner(3, a))
+                  xe(1:d, a) = m%x(:, m%conn(a, e))
+               end do
+               do g = 1, ngp
+                  xi = [gx(1 + mod(g - 1, 2)), gx(1 + mod((g - 1)/2, 2)), gx(1 + (g - 1)/4)]
+                  call multilinear(d, xi, shp, dshp)
+                  m%gp(:, g, e) = matmul(xe(1:d, 1:2**d), shp(1:2**d))
+                  jac(1:d, 1:d) = matmul(xe(1:d, 1:2**d), transpose(dshp(1:d, 1:2**d)))
+                  m%gw(g, e) = abs(det(d, jac))/2**d
+                  call lame(m%gp(:, g, e), m%gs(:, g, e))
+               end do
+            end do
+         end do
+      end do
+      call facets(m, nr, nt, nz)
+   end subroutine annulus
+
+   !> Node of lattice point (i, j, k) of an nr x nt (x nz) annulus mesh.
+   pure integer function lattice(nr, nt, i, j, k)
+      integer, intent(in) :: nr, nt, i, j, k
+      lattice = 1 + i + (nr + 1)*(j + (nt + 1)*k)
+   end function lattice
+
+   !> Boundary facets: pressure 1 on r = r_in, symmetry on x = 0, y = 0 (and z = 0, 10),
+   !> free on r = r_out.
+   subroutine facets(m, nr, nt, nz)
+      type(mesh_type), intent(inout) :: m
+      integer, intent(in) :: nr, nt, nz
+      integer :: f, i, j, k, nf, nfn
+
+      nfn = 2**(m%dim - 1)
+      if (m%dim == 2) then
+         nf = 2*nt + 2*nr
+      else
+         nf = 2*nt*nz + 2*nr*nz + 2*nr*nt
+      end if
+      allocate (m%fn(nfn, nf), m%fk(nf), m%ft(m%dim, nf))
+      m%ft = 0.0_wp
+      f = 0
+      do k = 0, max(nz, 1) - 1
+         do j = 0, nt - 1
+            call add_side(m, nr, nt, f, [0, j, k], [0, j + 1, k], facet_pressure)
+            call add_side(m, nr, nt, f, [nr, j, k], [nr, j + 1, k], facet_free)
+         end do
+         do i = 0, nr - 1
+            call add_side(m, nr, nt, f, [i, 0, k], [i + 1, 0, k], facet_symmetry)
+            call add_side(m, nr, nt, f, [i, nt, k], [i + 1, nt, k], facet_symmetry)
+         end do
+      end do
+      if (m%dim == 3) then
+         do k = 0, nz, nz
+            do j = 0, nt - 1
+               do i = 0, nr - 1
+                  f = f + 1
+                  m%fn(:, f) = [lattice(nr, nt, i, j, k), lattice(nr, nt, i + 1, j, k), &
+                     & lattice(nr, nt, i + 1, j + 1, k), lattice(nr, nt, i, j + 1, k)]
+                  m%fk(f) = facet_symmetry
+               end do
+            end do
+         end do
+      end if
+      where (m%fk == facet_pressure) m%ft(1, :) = 1.0_wp
+   end subroutine facets
+
+   !> Facet f + 1: the side from lattice point a to b (2D), or the quad a, b, b + dz, a + dz (3D).
+   subroutine add_side(m, nr, nt, f, a, b, kind)
+      type(mesh_type), intent(inout) :: m
+      integer, intent(in) :: nr, nt, a(3), b(3), kind
+      integer, intent(inout) :: f
+      f = f + 1
+      if (m%dim == 2) then
+         m%fn(:, f) = [lattice(nr, nt, a(1), a(2), 0), lattice(nr, nt, b(1), b(2), 0)]
+      else
+         m%fn(:, f) = [lattice(nr, nt, a(1), a(2), a(3)), lattice(nr, nt, b(1), b(2), b(3)), &
+            & lattice(nr, nt, b(1), b(2), b(3) + 1), lattice(nr, nt, a(1), a(2), a(3) + 1)]
+      end if
+      m%fk(f) = kind
+   end subroutine add_side
+
+   !> Lame stresses (internal pressure 1, plane strain) at x, perturbed by 1 %, Voigt.
+   subroutine lame(x, s)
+      real(wp), intent(in) :: x(:)
+      real(wp), intent(out) :: s(:)
+      real(wp) :: r2, a, b, srr, stt, c, sn, noise
+
+      r2 = x(1)**2 + x(2)**2
+      a = r_in**2/(r_out**2 - r_in**2)
+      b = a*r_out**2
+      srr = a - b/r2
+      stt = a + b/r2
+      c = x(1)/sqrt(r2)
+      sn = x(2)/sqrt(r2)
+      noise = 0.01_wp*sin(3.0_wp*x(1) + 2.0_wp*x(2))
+      if (size(s) == 3) then
+         s = [srr*c**2 + stt*sn**2, srr*sn**2 + stt*c**2, (srr - stt)*c*sn] + noise
+      else
+         s = [srr*c**2 + stt*sn**2, srr*sn**2 + stt*c**2, nu*(srr + stt), (srr - stt)*c*sn, 0.0_wp, 0.0_wp] + noise
+      end if
+   end subroutine lame
+
+   pure subroutine multilinear(d, xi, n, dn)
+      integer, intent(in) :: d
+      real(wp), intent(in) :: xi(3)
+      real(wp), intent(out) :: n(8), dn(3, 8)
+      integer, parameter :: c(3, 8) = reshape([0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0, 0, 1, 1, 0, 1, 1, 1, 1, &
+         & 0, 1, 1], [3, 8])
+      real(wp) :: l(0:1, 3), dl(0:1, 3)
+      integer :: a, k
+
+      do k = 1, 3
+         l(:, k) = [1.0_wp - xi(k), xi(k)]
+         dl(:, k) = [-1.0_wp, 1.0_wp]
+      end do
+      if (d == 2) then
+         l(:, 3) = [1.0_wp, 0.0_wp]
+         dl(:, 3) = 0.0_wp
+      end if
+      do a = 1, 2**d
+         n(a) = l(c(1, a), 1)*l(c(2, a), 2)*l(c(3, a), 3)
+         dn(1, a) = dl(c(1, a), 1)*l(c(2, a), 2)*l(c(3, a), 3)
+         dn(2, a) = l(c(1, a), 1)*dl(c(2, a), 2)*l(c(3, a), 3)
+         dn(3, a) = l(c(1, a), 1)*l(c(2, a), 2)*dl(c(3, a), 3)
+      end do
+   end subroutine multilinear
+
+   pure real(wp) function det(d, a)
+      integer, intent(in) :: d
+      real(wp), intent(in) :: a(3, 3)
+      if (d == 2) then
+         det = a(1, 1)*a(2, 2) - a(1, 2)*a(2, 1)
+      else
+         det = a(1, 1)*(a(2, 2)*a(3, 3) - a(2, 3)*a(3, 2)) - a(1, 2)*(a(2, 1)*a(3, 3) - a(2, 3)*a(3, 1)) + &
+            & a(1, 3)*(a(2, 1)*a(3, 2) - a(2, 2)*a(3, 1))
+      end if
+   end function det
+
+end program bench_mesh_recovery
