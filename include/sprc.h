@@ -136,9 +136,12 @@ void sprc_delete_report(sprc_report *report);
 /* Recovery methods. */
 #define SPRC_METHOD_SPR 1
 #define SPRC_METHOD_SPRC 2
-/* Flag to OR into the method: patch polynomials one degree above the
- * element's (the scene key recovery_degree = 'p+1'). */
+/* Flags to OR into the method: patch polynomials one degree above the
+ * element's (the scene key recovery_degree = 'p+1'), or of the element's
+ * degree ('p'). Without either, 'auto': SPR at the element's degree p,
+ * SPR-C at p + 1 for SPRC_QUAD9 / SPRC_HEX27 and at p for linear elements. */
 #define SPRC_RECOVERY_P_PLUS_1 256
+#define SPRC_RECOVERY_P 512
 
 /* Boundary facet kinds: a constant traction given per facet, a symmetry
  * plane (zero shear), a free surface (zero traction), a pressure p
@@ -170,8 +173,7 @@ typedef struct _sprc_recovery *sprc_recovery;
  * dim 2 or 3; analysis SPRC_PLANE_STRESS / SPRC_PLANE_STRAIN in 2D,
  * SPRC_SOLID in 3D; method SPRC_METHOD_SPR or SPRC_METHOD_SPRC (SPR ignores
  * the facets once validated), optionally OR-ed with SPRC_RECOVERY_P_PLUS_1.
- * The patch degree is the element's (1, or 2 for quad9 and hex27), one more
- * with that flag. Boundary constraints apply only on the facets given.
+ * The patch degree is 'auto' (above) unless a degree flag is given. Boundary constraints apply only on the facets given.
  * Returns a new recovery (free it with sprc_delete_recovery) or NULL with
  * the error set: SPRC_STAT_INVALID_INPUT for a bad size, code, NULL array,
  * index out of range, non-finite value, point outside its element;

@@ -28,8 +28,9 @@ ELEMENT_TYPES = {
 ANALYSES = {"plane_stress": 1, "plane_strain": 2, "solid": 3}
 #: Recovery methods (SPRC_METHOD_*).
 METHODS = {"spr": 1, "sprc": 2}
-#: Patch degree: the element's, or one more (SPRC_RECOVERY_P_PLUS_1 OR-ed into the method).
-DEGREES = {"p": 0, "p+1": 256}
+#: Patch degree: 'auto' (SPR at the element's degree p, SPR-C at p+1 for quad9 / hex27, p
+#: otherwise), the element's (SPRC_RECOVERY_P) or one more (SPRC_RECOVERY_P_PLUS_1).
+DEGREES = {"auto": 0, "p": 512, "p+1": 256}
 #: Boundary facet kinds (SPRC_FACET_*).
 FACET_KINDS = {"traction": 1, "symmetry": 2, "free": 3, "pressure": 4}
 
@@ -197,7 +198,7 @@ def _facets(boundary, dim, nfn):
 
 
 def recover(nodes, elements, element_type, gauss_points, gauss_weights, gauss_stress, *, young, poisson,
-            analysis=None, method="sprc", body_force=None, boundary=None, degree="p"):
+            analysis=None, method="sprc", body_force=None, boundary=None, degree="auto"):
     """Recover the stresses of a finite-element solution on your own mesh
     and estimate its error (SPR or SPR-C with the ZZ estimate).
 
@@ -214,8 +215,9 @@ def recover(nodes, elements, element_type, gauss_points, gauss_weights, gauss_st
     analysis       'plane_stress' or 'plane_strain' in 2D, 'solid' in 3D
                    (default: 'plane_stress' in 2D, 'solid' in 3D).
     method         'sprc' (default) or 'spr'.
-    degree         'p' (default: the patch polynomials have the element's degree,
-                   1, or 2 for quad9 and hex27) or 'p+1' (one more).
+    degree         'auto' (default: SPR at the element's degree p, 1, or 2 for
+                   quad9 and hex27; SPR-C at p+1 for quad9 and hex27, p for the
+                   linear elements), 'p' (the element's degree) or 'p+1' (one more).
     body_force     [dim] constant body force b with div(sigma) + b = 0, or None.
     boundary       boundary facets for SPR-C (SPR validates and ignores them):
                    either a dict of arrays

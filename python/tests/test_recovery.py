@@ -231,6 +231,21 @@ def test_degree_p_plus_1(method):
     assert nodal_deviation(case, recover(case, method=method)) > 1e-3
 
 
+def test_degree_auto_default():
+    """The default degree is 'auto': on quad9 SPR-C recovers at p+1 (the same bits as
+    degree='p+1', not those of 'p'), SPR at p; on quad4 SPR-C stays at p."""
+    case = build_case("quad9", 3, "quadratic")
+    case["gauss_stress"] = case["gauss_stress"] + 0.05 * np.sin(5 * case["gauss_points"][..., :1])
+    auto = recover(case, method="sprc")
+    assert np.array_equal(auto.nodal_stress, recover(case, method="sprc", degree="p+1").nodal_stress)
+    assert not np.array_equal(auto.nodal_stress, recover(case, method="sprc", degree="p").nodal_stress)
+    assert np.array_equal(recover(case, method="spr").nodal_stress, recover(case, method="spr", degree="p").nodal_stress)
+    quad = build_case("quad4", 3, "linear")
+    quad["gauss_stress"] = quad["gauss_stress"] + 0.05 * np.sin(5 * quad["gauss_points"][..., :1])
+    assert np.array_equal(recover(quad, method="sprc").nodal_stress,
+                          recover(quad, method="sprc", degree="p").nodal_stress)
+
+
 def test_inexact_data_gives_positive_estimate():
     """The estimate is not trivially zero: a perturbed field gives eta in (0, 1)
     and element errors that sum in squares to the global error."""

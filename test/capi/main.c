@@ -563,7 +563,8 @@ static void test_recovery_linear_quad4(void) {
 }
 
 /* SPRC_RECOVERY_P_PLUS_1 OR-ed into the method: quadratic patches on quad4
- * still reproduce the linear field; an unknown flag bit is refused. */
+ * still reproduce the linear field; SPRC_RECOVERY_P is accepted; an unknown
+ * flag bit and both degree flags at once are refused. */
 static void test_recovery_degree_flag(void) {
   const char *name = "recovery_degree_flag";
   static quad_mesh m;
@@ -576,8 +577,13 @@ static void test_recovery_degree_flag(void) {
   sprc_get_recovery_nodal_stress(err, rec, &nodal[0][0], NNODE);
   CHECK(nodal_deviation(&m, nodal) <= 5e-10, "p+1 nodal stresses deviate from the linear field");
   sprc_delete_recovery(&rec);
-  rec = recover_quad_mesh(err, &m, SPRC_METHOD_SPRC | 512);
+  rec = recover_quad_mesh(err, &m, SPRC_METHOD_SPRC | SPRC_RECOVERY_P);
+  CHECK(rec != NULL && sprc_check_error(err) == 0, "recovery with SPRC_RECOVERY_P failed");
+  sprc_delete_recovery(&rec);
+  rec = recover_quad_mesh(err, &m, SPRC_METHOD_SPRC | 1024);
   CHECK(rec == NULL && has_error(err, "unknown flag bits"), "an unknown flag bit was accepted");
+  rec = recover_quad_mesh(err, &m, SPRC_METHOD_SPRC | SPRC_RECOVERY_P | SPRC_RECOVERY_P_PLUS_1);
+  CHECK(rec == NULL && has_error(err, "sets both"), "both degree flags were accepted");
   sprc_delete_error(&err);
   PASS();
 }

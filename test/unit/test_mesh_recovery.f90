@@ -97,6 +97,7 @@ contains
          new_unittest('duplicates', test_duplicates), &
          new_unittest('c_index_messages', test_c_index_messages), &
          new_unittest('patch_loop_skip', test_patch_loop_skip), &
+         new_unittest('degree_auto', test_degree_auto), &
          new_unittest('legacy_wrapper', test_legacy) &
          ]
    end subroutine collect_mesh_recovery
@@ -1283,6 +1284,30 @@ contains
          if (allocated(error)) return
       end do
    end subroutine test_patch_loop_skip
+
+   !> The default degree is 'auto' (issue 13): SPR-C at p + 1 on quad9 and hex27, at p on
+   !> linear elements; SPR at p.
+   subroutine test_degree_auto(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(case_type) :: c
+      type(mesh_recovery_type) :: res
+      integer, parameter :: etypes(3) = [elem_quad9, elem_hex27, elem_quad4], want(3) = [3, 3, 1]
+      integer :: k
+
+      do k = 1, 3
+         call build_case(c, etypes(k), 2, f_linear, 0.0_wp)
+         call recover_on_mesh(c%dim, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
+            & mesh_method_sprc, res, error, body_force=c%body(1:c%dim))
+         if (allocated(error)) return
+         call check(error, res%degree, want(k), 'SPR-C auto degree')
+         if (allocated(error)) return
+         call recover_on_mesh(c%dim, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
+            & mesh_method_spr, res, error)
+         if (allocated(error)) return
+         call check(error, res%degree, merge(2, 1, k < 3), 'SPR auto degree')
+         if (allocated(error)) return
+      end do
+   end subroutine test_degree_auto
 
    !> Elements small against their distance from the origin (issue 13, defect 1): the inverse
    !> map's stopping test follows the map's round-off, so a unit quad4 shifted by 1000 and a

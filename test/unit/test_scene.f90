@@ -210,9 +210,10 @@ contains
       if (allocated(error)) return
       call check(error, s%recovery, 'both', 'recovery default')
       if (allocated(error)) return
-      call check(error, s%recovery_degree, 'p', 'recovery_degree default')
+      call check(error, s%recovery_degree, 'auto', 'recovery_degree default')
       if (allocated(error)) return
-      call check(error, recovery_degree(s), s%order, 'recovery degree is the FE order by default')
+      call check(error, recovery_degree(s, 1) == s%order .and. recovery_degree(s, 2) == s%order, &
+         & 'order 1, auto: SPR and SPR-C at the FE order')
       if (allocated(error)) return
       call check(error, s%output, '', 'output default')
       if (allocated(error)) return
@@ -281,10 +282,23 @@ contains
       text = replaced(minimal, 'box_size=4', "box_size=4 order=2 recovery_degree='P+1'")
       call read_ok(text, s, error)
       if (allocated(error)) return
-      call check(error, recovery_degree(s), 3, "recovery_degree = 'p+1' with order 2")
+      call check(error, recovery_degree(s, 1) == 3 .and. recovery_degree(s, 2) == 3, "recovery_degree = 'p+1', order 2")
       if (allocated(error)) return
-      call check(error, index(scene_summary(s), "recovery_degree = 'p+1' (patch degree 3)") > 0, &
-         & 'summary shows the recovery degree keyword and the patch degree')
+      call check(error, index(scene_summary(s), "recovery_degree = 'p+1' (SPR 3, SPR-C 3)") > 0, &
+         & 'summary shows the recovery degree keyword and the patch degrees')
+      if (allocated(error)) return
+      text = replaced(minimal, 'box_size=4', "box_size=4 order=2")
+      call read_ok(text, s, error)
+      if (allocated(error)) return
+      call check(error, recovery_degree(s, 1) == 2 .and. recovery_degree(s, 2) == 3, 'order 2, auto: SPR 2, SPR-C 3')
+      if (allocated(error)) return
+      call check(error, index(scene_summary(s), "recovery_degree = 'auto' (SPR 2, SPR-C 3)") > 0, &
+         & 'summary shows the auto degrees')
+      if (allocated(error)) return
+      text = replaced(minimal, 'box_size=4', "box_size=4 order=2 recovery_degree='p'")
+      call read_ok(text, s, error)
+      if (allocated(error)) return
+      call check(error, recovery_degree(s, 1) == 2 .and. recovery_degree(s, 2) == 2, "recovery_degree = 'p', order 2")
    end subroutine test_case
 
    subroutine test_summary_order1(error)

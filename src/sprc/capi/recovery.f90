@@ -13,7 +13,8 @@ module sprc_capi_recovery
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_out_of_memory
    use sprc_core_material, only: voigt_size
-   use sprc_recovery_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval
+   use sprc_recovery_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, mesh_method_sprc
+   use sprc_recovery_patch_loop, only: auto_degree
    use sprc_recovery_mesh_element, only: element_known, element_nodes, element_facet_nodes, element_name, &
       & element_degree
    use sprc_capi_error, only: capi_error_type, get_capi_error, set_capi_error
@@ -29,9 +30,10 @@ module sprc_capi_recovery
       type(mesh_recovery_type) :: result
    end type capi_recovery_type
 
-   !> Flag OR-ed into `method` (sprc.h SPRC_RECOVERY_P_PLUS_1): patch degree one above the
-   !> element's; the low byte is the method proper.
-   integer(c_int), parameter :: flag_p_plus_1 = 256, method_mask = 255
+   !> Flags OR-ed into `method` (sprc.h SPRC_RECOVERY_P_PLUS_1, SPRC_RECOVERY_P): patch degree
+   !> one above the element's, or the element's; neither: 'auto' (the library's default). The
+   !> low byte is the method proper.
+   integer(c_int), parameter :: flag_p_plus_1 = 256, flag_p = 512, method_mask = 255
 
    !> Sizes and codes of one `sprc_recover` call, checked before any array is touched.
    type :: mesh_sizes_type
@@ -68,9 +70,12 @@ contains
       sz = mesh_sizes_type(dim, analysis, nnode, element_type, nen, nelem, ngp, voigt_size(analysis), nfacet, &
          & facet_nnode)
       call check_sizes(sz, error)
-      if (.not. allocated(error) .and. iand(method, not(ior(method_mask, flag_p_plus_1))) /= 0) &
-         & call fail(error, 'sprc_recover: method = '//itoa(method)//' has unknown flag bits (the only flag is '// &
-         & 'SPRC_RECOVERY_P_PLUS_1 = 256)')
+      if (.not. allocated(error) .and. iand(method, not(ior(method_mask, ior(flag_p_plus_1, flag_p)))) /= 0) &
+         & call fail(error, 'sprc_recover: method = '//itoa(method)//' has unknown flag bits (the flags are '// &
+         & 'SPRC_RECOVERY_P_PLUS_1 = 256 and SPRC_RECOVERY_P = 512)')
+      if (.not. allocated(error) .and. iand(method, flag_p_plus_1) /= 0 .and. iand(method, flag_p) /= 0) &
+         & call fail(error, 'sprc_recover: method = '//itoa(method)//' sets both SPRC_RECOVERY_P_PLUS_1 and '// &
+         & 'SPRC_RECOVERY_P')
       if (.not. allocated(error)) call check_pointers(sz, nodes, connectivity, gauss_points, gauss_weights, &
          & gauss_stress, facet_nodes, facet_kind, error)
       if (allocated(error)) then
@@ -112,8 +117,9 @@ contains
          return
       end if
       ! Unallocated bf, fn, fk, ft reach the optional dummies as absent (F2008).
-      degree = element_degree(element_type)
-      if (iand(method, flag_p_plus_1) /= 0) degree = degree + 1
+      degree = auto_degree(iand(method, method_mask) == mesh_method_sprc, element_degree(element_type))
+      if (iand(method, flag_p) /= 0) degree = element_degree(element_type)
+      if (iand(method, flag_p_plus_1) /= 0) degree = element_degree(element_type) + 1
       call recover_on_mesh(dim, analysis, x, element_type, conn, gp, gw, gs, young, poisson, &
          & int(iand(method, method_mask)), rec%result, error, body_force=bf, facet_nodes=fn, facet_kind=fk, &
          & facet_traction=ft, degree=degree, c_indices=.true.)

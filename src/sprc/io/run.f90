@@ -184,7 +184,7 @@ contains
       end if
       do m = 1, 2
          if (.not. done(m)) cycle
-         call recover_and_estimate(model, input, grid, nodes, hanging, m, recovery_degree(scene), field(m), est(m), &
+         call recover_and_estimate(model, input, grid, nodes, hanging, m, recovery_degree(scene, m), field(m), est(m), &
             & error)
          if (allocated(error)) return
          row%t_recovery = row%t_recovery + field(m)%t_recovery

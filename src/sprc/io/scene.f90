@@ -9,6 +9,7 @@ module sprc_io_scene
    use sprc_core_error, only: error_type, fatal_error, stat_unsupported
    use sprc_io_namelist, only: nml_group_type, parse_namelist, read_text_file, nml_get, nml_get_array, &
       & nml_has, nml_check_consumed, nml_field_error, nml_group_error, nml_item_text
+   use sprc_recovery_patch_loop, only: auto_degree
    implicit none
    private
 
@@ -123,7 +124,8 @@ module sprc_io_scene
       real(wp) :: box_size = 0.0_wp
       !> 'none' | 'spr' | 'sprc' | 'both'.
       character(len=:), allocatable :: recovery
-      !> Patch polynomial degree of SPR and SPR-C: 'p' (the FE degree) or 'p+1'.
+      !> Patch polynomial degree of SPR and SPR-C: 'auto' (SPR at p, SPR-C at p+1 for order 2
+      !> and p for order 1), 'p' (the FE degree) or 'p+1'.
       character(len=:), allocatable :: recovery_degree
       !> Prefix of the files written; '' writes none.
       character(len=:), allocatable :: output
@@ -149,7 +151,7 @@ module sprc_io_scene
 
    character(len=*), parameter :: analyses = 'plane_stress plane_strain solid'
    character(len=*), parameter :: recoveries = 'none spr sprc both'
-   character(len=*), parameter :: recovery_degrees = 'p p+1'
+   character(len=*), parameter :: recovery_degrees = 'auto p p+1'
    character(len=*), parameter :: ops = 'add subtract intersect'
    character(len=*), parameter :: shape_kinds = 'disk sphere ellipse ellipsoid box halfspace cylinder'
    character(len=*), parameter :: bc_types = 'free pressure traction displacement symmetry exact_traction '// &
@@ -320,7 +322,7 @@ contains
          scene%recovery = 'both'
          call get_choice(g, 'recovery', recoveries, .false., scene%recovery, error)
          if (allocated(error)) return
-         scene%recovery_degree = 'p'
+         scene%recovery_degree = 'auto'
          call get_choice(g, 'recovery_degree', recovery_degrees, .false., scene%recovery_degree, error)
          if (allocated(error)) return
          scene%output = ''
@@ -941,8 +943,8 @@ contains
       text = text//'  box_min         = '//real_list(scene%box_min)//nl
       text = text//'  box_size        = '//real_text(scene%box_size)//nl
       text = text//'  recovery        = '//scene%recovery//nl
-      text = text//"  recovery_degree = '"//scene%recovery_degree//"' (patch degree "// &
-         & int_text(recovery_degree(scene))//')'//nl
+      text = text//"  recovery_degree = '"//scene%recovery_degree//"' (SPR "//int_text(recovery_degree(scene, 1))// &
+         & ', SPR-C '//int_text(recovery_degree(scene, 2))//')'//nl
       text = text//"  output          = '"//scene%output//"'"//nl
       do i = 1, size(scene%bodies)
          associate (b => scene%bodies(i))
@@ -1220,12 +1222,14 @@ contains
       end do
    end function lower
 
-   !> Patch polynomial degree of the scene's recoveries: the FE order, plus one with
-   !> recovery_degree = 'p+1'.
-   pure integer function recovery_degree(scene)
+   !> Patch polynomial degree of the scene's recovery `method` (1 SPR, 2 SPR-C): 'auto' (the
+   !> default) by sprc_recovery_patch_loop's `auto_degree`, 'p' the FE order, 'p+1' one more.
+   pure integer function recovery_degree(scene, method)
       type(scene_type), intent(in) :: scene
-      recovery_degree = scene%order
+      integer, intent(in) :: method
+      recovery_degree = auto_degree(method == 2, scene%order)
       if (.not. allocated(scene%recovery_degree)) return
+      if (scene%recovery_degree == 'p') recovery_degree = scene%order
       if (scene%recovery_degree == 'p+1') recovery_degree = scene%order + 1
    end function recovery_degree
 

@@ -11,7 +11,8 @@ module sprc_recovery_estimate
    implicit none
    private
 
-   public :: eval_recovered, eval_union, zz_error_integral, zz_error_norm, energy_norms, scaled_norm, relative_error
+   public :: eval_recovered, eval_recovered_unchecked, eval_union, zz_error_integral, zz_error_norm, energy_norms
+   public :: scaled_norm, relative_error
 
 contains
 
@@ -25,10 +26,12 @@ contains
 
       call check_rec(rec, size(x), size(sigma), 'eval_recovered', error)
       if (allocated(error)) return
-      call eval_unchecked(rec, x, sigma)
+      call eval_recovered_unchecked(rec, x, sigma)
    end subroutine eval_recovered
 
-   pure subroutine eval_unchecked(rec, x, sigma)
+   !> `eval_recovered` without its checks, for a producer's own patches from successful
+   !> solves (x(1:dim), sigma(1:nstress)).
+   pure subroutine eval_recovered_unchecked(rec, x, sigma)
       type(recovered_patch_type), intent(in) :: rec
       real(wp), intent(in) :: x(:)
       real(wp), intent(out) :: sigma(:)
@@ -47,7 +50,7 @@ contains
          p = s(1)**e(1)*s(2)**e(2)*s(3)**e(3)
          sigma(1:rec%nstress) = sigma(1:rec%nstress) + p*rec%coef(i, 1:rec%nstress)
       end do
-   end subroutine eval_unchecked
+   end subroutine eval_recovered_unchecked
 
    pure subroutine check_rec(rec, nx, nsig, context, error)
       type(recovered_patch_type), intent(in) :: rec
@@ -102,7 +105,7 @@ contains
       ns = recs(1)%nstress
       sigma(1:ns) = 0.0_wp
       do j = 1, size(recs)
-         call eval_unchecked(recs(j), x, sj)
+         call eval_recovered_unchecked(recs(j), x, sj)
          sigma(1:ns) = sigma(1:ns) + shape_values(j)*sj(1:ns)
       end do
    end subroutine eval_union

@@ -33,8 +33,10 @@
 !> distance from x0 to a node of those elements. SPR-C adds the boundary points of facets
 !> owned by those elements. A patch whose basis matrix lacks rank is expanded by one ring
 !> (every element sharing a node with the patch) up to `max_rounds` times (default
-!> mesh_default_max_rounds = 3), as on the grid (sprc_grid_patches). Degree p: the element
-!> degree (1 for tri3, quad4, tet4, hex8; 2 for quad9, hex27) unless `degree` is given.
+!> mesh_default_max_rounds = 3), as on the grid (sprc_grid_patches). Degree: unless `degree`
+!> is given, 'auto' (sprc_recovery_patch_loop's auto_degree): SPR at the element degree p
+!> (1 for tri3, quad4, tet4, hex8; 2 for quad9, hex27), SPR-C at p + 1 for quad9 and hex27
+!> and at p for the linear elements.
 !>
 !> Output fields:
 !> - nodal(nstress, nnode): at a vertex node its patch polynomial at the node (SPR and SPR-C
@@ -63,8 +65,8 @@ module sprc_recovery_mesh
    use sprc_core_timer, only: wall_time
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reset, patch_reserve, &
       & boundary_traction, boundary_symmetry
-   use sprc_recovery_patch_loop, only: patch_source_type, patch_loop_type, run_patch_loop, patch_capacity
-   use sprc_recovery_estimate, only: eval_recovered, energy_norms, scaled_norm, relative_error
+   use sprc_recovery_patch_loop, only: patch_source_type, patch_loop_type, run_patch_loop, patch_capacity, auto_degree
+   use sprc_recovery_estimate, only: eval_recovered_unchecked, energy_norms, scaled_norm, relative_error
    use sprc_recovery_mesh_element, only: elem_tri3, elem_quad4, elem_tet4, elem_hex8, elem_quad9, elem_hex27, &
       & element_dim, element_nodes, element_vertices, element_degree, element_facet_nodes, element_shape, &
       & element_vertex_shape, element_node_xi, element_inside, element_inverse_map, element_name, &
@@ -164,7 +166,7 @@ contains
       !> Boundary facets (nfn, nfacet), their kinds (nfacet) and tractions (dim, nfacet).
       integer, intent(in), optional :: facet_nodes(:, :), facet_kind(:)
       real(wp), intent(in), optional :: facet_traction(:, :)
-      !> Patch polynomial degree (1..3; default the element degree); expansion rounds (>= 0).
+      !> Patch polynomial degree (1..3; default 'auto', module notes); expansion rounds (>= 0).
       integer, intent(in), optional :: degree, max_rounds
       !> Name array entries in messages as C does (the C and Python entries): 0-based,
       !> row-major, C argument names (default false: Fortran's gw(i, e)).
@@ -175,7 +177,7 @@ contains
       logical :: ci
       real(wp) :: t(0:6)
 
-      deg = element_degree(element_type)
+      deg = auto_degree(method == mesh_method_sprc, element_degree(element_type))
       if (present(degree)) deg = degree
       rounds = mesh_default_max_rounds
       if (present(max_rounds)) rounds = max_rounds
@@ -224,7 +226,7 @@ contains
       integer, intent(in) :: dim, analysis, element_type, method, deg
       real(wp), intent(in) :: young, poisson, nodes(:, :)
       integer, intent(in) :: connectivity(:, :)
-      integer :: e
+      integer :: e, a
 
       r%dim = dim
       r%analysis = analysis
@@ -241,10 +243,16 @@ contains
       r%x = nodes
       r%connectivity = connectivity
       allocate (r%box_lo(dim, r%nelem), r%box_hi(dim, r%nelem))
+      !$omp parallel do schedule(static) private(a)
       do e = 1, r%nelem
-         r%box_lo(:, e) = minval(nodes(:, connectivity(:, e)), dim=2)
-         r%box_hi(:, e) = maxval(nodes(:, connectivity(:, e)), dim=2)
+         r%box_lo(:, e) = nodes(:, connectivity(1, e))
+         r%box_hi(:, e) = nodes(:, connectivity(1, e))
+         do a = 2, r%nen
+            r%box_lo(:, e) = min(r%box_lo(:, e), nodes(:, connectivity(a, e)))
+            r%box_hi(:, e) = max(r%box_hi(:, e), nodes(:, connectivity(a, e)))
+         end do
       end do
+      !$omp end parallel do
    end subroutine init_result
 
    !> Node -> element CSR (elements ascending per node); patches at the vertex nodes.
@@ -523,15 +531,18 @@ contains
       d = self%dim
       ns = self%nstress
       ngp = size(self%gp, 2)
+      ! h = the largest distance: the largest square, one root (sqrt is monotonic and
+      ! correctly rounded: the same value as the largest root).
       h = 0.0_wp
       nb = 0
       do i = 1, size(elements)
          e = elements(i)
          do a = 1, self%nen
-            h = max(h, sqrt(sum((self%x(:, self%connectivity(a, e)) - self%x(:, node))**2)))
+            h = max(h, sum((self%x(:, self%connectivity(a, e)) - self%x(:, node))**2))
          end do
          if (self%sprc) nb = nb + self%topo%bptr(e + 1) - self%topo%bptr(e)
       end do
+      h = sqrt(h)
       np = ngp*size(elements)
       call patch_reset(patch, d, self%analysis, self%young, self%poisson, self%x(:, node), h)
       call patch_reserve(patch, np, nb)
@@ -563,8 +574,9 @@ contains
       integer :: n, e, a
 
       allocate (r%nodal(r%nstress, r%nnode))
-      r%nodal = 0.0_wp
+      !$omp parallel do schedule(static) private(e, a, xi)
       do n = 1, r%nnode
+         r%nodal(:, n) = 0.0_wp
          if (r%patch_of_node(n) > 0) then
             call eval_patch(r, r%patch_of_node(n), r%x(:, n), r%nodal(:, n))
          else if (topo%ne_ptr(n + 1) > topo%ne_ptr(n)) then
@@ -574,16 +586,16 @@ contains
             call union_at(r, e, xi, r%x(:, n), r%nodal(:, n))
          end if
       end do
+      !$omp end parallel do
    end subroutine nodal_values
 
-   subroutine eval_patch(r, ip, x, sigma)
+   !> Patch ip's polynomial at x (recovered by a successful solve: no checks needed).
+   pure subroutine eval_patch(r, ip, x, sigma)
       type(mesh_recovery_type), intent(in) :: r
       integer, intent(in) :: ip
       real(wp), intent(in) :: x(:)
       real(wp), intent(out) :: sigma(:)
-      type(error_type), allocatable :: err
-      ! Cannot fail: the patch was recovered and the sizes are the result's own.
-      call eval_recovered(r%recs(ip), x, sigma, err)
+      call eval_recovered_unchecked(r%recs(ip), x, sigma)
    end subroutine eval_patch
 
    !> Union (eq. 102) at reference point xi / physical point x of element e.
