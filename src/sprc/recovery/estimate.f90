@@ -209,34 +209,97 @@ contains
    end subroutine energy_norms
 
    !> ssq = sum_i w_i d_i^T cmat d_i / s**2, d_i = a_i - b_i (a = 0 if absent), s the power
-   !> of two of the largest |d| (`power_of_two`).
+   !> of two of the largest |d| (`power_of_two`), or s = 1 where every nonzero |d| lies
+   !> within 2**(+-200) (squares far from overflow and underflow): scaling by a power of two
+   !> is exact, so the final norm s sqrt(ssq) has the same bits either way, and the common
+   !> case saves the divisions. The products are those of dot_product(d, matmul(cmat, d)).
    pure subroutine scaled_sum(cmat, w, b, s, ssq, a)
       real(wp), intent(in) :: cmat(:, :), w(:), b(:, :)
       real(wp), intent(out) :: s, ssq
       real(wp), intent(in), optional :: a(:, :)
-      real(wp) :: diff(6), big
-      integer :: i, ns
+      real(wp), parameter :: safe_hi = 2.0_wp**200, safe_lo = 2.0_wp**(-200)
+      real(wp) :: big, small, d
+      integer :: i, j
+
+      big = 0.0_wp
+      small = huge(1.0_wp)
+      do i = 1, size(w)
+         do j = 1, size(cmat, 1)
+            if (present(a)) then
+               d = abs(a(j, i) - b(j, i))
+            else
+               d = abs(b(j, i))
+            end if
+            big = max(big, d)
+            if (d > 0.0_wp) small = min(small, d)
+         end do
+      end do
+      s = 1.0_wp
+      if (.not. (big <= safe_hi .and. (small >= safe_lo .or. big == 0.0_wp))) s = power_of_two(big)
+      call accumulate(cmat, w, b, 1.0_wp/s, ssq, a)
+   end subroutine scaled_sum
+
+   !> sum_i w_i d_i^T cmat d_i with d_i = (a_i - b_i) scale.
+   pure subroutine accumulate(cmat, w, b, scale, ssq, a)
+      real(wp), intent(in) :: cmat(:, :), w(:), b(:, :), scale
+      real(wp), intent(out) :: ssq
+      real(wp), intent(in), optional :: a(:, :)
+      real(wp) :: d(6), cd(6), q
+      integer :: i, j, k, ns
 
       ns = size(cmat, 1)
-      big = 0.0_wp
-      do i = 1, size(w)
-         if (present(a)) then
-            big = max(big, maxval(abs(a(1:ns, i) - b(1:ns, i))))
-         else
-            big = max(big, maxval(abs(b(1:ns, i))))
-         end if
-      end do
-      s = power_of_two(big)
       ssq = 0.0_wp
+      if (ns == 3) then
+         call accumulate3(cmat, w, b, scale, ssq, a)
+         return
+      end if
+      do i = 1, size(w)
+         do j = 1, ns
+            if (present(a)) then
+               d(j) = (a(j, i) - b(j, i))*scale
+            else
+               d(j) = (0.0_wp - b(j, i))*scale
+            end if
+         end do
+         cd(1:ns) = 0.0_wp
+         do k = 1, ns
+            do j = 1, ns
+               cd(j) = cd(j) + cmat(j, k)*d(k)
+            end do
+         end do
+         q = 0.0_wp
+         do j = 1, ns
+            q = q + d(j)*cd(j)
+         end do
+         ssq = ssq + w(i)*q
+      end do
+   end subroutine accumulate
+
+   !> `accumulate` for 2D stresses, written out (the estimate's inner loop); the products
+   !> and sums in the same order, so the same bits.
+   pure subroutine accumulate3(cmat, w, b, scale, ssq, a)
+      real(wp), intent(in) :: cmat(:, :), w(:), b(:, :), scale
+      real(wp), intent(inout) :: ssq
+      real(wp), intent(in), optional :: a(:, :)
+      real(wp) :: c(3, 3), d1, d2, d3, q
+      integer :: i
+
+      c = cmat(1:3, 1:3)
       do i = 1, size(w)
          if (present(a)) then
-            diff(1:ns) = (a(1:ns, i) - b(1:ns, i))/s
+            d1 = (a(1, i) - b(1, i))*scale
+            d2 = (a(2, i) - b(2, i))*scale
+            d3 = (a(3, i) - b(3, i))*scale
          else
-            diff(1:ns) = (0.0_wp - b(1:ns, i))/s
+            d1 = (0.0_wp - b(1, i))*scale
+            d2 = (0.0_wp - b(2, i))*scale
+            d3 = (0.0_wp - b(3, i))*scale
          end if
-         ssq = ssq + w(i)*dot_product(diff(1:ns), matmul(cmat, diff(1:ns)))
+         q = ((d1*((c(1, 1)*d1 + c(1, 2)*d2) + c(1, 3)*d3) + d2*((c(2, 1)*d1 + c(2, 2)*d2) + c(2, 3)*d3)) + &
+            & d3*((c(3, 1)*d1 + c(3, 2)*d2) + c(3, 3)*d3))
+         ssq = ssq + w(i)*q
       end do
-   end subroutine scaled_sum
+   end subroutine accumulate3
 
    !> sqrt(sum(v**2)) without overflow or underflow; the same bits as that expression
    !> wherever it neither overflows nor underflows (scaling by a power of two).

@@ -257,31 +257,46 @@ contains
       call newton(etype, xe, x, xi, converged)
    end subroutine element_inverse_map
 
-   !> Newton's iteration of `element_inverse_map` from xi.
+   !> Newton's iteration of `element_inverse_map` from xi (loops written out: it runs per
+   !> point; the round-off floor is computed only when a step is not already below 1e-13).
    pure subroutine newton(etype, xe, x, xi, converged)
       integer, intent(in) :: etype
       real(wp), intent(in) :: xe(:, :), x(:)
       real(wp), intent(inout) :: xi(:)
       logical, intent(out) :: converged
       real(wp) :: n(max_element_nodes), dn(3, max_element_nodes), jac(3, 3), inv(3, 3), r(3), step(3), det
-      real(wp) :: map_size, floor
-      integer :: d, nen, it
+      real(wp) :: map_size, floor, xmap(3)
+      integer :: d, nen, it, a, k
 
       d = element_dim(etype)
       nen = element_nodes(etype)
       converged = .false.
       do it = 1, 50
          call element_shape(etype, xi, n, dn)
-         r(1:d) = x(1:d) - matmul(xe(1:d, 1:nen), n(1:nen))
-         jac(1:d, 1:d) = matmul(xe(1:d, 1:nen), transpose(dn(1:d, 1:nen)))
+         xmap(1:d) = 0.0_wp
+         jac(1:d, 1:d) = 0.0_wp
+         do a = 1, nen
+            xmap(1:d) = xmap(1:d) + xe(1:d, a)*n(a)
+            do k = 1, d
+               jac(1:d, k) = jac(1:d, k) + xe(1:d, a)*dn(k, a)
+            end do
+         end do
+         r(1:d) = x(1:d) - xmap(1:d)
          call small_inverse(d, jac, inv, det)
          if (.not. (abs(det) > 0.0_wp)) return
-         step(1:d) = matmul(inv(1:d, 1:d), r(1:d))
+         step(1:d) = 0.0_wp
+         do k = 1, d
+            step(1:d) = step(1:d) + inv(1:d, k)*r(k)
+         end do
          if (.not. all(abs(step(1:d)) <= 1.0e3_wp)) return
          xi(1:d) = xi(1:d) + step(1:d)
+         if (maxval(abs(step(1:d))) < 1.0e-13_wp) then
+            converged = .true.
+            return
+         end if
          map_size = maxval(abs(x(1:d))) + sum(abs(n(1:nen)))*maxval(abs(xe(1:d, 1:nen)))
          floor = real(nen + 2, wp)*epsilon(1.0_wp)*map_size*maxval(sum(abs(inv(1:d, 1:d)), dim=2))
-         if (maxval(abs(step(1:d))) < max(1.0e-13_wp, floor)) then
+         if (maxval(abs(step(1:d))) < floor) then
             converged = .true.
             return
          end if
