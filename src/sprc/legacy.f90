@@ -5,7 +5,8 @@
 !> - element type (VTK cell type ids): tri3 = 5, quad4 = 9, tet4 = 10, hex8 = 12,
 !>   quad9 = 28, hex27 = 29 (VTK node order, sprc_recovery_mesh_element);
 !> - analysis: plane stress = 1, plane strain = 2, solid (3D) = 3;
-!> - method: SPR = 1, SPR-C = 2;
+!> - method: SPR = 1, SPR-C = 2 (patch degree 'auto': SPR at the element degree p, SPR-C at
+!>   p + 1 for quad9 and hex27);
 !> - facet kind: traction = 1 (value in ftrac), symmetry = 2, free = 3 (zero traction),
 !>   pressure = 4 (p = ftrac(1, f), t = -p n with the facet's own normal at each point);
 !> - stat: 0 success, 1 invalid input, 2 singular (a patch stayed rank deficient),

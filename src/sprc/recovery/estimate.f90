@@ -191,7 +191,7 @@ contains
             return
          end if
       end do
-      call scaled_sum(cmat(1:ns, 1:ns), w, sigma_h, s, ssq, sigma_star)
+      call scaled_sum(ns, size(w), cmat(1:ns, 1:ns), w, sigma_star, sigma_h, .true., s, ssq)
    end subroutine scaled_integral
 
    !> Both energy norms of one element for a validated caller (finite stresses, weights
@@ -202,60 +202,61 @@ contains
       real(wp), intent(out) :: err, norm_h
       real(wp) :: s, ssq
 
-      call scaled_sum(cmat, w, sigma_h, s, ssq, sigma_star)
+      call scaled_sum(size(cmat, 1), size(w), cmat, w, sigma_star, sigma_h, .true., s, ssq)
       err = s*sqrt(ssq)
-      call scaled_sum(cmat, w, sigma_h, s, ssq)
+      call scaled_sum(size(cmat, 1), size(w), cmat, w, sigma_h, sigma_h, .false., s, ssq)
       norm_h = s*sqrt(ssq)
    end subroutine energy_norms
 
-   !> ssq = sum_i w_i d_i^T cmat d_i / s**2, d_i = a_i - b_i (a = 0 if absent), s the power
+   !> ssq = sum_i w_i d_i^T cmat d_i / s**2, d_i = a_i - b_i (a = 0 if not use_a), s the power
    !> of two of the largest |d| (`power_of_two`), or s = 1 where every nonzero |d| lies
    !> within 2**(+-200) (squares far from overflow and underflow): scaling by a power of two
    !> is exact, so the final norm s sqrt(ssq) has the same bits either way, and the common
    !> case saves the divisions. The products are those of dot_product(d, matmul(cmat, d)).
-   pure subroutine scaled_sum(cmat, w, b, s, ssq, a)
-      real(wp), intent(in) :: cmat(:, :), w(:), b(:, :)
+   pure subroutine scaled_sum(ns, n, cmat, w, a, b, use_a, s, ssq)
+      integer, intent(in) :: ns, n
+      real(wp), intent(in) :: cmat(ns, ns), w(n), a(ns, n), b(ns, n)
+      logical, intent(in) :: use_a
       real(wp), intent(out) :: s, ssq
-      real(wp), intent(in), optional :: a(:, :)
       real(wp), parameter :: safe_hi = 2.0_wp**200, safe_lo = 2.0_wp**(-200)
       real(wp) :: big, small, d
       integer :: i, j
 
       big = 0.0_wp
       small = huge(1.0_wp)
-      do i = 1, size(w)
-         do j = 1, size(cmat, 1)
-            if (present(a)) then
+      do i = 1, n
+         do j = 1, ns
+            if (use_a) then
                d = abs(a(j, i) - b(j, i))
             else
                d = abs(b(j, i))
             end if
             big = max(big, d)
-            if (d > 0.0_wp) small = min(small, d)
+            small = min(small, merge(d, huge(1.0_wp), d > 0.0_wp))
          end do
       end do
       s = 1.0_wp
       if (.not. (big <= safe_hi .and. (small >= safe_lo .or. big == 0.0_wp))) s = power_of_two(big)
-      call accumulate(cmat, w, b, 1.0_wp/s, ssq, a)
+      call accumulate(ns, n, cmat, w, a, b, use_a, 1.0_wp/s, ssq)
    end subroutine scaled_sum
 
-   !> sum_i w_i d_i^T cmat d_i with d_i = (a_i - b_i) scale.
-   pure subroutine accumulate(cmat, w, b, scale, ssq, a)
-      real(wp), intent(in) :: cmat(:, :), w(:), b(:, :), scale
+   !> sum_i w_i d_i^T cmat d_i with d_i = (a_i - b_i) scale (a = 0 if not use_a).
+   pure subroutine accumulate(ns, n, cmat, w, a, b, use_a, scale, ssq)
+      integer, intent(in) :: ns, n
+      real(wp), intent(in) :: cmat(ns, ns), w(n), a(ns, n), b(ns, n), scale
+      logical, intent(in) :: use_a
       real(wp), intent(out) :: ssq
-      real(wp), intent(in), optional :: a(:, :)
       real(wp) :: d(6), cd(6), q
-      integer :: i, j, k, ns
+      integer :: i, j, k
 
-      ns = size(cmat, 1)
       ssq = 0.0_wp
       if (ns == 3) then
-         call accumulate3(cmat, w, b, scale, ssq, a)
+         call accumulate3(n, cmat, w, a, b, use_a, scale, ssq)
          return
       end if
-      do i = 1, size(w)
+      do i = 1, n
          do j = 1, ns
-            if (present(a)) then
+            if (use_a) then
                d(j) = (a(j, i) - b(j, i))*scale
             else
                d(j) = (0.0_wp - b(j, i))*scale
@@ -277,16 +278,16 @@ contains
 
    !> `accumulate` for 2D stresses, written out (the estimate's inner loop); the products
    !> and sums in the same order, so the same bits.
-   pure subroutine accumulate3(cmat, w, b, scale, ssq, a)
-      real(wp), intent(in) :: cmat(:, :), w(:), b(:, :), scale
+   pure subroutine accumulate3(n, c, w, a, b, use_a, scale, ssq)
+      integer, intent(in) :: n
+      real(wp), intent(in) :: c(3, 3), w(n), a(3, n), b(3, n), scale
+      logical, intent(in) :: use_a
       real(wp), intent(inout) :: ssq
-      real(wp), intent(in), optional :: a(:, :)
-      real(wp) :: c(3, 3), d1, d2, d3, q
+      real(wp) :: d1, d2, d3, q
       integer :: i
 
-      c = cmat(1:3, 1:3)
-      do i = 1, size(w)
-         if (present(a)) then
+      do i = 1, n
+         if (use_a) then
             d1 = (a(1, i) - b(1, i))*scale
             d2 = (a(2, i) - b(2, i))*scale
             d3 = (a(3, i) - b(3, i))*scale

@@ -641,14 +641,13 @@ contains
       type(mesh_recovery_type), intent(inout) :: r
       real(wp), intent(in) :: gp(:, :, :), gw(:, :), gs(:, :, :), xi(:, :, :)
       type(error_type), allocatable, intent(out) :: error
-      real(wp), allocatable :: sstar(:, :)
-      real(wp) :: cmat(6, 6)
+      real(wp), allocatable :: sstar(:, :), cmat(:, :)
       integer :: e, i, ngp, ns
 
       ngp = size(gp, 2)
       ns = r%nstress
-      allocate (r%elem_err(r%nelem), r%elem_norm_h(r%nelem))
-      call compliance_matrix(r%analysis, r%young, r%poisson, cmat(1:ns, 1:ns), error)
+      allocate (r%elem_err(r%nelem), r%elem_norm_h(r%nelem), cmat(ns, ns))
+      call compliance_matrix(r%analysis, r%young, r%poisson, cmat, error)
       if (allocated(error)) return
       !$omp parallel default(shared) private(sstar, i)
       allocate (sstar(ns, ngp))
@@ -657,7 +656,7 @@ contains
          do i = 1, ngp
             call field_at(r, e, xi(:, i, e), gp(:, i, e), sstar(:, i))
          end do
-         call energy_norms(cmat(1:ns, 1:ns), gw(:, e), sstar, gs(:, :, e), r%elem_err(e), r%elem_norm_h(e))
+         call energy_norms(cmat, gw(:, e), sstar, gs(:, :, e), r%elem_err(e), r%elem_norm_h(e))
       end do
       !$omp end do
       !$omp end parallel
