@@ -67,7 +67,7 @@ contains
    !> Shapes and values of nodes, connectivity, integration points, weights, stresses and
    !> body force (options already checked). Shapes are named in Fortran order (the C entry
    !> checks its own counts first); entries in the caller's convention (`c_indices`).
-   pure subroutine check_mesh_arrays(dim, analysis, nodes, element_type, connectivity, gp, gw, gs, c_indices, &
+   subroutine check_mesh_arrays(dim, analysis, nodes, element_type, connectivity, gp, gw, gs, c_indices, &
          & error, body_force)
       integer, intent(in) :: dim, analysis, element_type
       real(wp), intent(in) :: nodes(:, :)
@@ -76,7 +76,7 @@ contains
       logical, intent(in) :: c_indices
       type(error_type), allocatable, intent(out) :: error
       real(wp), intent(in), optional :: body_force(:)
-      integer :: nnode, nelem, nen, ngp, ns, e, a, b, i
+      integer :: nnode, nelem, nen, ngp, ns, e, a, b, i, bad
 
       nnode = size(nodes, 2)
       nelem = size(connectivity, 2)
@@ -113,35 +113,61 @@ contains
             return
          end if
       end do
+      ! The first element with a bad entry, found in parallel; its message serially.
+      bad = nelem + 1
+      !$omp parallel do schedule(static) reduction(min:bad)
       do e = 1, nelem
-         do a = 1, nen
-            if (connectivity(a, e) < 1 .or. connectivity(a, e) > nnode) then
-               call fail(error, entry_name(c_indices, 'connectivity', 'connectivity', [a, e])//' = '// &
-                  & index_name(c_indices, connectivity(a, e))//' is not a node in '//index_name(c_indices, 1)// &
-                  & '..'//index_name(c_indices, nnode))
+         if (.not. element_ok(e)) bad = min(bad, e)
+      end do
+      !$omp end parallel do
+      if (bad > nelem) return
+      e = bad
+      do a = 1, nen
+         if (connectivity(a, e) < 1 .or. connectivity(a, e) > nnode) then
+            call fail(error, entry_name(c_indices, 'connectivity', 'connectivity', [a, e])//' = '// &
+               & index_name(c_indices, connectivity(a, e))//' is not a node in '//index_name(c_indices, 1)// &
+               & '..'//index_name(c_indices, nnode))
+            return
+         end if
+         do b = 1, a - 1
+            if (connectivity(b, e) == connectivity(a, e)) then
+               call fail(error, 'element '//index_name(c_indices, e)//' repeats node '// &
+                  & index_name(c_indices, connectivity(a, e))//' (local nodes '//index_name(c_indices, b)// &
+                  & ' and '//index_name(c_indices, a)//')')
                return
             end if
+         end do
+      end do
+      do i = 1, ngp
+         if (.not. all(abs(gp(:, i, e)) <= huge(1.0_wp))) then
+            call fail(error, entry_name(c_indices, 'gp', 'gauss_points', [0, i, e])//' is not finite')
+         else if (.not. (gw(i, e) > 0.0_wp .and. gw(i, e) <= huge(1.0_wp))) then
+            call fail(error, entry_name(c_indices, 'gw', 'gauss_weights', [i, e])//' = '//rtoa(gw(i, e))// &
+               & ' must be finite and > 0')
+         else if (.not. all(abs(gs(:, i, e)) <= huge(1.0_wp))) then
+            call fail(error, entry_name(c_indices, 'gs', 'gauss_stress', [0, i, e])//' is not finite (NaN or Inf)')
+         end if
+         if (allocated(error)) return
+      end do
+   contains
+      !> Connectivity in range without repeats, finite points and stresses, weights > 0.
+      pure logical function element_ok(e) result(ok)
+         integer, intent(in) :: e
+         integer :: a, b, i
+         ok = .false.
+         do a = 1, nen
+            if (connectivity(a, e) < 1 .or. connectivity(a, e) > nnode) return
             do b = 1, a - 1
-               if (connectivity(b, e) == connectivity(a, e)) then
-                  call fail(error, 'element '//index_name(c_indices, e)//' repeats node '// &
-                     & index_name(c_indices, connectivity(a, e))//' (local nodes '//index_name(c_indices, b)// &
-                     & ' and '//index_name(c_indices, a)//')')
-                  return
-               end if
+               if (connectivity(b, e) == connectivity(a, e)) return
             end do
          end do
          do i = 1, ngp
-            if (.not. all(abs(gp(:, i, e)) <= huge(1.0_wp))) then
-               call fail(error, entry_name(c_indices, 'gp', 'gauss_points', [0, i, e])//' is not finite')
-            else if (.not. (gw(i, e) > 0.0_wp .and. gw(i, e) <= huge(1.0_wp))) then
-               call fail(error, entry_name(c_indices, 'gw', 'gauss_weights', [i, e])//' = '//rtoa(gw(i, e))// &
-                  & ' must be finite and > 0')
-            else if (.not. all(abs(gs(:, i, e)) <= huge(1.0_wp))) then
-               call fail(error, entry_name(c_indices, 'gs', 'gauss_stress', [0, i, e])//' is not finite (NaN or Inf)')
-            end if
-            if (allocated(error)) return
+            if (.not. all(abs(gp(:, i, e)) <= huge(1.0_wp))) return
+            if (.not. (gw(i, e) > 0.0_wp .and. gw(i, e) <= huge(1.0_wp))) return
+            if (.not. all(abs(gs(:, i, e)) <= huge(1.0_wp))) return
          end do
-      end do
+         ok = .true.
+      end function element_ok
    end subroutine check_mesh_arrays
 
    !> Facet arrays: given together, shapes, kinds, node range, finite tractions (pressure
@@ -243,24 +269,37 @@ contains
    !> No two elements on the same set of vertices (a repeated element would count its
    !> points twice). Candidates share the first vertex: ne_ptr / ne_list is the node ->
    !> element CSR (elements ascending per node); O(nelem) for bounded valence.
-   pure subroutine check_duplicate_elements(connectivity, nvertex, ne_ptr, ne_list, c_indices, error)
+   subroutine check_duplicate_elements(connectivity, nvertex, ne_ptr, ne_list, c_indices, error)
       integer, intent(in) :: connectivity(:, :), nvertex, ne_ptr(:), ne_list(:)
       logical, intent(in) :: c_indices
       type(error_type), allocatable, intent(out) :: error
-      integer :: e, k, o, n, a
+      integer :: e, bad
 
+      bad = size(connectivity, 2) + 1
+      !$omp parallel do schedule(static) reduction(min:bad)
       do e = 1, size(connectivity, 2)
+         if (twin(e) > 0) bad = min(bad, e)
+      end do
+      !$omp end parallel do
+      if (bad > size(connectivity, 2)) return
+      call fail(error, 'elements '//index_name(c_indices, twin(bad))//' and '//index_name(c_indices, bad)// &
+         & ' have the same vertices (duplicate elements)')
+   contains
+      !> An element before e on the same vertices, 0 if none.
+      pure integer function twin(e) result(o)
+         integer, intent(in) :: e
+         integer :: k, n, a
          n = connectivity(1, e)
          do k = ne_ptr(n), ne_ptr(n + 1) - 1
             o = ne_list(k)
             if (o >= e) exit
-            if (all([(any(connectivity(1:nvertex, o) == connectivity(a, e)), a=1, nvertex)])) then
-               call fail(error, 'elements '//index_name(c_indices, o)//' and '//index_name(c_indices, e)// &
-                  & ' have the same vertices (duplicate elements)')
-               return
-            end if
+            do a = 1, nvertex
+               if (.not. any(connectivity(1:nvertex, o) == connectivity(a, e))) exit
+            end do
+            if (a > nvertex) return
          end do
-      end do
+         o = 0
+      end function twin
    end subroutine check_duplicate_elements
 
    !> xorshift hash of the coordinates' bits (+0 for -0 so that equal points hash equal).
