@@ -26,7 +26,7 @@ all: build
 help:
 	@echo "make run     install what is missing, build (release) and run the driver on its default scene"
 	@echo "make test    install what is missing and run the whole test suite"
-	@echo "make bench   benchmarks (sparse direct solvers, grid build)"
+	@echo "make bench   benchmarks (sparse direct solvers, grid build, recovery on a caller's mesh)"
 	@echo "make fuzz    5000 seeded mutants of the example scenes through sprc check and run (FUZZ_COUNT, FUZZ_SEED)"
 	@echo "make build   build the release profile"
 	@echo "make lib     build/lib/libsprc.so and libsprc.a, Fortran modules in build/lib/mod"
@@ -55,6 +55,7 @@ fuzz: deps
 bench: deps
 	@tools/bench-sparse
 	$(FPM) run --profile release --example bench_grid
+	$(FPM) run --profile release --example bench_mesh_recovery
 
 # fpm names its build directories by hashes: remove every archive, build the
 # profile verbosely and take the archive and module directory from the one
