@@ -347,11 +347,13 @@ contains
          end do
          status = 0
          do j = 1, ngp
+            ok = .false.
             if (present(start)) then
                call element_inverse_map(r%element_type, xe, gp(:, j, e), xi(:, j, e), ok, start(:, j))
-            else
-               call element_inverse_map(r%element_type, xe, gp(:, j, e), xi(:, j, e), ok)
+               ! A curved element's map may have a root outside it too: then from the centroid.
+               if (ok) ok = element_inside(r%element_type, xi(:, j, e), inside_tol)
             end if
+            if (.not. ok) call element_inverse_map(r%element_type, xe, gp(:, j, e), xi(:, j, e), ok)
             if (.not. ok) then
                status = -j
             else if (.not. element_inside(r%element_type, xi(:, j, e), inside_tol)) then
