@@ -254,6 +254,10 @@ contains
          call accumulate3(n, cmat, w, a, b, use_a, scale, ssq)
          return
       end if
+      if (ns == 6) then
+         call accumulate6(n, cmat, w, a, b, use_a, scale, ssq)
+         return
+      end if
       do i = 1, n
          do j = 1, ns
             if (use_a) then
@@ -301,6 +305,36 @@ contains
          ssq = ssq + w(i)*q
       end do
    end subroutine accumulate3
+
+   !> `accumulate` for 3D stresses with fixed bounds (the same products and sums in the same
+   !> order, so the same bits).
+   pure subroutine accumulate6(n, c, w, a, b, use_a, scale, ssq)
+      integer, intent(in) :: n
+      real(wp), intent(in) :: c(6, 6), w(n), a(6, n), b(6, n), scale
+      logical, intent(in) :: use_a
+      real(wp), intent(inout) :: ssq
+      real(wp) :: d(6), cd(6), q
+      integer :: i, j, k
+
+      do i = 1, n
+         if (use_a) then
+            d = (a(:, i) - b(:, i))*scale
+         else
+            d = (0.0_wp - b(:, i))*scale
+         end if
+         cd = 0.0_wp
+         do k = 1, 6
+            do j = 1, 6
+               cd(j) = cd(j) + c(j, k)*d(k)
+            end do
+         end do
+         q = 0.0_wp
+         do j = 1, 6
+            q = q + d(j)*cd(j)
+         end do
+         ssq = ssq + w(i)*q
+      end do
+   end subroutine accumulate6
 
    !> sqrt(sum(v**2)) without overflow or underflow; the same bits as that expression
    !> wherever it neither overflows nor underflows (scaling by a power of two).
