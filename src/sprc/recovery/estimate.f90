@@ -191,7 +191,11 @@ contains
             return
          end if
       end do
-      call scaled_sum(ns, size(w), cmat(1:ns, 1:ns), w, sigma_star, sigma_h, .true., s, ssq)
+      block
+         real(wp) :: c(ns, ns)
+         c = cmat(1:ns, 1:ns)
+         call scaled_sum(ns, size(w), c, ns, w, sigma_star, sigma_h, .true., s, ssq)
+      end block
    end subroutine scaled_integral
 
    !> Both energy norms of one element for a validated caller (finite stresses, weights
@@ -202,9 +206,9 @@ contains
       real(wp), intent(out) :: err, norm_h
       real(wp) :: s, ssq
 
-      call scaled_sum(size(cmat, 1), size(w), cmat, w, sigma_star, sigma_h, .true., s, ssq)
+      call scaled_sum(size(cmat, 1), size(w), cmat, size(cmat, 1), w, sigma_star, sigma_h, .true., s, ssq)
       err = s*sqrt(ssq)
-      call scaled_sum(size(cmat, 1), size(w), cmat, w, sigma_h, sigma_h, .false., s, ssq)
+      call scaled_sum(size(cmat, 1), size(w), cmat, size(cmat, 1), w, sigma_h, sigma_h, .false., s, ssq)
       norm_h = s*sqrt(ssq)
    end subroutine energy_norms
 
@@ -213,9 +217,10 @@ contains
    !> within 2**(+-200) (squares far from overflow and underflow): scaling by a power of two
    !> is exact, so the final norm s sqrt(ssq) has the same bits either way, and the common
    !> case saves the divisions. The products are those of dot_product(d, matmul(cmat, d)).
-   pure subroutine scaled_sum(ns, n, cmat, w, a, b, use_a, s, ssq)
-      integer, intent(in) :: ns, n
-      real(wp), intent(in) :: cmat(ns, ns), w(n), a(ns, n), b(ns, n)
+   pure subroutine scaled_sum(ns, n, cmat, ldc, w, a, b, use_a, s, ssq)
+      integer, intent(in) :: ns, n, ldc
+      !> The compliance in cmat(1:ns, 1:ns) of an array with leading dimension ldc.
+      real(wp), intent(in) :: cmat(ldc, ns), w(n), a(ns, n), b(ns, n)
       logical, intent(in) :: use_a
       real(wp), intent(out) :: s, ssq
       real(wp), parameter :: safe_hi = 2.0_wp**200, safe_lo = 2.0_wp**(-200)
@@ -237,13 +242,13 @@ contains
       end do
       s = 1.0_wp
       if (.not. (big <= safe_hi .and. (small >= safe_lo .or. big == 0.0_wp))) s = power_of_two(big)
-      call accumulate(ns, n, cmat, w, a, b, use_a, 1.0_wp/s, ssq)
+      call accumulate(ns, n, cmat, ldc, w, a, b, use_a, 1.0_wp/s, ssq)
    end subroutine scaled_sum
 
    !> sum_i w_i d_i^T cmat d_i with d_i = (a_i - b_i) scale (a = 0 if not use_a).
-   pure subroutine accumulate(ns, n, cmat, w, a, b, use_a, scale, ssq)
-      integer, intent(in) :: ns, n
-      real(wp), intent(in) :: cmat(ns, ns), w(n), a(ns, n), b(ns, n), scale
+   pure subroutine accumulate(ns, n, cmat, ldc, w, a, b, use_a, scale, ssq)
+      integer, intent(in) :: ns, n, ldc
+      real(wp), intent(in) :: cmat(ldc, ns), w(n), a(ns, n), b(ns, n), scale
       logical, intent(in) :: use_a
       real(wp), intent(out) :: ssq
       real(wp) :: d(6), cd(6), q
@@ -251,11 +256,11 @@ contains
 
       ssq = 0.0_wp
       if (ns == 3) then
-         call accumulate3(n, cmat, w, a, b, use_a, scale, ssq)
+         call accumulate3(n, cmat, ldc, w, a, b, use_a, scale, ssq)
          return
       end if
       if (ns == 6) then
-         call accumulate6(n, cmat, w, a, b, use_a, scale, ssq)
+         call accumulate6(n, cmat, ldc, w, a, b, use_a, scale, ssq)
          return
       end if
       do i = 1, n
@@ -282,9 +287,9 @@ contains
 
    !> `accumulate` for 2D stresses, written out (the estimate's inner loop); the products
    !> and sums in the same order, so the same bits.
-   pure subroutine accumulate3(n, c, w, a, b, use_a, scale, ssq)
-      integer, intent(in) :: n
-      real(wp), intent(in) :: c(3, 3), w(n), a(3, n), b(3, n), scale
+   pure subroutine accumulate3(n, c, ldc, w, a, b, use_a, scale, ssq)
+      integer, intent(in) :: n, ldc
+      real(wp), intent(in) :: c(ldc, 3), w(n), a(3, n), b(3, n), scale
       logical, intent(in) :: use_a
       real(wp), intent(inout) :: ssq
       real(wp) :: d1, d2, d3, q
@@ -308,9 +313,9 @@ contains
 
    !> `accumulate` for 3D stresses with fixed bounds (the same products and sums in the same
    !> order, so the same bits).
-   pure subroutine accumulate6(n, c, w, a, b, use_a, scale, ssq)
-      integer, intent(in) :: n
-      real(wp), intent(in) :: c(6, 6), w(n), a(6, n), b(6, n), scale
+   pure subroutine accumulate6(n, c, ldc, w, a, b, use_a, scale, ssq)
+      integer, intent(in) :: n, ldc
+      real(wp), intent(in) :: c(ldc, 6), w(n), a(6, n), b(6, n), scale
       logical, intent(in) :: use_a
       real(wp), intent(inout) :: ssq
       real(wp) :: d(6), cd(6), q
