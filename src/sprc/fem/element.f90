@@ -22,7 +22,7 @@ module sprc_fem_element
    private
 
    public :: shape_functions, strain_matrix, traction_matrix, displacement_matrix
-   public :: add_stiffness, element_stress
+   public :: add_stiffness, element_stress, element_strain
 
 contains
 
@@ -141,12 +141,23 @@ contains
       integer, intent(in) :: dim, degree
       real(wp), intent(in) :: d(:, :), lo(:), hi(:), x(:), ue(:)
       real(wp), intent(out) :: sigma(:)
+      real(wp) :: eps(size(d, 1))
+
+      call element_strain(dim, degree, lo, hi, x, ue, eps)
+      sigma = matmul(d, eps)
+   end subroutine element_stress
+
+   !> Strain eps(nstress) = b u_e at a point of the box [lo, hi] (as `element_stress`).
+   pure subroutine element_strain(dim, degree, lo, hi, x, ue, eps)
+      integer, intent(in) :: dim, degree
+      real(wp), intent(in) :: lo(:), hi(:), x(:), ue(:)
+      real(wp), intent(out) :: eps(:)
       real(wp) :: n((degree + 1)**dim), dndx(dim, (degree + 1)**dim)
-      real(wp) :: b(size(d, 1), dim*(degree + 1)**dim)
+      real(wp) :: b(size(eps), dim*(degree + 1)**dim)
 
       call shape_functions(dim, degree, lo, hi, x, n, dndx)
       call strain_matrix(dim, dndx, b)
-      sigma = matmul(d, matmul(b, ue))
-   end subroutine element_stress
+      eps = matmul(b, ue)
+   end subroutine element_strain
 
 end module sprc_fem_element

@@ -53,7 +53,7 @@
 !> in element order; reductions (norms, errors) are summed serially in
 !> element order. The bits do not depend on the thread count.
 module sprc_fem_problem
-   use sprc_core_kinds, only: wp
+   use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular, &
       & stat_not_positive_definite
    use sprc_core_lapack, only: dgemm, dsyev
@@ -74,11 +74,12 @@ module sprc_fem_problem
    use sprc_fem_cholmod, only: cholmod_solver_type
    use sprc_fem_umfpack, only: umfpack_solver_type
    use sprc_fem_element, only: shape_functions, strain_matrix, traction_matrix, displacement_matrix, &
-      & add_stiffness, element_stress
+      & add_stiffness, element_stress, element_strain
    use sprc_fem_bc, only: fe_bc_type, check_bcs, bc_free, bc_pressure, bc_traction, bc_displacement, &
       & bc_symmetry, bc_exact_traction, bc_exact_displacement
    use sprc_fem_aggregation, only: aggregate_cells, default_eta
    use sprc_fem_constraints, only: constraint_type
+   use sprc_fem_dilatation, only: dilatation_type, dilatation_auto, resolve_dilatation
    implicit none
    private
 
@@ -131,6 +132,8 @@ module sprc_fem_problem
       integer :: n_cut = 0, n_aggregated = 0
       !> u = T ubar.
       type(constraint_type) :: constraints
+      !> Projected dilatation (B-bar) when active (`sprc_fem_dilatation`).
+      type(dilatation_type) :: dilatation
       !> Reduced stiffness and load.
       type(csr_type) :: k
       real(wp), allocatable :: f(:)
@@ -212,7 +215,7 @@ contains
    !> cells and build T (t_assembly). `body_force` has dim entries; `eta`
    !> defaults to `default_eta`, `gamma` to `default_gamma(degree)`.
    subroutine problem_setup(self, body, grid, nodes, hanging, quad, analysis, young, poisson, body_force, bcs, &
-         & error, exact, eta, gamma)
+         & error, exact, eta, gamma, dilatation)
       class(elasticity_problem_type), intent(out) :: self
       type(body_type), intent(in) :: body
       type(grid_type), intent(in) :: grid
@@ -225,6 +228,8 @@ contains
       type(error_type), allocatable, intent(out) :: error
       class(exact_solution_type), intent(in), optional :: exact
       real(wp), intent(in), optional :: eta, gamma
+      !> `sprc_fem_dilatation` choice (default `dilatation_auto`).
+      integer, intent(in), optional :: dilatation
       type(timer_type) :: timer
       integer, allocatable :: plane_axis(:)
       real(wp), allocatable :: plane_coord(:)
@@ -286,9 +291,23 @@ contains
          call self%constraints%build(grid, nodes, hanging, self%root, plane_axis, plane_coord, &
             & plane_tol(grid), error)
       end if
+      if (.not. allocated(error)) call setup_dilatation(self, dilatation, error)
       call timer%stop()
       self%t_assembly = timer%elapsed
    end subroutine problem_setup
+
+   !> The projected dilatation if `choice` (default auto) asks for it here.
+   subroutine setup_dilatation(self, choice, error)
+      type(elasticity_problem_type), intent(inout) :: self
+      integer, intent(in), optional :: choice
+      type(error_type), allocatable, intent(out) :: error
+      integer :: c
+      c = dilatation_auto
+      if (present(choice)) c = choice
+      if (.not. resolve_dilatation(c, self%analysis, self%poisson)) return
+      call self%dilatation%build(self%analysis, self%d(1:self%nstress, 1:self%nstress), self%degree, self%grid, &
+         & self%root, self%vol_ptr, self%vol_x, self%vol_w, error)
+   end subroutine setup_dilatation
 
    pure real(wp) function plane_tol(grid)
       type(grid_type), intent(in) :: grid
@@ -500,6 +519,7 @@ contains
       if (allocated(error)) return
       allocate (self%u(self%dim, self%nodes%n_nodes))
       call self%constraints%expand(self%ubar, self%u)
+      call dilatation_coefficients(self)
       self%solved = .true.
    end subroutine problem_solve
 
@@ -526,7 +546,7 @@ contains
       end block
       maxm = maxval(mdof)
       call coo%init(self%constraints%n_dofs, self%constraints%n_dofs, error, &
-         & capacity=sum(int(mdof, kind(coo%nnz))**2))
+         & capacity=sum(int(mdof, kind(coo%nnz))**2) + aggregate_capacity(self, mdof))
       if (allocated(error)) return
       allocate (self%f(self%constraints%n_dofs))
       self%f = 0.0_wp
@@ -561,8 +581,81 @@ contains
       end do
       call blas_serial_end(saved_blas)
       if (allocated(error)) return
+      call assemble_aggregates(self, maxm, coo, error)
+      if (allocated(error)) return
       call coo%to_csr(self%k, error)
    end subroutine assemble
+
+   !> COO entries the dilatation blocks of aggregates of several cells need at most.
+   integer(i8) function aggregate_capacity(self, mdof) result(n)
+      type(elasticity_problem_type), intent(in) :: self
+      integer, intent(in) :: mdof(:)
+      integer :: a, j
+      integer(i8) :: m
+      n = 0
+      if (.not. self%dilatation%active) return
+      do a = 1, self%dilatation%n_aggregates
+         if (self%dilatation%ptr(a + 1) - self%dilatation%ptr(a) == 1) cycle
+         m = 0
+         do j = self%dilatation%ptr(a), self%dilatation%ptr(a + 1) - 1
+            m = m + mdof(self%dilatation%member(j))
+         end do
+         n = n + m*m
+      end do
+   end function aggregate_capacity
+
+   !> Dilatation blocks of the aggregates of several cells (serially, in
+   !> aggregate order): the members' moments reduced by T_e and summed on the
+   !> union of their reduced dofs.
+   subroutine assemble_aggregates(self, maxm, coo, error)
+      type(elasticity_problem_type), intent(inout) :: self
+      integer, intent(in) :: maxm
+      type(coo_type), intent(inout) :: coo
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: ke(self%dim*self%nen, self%dim*self%nen), fe(self%dim*self%nen)
+      real(wp) :: tmat(self%dim*self%nen, maxm)
+      real(wp) :: g(self%dim*self%nen, self%dilatation%np), h(self%dim*self%nen, self%dilatation%np)
+      real(wp) :: sv(self%dilatation%np), svsum(self%dilatation%np)
+      real(wp), allocatable :: gu(:, :), hu(:, :), ku(:, :), fu(:)
+      integer, allocatable :: union(:)
+      integer :: dofs(maxm), a, j, e, m, nu, i, k, np
+
+      if (.not. self%dilatation%active) return
+      np = self%dilatation%np
+      do a = 1, self%dilatation%n_aggregates
+         if (self%dilatation%ptr(a + 1) - self%dilatation%ptr(a) == 1) cycle
+         nu = 0
+         allocate (union(maxm*(self%dilatation%ptr(a + 1) - self%dilatation%ptr(a))))
+         allocate (gu(size(union), np), hu(size(union), np))
+         gu = 0.0_wp
+         hu = 0.0_wp
+         svsum = 0.0_wp
+         do j = self%dilatation%ptr(a), self%dilatation%ptr(a + 1) - 1
+            e = self%dilatation%member(j)
+            call element_system(self, e, ke, fe, g, h, sv)
+            call self%constraints%element_map(self%nodes%connectivity(:, e), dofs, tmat, m)
+            svsum = svsum + sv
+            do i = 1, m
+               k = findloc(union(1:nu), dofs(i), 1)
+               if (k == 0) then
+                  nu = nu + 1
+                  union(nu) = dofs(i)
+                  k = nu
+               end if
+               gu(k, :) = gu(k, :) + matmul(tmat(:, i), g)
+               hu(k, :) = hu(k, :) + matmul(tmat(:, i), h)
+            end do
+         end do
+         allocate (ku(nu, nu), fu(nu))
+         ku = 0.0_wp
+         fu = 0.0_wp
+         call self%dilatation%add_aggregate_block(a, gu(1:nu, :), hu(1:nu, :), svsum, ku, fu)
+         call coo%add(union(1:nu), ku, error)
+         if (allocated(error)) return
+         self%f(union(1:nu)) = self%f(union(1:nu)) + fu
+         deallocate (union, gu, hu, ku, fu)
+      end do
+   end subroutine assemble_aggregates
 
    !> Reduced system of element e: kr = T_e^T k_e T_e (m x m, column-major in
    !> kr), fr = T_e^T f_e, on the reduced dofs dofs(1:m).
@@ -573,10 +666,18 @@ contains
       real(wp), intent(out) :: kr(:), fr(:)
       real(wp) :: ke(self%dim*self%nen, self%dim*self%nen), fe(self%dim*self%nen)
       real(wp) :: tmat(self%dim*self%nen, maxm), kt(self%dim*self%nen, maxm)
-      integer :: nd
+      real(wp) :: g(self%dim*self%nen, self%dilatation%np), h(self%dim*self%nen, self%dilatation%np)
+      real(wp) :: sv(self%dilatation%np)
+      integer :: nd, a
 
       nd = self%dim*self%nen
-      call element_system(self, e, ke, fe)
+      call element_system(self, e, ke, fe, g, h, sv)
+      if (self%dilatation%active) then
+         ! an aggregate of one cell: its dilatation terms live on this element's dofs
+         a = self%dilatation%aggregate(e)
+         if (self%dilatation%ptr(a + 1) - self%dilatation%ptr(a) == 1) &
+            & call self%dilatation%add_aggregate_block(a, g, h, sv, ke, fe)
+      end if
       call self%constraints%element_map(self%nodes%connectivity(:, e), dofs, tmat, m)
       if (m == 0) return
       call dgemm('N', 'N', nd, m, nd, 1.0_wp, ke, nd, tmat, nd, 0.0_wp, kt, nd)
@@ -585,13 +686,15 @@ contains
    end subroutine reduced_element_system
 
    !> Unreduced stiffness ke and load fe of element e: volume terms, Neumann
-   !> loads and Nitsche terms of its surface points.
-   subroutine element_system(self, e, ke, fe)
+   !> loads and Nitsche terms of its surface points. With the projected
+   !> dilatation, ke and fe hold the deviatoric part and gm, hm, sv the
+   !> element's share of its aggregate's terms (`add_aggregate_block`).
+   subroutine element_system(self, e, ke, fe, gm, hm, sv)
       type(elasticity_problem_type), intent(in) :: self
       integer, intent(in) :: e
-      real(wp), intent(out) :: ke(:, :), fe(:)
-      integer :: d, ns, nd, q, c, ib, kind
-      real(wp) :: lo(3), hi(3), h, pen, t(3), g(3), p(3, 3)
+      real(wp), intent(out) :: ke(:, :), fe(:), gm(:, :), hm(:, :), sv(:)
+      integer :: d, ns, nd, q, c, ib, kind, a
+      real(wp) :: lo(3), hi(3), h, pen, t(3), g(3), p(3, 3), pb(4), dmat(6, 6), pn(3)
       real(wp) :: n(self%nen), dndx(self%dim, self%nen)
       real(wp) :: b(self%nstress, self%dim*self%nen), db(self%nstress, self%dim*self%nen)
       real(wp) :: nm(self%dim, self%dim*self%nen), tn(self%dim, self%nstress), s(self%dim, self%dim*self%nen)
@@ -604,10 +707,20 @@ contains
       pen = self%gamma*self%dmax/h
       ke = 0.0_wp
       fe = 0.0_wp
+      hm = 0.0_wp
+      sv = 0.0_wp
+      dmat = self%d
+      a = 0
+      if (self%dilatation%active) then
+         dmat = self%dilatation%d_dev
+         a = self%dilatation%aggregate(e)
+         call self%dilatation%element_moments(a, self%degree, lo(1:d), hi(1:d), &
+            & self%vol_x(:, self%vol_ptr(e):self%vol_ptr(e + 1) - 1), self%vol_w(self%vol_ptr(e):self%vol_ptr(e + 1) - 1), gm)
+      end if
       do q = self%vol_ptr(e), self%vol_ptr(e + 1) - 1
          call shape_functions(d, self%degree, lo(1:d), hi(1:d), self%vol_x(:, q), n, dndx)
          call strain_matrix(d, dndx, b)
-         db = matmul(self%d(1:ns, 1:ns), b)
+         db = matmul(dmat(1:ns, 1:ns), b)
          call add_stiffness(b, db, self%vol_w(q), ke)
          do c = 1, d
             fe(c:nd:d) = fe(c:nd:d) + self%vol_w(q)*self%body_force(c)*n
@@ -653,11 +766,20 @@ contains
                call strain_matrix(d, dndx, b)
                call displacement_matrix(d, n, nm)
                call traction_matrix(d, nrm, tn)
-               s = matmul(tn, matmul(self%d(1:ns, 1:ns), b))
+               s = matmul(tn, matmul(dmat(1:ns, 1:ns), b))
                s = matmul(p(1:d, 1:d), s)
                ke = ke - w*(matmul(transpose(nm), s) + matmul(transpose(s), nm)) &
                   & + (w*pen)*matmul(transpose(nm), matmul(p(1:d, 1:d), nm))
                fe = fe - w*matmul(g(1:d), s) + (w*pen)*matmul(matmul(p(1:d, 1:d), g(1:d)), nm)
+               if (a > 0) then
+                  ! the dilatation's share of sigma_bar n: kappa theta_bar P n
+                  call self%dilatation%basis(a, x, pb)
+                  pn(1:d) = matmul(p(1:d, 1:d), nrm)
+                  do c = 1, self%dilatation%np
+                     hm(:, c) = hm(:, c) + (w*pb(c))*matmul(pn(1:d), nm)
+                     sv(c) = sv(c) + w*pb(c)*dot_product(g(1:d), pn(1:d))
+                  end do
+               end if
             end select
          end associate
       end do
@@ -800,6 +922,29 @@ contains
       if (allocated(error)) error%message = 'elasticity solve (UMFPACK fallback): '//error%message
    end subroutine factor_and_solve
 
+   !> theta_bar on every aggregate from the nodal displacements (projected dilatation only).
+   subroutine dilatation_coefficients(self)
+      type(elasticity_problem_type), intent(inout) :: self
+      real(wp) :: g(self%dim*self%nen, self%dilatation%np), ue(self%dim*self%nen), gu(self%dilatation%np)
+      real(wp) :: lo(3), hi(3)
+      integer :: a, j, e, d
+
+      if (.not. self%dilatation%active) return
+      d = self%dim
+      do a = 1, self%dilatation%n_aggregates
+         gu = 0.0_wp
+         do j = self%dilatation%ptr(a), self%dilatation%ptr(a + 1) - 1
+            e = self%dilatation%member(j)
+            call self%grid%leaf_box(e, lo(1:d), hi(1:d))
+            call self%dilatation%element_moments(a, self%degree, lo(1:d), hi(1:d), &
+               & self%vol_x(:, self%vol_ptr(e):self%vol_ptr(e + 1) - 1), self%vol_w(self%vol_ptr(e):self%vol_ptr(e + 1) - 1), g)
+            call self%element_displacements(e, ue)
+            gu = gu + matmul(ue, g)
+         end do
+         call self%dilatation%set_coefficients(a, gu)
+      end do
+   end subroutine dilatation_coefficients
+
    !> Nodal displacements ue(dim*nen) of element e, node-major.
    pure subroutine element_displacements(self, e, ue)
       class(elasticity_problem_type), intent(in) :: self
@@ -818,9 +963,14 @@ contains
       integer, intent(in) :: e
       real(wp), intent(in) :: x(:)
       real(wp), intent(out) :: sigma(:)
-      real(wp) :: ue(self%dim*self%nen), lo(3), hi(3)
+      real(wp) :: ue(self%dim*self%nen), lo(3), hi(3), eps(6)
       call self%element_displacements(e, ue)
       call self%grid%leaf_box(e, lo(1:self%dim), hi(1:self%dim))
+      if (self%dilatation%active) then
+         call element_strain(self%dim, self%degree, lo(1:self%dim), hi(1:self%dim), x, ue, eps(1:self%nstress))
+         call self%dilatation%projected_stress(e, x, eps(1:self%nstress), sigma)
+         return
+      end if
       call element_stress(self%dim, self%degree, self%d(1:self%nstress, 1:self%nstress), lo(1:self%dim), &
          & hi(1:self%dim), x, ue, sigma)
    end subroutine stress_in_element
