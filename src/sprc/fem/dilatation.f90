@@ -46,7 +46,7 @@ module sprc_fem_dilatation
    private
 
    public :: dilatation_type, dilatation_auto, dilatation_full, dilatation_projected, projected_poisson
-   public :: resolve_dilatation, dilatation_name
+   public :: resolve_dilatation, dilatation_name, dilatation_choice
 
    !> Formulation choices: automatic (by analysis and nu), the plain
    !> displacement formulation, the projected dilatation.
@@ -111,6 +111,19 @@ contains
          name = 'auto'
       end select
    end function dilatation_name
+
+   !> The choice named 'full' or 'projected'; anything else is `dilatation_auto`.
+   pure integer function dilatation_choice(name)
+      character(len=*), intent(in) :: name
+      select case (name)
+      case ('full')
+         dilatation_choice = dilatation_full
+      case ('projected')
+         dilatation_choice = dilatation_projected
+      case default
+         dilatation_choice = dilatation_auto
+      end select
+   end function dilatation_choice
 
    !> Set up the projection: material split, aggregates from `root`
    !> (`sprc_fem_aggregation`), Gram matrices from the volume rules

@@ -25,6 +25,7 @@ module sprc_io_run
    use sprc_grid_recovered_estimate, only: zz_estimate_type, estimate_error
    use sprc_fem_bc, only: fe_bc_type, new_fe_bc, bc_kind_from_name
    use sprc_fem_problem, only: elasticity_problem_type
+   use sprc_fem_dilatation, only: dilatation_choice
    use sprc_io_scene, only: scene_type, recovery_degree
    use sprc_io_model, only: build_bodies, build_exact, analysis_kind, analysis_units_type, analysis_units, in_units
    use sprc_io_budget, only: check_level_memory
@@ -151,10 +152,10 @@ contains
       associate (mat => scene%bodies(1))
          if (allocated(model%exact)) then
             call problem%setup(model%body, grid, nodes, hanging, quad, model%analysis, model%young, mat%poisson, &
-               model%body_force, model%bcs, error, exact=model%exact)
+               model%body_force, model%bcs, error, exact=model%exact, dilatation=dilatation_choice(scene%dilatation))
          else
             call problem%setup(model%body, grid, nodes, hanging, quad, model%analysis, model%young, mat%poisson, &
-               model%body_force, model%bcs, error)
+               model%body_force, model%bcs, error, dilatation=dilatation_choice(scene%dilatation))
          end if
       end associate
       if (allocated(error)) return

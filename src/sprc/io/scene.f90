@@ -6,6 +6,7 @@
 module sprc_io_scene
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
    use sprc_core_kinds, only: wp, i8
+   use sprc_fem_dilatation, only: projected_poisson
    use sprc_core_error, only: error_type, fatal_error, stat_unsupported
    use sprc_io_namelist, only: nml_group_type, parse_namelist, read_text_file, nml_get, nml_get_array, &
       & nml_has, nml_check_consumed, nml_field_error, nml_group_error, nml_item_text
@@ -129,6 +130,8 @@ module sprc_io_scene
       character(len=:), allocatable :: recovery_degree
       !> Prefix of the files written; '' writes none.
       character(len=:), allocatable :: output
+      !> Volumetric formulation: 'auto' | 'full' | 'projected' (`sprc_fem_dilatation`).
+      character(len=:), allocatable :: dilatation
       type(body_type), allocatable :: bodies(:)
       type(shape_type), allocatable :: shapes(:)
       type(bc_type), allocatable :: bcs(:)
@@ -139,7 +142,7 @@ module sprc_io_scene
    character(len=*), parameter :: known_groups(6) = [character(len=7) :: 'scene', 'body', 'shape', 'bc', &
       & 'exact', 'contact']
    character(len=*), parameter :: scene_keys = 'title analysis order levels refine_boundary box_min box_size '// &
-      & 'recovery recovery_degree output'
+      & 'recovery recovery_degree output dilatation'
    character(len=*), parameter :: body_keys = 'name young poisson body_force'
    character(len=*), parameter :: shape_fields = 'center radius semi_axes lower upper point normal axis'
    character(len=*), parameter :: shape_keys = 'body op kind name '//shape_fields
@@ -152,6 +155,7 @@ module sprc_io_scene
    character(len=*), parameter :: analyses = 'plane_stress plane_strain solid'
    character(len=*), parameter :: recoveries = 'none spr sprc both'
    character(len=*), parameter :: recovery_degrees = 'auto p p+1'
+   character(len=*), parameter :: dilatations = 'auto full projected'
    character(len=*), parameter :: ops = 'add subtract intersect'
    character(len=*), parameter :: shape_kinds = 'disk sphere ellipse ellipsoid box halfspace cylinder'
    character(len=*), parameter :: bc_types = 'free pressure traction displacement symmetry exact_traction '// &
@@ -336,6 +340,9 @@ contains
                return
             end if
          end if
+         scene%dilatation = 'auto'
+         call get_choice(g, 'dilatation', dilatations, .false., scene%dilatation, error)
+         if (allocated(error)) return
          call nml_check_consumed(g, error)
       end associate
    end subroutine read_scene_group
@@ -946,6 +953,7 @@ contains
       text = text//"  recovery_degree = '"//scene%recovery_degree//"' (SPR "//int_text(recovery_degree(scene, 1))// &
          & ', SPR-C '//int_text(recovery_degree(scene, 2))//')'//nl
       text = text//"  output          = '"//scene%output//"'"//nl
+      text = text//'  dilatation      = '//scene%dilatation//nl
       do i = 1, size(scene%bodies)
          associate (b => scene%bodies(i))
             text = text//"body '"//b%name//"': young = "//real_text(b%young)//', poisson = '// &
@@ -1029,6 +1037,7 @@ contains
          text = text//'  error columns (err_*, theta_*): off (no &exact)'//nl
       end if
       text = text//'  estimate columns (eta_*): '//on_off(spr .or. sprc)//nl
+      text = text//dilatation_lines(scene)
       if (len(scene%output) > 0) then
          text = text//'  output files: on ('//scene%output//'.csv, '//scene%output//'.svg, '//scene%output// &
             & '.h5, '//scene%output//'.xdmf)'//nl
@@ -1036,6 +1045,40 @@ contains
          text = text//"  output files: off (output = '')"//nl
       end if
    end function switches
+
+   !> Per body: whether the locking-free formulation (projected dilatation) is on, and why.
+   function dilatation_lines(scene) result(text)
+      type(scene_type), intent(in) :: scene
+      character(len=:), allocatable :: text
+      character(len=*), parameter :: nl = new_line('a')
+      character(len=:), allocatable :: why
+      logical :: on
+      integer :: i
+      text = ''
+      do i = 1, size(scene%bodies)
+         associate (b => scene%bodies(i))
+            select case (scene%dilatation)
+            case ('projected')
+               on = .true.
+               why = "dilatation = 'projected'"
+            case ('full')
+               on = .false.
+               why = "dilatation = 'full'"
+            case default
+               on = scene%analysis /= 'plane_stress' .and. b%poisson >= projected_poisson
+               if (scene%analysis == 'plane_stress') then
+                  why = 'auto: plane stress does not lock'
+               else if (on) then
+                  why = 'auto: poisson = '//real_text(b%poisson)//' >= '//real_text(projected_poisson)
+               else
+                  why = 'auto: poisson = '//real_text(b%poisson)//' < '//real_text(projected_poisson)
+               end if
+            end select
+            text = text//"  locking-free formulation (projected dilatation, B-bar), body '"//b%name//"': "// &
+               & on_off(on)//' ('//why//')'//nl
+         end associate
+      end do
+   end function dilatation_lines
 
    function on_off(flag) result(text)
       logical, intent(in) :: flag
