@@ -20,6 +20,7 @@ program sprc_unit_tests
    use sprc_test_fem, only: collect_fem
    use sprc_test_patches, only: collect_patches
    use sprc_test_mesh_recovery, only: collect_mesh_recovery
+   use sprc_test_dilatation, only: collect_dilatation
    implicit none
 
    type(testsuite_type), allocatable :: suites(:)
@@ -42,7 +43,8 @@ program sprc_unit_tests
       new_testsuite('patches', collect_patches), &
       new_testsuite('output', collect_output), &
       new_testsuite('fem', collect_fem), &
-      new_testsuite('mesh_recovery', collect_mesh_recovery) &
+      new_testsuite('mesh_recovery', collect_mesh_recovery), &
+      new_testsuite('dilatation', collect_dilatation) &
       ]
 
    call get_arg(1, suite_name)

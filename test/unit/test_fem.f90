@@ -29,6 +29,9 @@ module sprc_test_fem
    private
 
    public :: collect_fem
+   ! shared with test_dilatation
+   public :: poly_field_type, new_poly_field, polygon_2d, polygon_3d, lame_quarter, sphere_octant, make_body, &
+      & field_errors, young
 
    real(wp), parameter :: young = 1000.0_wp, poisson = 0.3_wp
 
@@ -77,21 +80,26 @@ contains
 
    ! ------------------------------------------------------------ fields
 
-   subroutine new_poly_field(self, analysis, a, g, h, error)
+   subroutine new_poly_field(self, analysis, a, g, h, error, nu)
       type(poly_field_type), intent(out) :: self
       integer, intent(in) :: analysis
       real(wp), intent(in) :: a(:), g(:, :)
       real(wp), intent(in), optional :: h(:, :, :)
       type(error_type), allocatable, intent(out) :: error
+      !> Poisson ratio (default the module's `poisson`).
+      real(wp), intent(in), optional :: nu
       integer :: d, ns
-      call init_exact_solution(self, 'poly', analysis, [plane_stress, plane_strain, solid], young, poisson, error)
+      real(wp) :: v
+      v = poisson
+      if (present(nu)) v = nu
+      call init_exact_solution(self, 'poly', analysis, [plane_stress, plane_strain, solid], young, v, error)
       if (allocated(error)) return
       d = self%dim
       ns = self%nstress
       self%a(1:d) = a
       self%g(1:d, 1:d) = g
       if (present(h)) self%h(1:d, 1:d, 1:d) = h
-      call material_matrix(analysis, young, poisson, self%d(1:ns, 1:ns), error)
+      call material_matrix(analysis, young, v, self%d(1:ns, 1:ns), error)
    end subroutine new_poly_field
 
    pure subroutine poly_displacement(self, x, v)
@@ -513,14 +521,17 @@ contains
 
    !> Lame cylinder quarter: disk r=20 minus disk r=5, x >= 0, y >= 0; pressure 1
    !> inside, symmetry planes.
-   subroutine lame_quarter(body, bcs, exact, analysis, error, extra_offset)
+   subroutine lame_quarter(body, bcs, exact, analysis, error, extra_offset, nu)
       type(body_type), intent(out) :: body
       type(fe_bc_type), allocatable, intent(out) :: bcs(:)
       type(lame_cylinder_type), intent(out) :: exact
       integer, intent(in) :: analysis
       type(error_type), allocatable, intent(out) :: error
       real(wp), intent(in), optional :: extra_offset
+      !> Poisson ratio (default the module's `poisson`).
+      real(wp), intent(in), optional :: nu
       type(shape_type) :: s(5)
+      real(wp) :: v
       call new_disk(s(1), 'outer', [0.0_wp, 0.0_wp], 20.0_wp, error)
       if (allocated(error)) return
       call new_disk(s(2), 'inner', [0.0_wp, 0.0_wp], 5.0_wp, error)
@@ -539,8 +550,9 @@ contains
          call make_body(body, s(1:4), [csg_add, csg_subtract, csg_intersect, csg_intersect], error)
       end if
       if (allocated(error)) return
-      call new_lame_cylinder(exact, [0.0_wp, 0.0_wp], 5.0_wp, 20.0_wp, 1.0_wp, 0.0_wp, young, poisson, analysis, &
-         & error)
+      v = poisson
+      if (present(nu)) v = nu
+      call new_lame_cylinder(exact, [0.0_wp, 0.0_wp], 5.0_wp, 20.0_wp, 1.0_wp, 0.0_wp, young, v, analysis, error)
    end subroutine lame_quarter
 
    !> Kirsch quarter plate: box [-10, 10]^2 minus the unit disk, x >= 0, y >= 0;
@@ -569,14 +581,16 @@ contains
    end subroutine kirsch_quarter
 
    !> Lame sphere octant of example/scenes/lame_sphere.nml: r 10..20, pressure 1 inside.
-   subroutine sphere_octant(body, bcs, exact, error)
+   subroutine sphere_octant(body, bcs, exact, error, nu)
       type(body_type), intent(out) :: body
       type(fe_bc_type), allocatable, intent(out) :: bcs(:)
       type(lame_sphere_type), intent(out) :: exact
       type(error_type), allocatable, intent(out) :: error
+      !> Poisson ratio (default the module's `poisson`).
+      real(wp), intent(in), optional :: nu
       type(shape_type) :: s(5)
       integer :: k
-      real(wp) :: n(3)
+      real(wp) :: n(3), v
       call new_sphere(s(1), 'outer', [0.0_wp, 0.0_wp, 0.0_wp], 20.0_wp, error)
       if (allocated(error)) return
       call new_sphere(s(2), 'inner', [0.0_wp, 0.0_wp, 0.0_wp], 10.0_wp, error)
@@ -590,7 +604,9 @@ contains
       call make_body(body, s, [csg_add, csg_subtract, csg_intersect, csg_intersect, csg_intersect], error)
       if (allocated(error)) return
       bcs = [new_fe_bc(2, bc_pressure, value=1.0_wp), (new_fe_bc(2 + k, bc_symmetry), k = 1, 3)]
-      call new_lame_sphere(exact, [0.0_wp, 0.0_wp, 0.0_wp], 10.0_wp, 20.0_wp, 1.0_wp, 0.0_wp, young, poisson, error)
+      v = poisson
+      if (present(nu)) v = nu
+      call new_lame_sphere(exact, [0.0_wp, 0.0_wp, 0.0_wp], 10.0_wp, 20.0_wp, 1.0_wp, 0.0_wp, young, v, error)
    end subroutine sphere_octant
 
    !> err_fe at the given levels; rate between the last two must reach

@@ -44,7 +44,8 @@ contains
          new_unittest('contact_accepted_not_runnable', test_contact), &
          new_unittest('missing_file', test_missing_file), &
          new_unittest('expect_has_enough_entries', test_expect_count), &
-         new_unittest('malformed_files', test_malformed) &
+         new_unittest('malformed_files', test_malformed), &
+         new_unittest('dilatation_key', test_dilatation_key) &
          ]
    end subroutine collect_scene
 
@@ -300,6 +301,30 @@ contains
       if (allocated(error)) return
       call check(error, recovery_degree(s, 1) == 2 .and. recovery_degree(s, 2) == 2, "recovery_degree = 'p', order 2")
    end subroutine test_case
+
+   !> &scene dilatation: default 'auto'; check says per body whether the
+   !> locking-free formulation is on, and why.
+   subroutine test_dilatation_key(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: s
+      call read_ok(minimal, s, error)
+      if (allocated(error)) return
+      call check(error, s%dilatation, 'auto', 'dilatation default')
+      if (allocated(error)) return
+      call check(error, index(scene_summary(s), "body 'b': off (auto: plane stress does not lock)") > 0, &
+         & 'summary: plane stress, auto: off')
+      if (allocated(error)) return
+      call read_ok(replaced(replaced(minimal, "'plane_stress'", "'plane_strain'"), 'poisson=0', 'poisson=0.4999'), &
+         & s, error)
+      if (allocated(error)) return
+      call check(error, index(scene_summary(s), "body 'b': on (auto: poisson = 0.4999 >= 0.4)") > 0, &
+         & 'summary: plane strain at 0.4999, auto: on')
+      if (allocated(error)) return
+      call read_ok(replaced(minimal, 'box_size=4', "box_size=4 dilatation='Projected'"), s, error)
+      if (allocated(error)) return
+      call check(error, index(scene_summary(s), "dilatation      = projected") > 0 .and. &
+         & index(scene_summary(s), "body 'b': on (dilatation = 'projected')") > 0, 'summary: projected on request')
+   end subroutine test_dilatation_key
 
    subroutine test_summary_order1(error)
       type(error_type), allocatable, intent(out) :: error

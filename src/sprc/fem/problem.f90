@@ -173,7 +173,7 @@ contains
    !> then `setup` and `solve` the problem. `t_mesh` (optional) gets the grid,
    !> node and constraint build time.
    subroutine solve_on_grid(problem, body, box_min, box_size, level, refine_boundary, degree, analysis, young, &
-         & poisson, body_force, bcs, error, exact, points, eta, gamma, t_mesh)
+         & poisson, body_force, bcs, error, exact, points, eta, gamma, t_mesh, dilatation)
       type(elasticity_problem_type), intent(out) :: problem
       type(body_type), intent(in) :: body
       real(wp), intent(in) :: box_min(:), box_size
@@ -185,6 +185,7 @@ contains
       integer, intent(in), optional :: points
       real(wp), intent(in), optional :: eta, gamma
       real(wp), intent(out), optional :: t_mesh
+      integer, intent(in), optional :: dilatation
       type(grid_type) :: grid
       type(grid_nodes_type) :: nodes
       type(hanging_type) :: hanging
@@ -206,7 +207,7 @@ contains
       call new_cut_quadrature(quad, body%dim, q, error)
       if (allocated(error)) return
       call problem%setup(body, grid, nodes, hanging, quad, analysis, young, poisson, body_force, bcs, error, &
-         & exact, eta, gamma)
+         & exact, eta, gamma, dilatation)
       if (allocated(error)) return
       call problem%solve(error)
    end subroutine solve_on_grid
@@ -649,7 +650,10 @@ contains
          allocate (ku(nu, nu), fu(nu))
          ku = 0.0_wp
          fu = 0.0_wp
-         call self%dilatation%add_aggregate_block(a, gu(1:nu, :), hu(1:nu, :), svsum, ku, fu)
+         ! contiguous copies for the BLAS calls
+         gu = gu(1:nu, :)
+         hu = hu(1:nu, :)
+         call self%dilatation%add_aggregate_block(a, gu, hu, svsum, ku, fu)
          call coo%add(union(1:nu), ku, error)
          if (allocated(error)) return
          self%f(union(1:nu)) = self%f(union(1:nu)) + fu
