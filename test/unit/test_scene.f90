@@ -45,7 +45,8 @@ contains
          new_unittest('missing_file', test_missing_file), &
          new_unittest('expect_has_enough_entries', test_expect_count), &
          new_unittest('malformed_files', test_malformed), &
-         new_unittest('dilatation_key', test_dilatation_key) &
+         new_unittest('dilatation_key', test_dilatation_key), &
+         new_unittest('nitsche_gamma_key', test_nitsche_gamma_key) &
          ]
    end subroutine collect_scene
 
@@ -325,6 +326,23 @@ contains
       call check(error, index(scene_summary(s), "dilatation      = projected") > 0 .and. &
          & index(scene_summary(s), "body 'b': on (dilatation = 'projected')") > 0, 'summary: projected on request')
    end subroutine test_dilatation_key
+
+   !> &scene nitsche_gamma: default 10 (p+1)^2; outside the safe range the
+   !> summary carries a warning (and the driver prints it on standard error).
+   subroutine test_nitsche_gamma_key(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: s
+      call read_ok(replaced(minimal, 'box_size=4', 'box_size=4 order=2'), s, error)
+      if (allocated(error)) return
+      call check(error, s%nitsche_gamma, 90.0_wp, 0.0_wp, 'default 10 (p+1)^2 for order 2')
+      if (allocated(error)) return
+      call check(error, index(scene_summary(s), 'WARNING') == 0, 'no warning at the default')
+      if (allocated(error)) return
+      call read_ok(replaced(minimal, 'box_size=4', 'box_size=4 nitsche_gamma=5'), s, error)
+      if (allocated(error)) return
+      call check(error, index(scene_summary(s), 'WARNING: Nitsche gamma = 5.000E+00 lies outside the safe range '// &
+         & '[20.0, 4000.0] for Q1: coercivity') > 0, 'warning below the range: '//scene_summary(s))
+   end subroutine test_nitsche_gamma_key
 
    subroutine test_summary_order1(error)
       type(error_type), allocatable, intent(out) :: error

@@ -83,7 +83,7 @@ module sprc_fem_problem
    implicit none
    private
 
-   public :: elasticity_problem_type, default_gamma, rigid_tol, solve_on_grid
+   public :: elasticity_problem_type, default_gamma, rigid_tol, solve_on_grid, gamma_range, gamma_note
 
    !> Elements per chunk of the parallel assembly (bounds the buffer of reduced matrices).
    integer, parameter :: chunk_size = 256
@@ -166,6 +166,42 @@ contains
       integer, intent(in) :: degree
       default_gamma = 10.0_wp*real((degree + 1)**2, wp)
    end function default_gamma
+
+   !> Safe range [lo, hi] of the Nitsche factor for degree p: default / 2 to
+   !> 100 default. Below, coercivity is no longer guaranteed by the estimate
+   !> of the module notes (the default keeps a margin of 2); above, the
+   !> condition number grows in proportion to gamma (the stiffness's rcond
+   !> falls 10x per decade) and the method tends to a pure penalty. Inside,
+   !> the errors move by less than the discretization error (stability_study).
+   pure function gamma_range(degree) result(range)
+      integer, intent(in) :: degree
+      real(wp) :: range(2)
+      range = [0.5_wp, 100.0_wp]*default_gamma(degree)
+   end function gamma_range
+
+   !> '' when gamma lies in `gamma_range(degree)`, else a sentence saying what
+   !> to expect (for a warning).
+   function gamma_note(degree, gamma) result(note)
+      integer, intent(in) :: degree
+      real(wp), intent(in) :: gamma
+      character(len=:), allocatable :: note
+      real(wp) :: range(2)
+      character(len=16) :: b(3)
+      range = gamma_range(degree)
+      note = ''
+      if (gamma >= range(1) .and. gamma <= range(2)) return
+      write (b(1), '(es10.3)') gamma
+      write (b(2), '(f0.1)') range(1)
+      write (b(3), '(f0.1)') range(2)
+      note = 'Nitsche gamma = '//trim(adjustl(b(1)))//' lies outside the safe range ['//trim(b(2))//', '// &
+         & trim(b(3))//'] for Q'//achar(48 + degree)//': '
+      if (gamma < range(1)) then
+         note = note//'coercivity is not guaranteed (the stiffness may be indefinite, the weak conditions '// &
+            & 'poorly held); raise it'
+      else
+         note = note//'the condition number grows in proportion to gamma; lower it'
+      end if
+   end function gamma_note
 
    !> Convenience: build the grid of `body` (uniform `level`, `refine_boundary`
    !> extra levels on cut cells), its Q`degree` nodes and hanging constraints,

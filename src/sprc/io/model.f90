@@ -14,6 +14,7 @@ module sprc_io_model
    use sprc_exact_lame, only: lame_cylinder_type, lame_sphere_type, new_lame_cylinder, new_lame_sphere
    use sprc_exact_kirsch, only: kirsch_type, new_kirsch
    use sprc_io_scene, only: scene_type, shape_type, real_text, int_text
+   use sprc_fem_problem, only: gamma_note
    implicit none
    private
 
@@ -156,6 +157,8 @@ contains
       if (.not. (load > 0.0_wp) .and. size(scene%contacts) == 0) text = text//'warning: no load: every '// &
          & 'pressure, traction, body force and prescribed displacement is zero, so the displacement is zero '// &
          & 'and the errors and estimates mean nothing'//new_line('a')
+      if (len(gamma_note(scene%order, scene%nitsche_gamma)) > 0) &
+         & text = text//'warning: '//gamma_note(scene%order, scene%nitsche_gamma)//new_line('a')
       if (.not. scene%exact%present .or. size(bodies) == 0) return
       if (index(scene%exact%kind, 'hertz_') == 1) return
       call distance_range(scene, bodies(1), scene%exact%center, r, step)

@@ -50,6 +50,8 @@ module sprc_io_run
       type(analysis_units_type) :: units
       real(wp) :: young = 0.0_wp
       real(wp), allocatable :: body_force(:)
+      !> Nitsche penalty factor (the scene's `nitsche_gamma`; a study may change it).
+      real(wp) :: gamma = 0.0_wp
    end type run_model_type
 
 contains
@@ -88,6 +90,7 @@ contains
       if (points == 0) model%points = default_points(scene%order)
       model%run_spr = scene%recovery == 'spr' .or. scene%recovery == 'both'
       model%run_sprc = scene%recovery == 'sprc' .or. scene%recovery == 'both'
+      model%gamma = scene%nitsche_gamma
    end subroutine prepare_run
 
    !> The scene's &bc groups as FE conditions on the body's shape indices
@@ -110,14 +113,16 @@ contains
       end do
    end subroutine fe_conditions
 
-   !> One level of the study: the report row and, if `h5` is open, the fields.
-   subroutine run_level(scene, model, level, row, error, h5)
+   !> One level of the study: the report row and, if `h5` is open, the fields;
+   !> `rcond`: the solver's reciprocal condition estimate of the stiffness.
+   subroutine run_level(scene, model, level, row, error, h5, rcond)
       type(scene_type), intent(in) :: scene
       type(run_model_type), intent(in) :: model
       integer, intent(in) :: level
       type(report_row_type), intent(out) :: row
       type(error_type), allocatable, intent(out) :: error
       type(h5_output_type), intent(inout), optional :: h5
+      real(wp), intent(out), optional :: rcond
       type(grid_type) :: grid
       type(grid_nodes_type) :: nodes
       type(hanging_type) :: hanging
@@ -152,15 +157,17 @@ contains
       associate (mat => scene%bodies(1))
          if (allocated(model%exact)) then
             call problem%setup(model%body, grid, nodes, hanging, quad, model%analysis, model%young, mat%poisson, &
-               model%body_force, model%bcs, error, exact=model%exact, dilatation=dilatation_choice(scene%dilatation))
+               model%body_force, model%bcs, error, exact=model%exact, gamma=model%gamma, &
+               & dilatation=dilatation_choice(scene%dilatation))
          else
             call problem%setup(model%body, grid, nodes, hanging, quad, model%analysis, model%young, mat%poisson, &
-               model%body_force, model%bcs, error, dilatation=dilatation_choice(scene%dilatation))
+               model%body_force, model%bcs, error, gamma=model%gamma, dilatation=dilatation_choice(scene%dilatation))
          end if
       end associate
       if (allocated(error)) return
       call problem%solve(error)
       if (allocated(error)) return
+      if (present(rcond)) rcond = problem%rcond
 
       row%level = level
       row%h = scene%box_size/real(2**level, wp)

@@ -7,6 +7,7 @@ module sprc_io_scene
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
    use sprc_core_kinds, only: wp, i8
    use sprc_fem_dilatation, only: projected_poisson
+   use sprc_fem_problem, only: default_gamma, gamma_note
    use sprc_core_error, only: error_type, fatal_error, stat_unsupported
    use sprc_io_namelist, only: nml_group_type, parse_namelist, read_text_file, nml_get, nml_get_array, &
       & nml_has, nml_check_consumed, nml_field_error, nml_group_error, nml_item_text
@@ -132,6 +133,8 @@ module sprc_io_scene
       character(len=:), allocatable :: output
       !> Volumetric formulation: 'auto' | 'full' | 'projected' (`sprc_fem_dilatation`).
       character(len=:), allocatable :: dilatation
+      !> Nitsche penalty factor, > 0 (default `default_gamma(order)`).
+      real(wp) :: nitsche_gamma = 0.0_wp
       type(body_type), allocatable :: bodies(:)
       type(shape_type), allocatable :: shapes(:)
       type(bc_type), allocatable :: bcs(:)
@@ -142,7 +145,7 @@ module sprc_io_scene
    character(len=*), parameter :: known_groups(6) = [character(len=7) :: 'scene', 'body', 'shape', 'bc', &
       & 'exact', 'contact']
    character(len=*), parameter :: scene_keys = 'title analysis order levels refine_boundary box_min box_size '// &
-      & 'recovery recovery_degree output dilatation'
+      & 'recovery recovery_degree output dilatation nitsche_gamma'
    character(len=*), parameter :: body_keys = 'name young poisson body_force'
    character(len=*), parameter :: shape_fields = 'center radius semi_axes lower upper point normal axis'
    character(len=*), parameter :: shape_keys = 'body op kind name '//shape_fields
@@ -342,6 +345,9 @@ contains
          end if
          scene%dilatation = 'auto'
          call get_choice(g, 'dilatation', dilatations, .false., scene%dilatation, error)
+         if (allocated(error)) return
+         scene%nitsche_gamma = default_gamma(scene%order)
+         call get_positive(g, 'nitsche_gamma', .false., scene%nitsche_gamma, error)
          if (allocated(error)) return
          call nml_check_consumed(g, error)
       end associate
@@ -954,6 +960,7 @@ contains
          & ', SPR-C '//int_text(recovery_degree(scene, 2))//')'//nl
       text = text//"  output          = '"//scene%output//"'"//nl
       text = text//'  dilatation      = '//scene%dilatation//nl
+      text = text//'  nitsche_gamma   = '//real_text(scene%nitsche_gamma)//nl
       do i = 1, size(scene%bodies)
          associate (b => scene%bodies(i))
             text = text//"body '"//b%name//"': young = "//real_text(b%young)//', poisson = '// &
@@ -1038,6 +1045,8 @@ contains
       end if
       text = text//'  estimate columns (eta_*): '//on_off(spr .or. sprc)//nl
       text = text//dilatation_lines(scene)
+      if (len(gamma_note(scene%order, scene%nitsche_gamma)) > 0) &
+         & text = text//'  WARNING: '//gamma_note(scene%order, scene%nitsche_gamma)//nl
       if (len(scene%output) > 0) then
          text = text//'  output files: on ('//scene%output//'.csv, '//scene%output//'.svg, '//scene%output// &
             & '.h5, '//scene%output//'.xdmf)'//nl
