@@ -20,7 +20,7 @@ program sprc_unit_tests
    use sprc_test_fem, only: collect_fem
    use sprc_test_patches, only: collect_patches
    use sprc_test_mesh_recovery, only: collect_mesh_recovery
-   use sprc_test_dilatation, only: collect_dilatation
+   use sprc_test_stiff, only: collect_stiff
    implicit none
 
    type(testsuite_type), allocatable :: suites(:)
@@ -44,7 +44,7 @@ program sprc_unit_tests
       new_testsuite('output', collect_output), &
       new_testsuite('fem', collect_fem), &
       new_testsuite('mesh_recovery', collect_mesh_recovery), &
-      new_testsuite('dilatation', collect_dilatation) &
+      new_testsuite('stiff', collect_stiff) &
       ]
 
    call get_arg(1, suite_name)

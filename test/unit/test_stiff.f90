@@ -1,5 +1,6 @@
-!> Tests of the projected dilatation (B-bar / mean dilatation on cell
-!> aggregates, `sprc_fem_dilatation`): the locking-free formulation.
+!> Stiff and extreme cases of the FE layer: the projected dilatation (B-bar /
+!> mean dilatation on cell aggregates, `sprc_fem_dilatation`), the
+!> locking-free formulation; tiny cuts in 3D, Q1 and Q2.
 !>
 !> Independent references: linear displacement fields (uniform stress), which
 !> the projection leaves unchanged, so the discrete solution must equal them
@@ -9,10 +10,11 @@
 !> nu = 0.3 (the displacement formulation locks there, so these tests fail
 !> without the projection); the definition of the projection itself, checked
 !> from the displacement formulation's stress of the same u_h.
-module sprc_test_dilatation
+module sprc_test_stiff
    use sprc_core_kinds, only: wp
    use sprc_core_material, only: plane_strain, solid, material_matrix
-   use sprc_geometry_body, only: body_type
+   use sprc_geometry_body, only: body_type, csg_intersect
+   use sprc_geometry_shape, only: shape_type, new_halfspace
    use sprc_exact_solution, only: exact_solution_type
    use sprc_exact_lame, only: lame_cylinder_type, lame_sphere_type
    use sprc_fem_element, only: element_stress
@@ -26,7 +28,7 @@ module sprc_test_dilatation
    implicit none
    private
 
-   public :: collect_dilatation
+   public :: collect_stiff
 
    !> The nearly incompressible Poisson ratio of issue 15's target.
    real(wp), parameter :: nu_inc = 0.4999_wp
@@ -41,7 +43,7 @@ module sprc_test_dilatation
 
 contains
 
-   subroutine collect_dilatation(testsuite)
+   subroutine collect_stiff(testsuite)
       type(unittest_type), allocatable, intent(out) :: testsuite(:)
       testsuite = [ &
          new_unittest('auto_choice', test_auto_choice), &
@@ -50,9 +52,10 @@ contains
          new_unittest('projected_stress', test_projected_stress), &
          new_unittest('lame_cylinder_incompressible', test_lame_cylinder), &
          new_unittest('lame_sphere_incompressible', test_lame_sphere), &
-         new_unittest('small_cuts', test_small_cuts) &
+         new_unittest('small_cuts', test_small_cuts), &
+         new_unittest('small_cuts_3d', test_small_cuts_3d) &
          ]
-   end subroutine collect_dilatation
+   end subroutine collect_stiff
 
    !> auto: projected in plane strain and 3D from `projected_poisson` up, never in plane stress.
    subroutine test_auto_choice(error)
@@ -326,4 +329,52 @@ contains
       end do
    end subroutine test_small_cuts
 
-end module sprc_test_dilatation
+   !> Tiny cuts in 3D: the Lame sphere octant (level 3, Q1 and Q2, nu = 0.3
+   !> and 0.4999) cut by the plane x = 3 h + delta h with exact traction on
+   !> it, delta = 1e-6 and 1e-12 against delta = 0 (the plane on grid planes):
+   !> the diagonally scaled condition estimate within 10x and err_fe within 1%.
+   subroutine test_small_cuts_3d(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: body
+      type(fe_bc_type), allocatable :: bcs(:)
+      type(lame_sphere_type) :: exact
+      type(shape_type) :: cut
+      type(elasticity_problem_type) :: problem
+      real(wp), parameter :: deltas(3) = [0.0_wp, 1.0e-6_wp, 1.0e-12_wp], nus(2) = [0.3_wp, nu_inc]
+      real(wp) :: h, rc(3), err(3), nfe, nex
+      real(wp), allocatable :: ee(:)
+      integer :: i, p, k
+
+      h = 25.0_wp/8.0_wp
+      do k = 1, 2
+         do p = 1, 2
+            do i = 1, size(deltas)
+               call sphere_octant(body, bcs, exact, error, nu=nus(k))
+               if (allocated(error)) return
+               call new_halfspace(cut, 'cut', [3.0_wp*h + deltas(i)*h, 0.0_wp, 0.0_wp], [1.0_wp, 0.0_wp, 0.0_wp], &
+                  & error)
+               if (allocated(error)) return
+               call body%add_shape(csg_intersect, cut, error)
+               if (allocated(error)) return
+               bcs = [bcs, new_fe_bc(6, bc_exact_traction)]
+               call solve_on_grid(problem, body, [0.0_wp, 0.0_wp, 0.0_wp], 25.0_wp, 3, 0, p, solid, young, nus(k), &
+                  & [0.0_wp, 0.0_wp, 0.0_wp], bcs, error, exact=exact)
+               if (allocated(error)) return
+               call problem%energy_error(err(i), ee, nfe, nex, error)
+               if (allocated(error)) return
+               call problem%scaled_rcond(rc(i), error)
+               if (allocated(error)) return
+               if (i > 1) then
+                  call check(error, minval(problem%fraction) < 2.0_wp*deltas(i), 'a cut as small as delta exists')
+                  if (allocated(error)) return
+                  call check(error, rc(i) >= 0.1_wp*rc(1), 'scaled condition within 10x')
+                  if (allocated(error)) return
+                  call check(error, err(i), err(1), 0.01_wp, 'err_fe within 1%', rel=.true.)
+                  if (allocated(error)) return
+               end if
+            end do
+         end do
+      end do
+   end subroutine test_small_cuts_3d
+
+end module sprc_test_stiff
