@@ -31,7 +31,7 @@ module sprc_test_fem
    public :: collect_fem
    ! shared with test_dilatation
    public :: poly_field_type, new_poly_field, polygon_2d, polygon_3d, lame_quarter, sphere_octant, make_body, &
-      & field_errors, young
+      & field_errors, young, kirsch_quarter
 
    real(wp), parameter :: young = 1000.0_wp, poisson = 0.3_wp
 
@@ -558,13 +558,16 @@ contains
    !> Kirsch quarter plate: box [-10, 10]^2 minus the unit disk, x >= 0, y >= 0;
    !> exact traction on the outer edges (x = 10 and y = 10, on the level-0 box
    !> boundary), free hole, symmetry planes.
-   subroutine kirsch_quarter(body, bcs, exact, analysis, error)
+   subroutine kirsch_quarter(body, bcs, exact, analysis, error, nu)
       type(body_type), intent(out) :: body
       type(fe_bc_type), allocatable, intent(out) :: bcs(:)
       type(kirsch_type), intent(out) :: exact
       integer, intent(in) :: analysis
       type(error_type), allocatable, intent(out) :: error
+      !> Poisson ratio (default the module's `poisson`).
+      real(wp), intent(in), optional :: nu
       type(shape_type) :: s(4)
+      real(wp) :: v
       call new_box(s(1), 'edges', [-10.0_wp, -10.0_wp], [10.0_wp, 10.0_wp], error)
       if (allocated(error)) return
       call new_disk(s(2), 'hole', [0.0_wp, 0.0_wp], 1.0_wp, error)
@@ -577,7 +580,9 @@ contains
       if (allocated(error)) return
       bcs = [new_fe_bc(1, bc_exact_traction), new_fe_bc(2, bc_free), new_fe_bc(3, bc_symmetry), &
          & new_fe_bc(4, bc_symmetry)]
-      call new_kirsch(exact, [0.0_wp, 0.0_wp], 1.0_wp, 1.0_wp, young, poisson, analysis, error)
+      v = poisson
+      if (present(nu)) v = nu
+      call new_kirsch(exact, [0.0_wp, 0.0_wp], 1.0_wp, 1.0_wp, young, v, analysis, error)
    end subroutine kirsch_quarter
 
    !> Lame sphere octant of example/scenes/lame_sphere.nml: r 10..20, pressure 1 inside.

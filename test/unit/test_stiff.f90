@@ -17,13 +17,14 @@ module sprc_test_stiff
    use sprc_geometry_shape, only: shape_type, new_halfspace
    use sprc_exact_solution, only: exact_solution_type
    use sprc_exact_lame, only: lame_cylinder_type, lame_sphere_type
+   use sprc_exact_kirsch, only: kirsch_type
    use sprc_fem_element, only: element_stress
    use sprc_fem_bc, only: fe_bc_type, new_fe_bc, bc_exact_traction, bc_exact_displacement
    use sprc_fem_dilatation, only: dilatation_full, dilatation_projected, dilatation_auto, resolve_dilatation, &
       & projected_poisson
    use sprc_fem_problem, only: elasticity_problem_type, solve_on_grid
    use sprc_test_fem, only: poly_field_type, new_poly_field, polygon_2d, polygon_3d, lame_quarter, sphere_octant, &
-      & field_errors, young
+      & field_errors, young, kirsch_quarter
    use sprc_testsuite, only: unittest_type, new_unittest, check, error_type
    implicit none
    private
@@ -52,6 +53,7 @@ contains
          new_unittest('projected_stress', test_projected_stress), &
          new_unittest('lame_cylinder_incompressible', test_lame_cylinder), &
          new_unittest('lame_sphere_incompressible', test_lame_sphere), &
+         new_unittest('kirsch_q2_rate', test_kirsch_q2_rate), &
          new_unittest('small_cuts', test_small_cuts), &
          new_unittest('small_cuts_3d', test_small_cuts_3d) &
          ]
@@ -288,6 +290,32 @@ contains
       rate = log(e5(1)/e5(2))/log(2.0_wp)
       call check(error, rate >= 0.95_wp, 'Lame sphere: rate at nu = 0.4999')
    end subroutine test_lame_sphere
+
+   !> Q2 keeps its order with the projection: Kirsch plate in plane strain at
+   !> nu = 0.4999 (the dilatation is not constant, unlike Lame's), levels 5
+   !> and 6: rate of err_fe >= 1.9. With a constant dilatation per aggregate
+   !> (Q2/P0) the rate is 0.74 (err_fe 2.25e-2, 1.35e-2; P1: 5.20e-3, 1.01e-3).
+   subroutine test_kirsch_q2_rate(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: body
+      type(fe_bc_type), allocatable :: bcs(:)
+      type(kirsch_type) :: exact
+      type(elasticity_problem_type) :: problem
+      real(wp), allocatable :: ee(:)
+      real(wp) :: err(2), nfe, nex
+      integer :: l
+
+      call kirsch_quarter(body, bcs, exact, plane_strain, error, nu=nu_inc)
+      if (allocated(error)) return
+      do l = 1, 2
+         call solve_on_grid(problem, body, [0.0_wp, 0.0_wp], 10.0_wp, 4 + l, 0, 2, plane_strain, young, nu_inc, &
+            & [0.0_wp, 0.0_wp], bcs, error, exact=exact)
+         if (allocated(error)) return
+         call problem%energy_error(err(l), ee, nfe, nex, error)
+         if (allocated(error)) return
+      end do
+      call check(error, log(err(1)/err(2))/log(2.0_wp) >= 1.9_wp, 'Kirsch Q2 at nu = 0.4999: rate of err_fe')
+   end subroutine test_kirsch_q2_rate
 
    !> Stability of the dilatation on aggregates: the Lame quarter at nu =
    !> 0.4999, level 4, Q1 and Q2, cut by the plane x = 10 h + delta h (exact
