@@ -31,7 +31,7 @@ module sprc_test_fem
    public :: collect_fem
    ! shared with test_dilatation
    public :: poly_field_type, new_poly_field, polygon_2d, polygon_3d, lame_quarter, sphere_octant, make_body, &
-      & field_errors, young, kirsch_quarter
+      & field_errors, young, kirsch_quarter, small_cut_sweep, lame_cut, cut_body_builder
 
    real(wp), parameter :: young = 1000.0_wp, poisson = 0.3_wp
 
@@ -53,6 +53,19 @@ module sprc_test_fem
       procedure :: displacement => poly_displacement
       procedure :: body_force => poly_body_force
    end type poly_field_type
+
+   abstract interface
+      !> The body of a small-cut sweep cut at delta (cell sizes), its conditions
+      !> and exact solution for the Poisson ratio nu.
+      subroutine cut_body_builder(delta, nu, body, bcs, exact, error)
+         import :: wp, body_type, fe_bc_type, exact_solution_type, error_type
+         real(wp), intent(in) :: delta, nu
+         type(body_type), intent(out) :: body
+         type(fe_bc_type), allocatable, intent(out) :: bcs(:)
+         class(exact_solution_type), allocatable, intent(out) :: exact
+         type(error_type), allocatable, intent(out) :: error
+      end subroutine cut_body_builder
+   end interface
 
 contains
 
@@ -705,42 +718,69 @@ contains
    !> Small cuts: the Lame quarter (level 4, Q1 and Q2) cut by the plane
    !> x = 10 h + delta h with exact traction on it; delta = 1e-1, 1e-6, 1e-12
    !> (cut fractions down to ~1e-12) against delta = 0 (plane on grid lines, no
-   !> cut there): the diagonally scaled condition estimate stays within 10x
-   !> and err_fe within 1%.
+   !> cut there): `small_cut_sweep`.
    subroutine test_small_cuts(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: p
+      do p = 1, 2
+         call small_cut_sweep(lame_cut, poisson, [0.0_wp, 1.0e-1_wp, 1.0e-6_wp, 1.0e-12_wp], [0.0_wp, 0.0_wp], &
+            & 25.0_wp, 4, p, plane_strain, error)
+         if (allocated(error)) return
+      end do
+   end subroutine test_small_cuts
+
+   !> The Lame quarter (plane strain, Poisson ratio nu) cut by x = 10 h + delta h,
+   !> h the cell of level 4 (a `cut_body_builder`).
+   subroutine lame_cut(delta, nu, body, bcs, exact, error)
+      real(wp), intent(in) :: delta, nu
+      type(body_type), intent(out) :: body
+      type(fe_bc_type), allocatable, intent(out) :: bcs(:)
+      class(exact_solution_type), allocatable, intent(out) :: exact
+      type(error_type), allocatable, intent(out) :: error
+      type(lame_cylinder_type) :: lame
+      real(wp), parameter :: h = 25.0_wp/16.0_wp
+      call lame_quarter(body, bcs, lame, plane_strain, error, extra_offset=10.0_wp*h + delta*h, nu=nu)
+      if (allocated(error)) return
+      allocate (exact, source=lame)
+   end subroutine lame_cut
+
+   !> Small-cut sweep: `build` gives the body cut at each of `deltas` (deltas(1)
+   !> = 0: no cut there), solved at `level` with Q`degree`; against delta = 0 a
+   !> cut as small as delta must exist, the diagonally scaled condition
+   !> estimate stay within 10x and err_fe within 1%.
+   subroutine small_cut_sweep(build, nu, deltas, box_min, box_size, level, degree, analysis, error)
+      procedure(cut_body_builder) :: build
+      real(wp), intent(in) :: nu, deltas(:), box_min(:), box_size
+      integer, intent(in) :: level, degree, analysis
       type(error_type), allocatable, intent(out) :: error
       type(body_type) :: body
       type(fe_bc_type), allocatable :: bcs(:)
-      type(lame_cylinder_type) :: exact
+      class(exact_solution_type), allocatable :: exact
       type(elasticity_problem_type) :: problem
-      real(wp), parameter :: deltas(4) = [0.0_wp, 1.0e-1_wp, 1.0e-6_wp, 1.0e-12_wp]
-      real(wp) :: h, rc(4), err(4), nfe, nex
+      real(wp) :: rc(size(deltas)), err(size(deltas)), nfe, nex
       real(wp), allocatable :: ee(:)
-      integer :: i, p
+      integer :: i
 
-      h = 25.0_wp/16.0_wp
-      do p = 1, 2
-         do i = 1, size(deltas)
-            call lame_quarter(body, bcs, exact, plane_strain, error, extra_offset=10.0_wp*h + deltas(i)*h)
+      do i = 1, size(deltas)
+         call build(deltas(i), nu, body, bcs, exact, error)
+         if (allocated(error)) return
+         call solve_on_grid(problem, body, box_min, box_size, level, 0, degree, analysis, young, nu, &
+            & spread(0.0_wp, 1, size(box_min)), bcs, error, exact=exact)
+         if (allocated(error)) return
+         call problem%energy_error(err(i), ee, nfe, nex, error)
+         if (allocated(error)) return
+         call problem%scaled_rcond(rc(i), error)
+         if (allocated(error)) return
+         if (i > 1) then
+            call check(error, minval(problem%fraction) < 2.0_wp*deltas(i), 'a cut as small as delta exists')
             if (allocated(error)) return
-            call solve_on_grid(problem, body, [0.0_wp, 0.0_wp], 25.0_wp, 4, 0, p, plane_strain, young, poisson, &
-               & [0.0_wp, 0.0_wp], bcs, error, exact=exact)
+            call check(error, rc(i) >= 0.1_wp*rc(1), 'scaled condition within 10x')
             if (allocated(error)) return
-            call problem%energy_error(err(i), ee, nfe, nex, error)
+            call check(error, err(i), err(1), 0.01_wp, 'err_fe within 1%', rel=.true.)
             if (allocated(error)) return
-            call problem%scaled_rcond(rc(i), error)
-            if (allocated(error)) return
-            if (i > 1) then
-               call check(error, minval(problem%fraction) < 2.0_wp*deltas(i), 'a cut as small as delta exists')
-               if (allocated(error)) return
-               call check(error, rc(i) >= 0.1_wp*rc(1), 'scaled condition within 10x')
-               if (allocated(error)) return
-               call check(error, err(i), err(1), 0.01_wp, 'err_fe within 1%', rel=.true.)
-               if (allocated(error)) return
-            end if
-         end do
+         end if
       end do
-   end subroutine test_small_cuts
+   end subroutine small_cut_sweep
 
    ! ------------------------------------------------------------ errors
 

@@ -24,7 +24,7 @@ module sprc_test_stiff
       & projected_poisson
    use sprc_fem_problem, only: elasticity_problem_type, solve_on_grid
    use sprc_test_fem, only: poly_field_type, new_poly_field, polygon_2d, polygon_3d, lame_quarter, sphere_octant, &
-      & field_errors, young, kirsch_quarter
+      & field_errors, young, kirsch_quarter, small_cut_sweep, lame_cut
    use sprc_testsuite, only: unittest_type, new_unittest, check, error_type
    implicit none
    private
@@ -319,90 +319,52 @@ contains
 
    !> Stability of the dilatation on aggregates: the Lame quarter at nu =
    !> 0.4999, level 4, Q1 and Q2, cut by the plane x = 10 h + delta h (exact
-   !> traction): delta = 1e-6 and 1e-12 against delta = 0: the diagonally
-   !> scaled condition estimate within 10x and err_fe within 1% (as the small
-   !> cut test of the displacement formulation).
+   !> traction), delta = 1e-6 and 1e-12 against 0 (`small_cut_sweep`).
    subroutine test_small_cuts(error)
       type(error_type), allocatable, intent(out) :: error
-      type(body_type) :: body
-      type(fe_bc_type), allocatable :: bcs(:)
-      type(lame_cylinder_type) :: exact
-      type(elasticity_problem_type) :: problem
-      real(wp), parameter :: deltas(3) = [0.0_wp, 1.0e-6_wp, 1.0e-12_wp]
-      real(wp) :: h, rc(3), err(3), nfe, nex
-      real(wp), allocatable :: ee(:)
-      integer :: i, p
-
-      h = 25.0_wp/16.0_wp
+      integer :: p
       do p = 1, 2
-         do i = 1, size(deltas)
-            call lame_quarter(body, bcs, exact, plane_strain, error, extra_offset=10.0_wp*h + deltas(i)*h, nu=nu_inc)
-            if (allocated(error)) return
-            call solve_on_grid(problem, body, [0.0_wp, 0.0_wp], 25.0_wp, 4, 0, p, plane_strain, young, nu_inc, &
-               & [0.0_wp, 0.0_wp], bcs, error, exact=exact)
-            if (allocated(error)) return
-            call problem%energy_error(err(i), ee, nfe, nex, error)
-            if (allocated(error)) return
-            call problem%scaled_rcond(rc(i), error)
-            if (allocated(error)) return
-            if (i > 1) then
-               call check(error, minval(problem%fraction) < 2.0_wp*deltas(i), 'a cut as small as delta exists')
-               if (allocated(error)) return
-               call check(error, rc(i) >= 0.1_wp*rc(1), 'scaled condition within 10x')
-               if (allocated(error)) return
-               call check(error, err(i), err(1), 0.01_wp, 'err_fe within 1%', rel=.true.)
-               if (allocated(error)) return
-            end if
-         end do
+         call small_cut_sweep(lame_cut, nu_inc, [0.0_wp, 1.0e-6_wp, 1.0e-12_wp], [0.0_wp, 0.0_wp], 25.0_wp, 4, p, &
+            & plane_strain, error)
+         if (allocated(error)) return
       end do
    end subroutine test_small_cuts
 
    !> Tiny cuts in 3D: the Lame sphere octant (level 3, Q1 and Q2, nu = 0.3
    !> and 0.4999) cut by the plane x = 3 h + delta h with exact traction on
-   !> it, delta = 1e-6 and 1e-12 against delta = 0 (the plane on grid planes):
-   !> the diagonally scaled condition estimate within 10x and err_fe within 1%.
+   !> it, delta = 1e-6 and 1e-12 against 0 (`small_cut_sweep`).
    subroutine test_small_cuts_3d(error)
       type(error_type), allocatable, intent(out) :: error
-      type(body_type) :: body
-      type(fe_bc_type), allocatable :: bcs(:)
-      type(lame_sphere_type) :: exact
-      type(shape_type) :: cut
-      type(elasticity_problem_type) :: problem
-      real(wp), parameter :: deltas(3) = [0.0_wp, 1.0e-6_wp, 1.0e-12_wp], nus(2) = [0.3_wp, nu_inc]
-      real(wp) :: h, rc(3), err(3), nfe, nex
-      real(wp), allocatable :: ee(:)
-      integer :: i, p, k
-
-      h = 25.0_wp/8.0_wp
+      real(wp), parameter :: nus(2) = [0.3_wp, nu_inc]
+      integer :: p, k
       do k = 1, 2
          do p = 1, 2
-            do i = 1, size(deltas)
-               call sphere_octant(body, bcs, exact, error, nu=nus(k))
-               if (allocated(error)) return
-               call new_halfspace(cut, 'cut', [3.0_wp*h + deltas(i)*h, 0.0_wp, 0.0_wp], [1.0_wp, 0.0_wp, 0.0_wp], &
-                  & error)
-               if (allocated(error)) return
-               call body%add_shape(csg_intersect, cut, error)
-               if (allocated(error)) return
-               bcs = [bcs, new_fe_bc(6, bc_exact_traction)]
-               call solve_on_grid(problem, body, [0.0_wp, 0.0_wp, 0.0_wp], 25.0_wp, 3, 0, p, solid, young, nus(k), &
-                  & [0.0_wp, 0.0_wp, 0.0_wp], bcs, error, exact=exact)
-               if (allocated(error)) return
-               call problem%energy_error(err(i), ee, nfe, nex, error)
-               if (allocated(error)) return
-               call problem%scaled_rcond(rc(i), error)
-               if (allocated(error)) return
-               if (i > 1) then
-                  call check(error, minval(problem%fraction) < 2.0_wp*deltas(i), 'a cut as small as delta exists')
-                  if (allocated(error)) return
-                  call check(error, rc(i) >= 0.1_wp*rc(1), 'scaled condition within 10x')
-                  if (allocated(error)) return
-                  call check(error, err(i), err(1), 0.01_wp, 'err_fe within 1%', rel=.true.)
-                  if (allocated(error)) return
-               end if
-            end do
+            call small_cut_sweep(sphere_cut, nus(k), [0.0_wp, 1.0e-6_wp, 1.0e-12_wp], [0.0_wp, 0.0_wp, 0.0_wp], &
+               & 25.0_wp, 3, p, solid, error)
+            if (allocated(error)) return
          end do
       end do
    end subroutine test_small_cuts_3d
+
+   !> The Lame sphere octant cut by x = 3 h + delta h, h the cell of level 3
+   !> (a `cut_body_builder`).
+   subroutine sphere_cut(delta, nu, body, bcs, exact, error)
+      real(wp), intent(in) :: delta, nu
+      type(body_type), intent(out) :: body
+      type(fe_bc_type), allocatable, intent(out) :: bcs(:)
+      class(exact_solution_type), allocatable, intent(out) :: exact
+      type(error_type), allocatable, intent(out) :: error
+      type(lame_sphere_type) :: lame
+      type(shape_type) :: cut
+      real(wp), parameter :: h = 25.0_wp/8.0_wp
+      call sphere_octant(body, bcs, lame, error, nu=nu)
+      if (allocated(error)) return
+      call new_halfspace(cut, 'cut', [3.0_wp*h + delta*h, 0.0_wp, 0.0_wp], [1.0_wp, 0.0_wp, 0.0_wp], error)
+      if (allocated(error)) return
+      call body%add_shape(csg_intersect, cut, error)
+      if (allocated(error)) return
+      bcs = [bcs, new_fe_bc(6, bc_exact_traction)]
+      allocate (exact, source=lame)
+   end subroutine sphere_cut
 
 end module sprc_test_stiff
