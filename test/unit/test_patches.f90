@@ -108,6 +108,7 @@ contains
          new_unittest('expansion_box_count', test_expansion_box), &
          new_unittest('expansion_cut_cells', test_expansion_cut), &
          new_unittest('expansion_limit_error', test_expansion_limit), &
+         new_unittest('expansion_3d_q1_q2', test_expansion_3d), &
          new_unittest('threads_bitwise', test_threads), &
          new_unittest('input_errors', test_input_errors), &
          new_unittest('eval_errors', test_eval_errors) &
@@ -890,6 +891,42 @@ contains
       if (allocated(error)) return
       call check_reproduction(pb, f, method_sprc, 2, .false., .false., 'expanded cut patches', error)
    end subroutine test_expansion_cut
+
+   !> Rank-deficient patches in 3D: the box [0, 1]^3 on a 4^3 grid with one point per element,
+   !> Q1 nodes with degree-1 patches (4 unknowns per component, boundary patches of 1 to 4
+   !> points) and Q2 nodes with degree-2 patches (10 per component): the boundary patches
+   !> are expanded, and SPR and SPR-C still reproduce the linear / quadratic field.
+   subroutine test_expansion_3d(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(problem_type) :: pb
+      type(poly_field_type) :: f
+      type(shape_type) :: s
+      type(recovered_field_type) :: field
+      integer :: p, m
+      integer, parameter :: methods(2) = [method_spr, method_sprc]
+
+      call new_box(s, 'box', [0.0_wp, 0.0_wp, 0.0_wp], [1.0_wp, 1.0_wp, 1.0_wp], error)
+      if (allocated(error)) return
+      do p = 1, 2
+         pb = problem_type()
+         call new_body(pb%body, 'box')
+         call pb%body%add_shape(csg_add, s, error)
+         if (allocated(error)) return
+         call make_field(solid, 1.0_wp, real(p - 1, wp), f, error)
+         if (allocated(error)) return
+         call build_problem(pb, 1.0_wp, 2, 0, p, 1, solid, f, [bc_exact_traction], error)
+         if (allocated(error)) return
+         do m = 1, 2
+            call recover_grid(pb%input, pb%grid, pb%nodes, pb%hanging, methods(m), p, field, error, exact=f)
+            if (allocated(error)) return
+            call check(error, field%n_expanded > 0, 'boundary patches expanded (3D, degree '//achar(48 + p)//')')
+            if (allocated(error)) return
+         end do
+         call check_reproduction(pb, f, method_sprc, p, p == 1, .false., 'expanded 3D box, degree '// &
+            & achar(48 + p), error)
+         if (allocated(error)) return
+      end do
+   end subroutine test_expansion_3d
 
    !> Expansion that cannot succeed: a single element with one point (no neighbours), and the
    !> 4 x 4 box with expansion switched off (max_rounds = 0): stat_singular naming the node.
