@@ -48,6 +48,12 @@
 !> Small cut cells: cell aggregation (`sprc_fem_aggregation`, threshold `eta`)
 !> through the constraint machinery (`sprc_fem_constraints`).
 !>
+!> Nearly incompressible materials: with the projected dilatation
+!> (`sprc_fem_dilatation`, optional `dilatation` of setup) D is replaced by its
+!> deviatoric part in a, in the Nitsche terms and in the stresses, and each
+!> aggregate adds its projected volumetric term (`add_aggregate_block`);
+!> every stress this type returns is then sigma_bar.
+!>
 !> Determinism: quadrature and element matrices are computed in parallel
 !> (OpenMP), in chunks of elements, and inserted into the COO list serially
 !> in element order; reductions (norms, errors) are summed serially in
