@@ -22,7 +22,7 @@ module sprc_test_stiff
    use sprc_fem_bc, only: fe_bc_type, new_fe_bc, bc_exact_traction, bc_exact_displacement
    use sprc_fem_dilatation, only: dilatation_full, dilatation_projected, dilatation_auto, resolve_dilatation, &
       & projected_poisson
-   use sprc_fem_problem, only: elasticity_problem_type, solve_on_grid
+   use sprc_fem_problem, only: elasticity_problem_type, solve_on_grid, default_gamma, gamma_range, gamma_note
    use sprc_test_fem, only: poly_field_type, new_poly_field, polygon_2d, polygon_3d, lame_quarter, sphere_octant, &
       & field_errors, young, kirsch_quarter, small_cut_sweep, lame_cut
    use sprc_testsuite, only: unittest_type, new_unittest, check, error_type
@@ -55,7 +55,8 @@ contains
          new_unittest('lame_sphere_incompressible', test_lame_sphere), &
          new_unittest('kirsch_q2_rate', test_kirsch_q2_rate), &
          new_unittest('small_cuts', test_small_cuts), &
-         new_unittest('small_cuts_3d', test_small_cuts_3d) &
+         new_unittest('small_cuts_3d', test_small_cuts_3d), &
+         new_unittest('nitsche_gamma_range', test_gamma_range) &
          ]
    end subroutine collect_stiff
 
@@ -366,5 +367,45 @@ contains
       bcs = [bcs, new_fe_bc(6, bc_exact_traction)]
       allocate (exact, source=lame)
    end subroutine sphere_cut
+
+   !> The Nitsche factor over its safe range (`gamma_range`, both ends and the
+   !> default): the Lame quarter with every condition weak (grid shifted by 0.3
+   !> off the symmetry planes, exact displacement outside), level 4, Q1 and Q2:
+   !> err_fe moves by less than the discretization error (err_fe at the
+   !> default). `gamma_note` is empty inside and names the range outside.
+   subroutine test_gamma_range(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: body
+      type(fe_bc_type), allocatable :: bcs(:)
+      type(lame_cylinder_type) :: exact
+      type(elasticity_problem_type) :: problem
+      real(wp), allocatable :: ee(:)
+      real(wp) :: g(3), err(3), nfe, nex
+      integer :: p, k
+
+      call lame_quarter(body, bcs, exact, plane_strain, error)
+      if (allocated(error)) return
+      bcs = [bcs, new_fe_bc(1, bc_exact_displacement)]
+      do p = 1, 2
+         g = [default_gamma(p), gamma_range(p)]
+         do k = 1, 3
+            call check(error, len(gamma_note(p, g(k))), 0, 'no note inside the range')
+            if (allocated(error)) return
+            call solve_on_grid(problem, body, [-0.3_wp, -0.3_wp], 25.0_wp, 4, 0, p, plane_strain, young, 0.3_wp, &
+               & [0.0_wp, 0.0_wp], bcs, error, exact=exact, gamma=g(k))
+            if (allocated(error)) return
+            call check(error, .not. problem%strong_shape(3) .and. problem%solver_name == 'cholmod', &
+               & 'weak symmetry, SPD system')
+            if (allocated(error)) return
+            call problem%energy_error(err(k), ee, nfe, nex, error)
+            if (allocated(error)) return
+            call check(error, abs(err(k) - err(1)) < err(1), 'err_fe moves by less than itself')
+            if (allocated(error)) return
+         end do
+         call check(error, index(gamma_note(p, 0.4_wp*default_gamma(p)), 'outside the safe range') > 0 .and. &
+            & index(gamma_note(p, 101.0_wp*default_gamma(p)), 'lower it') > 0, 'notes outside the range')
+         if (allocated(error)) return
+      end do
+   end subroutine test_gamma_range
 
 end module sprc_test_stiff
