@@ -82,6 +82,7 @@ module sprc_fem_dilatation
       procedure :: build
       procedure :: basis
       procedure :: element_moments
+      procedure :: add_moment
       procedure :: add_aggregate_block
       procedure :: set_coefficients
       procedure :: projected_stress
@@ -242,20 +243,32 @@ contains
       real(wp), intent(in) :: lo(:), hi(:), x(:, :), w(:)
       real(wp), intent(out) :: g(:, :)
       real(wp) :: n((degree + 1)**self%dim), dndx(self%dim, (degree + 1)**self%dim)
-      real(wp) :: b(self%nstress, self%dim*(degree + 1)**self%dim), div(self%dim*(degree + 1)**self%dim), p(4)
-      integer :: q, i
+      real(wp) :: b(self%nstress, self%dim*(degree + 1)**self%dim)
+      integer :: q
 
       g = 0.0_wp
       do q = 1, size(w)
          call shape_functions(self%dim, degree, lo, hi, x(:, q), n, dndx)
          call strain_matrix(self%dim, dndx, b)
-         div = matmul(self%m(1:self%nstress), b)
-         call self%basis(a, x(:, q), p(1:self%np))
-         do i = 1, self%np
-            g(:, i) = g(:, i) + (w(q)*p(i))*div
-         end do
+         call self%add_moment(a, x(:, q), w(q), b, g)
       end do
    end subroutine element_moments
+
+   !> One point's share of `element_moments`: g += w (m^T b)^T p(x)^T, b the
+   !> strain matrix at x (for callers that have it already).
+   pure subroutine add_moment(self, a, x, w, b, g)
+      class(dilatation_type), intent(in) :: self
+      integer, intent(in) :: a
+      real(wp), intent(in) :: x(:), w, b(:, :)
+      real(wp), intent(inout) :: g(:, :)
+      real(wp) :: div(size(b, 2)), p(4)
+      integer :: i
+      div = matmul(self%m(1:self%nstress), b)
+      call self%basis(a, x, p(1:self%np))
+      do i = 1, self%np
+         g(:, i) = g(:, i) + (w*p(i))*div
+      end do
+   end subroutine add_moment
 
    !> Add the dilatation terms of aggregate a on a dof set of size nd:
    !>   k += kappa (G M^-1 G^T - H M^-1 G^T - G M^-1 H^T),  f -= kappa G M^-1 s,

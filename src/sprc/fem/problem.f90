@@ -757,15 +757,15 @@ contains
       sv = 0.0_wp
       dmat = self%d
       a = 0
+      gm = 0.0_wp
       if (self%dilatation%active) then
          dmat = self%dilatation%d_dev
          a = self%dilatation%aggregate(e)
-         call self%dilatation%element_moments(a, self%degree, lo(1:d), hi(1:d), &
-            & self%vol_x(:, self%vol_ptr(e):self%vol_ptr(e + 1) - 1), self%vol_w(self%vol_ptr(e):self%vol_ptr(e + 1) - 1), gm)
       end if
       do q = self%vol_ptr(e), self%vol_ptr(e + 1) - 1
          call shape_functions(d, self%degree, lo(1:d), hi(1:d), self%vol_x(:, q), n, dndx)
          call strain_matrix(d, dndx, b)
+         if (a > 0) call self%dilatation%add_moment(a, self%vol_x(:, q), self%vol_w(q), b, gm)
          db = matmul(dmat(1:ns, 1:ns), b)
          call add_stiffness(b, db, self%vol_w(q), ke)
          do c = 1, d
