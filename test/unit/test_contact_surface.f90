@@ -52,13 +52,15 @@ contains
    ! ---------------------------------------------------------- slave points
 
    !> The slave points of a disk's circle carry its length 2 pi r, with unit
-   !> normals e_r, each in the leaf it came from. The cut-cell rule's error
+   !> normals e_r, each in the leaf it came from (and a box on grid planes its
+   !> perimeter). The cut-cell rule's error
    !> is below rho^(-2q), rho >= 13.9 (sprc_grid_quadrature notes) relative.
    subroutine test_slave_points(error)
       type(error_type), allocatable, intent(out) :: error
-      type(body_type) :: shaft
+      type(body_type) :: shaft, block
       type(grid_type) :: grid
       type(contact_surface_type) :: surf
+      type(shape_type) :: s
       integer :: i
       real(wp) :: lo(2), hi(2), r
 
@@ -78,6 +80,16 @@ contains
          call check(error, all(surf%x(:, i) >= lo) .and. all(surf%x(:, i) <= hi), 'slave point in its leaf')
          if (allocated(error)) return
       end do
+      ! A box whose faces lie on grid planes (h = 0.5): its surface points come
+      ! from the faces of inside leaves; perimeter 6, exact up to round-off.
+      call new_body(block, 'block')
+      call new_box(s, 'faces', [-1.0_wp, -1.0_wp], [1.0_wp, 0.0_wp], error)
+      if (allocated(error)) return
+      call block%add_shape(csg_add, s, error)
+      if (allocated(error)) return
+      call slave_points(block, [-2.0_wp, -2.0_wp], 4.0_wp, 3, 0, surf, grid, error)
+      if (allocated(error)) return
+      call check(error, sum(surf%weight), 6.0_wp, 64.0_wp*epsilon(1.0_wp), 'box on grid planes: perimeter', rel=.true.)
    end subroutine test_slave_points
 
    ! ---------------------------------------------------------------- circles

@@ -30,7 +30,8 @@ module sprc_contact_surface
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_not_converged
    use sprc_geometry_body, only: body_type, snap_tolerance
    use sprc_grid_tree, only: grid_type
-   use sprc_grid_quadrature, only: cut_quadrature_type, cell_rule_type, cell_rule
+   use sprc_grid_quadrature, only: cut_quadrature_type, cell_rule_type, cell_rule, boundary_face_rule
+   use sprc_geometry_region, only: cell_inside
    use sprc_contact_ray, only: ray_hit_type, nearest_crossing, position_tolerance
    implicit none
    private
@@ -128,7 +129,12 @@ contains
       allocate (x(d, 64), w(64), nrm(d, 64), cell(64))
       do leaf = 1, grid%n_leaves
          call grid%leaf_box(leaf, lo(1:d), hi(1:d))
-         call cell_rule(quad, body, lo(1:d), hi(1:d), rule, error)
+         ! An inside leaf has surface points only on grid-plane boundaries: skip its volume rule.
+         if (grid%leaf_class(leaf) == cell_inside) then
+            call boundary_face_rule(quad, body, lo(1:d), hi(1:d), rule, error)
+         else
+            call cell_rule(quad, body, lo(1:d), hi(1:d), rule, error)
+         end if
          if (allocated(error)) then
             error%message = 'contact surface, leaf '//int_str(leaf)//': '//error%message
             return
