@@ -28,6 +28,8 @@ module sprc_test_exact_contact
    real(wp), parameter :: roundoff = 64.0_wp*epsilon(1.0_wp)
    !> Issue 11's compound cylinder: a = 1, c = 1.5, b = 2, delta = 1e-3.
    real(wp), parameter :: a = 1.0_wp, c = 1.5_wp, b = 2.0_wp, delta = 1.0e-3_wp
+   !> Number of compound cases (make_compound).
+   integer, parameter :: ncompound = 4
 
 contains
 
@@ -227,7 +229,7 @@ contains
       character(len=:), allocatable :: label
 
       seed = 7_i8
-      do k = 1, 3
+      do k = 1, ncompound
          call make_compound(k, cc, label, error)
          if (allocated(error)) return
          scale = max(cc%p_in, cc%contact_pressure)
@@ -257,7 +259,7 @@ contains
       character(len=:), allocatable :: label
 
       seed = 11_i8
-      do k = 1, 3
+      do k = 1, ncompound
          call make_compound(k, cc, label, error)
          if (allocated(error)) return
          associate (d => cc%dim, x0 => cc%center(1:cc%dim))
@@ -298,7 +300,7 @@ contains
       character(len=:), allocatable :: label
 
       seed = 13_i8
-      do k = 1, 3
+      do k = 1, ncompound
          call make_compound(k, cc, label, error)
          if (allocated(error)) return
          s_scale = max(cc%p_in, cc%contact_pressure)
@@ -386,7 +388,8 @@ contains
    end subroutine test_compound_errors
 
    !> Case k: 1 cylinder plane stress, 2 cylinder plane strain (two materials,
-   !> p_in and delta), 3 sphere; centers off the origin.
+   !> p_in and delta), 3 sphere, 4 cylinder with a material ratio of 1000
+   !> (the issue's largest); centers off the origin.
    subroutine make_compound(k, cc, label, error)
       integer, intent(in) :: k
       type(compound_type), intent(out) :: cc
@@ -398,10 +401,14 @@ contains
          label = 'compound_cylinder '//analysis_name(k)
          call new_compound_cylinder(cc, [0.5_wp, -1.5_wp], a, c, b, 1.0e-3_wp, delta, 2.0_wp, 0.3_wp, 1.0_wp, &
             & 0.25_wp, k, error)
-      case default
+      case (3)
          label = 'compound_sphere'
          call new_compound_sphere(cc, [0.5_wp, -1.5_wp, 2.0_wp], a, c, b, 1.0e-3_wp, delta, 2.0_wp, 0.3_wp, &
             & 1.0_wp, 0.25_wp, error)
+      case default
+         label = 'compound_cylinder E_inner/E_outer = 1000'
+         call new_compound_cylinder(cc, [0.5_wp, -1.5_wp], a, c, b, 1.0e-3_wp, delta, 1000.0_wp, 0.3_wp, 1.0_wp, &
+            & 0.45_wp, plane_strain, error)
       end select
    end subroutine make_compound
 
