@@ -12,9 +12,10 @@
 !> n_s is intersected with the master surface on the master body's exact
 !> implicit geometry (sprc_contact_ray). If x_s lies outside the master body
 !> the crossing is sought ahead, t in [-margin, L]; if inside (the shapes
-!> overlap) behind, t in [-L, margin]; L = `search_distance`, margin the
-!> position tolerance of the test that decides the side, so that touching
-!> surfaces (g0 = 0) are found from either side. Only crossings where the
+!> overlap) behind, t in [-L, margin]; L = `search_distance`, margin four
+!> times the distance that the side test's tolerance stands for (tol over
+!> |grad phi|, plus a few ulps), so that touching surfaces (g0 = 0) are found
+!> from either side. Only crossings where the
 !> master surface faces the slave one (n_s . n_m <= 0) and bounds the master
 !> body count. Then g0 = t: positive for a gap, negative for an interference
 !> (shrink) fit; small deformations linearize g = g0 + (u_m - u_s).n_s. A point
@@ -150,7 +151,7 @@ contains
          end do
       end do
       if (n == 0) then
-         call fatal_error(error, "contact surface: surface '"//body%shapes(shape)%name//"' of body '"// &
+         call fatal_error(error, "contact surface: surface '"//shape_name(body, shape)//"' of body '"// &
             & body_name(body)//"' has no quadrature points on the grid (it does not bound the body)")
          return
       end if
@@ -248,10 +249,13 @@ contains
       integer, intent(in) :: shape
       real(wp), intent(in) :: x(:), n(:), search_distance
       type(ray_hit_type), intent(out) :: hit
-      real(wp) :: tol, margin
+      real(wp) :: tol, margin, slope
 
+      ! Within tol of the surface the side is not decided: start the search a
+      ! margin behind, the distance that tol can stand for (tol/|grad phi|).
       tol = snap_tolerance(master%shapes(shape), x, x)
-      margin = 4.0_wp*(tol + position_tolerance(x, 0.0_wp, search_distance))
+      slope = max(norm2(master%shapes(shape)%gradient(x)), epsilon(1.0_wp))
+      margin = min(search_distance, 4.0_wp*(tol/slope + position_tolerance(x, 0.0_wp, 0.0_wp)))
       if (master%phi(x) < -tol) then
          call nearest_crossing(master, shape, x, n, -search_distance, margin, .true., hit)
       else
@@ -279,6 +283,14 @@ contains
       name = ''
       if (allocated(body%name)) name = body%name
    end function body_name
+
+   pure function shape_name(body, shape) result(name)
+      type(body_type), intent(in) :: body
+      integer, intent(in) :: shape
+      character(len=:), allocatable :: name
+      name = ''
+      if (allocated(body%shapes(shape)%name)) name = body%shapes(shape)%name
+   end function shape_name
 
    pure function real_list(v) result(s)
       real(wp), intent(in) :: v(:)
