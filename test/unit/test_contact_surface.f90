@@ -9,9 +9,9 @@
 !> the reported tolerance itself is checked to be small, so the comparison is
 !> not vacuous.
 module sprc_test_contact_surface
-   use sprc_core_kinds, only: wp
+   use sprc_core_kinds, only: wp, i8
    use sprc_geometry_region, only: cell_cut
-   use sprc_geometry_shape, only: shape_type, new_disk, new_sphere, new_ellipse, new_box, new_halfspace
+   use sprc_geometry_shape, only: shape_type, new_disk, new_sphere, new_ellipse, new_box, new_halfspace, new_cylinder
    use sprc_geometry_body, only: body_type, new_body, csg_add, csg_subtract, csg_intersect
    use sprc_grid_tree, only: grid_type
    use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature
@@ -45,6 +45,7 @@ contains
          new_unittest('back_facing_and_nearest', test_back_facing), &
          new_unittest('grazing_incidence', test_grazing), &
          new_unittest('ellipse_far_away', test_ellipse_far), &
+         new_unittest('random_lines_box_cylinder', test_random_lines), &
          new_unittest('errors', test_errors) &
          ]
    end subroutine collect_contact_surface
@@ -458,6 +459,131 @@ contains
       ! a dozen iterations, where bisection alone would need about 50.
       call check(error, hit%iterations <= 12, 'ellipse: safeguarded Newton converges fast')
    end subroutine test_ellipse_far
+
+   !> 400 pseudo-random lines from outside against a 3D box (slab method:
+   !> entry t = max over axes of the near-slab t, a hit if it is below the
+   !> exit and in [0, L]) and against an oblique infinite cylinder (the
+   !> smaller root of the quadratic in the components normal to the axis).
+   !> The box's gradient enclosure is only sound (not exact) at its edges and
+   !> the oblique cylinder's is an over-estimate: the isolation must still find
+   !> every crossing and no other. Lines within 1e-9 of an edge or of
+   !> tangency are not decided and skipped.
+   subroutine test_random_lines(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: box_body, cyl_body
+      type(shape_type) :: s
+      type(ray_hit_type) :: hit
+      real(wp), parameter :: length = 10.0_wp, lo(3) = [-1.0_wp, -0.5_wp, -2.0_wp], hi(3) = [1.5_wp, 0.5_wp, 1.0_wp]
+      real(wp), parameter :: axis(3) = [1.0_wp, 2.0_wp, 2.0_wp]/3.0_wp, radius = 0.8_wp
+      real(wp) :: x0(3), n(3), t_expected, margin
+      integer(i8) :: seed
+      integer :: k, body_kind, decided, nhit
+      logical :: expect
+
+      call new_body(box_body, 'box')
+      call new_box(s, 'faces', lo, hi, error)
+      if (allocated(error)) return
+      call box_body%add_shape(csg_add, s, error)
+      if (allocated(error)) return
+      call new_body(cyl_body, 'cylinder')
+      call new_cylinder(s, 'mantle', [0.1_wp, -0.2_wp, 0.3_wp], axis, radius, error)
+      if (allocated(error)) return
+      call cyl_body%add_shape(csg_add, s, error)
+      if (allocated(error)) return
+      seed = 2024_i8
+      decided = 0
+      nhit = 0
+      do k = 1, 400
+         body_kind = mod(k, 2)
+         x0 = 6.0_wp*[random(seed), random(seed), random(seed)] - 3.0_wp
+         ! Aim at a random point of the same cube: many lines hit, many miss.
+         n = 6.0_wp*[random(seed), random(seed), random(seed)] - 3.0_wp - x0
+         n = n/norm2(n)
+         if (body_kind == 0) then
+            if (all(x0 > lo .and. x0 < hi)) cycle
+            call box_entry(x0, n, lo, hi, t_expected, margin)
+            call nearest_crossing(box_body, 1, x0, n, 0.0_wp, length, .true., hit)
+         else
+            if (norm2(perp(x0 - [0.1_wp, -0.2_wp, 0.3_wp])) <= radius) cycle
+            call cylinder_entry(x0 - [0.1_wp, -0.2_wp, 0.3_wp], n, t_expected, margin)
+            call nearest_crossing(cyl_body, 1, x0, n, 0.0_wp, length, .true., hit)
+         end if
+         if (margin < 1.0e-9_wp .or. abs(t_expected - length) < 1.0e-9_wp) cycle
+         decided = decided + 1
+         expect = t_expected <= length
+         call check(error, .not. hit%exhausted .and. (hit%found .eqv. expect), 'random line: hit iff it crosses')
+         if (allocated(error)) return
+         if (.not. expect) cycle
+         nhit = nhit + 1
+         call check(error, hit%t, t_expected, hit%tolerance + closed_form_ulps*(3.0_wp + t_expected), &
+            & 'random line: t of the entry')
+         if (allocated(error)) return
+      end do
+      call check(error, decided > 300 .and. nhit > 80 .and. decided - nhit > 80, &
+         & 'random lines: most lines decided, many hits and many misses')
+
+   contains
+
+      pure function perp(v) result(w)
+         real(wp), intent(in) :: v(3)
+         real(wp) :: w(3)
+         w = v - dot_product(v, axis)*axis
+      end function perp
+
+      !> Entry of the line into the cylinder (huge if none ahead); margin: the
+      !> discriminant's distance from tangency.
+      pure subroutine cylinder_entry(d, n, t, margin)
+         real(wp), intent(in) :: d(3), n(3)
+         real(wp), intent(out) :: t, margin
+         real(wp) :: pa, pb, pc, disc
+         pa = dot_product(perp(n), perp(n))
+         pb = dot_product(perp(n), perp(d))
+         pc = dot_product(perp(d), perp(d)) - radius**2
+         disc = pb**2 - pa*pc
+         t = huge(1.0_wp)
+         margin = abs(disc)
+         if (disc <= 0.0_wp .or. pa <= 0.0_wp) return
+         ! Outside (pc > 0): both roots share the sign of -pb; the entry is the smaller.
+         if (pb < 0.0_wp) t = pc/(-pb + sqrt(disc))
+      end subroutine cylinder_entry
+
+   end subroutine test_random_lines
+
+   !> Slab entry of the line x0 + t n into the box [lo, hi] for t >= 0 (huge
+   !> if none); margin: how far the entry is from an edge (exit - entry and
+   !> the gap to the second-latest slab).
+   pure subroutine box_entry(x0, n, lo, hi, t, margin)
+      real(wp), intent(in) :: x0(3), n(3), lo(3), hi(3)
+      real(wp), intent(out) :: t, margin
+      real(wp) :: t1(3), t2(3), t_in(3), t_out
+      integer :: k
+
+      do k = 1, 3
+         if (abs(n(k)) < 1.0e-12_wp) then
+            t_in(k) = merge(-huge(1.0_wp), huge(1.0_wp), x0(k) > lo(k) .and. x0(k) < hi(k))
+            t2(k) = -t_in(k)
+            cycle
+         end if
+         t1(k) = (lo(k) - x0(k))/n(k)
+         t2(k) = (hi(k) - x0(k))/n(k)
+         t_in(k) = min(t1(k), t2(k))
+         t2(k) = max(t1(k), t2(k))
+      end do
+      t_out = minval(t2)
+      t = maxval(t_in)
+      margin = min(t_out - t, t - maxval(t_in, mask=t_in < t), abs(t))
+      if (t > t_out .or. t < 0.0_wp) then
+         margin = abs(t - t_out)
+         t = huge(1.0_wp)
+      end if
+   end subroutine box_entry
+
+   !> Park-Miller minimal standard generator: deterministic on every compiler.
+   real(wp) function random(seed)
+      integer(i8), intent(inout) :: seed
+      seed = mod(16807_i8*seed, 2147483647_i8)
+      random = real(seed, wp)/2147483647.0_wp
+   end function random
 
    ! ------------------------------------------------------------------ errors
 
