@@ -378,7 +378,7 @@ contains
       call expect_error(error, e, 'center has 3 entries, expected 2', 'cylinder center in 3D')
       if (allocated(error)) return
       call new_compound_cylinder(cc, z2, a, c, b, 0.0_wp, delta, 1.0_wp, 0.3_wp, 1.0_wp, 0.3_wp, solid, e)
-      call expect_error(error, e, 'analysis must be plane_stress or plane_strain', 'cylinder analysis solid')
+      call expect_error(error, e, 'compound_cylinder: analysis solid is not supported', 'cylinder analysis solid')
       if (allocated(error)) return
       call new_compound_sphere(cc, z2, a, c, b, 0.0_wp, delta, 1.0_wp, 0.3_wp, 1.0_wp, 0.3_wp, e)
       call expect_error(error, e, 'compound_sphere: center has 2 entries, expected 3', 'sphere center in 2D')

@@ -33,7 +33,7 @@
 !> own material, as the per-body error norms need.
 module sprc_exact_compound
    use sprc_core_kinds, only: wp
-   use sprc_core_error, only: error_type
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_material, only: plane_stress, plane_strain, solid, analysis_name, check_material
    use sprc_exact_solution, only: exact_solution_type, check_center, check_field, is_finite
    use sprc_exact_lame, only: lame_cylinder_type, lame_sphere_type, new_lame_cylinder, new_lame_sphere
@@ -73,8 +73,8 @@ contains
       type(error_type), allocatable, intent(out) :: error
 
       if (analysis /= plane_stress .and. analysis /= plane_strain) then
-         call check_field(.false., 'compound_cylinder', 'analysis', 'must be plane_stress or plane_strain ('// &
-            & analysis_name(analysis)//')', real(analysis, wp), error)
+         call fatal_error(error, 'compound_cylinder: analysis '//analysis_name(analysis)// &
+            & ' is not supported; expected one of: plane_stress plane_strain', stat_invalid_input)
          return
       end if
       call build(self, 'compound_cylinder', 2, analysis, center, [r_in, r_contact, r_out], p_in, interference, &
