@@ -9,6 +9,7 @@
 !> reference interface pressures of issue 11. Hertz is checked against hand
 !> values and against its defining integral (the pressure sums to the load).
 module sprc_test_exact_contact
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use sprc_core_kinds, only: wp, i8
    use sprc_core_gauss, only: gauss_legendre
    use sprc_core_material, only: plane_stress, plane_strain, solid, analysis_name
@@ -120,8 +121,7 @@ contains
       type(error_type), allocatable :: e
       real(wp) :: nan
 
-      nan = -1.0_wp
-      nan = sqrt(nan + tiny(nan))
+      nan = ieee_value(1.0_wp, ieee_quiet_nan)
       call new_uniform(sol, [1.0_wp, 2.0_wp], 1.0_wp, 0.3_wp, plane_stress, e)
       call expect_error(error, e, 'stress has 2 entries, expected 3', 'uniform stress size')
       if (allocated(error)) return
@@ -351,8 +351,7 @@ contains
       real(wp) :: nan
       real(wp), parameter :: z2(2) = 0.0_wp, z3(3) = 0.0_wp
 
-      nan = -1.0_wp
-      nan = sqrt(nan + tiny(nan))
+      nan = ieee_value(1.0_wp, ieee_quiet_nan)
       call new_compound_cylinder(cc, z2, a, a, b, 0.0_wp, delta, 1.0_wp, 0.3_wp, 1.0_wp, 0.3_wp, plane_stress, e)
       call expect_error(error, e, 'compound_cylinder: r_contact must be finite and > r_in', 'r_contact = r_in')
       if (allocated(error)) return
