@@ -179,7 +179,9 @@ contains
    !> Against the closed forms of the module doc (written out here, not through
    !> the Lame modules): one material, textbook E delta (c^2-a^2)(b^2-c^2)/(2 c^3 (b^2-a^2));
    !> two materials in plane stress with p_in from f_i, f_o, u_i(c; p_in, 0);
-   !> plane strain by E -> E/(1-nu^2), nu -> nu/(1-nu). Round-off tier.
+   !> plane strain by E -> E/(1-nu^2), nu -> nu/(1-nu); the sphere's
+   !> 2 E delta (c^3-a^3)(b^3-c^3)/(3 (1-nu) c^4 (b^3-a^3)) and its f_i, f_o,
+   !> u_i(c; p_in, 0) (derived by hand from the Lame sphere). Round-off tier.
    subroutine test_compound_closed_form(error)
       type(error_type), allocatable, intent(out) :: error
       type(compound_type) :: cc
@@ -204,8 +206,26 @@ contains
             & rel=.true.)
          if (allocated(error)) return
       end do
+      call new_compound_sphere(cc, [3.0_wp, -1.0_wp, 0.5_wp], a, c, b, 0.0_wp, delta, ei, ni, ei, ni, error)
+      if (allocated(error)) return
+      expected = 2.0_wp*ei*delta*(c**3 - a**3)*(b**3 - c**3)/(3.0_wp*(1.0_wp - ni)*c**4*(b**3 - a**3))
+      call check(error, cc%contact_pressure, expected, roundoff, 'textbook compound sphere', rel=.true.)
+      if (allocated(error)) return
+      call new_compound_sphere(cc, [3.0_wp, -1.0_wp, 0.5_wp], a, c, b, p_in, delta, ei, ni, eo, no, error)
+      if (allocated(error)) return
+      call check(error, cc%contact_pressure, sphere_pc(ei, ni, eo, no), roundoff, 'p_c closed form, sphere', &
+         & rel=.true.)
 
    contains
+
+      pure real(wp) function sphere_pc(e_i, n_i, e_o, n_o)
+         real(wp), intent(in) :: e_i, n_i, e_o, n_o
+         real(wp) :: f_i, f_o, u_p
+         f_o = c/e_o*((1.0_wp - 2.0_wp*n_o)*c**3 + 0.5_wp*(1.0_wp + n_o)*b**3)/(b**3 - c**3)
+         f_i = c/e_i*((1.0_wp - 2.0_wp*n_i)*c**3 + 0.5_wp*(1.0_wp + n_i)*a**3)/(c**3 - a**3)
+         u_p = 1.5_wp*(1.0_wp - n_i)*a**3*c*p_in/(e_i*(c**3 - a**3))
+         sphere_pc = (delta + u_p)/(f_o + f_i)
+      end function sphere_pc
 
       pure real(wp) function plane_stress_pc(e_i, n_i, e_o, n_o)
          real(wp), intent(in) :: e_i, n_i, e_o, n_o

@@ -21,9 +21,14 @@
 !>   f_o = c/E_o ((b^2 + c^2)/(b^2 - c^2) + nu_o),  f_i = c/E_i ((c^2 + a^2)/(c^2 - a^2) - nu_i),
 !>   u_i(c; p_in, 0) = 2 a^2 c p_in/(E_i (c^2 - a^2)),
 !> and with one material and p_in = 0 the textbook p_c = E delta (c^2 - a^2)(b^2 - c^2)/(2 c^3 (b^2 - a^2));
-!> plane strain replaces E by E/(1 - nu^2) and nu by nu/(1 - nu). The
-!> compliances are evaluated through the Lame modules (superposition), so the
-!> shell formulas exist once.
+!> plane strain replaces E by E/(1 - nu^2) and nu by nu/(1 - nu). For the
+!> sphere
+!>   f_o = c/E_o ((1 - 2 nu_o) c^3 + (1 + nu_o) b^3/2)/(b^3 - c^3),
+!>   f_i = c/E_i ((1 - 2 nu_i) c^3 + (1 + nu_i) a^3/2)/(c^3 - a^3),
+!>   u_i(c; p_in, 0) = 3 (1 - nu_i) a^3 c p_in/(2 E_i (c^3 - a^3)),
+!> and with one material and p_in = 0 p_c = 2 E delta (c^3 - a^3)(b^3 - c^3)/(3 (1 - nu) c^4 (b^3 - a^3)).
+!> The compliances are evaluated through the Lame modules (superposition), so
+!> the shell formulas exist once.
 !>
 !> A contact interface carries no tension: when the formula gives p_c < 0 (a
 !> clearance, or suction p_in < 0) the interface opens, p_c = 0, and each
