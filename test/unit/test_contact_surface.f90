@@ -15,7 +15,7 @@ module sprc_test_contact_surface
    use sprc_geometry_body, only: body_type, new_body, csg_add, csg_subtract, csg_intersect
    use sprc_grid_tree, only: grid_type
    use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature
-   use sprc_contact_ray, only: ray_hit_type, nearest_crossing
+   use sprc_contact_ray, only: ray_hit_type, nearest_crossing, max_visits
    use sprc_contact_surface, only: contact_surface_type, new_contact_surface, slave_surface_points, initial_gaps
    use sprc_test_exact, only: expect_error
    use sprc_testsuite, only: unittest_type, new_unittest, check, error_type
@@ -46,6 +46,7 @@ contains
          new_unittest('grazing_incidence', test_grazing), &
          new_unittest('ellipse_far_away', test_ellipse_far), &
          new_unittest('random_lines_box_cylinder', test_random_lines), &
+         new_unittest('line_in_the_surface', test_line_in_surface), &
          new_unittest('errors', test_errors) &
          ]
    end subroutine collect_contact_surface
@@ -548,6 +549,34 @@ contains
       end subroutine cylinder_entry
 
    end subroutine test_random_lines
+
+   !> A line that runs down the right face x = 1 of the square [0, 1]^2
+   !> trimmed to y <= 0.5: phi = 0 along the whole face, which bounds the body
+   !> only below y = 0.5. The first point that bounds it, t = 2.5, is found
+   !> to the plateau resolution (2^-12 of the search length 10) with a
+   !> bounded number of visits, not by enumerating t_tol-long pieces.
+   subroutine test_line_in_surface(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: body
+      type(shape_type) :: s
+      type(ray_hit_type) :: hit
+
+      call new_body(body, 'square')
+      call new_box(s, 'faces', [0.0_wp, 0.0_wp], [1.0_wp, 1.0_wp], error)
+      if (allocated(error)) return
+      call body%add_shape(csg_add, s, error)
+      if (allocated(error)) return
+      call new_halfspace(s, 'cut', [0.0_wp, 0.5_wp], [0.0_wp, 1.0_wp], error)
+      if (allocated(error)) return
+      call body%add_shape(csg_intersect, s, error)
+      if (allocated(error)) return
+      call nearest_crossing(body, 1, [1.0_wp, 3.0_wp], [0.0_wp, -1.0_wp], 0.0_wp, 10.0_wp, .true., hit)
+      call check(error, hit%found .and. .not. hit%exhausted, 'line in the surface: found')
+      if (allocated(error)) return
+      call check(error, hit%t, 2.5_wp, 10.0_wp*2.0_wp**(-12), 'line in the surface: first bounding point')
+      if (allocated(error)) return
+      call check(error, hit%visits <= 2**13 .and. hit%visits < max_visits, 'line in the surface: bounded work')
+   end subroutine test_line_in_surface
 
    !> Slab entry of the line x0 + t n into the box [lo, hi] for t >= 0 (huge
    !> if none); margin: how far the entry is from an edge (exit - entry and

@@ -32,7 +32,12 @@
 !> Segments shorter than t_tol are not split further: a sign change there is
 !> a crossing at the midpoint; no sign change means the line touches the
 !> surface without a resolved crossing (grazing within the position
-!> tolerance) and is not a root.
+!> tolerance) and is not a root. A line that runs in the surface (phi within
+!> rounding of 0 over a whole segment, e.g. along a box face) has no
+!> isolated crossing: such segments are split only down to 2^-12 of the
+!> search interval and each is one candidate at its midpoint, with half its
+!> length in the tolerance, so the work stays bounded (at most 2^13 visits)
+!> where a face is refused (not bounding the body, or not facing).
 !>
 !> Tolerances: t_tol = 8 eps (|x0|_inf + max(|a|, |b|)) on a segment [a, b],
 !> a few ulps of the coordinates there (the line's points cannot be placed
@@ -52,6 +57,10 @@ module sprc_contact_ray
 
    !> Guard on the segments one search may visit (module notes).
    integer, parameter :: max_visits = 100000
+
+   !> A line lying in the surface is resolved to segments of this fraction of
+   !> the search interval (module notes).
+   real(wp), parameter :: plateau_fraction = 2.0_wp**(-12)
 
    !> Result of a search.
    type :: ray_hit_type
@@ -135,6 +144,12 @@ contains
       end if
       call enclosures(body, line, near, far, fmin, fmax, dmin, dmax, tol_f)
       if (fmin > tol_f .or. fmax < -tol_f) return
+      if (fmin >= -tol_f .and. fmax <= tol_f .and. abs(far - near) <= line%span*plateau_fraction) then
+         ! The segment lies in the surface (within rounding): one candidate for all of it.
+         call accept(body, line, near, far, tol_f, hit, verdict)
+         done = verdict == 1
+         return
+      end if
       f_near = f_at(body, line, near)
       f_far = f_at(body, line, far)
       t_tol = position_tolerance(line%x0(1:line%dim), near, far)
