@@ -17,7 +17,7 @@ module sprc_test_contact_surface
    use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature
    use sprc_contact_ray, only: ray_hit_type, nearest_crossing, max_visits
    use sprc_contact_surface, only: contact_surface_type, new_contact_surface, slave_surface_points, initial_gaps
-   use sprc_test_exact, only: expect_error
+   use sprc_test_exact, only: expect_error, random => uniform
    use sprc_testsuite, only: unittest_type, new_unittest, check, error_type
    implicit none
    private
@@ -606,13 +606,6 @@ contains
          t = huge(1.0_wp)
       end if
    end subroutine box_entry
-
-   !> Park-Miller minimal standard generator: deterministic on every compiler.
-   real(wp) function random(seed)
-      integer(i8), intent(inout) :: seed
-      seed = mod(16807_i8*seed, 2147483647_i8)
-      random = real(seed, wp)/2147483647.0_wp
-   end function random
 
    ! ------------------------------------------------------------------ errors
 

@@ -19,7 +19,7 @@ module sprc_test_exact
    private
 
    public :: collect_exact
-   public :: check_equilibrium_fd, check_compatibility_fd, shell_points, expect_error, npoint
+   public :: check_equilibrium_fd, check_compatibility_fd, shell_points, expect_error, npoint, uniform
 
    real(wp), parameter :: pi = acos(-1.0_wp)
    real(wp), parameter :: young = 2.1e5_wp, poisson = 0.3_wp
