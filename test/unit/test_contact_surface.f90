@@ -16,7 +16,8 @@ module sprc_test_contact_surface
    use sprc_grid_tree, only: grid_type
    use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature
    use sprc_contact_ray, only: ray_hit_type, nearest_crossing, max_visits
-   use sprc_contact_surface, only: contact_surface_type, new_contact_surface, slave_surface_points, initial_gaps
+   use sprc_contact_surface, only: contact_surface_type, new_contact_surface, slave_surface_points, initial_gaps, &
+      & linearized_gap
    use sprc_test_exact, only: expect_error, random => uniform
    use sprc_testsuite, only: unittest_type, new_unittest, check, error_type
    implicit none
@@ -47,6 +48,7 @@ contains
          new_unittest('ellipse_far_away', test_ellipse_far), &
          new_unittest('random_lines_box_cylinder', test_random_lines), &
          new_unittest('line_in_the_surface', test_line_in_surface), &
+         new_unittest('linearized_gap', test_linearized_gap), &
          new_unittest('errors', test_errors) &
          ]
    end subroutine collect_contact_surface
@@ -606,6 +608,72 @@ contains
          t = huge(1.0_wp)
       end if
    end subroutine box_entry
+
+   !> g = g0 + (u_m - u_s).n_s on the shaft-in-hub pair: a common rigid
+   !> translation leaves g = g0; the hub moved by d changes g by d.n_s; the
+   !> shaft expanded radially by e (u_s = e x) closes the gap by e |x|; an
+   !> open point keeps g = huge; wrong shapes and a missing initial_gaps are
+   !> errors. Round-off tier on O(1) quantities.
+   subroutine test_linearized_gap(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: shaft, hub
+      type(grid_type) :: grid, hub_grid
+      type(contact_surface_type) :: surf, fresh
+      type(shape_type) :: s
+      type(error_type), allocatable :: e
+      real(wp), allocatable :: us(:, :), um(:, :), g(:)
+      real(wp), parameter :: d(2) = [0.003_wp, -0.002_wp], expansion = 1.0e-3_wp, tol = 16.0_wp*epsilon(1.0_wp)
+      integer :: i
+
+      call make_disk_body(shaft, 'shaft', 'rim', [0.0_wp, 0.0_wp], 1.0_wp, error)
+      if (allocated(error)) return
+      call slave_points(shaft, [-1.3_wp, -1.3_wp], 2.6_wp, 3, 0, surf, grid, error)
+      if (allocated(error)) return
+      call make_disk_body(hub, 'hub', 'outer', [0.0_wp, 0.0_wp], 2.0_wp, error)
+      if (allocated(error)) return
+      call new_disk(s, 'bore', [0.0_wp, 0.0_wp], 1.1_wp, error)
+      if (allocated(error)) return
+      call hub%add_shape(csg_subtract, s, error)
+      if (allocated(error)) return
+      call hub_grid%build(hub, 2, [-2.1_wp, -2.2_wp], 4.3_wp, 3, 0, error)
+      if (allocated(error)) return
+      fresh = surf
+      call initial_gaps(surf, hub, 2, hub_grid, 1.0_wp, error)
+      if (allocated(error)) return
+      allocate (us(2, surf%npoint), um(2, surf%npoint), g(surf%npoint))
+      us = spread(d, 2, surf%npoint)
+      um = us
+      call linearized_gap(surf, us, um, g, error)
+      if (allocated(error)) return
+      call check(error, maxval(abs(g - surf%g0)), 0.0_wp, tol, 'rigid translation of both: g = g0')
+      if (allocated(error)) return
+      us = 0.0_wp
+      call linearized_gap(surf, us, um, g, error)
+      if (allocated(error)) return
+      do i = 1, surf%npoint
+         call check(error, g(i), surf%g0(i) + dot_product(d, surf%normal(:, i)), tol, 'hub moved by d')
+         if (allocated(error)) return
+      end do
+      us = expansion*surf%x
+      um = 0.0_wp
+      call linearized_gap(surf, us, um, g, error)
+      if (allocated(error)) return
+      do i = 1, surf%npoint
+         call check(error, g(i), surf%g0(i) - expansion*norm2(surf%x(:, i)), tol, 'shaft expanded')
+         if (allocated(error)) return
+      end do
+      surf%has_master(1) = .false.
+      surf%g0(1) = huge(1.0_wp)
+      call linearized_gap(surf, us, um, g, error)
+      if (allocated(error)) return
+      call check(error, g(1) == huge(1.0_wp), 'open point keeps g = huge')
+      if (allocated(error)) return
+      call linearized_gap(surf, us(:, 2:), um, g, e)
+      call expect_error(error, e, 'displacements must be (2, ', 'wrong displacement shape')
+      if (allocated(error)) return
+      call linearized_gap(fresh, us, um, g, e)
+      call expect_error(error, e, 'initial_gaps has not been called', 'no initial gaps')
+   end subroutine test_linearized_gap
 
    ! ------------------------------------------------------------------ errors
 

@@ -21,7 +21,8 @@
 !> (shrink) fit; small deformations linearize g = g0 + (u_m - u_s).n_s. A point
 !> whose line meets no such crossing within L is open: `has_master` false, no
 !> master point, g0 = huge. `g0_tolerance` bounds |g0 - g0_exact| (the root
-!> finder's stopping test and the level-set rounding).
+!> finder's stopping test and the level-set rounding). `linearized_gap`
+!> adds the displacements: g = g0 + (u_m - u_s).n_s.
 !>
 !> The master point's host cell is the master-grid leaf containing it; a
 !> point on a leaf face that the floor convention of `locate_point` would give
@@ -37,7 +38,7 @@ module sprc_contact_surface
    implicit none
    private
 
-   public :: contact_surface_type, new_contact_surface, slave_surface_points, initial_gaps
+   public :: contact_surface_type, new_contact_surface, slave_surface_points, initial_gaps, linearized_gap
 
    !> Slave-surface points and their initial gaps.
    type :: contact_surface_type
@@ -222,6 +223,34 @@ contains
          end do
       end associate
    end subroutine initial_gaps
+
+   !> Linearized gap g = g0 + (u_m - u_s).n_s of every slave point (small
+   !> deformations): u_s the displacement of the slave body at the slave
+   !> point, u_m the master body's at the master point, both (dim, npoint)
+   !> (the caller interpolates them in slave_cell / master_cell). Open points
+   !> keep g = huge. Needs `initial_gaps` first.
+   pure subroutine linearized_gap(self, u_slave, u_master, g, error)
+      type(contact_surface_type), intent(in) :: self
+      real(wp), intent(in) :: u_slave(:, :), u_master(:, :)
+      real(wp), intent(out) :: g(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: i
+
+      if (.not. allocated(self%g0)) then
+         call fatal_error(error, 'linearized gap: initial_gaps has not been called')
+         return
+      end if
+      if (any(shape(u_slave) /= [self%dim, self%npoint]) .or. any(shape(u_master) /= [self%dim, self%npoint]) &
+         & .or. size(g) /= self%npoint) then
+         call fatal_error(error, 'linearized gap: displacements must be ('//int_str(self%dim)//', '// &
+            & int_str(self%npoint)//') and g of size '//int_str(self%npoint))
+         return
+      end if
+      do i = 1, self%npoint
+         g(i) = self%g0(i)
+         if (self%has_master(i)) g(i) = g(i) + dot_product(u_master(:, i) - u_slave(:, i), self%normal(:, i))
+      end do
+   end subroutine linearized_gap
 
    subroutine check_gap_input(self, master, shape, master_grid, search_distance, error)
       type(contact_surface_type), intent(in) :: self
