@@ -19,6 +19,7 @@ module sprc_test_exact
    private
 
    public :: collect_exact
+   public :: check_equilibrium_fd, check_compatibility_fd, shell_points, expect_error, npoint, uniform
 
    real(wp), parameter :: pi = acos(-1.0_wp)
    real(wp), parameter :: young = 2.1e5_wp, poisson = 0.3_wp
@@ -216,27 +217,13 @@ contains
    subroutine test_equilibrium(error)
       type(error_type), allocatable, intent(out) :: error
       type(case_type) :: c
-      integer :: ic, ip, i, j, dim
-      real(wp) :: g(6, 3), b(3), div(3), h
+      integer :: ic
 
       do ic = 1, ncase
          call make_case(ic, c, error)
          if (allocated(error)) return
-         dim = c%sol%dim
-         h = 1.0e-4_wp*c%length
-         do ip = 1, npoint
-            call fd_gradient(c%sol, .true., c%points(:, ip), h, g(1:c%sol%nstress, 1:dim))
-            call c%sol%body_force(c%points(:, ip), b(1:dim))
-            do i = 1, dim
-               div(i) = b(i)
-               do j = 1, dim
-                  div(i) = div(i) + g(voigt_index(dim, i, j), j)
-               end do
-            end do
-            call check(error, maxval(abs(div(1:dim))), 0.0_wp, 1.0e-5_wp*c%scale/c%length, &
-               & 'equilibrium, '//c%label)
-            if (allocated(error)) return
-         end do
+         call check_equilibrium_fd(error, c%sol, c%points, c%length, c%scale, c%label)
+         if (allocated(error)) return
       end do
    end subroutine test_equilibrium
 
@@ -247,32 +234,71 @@ contains
    subroutine test_strain_displacement_stress(error)
       type(error_type), allocatable, intent(out) :: error
       type(case_type) :: c
-      integer :: ic, ip, dim, ns
-      real(wp) :: g(3, 3), eps_fd(6), eps(6), sigma(6), comp(6, 6), h
+      integer :: ic
 
       do ic = 1, ncase
          call make_case(ic, c, error)
          if (allocated(error)) return
-         dim = c%sol%dim
-         ns = c%sol%nstress
-         call compliance_matrix(c%sol%analysis, c%sol%young, c%sol%poisson, comp(1:ns, 1:ns), error)
+         call check_compatibility_fd(error, c%sol, c%points, c%length, c%scale, c%label)
          if (allocated(error)) return
-         h = 1.0e-4_wp*c%length
-         do ip = 1, npoint
-            call fd_gradient(c%sol, .false., c%points(:, ip), h, g(1:dim, 1:dim))
-            if (dim == 2) then
-               eps_fd(1:3) = [g(1, 1), g(2, 2), g(1, 2) + g(2, 1)]
-            else
-               eps_fd = [g(1, 1), g(2, 2), g(3, 3), g(1, 2) + g(2, 1), g(2, 3) + g(3, 2), g(1, 3) + g(3, 1)]
-            end if
-            call c%sol%stress(c%points(:, ip), sigma(1:ns))
-            eps(1:ns) = matmul(comp(1:ns, 1:ns), sigma(1:ns))
-            call check(error, maxval(abs(eps_fd(1:ns) - eps(1:ns))), 0.0_wp, 1.0e-5_wp*c%scale/c%sol%young, &
-               & 'strain-displacement-stress, '//c%label)
-            if (allocated(error)) return
-         end do
       end do
    end subroutine test_strain_displacement_stress
+
+   !> div(sigma) + b = 0 by central differences at `points` with step
+   !> h = 1e-4 `length` and tolerance 1e-5 `scale`/`length` (see test_equilibrium).
+   subroutine check_equilibrium_fd(error, sol, points, length, scale, label)
+      type(error_type), allocatable, intent(out) :: error
+      class(exact_solution_type), intent(in) :: sol
+      real(wp), intent(in) :: points(:, :), length, scale
+      character(len=*), intent(in) :: label
+      integer :: ip, i, j, dim
+      real(wp) :: g(6, 3), b(3), div(3), h
+
+      dim = sol%dim
+      h = 1.0e-4_wp*length
+      do ip = 1, size(points, 2)
+         call fd_gradient(sol, .true., points(:, ip), h, g(1:sol%nstress, 1:dim))
+         call sol%body_force(points(:, ip), b(1:dim))
+         do i = 1, dim
+            div(i) = b(i)
+            do j = 1, dim
+               div(i) = div(i) + g(voigt_index(dim, i, j), j)
+            end do
+         end do
+         call check(error, maxval(abs(div(1:dim))), 0.0_wp, 1.0e-5_wp*scale/length, 'equilibrium, '//label)
+         if (allocated(error)) return
+      end do
+   end subroutine check_equilibrium_fd
+
+   !> Central-difference strain of u equals C sigma at `points`, step
+   !> h = 1e-4 `length`, tolerance 1e-5 `scale`/E (see test_strain_displacement_stress).
+   subroutine check_compatibility_fd(error, sol, points, length, scale, label)
+      type(error_type), allocatable, intent(out) :: error
+      class(exact_solution_type), intent(in) :: sol
+      real(wp), intent(in) :: points(:, :), length, scale
+      character(len=*), intent(in) :: label
+      integer :: ip, dim, ns
+      real(wp) :: g(3, 3), eps_fd(6), eps(6), sigma(6), comp(6, 6), h
+
+      dim = sol%dim
+      ns = sol%nstress
+      call compliance_matrix(sol%analysis, sol%young, sol%poisson, comp(1:ns, 1:ns), error)
+      if (allocated(error)) return
+      h = 1.0e-4_wp*length
+      do ip = 1, size(points, 2)
+         call fd_gradient(sol, .false., points(:, ip), h, g(1:dim, 1:dim))
+         if (dim == 2) then
+            eps_fd(1:3) = [g(1, 1), g(2, 2), g(1, 2) + g(2, 1)]
+         else
+            eps_fd = [g(1, 1), g(2, 2), g(3, 3), g(1, 2) + g(2, 1), g(2, 3) + g(3, 2), g(1, 3) + g(3, 1)]
+         end if
+         call sol%stress(points(:, ip), sigma(1:ns))
+         eps(1:ns) = matmul(comp(1:ns, 1:ns), sigma(1:ns))
+         call check(error, maxval(abs(eps_fd(1:ns) - eps(1:ns))), 0.0_wp, 1.0e-5_wp*scale/sol%young, &
+            & 'strain-displacement-stress, '//label)
+         if (allocated(error)) return
+      end do
+   end subroutine check_compatibility_fd
 
    ! ------------------------------------------------------- boundary values
 

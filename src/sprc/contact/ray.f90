@@ -1,0 +1,319 @@
+!> Where a line meets a body's named surface on its exact implicit geometry:
+!> the root finder of the contact gap (seed eq. 3).
+!>
+!> The line is x(t) = x0 + t n (n a unit vector); the surface is the zero set
+!> of shape s's level set f(t) = phi_s(x(t)), restricted to the part that
+!> bounds the body (`body%is_boundary_on`). Sought: in a search interval
+!> [t_lo, t_hi] on one side of 0 (it may reach a small margin past 0), the
+!> first crossing met going from the end nearer to 0 towards the other end,
+!> i.e. the crossing nearest to the start.
+!>
+!> Method, robust for every shape kind without a Lipschitz bound on phi:
+!> 1. Isolation by certified enclosures. A segment [a, b] of the line lies in
+!>    the box spanned by x(a), x(b); `phi_range` over that box encloses f on
+!>    the segment. A segment whose enclosure excludes 0 (beyond the snapping
+!>    tolerance of sprc_geometry_body, the rounding of phi) has no root and is
+!>    dropped. Otherwise, if the enclosure of f' = grad phi . n over the box
+!>    (from `gradient_range`, interval sums) excludes 0, f is monotone there:
+!>    at most one root, solved in step 2. Otherwise the segment is halved and
+!>    the half nearer the start is searched first, so the first accepted
+!>    root is the nearest one. Only segments near the surface or near a tangency are
+!>    split: the work is O(log(length/t_tol)) per root or turning point.
+!> 2. A monotone segment with a sign change of f at its ends is solved by
+!>    safeguarded Newton: Newton steps that leave the bracket are replaced by
+!>    bisection, and a Newton step shorter than t_tol/2 (converged: f is at
+!>    its rounding level) is closed by evaluating f at t -+ t_tol/2.
+!>    Stopping test: bracket width <= t_tol (or f = 0 exactly); the answer is
+!>    the bracket's midpoint.
+!> 3. A root is accepted if it lies on the part of the surface that bounds
+!>    the body and the surface faces the line's direction (n . n_body <= 0
+!>    is asked by the caller through `facing`); otherwise the search goes on
+!>    beyond it.
+!> Segments shorter than t_tol are not split further: a sign change there is
+!> a crossing at the midpoint; no sign change means the line touches the
+!> surface without a resolved crossing (grazing within the position
+!> tolerance) and is not a root. A line that runs in the surface (phi within
+!> rounding of 0 over a whole segment, e.g. along a box face) has no
+!> isolated crossing: such segments are split only down to 2^-12 of the
+!> search interval and each is one candidate at its midpoint, with half its
+!> length in the tolerance, so the work stays bounded (at most 2^13 visits)
+!> where a face is refused (not bounding the body, or not facing).
+!>
+!> Tolerances: t_tol = 8 eps (|x0|_inf + max(|a|, |b|)) on a segment [a, b],
+!> a few ulps of the coordinates there (the line's points cannot be placed
+!> more finely), so a root's accuracy does not depend on how far the search
+!> could have gone. The reported `tolerance` of a root bounds |t - t_exact|: half the final
+!> bracket plus the level-set rounding tol_f over |f'(t)| (the shift of the
+!> root that a rounding of f by tol_f can cause); it grows as the line
+!> approaches tangency. A search that visits more than `max_visits` segments
+!> (impossible with exact enclosures; a guard against hangs) reports failure.
+module sprc_contact_ray
+   use sprc_core_kinds, only: wp
+   use sprc_geometry_body, only: body_type, snap_tolerance
+   implicit none
+   private
+
+   public :: ray_hit_type, nearest_crossing, position_tolerance, max_visits
+
+   !> Guard on the segments one search may visit (module notes).
+   integer, parameter :: max_visits = 100000
+
+   !> A line lying in the surface is resolved to segments of this fraction of
+   !> the search interval (module notes).
+   real(wp), parameter :: plateau_fraction = 2.0_wp**(-12)
+
+   !> Result of a search.
+   type :: ray_hit_type
+      !> A crossing was found.
+      logical :: found = .false.
+      !> The search exceeded max_visits (then found is false).
+      logical :: exhausted = .false.
+      !> Line parameter of the crossing (signed distance from x0 along n).
+      real(wp) :: t = 0.0_wp
+      !> Bound on |t - t_exact| (module notes).
+      real(wp) :: tolerance = 0.0_wp
+      !> The crossing point x0 + t n and the body's outward unit normal there.
+      real(wp) :: x(3) = 0.0_wp, normal(3) = 0.0_wp
+      !> Segments visited, and Newton/bisection iterations of the accepted root.
+      integer :: visits = 0, iterations = 0
+   end type ray_hit_type
+
+   !> The fixed data of one search.
+   type :: line_type
+      integer :: dim = 0, shape = 0
+      real(wp) :: x0(3) = 0.0_wp, n(3) = 0.0_wp
+      !> Length of the search interval (caps the reported tolerance).
+      real(wp) :: span = 0.0_wp
+      !> Accept only crossings where the body's outward normal m has n . m <= 0.
+      logical :: facing = .true.
+   end type line_type
+
+contains
+
+   !> Position tolerance t_tol of the points x0 + t n, t in [a, b] (module notes).
+   pure real(wp) function position_tolerance(x0, a, b) result(t_tol)
+      real(wp), intent(in) :: x0(:), a, b
+      t_tol = 8.0_wp*epsilon(1.0_wp)*(maxval(abs(x0)) + max(abs(a), abs(b)))
+   end function position_tolerance
+
+   !> Crossing of the line x0 + t n (n unit) with shape `shape`'s surface where
+   !> it bounds `body`: the first in [t_lo, t_hi] going from the end nearer to
+   !> 0 towards the other (module notes).
+   !> With `facing`, only crossings where the body's outward normal opposes n
+   !> (n . normal <= 0) count.
+   pure subroutine nearest_crossing(body, shape, x0, n, t_lo, t_hi, facing, hit)
+      class(body_type), intent(in) :: body
+      integer, intent(in) :: shape
+      real(wp), intent(in) :: x0(:), n(:), t_lo, t_hi
+      logical, intent(in) :: facing
+      type(ray_hit_type), intent(out) :: hit
+      type(line_type) :: line
+      logical :: done
+
+      line%dim = size(x0)
+      line%shape = shape
+      line%x0(1:line%dim) = x0
+      line%n(1:line%dim) = n(1:line%dim)
+      line%span = abs(t_hi - t_lo)
+      line%facing = facing
+      if (abs(t_hi) >= abs(t_lo)) then
+         call search(body, line, t_lo, t_hi, hit, done)
+      else
+         call search(body, line, t_hi, t_lo, hit, done)
+      end if
+   end subroutine nearest_crossing
+
+   !> Depth-first search of the segment from `near` to `far` (either order
+   !> on the t axis), nearer half first. `done` once a root is accepted or
+   !> the visit guard is exceeded.
+   pure recursive subroutine search(body, line, near, far, hit, done)
+      class(body_type), intent(in) :: body
+      type(line_type), intent(in) :: line
+      real(wp), intent(in) :: near, far
+      type(ray_hit_type), intent(inout) :: hit
+      logical, intent(out) :: done
+      real(wp) :: fmin, fmax, dmin, dmax, tol_f, f_near, f_far, mid, t_tol
+      integer :: verdict
+
+      done = .false.
+      hit%visits = hit%visits + 1
+      if (hit%visits > max_visits) then
+         hit%exhausted = .true.
+         done = .true.
+         return
+      end if
+      call enclosures(body, line, near, far, fmin, fmax, dmin, dmax, tol_f)
+      if (fmin > tol_f .or. fmax < -tol_f) return
+      if (fmin >= -tol_f .and. fmax <= tol_f .and. abs(far - near) <= line%span*plateau_fraction) then
+         ! The segment lies in the surface (within rounding): one candidate for all of it.
+         call accept(body, line, near, far, tol_f, hit, verdict)
+         done = verdict == 1
+         return
+      end if
+      f_near = f_at(body, line, near)
+      f_far = f_at(body, line, far)
+      t_tol = position_tolerance(line%x0(1:line%dim), near, far)
+      if (abs(far - near) <= t_tol .or. dmin > 0.0_wp .or. dmax < 0.0_wp) then
+         if (.not. brackets(f_near, f_far)) return
+         if (abs(far - near) <= t_tol) then
+            call accept(body, line, near, far, tol_f, hit, verdict)
+         else
+            call solve(body, line, near, far, f_near, f_far, tol_f, hit, verdict)
+         end if
+         done = verdict == 1
+         return
+      end if
+      mid = 0.5_wp*(near + far)
+      call search(body, line, near, mid, hit, done)
+      if (done) return
+      call search(body, line, mid, far, hit, done)
+   end subroutine search
+
+   !> Enclosures of f and f' over the box spanned by the segment [a, b].
+   pure subroutine enclosures(body, line, a, b, fmin, fmax, dmin, dmax, tol_f)
+      class(body_type), intent(in) :: body
+      type(line_type), intent(in) :: line
+      real(wp), intent(in) :: a, b
+      real(wp), intent(out) :: fmin, fmax, dmin, dmax, tol_f
+      real(wp) :: lo(3), hi(3), gmin, gmax
+      integer :: k
+
+      associate (d => line%dim, s => body%shapes(line%shape))
+         lo(1:d) = min(line%x0(1:d) + a*line%n(1:d), line%x0(1:d) + b*line%n(1:d))
+         hi(1:d) = max(line%x0(1:d) + a*line%n(1:d), line%x0(1:d) + b*line%n(1:d))
+         call s%phi_range(lo(1:d), hi(1:d), fmin, fmax)
+         tol_f = snap_tolerance(s, lo(1:d), hi(1:d))
+         dmin = 0.0_wp
+         dmax = 0.0_wp
+         do k = 1, d
+            call s%gradient_range(lo(1:d), hi(1:d), k, gmin, gmax)
+            dmin = dmin + min(line%n(k)*gmin, line%n(k)*gmax)
+            dmax = dmax + max(line%n(k)*gmin, line%n(k)*gmax)
+         end do
+      end associate
+   end subroutine enclosures
+
+   !> Safeguarded Newton on a monotone bracket [a, b] with f(a) f(b) <= 0.
+   !> verdict: 1 accepted, 0 rejected (see `accept`).
+   pure subroutine solve(body, line, a0, b0, fa0, fb0, tol_f, hit, verdict)
+      class(body_type), intent(in) :: body
+      type(line_type), intent(in) :: line
+      real(wp), intent(in) :: a0, b0, fa0, fb0, tol_f
+      type(ray_hit_type), intent(inout) :: hit
+      integer, intent(out) :: verdict
+      real(wp) :: a, b, fa, t, f, df, t_new, probe, t_tol
+      integer :: iter, side
+
+      ! The bracket [a, b], a < b, with fa the value at a; a zero end closes it.
+      a = min(a0, b0)
+      b = max(a0, b0)
+      fa = merge(fa0, fb0, a0 < b0)
+      if (is_zero(fa)) then
+         b = a
+      else if (is_zero(merge(fb0, fa0, a0 < b0))) then
+         a = b
+      end if
+      t = 0.5_wp*(a + b)
+      do iter = 1, 200
+         t_tol = position_tolerance(line%x0(1:line%dim), a, b)
+         if (b - a <= t_tol) exit
+         f = f_at(body, line, t)
+         call shrink(a, b, fa, t, f)
+         df = df_at(body, line, t)
+         t_new = 0.5_wp*(a + b)
+         if (abs(df) > 0.0_wp) then
+            t_new = t - f/df
+            ! A converged step (f is then at its rounding level, its sign
+            ! unreliable): close the bracket by probing t_tol/2 either side.
+            if (abs(f/df) < 0.5_wp*t_tol) then
+               do side = -1, 1, 2
+                  probe = min(b, max(a, t_new + side*0.5_wp*t_tol))
+                  call shrink(a, b, fa, probe, f_at(body, line, probe))
+               end do
+            end if
+         end if
+         if (.not. (t_new > a .and. t_new < b)) t_new = 0.5_wp*(a + b)
+         t = t_new
+      end do
+      call accept(body, line, a, b, tol_f, hit, verdict)
+      hit%iterations = iter
+   end subroutine solve
+
+   !> Move the end of the bracket [a, b] whose value has the sign of f(x) to
+   !> x; a zero value closes the bracket at x.
+   pure subroutine shrink(a, b, fa, x, fx)
+      real(wp), intent(inout) :: a, b, fa
+      real(wp), intent(in) :: x, fx
+      if (is_zero(fx)) then
+         a = x
+         b = x
+      else if ((fx > 0.0_wp) .eqv. (fa > 0.0_wp)) then
+         a = x
+         fa = fx
+      else
+         b = x
+      end if
+   end subroutine shrink
+
+   !> The crossing at the midpoint of the final bracket [a, b]: accepted
+   !> (verdict 1) if it bounds the body and faces the line, else rejected (0).
+   pure subroutine accept(body, line, a, b, tol_f, hit, verdict)
+      class(body_type), intent(in) :: body
+      type(line_type), intent(in) :: line
+      real(wp), intent(in) :: a, b, tol_f
+      type(ray_hit_type), intent(inout) :: hit
+      integer, intent(out) :: verdict
+      real(wp) :: t, x(3), m(3), df, t_tol
+
+      verdict = 0
+      t = 0.5_wp*(a + b)
+      associate (d => line%dim)
+         t_tol = position_tolerance(line%x0(1:d), a, b)
+         x(1:d) = line%x0(1:d) + t*line%n(1:d)
+         if (.not. body%is_boundary_on(x(1:d), line%shape, tol_f + t_tol)) return
+         call body%outward_normal(x(1:d), line%shape, m(1:d))
+         if (line%facing .and. dot_product(m(1:d), line%n(1:d)) > 0.0_wp) return
+         df = abs(df_at(body, line, t))
+         hit%found = .true.
+         hit%t = t
+         hit%tolerance = 0.5_wp*abs(b - a) + 0.5_wp*t_tol + tol_f/max(df, tol_f/max(line%span, tiny(df)))
+         hit%x = 0.0_wp
+         hit%x(1:d) = x(1:d)
+         hit%normal = 0.0_wp
+         hit%normal(1:d) = m(1:d)
+      end associate
+      verdict = 1
+   end subroutine accept
+
+   !> f = 0 (written without a real equality).
+   pure logical function is_zero(f)
+      real(wp), intent(in) :: f
+      is_zero = .not. (f < 0.0_wp .or. f > 0.0_wp)
+   end function is_zero
+
+   !> f(a) and f(b) of opposite signs or one of them zero (no products: they
+   !> could underflow to zero or overflow).
+   pure logical function brackets(fa, fb)
+      real(wp), intent(in) :: fa, fb
+      brackets = (fa <= 0.0_wp .and. fb >= 0.0_wp) .or. (fa >= 0.0_wp .and. fb <= 0.0_wp)
+   end function brackets
+
+   pure real(wp) function f_at(body, line, t)
+      class(body_type), intent(in) :: body
+      type(line_type), intent(in) :: line
+      real(wp), intent(in) :: t
+      associate (d => line%dim)
+         f_at = body%shapes(line%shape)%phi(line%x0(1:d) + t*line%n(1:d))
+      end associate
+   end function f_at
+
+   pure real(wp) function df_at(body, line, t)
+      class(body_type), intent(in) :: body
+      type(line_type), intent(in) :: line
+      real(wp), intent(in) :: t
+      associate (d => line%dim)
+         df_at = dot_product(body%shapes(line%shape)%gradient(line%x0(1:d) + t*line%n(1:d)), line%n(1:d))
+      end associate
+   end function df_at
+
+end module sprc_contact_ray

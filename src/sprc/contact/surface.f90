@@ -1,0 +1,345 @@
+!> The contact surface of a slave/master pair: the slave surface's quadrature
+!> points and, for each, the initial gap to the master surface (seed eq. 3,
+!> SCENE.md `&contact`).
+!>
+!> Slave points are the surface points of the cut-cell rules
+!> (sprc_grid_quadrature) on the slave surface: coordinates, weights (surface
+!> measure) and exact unit outward normals of the slave body, with the slave
+!> leaf that produced them. `slave_surface_points` builds them from the slave
+!> grid; `new_contact_surface` takes them from a caller that already has them.
+!>
+!> Gap (`initial_gaps`): the line through a slave point x_s along its normal
+!> n_s is intersected with the master surface on the master body's exact
+!> implicit geometry (sprc_contact_ray). If x_s lies outside the master body
+!> the crossing is sought ahead, t in [-margin, L]; if inside (the shapes
+!> overlap) behind, t in [-L, margin]; L = `search_distance`, margin four
+!> times the distance that the side test's tolerance stands for (tol over
+!> |grad phi|, plus a few ulps), so that touching surfaces (g0 = 0) are found
+!> from either side. Only crossings where the
+!> master surface faces the slave one (n_s . n_m <= 0) and bounds the master
+!> body count. Then g0 = t: positive for a gap, negative for an interference
+!> (shrink) fit; small deformations linearize g = g0 + (u_m - u_s).n_s. A point
+!> whose line meets no such crossing within L is open: `has_master` false, no
+!> master point, g0 = huge. `g0_tolerance` bounds |g0 - g0_exact| (the root
+!> finder's stopping test and the level-set rounding). `linearized_gap`
+!> adds the displacements: g = g0 + (u_m - u_s).n_s.
+!>
+!> The master point's host cell is the master-grid leaf containing it; a
+!> point on a leaf face that the floor convention of `locate_point` would give
+!> to the external neighbour is nudged into the master body by a few ulps.
+module sprc_contact_surface
+   use sprc_core_kinds, only: wp
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_not_converged
+   use sprc_geometry_body, only: body_type, snap_tolerance
+   use sprc_grid_tree, only: grid_type
+   use sprc_grid_quadrature, only: cut_quadrature_type, cell_rule_type, cell_rule, boundary_face_rule
+   use sprc_geometry_region, only: cell_inside
+   use sprc_contact_ray, only: ray_hit_type, nearest_crossing, position_tolerance
+   implicit none
+   private
+
+   public :: contact_surface_type, new_contact_surface, slave_surface_points, initial_gaps, linearized_gap
+
+   !> Slave-surface points and their initial gaps.
+   type :: contact_surface_type
+      !> Space dimension and number of slave points.
+      integer :: dim = 0, npoint = 0
+      !> Coordinates (dim, npoint), weights (npoint), unit outward normals (dim, npoint).
+      real(wp), allocatable :: x(:, :), weight(:), normal(:, :)
+      !> Leaf of the slave grid holding each point (0 if not known).
+      integer, allocatable :: slave_cell(:)
+      !> Set by `initial_gaps`: the point's line meets the master surface.
+      logical, allocatable :: has_master(:)
+      !> Initial gap g0 (huge when open) and a bound on its error.
+      real(wp), allocatable :: g0(:), g0_tolerance(:)
+      !> Master point and the master body's outward unit normal there (dim, npoint; zero when open).
+      real(wp), allocatable :: master_x(:, :), master_normal(:, :)
+      !> Leaf of the master grid holding the master point (0 when open).
+      integer, allocatable :: master_cell(:)
+   end type contact_surface_type
+
+contains
+
+   !> A contact surface from given slave points. `slave_cell` may be empty
+   !> (cells unknown). Errors name the first bad point (1-based).
+   subroutine new_contact_surface(self, x, weight, normal, slave_cell, error)
+      type(contact_surface_type), intent(out) :: self
+      real(wp), intent(in) :: x(:, :), weight(:), normal(:, :)
+      integer, intent(in) :: slave_cell(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: d, n, i
+
+      d = size(x, 1)
+      n = size(x, 2)
+      if (d /= 2 .and. d /= 3) then
+         call fatal_error(error, 'contact surface: points have '//int_str(d)//' coordinates, expected 2 or 3')
+         return
+      end if
+      if (size(weight) /= n .or. any(shape(normal) /= [d, n]) .or. (size(slave_cell) /= n .and. &
+         & size(slave_cell) /= 0)) then
+         call fatal_error(error, 'contact surface: '//int_str(n)//' points but '//int_str(size(weight))// &
+            & ' weights, '//int_str(size(normal, 2))//' normals of size '//int_str(size(normal, 1))//', '// &
+            & int_str(size(slave_cell))//' cells')
+         return
+      end if
+      do i = 1, n
+         if (.not. (all(abs(x(:, i)) <= huge(1.0_wp)) .and. weight(i) > 0.0_wp .and. weight(i) <= huge(1.0_wp))) then
+            call fatal_error(error, 'contact surface: point '//int_str(i)//' has a non-finite coordinate or a '// &
+               & 'weight that is not finite and > 0')
+            return
+         end if
+         ! Normals come normalized from the geometry: round-off only.
+         if (.not. abs(norm2(normal(:, i)) - 1.0_wp) <= 64.0_wp*epsilon(1.0_wp)) then
+            call fatal_error(error, 'contact surface: the normal of point '//int_str(i)//' is not a unit vector')
+            return
+         end if
+      end do
+      self%dim = d
+      self%npoint = n
+      self%x = x
+      self%weight = weight
+      self%normal = normal
+      if (size(slave_cell) == n) then
+         self%slave_cell = slave_cell
+      else
+         allocate (self%slave_cell(n), source=0)
+      end if
+   end subroutine new_contact_surface
+
+   !> The surface points of shape `shape` of `body` from the cut-cell rules of
+   !> every leaf of its grid, in leaf order.
+   subroutine slave_surface_points(self, grid, body, quad, shape, error)
+      type(contact_surface_type), intent(out) :: self
+      type(grid_type), intent(in) :: grid
+      type(body_type), intent(in) :: body
+      type(cut_quadrature_type), intent(in) :: quad
+      integer, intent(in) :: shape
+      type(error_type), allocatable, intent(out) :: error
+      type(cell_rule_type) :: rule
+      real(wp), allocatable :: x(:, :), w(:), nrm(:, :)
+      integer, allocatable :: cell(:)
+      real(wp) :: lo(3), hi(3)
+      integer :: leaf, k, n, d
+
+      if (shape < 1 .or. shape > body%nshape) then
+         call fatal_error(error, "contact surface: shape "//int_str(shape)//" of body '"//body_name(body)// &
+            & "' does not exist (it has "//int_str(body%nshape)//')')
+         return
+      end if
+      d = grid%dim
+      n = 0
+      allocate (x(d, 64), w(64), nrm(d, 64), cell(64))
+      do leaf = 1, grid%n_leaves
+         call grid%leaf_box(leaf, lo(1:d), hi(1:d))
+         ! An inside leaf has surface points only on grid-plane boundaries: skip its volume rule.
+         if (grid%leaf_class(leaf) == cell_inside) then
+            call boundary_face_rule(quad, body, lo(1:d), hi(1:d), rule, error)
+         else
+            call cell_rule(quad, body, lo(1:d), hi(1:d), rule, error)
+         end if
+         if (allocated(error)) then
+            error%message = 'contact surface, leaf '//int_str(leaf)//': '//error%message
+            return
+         end if
+         do k = 1, rule%nsurf
+            if (rule%surf_shape(k) /= shape) cycle
+            if (n == size(w)) call grow(x, w, nrm, cell)
+            n = n + 1
+            x(:, n) = rule%surf_x(1:d, k)
+            w(n) = rule%surf_w(k)
+            nrm(:, n) = rule%surf_n(1:d, k)
+            cell(n) = leaf
+         end do
+      end do
+      if (n == 0) then
+         call fatal_error(error, "contact surface: surface '"//shape_name(body, shape)//"' of body '"// &
+            & body_name(body)//"' has no quadrature points on the grid (it does not bound the body)")
+         return
+      end if
+      call new_contact_surface(self, x(:, 1:n), w(1:n), nrm(:, 1:n), cell(1:n), error)
+   end subroutine slave_surface_points
+
+   subroutine grow(x, w, nrm, cell)
+      real(wp), allocatable, intent(inout) :: x(:, :), w(:), nrm(:, :)
+      integer, allocatable, intent(inout) :: cell(:)
+      real(wp), allocatable :: x2(:, :), w2(:), n2(:, :)
+      integer, allocatable :: c2(:)
+      integer :: m
+
+      m = size(w)
+      allocate (x2(size(x, 1), 2*m), w2(2*m), n2(size(x, 1), 2*m), c2(2*m))
+      x2(:, 1:m) = x
+      w2(1:m) = w
+      n2(:, 1:m) = nrm
+      c2(1:m) = cell
+      call move_alloc(x2, x)
+      call move_alloc(w2, w)
+      call move_alloc(n2, nrm)
+      call move_alloc(c2, cell)
+   end subroutine grow
+
+   !> Initial gaps of every slave point to shape `shape` of `master` (module
+   !> notes), searched up to `search_distance` along the normal; master
+   !> points located in `master_grid`.
+   subroutine initial_gaps(self, master, shape, master_grid, search_distance, error)
+      type(contact_surface_type), intent(inout) :: self
+      type(body_type), intent(in) :: master
+      integer, intent(in) :: shape
+      type(grid_type), intent(in) :: master_grid
+      real(wp), intent(in) :: search_distance
+      type(error_type), allocatable, intent(out) :: error
+      type(ray_hit_type) :: hit
+      integer :: i
+
+      call check_gap_input(self, master, shape, master_grid, search_distance, error)
+      if (allocated(error)) return
+      associate (d => self%dim, n => self%npoint)
+         if (allocated(self%has_master)) deallocate (self%has_master, self%g0, self%g0_tolerance, self%master_x, &
+            & self%master_normal, self%master_cell)
+         allocate (self%has_master(n), source=.false.)
+         allocate (self%g0(n), source=huge(1.0_wp))
+         allocate (self%g0_tolerance(n), source=0.0_wp)
+         allocate (self%master_x(d, n), self%master_normal(d, n), source=0.0_wp)
+         allocate (self%master_cell(n), source=0)
+         do i = 1, n
+            call gap_of_point(master, shape, self%x(:, i), self%normal(:, i), search_distance, hit)
+            if (hit%exhausted) then
+               call fatal_error(error, 'contact gap: the search along the normal of slave point '//int_str(i)// &
+                  & ' did not isolate a crossing within '//int_str(hit%visits - 1)//' segments', stat_not_converged)
+               return
+            end if
+            if (.not. hit%found) cycle
+            self%has_master(i) = .true.
+            self%g0(i) = hit%t
+            self%g0_tolerance(i) = hit%tolerance
+            self%master_x(:, i) = hit%x(1:d)
+            self%master_normal(:, i) = hit%normal(1:d)
+            self%master_cell(i) = host_cell(master_grid, hit%x(1:d), hit%normal(1:d), hit%tolerance)
+            if (self%master_cell(i) == 0) then
+               call fatal_error(error, 'contact gap: the master point '//real_list(hit%x(1:d))//' of slave point '// &
+                  & int_str(i)//' lies in no leaf of the master grid (is the grid built for the master body?)')
+               return
+            end if
+         end do
+      end associate
+   end subroutine initial_gaps
+
+   !> Linearized gap g = g0 + (u_m - u_s).n_s of every slave point (small
+   !> deformations): u_s the displacement of the slave body at the slave
+   !> point, u_m the master body's at the master point, both (dim, npoint)
+   !> (the caller interpolates them in slave_cell / master_cell). Open points
+   !> keep g = huge. Needs `initial_gaps` first.
+   pure subroutine linearized_gap(self, u_slave, u_master, g, error)
+      type(contact_surface_type), intent(in) :: self
+      real(wp), intent(in) :: u_slave(:, :), u_master(:, :)
+      real(wp), intent(out) :: g(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: i
+
+      if (.not. allocated(self%g0)) then
+         call fatal_error(error, 'linearized gap: initial_gaps has not been called')
+         return
+      end if
+      if (any(shape(u_slave) /= [self%dim, self%npoint]) .or. any(shape(u_master) /= [self%dim, self%npoint]) &
+         & .or. size(g) /= self%npoint) then
+         call fatal_error(error, 'linearized gap: displacements must be ('//int_str(self%dim)//', '// &
+            & int_str(self%npoint)//') and g of size '//int_str(self%npoint))
+         return
+      end if
+      do i = 1, self%npoint
+         g(i) = self%g0(i)
+         if (self%has_master(i)) g(i) = g(i) + dot_product(u_master(:, i) - u_slave(:, i), self%normal(:, i))
+      end do
+   end subroutine linearized_gap
+
+   subroutine check_gap_input(self, master, shape, master_grid, search_distance, error)
+      type(contact_surface_type), intent(in) :: self
+      type(body_type), intent(in) :: master
+      integer, intent(in) :: shape
+      type(grid_type), intent(in) :: master_grid
+      real(wp), intent(in) :: search_distance
+      type(error_type), allocatable, intent(out) :: error
+
+      if (shape < 1 .or. shape > master%nshape) then
+         call fatal_error(error, "contact gap: shape "//int_str(shape)//" of master body '"//body_name(master)// &
+            & "' does not exist (it has "//int_str(master%nshape)//')')
+      else if (master%dim /= self%dim .or. master_grid%dim /= self%dim) then
+         call fatal_error(error, 'contact gap: slave points are '//int_str(self%dim)//'D, the master body '// &
+            & int_str(master%dim)//'D, its grid '//int_str(master_grid%dim)//'D')
+      else if (.not. (search_distance > 0.0_wp .and. search_distance <= huge(1.0_wp))) then
+         call fatal_error(error, 'contact gap: search_distance must be finite and > 0')
+      end if
+   end subroutine check_gap_input
+
+   !> The crossing for one slave point: ahead if x is outside the master body
+   !> (or on it), behind if inside.
+   pure subroutine gap_of_point(master, shape, x, n, search_distance, hit)
+      type(body_type), intent(in) :: master
+      integer, intent(in) :: shape
+      real(wp), intent(in) :: x(:), n(:), search_distance
+      type(ray_hit_type), intent(out) :: hit
+      real(wp) :: tol, margin, slope
+
+      ! Within tol of the surface the side is not decided: start the search a
+      ! margin behind, the distance that tol can stand for (tol/|grad phi|).
+      tol = snap_tolerance(master%shapes(shape), x, x)
+      slope = max(norm2(master%shapes(shape)%gradient(x)), epsilon(1.0_wp))
+      margin = min(search_distance, 4.0_wp*(tol/slope + position_tolerance(x, 0.0_wp, 0.0_wp)))
+      if (master%phi(x) < -tol) then
+         call nearest_crossing(master, shape, x, n, -search_distance, margin, .true., hit)
+      else
+         call nearest_crossing(master, shape, x, n, -margin, search_distance, .true., hit)
+      end if
+   end subroutine gap_of_point
+
+   !> Leaf of `grid` holding x, nudging x into the body (against the outward
+   !> normal m) when x sits on a face owned by an external cell; x is off the
+   !> surface by at most `tolerance` (the gap's) plus rounding.
+   pure integer function host_cell(grid, x, m, tolerance) result(leaf)
+      type(grid_type), intent(in) :: grid
+      real(wp), intent(in) :: x(:), m(:), tolerance
+      real(wp) :: nudge
+
+      leaf = grid%locate_point(x)
+      if (leaf /= 0) return
+      nudge = 2.0_wp*tolerance + 4.0_wp*epsilon(1.0_wp)*(maxval(abs(x)) + grid%box_size)
+      leaf = grid%locate_point(x - nudge*m)
+   end function host_cell
+
+   pure function body_name(body) result(name)
+      type(body_type), intent(in) :: body
+      character(len=:), allocatable :: name
+      name = ''
+      if (allocated(body%name)) name = body%name
+   end function body_name
+
+   pure function shape_name(body, shape) result(name)
+      type(body_type), intent(in) :: body
+      integer, intent(in) :: shape
+      character(len=:), allocatable :: name
+      name = ''
+      if (allocated(body%shapes(shape)%name)) name = body%shapes(shape)%name
+   end function shape_name
+
+   pure function real_list(v) result(s)
+      real(wp), intent(in) :: v(:)
+      character(len=:), allocatable :: s
+      character(len=24) :: buf
+      integer :: k
+      s = '('
+      do k = 1, size(v)
+         write (buf, '(es23.15)') v(k)
+         s = s//trim(adjustl(buf))//merge(', ', ') ', k < size(v))
+      end do
+      s = trim(s)
+   end function real_list
+
+   pure function int_str(i) result(s)
+      integer, intent(in) :: i
+      character(len=:), allocatable :: s
+      character(len=16) :: buf
+      write (buf, '(i0)') i
+      s = trim(buf)
+   end function int_str
+
+end module sprc_contact_surface

@@ -1,0 +1,64 @@
+!> Exact contact pressure on the slave surface, the reference of the contact
+!> report's p_max_exact and err_p_* columns.
+!>
+!> p = -n.sigma.n, positive in compression, with n the slave body's outward
+!> normal (SCENE.md). Two sources: a field solution of the slave body
+!> (`field_pressure_type`: uniform, the rings of compound_cylinder /
+!> compound_sphere), or a closed-form pressure distribution without a stress
+!> field (`sprc_exact_hertz`). The study holds one `class(exact_pressure_type)`
+!> and evaluates either the same way.
+module sprc_exact_pressure
+   use sprc_core_kinds, only: wp
+   use sprc_exact_solution, only: exact_solution_type
+   implicit none
+   private
+
+   public :: exact_pressure_type, field_pressure_type, new_field_pressure
+
+   !> An exact contact pressure p(x, n) on the slave surface.
+   type, abstract :: exact_pressure_type
+      !> Space dimension, 2 or 3.
+      integer :: dim = 0
+   contains
+      !> Pressure at a slave-surface point x with outward unit normal n.
+      procedure(pressure_interface), deferred :: pressure
+   end type exact_pressure_type
+
+   abstract interface
+      pure real(wp) function pressure_interface(self, x, n)
+         import :: exact_pressure_type, wp
+         class(exact_pressure_type), intent(in) :: self
+         !> Point, size dim.
+         real(wp), intent(in) :: x(:)
+         !> Slave body's outward unit normal, size dim.
+         real(wp), intent(in) :: n(:)
+      end function pressure_interface
+   end interface
+
+   !> p = -n.sigma(x).n from the slave body's exact stress field.
+   type, extends(exact_pressure_type) :: field_pressure_type
+      class(exact_solution_type), allocatable :: field
+   contains
+      procedure :: pressure => field_pressure
+   end type field_pressure_type
+
+contains
+
+   !> Wrap the slave body's exact solution (a copy is kept).
+   pure subroutine new_field_pressure(self, field)
+      type(field_pressure_type), intent(out) :: self
+      class(exact_solution_type), intent(in) :: field
+      self%dim = field%dim
+      allocate (self%field, source=field)
+   end subroutine new_field_pressure
+
+   pure real(wp) function field_pressure(self, x, n)
+      class(field_pressure_type), intent(in) :: self
+      real(wp), intent(in) :: x(:), n(:)
+      real(wp) :: t(3)
+
+      call self%field%traction(x, n, t(1:self%dim))
+      field_pressure = -dot_product(n(1:self%dim), t(1:self%dim))
+   end function field_pressure
+
+end module sprc_exact_pressure
