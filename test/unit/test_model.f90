@@ -179,7 +179,7 @@ contains
 
       call load('', scene, error)
       if (allocated(error)) return
-      call build_exact(scene, exact, error)
+      call build_exact(scene, 1, exact, error)
       if (allocated(error)) return
       call check(error, allocated(exact), 'exact solution built')
       if (allocated(error)) return
@@ -199,7 +199,7 @@ contains
 
       call load('example/scenes/kirsch_plate.nml', scene, error)
       if (allocated(error)) return
-      call build_exact(scene, exact, error)
+      call build_exact(scene, 1, exact, error)
       if (allocated(error)) return
       call build_bodies(scene, bodies, error)
       if (allocated(error)) return
@@ -219,7 +219,7 @@ contains
 
       call load('example/scenes/lame_sphere.nml', scene, error)
       if (allocated(error)) return
-      call build_exact(scene, exact, error)
+      call build_exact(scene, 1, exact, error)
       if (allocated(error)) return
       x = scene%exact%center + [scene%exact%r_in, 0.0_wp, 0.0_wp]
       call exact%traction(x, [-1.0_wp, 0.0_wp, 0.0_wp], t)
@@ -238,7 +238,7 @@ contains
 
       call read_scene_text(text, 'inline', scene, error)
       if (allocated(error)) return
-      call build_exact(scene, exact, error)
+      call build_exact(scene, 1, exact, error)
       if (allocated(error)) return
       call check(error, .not. allocated(exact), 'no exact solution without &exact')
    end subroutine test_no_exact

@@ -42,6 +42,7 @@ contains
          new_unittest('summary_switches_off', test_summary_off), &
          new_unittest('summary_real_format', test_summary_reals), &
          new_unittest('contact_accepted_not_runnable', test_contact), &
+         new_unittest('body_local_shape_indices', test_body_shapes), &
          new_unittest('missing_file', test_missing_file), &
          new_unittest('expect_has_enough_entries', test_expect_count), &
          new_unittest('malformed_files', test_malformed), &
@@ -511,6 +512,27 @@ contains
       if (allocated(error)) return
       call check(error, index(summary, 'NOT RUNNABLE: this version cannot run contact') > 0, 'plain statement')
    end subroutine test_contact
+
+   !> Shapes of two bodies interleaved in the file: each shape's index among
+   !> its own body's shapes (what the body's geometry and conditions use).
+   subroutine test_body_shapes(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: s
+      character(len=:), allocatable :: text
+      text = "&scene analysis='plane_strain' levels=3 box_min=0,0 box_size=4 /"//nl// &
+         & "&body name='a' young=1000 poisson=0.3 /"//nl// &
+         & "&body name='b' young=2000 poisson=0.25 /"//nl// &
+         & "&shape body='b' op='add' kind='box' name='b1' lower=0,0 upper=1,1 /"//nl// &
+         & "&shape body='a' op='add' kind='disk' name='a1' center=3,3 radius=0.5 /"//nl// &
+         & "&shape body='b' op='subtract' kind='disk' name='b2' center=0,0 radius=0.5 /"//nl// &
+         & "&shape body='a' op='intersect' kind='halfspace' name='a2' point=3,3 normal=0,-1 /"//nl// &
+         & "&shape body='b' op='intersect' kind='halfspace' name='b3' point=0,0 normal=-1,0 /"//nl
+      call read_ok(text, s, error)
+      if (allocated(error)) return
+      call check(error, all(s%shapes%body_index == [2, 1, 2, 1, 2]), 'body of each shape')
+      if (allocated(error)) return
+      call check(error, all(s%shapes%body_shape == [1, 1, 2, 2, 3]), 'index among the body''s shapes')
+   end subroutine test_body_shapes
 
    subroutine test_missing_file(error)
       type(error_type), allocatable, intent(out) :: error

@@ -270,15 +270,18 @@ contains
       end select
    end subroutine build_shape
 
-   !> The scene's exact solution, with the material of its first body (the
-   !> closed forms are single-body solutions). Not allocated without `&exact`.
-   subroutine build_exact(scene, exact, error)
+   !> The scene's exact solution as it holds in body `b`, with that body's
+   !> material (the closed forms are single-body solutions). Not allocated
+   !> without `&exact`.
+   subroutine build_exact(scene, b, exact, error)
       type(scene_type), intent(in) :: scene
+      !> Index of the body in `scene%bodies`.
+      integer, intent(in) :: b
       class(exact_solution_type), allocatable, intent(out) :: exact
       type(error_type), allocatable, intent(out) :: error
 
       if (.not. scene%exact%present) return
-      associate (spec => scene%exact, young => scene%bodies(1)%young, nu => scene%bodies(1)%poisson)
+      associate (spec => scene%exact, young => scene%bodies(b)%young, nu => scene%bodies(b)%poisson)
          select case (spec%kind)
          case ('lame_cylinder')
             allocate (lame_cylinder_type :: exact)

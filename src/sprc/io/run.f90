@@ -39,6 +39,8 @@ module sprc_io_run
 
    !> What a study needs across its levels, built once from the scene.
    type :: run_model_type
+      !> Index of the analysed body in `scene%bodies`.
+      integer :: b = 0
       type(body_type) :: body
       class(exact_solution_type), allocatable :: exact
       type(fe_bc_type), allocatable :: bcs(:)
@@ -76,15 +78,16 @@ contains
       end if
       call build_bodies(scene, bodies, error)
       if (allocated(error)) return
-      model%body = bodies(1)
+      model%b = 1
+      model%body = bodies(model%b)
       call analysis_units(scene, model%units, error)
       if (allocated(error)) return
       scaled = in_units(scene, model%units)
-      model%young = scaled%bodies(1)%young
-      model%body_force = scaled%bodies(1)%body_force
-      call build_exact(scaled, model%exact, error)
+      model%young = scaled%bodies(model%b)%young
+      model%body_force = scaled%bodies(model%b)%body_force
+      call build_exact(scaled, model%b, model%exact, error)
       if (allocated(error)) return
-      call fe_conditions(scaled, model%bcs)
+      call fe_conditions(scaled, model%b, model%bcs)
       model%analysis = analysis_kind(scene)
       model%points = points
       if (points == 0) model%points = default_points(scene%order)
@@ -93,21 +96,26 @@ contains
       model%gamma = scene%nitsche_gamma
    end subroutine prepare_run
 
-   !> The scene's &bc groups as FE conditions on the body's shape indices
-   !> (shapes of the one body, in file order); surfaces without &bc are free.
-   subroutine fe_conditions(scene, bcs)
+   !> The &bc groups on the surfaces of body `b` as FE conditions on the
+   !> body's own shape indices (its shapes in file order); surfaces without
+   !> &bc are free.
+   subroutine fe_conditions(scene, b, bcs)
       type(scene_type), intent(in) :: scene
+      integer, intent(in) :: b
       type(fe_bc_type), allocatable, intent(out) :: bcs(:)
-      integer :: i, kind
+      integer :: i, kind, n
 
-      allocate (bcs(size(scene%bcs)))
+      allocate (bcs(count(scene%shapes(scene%bcs%shape_index)%body_index == b)))
+      n = 0
       do i = 1, size(scene%bcs)
-         kind = bc_kind_from_name(scene%bcs(i)%type)
-         associate (bc => scene%bcs(i))
+         associate (bc => scene%bcs(i), shape => scene%shapes(scene%bcs(i)%shape_index))
+            if (shape%body_index /= b) cycle
+            n = n + 1
+            kind = bc_kind_from_name(bc%type)
             if (allocated(bc%vector)) then
-               bcs(i) = new_fe_bc(bc%shape_index, kind, bc%value, bc%vector)
+               bcs(n) = new_fe_bc(shape%body_shape, kind, bc%value, bc%vector)
             else
-               bcs(i) = new_fe_bc(bc%shape_index, kind, bc%value)
+               bcs(n) = new_fe_bc(shape%body_shape, kind, bc%value)
             end if
          end associate
       end do
@@ -154,7 +162,7 @@ contains
       end if
       call new_cut_quadrature(quad, scene%dim, model%points, error)
       if (allocated(error)) return
-      associate (mat => scene%bodies(1))
+      associate (mat => scene%bodies(model%b))
          if (allocated(model%exact)) then
             call problem%setup(model%body, grid, nodes, hanging, quad, model%analysis, model%young, mat%poisson, &
                model%body_force, model%bcs, error, exact=model%exact, gamma=model%gamma, &
@@ -264,7 +272,7 @@ contains
       ns = voigt_size(model%analysis)
       input%analysis = model%analysis
       input%young = model%young
-      input%poisson = scene%bodies(1)%poisson
+      input%poisson = scene%bodies(model%b)%poisson
       input%body_force(1:scene%dim) = model%body_force
       input%elem_ptr = problem%vol_ptr
       input%x = problem%vol_x(1:scene%dim, :)
@@ -288,7 +296,8 @@ contains
       input%bc_traction = 0.0_wp
       input%bc_pressure = 0.0_wp
       do i = 1, size(scene%bcs)
-         s = scene%bcs(i)%shape_index
+         if (scene%shapes(scene%bcs(i)%shape_index)%body_index /= model%b) cycle
+         s = scene%shapes(scene%bcs(i)%shape_index)%body_shape
          select case (scene%bcs(i)%type)
          case ('pressure')
             input%bc_kind(s) = rec_pressure

@@ -37,6 +37,9 @@ module sprc_io_scene
       character(len=:), allocatable :: body
       !> Index of that body in `scene%bodies`.
       integer :: body_index = 0
+      !> Index of the shape among its body's shapes (1..number of shapes of that body, file order):
+      !> the shape index the body's geometry, FE conditions and recovery input use.
+      integer :: body_shape = 0
       !> 'add' | 'subtract' | 'intersect'.
       character(len=:), allocatable :: op
       !> 'disk' | 'sphere' | 'ellipse' | 'ellipsoid' | 'box' | 'halfspace' | 'cylinder'.
@@ -440,6 +443,7 @@ contains
                return
             end if
             nshape(shape%body_index) = nshape(shape%body_index) + 1
+            shape%body_shape = nshape(shape%body_index)
             call get_choice(g, 'kind', shape_kinds, .true., shape%kind, error)
             if (allocated(error)) return
             if (kind_dim(shape%kind) /= 0 .and. kind_dim(shape%kind) /= scene%dim) then
