@@ -2,9 +2,8 @@
 !> recovery): for the Lame quarter cylinder (plane strain, Q1 levels 3..6, Q2 3..5), the
 !> Kirsch quarter plate (plane stress, Q1 / Q2 levels 3..7) and the Lame sphere octant
 !> (Q1 levels 2..5) it solves the FE problem (solve_on_grid), builds the recovery input
-!> from the problem's volume points (element_points) and surface points (the shape index
-!> of each point selects its recovery kind: pressure / free (traction 0) / exact traction /
-!> symmetry from the FE conditions; Dirichlet surfaces none), recovers with SPR and SPR-C
+!> with the library's FE adapter (fe_recovery_input: the shape index of each boundary point
+!> selects its recovery kind from the FE conditions), recovers with SPR and SPR-C
 !> (degree 'auto', the scenes' default: SPR at p, SPR-C at p + 1 for Q2 and p for Q1) and
 !> estimates the error against the exact solution. Printed per level:
 !> err_fe = ||s_ex - s_h|| / ||s_ex||, err_spr / err_sprc = ||s_ex - s*|| / ||s_ex||
@@ -28,11 +27,11 @@ program recovery_study
    use sprc_exact_lame, only: lame_cylinder_type, new_lame_cylinder, lame_sphere_type, new_lame_sphere
    use sprc_exact_kirsch, only: kirsch_type, new_kirsch
    use sprc_fem_bc, only: fe_bc_type, new_fe_bc, fe_free => bc_free, fe_pressure => bc_pressure, &
-      & fe_traction => bc_traction, fe_symmetry => bc_symmetry, fe_exact_traction => bc_exact_traction
+      & fe_symmetry => bc_symmetry, fe_exact_traction => bc_exact_traction
    use sprc_fem_problem, only: elasticity_problem_type, solve_on_grid
    use sprc_grid_hanging, only: hanging_type
-   use sprc_grid_patches, only: recovery_input_type, recover_grid, bc_none, bc_traction, bc_pressure, &
-      & bc_exact_traction, bc_symmetry
+   use sprc_grid_patches, only: recovery_input_type, recover_grid
+   use sprc_fem_recovery_input, only: fe_recovery_input
    use sprc_grid_recovered_field, only: recovered_field_type, method_spr, method_sprc
    use sprc_grid_recovered_estimate, only: zz_estimate_type, estimate_error
    use sprc_recovery_patch_loop, only: auto_degree
@@ -165,61 +164,6 @@ contains
       call stop_on(error)
    end subroutine sphere_body
 
-   !> Recovery input of a solved problem: volume points and FE stresses per element, surface
-   !> points with their shape index, recovery kind per shape from the FE conditions.
-   subroutine recovery_input(problem, bcs, input)
-      type(elasticity_problem_type), intent(in) :: problem
-      type(fe_bc_type), intent(in) :: bcs(:)
-      type(recovery_input_type), intent(out) :: input
-      real(wp), allocatable :: x(:, :), w(:), sigma(:, :)
-      integer :: e, ne, nshape, i, s, d
-
-      d = problem%dim
-      ne = problem%grid%n_leaves
-      input%analysis = problem%analysis
-      input%young = problem%young
-      input%poisson = problem%poisson
-      input%body_force = problem%body_force
-      input%elem_ptr = problem%vol_ptr
-      input%x = problem%vol_x
-      input%w = problem%vol_w
-      allocate (input%stress(problem%nstress, size(problem%vol_w)))
-      do e = 1, ne
-         call problem%element_points(e, x, w, sigma)
-         input%stress(:, problem%vol_ptr(e):problem%vol_ptr(e + 1) - 1) = sigma
-      end do
-      input%belem_ptr = problem%surf_ptr
-      input%bx = problem%surf_x
-      input%bw = problem%surf_w
-      input%bn = problem%surf_n
-      input%bshape = problem%surf_shape
-      nshape = body%nshape
-      allocate (input%bc_kind(nshape), input%bc_traction(3, nshape), input%bc_pressure(nshape))
-      ! A shape without a condition is a free surface.
-      input%bc_kind = bc_traction
-      input%bc_traction = 0.0_wp
-      input%bc_pressure = 0.0_wp
-      do i = 1, size(bcs)
-         s = bcs(i)%shape
-         select case (bcs(i)%kind)
-         case (fe_free)
-            input%bc_kind(s) = bc_traction
-         case (fe_pressure)
-            input%bc_kind(s) = bc_pressure
-            input%bc_pressure(s) = bcs(i)%value
-         case (fe_traction)
-            input%bc_kind(s) = bc_traction
-            input%bc_traction(1:d, s) = bcs(i)%vector(1:d)
-         case (fe_exact_traction)
-            input%bc_kind(s) = bc_exact_traction
-         case (fe_symmetry)
-            input%bc_kind(s) = bc_symmetry
-         case default
-            input%bc_kind(s) = bc_none
-         end select
-      end do
-   end subroutine recovery_input
-
    subroutine study(title, exact, box_min, box_size, degree, analysis, l0, l1)
       character(len=*), intent(in) :: title
       class(exact_solution_type), intent(in) :: exact
@@ -245,7 +189,8 @@ contains
          call stop_on(error)
          call hanging%build(problem%grid, problem%nodes, error)
          call stop_on(error)
-         call recovery_input(problem, bcs, input)
+         call fe_recovery_input(problem, input, error)
+         call stop_on(error)
          inside = [(body%phi(problem%nodes%x(:, n)) <= 0.0_wp, n=1, problem%nodes%n_nodes)]
          bites = 0
          do m = method_spr, method_sprc

@@ -24,6 +24,9 @@ module sprc_test_fem
    use sprc_fem_bc, only: fe_bc_type, new_fe_bc, bc_free, bc_pressure, bc_traction, bc_displacement, &
       & bc_symmetry, bc_exact_traction, bc_exact_displacement
    use sprc_fem_problem, only: elasticity_problem_type, solve_on_grid
+   use sprc_fem_recovery_input, only: fe_recovery_input
+   use sprc_grid_patches, only: recovery_input_type, rec_none => bc_none, rec_traction => bc_traction, &
+      & rec_pressure => bc_pressure, rec_symmetry => bc_symmetry
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type
    implicit none
    private
@@ -87,7 +90,8 @@ contains
          new_unittest('bad_inputs', test_bad_inputs), &
          new_unittest('umfpack_fallback', test_umfpack_fallback), &
          new_unittest('threads', test_threads), &
-         new_unittest('queries_and_api_errors', test_queries) &
+         new_unittest('queries_and_api_errors', test_queries), &
+         new_unittest('recovery_input_adapter', test_recovery_input) &
          ]
    end subroutine collect_fem
 
@@ -529,6 +533,67 @@ contains
       if (allocated(error)) return
       call check(error, index(patch_error%message, 'field at the nodes') > 0, 'fails on the values')
    end subroutine test_q1_misses_quadratic
+
+   !> The FE -> recovery adapter: the recovery kind of each shape follows its
+   !> FE condition (Dirichlet: none; pressure and traction with their data),
+   !> the points and weights are the problem's, the stresses the FE stresses
+   !> at those points bit for bit; an unsolved problem is refused.
+   subroutine test_recovery_input(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: body
+      type(fe_bc_type), allocatable :: bcs(:)
+      type(lame_cylinder_type) :: exact
+      type(elasticity_problem_type) :: problem
+      type(recovery_input_type) :: input
+      type(error_type), allocatable :: refused
+      real(wp), allocatable :: x(:, :), w(:), sigma(:, :)
+      integer :: e, q0, q1
+
+      call fe_recovery_input(problem, input, refused)
+      if (.not. allocated(refused)) then
+         call test_failed(error, 'an unsolved problem was accepted')
+         return
+      end if
+      call check(error, index(refused%message, 'not solved') > 0, 'an unsolved problem is refused: '//refused%message)
+      if (allocated(error)) return
+      call lame_quarter(body, bcs, exact, plane_strain, error)
+      if (allocated(error)) return
+      bcs = [new_fe_bc(1, bc_exact_displacement), new_fe_bc(2, bc_pressure, value=1.5_wp), &
+         & new_fe_bc(3, bc_symmetry), new_fe_bc(4, bc_traction, vector=[0.5_wp, -0.25_wp])]
+      call solve_on_grid(problem, body, [0.0_wp, 0.0_wp], 25.0_wp, 2, 0, 1, plane_strain, young, poisson, &
+         & [0.0_wp, 0.0_wp], bcs, error, exact=exact)
+      if (allocated(error)) return
+      call fe_recovery_input(problem, input, error)
+      if (allocated(error)) return
+      call check(error, all(input%bc_kind == [rec_none, rec_pressure, rec_symmetry, rec_traction]), &
+         & 'recovery kind of each shape')
+      if (allocated(error)) return
+      call check(error, input%bc_pressure(2) == 1.5_wp .and. all(input%bc_traction(1:2, 4) == [0.5_wp, -0.25_wp]) &
+         & .and. all(input%bc_traction(:, 1:3) == 0.0_wp), 'pressure and traction data')
+      if (allocated(error)) return
+      call check(error, all(input%bshape == problem%surf_shape) .and. all(input%bw == problem%surf_w) .and. &
+         & all(input%w == problem%vol_w) .and. input%young == young .and. input%analysis == plane_strain, &
+         & 'points, weights and material are the problem''s')
+      if (allocated(error)) return
+      do e = 1, problem%grid%n_leaves
+         call problem%element_points(e, x, w, sigma)
+         q0 = input%elem_ptr(e)
+         q1 = input%elem_ptr(e + 1) - 1
+         if (any(input%stress(:, q0:q1) /= sigma) .or. any(input%x(:, q0:q1) /= x)) then
+            call test_failed(error, 'the stresses are the FE stresses at the volume points')
+            return
+         end if
+      end do
+      call lame_quarter(body, bcs, exact, plane_strain, error)
+      if (allocated(error)) return
+      call solve_on_grid(problem, body, [0.0_wp, 0.0_wp], 25.0_wp, 2, 0, 1, plane_strain, young, poisson, &
+         & [0.0_wp, 0.0_wp], bcs, error, exact=exact)
+      if (allocated(error)) return
+      call fe_recovery_input(problem, input, error)
+      if (allocated(error)) return
+      call check(error, all(input%bc_kind == [rec_traction, rec_pressure, rec_symmetry, rec_symmetry]), &
+         & 'a shape without a condition is a free (traction 0) surface')
+   end subroutine test_recovery_input
 
    ! ------------------------------------------------------------ benchmarks with exact solutions
 

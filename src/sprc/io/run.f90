@@ -18,14 +18,13 @@ module sprc_io_run
    use sprc_grid_nodes, only: grid_nodes_type
    use sprc_grid_hanging, only: hanging_type
    use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature, default_points
-   use sprc_grid_patches, only: recovery_input_type, recover_grid, rec_none => bc_none, &
-      & rec_traction => bc_traction, rec_pressure => bc_pressure, rec_exact_traction => bc_exact_traction, &
-      & rec_symmetry => bc_symmetry
+   use sprc_grid_patches, only: recovery_input_type, recover_grid
    use sprc_grid_recovered_field, only: recovered_field_type, method_spr, method_sprc
    use sprc_grid_recovered_estimate, only: zz_estimate_type, estimate_error
    use sprc_fem_bc, only: fe_bc_type, new_fe_bc, bc_kind_from_name
    use sprc_fem_problem, only: elasticity_problem_type
    use sprc_fem_dilatation, only: dilatation_choice
+   use sprc_fem_recovery_input, only: fe_recovery_input
    use sprc_io_scene, only: scene_type, recovery_degree
    use sprc_io_model, only: build_bodies, build_exact, analysis_kind, analysis_units_type, analysis_units, in_units
    use sprc_io_budget, only: check_level_memory
@@ -194,7 +193,8 @@ contains
 
       done = [model%run_spr, model%run_sprc]
       if (any(done)) then
-         call recovery_input(scene, model, problem, input)
+         call fe_recovery_input(problem, input, error)
+         if (allocated(error)) return
          row%t_recovery = 0.0_wp
          row%t_estimate = 0.0_wp
       end if
@@ -257,63 +257,6 @@ contains
          if (have_exact) row%theta_sprc = est%theta
       end if
    end subroutine fill_method_columns
-
-   !> The recovery's view of the FE solution: volume points with w|J| and FE
-   !> stress, boundary points with normals and shape indices, and for each
-   !> shape the boundary kind the SPR-C constraints use.
-   subroutine recovery_input(scene, model, problem, input)
-      type(scene_type), intent(in) :: scene
-      type(run_model_type), intent(in) :: model
-      type(elasticity_problem_type), intent(in) :: problem
-      type(recovery_input_type), intent(out) :: input
-      integer :: e, q, ne, ns, nshape, i, s
-
-      ne = problem%grid%n_leaves
-      ns = voigt_size(model%analysis)
-      input%analysis = model%analysis
-      input%young = model%young
-      input%poisson = scene%bodies(model%b)%poisson
-      input%body_force(1:scene%dim) = model%body_force
-      input%elem_ptr = problem%vol_ptr
-      input%x = problem%vol_x(1:scene%dim, :)
-      input%w = problem%vol_w
-      allocate (input%stress(ns, size(problem%vol_w)))
-      do e = 1, ne
-         do q = problem%vol_ptr(e), problem%vol_ptr(e + 1) - 1
-            call problem%stress_in_element(e, problem%vol_x(1:scene%dim, q), input%stress(:, q))
-         end do
-      end do
-      input%belem_ptr = problem%surf_ptr
-      input%bx = problem%surf_x(1:scene%dim, :)
-      input%bw = problem%surf_w
-      input%bn = problem%surf_n(1:scene%dim, :)
-      input%bshape = problem%surf_shape
-
-      ! Surfaces without &bc are traction-free: traction constraint with t = 0.
-      nshape = model%body%nshape
-      allocate (input%bc_kind(nshape), input%bc_traction(3, nshape), input%bc_pressure(nshape))
-      input%bc_kind = rec_traction
-      input%bc_traction = 0.0_wp
-      input%bc_pressure = 0.0_wp
-      do i = 1, size(scene%bcs)
-         if (scene%shapes(scene%bcs(i)%shape_index)%body_index /= model%b) cycle
-         s = scene%shapes(scene%bcs(i)%shape_index)%body_shape
-         select case (scene%bcs(i)%type)
-         case ('pressure')
-            input%bc_kind(s) = rec_pressure
-            input%bc_pressure(s) = scene%bcs(i)%value
-         case ('traction')
-            input%bc_kind(s) = rec_traction
-            input%bc_traction(1:scene%dim, s) = scene%bcs(i)%vector
-         case ('exact_traction')
-            input%bc_kind(s) = rec_exact_traction
-         case ('symmetry')
-            input%bc_kind(s) = rec_symmetry
-         case ('displacement', 'exact_displacement')
-            input%bc_kind(s) = rec_none
-         end select
-      end do
-   end subroutine recovery_input
 
    !> No computed column may carry a NaN or an infinity: an empty cell means
    !> "does not apply", never "went wrong". Every column that was set (the

@@ -1,0 +1,93 @@
+!> The FE → recovery adapter: the recovery's view of a solved FE problem on
+!> a cut grid (`recovery_input_type` of `sprc_grid_patches`).
+!>
+!> - volume points of each element with w|J| and the FE stress there;
+!> - boundary points with w|J|, outward normals and the body's shape index;
+!> - per shape the boundary kind the SPR-C constraints use, from the FE
+!>   conditions: free surfaces (and shapes without a condition) are
+!>   traction with t = 0, pressure and traction keep their data, exact
+!>   traction needs the exact solution at recovery time, symmetry is a
+!>   symmetry plane, and Dirichlet surfaces (displacement, exact
+!>   displacement) carry no recovery constraint.
+module sprc_fem_recovery_input
+   use sprc_core_kinds, only: wp
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
+   use sprc_grid_patches, only: recovery_input_type, rec_none => bc_none, rec_traction => bc_traction, &
+      & rec_pressure => bc_pressure, rec_exact_traction => bc_exact_traction, rec_symmetry => bc_symmetry
+   use sprc_fem_bc, only: bc_free, bc_pressure, bc_traction, bc_symmetry, bc_exact_traction
+   use sprc_fem_problem, only: elasticity_problem_type
+   implicit none
+   private
+
+   public :: fe_recovery_input
+
+contains
+
+   !> The recovery input of the solved `problem` (module notes). Error if the
+   !> problem is not solved.
+   subroutine fe_recovery_input(problem, input, error)
+      type(elasticity_problem_type), intent(in) :: problem
+      type(recovery_input_type), intent(out) :: input
+      type(error_type), allocatable, intent(out) :: error
+      integer :: e, q, d
+
+      if (.not. problem%solved) then
+         call fatal_error(error, 'FE recovery input: the problem is not solved', stat_invalid_input)
+         return
+      end if
+      d = problem%dim
+      input%analysis = problem%analysis
+      input%young = problem%young
+      input%poisson = problem%poisson
+      input%body_force(1:d) = problem%body_force(1:d)
+      input%elem_ptr = problem%vol_ptr
+      input%x = problem%vol_x(1:d, :)
+      input%w = problem%vol_w
+      allocate (input%stress(problem%nstress, size(problem%vol_w)))
+      do e = 1, problem%grid%n_leaves
+         do q = problem%vol_ptr(e), problem%vol_ptr(e + 1) - 1
+            call problem%stress_in_element(e, problem%vol_x(1:d, q), input%stress(:, q))
+         end do
+      end do
+      input%belem_ptr = problem%surf_ptr
+      input%bx = problem%surf_x(1:d, :)
+      input%bw = problem%surf_w
+      input%bn = problem%surf_n(1:d, :)
+      input%bshape = problem%surf_shape
+      call boundary_kinds(problem, input)
+   end subroutine fe_recovery_input
+
+   !> Recovery kind and data of each shape from the problem's conditions.
+   subroutine boundary_kinds(problem, input)
+      type(elasticity_problem_type), intent(in) :: problem
+      type(recovery_input_type), intent(inout) :: input
+      integer :: nshape, i, s, d
+
+      d = problem%dim
+      nshape = size(problem%bc_of_shape)
+      allocate (input%bc_kind(nshape), input%bc_traction(3, nshape), input%bc_pressure(nshape))
+      input%bc_kind = rec_traction
+      input%bc_traction = 0.0_wp
+      input%bc_pressure = 0.0_wp
+      do i = 1, size(problem%bcs)
+         s = problem%bcs(i)%shape
+         select case (problem%bcs(i)%kind)
+         case (bc_free)
+            input%bc_kind(s) = rec_traction
+         case (bc_pressure)
+            input%bc_kind(s) = rec_pressure
+            input%bc_pressure(s) = problem%bcs(i)%value
+         case (bc_traction)
+            input%bc_kind(s) = rec_traction
+            input%bc_traction(1:d, s) = problem%bcs(i)%vector(1:d)
+         case (bc_exact_traction)
+            input%bc_kind(s) = rec_exact_traction
+         case (bc_symmetry)
+            input%bc_kind(s) = rec_symmetry
+         case default
+            input%bc_kind(s) = rec_none
+         end select
+      end do
+   end subroutine boundary_kinds
+
+end module sprc_fem_recovery_input
