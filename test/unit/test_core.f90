@@ -6,6 +6,7 @@ module sprc_test_core
       & stat_singular, stat_not_positive_definite
    use sprc_core_timer, only: timer_type, wall_time
    use sprc_core_text, only: fixed_text
+   use sprc_core_strings, only: itoa, rtoa
    use sprc_core_lapack, only: dgesv, dgecon, dgetrf, dlange, dpotrf, dpotrs, dgeqp3, dgesvd, &
       & dgemm, dsyrk, dsysv, lapack_info_error
    use sprc_testsuite, only: unittest_type, new_unittest, check
@@ -31,7 +32,8 @@ contains
          new_unittest('fixed_text_leading_zero', test_fixed_text), &
          new_unittest('dgemm_dsyrk', test_dgemm_dsyrk), &
          new_unittest('dsysv_indefinite', test_dsysv), &
-         new_unittest('lapack_info_translation', test_info_translation) &
+         new_unittest('lapack_info_translation', test_info_translation), &
+         new_unittest('strings', test_strings) &
          ]
    end subroutine collect_core
 
@@ -221,5 +223,17 @@ contains
       call lapack_info_error('dgesv', -4, 'x', e)
       call check(error, e%stat, stat_invalid_input, 'negative info')
    end subroutine test_info_translation
+
+   !> Integers and reals as text, checked against literal strings.
+   subroutine test_strings(error)
+      type(error_type), allocatable, intent(out) :: error
+      call check(error, itoa(0)//' '//itoa(-12)//' '//itoa(huge(1_i4))//' '//itoa(-huge(1_i8)), &
+         & '0 -12 2147483647 -9223372036854775807', 'itoa')
+      if (allocated(error)) return
+      call check(error, itoa(4, 2)//' '//itoa(123, 2)//' '//itoa(-4_i8, 3)//' '//itoa(7, 0), '04 123 -004 7', &
+         & 'itoa with digits')
+      if (allocated(error)) return
+      call check(error, rtoa(-1234.5_wp)//' '//rtoa(0.0_wp), '-1.2345E+03 0.0000E+00', 'rtoa')
+   end subroutine test_strings
 
 end module sprc_test_core

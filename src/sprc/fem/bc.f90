@@ -14,6 +14,7 @@
 !>   (weakly), both from an exact solution the caller supplies.
 module sprc_fem_bc
    use sprc_core_kinds, only: wp
+   use sprc_core_strings, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    implicit none
    private
@@ -93,19 +94,19 @@ contains
       integer :: i, nvec
 
       do i = 1, size(bcs)
-         where = 'boundary condition '//str(i)//': '
+         where = 'boundary condition '//itoa(i)//': '
          if (bcs(i)%shape < 1 .or. bcs(i)%shape > nshape) then
-            call fatal_error(error, where//'unknown shape index '//str(bcs(i)%shape)//' (the body has '// &
-               & str(nshape)//' shapes)', stat_invalid_input)
+            call fatal_error(error, where//'unknown shape index '//itoa(bcs(i)%shape)//' (the body has '// &
+               & itoa(nshape)//' shapes)', stat_invalid_input)
             return
          end if
          if (any(bcs(1:i - 1)%shape == bcs(i)%shape)) then
-            call fatal_error(error, where//'shape '//str(bcs(i)%shape)//' already has a condition', &
+            call fatal_error(error, where//'shape '//itoa(bcs(i)%shape)//' already has a condition', &
                & stat_invalid_input)
             return
          end if
          if (bc_kind_name(bcs(i)%kind) == '') then
-            call fatal_error(error, where//'unknown kind '//str(bcs(i)%kind), stat_invalid_input)
+            call fatal_error(error, where//'unknown kind '//itoa(bcs(i)%kind), stat_invalid_input)
             return
          end if
          nvec = 0
@@ -113,8 +114,8 @@ contains
          select case (bcs(i)%kind)
          case (bc_traction, bc_displacement)
             if (nvec /= dim) then
-               call fatal_error(error, where//bc_kind_name(bcs(i)%kind)//' needs a vector of '//str(dim)// &
-                  & ' values, got '//str(nvec), stat_invalid_input)
+               call fatal_error(error, where//bc_kind_name(bcs(i)%kind)//' needs a vector of '//itoa(dim)// &
+                  & ' values, got '//itoa(nvec), stat_invalid_input)
                return
             end if
             if (.not. all(abs(bcs(i)%vector) <= huge(1.0_wp))) then
@@ -135,13 +136,5 @@ contains
          end select
       end do
    end subroutine check_bcs
-
-   pure function str(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=16) :: buf
-      write (buf, '(i0)') i
-      s = trim(buf)
-   end function str
 
 end module sprc_fem_bc

@@ -43,6 +43,7 @@
 !> module (contact recovers the patches it owns).
 module sprc_grid_patches
    use sprc_core_kinds, only: wp
+   use sprc_core_strings, only: itoa, rtoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular
    use sprc_core_material, only: plane_stress, plane_strain, solid, voigt_size, check_material
    use sprc_core_poly, only: poly_max_degree
@@ -510,21 +511,5 @@ contains
       character(len=*), intent(in) :: message
       call fatal_error(error, 'recovery input: '//message, stat_invalid_input)
    end subroutine input_error
-
-   pure function itoa(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=16) :: buf
-      write (buf, '(i0)') i
-      s = trim(buf)
-   end function itoa
-
-   pure function rtoa(x) result(s)
-      real(wp), intent(in) :: x
-      character(len=:), allocatable :: s
-      character(len=24) :: buf
-      write (buf, '(es12.4)') x
-      s = trim(adjustl(buf))
-   end function rtoa
 
 end module sprc_grid_patches

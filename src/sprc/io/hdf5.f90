@@ -27,6 +27,7 @@ module sprc_io_hdf5
       & h5screate_simple_f, h5sclose_f, h5dcreate_f, h5dwrite_f, h5dclose_f, &
       & H5F_ACC_TRUNC_F, H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER
    use sprc_core_kinds, only: wp
+   use sprc_core_strings, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_io, stat_invalid_input
    use sprc_io_xdmf, only: xdmf_grid_type, xdmf_field_type, write_xdmf_file => write_xdmf, &
       & cell_nodes, cell_dim, topology_name, center_node, center_cell, field_scalar, field_vector, &
@@ -533,13 +534,5 @@ contains
       integer(c_int) :: status
       if (quiet%saved) status = h5eset_auto2(h5e_default, quiet%func, quiet%client_data)
    end subroutine quiet_end
-
-   pure function itoa(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=16) :: buf
-      write (buf, '(i0)') i
-      s = trim(buf)
-   end function itoa
 
 end module sprc_io_hdf5

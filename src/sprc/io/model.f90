@@ -13,8 +13,9 @@ module sprc_io_model
    use sprc_exact_solution, only: exact_solution_type
    use sprc_exact_lame, only: lame_cylinder_type, lame_sphere_type, new_lame_cylinder, new_lame_sphere
    use sprc_exact_kirsch, only: kirsch_type, new_kirsch
-   use sprc_io_scene, only: scene_type, shape_type, real_text, int_text
+   use sprc_io_scene, only: scene_type, shape_type, real_text
    use sprc_fem_problem, only: gamma_note
+   use sprc_core_strings, only: itoa
    implicit none
    private
 
@@ -81,7 +82,7 @@ contains
       ! displacements and stresses lose digits then, not the analysis)
       if (k >= maxexponent(1.0_wp) .or. k <= minexponent(1.0_wp) - digits(1.0_wp)) then
          call fatal_error(error, "the loads (or prescribed displacements) imply strains of about 1e"// &
-            & int_text(nint(0.30103_wp*real(k, wp)))//" (load / young), beyond double precision: "// &
+            & itoa(nint(0.30103_wp*real(k, wp)))//" (load / young), beyond double precision: "// &
             & "check the units of young and of the loads", stat_invalid_input)
          return
       end if

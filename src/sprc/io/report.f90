@@ -11,6 +11,7 @@ module sprc_io_report
    use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_is_finite
    use sprc_core_kinds, only: wp, i8
    use sprc_core_text, only: fixed_text
+   use sprc_core_strings, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_io, stat_invalid_input
    implicit none
    private
@@ -489,13 +490,5 @@ contains
          if (line(len(line):) == achar(13)) line = line(:len(line) - 1)
       end if
    end subroutine read_line
-
-   pure function itoa(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=16) :: buf
-      write (buf, '(i0)') i
-      s = trim(buf)
-   end function itoa
 
 end module sprc_io_report

@@ -8,6 +8,7 @@ module sprc_io_scene
    use sprc_core_kinds, only: wp, i8
    use sprc_fem_dilatation, only: projected_poisson
    use sprc_fem_problem, only: default_gamma, gamma_note
+   use sprc_core_strings, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_unsupported
    use sprc_io_namelist, only: nml_group_type, parse_namelist, read_text_file, nml_get, nml_get_array, &
       & nml_has, nml_check_consumed, nml_field_error, nml_group_error, nml_item_text
@@ -16,7 +17,7 @@ module sprc_io_scene
    private
 
    public :: scene_type, body_type, shape_type, bc_type, exact_type, contact_type
-   public :: read_scene, read_scene_text, default_scene_text, scene_summary, recovery_degree, real_text, int_text
+   public :: read_scene, read_scene_text, default_scene_text, scene_summary, recovery_degree, real_text
 
    !> One elastic body.
    type :: body_type
@@ -274,7 +275,7 @@ contains
          if (groups(i)%name /= 'scene') cycle
          if (ig > 0) then
             call nml_group_error(groups(i), 'a second &scene group (the first is on line '// &
-               & int_text(groups(ig)%line)//'): a scene file has exactly one', error)
+               & itoa(groups(ig)%line)//'): a scene file has exactly one', error)
             return
          end if
          ig = i
@@ -309,8 +310,8 @@ contains
             return
          end if
          if (any(scene%levels < 0 .or. scene%levels > max_level)) then
-            call nml_field_error(g, 'levels', 'each level must be 0 to '//int_text(max_level)//' in '// &
-               & int_text(scene%dim)//'D', error)
+            call nml_field_error(g, 'levels', 'each level must be 0 to '//itoa(max_level)//' in '// &
+               & itoa(scene%dim)//'D', error)
             return
          end if
          do i = 2, size(scene%levels)
@@ -322,7 +323,7 @@ contains
          call nml_get(g, 'refine_boundary', scene%refine_boundary, found, error)
          if (allocated(error)) return
          if (scene%refine_boundary < 0 .or. scene%refine_boundary > max_refine_boundary) then
-            call nml_field_error(g, 'refine_boundary', 'must be 0 to '//int_text(max_refine_boundary), error)
+            call nml_field_error(g, 'refine_boundary', 'must be 0 to '//itoa(max_refine_boundary), error)
             return
          end if
          call get_vector(g, 'box_min', scene%dim, .true., scene%box_min, error)
@@ -447,8 +448,8 @@ contains
             call get_choice(g, 'kind', shape_kinds, .true., shape%kind, error)
             if (allocated(error)) return
             if (kind_dim(shape%kind) /= 0 .and. kind_dim(shape%kind) /= scene%dim) then
-               call nml_field_error(g, 'kind', 'is a '//int_text(kind_dim(shape%kind))//'D shape; analysis = '''// &
-                  & scene%analysis//''' is '//int_text(scene%dim)//'D', error)
+               call nml_field_error(g, 'kind', 'is a '//itoa(kind_dim(shape%kind))//'D shape; analysis = '''// &
+                  & scene%analysis//''' is '//itoa(scene%dim)//'D', error)
                return
             end if
             call get_name(g, 'name', shape%name, error)
@@ -515,7 +516,7 @@ contains
          do i = 1, dim
             if (shape%lower(i) >= shape%upper(i)) then
                call nml_field_error(g, 'upper', 'must exceed lower = '//nml_item_text(g, 'lower')// &
-                  & ' in every component (component '//int_text(i)//' does not)', error)
+                  & ' in every component (component '//itoa(i)//' does not)', error)
                return
             end if
          end do
@@ -564,7 +565,7 @@ contains
             end if
             if (line_of(bc%shape_index) > 0) then
                call nml_field_error(g, 'on', 'this surface already has a &bc (on line '// &
-                  & int_text(line_of(bc%shape_index))//'): one &bc per surface', error)
+                  & itoa(line_of(bc%shape_index))//'): one &bc per surface', error)
                return
             end if
             line_of(bc%shape_index) = g%line
@@ -607,7 +608,7 @@ contains
          if (groups(i)%name /= 'exact') cycle
          if (ig > 0) then
             call nml_group_error(groups(i), 'a second &exact group (the first is on line '// &
-               & int_text(groups(ig)%line)//'): at most one exact solution', error)
+               & itoa(groups(ig)%line)//'): at most one exact solution', error)
             return
          end if
          ig = i
@@ -624,8 +625,8 @@ contains
             return
          end if
          if (kind_dim(exact%kind) /= scene%dim) then
-            call nml_field_error(g, 'kind', 'is a '//int_text(kind_dim(exact%kind))//'D solution; analysis = '''// &
-               & scene%analysis//''' is '//int_text(scene%dim)//'D', error)
+            call nml_field_error(g, 'kind', 'is a '//itoa(kind_dim(exact%kind))//'D solution; analysis = '''// &
+               & scene%analysis//''' is '//itoa(scene%dim)//'D', error)
             return
          end if
          if (exact%kind == 'kirsch') then
@@ -835,8 +836,8 @@ contains
       else if (verify(value, name_chars) /= 0) then
          call nml_field_error(g, key, 'may contain only letters, digits, ''_'', ''-'' and ''.''', error)
       else if (len(value) > max_name_length) then
-         call nml_field_error(g, key, 'is '//int_text(len(value))//' characters long; names have at most '// &
-            & int_text(max_name_length), error)
+         call nml_field_error(g, key, 'is '//itoa(len(value))//' characters long; names have at most '// &
+            & itoa(max_name_length), error)
       end if
    end subroutine get_name
 
@@ -868,7 +869,7 @@ contains
       logical :: found
       call nml_get_array(g, key, value, dim, dim, found, error)
       if (allocated(error)) return
-      if (.not. found .and. required) call nml_field_error(g, key, 'required ('//int_text(dim)//' values)', error)
+      if (.not. found .and. required) call nml_field_error(g, key, 'required ('//itoa(dim)//' values)', error)
    end subroutine get_vector
 
    !> A required nonzero direction, stored normalised.
@@ -953,15 +954,15 @@ contains
       integer :: i, j
 
       text = "scene '"//scene%title//"' from "//scene%source//nl
-      text = text//'  analysis        = '//scene%analysis//' ('//int_text(scene%dim)//'D)'//nl
-      text = text//'  order           = '//int_text(scene%order)//nl
+      text = text//'  analysis        = '//scene%analysis//' ('//itoa(scene%dim)//'D)'//nl
+      text = text//'  order           = '//itoa(scene%order)//nl
       text = text//'  levels          = '//int_list(scene%levels)//nl
-      text = text//'  refine_boundary = '//int_text(scene%refine_boundary)//nl
+      text = text//'  refine_boundary = '//itoa(scene%refine_boundary)//nl
       text = text//'  box_min         = '//real_list(scene%box_min)//nl
       text = text//'  box_size        = '//real_text(scene%box_size)//nl
       text = text//'  recovery        = '//scene%recovery//nl
-      text = text//"  recovery_degree = '"//scene%recovery_degree//"' (SPR "//int_text(recovery_degree(scene, 1))// &
-         & ', SPR-C '//int_text(recovery_degree(scene, 2))//')'//nl
+      text = text//"  recovery_degree = '"//scene%recovery_degree//"' (SPR "//itoa(recovery_degree(scene, 1))// &
+         & ', SPR-C '//itoa(recovery_degree(scene, 2))//')'//nl
       text = text//"  output          = '"//scene%output//"'"//nl
       text = text//'  dilatation      = '//scene%dilatation//nl
       text = text//'  nitsche_gamma   = '//real_text(scene%nitsche_gamma)//nl
@@ -1015,7 +1016,7 @@ contains
          if (scene%order == 1) then
             text = text//'  SPR-C compatibility: off (order 1: holds identically)'//nl
          else
-            text = text//'  SPR-C compatibility: on (order '//int_text(scene%order)//')'//nl
+            text = text//'  SPR-C compatibility: on (order '//itoa(scene%order)//')'//nl
          end if
          surfaces = traction_surfaces(scene)
          if (len(surfaces) > 0) then
@@ -1289,22 +1290,13 @@ contains
       if (scene%recovery_degree == 'p+1') recovery_degree = scene%order + 1
    end function recovery_degree
 
-   !> Decimal text of an integer (no blanks).
-   pure function int_text(i) result(text)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: text
-      character(len=16) :: buf
-      write (buf, '(i0)') i
-      text = trim(buf)
-   end function int_text
-
    function int_list(values) result(text)
       integer, intent(in) :: values(:)
       character(len=:), allocatable :: text
       integer :: i
       text = ''
       do i = 1, size(values)
-         text = join(text, int_text(values(i)))
+         text = join(text, itoa(values(i)))
       end do
    end function int_list
 
@@ -1374,9 +1366,9 @@ contains
          text = sign//'0.'//repeat('0', -e - 1)//digits
       else
          if (n == 1) then
-            text = sign//digits//'.0e'//int_text(e)
+            text = sign//digits//'.0e'//itoa(e)
          else
-            text = sign//digits(1:1)//'.'//digits(2:)//'e'//int_text(e)
+            text = sign//digits(1:1)//'.'//digits(2:)//'e'//itoa(e)
          end if
       end if
    end function real_text

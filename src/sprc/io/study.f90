@@ -2,6 +2,7 @@
 !> `sprc run`) computes, as rows of data; the driver or the C API format them.
 module sprc_io_study
    use sprc_core_kinds, only: wp, i8
+   use sprc_core_strings, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_timer, only: timer_type
    use sprc_geometry_body, only: body_type
@@ -166,24 +167,10 @@ contains
       write (tq, '(es10.3)') row%t_quadrature
       write (m, '(es24.16)') row%measure
       write (bm, '(es24.16)') row%boundary_measure
-      line = 'level='//itoa(row%level)//' body='//row%body//' internal='//itoa8(row%internal)// &
-         ' cut='//itoa8(row%cut)//' external='//itoa8(row%external)//' measure='//trim(adjustl(m))// &
+      line = 'level='//itoa(row%level)//' body='//row%body//' internal='//itoa(row%internal)// &
+         ' cut='//itoa(row%cut)//' external='//itoa(row%external)//' measure='//trim(adjustl(m))// &
          ' boundary_measure='//trim(adjustl(bm))//' points='//itoa(row%points)//' t_mesh='//trim(adjustl(t))// &
          ' t_quadrature='//trim(adjustl(tq))
    end function format_mesh_row
-
-   pure function itoa(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      s = itoa8(int(i, i8))
-   end function itoa
-
-   pure function itoa8(i) result(s)
-      integer(i8), intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=24) :: buf
-      write (buf, '(i0)') i
-      s = trim(buf)
-   end function itoa8
 
 end module sprc_io_study

@@ -39,6 +39,7 @@
 !> e.g. Gmsh; XDMF's own documentation does not fix it.)
 module sprc_io_xdmf
    use sprc_core_error, only: error_type, fatal_error, stat_io, stat_invalid_input
+   use sprc_core_strings, only: itoa
    implicit none
    private
 
@@ -243,7 +244,7 @@ contains
 
       geometry = 'XYZ'
       if (grid%ncoord == 2) geometry = 'XY'
-      text = '   <Grid Name="level_'//itoa2(grid%level)//'" GridType="Uniform">'//nl// &
+      text = '   <Grid Name="level_'//itoa(grid%level, 2)//'" GridType="Uniform">'//nl// &
          '    <Time Value="'//itoa(grid%level)//'"/>'//nl// &
          '    <Topology TopologyType="'//topology_name(grid%cell_type)//'" NumberOfElements="'// &
          itoa(grid%n_cells)//'">'//nl// &
@@ -345,21 +346,5 @@ contains
          end select
       end do
    end function escape
-
-   pure function itoa(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=16) :: buf
-      write (buf, '(i0)') i
-      s = trim(buf)
-   end function itoa
-
-   pure function itoa2(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=16) :: buf
-      write (buf, '(i2.2)') i
-      s = trim(buf)
-   end function itoa2
 
 end module sprc_io_xdmf
