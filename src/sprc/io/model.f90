@@ -7,13 +7,13 @@ module sprc_io_model
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_unsupported
    use sprc_core_material, only: plane_stress, plane_strain, solid
-   use sprc_geometry_shape, only: geometry_shape => shape_type, new_disk, new_sphere, new_ellipse, &
+   use sprc_geometry_shape, only: shape_type, new_disk, new_sphere, new_ellipse, &
       & new_ellipsoid, new_box, new_halfspace, new_cylinder
-   use sprc_geometry_body, only: geometry_body => body_type, new_body, csg_op_from_name, check_body_in_box
+   use sprc_geometry_body, only: body_type, new_body, csg_op_from_name, check_body_in_box
    use sprc_exact_solution, only: exact_solution_type
    use sprc_exact_lame, only: lame_cylinder_type, lame_sphere_type, new_lame_cylinder, new_lame_sphere
    use sprc_exact_kirsch, only: kirsch_type, new_kirsch
-   use sprc_io_scene, only: scene_type, shape_type, real_text
+   use sprc_io_scene, only: scene_type, shape_spec_type, real_text
    use sprc_fem_problem, only: gamma_note
    use sprc_core_strings, only: itoa
    implicit none
@@ -135,7 +135,7 @@ contains
    !> steps; the errors would compare with the solution of another problem).
    function scene_warnings(scene, bodies) result(text)
       type(scene_type), intent(in) :: scene
-      type(geometry_body), intent(in) :: bodies(:)
+      type(body_type), intent(in) :: bodies(:)
       character(len=:), allocatable :: text
       real(wp) :: load, r(2), step
       integer :: i
@@ -188,7 +188,7 @@ contains
    !> the body. `step` is the lattice diagonal.
    subroutine distance_range(scene, body, center, r, step)
       type(scene_type), intent(in) :: scene
-      type(geometry_body), intent(in) :: body
+      type(body_type), intent(in) :: body
       real(wp), intent(in) :: center(:)
       real(wp), intent(out) :: r(2), step
       real(wp) :: x(3), h, dist
@@ -227,9 +227,9 @@ contains
    !> material outside the scene's box is an input error (the grid would clip it).
    subroutine build_bodies(scene, bodies, error)
       type(scene_type), intent(in) :: scene
-      type(geometry_body), allocatable, intent(out) :: bodies(:)
+      type(body_type), allocatable, intent(out) :: bodies(:)
       type(error_type), allocatable, intent(out) :: error
-      type(geometry_shape) :: shape
+      type(shape_type) :: shape
       integer :: b, s
 
       allocate (bodies(size(scene%bodies)))
@@ -254,8 +254,8 @@ contains
    end subroutine build_bodies
 
    subroutine build_shape(spec, shape, error)
-      type(shape_type), intent(in) :: spec
-      type(geometry_shape), intent(out) :: shape
+      type(shape_spec_type), intent(in) :: spec
+      type(shape_type), intent(out) :: shape
       type(error_type), allocatable, intent(out) :: error
 
       select case (spec%kind)

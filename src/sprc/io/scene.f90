@@ -16,11 +16,11 @@ module sprc_io_scene
    implicit none
    private
 
-   public :: scene_type, body_type, shape_type, bc_type, exact_type, contact_type
+   public :: scene_type, body_spec_type, shape_spec_type, bc_spec_type, exact_spec_type, contact_spec_type
    public :: read_scene, read_scene_text, default_scene_text, scene_summary, recovery_degree, real_text
 
    !> One elastic body.
-   type :: body_type
+   type :: body_spec_type
       !> Unique non-empty name.
       character(len=:), allocatable :: name
       !> Young's modulus, > 0.
@@ -29,11 +29,11 @@ module sprc_io_scene
       real(wp) :: poisson = 0.0_wp
       !> Body force per unit volume, `dim` values.
       real(wp), allocatable :: body_force(:)
-   end type body_type
+   end type body_spec_type
 
    !> One CSG primitive of a body; its surface keeps `name`.
    !> Array fields are allocated (with `dim` values) only for the kinds using them.
-   type :: shape_type
+   type :: shape_spec_type
       !> Name of the body it builds.
       character(len=:), allocatable :: body
       !> Index of that body in `scene%bodies`.
@@ -61,10 +61,10 @@ module sprc_io_scene
       real(wp), allocatable :: normal(:)
       !> Unit axis direction (cylinder).
       real(wp), allocatable :: axis(:)
-   end type shape_type
+   end type shape_spec_type
 
    !> A boundary condition on one shape surface.
-   type :: bc_type
+   type :: bc_spec_type
       !> Name of the shape surface.
       character(len=:), allocatable :: on
       !> Index of that shape in `scene%shapes`.
@@ -76,10 +76,10 @@ module sprc_io_scene
       real(wp) :: value = 0.0_wp
       !> Traction or displacement (types 'traction', 'displacement'), `dim` values.
       real(wp), allocatable :: vector(:)
-   end type bc_type
+   end type bc_spec_type
 
    !> The analytical solution, if any.
-   type :: exact_type
+   type :: exact_spec_type
       !> Whether the scene has an `&exact` group.
       logical :: present = .false.
       !> 'lame_cylinder' | 'lame_sphere' | 'kirsch'.
@@ -90,10 +90,10 @@ module sprc_io_scene
       real(wp) :: r_in = 0.0_wp, r_out = 0.0_wp, p_in = 0.0_wp, p_out = 0.0_wp
       !> Kirsch: hole radius and remote uniaxial stress along x.
       real(wp) :: radius = 0.0_wp, s_inf = 0.0_wp
-   end type exact_type
+   end type exact_spec_type
 
    !> A contact pair between two bodies.
-   type :: contact_type
+   type :: contact_spec_type
       !> Body names and their indices in `scene%bodies`.
       character(len=:), allocatable :: slave, master
       integer :: slave_index = 0, master_index = 0
@@ -107,7 +107,7 @@ module sprc_io_scene
       !> Stabilisation parameter, > 0 when given.
       real(wp) :: kappa = 0.0_wp
       logical :: has_kappa = .false.
-   end type contact_type
+   end type contact_spec_type
 
    !> A validated scene, defaults filled in.
    type :: scene_type
@@ -139,11 +139,11 @@ module sprc_io_scene
       character(len=:), allocatable :: dilatation
       !> Nitsche penalty factor, > 0 (default `default_gamma(order)`).
       real(wp) :: nitsche_gamma = 0.0_wp
-      type(body_type), allocatable :: bodies(:)
-      type(shape_type), allocatable :: shapes(:)
-      type(bc_type), allocatable :: bcs(:)
-      type(exact_type) :: exact
-      type(contact_type), allocatable :: contacts(:)
+      type(body_spec_type), allocatable :: bodies(:)
+      type(shape_spec_type), allocatable :: shapes(:)
+      type(bc_spec_type), allocatable :: bcs(:)
+      type(exact_spec_type) :: exact
+      type(contact_spec_type), allocatable :: contacts(:)
    end type scene_type
 
    character(len=*), parameter :: known_groups(6) = [character(len=7) :: 'scene', 'body', 'shape', 'bc', &
@@ -480,7 +480,7 @@ contains
    subroutine read_shape_fields(g, dim, shape, error)
       type(nml_group_type), intent(inout) :: g
       integer, intent(in) :: dim
-      type(shape_type), intent(inout) :: shape
+      type(shape_spec_type), intent(inout) :: shape
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: fields
       integer :: i
@@ -1162,7 +1162,7 @@ contains
    end function surfaces_of_type
 
    function shape_line(shape) result(text)
-      type(shape_type), intent(in) :: shape
+      type(shape_spec_type), intent(in) :: shape
       character(len=:), allocatable :: text
       text = "shape '"//shape%name//"': "//shape%op//' '//shape%kind
       if (allocated(shape%center)) text = text//', center = '//real_list(shape%center)
@@ -1178,7 +1178,7 @@ contains
    end function shape_line
 
    function bc_line(bc) result(text)
-      type(bc_type), intent(in) :: bc
+      type(bc_spec_type), intent(in) :: bc
       character(len=:), allocatable :: text
       text = "on '"//bc%on//"': "//bc%type
       if (bc%type == 'pressure') text = text//', value = '//real_text(bc%value)
@@ -1186,7 +1186,7 @@ contains
    end function bc_line
 
    function exact_line(exact) result(text)
-      type(exact_type), intent(in) :: exact
+      type(exact_spec_type), intent(in) :: exact
       character(len=:), allocatable :: text
       text = exact%kind//', center = '//real_list(exact%center)
       if (exact%kind == 'kirsch') then
@@ -1198,7 +1198,7 @@ contains
    end function exact_line
 
    function contact_line(c) result(text)
-      type(contact_type), intent(in) :: c
+      type(contact_spec_type), intent(in) :: c
       character(len=:), allocatable :: text
       text = "slave '"//c%slave//"' surface '"//c%slave_surface//"', master '"//c%master//"' surface '"// &
          & c%master_surface//"', friction = "//c%friction
