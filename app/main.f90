@@ -9,12 +9,13 @@ program sprc_main
    use sprc_core_error, only: error_type, stat_invalid_input, stat_io
    use sprc_version, only: sprc_version_string
    use sprc_io_scene, only: scene_type, read_scene, read_scene_text, scene_summary, default_scene_text
-   use sprc_io_model, only: build_bodies, scene_warnings
-   use sprc_io_budget, only: level_memory
+   use sprc_study_model, only: build_bodies, scene_warnings
+   use sprc_study_budget, only: level_memory
    use sprc_geometry_body, only: body_type
-   use sprc_io_study, only: mesh_row_type, mesh_study, format_mesh_row, study_levels
-   use sprc_io_run, only: run_model_type, prepare_run, run_level
-   use sprc_io_report, only: report_row_type, report_table, write_report_csv
+   use sprc_study_mesh, only: mesh_row_type, mesh_study, study_levels
+   use sprc_study_level, only: study_type, prepare_study, run_level, level_type
+   use sprc_io_report, only: report_row_type, report_table, write_report_csv, format_mesh_row
+   use sprc_io_fields, only: write_level_fields
    use sprc_io_svg, only: write_report_svg
    use sprc_io_hdf5, only: h5_output_type
    use sprc_app_cli, only: cli_type, parse_cli, usage_text
@@ -96,21 +97,22 @@ contains
    subroutine run_study(scene, cli)
       type(scene_type), intent(in) :: scene
       type(cli_type), intent(in) :: cli
-      type(run_model_type) :: model
+      type(study_type) :: study
+      type(level_type) :: result
       type(report_row_type), allocatable :: rows(:)
       type(h5_output_type) :: h5
       type(error_type), allocatable :: error
       character(len=:), allocatable :: prefix
       integer, allocatable :: levels(:)
-      integer :: i, threads
+      integer :: i, b, threads
       character(len=16) :: buf
-      real(wp) :: cells, dofs, bytes
+      real(wp) :: cells, dofs, bytes, total_dofs
 
       call study_levels(scene, cli%levels, levels, error)
       if (allocated(error)) call fail(2, error%message)
-      call prepare_run(scene, cli%points, model, error)
+      call prepare_study(scene, cli%points, study, error)
       if (allocated(error)) call fail_with(error)
-      call print_warnings(scene_warnings(scene, [model%body]))
+      call print_warnings(scene_warnings(scene, study%bodies%geometry))
       if (cli%threads > 0) call omp_set_num_threads(cli%threads)
       prefix = scene%output
       if (len(cli%output) > 0) prefix = cli%output
@@ -124,13 +126,21 @@ contains
       threads = omp_get_max_threads()
       do i = 1, size(levels)
          if (cli%threads == 0) then
-            call level_memory(scene, model%body, levels(i), cells, dofs, bytes, error)
-            if (allocated(error)) call fail_with(error)
-            call omp_set_num_threads(merge(1, threads, dofs < serial_dofs))
+            total_dofs = 0.0_wp
+            do b = 1, size(study%bodies)
+               call level_memory(scene, study%bodies(b)%geometry, levels(i), cells, dofs, bytes, error)
+               if (allocated(error)) call fail_with(error)
+               total_dofs = total_dofs + dofs
+            end do
+            call omp_set_num_threads(merge(1, threads, total_dofs < serial_dofs))
          end if
          if (.not. cli%quiet) write (error_unit, '(a,i0,a,i0,a,i0,a)') 'sprc: level ', levels(i), &
             ' (', i, ' of ', size(levels), ')'
-         call run_level(scene, model, levels(i), rows(i), error, h5)
+         call run_level(study, levels(i), result, error)
+         if (.not. allocated(error)) then
+            rows(i) = result%row
+            if (h5%opened()) call write_level_fields(h5, study, result, error)
+         end if
          if (allocated(error)) then
             write (buf, '("level ",i0,":")') levels(i)
             error%message = trim(buf)//' '//error%message

@@ -22,14 +22,15 @@ module sprc
    use sprc_geometry_shape, only: geometry_shape_type => shape_type
    use sprc_geometry_body, only: geometry_body_type => body_type, new_body
    use sprc_io_scene, only: scene_type, read_scene, read_scene_text, scene_summary, default_scene_text
-   use sprc_io_model, only: build_bodies, build_exact
+   use sprc_study_model, only: build_bodies, build_exact, body_conditions
    use sprc_recovery_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, mesh_method_spr, &
       & mesh_method_sprc, facet_traction, facet_symmetry, facet_free, facet_pressure, elem_tri3, elem_quad4, &
       & elem_tet4, elem_hex8, elem_quad9, elem_hex27
-   use sprc_io_study, only: mesh_row_type, mesh_study, format_mesh_row, study_levels
-   use sprc_io_run, only: run_model_type, prepare_run, run_level
+   use sprc_study_mesh, only: mesh_row_type, mesh_study, study_levels
+   use sprc_study_level, only: study_type, study_body_type, prepare_study, run_level, level_type, body_level_type
+   use sprc_io_fields, only: write_level_fields
    use sprc_io_report, only: report_row_type, report_table, write_report_csv, read_report_csv, report_column, &
-      & report_empty, is_empty, report_columns
+      & report_empty, is_empty, report_columns, format_mesh_row
    use sprc_io_svg, only: write_report_svg
    use sprc_version, only: sprc_version_string, sprc_version_number, get_sprc_version
    implicit none

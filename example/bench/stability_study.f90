@@ -1,6 +1,6 @@
 !> Stability study (issue 15): the Lame quarter cylinder of the default scene
 !> (plane strain, pressure 1 inside) run through the driver's own path
-!> (`prepare_run`, `run_level`), under
+!> (`prepare_study`, `run_level`), under
 !>   1. a Poisson sweep 0.3 ... 0.4999, Q1 and Q2 (level 6), with the
 !>      displacement formulation (dilatation = 'full') and the locking-free one
 !>      ('projected');
@@ -22,8 +22,8 @@ program stability_study
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type
    use sprc_io_scene, only: scene_type, read_scene_text
-   use sprc_io_run, only: run_model_type, prepare_run, run_level
-   use sprc_io_report, only: report_row_type
+   use sprc_study_level, only: study_type, prepare_study, run_level, level_type
+   use sprc_study_row, only: report_row_type
    use sprc_fem_problem, only: default_gamma, gamma_note
    implicit none
 
@@ -120,15 +120,16 @@ contains
       real(wp), intent(in) :: gamma
       type(result_type) :: r
       type(scene_type) :: scene
-      type(run_model_type) :: model
+      type(study_type) :: study
+      type(level_type) :: result
       type(report_row_type) :: row
       type(error_type), allocatable :: error
 
       call read_scene_text(text, 'stability_study', scene, error)
-      if (.not. allocated(error)) call prepare_run(scene, 0, model, error)
+      if (.not. allocated(error)) call prepare_study(scene, 0, study, error)
       if (.not. allocated(error)) then
-         if (gamma > 0.0_wp) model%gamma = gamma
-         call run_level(scene, model, scene%levels(1), row, error, rcond=r%rcond)
+         if (gamma > 0.0_wp) study%gamma = gamma
+         call run_level(study, scene%levels(1), result, error)
       end if
       if (allocated(error)) then
          write (output_unit, '("run failed: ",a)') error%message
@@ -136,6 +137,8 @@ contains
          r%err_fe = huge(1.0_wp)
          return
       end if
+      row = result%row
+      r%rcond = result%bodies(1)%problem%rcond
       r%err_fe = row%err_fe
       r%err_sprc = row%err_sprc
       r%eta_sprc = row%eta_sprc

@@ -23,6 +23,7 @@ program sprc_unit_tests
    use sprc_test_patches, only: collect_patches
    use sprc_test_mesh_recovery, only: collect_mesh_recovery
    use sprc_test_stiff, only: collect_stiff
+   use sprc_test_study, only: collect_study
    implicit none
 
    type(testsuite_type), allocatable :: suites(:)
@@ -48,7 +49,8 @@ program sprc_unit_tests
       new_testsuite('output', collect_output), &
       new_testsuite('fem', collect_fem), &
       new_testsuite('mesh_recovery', collect_mesh_recovery), &
-      new_testsuite('stiff', collect_stiff) &
+      new_testsuite('stiff', collect_stiff), &
+      new_testsuite('study', collect_study) &
       ]
 
    call get_arg(1, suite_name)

@@ -6,8 +6,8 @@ module sprc_test_model
    use sprc_geometry_region, only: cell_inside, cell_outside, cell_cut
    use sprc_exact_solution, only: exact_solution_type
    use sprc_io_scene, only: scene_type, read_scene, read_scene_text, default_scene_text
-   use sprc_io_model, only: build_bodies, build_exact
-   use sprc_io_budget, only: level_memory, check_level_memory
+   use sprc_study_model, only: build_bodies, build_exact
+   use sprc_study_budget, only: level_memory, check_level_memory
    use sprc_core_memory, only: available_memory
    use sprc_grid_tree, only: grid_type
    use sprc_testsuite, only: unittest_type, new_unittest, check

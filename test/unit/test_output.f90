@@ -52,7 +52,8 @@ contains
          new_unittest('level_errors', test_level_errors), &
          new_unittest('field_errors', test_field_errors), &
          new_unittest('xdmf_errors', test_xdmf_errors), &
-         new_unittest('run_fields_resolve', test_run_fields) &
+         new_unittest('run_fields_resolve', test_run_fields), &
+         new_unittest('run_fields_two_bodies', test_run_fields_bodies) &
          ]
    end subroutine collect_output
 
@@ -454,6 +455,24 @@ contains
       xyz(1:2, :) = mesh%x
       call out%write_level(2, xyz, mesh%conn, cell_quad4, error)
       if (allocated(error)) return
+      ! Grids of bodies: valid names, each once, not next to an unnamed grid.
+      call out%write_level(1, mesh%x, mesh%conn, cell_quad4, err, body='a')
+      call check_error(error, err, stat_invalid_input, 'one unnamed grid or named ones')
+      if (allocated(error)) return
+      call out%write_level(3, mesh%x, mesh%conn, cell_quad4, err, body='1st')
+      call check_error(error, err, stat_invalid_input, 'a body name is a letter')
+      if (allocated(error)) return
+      call out%write_level(3, mesh%x, mesh%conn, cell_quad4, error, body='a')
+      if (allocated(error)) return
+      call out%write_level(3, mesh%x, mesh%conn, cell_quad4, err, body='a')
+      call check_error(error, err, stat_invalid_input, 'level 3 body "a": already written')
+      if (allocated(error)) return
+      call out%write_level(3, mesh%x, mesh%conn, cell_quad4, err)
+      call check_error(error, err, stat_invalid_input, 'one unnamed grid or named ones')
+      if (allocated(error)) return
+      call out%write_node_field(3, 'u', mesh%x, err, body='b')
+      call check_error(error, err, stat_invalid_input, 'level not written yet')
+      if (allocated(error)) return
       call out%close(error)
    end subroutine test_level_errors
 
@@ -538,26 +557,28 @@ contains
    !> shape, and the displacement has one row per node of the level's mesh.
    subroutine test_run_fields(error)
       use sprc_io_scene, only: scene_type, read_scene_text, default_scene_text
-      use sprc_io_run, only: run_model_type, prepare_run, run_level
-      use sprc_io_report, only: report_row_type
+      use sprc_study_level, only: study_type, prepare_study, run_level, level_type
+      use sprc_io_fields, only: write_level_fields
       type(error_type), allocatable, intent(out) :: error
       type(scene_type) :: scene
-      type(run_model_type) :: model
-      type(report_row_type) :: row
+      type(study_type) :: study
+      type(level_type) :: result
       type(h5_output_type) :: h5
       integer :: level
 
       call read_scene_text(default_scene_text(), 'default', scene, error)
       if (allocated(error)) return
-      call prepare_run(scene, 0, model, error)
+      call prepare_study(scene, 0, study, error)
       if (allocated(error)) return
       call h5%create('build/test_output_run.h5', error)
       if (allocated(error)) return
       do level = 3, 4
-         call run_level(scene, model, level, row, error, h5)
+         call run_level(study, level, result, error)
          if (allocated(error)) return
-         call check(error, row%err_fe > 0.0_wp .and. row%err_fe < 1.0_wp .and. row%eta_spr > 0.0_wp, &
-            'report row of the level has its errors')
+         call write_level_fields(h5, study, result, error)
+         if (allocated(error)) return
+         call check(error, result%row%err_fe > 0.0_wp .and. result%row%err_fe < 1.0_wp .and. &
+            result%row%eta_spr > 0.0_wp, 'report row of the level has its errors')
          if (allocated(error)) return
       end do
       call h5%close(error)
@@ -566,6 +587,59 @@ contains
       if (allocated(error)) return
       call check_xdmf('build/test_output_run.xdmf', 'test_output_run.h5', -1, error)
    end subroutine test_run_fields
+
+   !> Two bodies: each level is a spatial collection of one grid per body, under
+   !> `/level_LL/<body>/`; every reference resolves, and a body's displacement
+   !> reads back bit for bit.
+   subroutine test_run_fields_bodies(error)
+      use sprc_io_scene, only: scene_type, read_scene_text
+      use sprc_study_level, only: study_type, prepare_study, run_level, level_type
+      use sprc_io_fields, only: write_level_fields
+      use sprc_test_study, only: two_body_scene
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(study_type) :: study
+      type(level_type) :: result
+      type(h5_output_type) :: h5
+      character(len=:), allocatable :: text
+      real(wp), allocatable :: u(:, :)
+      integer(hid_t) :: file
+      integer :: level, hdferr
+
+      call read_scene_text(two_body_scene(.true., .true., '3'), 'two bodies', scene, error)
+      if (allocated(error)) return
+      call prepare_study(scene, 0, study, error)
+      if (allocated(error)) return
+      call h5%create('build/test_output_bodies.h5', error)
+      if (allocated(error)) return
+      do level = 4, 3, -1
+         call run_level(study, level, result, error)
+         if (allocated(error)) return
+         call write_level_fields(h5, study, result, error)
+         if (allocated(error)) return
+      end do
+      call h5%close(error)
+      if (allocated(error)) return
+      call h5%write_xdmf('build/test_output_bodies.xdmf', error)
+      if (allocated(error)) return
+      call check_xdmf('build/test_output_bodies.xdmf', 'test_output_bodies.h5', -1, error)
+      if (allocated(error)) return
+      call read_text_file('build/test_output_bodies.xdmf', text, error)
+      if (allocated(error)) return
+      call check(error, index(text, '<Grid Name="level_03" GridType="Collection" CollectionType="Spatial">') > 0 &
+         & .and. index(text, '<Grid Name="block" GridType="Uniform">') > 0 .and. &
+         & index(text, 'level_03') < index(text, 'level_04'), 'levels in order, bodies as spatial collections')
+      if (allocated(error)) return
+      call h5fopen_f('build/test_output_bodies.h5', H5F_ACC_RDONLY_F, file, hdferr)
+      call check(error, hdferr >= 0, 'open the HDF5 file')
+      if (allocated(error)) return
+      associate (ub => result%bodies(2)%problem%u)
+         call read_real(file, '/level_03/block/node/displacement', [3, size(ub, 2)], u, error)
+         if (.not. allocated(error)) call check(error, all(u(1:2, :) == study%bodies(2)%units%strain*ub) .and. &
+            & all(u(3, :) == 0.0_wp), 'displacement of the block at level 3 reads back (in the scene''s units)')
+      end associate
+      call h5fclose_f(file, hdferr)
+   end subroutine test_run_fields_bodies
 
    !> Every `<DataItem ... Format="HDF">FILE:/PATH</DataItem>` of the XDMF file
    !> must name `h5_name`, and PATH must be a dataset whose dimensions (C

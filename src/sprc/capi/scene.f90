@@ -5,9 +5,9 @@ module sprc_capi_scene
    use, intrinsic :: iso_c_binding, only: c_ptr, c_int, c_null_ptr, c_associated, c_f_pointer, c_loc
    use sprc_core_error, only: error_type, stat_invalid_input, stat_out_of_memory
    use sprc_io_scene, only: scene_type, read_scene
-   use sprc_io_study, only: study_levels
-   use sprc_io_run, only: run_model_type, prepare_run, run_level
-   use sprc_io_report, only: report_row_type
+   use sprc_study_mesh, only: study_levels
+   use sprc_study_level, only: study_type, prepare_study, run_level, level_type
+   use sprc_study_row, only: report_row_type
    use sprc_capi_error, only: capi_error_type, get_capi_error, set_capi_error
    use sprc_capi_report, only: capi_report_type
    use sprc_capi_string, only: c_string
@@ -73,7 +73,8 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer(c_int), intent(in), optional :: override(:)
       type(scene_type) :: scene
-      type(run_model_type) :: model
+      type(study_type) :: study
+      type(level_type) :: result
       integer, allocatable :: levels(:)
       integer :: i
 
@@ -85,12 +86,13 @@ contains
          call study_levels(scene, levels=levels, error=error)
       end if
       if (allocated(error)) return
-      call prepare_run(scene, 0, model, error)
+      call prepare_study(scene, 0, study, error)
       if (allocated(error)) return
       allocate (rows(size(levels)))
       do i = 1, size(levels)
-         call run_level(scene, model, levels(i), rows(i), error)
+         call run_level(study, levels(i), result, error)
          if (allocated(error)) return
+         rows(i) = result%row
       end do
    end subroutine run_study
 

@@ -1,11 +1,12 @@
 !> Numbers as text for messages and file formats: one implementation for
 !> every layer.
 module sprc_core_strings
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_is_finite
    use sprc_core_kinds, only: wp, i4, i8
    implicit none
    private
 
-   public :: itoa, rtoa
+   public :: itoa, rtoa, real_text
 
    !> An integer in its shortest decimal form (`i0`); with `digits`, padded
    !> with leading zeros to at least that many digits (`itoa(4, 2)` = '04',
@@ -45,5 +46,68 @@ contains
       write (buf, '(es12.4)') x
       s = trim(adjustl(buf))
    end function rtoa
+
+   !> Shortest decimal text that reads back as the same real: fixed notation
+   !> for moderate exponents (`1000.0`, `0.3`), else `2.5e-7` style (`1.0e-300`);
+   !> `NaN`, `Infinity`, `-Infinity` for the non-finite values.
+   function real_text(x) result(text)
+      real(wp), intent(in) :: x
+      character(len=:), allocatable :: text
+      character(len=40) :: buf
+      character(len=16) :: fmt
+      character(len=:), allocatable :: digits, sign
+      real(wp) :: y
+      integer :: d, ios, epos, e, n
+
+      if (ieee_is_nan(x)) then
+         text = 'NaN'
+         return
+      else if (.not. ieee_is_finite(x)) then
+         text = merge('-Infinity', ' Infinity', x < 0.0_wp)
+         text = trim(adjustl(text))
+         return
+      end if
+      ! Three exponent digits (e3): with the default width a three-digit
+      ! exponent is written without its 'E' (1.0+100).
+      do d = 1, 17
+         write (fmt, '("(es40.",i0,"e3)")') d - 1
+         write (buf, fmt) x
+         read (buf, *, iostat=ios) y
+         ! Bitwise identity is what 'reads back as the same real' means.
+         if (ios == 0 .and. transfer(y, 0_i8) == transfer(x, 0_i8)) exit
+      end do
+      buf = adjustl(buf)
+      sign = ''
+      if (buf(1:1) == '-') then
+         sign = '-'
+         buf = buf(2:)
+      end if
+      epos = index(buf, 'E')
+      read (buf(epos + 1:), *) e
+      digits = buf(1:1)//buf(3:epos - 1)
+      if (buf(2:2) /= '.') digits = buf(1:1)
+      n = len(digits)
+      do while (n > 1)
+         if (digits(n:n) /= '0') exit
+         n = n - 1
+      end do
+      digits = digits(1:n)
+      if (digits == '0') e = 0
+      if (e >= 0 .and. e < 15) then
+         if (n <= e + 1) then
+            text = sign//digits//repeat('0', e + 1 - n)//'.0'
+         else
+            text = sign//digits(1:e + 1)//'.'//digits(e + 2:)
+         end if
+      else if (e < 0 .and. e >= -4) then
+         text = sign//'0.'//repeat('0', -e - 1)//digits
+      else
+         if (n == 1) then
+            text = sign//digits//'.0e'//itoa(e)
+         else
+            text = sign//digits(1:1)//'.'//digits(2:)//'e'//itoa(e)
+         end if
+      end if
+   end function real_text
 
 end module sprc_core_strings

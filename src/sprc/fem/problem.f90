@@ -1070,13 +1070,15 @@ contains
    !> Energy norms over the true domain (cut-cell volume rules), with
    !> ||s||_E^2 = int s^T D^-1 s: err_fe = ||sigma_ex - sigma_h||_E / ||sigma_ex||_E,
    !> element_error(e) = ||sigma_ex - sigma_h||_E on element e, norm_fe = ||sigma_h||_E,
-   !> norm_exact = ||sigma_ex||_E. Needs the exact solution given to setup.
-   subroutine energy_error(self, err_fe, element_error, norm_fe, norm_exact, error)
+   !> norm_exact = ||sigma_ex||_E and optionally err_norm = ||sigma_ex - sigma_h||_E
+   !> (sums over several bodies add its square). Needs the exact solution given to setup.
+   subroutine energy_error(self, err_fe, element_error, norm_fe, norm_exact, error, err_norm)
       class(elasticity_problem_type), intent(in) :: self
       real(wp), intent(out) :: err_fe
       real(wp), allocatable, intent(out) :: element_error(:)
       real(wp), intent(out) :: norm_fe, norm_exact
       type(error_type), allocatable, intent(out) :: error
+      real(wp), intent(out), optional :: err_norm
       real(wp), allocatable :: parts(:, :)
       real(wp) :: sh(6), se(6), c(6, 6), de(6)
       integer :: e, q, ns, nel
@@ -1084,6 +1086,7 @@ contains
       err_fe = 0.0_wp
       norm_fe = 0.0_wp
       norm_exact = 0.0_wp
+      if (present(err_norm)) err_norm = 0.0_wp
       if (.not. self%solved) then
          call fatal_error(error, 'energy_error: the problem is not solved', stat_invalid_input)
          return
@@ -1113,6 +1116,7 @@ contains
       norm_fe = sqrt(sum(parts(2, :)))
       norm_exact = sqrt(sum(parts(3, :)))
       err_fe = sqrt(sum(parts(1, :)))/max(norm_exact, tiny(1.0_wp))
+      if (present(err_norm)) err_norm = sqrt(sum(parts(1, :)))
    end subroutine energy_error
 
    !> Reciprocal 1-norm condition estimate of the diagonally scaled reduced

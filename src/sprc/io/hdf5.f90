@@ -31,7 +31,7 @@ module sprc_io_hdf5
    use sprc_core_error, only: error_type, fatal_error, stat_io, stat_invalid_input
    use sprc_io_xdmf, only: xdmf_grid_type, xdmf_field_type, write_xdmf_file => write_xdmf, &
       & cell_nodes, cell_dim, topology_name, center_node, center_cell, field_scalar, field_vector, &
-      & field_components, level_group, mesh_x_path, mesh_connectivity_path, field_path, n_attributes, &
+      & field_components, level_group, grid_group, mesh_x_path, mesh_connectivity_path, field_path, n_attributes, &
       & attribute_name, valid_name, max_name_length
    implicit none
    private
@@ -124,28 +124,47 @@ contains
    !> (dim 2 or 3) and `connectivity(nodes_per_cell, n_cells)` with 1-based
    !> node numbers in VTK local order (stored 0-based). `cell_type` is one of
    !> `cell_quad4`, `cell_quad9`, `cell_hex8`, `cell_hex27` (`sprc_io_xdmf`).
-   !> Each level (0..99) is written once.
-   subroutine h5_write_level(self, level, nodes_x, connectivity, cell_type, error)
+   !> Each level (0..99) is written once; with `body` (a name as for fields),
+   !> each body of each level once, under `/level_LL/<body>/`. A level holds
+   !> either one unnamed grid or named ones.
+   subroutine h5_write_level(self, level, nodes_x, connectivity, cell_type, error, body)
       class(h5_output_type), intent(inout) :: self
       integer, intent(in) :: level
       real(wp), intent(in), target, contiguous :: nodes_x(:, :)
       integer, intent(in) :: connectivity(:, :)
       integer, intent(in) :: cell_type
       type(error_type), allocatable, intent(out) :: error
+      character(len=*), intent(in), optional :: body
       integer, allocatable, target :: conn0(:, :)
       type(xdmf_grid_type) :: grid
       type(h5_quiet_type) :: quiet
       character(len=:), allocatable :: where
+      logical :: new_level
 
-      where = 'HDF5 output "'//file_name(self)//'" level '//itoa(level)//': '
+      grid%level = level
+      grid%body = ''
+      if (present(body)) grid%body = body
+      where = grid_where(self, grid)//': '
       call check_open(self, where, error)
       if (allocated(error)) return
       if (level < 0 .or. level > 99) then
          call fatal_error(error, where//'level must be in 0..99', stat_invalid_input)
          return
       end if
-      if (find_grid(self, level) > 0) then
+      if (len(grid%body) > 0 .and. .not. valid_name(grid%body)) then
+         call fatal_error(error, where//'a body name is a letter or _, then letters, digits, _ - . (at most '// &
+            itoa(max_name_length)//')', stat_invalid_input)
+         return
+      end if
+      if (find_grid(self, level, grid%body) > 0) then
          call fatal_error(error, where//'already written', stat_invalid_input)
+         return
+      end if
+      new_level = .true.
+      if (self%n_grids > 0) new_level = .not. any(self%grids(:self%n_grids)%level == level)
+      if (.not. new_level .and. (len(grid%body) == 0 .or. find_grid(self, level, '') > 0)) then
+         call fatal_error(error, where//'a level holds one unnamed grid or named ones (bodies), not both', &
+            stat_invalid_input)
          return
       end if
       if (cell_nodes(cell_type) == 0) then
@@ -175,11 +194,10 @@ contains
 
       conn0 = connectivity - 1
       call quiet_begin(quiet)
-      call write_level_data(self, level, nodes_x, conn0, where, error)
+      call write_level_data(self, grid, new_level, nodes_x, conn0, where, error)
       call quiet_end(quiet)
       if (allocated(error)) return
 
-      grid%level = level
       grid%ncoord = size(nodes_x, 1)
       grid%n_nodes = size(nodes_x, 2)
       grid%n_cells = size(connectivity, 2)
@@ -190,9 +208,10 @@ contains
       self%grids(self%n_grids) = grid
    end subroutine h5_write_level
 
-   subroutine write_level_data(self, level, nodes_x, conn0, where, error)
+   subroutine write_level_data(self, grid, new_level, nodes_x, conn0, where, error)
       type(h5_output_type), intent(in) :: self
-      integer, intent(in) :: level
+      type(xdmf_grid_type), intent(in) :: grid
+      logical, intent(in) :: new_level
       real(wp), intent(in), target, contiguous :: nodes_x(:, :)
       integer, intent(in), target, contiguous :: conn0(:, :)
       character(len=*), intent(in) :: where
@@ -200,14 +219,18 @@ contains
       character(len=*), parameter :: groups(4) = [character(len=5) :: '', '/mesh', '/node', '/cell']
       integer :: k
 
+      if (new_level .and. len(grid%body) > 0) then
+         call create_group(self%file, level_group(grid%level), where, error)
+         if (allocated(error)) return
+      end if
       do k = 1, size(groups)
-         call create_group(self%file, level_group(level)//trim(groups(k)), where, error)
+         call create_group(self%file, grid_group(grid)//trim(groups(k)), where, error)
          if (allocated(error)) return
       end do
-      call write_dataset(self%file, mesh_x_path(level), shape(nodes_x, hsize_t), H5T_NATIVE_DOUBLE, &
+      call write_dataset(self%file, mesh_x_path(grid), shape(nodes_x, hsize_t), H5T_NATIVE_DOUBLE, &
          c_loc(nodes_x), where, error)
       if (allocated(error)) return
-      call write_dataset(self%file, mesh_connectivity_path(level), shape(conn0, hsize_t), H5T_NATIVE_INTEGER, &
+      call write_dataset(self%file, mesh_connectivity_path(grid), shape(conn0, hsize_t), H5T_NATIVE_INTEGER, &
          c_loc(conn0), where, error)
    end subroutine write_level_data
 
@@ -216,53 +239,59 @@ contains
    !> 3, z = 0 in 2D); with `components` (one name per row of `values`,
    !> e.g. ['xx', 'yy', 'xy'] for 2D Voigt stresses) ParaView shows one
    !> scalar `<name>_<component>` per row.
-   subroutine h5_write_node_field(self, level, name, values, error, components)
+   subroutine h5_write_node_field(self, level, name, values, error, components, body)
       class(h5_output_type), intent(inout) :: self
       integer, intent(in) :: level
       character(len=*), intent(in) :: name
       real(wp), intent(in) :: values(:, :)
       type(error_type), allocatable, intent(out) :: error
       character(len=*), intent(in), optional :: components(:)
+      !> The body of the level's grid (as given to write_level).
+      character(len=*), intent(in), optional :: body
 
-      call write_field(self, center_node, level, name, size(values, 1), size(values, 2), error, components, &
+      call write_field(self, center_node, level, name, size(values, 1), size(values, 2), error, components, body, &
          real_values=values)
    end subroutine h5_write_node_field
 
    !> Write a real cell field `values(ncomp, n_cells)` (e.g. element error
    !> indicators); components as for node fields.
-   subroutine h5_write_cell_field_real(self, level, name, values, error, components)
+   subroutine h5_write_cell_field_real(self, level, name, values, error, components, body)
       class(h5_output_type), intent(inout) :: self
       integer, intent(in) :: level
       character(len=*), intent(in) :: name
       real(wp), intent(in) :: values(:, :)
       type(error_type), allocatable, intent(out) :: error
       character(len=*), intent(in), optional :: components(:)
+      !> The body of the level's grid (as given to write_level).
+      character(len=*), intent(in), optional :: body
 
-      call write_field(self, center_cell, level, name, size(values, 1), size(values, 2), error, components, &
+      call write_field(self, center_cell, level, name, size(values, 1), size(values, 2), error, components, body, &
          real_values=values)
    end subroutine h5_write_cell_field_real
 
    !> Write an integer cell field `values(ncomp, n_cells)` (e.g. the cell
    !> class: internal / cut), stored as int32.
-   subroutine h5_write_cell_field_int(self, level, name, values, error, components)
+   subroutine h5_write_cell_field_int(self, level, name, values, error, components, body)
       class(h5_output_type), intent(inout) :: self
       integer, intent(in) :: level
       character(len=*), intent(in) :: name
       integer, intent(in) :: values(:, :)
       type(error_type), allocatable, intent(out) :: error
       character(len=*), intent(in), optional :: components(:)
+      !> The body of the level's grid (as given to write_level).
+      character(len=*), intent(in), optional :: body
 
-      call write_field(self, center_cell, level, name, size(values, 1), size(values, 2), error, components, &
+      call write_field(self, center_cell, level, name, size(values, 1), size(values, 2), error, components, body, &
          int_values=values)
    end subroutine h5_write_cell_field_int
 
    !> Check, store and record one field (real or integer values).
-   subroutine write_field(self, center, level, name, ncomp, n, error, components, real_values, int_values)
+   subroutine write_field(self, center, level, name, ncomp, n, error, components, body, real_values, int_values)
       type(h5_output_type), intent(inout) :: self
       integer, intent(in) :: center, level, ncomp, n
       character(len=*), intent(in) :: name
       type(error_type), allocatable, intent(out) :: error
-      character(len=*), intent(in), optional :: components(:)
+      character(len=*), intent(in), optional :: components(:), body
       real(wp), intent(in), optional :: real_values(:, :)
       integer, intent(in), optional :: int_values(:, :)
       type(xdmf_field_type) :: field
@@ -275,9 +304,15 @@ contains
 
       where = 'HDF5 output "'//file_name(self)//'" level '//itoa(level)//' '// &
          merge('node', 'cell', center == center_node)//' field "'//name//'": '
+      if (present(body)) where = 'HDF5 output "'//file_name(self)//'" level '//itoa(level)//' body "'//body// &
+         '" '//merge('node', 'cell', center == center_node)//' field "'//name//'": '
       call check_open(self, where, error)
       if (allocated(error)) return
-      g = find_grid(self, level)
+      if (present(body)) then
+         g = find_grid(self, level, body)
+      else
+         g = find_grid(self, level, '')
+      end if
       if (g == 0) then
          call fatal_error(error, where//'level not written yet (call write_level first)', stat_invalid_input)
          return
@@ -336,12 +371,12 @@ contains
       if (present(real_values)) then
          allocate (rbuf(stored, n), source=0.0_wp)
          rbuf(:ncomp, :) = real_values
-         call write_dataset(self%file, field_path(level, center, name), dims, H5T_NATIVE_DOUBLE, c_loc(rbuf), &
+         call write_dataset(self%file, field_path(self%grids(g), center, name), dims, H5T_NATIVE_DOUBLE, c_loc(rbuf), &
             where, error)
       else
          allocate (ibuf(stored, n), source=0)
          ibuf(:ncomp, :) = int_values
-         call write_dataset(self%file, field_path(level, center, name), dims, H5T_NATIVE_INTEGER, c_loc(ibuf), &
+         call write_dataset(self%file, field_path(self%grids(g), center, name), dims, H5T_NATIVE_INTEGER, c_loc(ibuf), &
             where, error)
       end if
       call quiet_end(quiet)
@@ -462,14 +497,25 @@ contains
          stat_invalid_input)
    end subroutine check_open
 
-   integer function find_grid(self, level) result(g)
+   !> Index of the grid of `level` and `body` ('' for the unnamed grid), 0 if not written.
+   integer function find_grid(self, level, body) result(g)
       type(h5_output_type), intent(in) :: self
       integer, intent(in) :: level
+      character(len=*), intent(in) :: body
       do g = 1, self%n_grids
-         if (self%grids(g)%level == level) return
+         if (self%grids(g)%level == level .and. self%grids(g)%body == body) return
       end do
       g = 0
    end function find_grid
+
+   !> `HDF5 output "FILE" level L` and ` body "NAME"` for a body's grid, for messages.
+   function grid_where(self, grid) result(where)
+      type(h5_output_type), intent(in) :: self
+      type(xdmf_grid_type), intent(in) :: grid
+      character(len=:), allocatable :: where
+      where = 'HDF5 output "'//file_name(self)//'" level '//itoa(grid%level)
+      if (len(grid%body) > 0) where = where//' body "'//grid%body//'"'
+   end function grid_where
 
    function file_name(self) result(name)
       type(h5_output_type), intent(in) :: self
@@ -534,5 +580,6 @@ contains
       integer(c_int) :: status
       if (quiet%saved) status = h5eset_auto2(h5e_default, quiet%func, quiet%client_data)
    end subroutine quiet_end
+
 
 end module sprc_io_hdf5

@@ -13,10 +13,12 @@ module sprc_io_report
    use sprc_core_text, only: fixed_text
    use sprc_core_strings, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_io, stat_invalid_input
+   use sprc_study_row, only: report_row_type, report_empty, is_empty
+   use sprc_study_mesh, only: mesh_row_type
    implicit none
    private
 
-   public :: report_row_type, report_table, write_report_csv, read_report_csv
+   public :: report_row_type, report_table, write_report_csv, read_report_csv, format_mesh_row
    public :: report_column, report_empty, is_empty
    public :: n_report_columns, report_columns, report_csv_header
 
@@ -34,42 +36,13 @@ module sprc_io_report
       & 't_quadrature,t_assembly,t_solve,t_recovery,t_estimate,t_total,err_fe,err_spr,err_sprc,'// &
       & 'eta_spr,eta_sprc,theta_spr,theta_sprc'
 
-   !> The value of an empty real cell: the default quiet NaN (bits 0x7FF8000000000000).
-   real(wp), parameter :: report_empty = transfer(9221120237041090560_i8, 1.0_wp)
-
    !> How each column is formatted in the table.
    integer, parameter :: kind_integer = 1, kind_sig3 = 2, kind_error = 3
    integer, parameter :: column_kind(n_report_columns) = [kind_integer, kind_sig3, kind_integer, &
       & kind_integer, kind_integer, kind_sig3, kind_sig3, kind_sig3, kind_sig3, kind_sig3, kind_sig3, &
       & kind_sig3, kind_error, kind_error, kind_error, kind_error, kind_error, kind_sig3, kind_sig3]
 
-   !> One level of a study. Times are wall-clock seconds for that level alone;
-   !> errors and estimates are relative, in the energy norm (SCENE.md).
-   !> Real components start empty: set only those that apply.
-   type :: report_row_type
-      integer :: level = 0
-      !> Element size of the level.
-      real(wp) :: h = report_empty
-      !> Active elements, of which cut by the boundary; degrees of freedom.
-      integer(i8) :: elements = 0, cut_elements = 0, dofs = 0
-      real(wp) :: t_mesh = report_empty, t_quadrature = report_empty, t_assembly = report_empty
-      real(wp) :: t_solve = report_empty, t_recovery = report_empty, t_estimate = report_empty
-      real(wp) :: t_total = report_empty
-      !> Exact relative errors of the FE, SPR and SPR-C stresses.
-      real(wp) :: err_fe = report_empty, err_spr = report_empty, err_sprc = report_empty
-      !> Estimated relative errors (ZZ with the SPR / SPR-C field).
-      real(wp) :: eta_spr = report_empty, eta_sprc = report_empty
-      !> Global effectivity indices.
-      real(wp) :: theta_spr = report_empty, theta_sprc = report_empty
-   end type report_row_type
-
 contains
-
-   !> True when `x` is an empty cell (any NaN).
-   elemental logical function is_empty(x)
-      real(wp), intent(in) :: x
-      is_empty = ieee_is_nan(x)
-   end function is_empty
 
    !> The values of column `name` over `rows` (integers converted to real;
    !> empty cells stay empty). An unknown name gives all-empty values.
@@ -490,5 +463,21 @@ contains
          if (line(len(line):) == achar(13)) line = line(:len(line) - 1)
       end if
    end subroutine read_line
+
+   !> `level=4 body=cylinder internal=1234 cut=210 external=604 ...` (SCENE.md).
+   function format_mesh_row(row) result(line)
+      type(mesh_row_type), intent(in) :: row
+      character(len=:), allocatable :: line
+      character(len=32) :: t, tq, m, bm
+
+      write (t, '(es10.3)') row%t_mesh
+      write (tq, '(es10.3)') row%t_quadrature
+      write (m, '(es24.16)') row%measure
+      write (bm, '(es24.16)') row%boundary_measure
+      line = 'level='//itoa(row%level)//' body='//row%body//' internal='//itoa(row%internal)// &
+         ' cut='//itoa(row%cut)//' external='//itoa(row%external)//' measure='//trim(adjustl(m))// &
+         ' boundary_measure='//trim(adjustl(bm))//' points='//itoa(row%points)//' t_mesh='//trim(adjustl(t))// &
+         ' t_quadrature='//trim(adjustl(tq))
+   end function format_mesh_row
 
 end module sprc_io_report

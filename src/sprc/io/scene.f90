@@ -8,143 +8,17 @@ module sprc_io_scene
    use sprc_core_kinds, only: wp, i8
    use sprc_fem_dilatation, only: projected_poisson
    use sprc_fem_problem, only: default_gamma, gamma_note
-   use sprc_core_strings, only: itoa
+   use sprc_core_strings, only: itoa, real_text
    use sprc_core_error, only: error_type, fatal_error, stat_unsupported
+   use sprc_study_spec, only: scene_type, body_spec_type, shape_spec_type, bc_spec_type, exact_spec_type, &
+      & contact_spec_type, recovery_degree
    use sprc_io_namelist, only: nml_group_type, parse_namelist, read_text_file, nml_get, nml_get_array, &
       & nml_has, nml_check_consumed, nml_field_error, nml_group_error, nml_item_text
-   use sprc_recovery_patch_loop, only: auto_degree
    implicit none
    private
 
    public :: scene_type, body_spec_type, shape_spec_type, bc_spec_type, exact_spec_type, contact_spec_type
    public :: read_scene, read_scene_text, default_scene_text, scene_summary, recovery_degree, real_text
-
-   !> One elastic body.
-   type :: body_spec_type
-      !> Unique non-empty name.
-      character(len=:), allocatable :: name
-      !> Young's modulus, > 0.
-      real(wp) :: young = 0.0_wp
-      !> Poisson's ratio, -1 < poisson < 0.5.
-      real(wp) :: poisson = 0.0_wp
-      !> Body force per unit volume, `dim` values.
-      real(wp), allocatable :: body_force(:)
-   end type body_spec_type
-
-   !> One CSG primitive of a body; its surface keeps `name`.
-   !> Array fields are allocated (with `dim` values) only for the kinds using them.
-   type :: shape_spec_type
-      !> Name of the body it builds.
-      character(len=:), allocatable :: body
-      !> Index of that body in `scene%bodies`.
-      integer :: body_index = 0
-      !> Index of the shape among its body's shapes (1..number of shapes of that body, file order):
-      !> the shape index the body's geometry, FE conditions and recovery input use.
-      integer :: body_shape = 0
-      !> 'add' | 'subtract' | 'intersect'.
-      character(len=:), allocatable :: op
-      !> 'disk' | 'sphere' | 'ellipse' | 'ellipsoid' | 'box' | 'halfspace' | 'cylinder'.
-      character(len=:), allocatable :: kind
-      !> Unique non-empty name of the surface.
-      character(len=:), allocatable :: name
-      !> Centre (disk, sphere, ellipse, ellipsoid).
-      real(wp), allocatable :: center(:)
-      !> Radius (disk, sphere, cylinder), > 0.
-      real(wp) :: radius = 0.0_wp
-      !> Semi-axes (ellipse, ellipsoid), all > 0.
-      real(wp), allocatable :: semi_axes(:)
-      !> Corners (box), lower < upper componentwise.
-      real(wp), allocatable :: lower(:), upper(:)
-      !> A point on the plane (halfspace) or on the axis (cylinder).
-      real(wp), allocatable :: point(:)
-      !> Unit outward normal (halfspace): the body side is (x - point).normal <= 0.
-      real(wp), allocatable :: normal(:)
-      !> Unit axis direction (cylinder).
-      real(wp), allocatable :: axis(:)
-   end type shape_spec_type
-
-   !> A boundary condition on one shape surface.
-   type :: bc_spec_type
-      !> Name of the shape surface.
-      character(len=:), allocatable :: on
-      !> Index of that shape in `scene%shapes`.
-      integer :: shape_index = 0
-      !> 'free' | 'pressure' | 'traction' | 'displacement' | 'symmetry' |
-      !> 'exact_traction' | 'exact_displacement'.
-      character(len=:), allocatable :: type
-      !> Pressure (type 'pressure'): t = -value n.
-      real(wp) :: value = 0.0_wp
-      !> Traction or displacement (types 'traction', 'displacement'), `dim` values.
-      real(wp), allocatable :: vector(:)
-   end type bc_spec_type
-
-   !> The analytical solution, if any.
-   type :: exact_spec_type
-      !> Whether the scene has an `&exact` group.
-      logical :: present = .false.
-      !> 'lame_cylinder' | 'lame_sphere' | 'kirsch'.
-      character(len=:), allocatable :: kind
-      !> Centre, `dim` values.
-      real(wp), allocatable :: center(:)
-      !> Lamé: inner and outer radius, inner and outer pressure.
-      real(wp) :: r_in = 0.0_wp, r_out = 0.0_wp, p_in = 0.0_wp, p_out = 0.0_wp
-      !> Kirsch: hole radius and remote uniaxial stress along x.
-      real(wp) :: radius = 0.0_wp, s_inf = 0.0_wp
-   end type exact_spec_type
-
-   !> A contact pair between two bodies.
-   type :: contact_spec_type
-      !> Body names and their indices in `scene%bodies`.
-      character(len=:), allocatable :: slave, master
-      integer :: slave_index = 0, master_index = 0
-      !> Shape surfaces in contact and their indices in `scene%shapes`.
-      character(len=:), allocatable :: slave_surface, master_surface
-      integer :: slave_surface_index = 0, master_surface_index = 0
-      !> 'frictionless' | 'coulomb' | 'stick'.
-      character(len=:), allocatable :: friction
-      !> Friction coefficient (coulomb), >= 0.
-      real(wp) :: mu = 0.0_wp
-      !> Stabilisation parameter, > 0 when given.
-      real(wp) :: kappa = 0.0_wp
-      logical :: has_kappa = .false.
-   end type contact_spec_type
-
-   !> A validated scene, defaults filled in.
-   type :: scene_type
-      !> Name of the source (file name) it was read from.
-      character(len=:), allocatable :: source
-      character(len=:), allocatable :: title
-      !> 'plane_stress' | 'plane_strain' | 'solid'.
-      character(len=:), allocatable :: analysis
-      !> 2 for plane_stress and plane_strain, 3 for solid.
-      integer :: dim = 0
-      !> FE degree, 1 or 2.
-      integer :: order = 1
-      !> Uniform grid levels, strictly increasing.
-      integer, allocatable :: levels(:)
-      !> Extra levels on cut elements, 0..6.
-      integer :: refine_boundary = 0
-      !> Corner of the level-0 cell, `dim` values.
-      real(wp), allocatable :: box_min(:)
-      !> Edge of the level-0 cell, > 0.
-      real(wp) :: box_size = 0.0_wp
-      !> 'none' | 'spr' | 'sprc' | 'both'.
-      character(len=:), allocatable :: recovery
-      !> Patch polynomial degree of SPR and SPR-C: 'auto' (SPR at p, SPR-C at p+1 for order 2
-      !> and p for order 1), 'p' (the FE degree) or 'p+1'.
-      character(len=:), allocatable :: recovery_degree
-      !> Prefix of the files written; '' writes none.
-      character(len=:), allocatable :: output
-      !> Volumetric formulation: 'auto' | 'full' | 'projected' (`sprc_fem_dilatation`).
-      character(len=:), allocatable :: dilatation
-      !> Nitsche penalty factor, > 0 (default `default_gamma(order)`).
-      real(wp) :: nitsche_gamma = 0.0_wp
-      type(body_spec_type), allocatable :: bodies(:)
-      type(shape_spec_type), allocatable :: shapes(:)
-      type(bc_spec_type), allocatable :: bcs(:)
-      type(exact_spec_type) :: exact
-      type(contact_spec_type), allocatable :: contacts(:)
-   end type scene_type
 
    character(len=*), parameter :: known_groups(6) = [character(len=7) :: 'scene', 'body', 'shape', 'bc', &
       & 'exact', 'contact']
@@ -1279,17 +1153,6 @@ contains
       end do
    end function lower
 
-   !> Patch polynomial degree of the scene's recovery `method` (1 SPR, 2 SPR-C): 'auto' (the
-   !> default) by sprc_recovery_patch_loop's `auto_degree`, 'p' the FE order, 'p+1' one more.
-   pure integer function recovery_degree(scene, method)
-      type(scene_type), intent(in) :: scene
-      integer, intent(in) :: method
-      recovery_degree = auto_degree(method == 2, scene%order)
-      if (.not. allocated(scene%recovery_degree)) return
-      if (scene%recovery_degree == 'p') recovery_degree = scene%order
-      if (scene%recovery_degree == 'p+1') recovery_degree = scene%order + 1
-   end function recovery_degree
-
    function int_list(values) result(text)
       integer, intent(in) :: values(:)
       character(len=:), allocatable :: text
@@ -1310,67 +1173,5 @@ contains
       end do
    end function real_list
 
-   !> Shortest decimal text that reads back as the same real: fixed notation
-   !> for moderate exponents (`1000.0`, `0.3`), else `2.5e-7` style (`1.0e-300`);
-   !> `NaN`, `Infinity`, `-Infinity` for the non-finite values.
-   function real_text(x) result(text)
-      real(wp), intent(in) :: x
-      character(len=:), allocatable :: text
-      character(len=40) :: buf
-      character(len=16) :: fmt
-      character(len=:), allocatable :: digits, sign
-      real(wp) :: y
-      integer :: d, ios, epos, e, n
-
-      if (ieee_is_nan(x)) then
-         text = 'NaN'
-         return
-      else if (.not. ieee_is_finite(x)) then
-         text = merge('-Infinity', ' Infinity', x < 0.0_wp)
-         text = trim(adjustl(text))
-         return
-      end if
-      ! Three exponent digits (e3): with the default width a three-digit
-      ! exponent is written without its 'E' (1.0+100).
-      do d = 1, 17
-         write (fmt, '("(es40.",i0,"e3)")') d - 1
-         write (buf, fmt) x
-         read (buf, *, iostat=ios) y
-         ! Bitwise identity is what 'reads back as the same real' means.
-         if (ios == 0 .and. transfer(y, 0_i8) == transfer(x, 0_i8)) exit
-      end do
-      buf = adjustl(buf)
-      sign = ''
-      if (buf(1:1) == '-') then
-         sign = '-'
-         buf = buf(2:)
-      end if
-      epos = index(buf, 'E')
-      read (buf(epos + 1:), *) e
-      digits = buf(1:1)//buf(3:epos - 1)
-      if (buf(2:2) /= '.') digits = buf(1:1)
-      n = len(digits)
-      do while (n > 1)
-         if (digits(n:n) /= '0') exit
-         n = n - 1
-      end do
-      digits = digits(1:n)
-      if (digits == '0') e = 0
-      if (e >= 0 .and. e < 15) then
-         if (n <= e + 1) then
-            text = sign//digits//repeat('0', e + 1 - n)//'.0'
-         else
-            text = sign//digits(1:e + 1)//'.'//digits(e + 2:)
-         end if
-      else if (e < 0 .and. e >= -4) then
-         text = sign//'0.'//repeat('0', -e - 1)//digits
-      else
-         if (n == 1) then
-            text = sign//digits//'.0e'//itoa(e)
-         else
-            text = sign//digits(1:1)//'.'//digits(2:)//'e'//itoa(e)
-         end if
-      end if
-   end function real_text
 
 end module sprc_io_scene

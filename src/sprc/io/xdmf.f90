@@ -3,12 +3,14 @@
 !>
 !> **Layout** of PREFIX.h5 (dimensions in C order, as h5dump shows them):
 !> ```
-!> /level_LL/mesh/x             float64 (n_nodes, dim)          dim = 2 or 3
-!> /level_LL/mesh/connectivity  int32   (n_cells, nodes_per_cell)  0-based, VTK order
-!> /level_LL/node/<name>        float64 (n_nodes) | (n_nodes, ncomp)
-!> /level_LL/cell/<name>        float64 or int32 (n_cells) | (n_cells, ncomp)
+!> /level_LL/<body>/mesh/x             float64 (n_nodes, dim)          dim = 2 or 3
+!> /level_LL/<body>/mesh/connectivity  int32   (n_cells, nodes_per_cell)  0-based, VTK order
+!> /level_LL/<body>/node/<name>        float64 (n_nodes) | (n_nodes, ncomp)
+!> /level_LL/<body>/cell/<name>        float64 or int32 (n_cells) | (n_cells, ncomp)
 !> ```
-!> LL is the level with two digits (`/level_04`). A field with one component
+!> LL is the level with two digits (`/level_04`), <body> the body's name
+!> (`sprc run` writes every body so, even a scene's only one); a writer that
+!> gives no body name gets `/level_LL/mesh/x` etc. A field with one component
 !> is a 1-D dataset. A vector field is stored with 3 components (a 2-D vector
 !> gets z = 0) because ParaView only treats 3-component arrays as vectors
 !> (warp, glyphs). A field with named components (e.g. Voigt stresses
@@ -16,9 +18,13 @@
 !>
 !> **XDMF** (version 3.0, also read by ParaView's legacy XDMF reader): one
 !> temporal collection whose Time is the level, so ParaView's time control
-!> steps through the levels; one Uniform grid per level, in level order.
-!> (Checked by hand with VTK 9.7's vtkXdmfReader: cell types, named
-!> component scalars, the displacement as active vectors, hex27 volumes.) Geometry is XY or
+!> steps through the levels; per level one Uniform grid, or for bodies a
+!> Spatial collection (Time = level) of one Uniform grid per body, named
+!> after it, in level order. (Checked by hand with VTK 9.7's vtkXdmfReader,
+!> for one unnamed grid per level: cell types, named component scalars, the
+!> displacement as active vectors, hex27 volumes; the per-body Spatial
+!> collection, XDMF's way of grouping blocks, was not opened in a reader
+!> here.) Geometry is XY or
 !> XYZ. Topology types: Quadrilateral, Quadrilateral_9, Hexahedron,
 !> Hexahedron_27. Attributes: Scalar, Vector (3 components), and for named
 !> components one Scalar per component, `<name>_<component>`, cut out of the
@@ -46,7 +52,7 @@ module sprc_io_xdmf
    public :: cell_quad4, cell_quad9, cell_hex8, cell_hex27, cell_nodes, cell_dim, topology_name
    public :: center_node, center_cell, field_scalar, field_vector, field_components
    public :: xdmf_field_type, xdmf_grid_type, xdmf_text, write_xdmf
-   public :: level_group, mesh_x_path, mesh_connectivity_path, field_path, n_attributes, attribute_name, &
+   public :: level_group, grid_group, mesh_x_path, mesh_connectivity_path, field_path, n_attributes, attribute_name, &
       & valid_name
    public :: max_name_length
 
@@ -73,9 +79,12 @@ module sprc_io_xdmf
       character(len=max_name_length), allocatable :: components(:)
    end type xdmf_field_type
 
-   !> One level's mesh and fields as stored in the HDF5 file.
+   !> One level's mesh and fields as stored in the HDF5 file; with several
+   !> bodies, one per body and level.
    type :: xdmf_grid_type
       integer :: level = 0
+      !> Name of the body ('' or not allocated: the level has one unnamed grid).
+      character(len=:), allocatable :: body
       !> Coordinates per node (2 or 3).
       integer :: ncoord = 0
       integer :: n_nodes = 0, n_cells = 0
@@ -125,32 +134,41 @@ contains
    pure function level_group(level) result(path)
       integer, intent(in) :: level
       character(len=:), allocatable :: path
-      character(len=16) :: buf
-      write (buf, '(i2.2)') level
-      path = '/level_'//trim(buf)
+      path = '/level_'//itoa(level, 2)
    end function level_group
 
-   pure function mesh_x_path(level) result(path)
-      integer, intent(in) :: level
+   !> HDF5 group of a grid: `/level_04`, or `/level_04/<body>` for a body's grid.
+   pure function grid_group(grid) result(path)
+      type(xdmf_grid_type), intent(in) :: grid
       character(len=:), allocatable :: path
-      path = level_group(level)//'/mesh/x'
+      path = level_group(grid%level)
+      if (allocated(grid%body)) then
+         if (len(grid%body) > 0) path = path//'/'//grid%body
+      end if
+   end function grid_group
+
+   pure function mesh_x_path(grid) result(path)
+      type(xdmf_grid_type), intent(in) :: grid
+      character(len=:), allocatable :: path
+      path = grid_group(grid)//'/mesh/x'
    end function mesh_x_path
 
-   pure function mesh_connectivity_path(level) result(path)
-      integer, intent(in) :: level
+   pure function mesh_connectivity_path(grid) result(path)
+      type(xdmf_grid_type), intent(in) :: grid
       character(len=:), allocatable :: path
-      path = level_group(level)//'/mesh/connectivity'
+      path = grid_group(grid)//'/mesh/connectivity'
    end function mesh_connectivity_path
 
-   !> Dataset of a field: `/level_04/node/<name>` or `/level_04/cell/<name>`.
-   pure function field_path(level, center, name) result(path)
-      integer, intent(in) :: level, center
+   !> Dataset of a field: `<grid group>/node/<name>` or `<grid group>/cell/<name>`.
+   pure function field_path(grid, center, name) result(path)
+      type(xdmf_grid_type), intent(in) :: grid
+      integer, intent(in) :: center
       character(len=*), intent(in) :: name
       character(len=:), allocatable :: path
       if (center == center_node) then
-         path = level_group(level)//'/node/'//name
+         path = grid_group(grid)//'/node/'//name
       else
-         path = level_group(level)//'/cell/'//name
+         path = grid_group(grid)//'/cell/'//name
       end if
    end function field_path
 
@@ -219,40 +237,67 @@ contains
       character(len=*), intent(in) :: h5_name
       type(xdmf_grid_type), intent(in) :: grids(:)
       character(len=:), allocatable :: text
-      integer :: g, k
+      integer :: g, k, level
       logical :: done(size(grids))
 
       text = '<?xml version="1.0" encoding="UTF-8"?>'//nl//'<!DOCTYPE Xdmf SYSTEM "Xdmf.dtd" []>'//nl// &
          '<Xdmf xmlns:xi="http://www.w3.org/2001/XInclude" Version="3.0">'//nl// &
          ' <Domain>'//nl// &
          '  <Grid Name="levels" GridType="Collection" CollectionType="Temporal">'//nl
-      ! Grids in increasing level (= time) order, whatever order they were written in.
+      ! Levels in increasing (= time) order, whatever order they were written in;
+      ! the bodies of a level in the order written.
       done = .false.
       do k = 1, size(grids)
+         if (all(done)) exit
          g = minloc(grids%level, dim=1, mask=.not. done)
-         done(g) = .true.
-         text = text//grid_text(escape(h5_name), grids(g))
+         level = grids(g)%level
+         if (count(grids%level == level) == 1 .and. .not. named(grids(g))) then
+            text = text//grid_text(escape(h5_name), grids(g), .true.)
+         else
+            text = text//'   <Grid Name="level_'//itoa(level, 2)//'" GridType="Collection" '// &
+               'CollectionType="Spatial">'//nl//'    <Time Value="'//itoa(level)//'"/>'//nl
+            do g = 1, size(grids)
+               if (grids(g)%level == level) text = text//grid_text(escape(h5_name), grids(g), .false.)
+            end do
+            text = text//'   </Grid>'//nl
+         end if
+         where (grids%level == level) done = .true.
       end do
       text = text//'  </Grid>'//nl//' </Domain>'//nl//'</Xdmf>'//nl
    end function xdmf_text
 
-   function grid_text(h5, grid) result(text)
+   pure logical function named(grid)
+      type(xdmf_grid_type), intent(in) :: grid
+      named = .false.
+      if (allocated(grid%body)) named = len(grid%body) > 0
+   end function named
+
+   !> A Uniform grid; `with_time`: it is a level of its own (Time = level),
+   !> otherwise one body's grid inside the level's spatial collection.
+   function grid_text(h5, grid, with_time) result(text)
       character(len=*), intent(in) :: h5
       type(xdmf_grid_type), intent(in) :: grid
-      character(len=:), allocatable :: text, geometry
+      logical, intent(in) :: with_time
+      character(len=:), allocatable :: text, geometry, name
       integer :: f
 
       geometry = 'XYZ'
       if (grid%ncoord == 2) geometry = 'XY'
-      text = '   <Grid Name="level_'//itoa(grid%level, 2)//'" GridType="Uniform">'//nl// &
-         '    <Time Value="'//itoa(grid%level)//'"/>'//nl// &
+      if (named(grid)) then
+         name = grid%body
+      else
+         name = 'level_'//itoa(grid%level, 2)
+      end if
+      text = '   <Grid Name="'//name//'" GridType="Uniform">'//nl
+      if (with_time) text = text//'    <Time Value="'//itoa(grid%level)//'"/>'//nl
+      text = text// &
          '    <Topology TopologyType="'//topology_name(grid%cell_type)//'" NumberOfElements="'// &
          itoa(grid%n_cells)//'">'//nl// &
-         '     '//data_item(h5, mesh_connectivity_path(grid%level), [grid%n_cells, cell_nodes(grid%cell_type)], &
+         '     '//data_item(h5, mesh_connectivity_path(grid), [grid%n_cells, cell_nodes(grid%cell_type)], &
          .true.)//nl// &
          '    </Topology>'//nl// &
          '    <Geometry GeometryType="'//geometry//'">'//nl// &
-         '     '//data_item(h5, mesh_x_path(grid%level), [grid%n_nodes, grid%ncoord], .false.)//nl// &
+         '     '//data_item(h5, mesh_x_path(grid), [grid%n_nodes, grid%ncoord], .false.)//nl// &
          '    </Geometry>'//nl
       do f = 1, grid%n_fields
          text = text//attribute_text(h5, grid, grid%fields(f))
@@ -270,7 +315,7 @@ contains
 
       n = merge(grid%n_nodes, grid%n_cells, field%center == center_node)
       center = merge('Node', 'Cell', field%center == center_node)
-      path = field_path(grid%level, field%center, field%name)
+      path = field_path(grid, field%center, field%name)
       text = ''
       select case (field%kind)
       case (field_scalar)
@@ -346,5 +391,7 @@ contains
          end select
       end do
    end function escape
+
+
 
 end module sprc_io_xdmf

@@ -1,6 +1,7 @@
-!> Studies over the levels of a scene: what `sprc mesh` (and later
-!> `sprc run`) computes, as rows of data; the driver or the C API format them.
-module sprc_io_study
+!> The levels of a study and what `sprc mesh` computes over them (cells,
+!> measure and boundary measure of each body's grid), as rows of data; the
+!> driver or the C API format them (`sprc_io_report`).
+module sprc_study_mesh
    use sprc_core_kinds, only: wp, i8
    use sprc_core_strings, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
@@ -9,13 +10,13 @@ module sprc_io_study
    use sprc_grid_tree, only: grid_type
    use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature, cell_rule_type, cell_rule, &
       & default_points
-   use sprc_io_scene, only: scene_type
-   use sprc_io_model, only: build_bodies
-   use sprc_io_budget, only: check_level_memory
+   use sprc_study_spec, only: scene_type
+   use sprc_study_model, only: build_bodies
+   use sprc_study_budget, only: check_level_memory
    implicit none
    private
 
-   public :: mesh_row_type, mesh_study, format_mesh_row, study_levels
+   public :: mesh_row_type, mesh_study, study_levels
 
    !> One line of `sprc mesh`: a body's grid at one level.
    type :: mesh_row_type
@@ -157,20 +158,4 @@ contains
       end do
    end subroutine neumaier_add
 
-   !> `level=4 body=cylinder internal=1234 cut=210 external=604 ...` (SCENE.md).
-   function format_mesh_row(row) result(line)
-      type(mesh_row_type), intent(in) :: row
-      character(len=:), allocatable :: line
-      character(len=32) :: t, tq, m, bm
-
-      write (t, '(es10.3)') row%t_mesh
-      write (tq, '(es10.3)') row%t_quadrature
-      write (m, '(es24.16)') row%measure
-      write (bm, '(es24.16)') row%boundary_measure
-      line = 'level='//itoa(row%level)//' body='//row%body//' internal='//itoa(row%internal)// &
-         ' cut='//itoa(row%cut)//' external='//itoa(row%external)//' measure='//trim(adjustl(m))// &
-         ' boundary_measure='//trim(adjustl(bm))//' points='//itoa(row%points)//' t_mesh='//trim(adjustl(t))// &
-         ' t_quadrature='//trim(adjustl(tq))
-   end function format_mesh_row
-
-end module sprc_io_study
+end module sprc_study_mesh

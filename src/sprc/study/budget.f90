@@ -26,14 +26,14 @@
 !> first does (malloc(134221824) per thread, seen in a debugger); without that
 !> reserve a level that passed the check hung in OpenBLAS's retry loop of
 !> blas_memory_alloc (3D level 5 under ulimit -v 600000).
-module sprc_io_budget
+module sprc_study_budget
    !$ use omp_lib, only: omp_get_max_threads
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_out_of_memory
    use sprc_core_memory, only: available_memory
    use sprc_geometry_body, only: body_type
    use sprc_grid_tree, only: grid_type
-   use sprc_io_scene, only: scene_type
+   use sprc_study_spec, only: scene_type
    implicit none
    private
 
@@ -128,4 +128,4 @@ contains
       text = trim(adjustl(buf))
    end function gigabytes
 
-end module sprc_io_budget
+end module sprc_study_budget

@@ -1,9 +1,10 @@
 !> From a validated scene to the objects the analysis works with: geometry
-!> bodies (one per `&body`, shapes in file order) and the exact solution.
+!> bodies (one per `&body`, shapes in file order), each body's FE conditions
+!> on its own shape indices, and the exact solution with a body's material.
 !>
 !> The scene reader has already validated every field; errors here are the
 !> constructors' own checks, prefixed with the scene group they came from.
-module sprc_io_model
+module sprc_study_model
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_unsupported
    use sprc_core_material, only: plane_stress, plane_strain, solid
@@ -13,13 +14,14 @@ module sprc_io_model
    use sprc_exact_solution, only: exact_solution_type
    use sprc_exact_lame, only: lame_cylinder_type, lame_sphere_type, new_lame_cylinder, new_lame_sphere
    use sprc_exact_kirsch, only: kirsch_type, new_kirsch
-   use sprc_io_scene, only: scene_type, shape_spec_type, real_text
+   use sprc_core_strings, only: itoa, real_text
+   use sprc_study_spec, only: scene_type, shape_spec_type
+   use sprc_fem_bc, only: fe_bc_type, new_fe_bc, bc_kind_from_name
    use sprc_fem_problem, only: gamma_note
-   use sprc_core_strings, only: itoa
    implicit none
    private
 
-   public :: build_bodies, build_exact, analysis_kind, analysis_units, in_units, scene_warnings
+   public :: build_bodies, build_exact, body_conditions, analysis_kind, analysis_units, in_units, scene_warnings
 
    !> Units of an analysis: moduli divided by `modulus`, displacements by `strain`
    !> (lengths unchanged), stresses and loads by modulus*strain. Both are powers of two, so
@@ -48,22 +50,31 @@ contains
    !> pressures, tractions, body force times box_size, the exact solution's pressures and
    !> remote stress) or prescribed displacement / box_size. stat_invalid_input when that
    !> strain is not representable (loads 1e300 times the modulus).
-   subroutine analysis_units(scene, units, error)
+   subroutine analysis_units(scene, units, error, body)
       type(scene_type), intent(in) :: scene
       type(analysis_units_type), intent(out) :: units
       type(error_type), allocatable, intent(out) :: error
+      !> The units of this body alone (its modulus and the loads on it): bodies
+      !> without contact are independent problems, each in its own units.
+      integer, intent(in), optional :: body
       real(wp) :: load, disp
-      integer :: i, k
+      integer :: i, k, b
 
       if (size(scene%bodies) == 0) return
-      units%modulus = scale(1.0_wp, exponent(scene%bodies(1)%young) - 1)
+      b = 1
+      if (present(body)) b = body
+      units%modulus = scale(1.0_wp, exponent(scene%bodies(b)%young) - 1)
       load = 0.0_wp
       disp = 0.0_wp
       do i = 1, size(scene%bodies)
+         if (present(body) .and. i /= b) cycle
          if (allocated(scene%bodies(i)%body_force)) &
             & load = max(load, maxval([0.0_wp, abs(scene%bodies(i)%body_force)])*scene%box_size)
       end do
       do i = 1, size(scene%bcs)
+         if (present(body)) then
+            if (scene%shapes(scene%bcs(i)%shape_index)%body_index /= b) cycle
+         end if
          load = max(load, abs(scene%bcs(i)%value))
          if (.not. allocated(scene%bcs(i)%vector)) cycle
          if (scene%bcs(i)%type == 'displacement') then
@@ -271,6 +282,32 @@ contains
       end select
    end subroutine build_shape
 
+   !> The &bc groups on the surfaces of body `b` as FE conditions on the
+   !> body's own shape indices (its shapes in file order); surfaces without
+   !> &bc are free.
+   subroutine body_conditions(scene, b, bcs)
+      type(scene_type), intent(in) :: scene
+      !> Index of the body in `scene%bodies`.
+      integer, intent(in) :: b
+      type(fe_bc_type), allocatable, intent(out) :: bcs(:)
+      integer :: i, kind, n
+
+      allocate (bcs(count(scene%shapes(scene%bcs%shape_index)%body_index == b)))
+      n = 0
+      do i = 1, size(scene%bcs)
+         associate (bc => scene%bcs(i), shape => scene%shapes(scene%bcs(i)%shape_index))
+            if (shape%body_index /= b) cycle
+            n = n + 1
+            kind = bc_kind_from_name(bc%type)
+            if (allocated(bc%vector)) then
+               bcs(n) = new_fe_bc(shape%body_shape, kind, bc%value, bc%vector)
+            else
+               bcs(n) = new_fe_bc(shape%body_shape, kind, bc%value)
+            end if
+         end associate
+      end do
+   end subroutine body_conditions
+
    !> The scene's exact solution as it holds in body `b`, with that body's
    !> material (the closed forms are single-body solutions). Not allocated
    !> without `&exact`.
@@ -315,4 +352,4 @@ contains
       end if
    end subroutine build_exact
 
-end module sprc_io_model
+end module sprc_study_model

@@ -1,0 +1,409 @@
+!> One level of a study (`sprc run`): for every body its cut mesh (grid,
+!> nodes, hanging-node constraints), cut-cell quadrature, FE solve, SPR /
+!> SPR-C recovery and ZZ estimate, and the level's report row with the norms
+!> summed over the bodies (SCENE.md "Report": ||.||^2 added, then the ratio).
+!>
+!> ```fortran
+!> call prepare_study(scene, points, study, error)   ! once: bodies, conditions, exact solutions
+!> call run_level(study, level, result, error)        ! result%row, result%bodies(b)%problem, ...
+!> ```
+!> Bodies without `&contact` between them are independent problems: each
+!> body's results are exactly those of a scene holding that body alone.
+!> Scenes with `&contact` are refused (stat_unsupported) before any
+!> computation: the contact FE is not implemented in this version.
+!>
+!> With an `&exact` group the closed form applies to every body, with that
+!> body's material.
+module sprc_study_level
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use sprc_core_kinds, only: wp, i8
+   use sprc_core_error, only: error_type, fatal_error, stat_unsupported, stat_internal, stat_invalid_input
+   use sprc_core_timer, only: timer_type, wall_time
+   use sprc_geometry_body, only: body_type
+   use sprc_exact_solution, only: exact_solution_type
+   use sprc_grid_tree, only: grid_type
+   use sprc_grid_nodes, only: grid_nodes_type
+   use sprc_grid_hanging, only: hanging_type
+   use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature, default_points
+   use sprc_grid_patches, only: recovery_input_type, recover_grid
+   use sprc_grid_recovered_field, only: recovered_field_type, method_spr, method_sprc
+   use sprc_grid_recovered_estimate, only: zz_estimate_type, estimate_error
+   use sprc_fem_bc, only: fe_bc_type
+   use sprc_fem_problem, only: elasticity_problem_type
+   use sprc_fem_recovery_input, only: fe_recovery_input
+   use sprc_fem_dilatation, only: dilatation_choice
+   use sprc_study_spec, only: scene_type, recovery_degree
+   use sprc_study_model, only: build_bodies, build_exact, body_conditions, analysis_kind, analysis_units_type, &
+      & analysis_units, in_units
+   use sprc_study_budget, only: check_level_memory
+   use sprc_study_row, only: report_row_type
+   implicit none
+   private
+
+   public :: study_type, study_body_type, prepare_study, run_level, level_type, body_level_type
+   public :: nodal_fe_stress
+
+   !> What every level needs of one body, built once from the scene.
+   type :: study_body_type
+      character(len=:), allocatable :: name
+      type(body_type) :: geometry
+      !> The exact solution with this body's material (not allocated without `&exact`).
+      class(exact_solution_type), allocatable :: exact
+      !> FE conditions on the body's own shape indices.
+      type(fe_bc_type), allocatable :: bcs(:)
+      !> The body's analysis runs in these units (`sprc_study_model`): scaled
+      !> modulus, body force, conditions and exact solution.
+      type(analysis_units_type) :: units
+      real(wp) :: young = 0.0_wp, poisson = 0.0_wp
+      real(wp), allocatable :: body_force(:)
+   end type study_body_type
+
+   !> A prepared study: its bodies and the settings every level shares.
+   type :: study_type
+      !> The scene (for the memory estimate of a level).
+      type(scene_type) :: scene
+      type(study_body_type), allocatable :: bodies(:)
+      integer :: dim = 0, order = 0, analysis = 0, refine_boundary = 0
+      !> The level-0 cell of every body's grid.
+      real(wp), allocatable :: box_min(:)
+      real(wp) :: box_size = 0.0_wp
+      !> Gauss points per direction of the cut-cell rules; patch polynomial degree.
+      integer :: points = 0, degree(2) = 0
+      !> Nitsche penalty factor (the scene's `nitsche_gamma`) and volumetric formulation
+      !> (`sprc_fem_dilatation`'s choice for the scene's `dilatation`).
+      real(wp) :: gamma = 0.0_wp
+      integer :: dilatation = 0
+      !> Recoveries to run (1 SPR, 2 SPR-C) and whether the scene has an exact solution.
+      logical :: run(2) = .false.
+      logical :: have_exact = .false.
+   end type study_type
+
+   !> One body at one level.
+   type :: body_level_type
+      type(grid_type) :: grid
+      type(grid_nodes_type) :: nodes
+      type(hanging_type) :: hanging
+      type(elasticity_problem_type) :: problem
+      !> Recovered fields and estimates per method (1 SPR, 2 SPR-C), where run.
+      type(recovered_field_type) :: field(2)
+      type(zz_estimate_type) :: est(2)
+      !> With an exact solution: ||sigma_ex - sigma_h||_E, ||sigma_ex||_E and the
+      !> error per element (energy norm) of the FE stress.
+      real(wp) :: err_norm = 0.0_wp, norm_exact = 0.0_wp
+      real(wp), allocatable :: element_error(:)
+      !> Seconds to build the grid, nodes and constraints.
+      real(wp) :: t_mesh = 0.0_wp
+      !> Factor taking this body's squared energy norms to those of the first
+      !> body's units (a power of two; 1 for the first body), for the sums.
+      real(wp) :: norm2_scale = 1.0_wp
+   end type body_level_type
+
+   !> One level of a study: every body's results and the report row.
+   type :: level_type
+      integer :: level = 0
+      !> Which recoveries ran (1 SPR, 2 SPR-C).
+      logical :: done(2) = .false.
+      type(body_level_type), allocatable :: bodies(:)
+      type(report_row_type) :: row
+   end type level_type
+
+contains
+
+   !> Check that this version can run the scene and build what every level
+   !> shares. `points` = 0 takes the default for the scene's FE order.
+   subroutine prepare_study(scene, points, study, error)
+      type(scene_type), intent(in) :: scene
+      integer, intent(in) :: points
+      type(study_type), intent(out) :: study
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type), allocatable :: bodies(:)
+      type(scene_type) :: scaled
+      integer :: b
+
+      if (size(scene%contacts) > 0) then
+         call fatal_error(error, 'sprc run: &contact is not implemented in this version (bodies in contact '// &
+            & 'need the contact FE); scenes with several bodies and no &contact run', stat_unsupported)
+         return
+      end if
+      call build_bodies(scene, bodies, error)
+      if (allocated(error)) return
+      allocate (study%bodies(size(bodies)))
+      do b = 1, size(bodies)
+         associate (sb => study%bodies(b), spec => scene%bodies(b))
+            sb%name = spec%name
+            sb%geometry = bodies(b)
+            call analysis_units(scene, sb%units, error, b)
+            if (allocated(error)) return
+            scaled = in_units(scene, sb%units)
+            call build_exact(scaled, b, sb%exact, error)
+            if (allocated(error)) return
+            call body_conditions(scaled, b, sb%bcs)
+            sb%young = scaled%bodies(b)%young
+            sb%poisson = spec%poisson
+            sb%body_force = scaled%bodies(b)%body_force
+         end associate
+      end do
+      study%scene = scene
+      study%dim = scene%dim
+      study%order = scene%order
+      study%analysis = analysis_kind(scene)
+      study%refine_boundary = scene%refine_boundary
+      study%box_min = scene%box_min
+      study%box_size = scene%box_size
+      study%gamma = scene%nitsche_gamma
+      study%dilatation = dilatation_choice(scene%dilatation)
+      study%points = points
+      if (points == 0) study%points = default_points(scene%order)
+      study%degree = [recovery_degree(scene, 1), recovery_degree(scene, 2)]
+      study%run = [scene%recovery == 'spr' .or. scene%recovery == 'both', &
+         & scene%recovery == 'sprc' .or. scene%recovery == 'both']
+      study%have_exact = scene%exact%present
+   end subroutine prepare_study
+
+   !> One level of the study: every body analysed, the report row summed.
+   subroutine run_level(study, level, result, error)
+      type(study_type), intent(in) :: study
+      integer, intent(in) :: level
+      type(level_type), intent(out) :: result
+      type(error_type), allocatable, intent(out) :: error
+      type(cut_quadrature_type) :: quad
+      real(wp) :: t_start
+      integer :: b
+
+      t_start = wall_time()
+      result%level = level
+      result%done = study%run
+      call new_cut_quadrature(quad, study%dim, study%points, error)
+      if (allocated(error)) return
+      allocate (result%bodies(size(study%bodies)))
+      do b = 1, size(study%bodies)
+         associate (u => study%bodies(b)%units, u1 => study%bodies(1)%units)
+            result%bodies(b)%norm2_scale = (u%modulus/u1%modulus)*(u%strain/u1%strain)**2
+         end associate
+         call run_body(study, study%bodies(b), level, quad, result%bodies(b), error)
+         if (allocated(error)) then
+            if (size(study%bodies) > 1) error%message = 'body '''//study%bodies(b)%name//''': '//error%message
+            return
+         end if
+      end do
+      call sum_row(study, result, result%row)
+      result%row%t_total = wall_time() - t_start
+      call check_row(result%row, study%have_exact, result%done, error)
+   end subroutine run_level
+
+   !> Mesh, FE solve, recoveries and estimates of one body at `level`.
+   subroutine run_body(study, sb, level, quad, bl, error)
+      type(study_type), intent(in) :: study
+      type(study_body_type), intent(in) :: sb
+      integer, intent(in) :: level
+      type(cut_quadrature_type), intent(in) :: quad
+      type(body_level_type), intent(inout) :: bl
+      type(error_type), allocatable, intent(out) :: error
+      type(recovery_input_type) :: input
+      type(timer_type) :: t_mesh
+      real(wp) :: err_fe, norm_fe
+      integer :: m
+
+      call check_level_memory(study%scene, sb%geometry, level, error)
+      if (allocated(error)) return
+      call t_mesh%start()
+      call bl%grid%build(sb%geometry, study%dim, study%box_min, study%box_size, level, study%refine_boundary, &
+         & error)
+      if (.not. allocated(error)) call bl%nodes%build(bl%grid, study%order, error)
+      if (.not. allocated(error)) call bl%hanging%build(bl%grid, bl%nodes, error)
+      call t_mesh%stop()
+      bl%t_mesh = t_mesh%elapsed
+      if (allocated(error)) return
+      if (any(study%run) .and. sum(bl%grid%n_inside) + sum(bl%grid%n_cut) < 2) then
+         call fatal_error(error, 'one cell holds the whole body at this level, so every recovery patch is that '// &
+            & 'one element: the recovered stress is the FE stress and the estimate (eta = 0) says nothing; '// &
+            & 'use a higher level (or a smaller box_size)', stat_invalid_input)
+         return
+      end if
+      if (allocated(sb%exact)) then
+         call bl%problem%setup(sb%geometry, bl%grid, bl%nodes, bl%hanging, quad, study%analysis, sb%young, &
+            & sb%poisson, sb%body_force, sb%bcs, error, exact=sb%exact, gamma=study%gamma, &
+            & dilatation=study%dilatation)
+      else
+         call bl%problem%setup(sb%geometry, bl%grid, bl%nodes, bl%hanging, quad, study%analysis, sb%young, &
+            & sb%poisson, sb%body_force, sb%bcs, error, gamma=study%gamma, dilatation=study%dilatation)
+      end if
+      if (allocated(error)) return
+      call bl%problem%solve(error)
+      if (allocated(error)) return
+      if (allocated(sb%exact)) then
+         call bl%problem%energy_error(err_fe, bl%element_error, norm_fe, bl%norm_exact, error, bl%err_norm)
+         if (allocated(error)) return
+      end if
+      if (.not. any(study%run)) return
+      call fe_recovery_input(bl%problem, input, error)
+      if (allocated(error)) return
+      do m = 1, 2
+         if (.not. study%run(m)) cycle
+         call recover_and_estimate(sb, input, bl, m, study%degree(m), error)
+         if (allocated(error)) return
+      end do
+   end subroutine run_body
+
+   !> Recovery and estimate with one method (1 SPR, 2 SPR-C) at the patch degree `degree`.
+   subroutine recover_and_estimate(sb, input, bl, m, degree, error)
+      type(study_body_type), intent(in) :: sb
+      type(recovery_input_type), intent(in) :: input
+      type(body_level_type), intent(inout) :: bl
+      integer, intent(in) :: m, degree
+      type(error_type), allocatable, intent(out) :: error
+      integer :: method
+
+      method = merge(method_spr, method_sprc, m == 1)
+      if (allocated(sb%exact)) then
+         call recover_grid(input, bl%grid, bl%nodes, bl%hanging, method, degree, bl%field(m), error, exact=sb%exact)
+         if (allocated(error)) return
+         call estimate_error(input, bl%field(m), bl%est(m), error, exact=sb%exact)
+      else
+         call recover_grid(input, bl%grid, bl%nodes, bl%hanging, method, degree, bl%field(m), error)
+         if (allocated(error)) return
+         call estimate_error(input, bl%field(m), bl%est(m), error)
+      end if
+   end subroutine recover_and_estimate
+
+   !> The level's report row: counts and times added over the bodies; each
+   !> energy norm over all bodies is sqrt(sum of the bodies' squares, taken to
+   !> common units by norm2_scale), then the ratios (for one body exactly its own values: sqrt(x*x) = |x| in
+   !> binary floating point).
+   subroutine sum_row(study, result, row)
+      type(study_type), intent(in) :: study
+      type(level_type), intent(in) :: result
+      type(report_row_type), intent(out) :: row
+      real(wp) :: err2, exact2
+      integer :: b, m
+
+      row%level = result%level
+      row%h = study%box_size/real(2**result%level, wp)
+      row%t_mesh = 0.0_wp
+      row%t_quadrature = 0.0_wp
+      row%t_assembly = 0.0_wp
+      row%t_solve = 0.0_wp
+      do b = 1, size(result%bodies)
+         associate (bl => result%bodies(b))
+            row%elements = row%elements + int(bl%grid%n_leaves, i8)
+            row%cut_elements = row%cut_elements + sum(bl%grid%n_cut)
+            row%dofs = row%dofs + int(bl%problem%n_dofs(), i8)
+            row%t_mesh = row%t_mesh + bl%t_mesh
+            row%t_quadrature = row%t_quadrature + bl%problem%t_quadrature
+            row%t_assembly = row%t_assembly + bl%problem%t_assembly
+            row%t_solve = row%t_solve + bl%problem%t_solve
+         end associate
+      end do
+      if (study%have_exact) then
+         err2 = 0.0_wp
+         exact2 = 0.0_wp
+         do b = 1, size(result%bodies)
+            err2 = err2 + result%bodies(b)%norm2_scale*result%bodies(b)%err_norm**2
+            exact2 = exact2 + result%bodies(b)%norm2_scale*result%bodies(b)%norm_exact**2
+         end do
+         row%err_fe = sqrt(err2)/max(sqrt(exact2), tiny(1.0_wp))
+      end if
+      if (any(result%done)) then
+         row%t_recovery = 0.0_wp
+         row%t_estimate = 0.0_wp
+      end if
+      do m = 1, 2
+         if (.not. result%done(m)) cycle
+         do b = 1, size(result%bodies)
+            row%t_recovery = row%t_recovery + result%bodies(b)%field(m)%t_recovery
+            row%t_estimate = row%t_estimate + result%bodies(b)%est(m)%t_estimate
+         end do
+         call sum_method_columns(row, m, result%bodies, study%have_exact)
+      end do
+   end subroutine sum_row
+
+   !> eta, err and theta of method m (1 SPR, 2 SPR-C) from the bodies' norms,
+   !> with the formulas of `sprc_grid_recovered_estimate`.
+   subroutine sum_method_columns(row, m, bodies, have_exact)
+      type(report_row_type), intent(inout) :: row
+      integer, intent(in) :: m
+      type(body_level_type), intent(in) :: bodies(:)
+      logical, intent(in) :: have_exact
+      real(wp) :: err, norm_h, err_star, norm_ex, err_ex, eta, rel_err_star, theta
+      integer :: b
+
+      err = 0.0_wp
+      norm_h = 0.0_wp
+      err_star = 0.0_wp
+      norm_ex = 0.0_wp
+      err_ex = 0.0_wp
+      do b = 1, size(bodies)
+         err = err + bodies(b)%norm2_scale*bodies(b)%est(m)%err**2
+         norm_h = norm_h + bodies(b)%norm2_scale*bodies(b)%est(m)%norm_h**2
+         err_star = err_star + bodies(b)%norm2_scale*bodies(b)%est(m)%err_star**2
+         norm_ex = norm_ex + bodies(b)%norm2_scale*bodies(b)%est(m)%norm_ex**2
+         err_ex = err_ex + bodies(b)%norm2_scale*bodies(b)%est(m)%err_ex**2
+      end do
+      err = sqrt(err)
+      norm_h = sqrt(norm_h)
+      err_star = sqrt(err_star)
+      norm_ex = sqrt(norm_ex)
+      err_ex = sqrt(err_ex)
+      eta = 0.0_wp
+      if (norm_h**2 + err**2 > 0.0_wp) eta = err/sqrt(norm_h**2 + err**2)
+      rel_err_star = 0.0_wp
+      if (norm_ex > 0.0_wp) rel_err_star = err_star/norm_ex
+      theta = 0.0_wp
+      if (err_ex > 0.0_wp) theta = err/err_ex
+      if (m == 1) then
+         row%eta_spr = eta
+         if (have_exact) row%err_spr = rel_err_star
+         if (have_exact) row%theta_spr = theta
+      else
+         row%eta_sprc = eta
+         if (have_exact) row%err_sprc = rel_err_star
+         if (have_exact) row%theta_sprc = theta
+      end if
+   end subroutine sum_method_columns
+
+   !> No computed column may carry a NaN or an infinity: an empty cell means
+   !> "does not apply", never "went wrong". Every column that was set (the
+   !> times always; errors and estimates where they apply) must be finite.
+   subroutine check_row(row, have_exact, done, error)
+      type(report_row_type), intent(in) :: row
+      logical, intent(in) :: have_exact, done(2)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=16) :: bad
+
+      bad = ''
+      if (.not. all(ieee_is_finite([row%h, row%t_mesh, row%t_quadrature, row%t_assembly, row%t_solve, &
+         row%t_total]))) bad = 'times'
+      if (have_exact .and. .not. ieee_is_finite(row%err_fe)) bad = 'err_fe'
+      if (done(1) .and. .not. all(ieee_is_finite([row%t_recovery, row%t_estimate, row%eta_spr]))) bad = 'spr'
+      if (done(2) .and. .not. all(ieee_is_finite([row%t_recovery, row%t_estimate, row%eta_sprc]))) bad = 'sprc'
+      if (have_exact .and. done(1) .and. .not. all(ieee_is_finite([row%err_spr, row%theta_spr]))) bad = 'spr'
+      if (have_exact .and. done(2) .and. .not. all(ieee_is_finite([row%err_sprc, row%theta_sprc]))) bad = 'sprc'
+      if (len_trim(bad) > 0) call fatal_error(error, 'level result: the '//trim(bad)// &
+         ' columns are not finite (a NaN or an overflow in the computation)', stat_internal)
+   end subroutine check_row
+
+   !> FE stress at each node: the average over the elements that hold it
+   !> (the FE stress is discontinuous; this is only for viewing).
+   subroutine nodal_fe_stress(problem, nodes, sigma)
+      type(elasticity_problem_type), intent(in) :: problem
+      type(grid_nodes_type), intent(in) :: nodes
+      real(wp), allocatable, intent(out) :: sigma(:, :)
+      real(wp) :: s(6)
+      integer :: n, k, e, ns, count
+
+      ns = problem%nstress
+      allocate (sigma(ns, nodes%n_nodes))
+      do n = 1, nodes%n_nodes
+         sigma(:, n) = 0.0_wp
+         count = 0
+         do k = nodes%node_element_ptr(n), nodes%node_element_ptr(n + 1) - 1
+            e = nodes%node_element(k)
+            call problem%stress_in_element(e, nodes%x(:, n), s(1:ns))
+            sigma(:, n) = sigma(:, n) + s(1:ns)
+            count = count + 1
+         end do
+         if (count > 0) sigma(:, n) = sigma(:, n)/real(count, wp)
+      end do
+   end subroutine nodal_fe_stress
+
+end module sprc_study_level

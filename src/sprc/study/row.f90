@@ -1,0 +1,47 @@
+!> One row of a study's report (SCENE.md "Report"): what one level of the
+!> study gives, summed over the bodies. `sprc_io_report` writes rows as a
+!> table and CSV, `sprc_io_svg` plots them.
+!>
+!> A real cell that does not apply (no exact solution, recovery not run) is
+!> *empty*: it holds a quiet NaN (`report_empty`) and `is_empty` is true for
+!> it.
+module sprc_study_row
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
+   use sprc_core_kinds, only: wp, i8
+   implicit none
+   private
+
+   public :: report_row_type, report_empty, is_empty
+
+   !> The value of an empty real cell: the default quiet NaN (bits 0x7FF8000000000000).
+   real(wp), parameter :: report_empty = transfer(9221120237041090560_i8, 1.0_wp)
+
+   !> One level of a study. Times are wall-clock seconds for that level alone;
+   !> errors and estimates are relative, in the energy norm (SCENE.md).
+   !> Real components start empty: set only those that apply.
+   type :: report_row_type
+      integer :: level = 0
+      !> Element size of the level.
+      real(wp) :: h = report_empty
+      !> Active elements, of which cut by the boundary; degrees of freedom.
+      integer(i8) :: elements = 0, cut_elements = 0, dofs = 0
+      real(wp) :: t_mesh = report_empty, t_quadrature = report_empty, t_assembly = report_empty
+      real(wp) :: t_solve = report_empty, t_recovery = report_empty, t_estimate = report_empty
+      real(wp) :: t_total = report_empty
+      !> Exact relative errors of the FE, SPR and SPR-C stresses.
+      real(wp) :: err_fe = report_empty, err_spr = report_empty, err_sprc = report_empty
+      !> Estimated relative errors (ZZ with the SPR / SPR-C field).
+      real(wp) :: eta_spr = report_empty, eta_sprc = report_empty
+      !> Global effectivity indices.
+      real(wp) :: theta_spr = report_empty, theta_sprc = report_empty
+   end type report_row_type
+
+contains
+
+   !> True when `x` is an empty cell (any NaN).
+   elemental logical function is_empty(x)
+      real(wp), intent(in) :: x
+      is_empty = ieee_is_nan(x)
+   end function is_empty
+
+end module sprc_study_row
