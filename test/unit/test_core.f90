@@ -234,6 +234,9 @@ contains
          & 'itoa with digits')
       if (allocated(error)) return
       call check(error, rtoa(-1234.5_wp)//' '//rtoa(0.0_wp), '-1.2345E+03 0.0000E+00', 'rtoa')
+      if (allocated(error)) return
+      call check(error, rtoa(0.5_wp, '(g0)')//' '//rtoa(-2.0_wp, '(es16.8)'), '0.50000000000000000 -2.00000000E+00', &
+         & 'rtoa with a format')
    end subroutine test_strings
 
 end module sprc_test_core

@@ -9,6 +9,7 @@
 !> monomials of degree <= 2n - 1).
 module sprc_core_gauss
    use sprc_core_kinds, only: wp
+   use sprc_core_strings, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    implicit none
    private
@@ -28,13 +29,13 @@ contains
       type(error_type), allocatable, intent(out) :: error
 
       if (n < 1 .or. n > max_gauss_points) then
-         call fatal_error(error, 'gauss_legendre: n = '//int_str(n)//' points, expected 1 to '// &
-            & int_str(max_gauss_points), stat_invalid_input)
+         call fatal_error(error, 'gauss_legendre: n = '//itoa(n)//' points, expected 1 to '// &
+            & itoa(max_gauss_points), stat_invalid_input)
          return
       end if
       if (size(x) < n .or. size(w) < n) then
-         call fatal_error(error, 'gauss_legendre: x and w need '//int_str(n)//' entries, got '// &
-            & int_str(min(size(x), size(w))), stat_invalid_input)
+         call fatal_error(error, 'gauss_legendre: x and w need '//itoa(n)//' entries, got '// &
+            & itoa(min(size(x), size(w))), stat_invalid_input)
          return
       end if
       call gauss_legendre_nodes(n, x, w)
@@ -105,12 +106,12 @@ contains
       dim = size(lo)
       if (dim < 1 .or. dim > 3 .or. size(hi) /= dim) then
          call fatal_error(error, 'tensor_gauss: lo and hi must have the same size 1 to 3, got '// &
-            & int_str(size(lo))//' and '//int_str(size(hi)), stat_invalid_input)
+            & itoa(size(lo))//' and '//itoa(size(hi)), stat_invalid_input)
          return
       end if
       do d = 1, dim
          if (.not. lo(d) <= hi(d)) then
-            call fatal_error(error, 'tensor_gauss: lo('//int_str(d)//') > hi('//int_str(d)//')', &
+            call fatal_error(error, 'tensor_gauss: lo('//itoa(d)//') > hi('//itoa(d)//')', &
                & stat_invalid_input)
             return
          end if
@@ -119,8 +120,8 @@ contains
       if (allocated(error)) return
       npt = n**dim
       if (size(x, 1) < dim .or. size(x, 2) < npt .or. size(w) < npt) then
-         call fatal_error(error, 'tensor_gauss: x needs shape ('//int_str(dim)//', '//int_str(npt)// &
-            & ') and w size '//int_str(npt), stat_invalid_input)
+         call fatal_error(error, 'tensor_gauss: x needs shape ('//itoa(dim)//', '//itoa(npt)// &
+            & ') and w size '//itoa(npt), stat_invalid_input)
          return
       end if
       half(1:dim) = 0.5_wp*(hi - lo)
@@ -138,13 +139,5 @@ contains
          end do
       end do
    end subroutine tensor_gauss
-
-   pure function int_str(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=16) :: buf
-      write (buf, '(i0)') i
-      s = trim(buf)
-   end function int_str
 
 end module sprc_core_gauss

@@ -11,6 +11,7 @@
 !> - solid: the 6x6 3D law with Lame constants lambda, mu.
 module sprc_core_material
    use sprc_core_kinds, only: wp
+   use sprc_core_strings, only: rtoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    implicit none
    private
@@ -58,11 +59,11 @@ contains
 
       ! Written so that NaN fails every test.
       if (.not. (young > 0.0_wp .and. young <= huge(young))) then
-         call fatal_error(error, context//': young must be finite and > 0, got '//real_string(young), &
+         call fatal_error(error, context//': young must be finite and > 0, got '//rtoa(young, '(es16.8)'), &
             & stat_invalid_input)
       else if (.not. (poisson > -1.0_wp .and. poisson < 0.5_wp)) then
          call fatal_error(error, context//': poisson must satisfy -1 < poisson < 0.5, got '// &
-            & real_string(poisson), stat_invalid_input)
+            & rtoa(poisson, '(es16.8)'), stat_invalid_input)
       end if
    end subroutine check_material
 
@@ -168,13 +169,5 @@ contains
             & ' for '//analysis_name(analysis), stat_invalid_input)
       end if
    end subroutine check_arguments
-
-   pure function real_string(x) result(text)
-      real(wp), intent(in) :: x
-      character(len=:), allocatable :: text
-      character(len=32) :: buf
-      write (buf, '(es16.8)') x
-      text = trim(adjustl(buf))
-   end function real_string
 
 end module sprc_core_material

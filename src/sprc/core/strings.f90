@@ -38,12 +38,18 @@ contains
       s = trim(adjustl(buf))
    end function itoa_i8
 
-   !> A real with five significant digits (`es12.4`), for messages.
-   pure function rtoa(x) result(s)
+   !> A real with five significant digits (`es12.4`), for messages, or in the
+   !> edit descriptor `fmt` (e.g. '(g0)', '(es16.8)'; at most 48 characters out).
+   pure function rtoa(x, fmt) result(s)
       real(wp), intent(in) :: x
+      character(len=*), intent(in), optional :: fmt
       character(len=:), allocatable :: s
-      character(len=24) :: buf
-      write (buf, '(es12.4)') x
+      character(len=48) :: buf
+      if (present(fmt)) then
+         write (buf, fmt) x
+      else
+         write (buf, '(es12.4)') x
+      end if
       s = trim(adjustl(buf))
    end function rtoa
 

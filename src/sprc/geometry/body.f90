@@ -20,6 +20,7 @@
 module sprc_geometry_body
    use sprc_core_kinds, only: wp
    use sprc_core_text, only: fixed_text
+   use sprc_core_strings, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_geometry_region, only: region_type, cell_outside, cell_inside, cell_cut
    use sprc_geometry_shape, only: shape_type, shape_kind_name
@@ -110,7 +111,7 @@ contains
 
       where = "body '"//body_name(self)//"', shape '"//shape_name(shape)//"': "
       if (op < 1 .or. op > size(op_names)) then
-         call fatal_error(error, where//'unknown op '//int_str(op)//' (expected add, subtract or intersect)', &
+         call fatal_error(error, where//'unknown op '//itoa(op)//' (expected add, subtract or intersect)', &
             & stat_invalid_input)
          return
       end if
@@ -124,8 +125,8 @@ contains
          return
       end if
       if (self%nshape > 0 .and. shape%dim /= self%dim) then
-         call fatal_error(error, where//shape_kind_name(shape%kind)//' has dimension '//int_str(shape%dim)// &
-            & ', the body has dimension '//int_str(self%dim), stat_invalid_input)
+         call fatal_error(error, where//shape_kind_name(shape%kind)//' has dimension '//itoa(shape%dim)// &
+            & ', the body has dimension '//itoa(self%dim), stat_invalid_input)
          return
       end if
       if (len_trim(shape_name(shape)) > 0) then
@@ -538,13 +539,5 @@ contains
       name = ''
       if (allocated(shape%name)) name = shape%name
    end function shape_name
-
-   pure function int_str(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=16) :: buf
-      write (buf, '(i0)') i
-      s = trim(buf)
-   end function int_str
 
 end module sprc_geometry_body

@@ -28,6 +28,7 @@
 module sprc_geometry_shape
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use sprc_core_kinds, only: wp
+   use sprc_core_strings, only: itoa, rtoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    implicit none
    private
@@ -194,8 +195,8 @@ contains
       if (allocated(error)) return
       do i = 1, self%dim
          if (.not. lower(i) < upper(i)) then
-            call fatal_error(error, prefix(self)//'lower('//int_str(i)//') = '//real_str(lower(i))// &
-               & ' must be < upper('//int_str(i)//') = '//real_str(upper(i)), stat_invalid_input)
+            call fatal_error(error, prefix(self)//'lower('//itoa(i)//') = '//rtoa(lower(i), '(g0)')// &
+               & ' must be < upper('//itoa(i)//') = '//rtoa(upper(i), '(g0)'), stat_invalid_input)
             return
          end if
       end do
@@ -676,7 +677,7 @@ contains
       character(len=*), intent(in) :: field
       type(error_type), allocatable, intent(out) :: error
       if (self%dim == 2 .or. self%dim == 3) return
-      call fatal_error(error, prefix(self)//field//' has '//int_str(self%dim)//' values, expected 2 or 3', &
+      call fatal_error(error, prefix(self)//field//' has '//itoa(self%dim)//' values, expected 2 or 3', &
          & stat_invalid_input)
    end subroutine check_dim_2_or_3
 
@@ -686,7 +687,7 @@ contains
       integer, intent(in) :: n
       type(error_type), allocatable, intent(out) :: error
       if (n == self%dim) return
-      call fatal_error(error, prefix(self)//field//' has '//int_str(n)//' values, expected '//int_str(self%dim), &
+      call fatal_error(error, prefix(self)//field//' has '//itoa(n)//' values, expected '//itoa(self%dim), &
          & stat_invalid_input)
    end subroutine check_size
 
@@ -698,7 +699,7 @@ contains
       integer :: i
       do i = 1, size(v)
          if (ieee_is_finite(v(i))) cycle
-         call fatal_error(error, prefix(self)//field//'('//int_str(i)//') = '//real_str(v(i))//' is not finite', &
+         call fatal_error(error, prefix(self)//field//'('//itoa(i)//') = '//rtoa(v(i), '(g0)')//' is not finite', &
             & stat_invalid_input)
          return
       end do
@@ -714,7 +715,7 @@ contains
          if (ieee_is_finite(v(i))) then
             if (v(i) > 0.0_wp) cycle
          end if
-         call fatal_error(error, prefix(self)//field//' = '//real_str(v(i))//' must be positive and finite', &
+         call fatal_error(error, prefix(self)//field//' = '//rtoa(v(i), '(g0)')//' must be positive and finite', &
             & stat_invalid_input)
          return
       end do
@@ -733,22 +734,6 @@ contains
       call fatal_error(error, prefix(self)//field//' = ('//vector_str(v)//') has zero length', stat_invalid_input)
    end subroutine check_direction
 
-   pure function int_str(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=16) :: buf
-      write (buf, '(i0)') i
-      s = trim(buf)
-   end function int_str
-
-   pure function real_str(x) result(s)
-      real(wp), intent(in) :: x
-      character(len=:), allocatable :: s
-      character(len=40) :: buf
-      write (buf, '(g0)') x
-      s = trim(adjustl(buf))
-   end function real_str
-
    pure function vector_str(v) result(s)
       real(wp), intent(in) :: v(:)
       character(len=:), allocatable :: s
@@ -756,7 +741,7 @@ contains
       s = ''
       do i = 1, size(v)
          if (i > 1) s = s//', '
-         s = s//real_str(v(i))
+         s = s//rtoa(v(i), '(g0)')
       end do
    end function vector_str
 

@@ -66,6 +66,7 @@
 !> use one per thread.
 module sprc_grid_quadrature
    use sprc_core_kinds, only: wp
+   use sprc_core_strings, only: itoa, rtoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_gauss, only: max_gauss_points, gauss_legendre_nodes
    use sprc_geometry_region, only: cell_outside, cell_inside, cell_cut
@@ -167,18 +168,18 @@ contains
       real(wp) :: t(max_gauss_points), w(max_gauss_points)
 
       if (dim /= 2 .and. dim /= 3) then
-         call fatal_error(error, 'new_cut_quadrature: dim = '//int_str(dim)//', expected 2 or 3', stat_invalid_input)
+         call fatal_error(error, 'new_cut_quadrature: dim = '//itoa(dim)//', expected 2 or 3', stat_invalid_input)
          return
       end if
       if (q < 1 .or. q > max_gauss_points) then
-         call fatal_error(error, 'new_cut_quadrature: q = '//int_str(q)//' points, expected 1 to '// &
-            & int_str(max_gauss_points), stat_invalid_input)
+         call fatal_error(error, 'new_cut_quadrature: q = '//itoa(q)//' points, expected 1 to '// &
+            & itoa(max_gauss_points), stat_invalid_input)
          return
       end if
       self%max_depth = default_max_depth(dim)
       if (present(max_depth)) then
          if (max_depth < 0 .or. max_depth > 30) then
-            call fatal_error(error, 'new_cut_quadrature: max_depth = '//int_str(max_depth)// &
+            call fatal_error(error, 'new_cut_quadrature: max_depth = '//itoa(max_depth)// &
                & ', expected 0 to 30', stat_invalid_input)
             return
          end if
@@ -187,7 +188,7 @@ contains
       self%min_ratio = default_min_ratio
       if (present(min_ratio)) then
          if (.not. (min_ratio >= 0.0_wp .and. min_ratio <= 100.0_wp)) then
-            call fatal_error(error, 'new_cut_quadrature: min_ratio = '//real_str(min_ratio)// &
+            call fatal_error(error, 'new_cut_quadrature: min_ratio = '//rtoa(min_ratio, '(g0)')// &
                & ', expected 0 to 100', stat_invalid_input)
             return
          end if
@@ -272,18 +273,18 @@ contains
          return
       end if
       if (body%nshape == 0 .or. body%dim /= quad%dim) then
-         call fatal_error(error, where//': body has dimension '//int_str(body%dim)//' and '// &
-            & int_str(body%nshape)//' shapes, the quadrature dimension '//int_str(quad%dim), stat_invalid_input)
+         call fatal_error(error, where//': body has dimension '//itoa(body%dim)//' and '// &
+            & itoa(body%nshape)//' shapes, the quadrature dimension '//itoa(quad%dim), stat_invalid_input)
          return
       end if
       if (size(lo) /= quad%dim .or. size(hi) /= quad%dim) then
-         call fatal_error(error, where//': lo and hi have '//int_str(size(lo))//' and '//int_str(size(hi))// &
-            & ' values, expected '//int_str(quad%dim), stat_invalid_input)
+         call fatal_error(error, where//': lo and hi have '//itoa(size(lo))//' and '//itoa(size(hi))// &
+            & ' values, expected '//itoa(quad%dim), stat_invalid_input)
          return
       end if
       do i = 1, quad%dim
          if (.not. (lo(i) < hi(i) .and. abs(hi(i) - lo(i)) < huge(1.0_wp))) then
-            call fatal_error(error, where//': cell extent lo('//int_str(i)//') < hi('//int_str(i)// &
+            call fatal_error(error, where//': cell extent lo('//itoa(i)//') < hi('//itoa(i)// &
                & ') violated or not finite', stat_invalid_input)
             return
          end if
@@ -1025,21 +1026,5 @@ contains
       rule%surf_n(:, rule%nsurf) = n
       rule%surf_shape(rule%nsurf) = s
    end subroutine push_surface
-
-   pure function real_str(x) result(s)
-      real(wp), intent(in) :: x
-      character(len=:), allocatable :: s
-      character(len=32) :: buf
-      write (buf, '(g0)') x
-      s = trim(adjustl(buf))
-   end function real_str
-
-   pure function int_str(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=16) :: buf
-      write (buf, '(i0)') i
-      s = trim(buf)
-   end function int_str
 
 end module sprc_grid_quadrature

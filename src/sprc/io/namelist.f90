@@ -20,6 +20,7 @@
 module sprc_io_namelist
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use sprc_core_kinds, only: wp, i8
+   use sprc_core_strings, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_io
    implicit none
    private
@@ -136,8 +137,8 @@ contains
       if (size < 0_i8) then
          call fatal_error(error, "cannot read '"//path//"': size unknown", stat_io)
       else if (size > int(max_text_size, i8)) then
-         call fatal_error(error, "'"//path//"': "//int_text(int(size / 1024_i8))// &
-            & ' KiB is too large for a text input file (limit '//int_text(max_text_size / 1024)//' KiB)')
+         call fatal_error(error, "'"//path//"': "//itoa(int(size / 1024_i8))// &
+            & ' KiB is too large for a text input file (limit '//itoa(max_text_size / 1024)//' KiB)')
       else
          allocate (character(len=int(size)) :: text)
          if (size > 0_i8) then
@@ -165,12 +166,12 @@ contains
          code = iachar(text(i:i))
          if (code == 10) line = line + 1
          if (code == 0) then
-            call fatal_error(error, source//':'//int_text(line)//': not a text file: NUL byte at offset ' &
-               & //int_text(i - 1))
+            call fatal_error(error, source//':'//itoa(line)//': not a text file: NUL byte at offset ' &
+               & //itoa(i - 1))
             return
          else if ((code < 32 .and. index(blanks, text(i:i)) == 0) .or. code == 127) then
-            call fatal_error(error, source//':'//int_text(line)//': not a text file: control byte ' &
-               & //int_text(code)//' at offset '//int_text(i - 1))
+            call fatal_error(error, source//':'//itoa(line)//': not a text file: control byte ' &
+               & //itoa(code)//' at offset '//itoa(i - 1))
             return
          else if (code >= 128) then
             ! Lead byte of a UTF-8 sequence: count the continuation bytes it needs.
@@ -188,8 +189,8 @@ contains
                ntrail = -1
             end if
             if (ntrail < 0) then
-               call fatal_error(error, source//':'//int_text(line)// &
-                  & ': not a text file: invalid UTF-8 byte '//int_text(code)//' at offset '//int_text(i - 1))
+               call fatal_error(error, source//':'//itoa(line)// &
+                  & ': not a text file: invalid UTF-8 byte '//itoa(code)//' at offset '//itoa(i - 1))
                return
             end if
             i = i + ntrail
@@ -221,12 +222,12 @@ contains
          call skip_blanks(text, s)
          if (s%pos > len(text)) exit
          if (text(s%pos:s%pos) /= '&') then
-            call fatal_error(error, source//':'//int_text(s%line)//": unexpected text '"//snippet(text, s%pos)// &
+            call fatal_error(error, source//':'//itoa(s%line)//": unexpected text '"//snippet(text, s%pos)// &
                & "' outside a namelist group (a group starts with &name and ends with /)")
             return
          end if
          if (ngroup == max_groups) then
-            call fatal_error(error, source//':'//int_text(s%line)//': more than '//int_text(max_groups)// &
+            call fatal_error(error, source//':'//itoa(s%line)//': more than '//itoa(max_groups)// &
                & ' namelist groups')
             return
          end if
@@ -255,11 +256,11 @@ contains
       s%pos = s%pos + 1
       call read_name(text, s, group%name)
       if (len(group%name) == 0) then
-         call fatal_error(error, source//':'//int_text(s%line)//": expected a group name after '&', found '"// &
+         call fatal_error(error, source//':'//itoa(s%line)//": expected a group name after '&', found '"// &
             & snippet(text, s%pos)//"'")
          return
       end if
-      where = source//':'//int_text(group%line)//': &'//group%name//': '
+      where = source//':'//itoa(group%line)//': &'//group%name//': '
       if (present(known_groups)) then
          if (.not. any(known_groups == group%name)) then
             call fatal_error(error, where//'unknown group; valid groups: '//join_names(known_groups, '&'))
@@ -279,20 +280,20 @@ contains
             exit
          case ('&')
             call fatal_error(error, where//"unterminated group: '&"//snippet(text, s%pos + 1)// &
-               & "' on line "//int_text(s%line)//" starts before the closing '/'")
+               & "' on line "//itoa(s%line)//" starts before the closing '/'")
             return
          end select
          if (nitem == max_items) then
-            call fatal_error(error, where//'more than '//int_text(max_items)//' keys in one group')
+            call fatal_error(error, where//'more than '//itoa(max_items)//' keys in one group')
             return
          end if
          call parse_item(text, s, group, item, error)
          if (allocated(error)) return
          do i = 1, nitem
             if (group%items(i)%key == item%key) then
-               call fatal_error(error, source//':'//int_text(item%line)//': &'//group%name//': '//item%key// &
+               call fatal_error(error, source//':'//itoa(item%line)//': &'//group%name//': '//item%key// &
                   & ' = '//values_text(item%values)//': duplicate key (first given on line '// &
-                  & int_text(group%items(i)%line)//')')
+                  & itoa(group%items(i)%line)//')')
                return
             end if
          end do
@@ -316,7 +317,7 @@ contains
       end do
       if (j > len(text)) return
       if (index('!'//achar(10)//achar(13), text(j:j)) > 0) return
-      call fatal_error(error, source//':'//int_text(s%line)//': &'//group%name//": text '"//snippet(text, j)// &
+      call fatal_error(error, source//':'//itoa(s%line)//': &'//group%name//": text '"//snippet(text, j)// &
          & "' after the closing '/' on the same line: Fortran ignores the rest of that line; start it on a new line")
    end subroutine check_line_end
 
@@ -331,7 +332,7 @@ contains
       character(len=:), allocatable :: where
       integer :: nvalue, total
 
-      where = group%source//':'//int_text(s%line)//': &'//group%name//': '
+      where = group%source//':'//itoa(s%line)//': &'//group%name//': '
       item%line = s%line
       call read_name(text, s, item%key)
       if (len(item%key) == 0) then
@@ -368,21 +369,21 @@ contains
          if (text(s%pos:s%pos) == '/' .or. text(s%pos:s%pos) == '&') exit
          if (starts_key(text, s%pos)) exit
          if (text(s%pos:s%pos) == ',') then
-            call fatal_error(error, group%source//':'//int_text(s%line)//': &'//group%name//': '//item%key// &
+            call fatal_error(error, group%source//':'//itoa(s%line)//': &'//group%name//': '//item%key// &
                & ': empty value before a comma (null values are not supported)')
             return
          end if
          call parse_value(text, s, value, error)
          if (allocated(error)) then
-            error%message = group%source//':'//int_text(s%line)//': &'//group%name//': '//item%key//' = '// &
+            error%message = group%source//':'//itoa(s%line)//': &'//group%name//': '//item%key//' = '// &
                & error%message
             return
          end if
          call append_value(item%values, nvalue, value)
          total = total + value%count
          if (total > max_values) then
-            call fatal_error(error, group%source//':'//int_text(item%line)//': &'//group%name//': '//item%key// &
-               & ': more than '//int_text(max_values)//' values')
+            call fatal_error(error, group%source//':'//itoa(item%line)//': &'//group%name//': '//item%key// &
+               & ': more than '//itoa(max_values)//' values')
             return
          end if
          if (s%pos <= len(text)) then
@@ -418,7 +419,7 @@ contains
                read (text(s%pos:j - 1), *, iostat=ios) value%count
             end if
             if (value%count < 1 .or. value%count > max_repeat) then
-               call fatal_error(error, text(s%pos:j)//': repeat count must be 1 to '//int_text(max_repeat))
+               call fatal_error(error, text(s%pos:j)//': repeat count must be 1 to '//itoa(max_repeat))
                return
             end if
             s%pos = j + 1
@@ -725,13 +726,13 @@ contains
       n = value_count(group%items(k))
       if (n < min_count .or. n > max_count) then
          if (min_count == max_count .and. min_count == 1) then
-            call nml_field_error(group, group%items(k)%key, 'expected one value, got '//int_text(n), error)
+            call nml_field_error(group, group%items(k)%key, 'expected one value, got '//itoa(n), error)
          else if (min_count == max_count) then
-            call nml_field_error(group, group%items(k)%key, 'expected '//int_text(min_count)// &
-               & ' values, got '//int_text(n), error)
+            call nml_field_error(group, group%items(k)%key, 'expected '//itoa(min_count)// &
+               & ' values, got '//itoa(n), error)
          else
-            call nml_field_error(group, group%items(k)%key, 'expected '//int_text(min_count)//' to '// &
-               & int_text(max_count)//' values, got '//int_text(n), error)
+            call nml_field_error(group, group%items(k)%key, 'expected '//itoa(min_count)//' to '// &
+               & itoa(max_count)//' values, got '//itoa(n), error)
          end if
       end if
    end subroutine check_item
@@ -875,10 +876,10 @@ contains
       integer :: k
       k = find_item(group, key)
       if (k > 0) then
-         call fatal_error(error, group%source//':'//int_text(group%items(k)%line)//': &'//group%name//': '// &
+         call fatal_error(error, group%source//':'//itoa(group%items(k)%line)//': &'//group%name//': '// &
             & key//' = '//nml_item_text(group, key)//': '//reason, stat_invalid_input)
       else
-         call fatal_error(error, group%source//':'//int_text(group%line)//': &'//group%name//': '//key//': ' &
+         call fatal_error(error, group%source//':'//itoa(group%line)//': &'//group%name//': '//key//': ' &
             & //reason, stat_invalid_input)
       end if
       if (present(stat)) error%stat = stat
@@ -891,7 +892,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       !> Status (default `stat_invalid_input`).
       integer, intent(in), optional :: stat
-      call fatal_error(error, group%source//':'//int_text(group%line)//': &'//group%name//': '//reason, &
+      call fatal_error(error, group%source//':'//itoa(group%line)//': &'//group%name//': '//reason, &
          & stat_invalid_input)
       if (present(stat)) error%stat = stat
    end subroutine nml_group_error
@@ -1027,13 +1028,5 @@ contains
          if (text(i:i) >= 'A' .and. text(i:i) <= 'Z') low(i:i) = achar(iachar(text(i:i)) + 32)
       end do
    end function lower
-
-   pure function int_text(i) result(text)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: text
-      character(len=16) :: buf
-      write (buf, '(i0)') i
-      text = trim(buf)
-   end function int_text
 
 end module sprc_io_namelist
