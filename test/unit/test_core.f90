@@ -7,6 +7,8 @@ module sprc_test_core
    use sprc_core_timer, only: timer_type, wall_time
    use sprc_core_text, only: fixed_text
    use sprc_core_strings, only: itoa, rtoa
+   use sprc_core_boundary, only: bc_none, bc_traction, bc_symmetry, bc_free, bc_pressure, bc_contact, bc_kind_name, &
+      & bc_kind_from_name
    use sprc_core_lapack, only: dgesv, dgecon, dgetrf, dlange, dpotrf, dpotrs, dgeqp3, dgesvd, &
       & dgemm, dsyrk, dsysv, lapack_info_error
    use sprc_testsuite, only: unittest_type, new_unittest, check
@@ -33,7 +35,8 @@ contains
          new_unittest('dgemm_dsyrk', test_dgemm_dsyrk), &
          new_unittest('dsysv_indefinite', test_dsysv), &
          new_unittest('lapack_info_translation', test_info_translation), &
-         new_unittest('strings', test_strings) &
+         new_unittest('strings', test_strings), &
+         new_unittest('boundary_kinds', test_boundary_kinds) &
          ]
    end subroutine collect_core
 
@@ -238,5 +241,37 @@ contains
       call check(error, rtoa(0.5_wp, '(g0)')//' '//rtoa(-2.0_wp, '(es16.8)'), '0.50000000000000000 -2.00000000E+00', &
          & 'rtoa with a format')
    end subroutine test_strings
+
+   !> One vocabulary: every kind's name maps back to it; the facet kinds of
+   !> the C header (include/sprc.h, read here) are the same numbers, and every
+   !> layer's names for them are the same constants.
+   subroutine test_boundary_kinds(error)
+      use sprc_fem_bc, only: fe_traction => bc_traction, fe_free => bc_free
+      use sprc_grid_patches, only: grid_traction => bc_traction, grid_symmetry => bc_symmetry
+      use sprc_recovery_mesh, only: facet_traction, facet_symmetry, facet_free
+      use sprc_recovery_patch, only: boundary_traction, boundary_symmetry, boundary_contact, boundary_none
+      use sprc_test_report, only: read_text_file
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: header
+      integer :: k
+
+      do k = bc_none, bc_contact
+         call check(error, bc_kind_from_name(bc_kind_name(k)), k, 'name of kind '//itoa(k)//' maps back')
+         if (allocated(error)) return
+      end do
+      call check(error, bc_kind_name(bc_contact + 1) == '' .and. bc_kind_from_name('torus') == -1, 'unknown kinds')
+      if (allocated(error)) return
+      call read_text_file('include/sprc.h', header, error)
+      if (allocated(error)) return
+      call check(error, index(header, '#define SPRC_FACET_TRACTION '//itoa(bc_traction)//new_line('a')) > 0 .and. &
+         & index(header, '#define SPRC_FACET_SYMMETRY '//itoa(bc_symmetry)//new_line('a')) > 0 .and. &
+         & index(header, '#define SPRC_FACET_FREE '//itoa(bc_free)//new_line('a')) > 0 .and. &
+         & index(header, '#define SPRC_FACET_PRESSURE '//itoa(bc_pressure)//new_line('a')) > 0, 'C facet kinds')
+      if (allocated(error)) return
+      call check(error, all([fe_traction, grid_traction, facet_traction, boundary_traction] == bc_traction) .and. &
+         & all([grid_symmetry, facet_symmetry, boundary_symmetry] == bc_symmetry) .and. &
+         & all([fe_free, facet_free] == bc_free) .and. boundary_contact == bc_contact .and. boundary_none == bc_none, &
+         & 'every layer uses the one vocabulary')
+   end subroutine test_boundary_kinds
 
 end module sprc_test_core

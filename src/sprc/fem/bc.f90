@@ -1,5 +1,6 @@
 !> Boundary conditions of the FE layer on a body's shape surfaces (SCENE.md
-!> `&bc`), as plain data: which shape, which kind, a value and a vector.
+!> `&bc`), as plain data: which shape, which kind (`sprc_core_boundary`'s
+!> vocabulary, re-exported here), a value and a vector.
 !>
 !> Every surface quadrature point carries the index of the shape whose surface
 !> it lies on; the condition of that shape applies there. A shape with no
@@ -16,6 +17,8 @@ module sprc_fem_bc
    use sprc_core_kinds, only: wp
    use sprc_core_strings, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
+   use sprc_core_boundary, only: bc_free, bc_pressure, bc_traction, bc_displacement, bc_symmetry, &
+      & bc_exact_traction, bc_exact_displacement, bc_kind_name, bc_kind_from_name
    implicit none
    private
 
@@ -23,23 +26,12 @@ module sprc_fem_bc
    public :: bc_free, bc_pressure, bc_traction, bc_displacement, bc_symmetry, bc_exact_traction, &
       & bc_exact_displacement
 
-   !> Condition kinds (values are stable).
-   integer, parameter :: bc_free = 1
-   integer, parameter :: bc_pressure = 2
-   integer, parameter :: bc_traction = 3
-   integer, parameter :: bc_displacement = 4
-   integer, parameter :: bc_symmetry = 5
-   integer, parameter :: bc_exact_traction = 6
-   integer, parameter :: bc_exact_displacement = 7
-
-   character(len=*), parameter :: kind_names(7) = [character(len=18) :: 'free', 'pressure', 'traction', &
-      & 'displacement', 'symmetry', 'exact_traction', 'exact_displacement']
-
    !> One boundary condition on the surface of shape `shape` of the body.
    type :: fe_bc_type
       !> Index of the shape in the body (1..nshape).
       integer :: shape = 0
-      !> One of the `bc_*` kinds.
+      !> One of the kinds of `sprc_core_boundary` an FE condition can have:
+      !> free, pressure, traction, displacement, symmetry, exact_traction, exact_displacement.
       integer :: kind = bc_free
       !> Pressure (kind pressure).
       real(wp) :: value = 0.0_wp
@@ -65,23 +57,6 @@ contains
       end if
    end function new_fe_bc
 
-   !> Name of a kind as the scene spells it; '' for an unknown kind.
-   pure function bc_kind_name(kind) result(name)
-      integer, intent(in) :: kind
-      character(len=:), allocatable :: name
-      name = ''
-      if (kind >= 1 .and. kind <= size(kind_names)) name = trim(kind_names(kind))
-   end function bc_kind_name
-
-   !> Kind of a name; 0 for an unknown name.
-   pure integer function bc_kind_from_name(name) result(kind)
-      character(len=*), intent(in) :: name
-      do kind = 1, size(kind_names)
-         if (trim(adjustl(name)) == trim(kind_names(kind))) return
-      end do
-      kind = 0
-   end function bc_kind_from_name
-
    !> Validate conditions for a body of `nshape` shapes in dimension `dim`:
    !> shape index in range and not repeated, known kind, finite data, vector of
    !> size dim where needed, an exact solution (`have_exact`) for exact_* kinds.
@@ -105,7 +80,8 @@ contains
                & stat_invalid_input)
             return
          end if
-         if (bc_kind_name(bcs(i)%kind) == '') then
+         if (.not. any(bcs(i)%kind == [bc_free, bc_pressure, bc_traction, bc_displacement, bc_symmetry, &
+            & bc_exact_traction, bc_exact_displacement])) then
             call fatal_error(error, where//'unknown kind '//itoa(bcs(i)%kind), stat_invalid_input)
             return
          end if

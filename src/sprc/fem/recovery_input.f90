@@ -12,9 +12,8 @@
 module sprc_fem_recovery_input
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
-   use sprc_grid_patches, only: recovery_input_type, rec_none => bc_none, rec_traction => bc_traction, &
-      & rec_pressure => bc_pressure, rec_exact_traction => bc_exact_traction, rec_symmetry => bc_symmetry
-   use sprc_fem_bc, only: bc_free, bc_pressure, bc_traction, bc_symmetry, bc_exact_traction
+   use sprc_core_boundary, only: bc_none, bc_free, bc_pressure, bc_traction, bc_symmetry, bc_exact_traction
+   use sprc_grid_patches, only: recovery_input_type
    use sprc_fem_problem, only: elasticity_problem_type
    implicit none
    private
@@ -66,26 +65,22 @@ contains
       d = problem%dim
       nshape = size(problem%bc_of_shape)
       allocate (input%bc_kind(nshape), input%bc_traction(3, nshape), input%bc_pressure(nshape))
-      input%bc_kind = rec_traction
+      input%bc_kind = bc_traction
       input%bc_traction = 0.0_wp
       input%bc_pressure = 0.0_wp
       do i = 1, size(problem%bcs)
          s = problem%bcs(i)%shape
+         input%bc_kind(s) = problem%bcs(i)%kind
          select case (problem%bcs(i)%kind)
          case (bc_free)
-            input%bc_kind(s) = rec_traction
+            input%bc_kind(s) = bc_traction
          case (bc_pressure)
-            input%bc_kind(s) = rec_pressure
             input%bc_pressure(s) = problem%bcs(i)%value
          case (bc_traction)
-            input%bc_kind(s) = rec_traction
             input%bc_traction(1:d, s) = problem%bcs(i)%vector(1:d)
-         case (bc_exact_traction)
-            input%bc_kind(s) = rec_exact_traction
-         case (bc_symmetry)
-            input%bc_kind(s) = rec_symmetry
+         case (bc_exact_traction, bc_symmetry)   ! the kind alone says it
          case default
-            input%bc_kind(s) = rec_none
+            input%bc_kind(s) = bc_none
          end select
       end do
    end subroutine boundary_kinds

@@ -48,6 +48,7 @@ module sprc_grid_patches
    use sprc_core_material, only: plane_stress, plane_strain, solid, voigt_size, check_material
    use sprc_core_poly, only: poly_max_degree
    use sprc_core_timer, only: wall_time
+   use sprc_core_boundary, only: bc_none, bc_traction, bc_pressure, bc_exact_traction, bc_symmetry, bc_kind_name
    use sprc_exact_solution, only: exact_solution_type
    use sprc_grid_tree, only: grid_type
    use sprc_grid_nodes, only: grid_nodes_type
@@ -60,9 +61,6 @@ module sprc_grid_patches
 
    public :: recovery_input_type, check_recovery_input, recover_grid, default_max_rounds
    public :: bc_none, bc_traction, bc_pressure, bc_exact_traction, bc_symmetry, bc_kind_name
-
-   !> Boundary kinds per shape index (values are part of the C API; never renumber).
-   integer, parameter :: bc_none = 0, bc_traction = 1, bc_pressure = 2, bc_exact_traction = 3, bc_symmetry = 4
 
    !> Default limit of expansion rounds per patch (module notes).
    integer, parameter :: default_max_rounds = 3
@@ -85,7 +83,8 @@ module sprc_grid_patches
       real(wp), allocatable :: bx(:, :), bw(:), bn(:, :)
       !> Shape index of each boundary point (nb), 1..size(bc_kind).
       integer, allocatable :: bshape(:)
-      !> Boundary kind per shape index (bc_none .. bc_symmetry).
+      !> Boundary kind per shape index (`sprc_core_boundary`: bc_none, bc_traction, bc_pressure,
+      !> bc_exact_traction or bc_symmetry).
       integer, allocatable :: bc_kind(:)
       !> Traction vector (3, nshape) of bc_traction shapes; pressure (nshape) of bc_pressure shapes.
       real(wp), allocatable :: bc_traction(:, :), bc_pressure(:)
@@ -107,19 +106,6 @@ module sprc_grid_patches
 
 contains
 
-   !> Name of a boundary kind of the input, for messages.
-   pure function bc_kind_name(kind) result(name)
-      integer, intent(in) :: kind
-      character(len=:), allocatable :: name
-      select case (kind)
-      case (bc_none); name = 'none'
-      case (bc_traction); name = 'traction'
-      case (bc_pressure); name = 'pressure'
-      case (bc_exact_traction); name = 'exact_traction'
-      case (bc_symmetry); name = 'symmetry'
-      case default; name = 'unknown'
-      end select
-   end function bc_kind_name
 
    !> Recover the stress of every free vertex node of `grid` and build the recovered field.
    !> `method` is method_spr or method_sprc, `degree` the patch polynomial degree (1..3;
@@ -458,8 +444,9 @@ contains
             if (.not. have_exact) call input_error(error, 'shape '//itoa(s)// &
                & ' has bc_exact_traction but no exact solution was given')
          case default
-            call input_error(error, 'bc_kind('//itoa(s)//') = '//itoa(input%bc_kind(s))// &
-               & ' is not none=0, traction=1, pressure=2, exact_traction=3 or symmetry=4')
+            call input_error(error, 'bc_kind('//itoa(s)//') = '//itoa(input%bc_kind(s))//' is not none='// &
+               & itoa(bc_none)//', traction='//itoa(bc_traction)//', pressure='//itoa(bc_pressure)// &
+               & ', exact_traction='//itoa(bc_exact_traction)//' or symmetry='//itoa(bc_symmetry))
          end select
          if (allocated(error)) return
       end do

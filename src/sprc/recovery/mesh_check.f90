@@ -11,6 +11,7 @@
 !> `gauss_weights[0][2]` with the C argument names (module procedure `entry_name`).
 module sprc_recovery_mesh_check
    use sprc_core_kinds, only: wp, i8
+   use sprc_core_boundary, only: bc_traction, bc_symmetry, bc_free, bc_pressure
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_material, only: plane_stress, plane_strain, solid, voigt_size, check_material
    use sprc_core_poly, only: poly_max_degree
@@ -25,10 +26,12 @@ module sprc_recovery_mesh_check
 
    !> Recovery methods (values are part of the C API; never renumber).
    integer, parameter :: mesh_method_spr = 1, mesh_method_sprc = 2
-   !> Facet kinds (values are part of the C API; never renumber): prescribed traction
-   !> (its value per facet), symmetry plane (zero shear), free surface (zero traction),
-   !> pressure p = facet_traction(1, f) (t = -p n with the facet's own normal at each point).
-   integer, parameter :: facet_traction = 1, facet_symmetry = 2, facet_free = 3, facet_pressure = 4
+   !> Facet kinds, the boundary kinds of `sprc_core_boundary` a facet can have (values are
+   !> part of the C API, SPRC_FACET_*): prescribed traction (its value per facet), symmetry
+   !> plane (zero shear), free surface (zero traction), pressure p = facet_traction(1, f)
+   !> (t = -p n with the facet's own normal at each point).
+   integer, parameter :: facet_traction = bc_traction, facet_symmetry = bc_symmetry, facet_free = bc_free, &
+      & facet_pressure = bc_pressure
 
 contains
 

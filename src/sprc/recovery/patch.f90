@@ -26,6 +26,7 @@
 !> zero shear on each whole plane, not only at the points.
 module sprc_recovery_patch
    use sprc_core_kinds, only: wp
+   use sprc_core_boundary, only: bc_none, bc_traction, bc_symmetry, bc_contact
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_material, only: plane_stress, plane_strain, solid, voigt_size, check_material
    implicit none
@@ -37,14 +38,14 @@ module sprc_recovery_patch
    public :: boundary_measure, dominant_boundary_kind, boundary_kind_name
    public :: kind_equilibrium, kind_compatibility, kind_traction, kind_symmetry, nconstraint_kinds
 
-   !> Boundary kinds of boundary points (values are part of the C API; never renumber).
-   integer, parameter :: boundary_none = 0
+   !> Boundary kinds of boundary points, those of `sprc_core_boundary` a patch constrains.
+   integer, parameter :: boundary_none = bc_none
    !> Prescribed traction t = sigma n (includes free surfaces, t = 0).
-   integer, parameter :: boundary_traction = 1
+   integer, parameter :: boundary_traction = bc_traction
    !> Symmetry plane: zero shear traction on the plane.
-   integer, parameter :: boundary_symmetry = 2
+   integer, parameter :: boundary_symmetry = bc_symmetry
    !> Contact surface (reserved: the contact constraints come with the contact layer).
-   integer, parameter :: boundary_contact = 3
+   integer, parameter :: boundary_contact = bc_contact
 
    !> Constraint kinds, the index of the per-kind diagnostics of `recovered_patch_type`.
    integer, parameter :: kind_equilibrium = 1, kind_compatibility = 2, kind_traction = 3, kind_symmetry = 4
@@ -379,8 +380,9 @@ contains
             write (buf, '("bw(",i0,") = ",es12.4," must be finite and >= 0")') j, patch%bw(j)
          else if (.not. (abs(nrm - 1.0_wp) <= 1.0e-8_wp)) then
             write (buf, '("bn(:, ",i0,") has length ",es12.4,", expected a unit normal")') j, nrm
-         else if (patch%bkind(j) < boundary_traction .or. patch%bkind(j) > boundary_contact) then
-            write (buf, '("bkind(",i0,") = ",i0," is not traction=1, symmetry=2 or contact=3")') j, patch%bkind(j)
+         else if (.not. any(patch%bkind(j) == [boundary_traction, boundary_symmetry, boundary_contact])) then
+            write (buf, '("bkind(",i0,") = ",i0," is not traction=",i0,", symmetry=",i0," or contact=",i0)') j, &
+               & patch%bkind(j), boundary_traction, boundary_symmetry, boundary_contact
          else if (patch%bpiece(j) < 1) then
             write (buf, '("bpiece(",i0,") = ",i0," must be >= 1")') j, patch%bpiece(j)
          else if (patch%bkind(j) == boundary_traction .and. &
