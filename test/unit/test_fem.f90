@@ -91,7 +91,8 @@ contains
          new_unittest('umfpack_fallback', test_umfpack_fallback), &
          new_unittest('threads', test_threads), &
          new_unittest('queries_and_api_errors', test_queries), &
-         new_unittest('recovery_input_adapter', test_recovery_input) &
+         new_unittest('recovery_input_adapter', test_recovery_input), &
+         new_unittest('solve_in_steps', test_solve_in_steps) &
          ]
    end subroutine collect_fem
 
@@ -594,6 +595,51 @@ contains
       call check(error, all(input%bc_kind == [rec_traction, rec_pressure, rec_symmetry, rec_symmetry]), &
          & 'a shape without a condition is a free (traction 0) surface')
    end subroutine test_recovery_input
+
+   !> solve = assemble + solve_reduced + set_solution: the steps repeated on a
+   !> solved problem give the same bits; set_solution(2 ubar) gives 2 u
+   !> exactly (u = T ubar is linear and doubling is exact); misuse is refused.
+   subroutine test_solve_in_steps(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: body
+      type(fe_bc_type), allocatable :: bcs(:)
+      type(lame_cylinder_type) :: exact
+      type(elasticity_problem_type) :: problem, empty
+      type(error_type), allocatable :: refused
+      real(wp), allocatable :: ubar(:), u(:, :)
+
+      call empty%assemble(refused)
+      call check(error, allocated(refused), 'assemble before setup is refused')
+      if (allocated(error)) return
+      deallocate (refused)
+      call empty%solve_reduced(refused)
+      call check(error, allocated(refused), 'solve_reduced before assemble is refused')
+      if (allocated(error)) return
+      call lame_quarter(body, bcs, exact, plane_strain, error)
+      if (allocated(error)) return
+      call solve_on_grid(problem, body, [0.0_wp, 0.0_wp], 25.0_wp, 3, 0, 2, plane_strain, young, poisson, &
+         & [0.0_wp, 0.0_wp], bcs, error, exact=exact)
+      if (allocated(error)) return
+      ubar = problem%ubar
+      u = problem%u
+      call problem%assemble(error)
+      if (allocated(error)) return
+      call check(error, .not. problem%solved, 'a new assembly is not solved yet')
+      if (allocated(error)) return
+      call problem%solve_reduced(error)
+      if (allocated(error)) return
+      call check(error, all(problem%ubar == ubar), 'the same reduced solution again')
+      if (allocated(error)) return
+      call problem%set_solution(2.0_wp*ubar, error)
+      if (allocated(error)) return
+      call check(error, problem%solved .and. all(problem%u == 2.0_wp*u), 'set_solution(2 ubar) gives 2 u')
+      if (allocated(error)) return
+      deallocate (refused)
+      call problem%set_solution(ubar(2:), refused)
+      call check(error, allocated(refused), 'a reduced solution of the wrong size is refused')
+      if (allocated(error)) return
+      call check(error, index(refused%message, 'unknowns') > 0, 'message: '//refused%message)
+   end subroutine test_solve_in_steps
 
    ! ------------------------------------------------------------ benchmarks with exact solutions
 

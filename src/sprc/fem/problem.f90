@@ -6,7 +6,7 @@
 !> ```
 !> call problem%setup(body, grid, nodes, hanging, quad, analysis, young, poisson, &
 !>                    body_force, bcs, error [, exact] [, eta] [, gamma])
-!> call problem%solve(error)
+!> call problem%solve(error)      ! = assemble, solve_reduced, set_solution(ubar)
 !> ! problem%u(dim, n_nodes), problem%stress_at(x, sigma, error),
 !> ! problem%element_points(e, x, w, sigma), problem%energy_error(...),
 !> ! problem%t_quadrature, t_assembly, t_solve
@@ -67,6 +67,7 @@ module sprc_fem_problem
    use sprc_core_material, only: plane_stress, plane_strain, solid, voigt_size, analysis_name, &
       & material_matrix, compliance_matrix
    use sprc_core_timer, only: timer_type
+   use sprc_core_strings, only: itoa
    use sprc_geometry_body, only: body_type
    use sprc_geometry_shape, only: shape_halfspace
    use sprc_geometry_region, only: cell_inside
@@ -79,6 +80,7 @@ module sprc_fem_problem
    use sprc_fem_sparse, only: coo_type, csr_type
    use sprc_fem_cholmod, only: cholmod_solver_type
    use sprc_fem_umfpack, only: umfpack_solver_type
+   use sprc_fem_linear_solver, only: linear_solver_type
    use sprc_fem_element, only: shape_functions, strain_matrix, traction_matrix, displacement_matrix, &
       & add_stiffness, element_stress, element_strain
    use sprc_fem_bc, only: fe_bc_type, check_bcs, bc_free, bc_pressure, bc_traction, bc_displacement, &
@@ -155,6 +157,9 @@ module sprc_fem_problem
    contains
       procedure :: setup => problem_setup
       procedure :: solve => problem_solve
+      procedure :: assemble => problem_assemble
+      procedure :: solve_reduced => problem_solve_reduced
+      procedure :: set_solution => problem_set_solution
       procedure :: n_dofs
       procedure :: element_box
       procedure :: element_displacements
@@ -535,9 +540,22 @@ contains
       call self%grid%leaf_box(e, lo, hi)
    end subroutine element_box
 
-   !> Assemble (t_assembly), check rigid-body modes, factorize and solve
-   !> (t_solve), and expand the nodal displacements `u`.
+   !> Assemble, solve and set the solution: `assemble`, `solve_reduced` and
+   !> `set_solution` in turn (a coupled solve, e.g. contact, calls them
+   !> separately).
    subroutine problem_solve(self, error)
+      class(elasticity_problem_type), intent(inout) :: self
+      type(error_type), allocatable, intent(out) :: error
+
+      call self%assemble(error)
+      if (allocated(error)) return
+      call self%solve_reduced(error)
+      if (allocated(error)) return
+      call expand_solution(self)
+   end subroutine problem_solve
+
+   !> The reduced stiffness `k` and load `f` (t_assembly). After setup.
+   subroutine problem_assemble(self, error)
       class(elasticity_problem_type), intent(inout) :: self
       type(error_type), allocatable, intent(out) :: error
       type(timer_type) :: timer
@@ -551,20 +569,55 @@ contains
       call assemble(self, error)
       call timer%stop()
       self%t_assembly = self%t_assembly + timer%elapsed
-      if (allocated(error)) return
+   end subroutine problem_assemble
 
-      call timer%reset()
+   !> Check the rigid-body modes of the assembled system, factorize and
+   !> solve for the reduced solution `ubar` (t_solve). After assemble.
+   subroutine problem_solve_reduced(self, error)
+      class(elasticity_problem_type), intent(inout) :: self
+      type(error_type), allocatable, intent(out) :: error
+      type(timer_type) :: timer
+
+      if (.not. allocated(self%f)) then
+         call fatal_error(error, 'elasticity solve: the system is not assembled', stat_invalid_input)
+         return
+      end if
       call timer%start()
       call check_rigid_modes(self, error)
       if (.not. allocated(error)) call factor_and_solve(self, error)
       call timer%stop()
       self%t_solve = timer%elapsed
-      if (allocated(error)) return
+   end subroutine problem_solve_reduced
+
+   !> Take `ubar` (one value per reduced unknown) as the solution: the nodal
+   !> displacements `u` follow (u = T ubar) and the problem counts as solved.
+   subroutine problem_set_solution(self, ubar, error)
+      class(elasticity_problem_type), intent(inout) :: self
+      real(wp), intent(in) :: ubar(:)
+      type(error_type), allocatable, intent(out) :: error
+
+      if (.not. allocated(self%root)) then
+         call fatal_error(error, 'elasticity set_solution: setup was not called or failed', stat_invalid_input)
+         return
+      end if
+      if (size(ubar) /= self%constraints%n_dofs) then
+         call fatal_error(error, 'elasticity set_solution: ubar has '//itoa(size(ubar))//' values, the problem '// &
+            & itoa(self%constraints%n_dofs)//' unknowns', stat_invalid_input)
+         return
+      end if
+      self%ubar = ubar
+      call expand_solution(self)
+   end subroutine problem_set_solution
+
+   !> u = T ubar; the problem counts as solved.
+   subroutine expand_solution(self)
+      class(elasticity_problem_type), intent(inout) :: self
+      if (allocated(self%u)) deallocate (self%u)
       allocate (self%u(self%dim, self%nodes%n_nodes))
       call self%constraints%expand(self%ubar, self%u)
       call dilatation_coefficients(self)
       self%solved = .true.
-   end subroutine problem_solve
+   end subroutine expand_solution
 
    !> K and f: element systems in parallel chunks, reduced by T_e, inserted in element order.
    subroutine assemble(self, error)
@@ -591,6 +644,7 @@ contains
       call coo%init(self%constraints%n_dofs, self%constraints%n_dofs, error, &
          & capacity=sum(int(mdof, kind(coo%nnz))**2) + aggregate_capacity(self, mdof))
       if (allocated(error)) return
+      if (allocated(self%f)) deallocate (self%f)
       allocate (self%f(self%constraints%n_dofs))
       self%f = 0.0_wp
       allocate (dofs(maxm, chunk_size), fbuf(maxm, chunk_size), offset(chunk_size + 1))
@@ -940,17 +994,12 @@ contains
       type(cholmod_solver_type) :: chol
       type(umfpack_solver_type) :: lu
 
+      if (allocated(self%ubar)) deallocate (self%ubar)
       allocate (self%ubar(self%constraints%n_dofs))
       self%solver_name = 'cholmod'
       self%solver_note = ''
-      call chol%factorize(self%k, error)
-      if (.not. allocated(error)) then
-         self%rcond = chol%rcond_estimate
-         call chol%solve(self%f, self%ubar, error)
-         call chol%destroy()
-         return
-      end if
-      call chol%destroy()
+      call direct_solve(chol, self%k, self%f, self%ubar, self%rcond, error)
+      if (.not. allocated(error)) return
       if (error%stat /= stat_not_positive_definite) then
          error%message = 'elasticity solve: '//error%message
          return
@@ -959,12 +1008,7 @@ contains
       self%solver_note = 'CHOLMOD found the stiffness not positive definite ('//error%message// &
          & '); solved by UMFPACK (LU). Raise gamma for an SPD system.'
       deallocate (error)
-      call lu%factorize(self%k, error)
-      if (.not. allocated(error)) then
-         self%rcond = lu%rcond_estimate
-         call lu%solve(self%f, self%ubar, error)
-      end if
-      call lu%destroy()
+      call direct_solve(lu, self%k, self%f, self%ubar, self%rcond, error)
       if (allocated(error)) error%message = 'elasticity solve (UMFPACK fallback): '//error%message
    end subroutine factor_and_solve
 
@@ -990,6 +1034,24 @@ contains
          call self%dilatation%set_coefficients(a, gu)
       end do
    end subroutine dilatation_coefficients
+
+   !> Factorize k with `solver`, solve k x = f, release the factor; `rcond`
+   !> gets the solver's condition estimate.
+   subroutine direct_solve(solver, k, f, x, rcond, error)
+      class(linear_solver_type), intent(inout) :: solver
+      type(csr_type), intent(in) :: k
+      real(wp), intent(in) :: f(:)
+      real(wp), intent(inout) :: x(:)
+      real(wp), intent(inout) :: rcond
+      type(error_type), allocatable, intent(out) :: error
+
+      call solver%factorize(k, error)
+      if (.not. allocated(error)) then
+         rcond = solver%rcond_estimate
+         call solver%solve(f, x, error)
+      end if
+      call solver%destroy()
+   end subroutine direct_solve
 
    !> Nodal displacements ue(dim*nen) of element e, node-major.
    pure subroutine element_displacements(self, e, ue)
