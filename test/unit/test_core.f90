@@ -5,8 +5,7 @@ module sprc_test_core
    use sprc_core_error, only: error_type, fatal_error, stat_name, stat_invalid_input, &
       & stat_singular, stat_not_positive_definite
    use sprc_core_timer, only: timer_type, wall_time
-   use sprc_core_text, only: fixed_text
-   use sprc_core_strings, only: itoa, rtoa
+   use sprc_core_text, only: fixed_text, itoa, rtoa
    use sprc_core_boundary, only: bc_none, bc_traction, bc_symmetry, bc_free, bc_pressure, bc_contact, bc_kind_name, &
       & bc_kind_from_name
    use sprc_core_lapack, only: dgesv, dgecon, dgetrf, dlange, dpotrf, dpotrs, dgeqp3, dgesvd, &

@@ -11,7 +11,7 @@ module sprc_capi_recovery
    use, intrinsic :: iso_c_binding, only: c_ptr, c_int, c_double, c_null_ptr, c_associated, c_f_pointer, c_loc
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use sprc_core_kinds, only: wp
-   use sprc_core_strings, only: itoa
+   use sprc_core_text, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_out_of_memory
    use sprc_core_material, only: voigt_size
    use sprc_recovery_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, mesh_method_sprc

@@ -6,7 +6,7 @@
 module sprc_capi_report
    use, intrinsic :: iso_c_binding, only: c_ptr, c_int, c_double, c_null_ptr, c_associated, c_f_pointer
    use sprc_core_error, only: stat_invalid_input
-   use sprc_core_strings, only: itoa
+   use sprc_core_text, only: itoa
    use sprc_io_report, only: report_row_type, report_column, report_columns, n_report_columns, report_empty
    use sprc_capi_error, only: capi_error_type, get_capi_error, set_capi_error
    use sprc_capi_string, only: c_string, copy_to_buffer

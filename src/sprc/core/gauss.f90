@@ -9,7 +9,7 @@
 !> monomials of degree <= 2n - 1).
 module sprc_core_gauss
    use sprc_core_kinds, only: wp
-   use sprc_core_strings, only: itoa
+   use sprc_core_text, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    implicit none
    private

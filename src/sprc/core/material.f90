@@ -11,7 +11,7 @@
 !> - solid: the 6x6 3D law with Lame constants lambda, mu.
 module sprc_core_material
    use sprc_core_kinds, only: wp
-   use sprc_core_strings, only: rtoa
+   use sprc_core_text, only: rtoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    implicit none
    private

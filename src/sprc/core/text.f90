@@ -1,10 +1,19 @@
-!> Text of numbers for messages and files.
+!> Text of numbers for messages and files: one implementation for every layer
+!> (integers, reals in a given edit descriptor, shortest round-trip reals, fixed notation).
 module sprc_core_text
-   use sprc_core_kinds, only: wp
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_is_finite
+   use sprc_core_kinds, only: wp, i4, i8
    implicit none
    private
 
-   public :: fixed_text
+   public :: fixed_text, itoa, rtoa, real_text
+
+   !> An integer in its shortest decimal form (`i0`); with `digits`, padded
+   !> with leading zeros to at least that many digits (`itoa(4, 2)` = '04',
+   !> `itoa(123, 2)` = '123').
+   interface itoa
+      module procedure itoa_i4, itoa_i8
+   end interface itoa
 
 contains
 
@@ -26,5 +35,104 @@ contains
          if (text(1:2) == '-.') text = '-0'//text(2:)
       end if
    end function fixed_text
+
+   pure function itoa_i4(i, digits) result(s)
+      integer(i4), intent(in) :: i
+      integer, intent(in), optional :: digits
+      character(len=:), allocatable :: s
+      s = itoa_i8(int(i, i8), digits)
+   end function itoa_i4
+
+   pure function itoa_i8(i, digits) result(s)
+      integer(i8), intent(in) :: i
+      integer, intent(in), optional :: digits
+      character(len=:), allocatable :: s
+      character(len=32) :: buf, fmt
+      if (present(digits)) then
+         write (fmt, '("(i",i0,".",i0,")")') len(buf), min(max(1, digits), len(buf) - 1)
+         write (buf, fmt) i
+      else
+         write (buf, '(i0)') i
+      end if
+      s = trim(adjustl(buf))
+   end function itoa_i8
+
+   !> A real with five significant digits (`es12.4`), for messages, or in the
+   !> edit descriptor `fmt` (e.g. '(g0)', '(es16.8)'; at most 48 characters out).
+   pure function rtoa(x, fmt) result(s)
+      real(wp), intent(in) :: x
+      character(len=*), intent(in), optional :: fmt
+      character(len=:), allocatable :: s
+      character(len=48) :: buf
+      if (present(fmt)) then
+         write (buf, fmt) x
+      else
+         write (buf, '(es12.4)') x
+      end if
+      s = trim(adjustl(buf))
+   end function rtoa
+
+   !> Shortest decimal text that reads back as the same real: fixed notation
+   !> for moderate exponents (`1000.0`, `0.3`), else `2.5e-7` style (`1.0e-300`);
+   !> `NaN`, `Infinity`, `-Infinity` for the non-finite values.
+   function real_text(x) result(text)
+      real(wp), intent(in) :: x
+      character(len=:), allocatable :: text
+      character(len=40) :: buf
+      character(len=16) :: fmt
+      character(len=:), allocatable :: digits, sign
+      real(wp) :: y
+      integer :: d, ios, epos, e, n
+
+      if (ieee_is_nan(x)) then
+         text = 'NaN'
+         return
+      else if (.not. ieee_is_finite(x)) then
+         text = merge('-Infinity', ' Infinity', x < 0.0_wp)
+         text = trim(adjustl(text))
+         return
+      end if
+      ! Three exponent digits (e3): with the default width a three-digit
+      ! exponent is written without its 'E' (1.0+100).
+      do d = 1, 17
+         write (fmt, '("(es40.",i0,"e3)")') d - 1
+         write (buf, fmt) x
+         read (buf, *, iostat=ios) y
+         ! Bitwise identity is what 'reads back as the same real' means.
+         if (ios == 0 .and. transfer(y, 0_i8) == transfer(x, 0_i8)) exit
+      end do
+      buf = adjustl(buf)
+      sign = ''
+      if (buf(1:1) == '-') then
+         sign = '-'
+         buf = buf(2:)
+      end if
+      epos = index(buf, 'E')
+      read (buf(epos + 1:), *) e
+      digits = buf(1:1)//buf(3:epos - 1)
+      if (buf(2:2) /= '.') digits = buf(1:1)
+      n = len(digits)
+      do while (n > 1)
+         if (digits(n:n) /= '0') exit
+         n = n - 1
+      end do
+      digits = digits(1:n)
+      if (digits == '0') e = 0
+      if (e >= 0 .and. e < 15) then
+         if (n <= e + 1) then
+            text = sign//digits//repeat('0', e + 1 - n)//'.0'
+         else
+            text = sign//digits(1:e + 1)//'.'//digits(e + 2:)
+         end if
+      else if (e < 0 .and. e >= -4) then
+         text = sign//'0.'//repeat('0', -e - 1)//digits
+      else
+         if (n == 1) then
+            text = sign//digits//'.0e'//itoa(e)
+         else
+            text = sign//digits(1:1)//'.'//digits(2:)//'e'//itoa(e)
+         end if
+      end if
+   end function real_text
 
 end module sprc_core_text

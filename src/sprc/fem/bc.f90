@@ -15,7 +15,7 @@
 !>   (weakly), both from an exact solution the caller supplies.
 module sprc_fem_bc
    use sprc_core_kinds, only: wp
-   use sprc_core_strings, only: itoa
+   use sprc_core_text, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_boundary, only: bc_free, bc_pressure, bc_traction, bc_displacement, bc_symmetry, &
       & bc_exact_traction, bc_exact_displacement, bc_kind_name, bc_kind_from_name

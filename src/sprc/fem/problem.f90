@@ -67,7 +67,7 @@ module sprc_fem_problem
    use sprc_core_material, only: plane_stress, plane_strain, solid, voigt_size, analysis_name, &
       & material_matrix, compliance_matrix
    use sprc_core_timer, only: timer_type
-   use sprc_core_strings, only: itoa
+   use sprc_core_text, only: itoa
    use sprc_geometry_body, only: body_type
    use sprc_geometry_shape, only: shape_halfspace
    use sprc_geometry_region, only: cell_inside

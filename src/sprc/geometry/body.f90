@@ -19,8 +19,7 @@
 !> gives fmin = 0: outside.
 module sprc_geometry_body
    use sprc_core_kinds, only: wp
-   use sprc_core_text, only: fixed_text
-   use sprc_core_strings, only: itoa
+   use sprc_core_text, only: fixed_text, itoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_geometry_region, only: region_type, cell_outside, cell_inside, cell_cut
    use sprc_geometry_shape, only: shape_type, shape_kind_name

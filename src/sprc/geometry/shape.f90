@@ -28,7 +28,7 @@
 module sprc_geometry_shape
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use sprc_core_kinds, only: wp
-   use sprc_core_strings, only: itoa, rtoa
+   use sprc_core_text, only: itoa, rtoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    implicit none
    private

@@ -43,7 +43,7 @@
 !> module (contact recovers the patches it owns).
 module sprc_grid_patches
    use sprc_core_kinds, only: wp
-   use sprc_core_strings, only: itoa, rtoa
+   use sprc_core_text, only: itoa, rtoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular
    use sprc_core_material, only: plane_stress, plane_strain, solid, voigt_size, check_material
    use sprc_core_poly, only: poly_max_degree

@@ -66,7 +66,7 @@
 !> use one per thread.
 module sprc_grid_quadrature
    use sprc_core_kinds, only: wp
-   use sprc_core_strings, only: itoa, rtoa
+   use sprc_core_text, only: itoa, rtoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_gauss, only: max_gauss_points, gauss_legendre_nodes
    use sprc_geometry_region, only: cell_outside, cell_inside, cell_cut

@@ -27,7 +27,7 @@ module sprc_io_hdf5
       & h5screate_simple_f, h5sclose_f, h5dcreate_f, h5dwrite_f, h5dclose_f, &
       & H5F_ACC_TRUNC_F, H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER
    use sprc_core_kinds, only: wp
-   use sprc_core_strings, only: itoa
+   use sprc_core_text, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_io, stat_invalid_input
    use sprc_io_xdmf, only: xdmf_grid_type, xdmf_field_type, write_xdmf_file => write_xdmf, &
       & cell_nodes, cell_dim, topology_name, center_node, center_cell, field_scalar, field_vector, &

@@ -20,7 +20,7 @@
 module sprc_io_namelist
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use sprc_core_kinds, only: wp, i8
-   use sprc_core_strings, only: itoa
+   use sprc_core_text, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_io
    implicit none
    private

@@ -10,8 +10,7 @@
 module sprc_io_report
    use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_is_finite
    use sprc_core_kinds, only: wp, i8
-   use sprc_core_text, only: fixed_text
-   use sprc_core_strings, only: itoa
+   use sprc_core_text, only: fixed_text, itoa
    use sprc_core_error, only: error_type, fatal_error, stat_io, stat_invalid_input
    use sprc_study_row, only: report_row_type, report_empty, is_empty
    use sprc_study_mesh, only: mesh_row_type

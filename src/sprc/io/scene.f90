@@ -8,7 +8,7 @@ module sprc_io_scene
    use sprc_core_kinds, only: wp, i8
    use sprc_fem_dilatation, only: projected_poisson
    use sprc_fem_problem, only: default_gamma, gamma_note
-   use sprc_core_strings, only: itoa, real_text
+   use sprc_core_text, only: itoa, real_text
    use sprc_core_error, only: error_type, fatal_error, stat_unsupported
    use sprc_study_spec, only: scene_type, body_spec_type, shape_spec_type, bc_spec_type, exact_spec_type, &
       & contact_spec_type, recovery_degree

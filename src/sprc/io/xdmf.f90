@@ -45,7 +45,7 @@
 !> e.g. Gmsh; XDMF's own documentation does not fix it.)
 module sprc_io_xdmf
    use sprc_core_error, only: error_type, fatal_error, stat_io, stat_invalid_input
-   use sprc_core_strings, only: itoa
+   use sprc_core_text, only: itoa
    implicit none
    private
 

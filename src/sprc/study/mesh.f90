@@ -3,7 +3,7 @@
 !> driver or the C API format them (`sprc_io_report`).
 module sprc_study_mesh
    use sprc_core_kinds, only: wp, i8
-   use sprc_core_strings, only: itoa
+   use sprc_core_text, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_timer, only: timer_type
    use sprc_geometry_body, only: body_type

@@ -14,7 +14,7 @@ module sprc_study_model
    use sprc_exact_solution, only: exact_solution_type
    use sprc_exact_lame, only: lame_cylinder_type, lame_sphere_type, new_lame_cylinder, new_lame_sphere
    use sprc_exact_kirsch, only: kirsch_type, new_kirsch
-   use sprc_core_strings, only: itoa, real_text
+   use sprc_core_text, only: itoa, real_text
    use sprc_study_spec, only: scene_type, shape_spec_type
    use sprc_fem_bc, only: fe_bc_type, new_fe_bc, bc_kind_from_name
    use sprc_fem_problem, only: gamma_note
