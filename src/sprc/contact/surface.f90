@@ -29,6 +29,7 @@
 !> to the external neighbour is nudged into the master body by a few ulps.
 module sprc_contact_surface
    use sprc_core_kinds, only: wp
+   use sprc_core_text, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_not_converged
    use sprc_geometry_body, only: body_type, snap_tolerance
    use sprc_grid_tree, only: grid_type
@@ -72,25 +73,25 @@ contains
       d = size(x, 1)
       n = size(x, 2)
       if (d /= 2 .and. d /= 3) then
-         call fatal_error(error, 'contact surface: points have '//int_str(d)//' coordinates, expected 2 or 3')
+         call fatal_error(error, 'contact surface: points have '//itoa(d)//' coordinates, expected 2 or 3')
          return
       end if
       if (size(weight) /= n .or. any(shape(normal) /= [d, n]) .or. (size(slave_cell) /= n .and. &
          & size(slave_cell) /= 0)) then
-         call fatal_error(error, 'contact surface: '//int_str(n)//' points but '//int_str(size(weight))// &
-            & ' weights, '//int_str(size(normal, 2))//' normals of size '//int_str(size(normal, 1))//', '// &
-            & int_str(size(slave_cell))//' cells')
+         call fatal_error(error, 'contact surface: '//itoa(n)//' points but '//itoa(size(weight))// &
+            & ' weights, '//itoa(size(normal, 2))//' normals of size '//itoa(size(normal, 1))//', '// &
+            & itoa(size(slave_cell))//' cells')
          return
       end if
       do i = 1, n
          if (.not. (all(abs(x(:, i)) <= huge(1.0_wp)) .and. weight(i) > 0.0_wp .and. weight(i) <= huge(1.0_wp))) then
-            call fatal_error(error, 'contact surface: point '//int_str(i)//' has a non-finite coordinate or a '// &
+            call fatal_error(error, 'contact surface: point '//itoa(i)//' has a non-finite coordinate or a '// &
                & 'weight that is not finite and > 0')
             return
          end if
          ! Normals come normalized from the geometry: round-off only.
          if (.not. abs(norm2(normal(:, i)) - 1.0_wp) <= 64.0_wp*epsilon(1.0_wp)) then
-            call fatal_error(error, 'contact surface: the normal of point '//int_str(i)//' is not a unit vector')
+            call fatal_error(error, 'contact surface: the normal of point '//itoa(i)//' is not a unit vector')
             return
          end if
       end do
@@ -122,8 +123,8 @@ contains
       integer :: leaf, k, n, d
 
       if (shape < 1 .or. shape > body%nshape) then
-         call fatal_error(error, "contact surface: shape "//int_str(shape)//" of body '"//body_name(body)// &
-            & "' does not exist (it has "//int_str(body%nshape)//')')
+         call fatal_error(error, "contact surface: shape "//itoa(shape)//" of body '"//body_name(body)// &
+            & "' does not exist (it has "//itoa(body%nshape)//')')
          return
       end if
       d = grid%dim
@@ -138,7 +139,7 @@ contains
             call cell_rule(quad, body, lo(1:d), hi(1:d), rule, error)
          end if
          if (allocated(error)) then
-            error%message = 'contact surface, leaf '//int_str(leaf)//': '//error%message
+            error%message = 'contact surface, leaf '//itoa(leaf)//': '//error%message
             return
          end if
          do k = 1, rule%nsurf
@@ -204,8 +205,8 @@ contains
          do i = 1, n
             call gap_of_point(master, shape, self%x(:, i), self%normal(:, i), search_distance, hit)
             if (hit%exhausted) then
-               call fatal_error(error, 'contact gap: the search along the normal of slave point '//int_str(i)// &
-                  & ' did not isolate a crossing within '//int_str(hit%visits - 1)//' segments', stat_not_converged)
+               call fatal_error(error, 'contact gap: the search along the normal of slave point '//itoa(i)// &
+                  & ' did not isolate a crossing within '//itoa(hit%visits - 1)//' segments', stat_not_converged)
                return
             end if
             if (.not. hit%found) cycle
@@ -217,7 +218,7 @@ contains
             self%master_cell(i) = host_cell(master_grid, hit%x(1:d), hit%normal(1:d), hit%tolerance)
             if (self%master_cell(i) == 0) then
                call fatal_error(error, 'contact gap: the master point '//real_list(hit%x(1:d))//' of slave point '// &
-                  & int_str(i)//' lies in no leaf of the master grid (is the grid built for the master body?)')
+                  & itoa(i)//' lies in no leaf of the master grid (is the grid built for the master body?)')
                return
             end if
          end do
@@ -242,8 +243,8 @@ contains
       end if
       if (any(shape(u_slave) /= [self%dim, self%npoint]) .or. any(shape(u_master) /= [self%dim, self%npoint]) &
          & .or. size(g) /= self%npoint) then
-         call fatal_error(error, 'linearized gap: displacements must be ('//int_str(self%dim)//', '// &
-            & int_str(self%npoint)//') and g of size '//int_str(self%npoint))
+         call fatal_error(error, 'linearized gap: displacements must be ('//itoa(self%dim)//', '// &
+            & itoa(self%npoint)//') and g of size '//itoa(self%npoint))
          return
       end if
       do i = 1, self%npoint
@@ -261,11 +262,11 @@ contains
       type(error_type), allocatable, intent(out) :: error
 
       if (shape < 1 .or. shape > master%nshape) then
-         call fatal_error(error, "contact gap: shape "//int_str(shape)//" of master body '"//body_name(master)// &
-            & "' does not exist (it has "//int_str(master%nshape)//')')
+         call fatal_error(error, "contact gap: shape "//itoa(shape)//" of master body '"//body_name(master)// &
+            & "' does not exist (it has "//itoa(master%nshape)//')')
       else if (master%dim /= self%dim .or. master_grid%dim /= self%dim) then
-         call fatal_error(error, 'contact gap: slave points are '//int_str(self%dim)//'D, the master body '// &
-            & int_str(master%dim)//'D, its grid '//int_str(master_grid%dim)//'D')
+         call fatal_error(error, 'contact gap: slave points are '//itoa(self%dim)//'D, the master body '// &
+            & itoa(master%dim)//'D, its grid '//itoa(master_grid%dim)//'D')
       else if (.not. (search_distance > 0.0_wp .and. search_distance <= huge(1.0_wp))) then
          call fatal_error(error, 'contact gap: search_distance must be finite and > 0')
       end if
@@ -333,13 +334,5 @@ contains
       end do
       s = trim(s)
    end function real_list
-
-   pure function int_str(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=16) :: buf
-      write (buf, '(i0)') i
-      s = trim(buf)
-   end function int_str
 
 end module sprc_contact_surface

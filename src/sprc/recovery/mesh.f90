@@ -71,8 +71,9 @@ module sprc_recovery_mesh
       & element_dim, element_nodes, element_vertices, element_degree, element_facet_nodes, element_shape, &
       & element_vertex_shape, element_node_xi, element_inside, element_inverse_map, element_name, &
       & facet_points, facet_npoints, max_facet_points, max_element_nodes
+   use sprc_core_text, only: itoa
    use sprc_recovery_mesh_check, only: check_mesh_options, check_mesh_arrays, check_mesh_facets, &
-      & check_duplicate_nodes, check_duplicate_elements, itoa, vec_str, entry_name, index_name, &
+      & check_duplicate_nodes, check_duplicate_elements, vec_str, entry_name, index_name, &
       & mesh_method_spr, mesh_method_sprc, facet_traction, facet_symmetry, facet_free, facet_pressure
    implicit none
    private

@@ -11,6 +11,7 @@
 !> `gauss_weights[0][2]` with the C argument names (module procedure `entry_name`).
 module sprc_recovery_mesh_check
    use sprc_core_kinds, only: wp, i8
+   use sprc_core_text, only: itoa, rtoa
    use sprc_core_boundary, only: bc_traction, bc_symmetry, bc_free, bc_pressure
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_material, only: plane_stress, plane_strain, solid, voigt_size, check_material
@@ -21,7 +22,7 @@ module sprc_recovery_mesh_check
    private
 
    public :: check_mesh_options, check_mesh_arrays, check_mesh_facets, check_duplicate_nodes, &
-      & check_duplicate_elements, itoa, rtoa, vec_str, entry_name, index_name
+      & check_duplicate_elements, vec_str, entry_name, index_name
    public :: mesh_method_spr, mesh_method_sprc, facet_traction, facet_symmetry, facet_free, facet_pressure
 
    !> Recovery methods (values are part of the C API; never renumber).
@@ -384,23 +385,5 @@ contains
       end do
       str = str//')'
    end function shape_str
-
-   !> Integer as text.
-   pure function itoa(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=16) :: buf
-      write (buf, '(i0)') i
-      s = trim(buf)
-   end function itoa
-
-   !> Real as text (es12.4).
-   pure function rtoa(x) result(s)
-      real(wp), intent(in) :: x
-      character(len=:), allocatable :: s
-      character(len=24) :: buf
-      write (buf, '(es12.4)') x
-      s = trim(adjustl(buf))
-   end function rtoa
 
 end module sprc_recovery_mesh_check
