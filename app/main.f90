@@ -31,10 +31,8 @@ program sprc_main
    character(len=*), parameter :: partial = '.partial'
    !> With the default thread count, a level estimated below this many dofs runs on one
    !> thread: its parallel regions are too short to pay for the threads' synchronisation,
-   !> which dominated the times of small levels (median t_total of the Lame cylinder, 2
-   !> threads against 1, on a 2-core machine shared with other jobs: level 5 (1056 dofs)
-   !> 0.072 s against 0.018 s, level 6 (4026 dofs) 0.049 s against 0.052 s), so the
-   !> error-against-time curve ran backwards. The results are the same bits either way.
+   !> which made small levels slower on two threads than on one and the error-against-time
+   !> curve run backwards (figures in the commit that set it). Same bits either way.
    real(wp), parameter :: serial_dofs = 5000.0_wp
 
    interface
