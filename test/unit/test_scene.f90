@@ -4,6 +4,7 @@
 !> test/data/scenes/bad/ fails with the message its EXPECT line demands.
 module sprc_test_scene
    use sprc_core_kinds, only: wp
+   use sprc_core_text, only: itoa
    use sprc_core_error, only: error_type, stat_invalid_input, stat_io, stat_unsupported
    use sprc_io_namelist, only: read_text_file
    use sprc_io_scene, only: scene_type, read_scene, read_scene_text, default_scene_text, scene_summary, recovery_degree
@@ -16,13 +17,22 @@ module sprc_test_scene
    character(len=*), parameter :: nl = new_line('a')
    character(len=*), parameter :: bad_dir = 'test/data/scenes/bad/'
    !> Minimum number of malformed scene files the suite must hold.
-   integer, parameter :: min_bad_files = 35
+   integer, parameter :: min_bad_files = 116
 
    !> A small valid 2D scene; tests edit it with `replaced`.
    character(len=*), parameter :: minimal = &
       & "&scene analysis='plane_stress' levels=2 box_min=0,0 box_size=4 /"//nl// &
       & "&body name='b' young=1 poisson=0 /"//nl// &
       & "&shape body='b' op='add' kind='box' name='sq' lower=1,1 upper=3,3 /"//nl
+   !> A valid contact scene: a disk on a block, Coulomb friction.
+   character(len=*), parameter :: contact_text = &
+      & "&scene analysis='plane_strain' levels=3 box_min=0,0 box_size=4 /"//nl// &
+      & "&body name='punch' young=1000 poisson=0.3 /"//nl// &
+      & "&body name='block' young=2000 poisson=0.25 /"//nl// &
+      & "&shape body='punch' op='add' kind='disk' name='tip' center=2,3 radius=1 /"//nl// &
+      & "&shape body='block' op='add' kind='box' name='top' lower=0,0 upper=4,2 /"//nl// &
+      & "&contact slave='punch' master='block' slave_surface='tip' master_surface='top'"//nl// &
+      & "         friction='coulomb' mu=0.3 kappa=10 /"//nl
 
 contains
 
@@ -42,6 +52,10 @@ contains
          new_unittest('summary_switches_off', test_summary_off), &
          new_unittest('summary_real_format', test_summary_reals), &
          new_unittest('contact_accepted_not_runnable', test_contact), &
+         new_unittest('contact_defaults', test_contact_defaults), &
+         new_unittest('contact_shrink_fit', test_shrink_fit), &
+         new_unittest('contact_hertz_roller', test_hertz_roller), &
+         new_unittest('contact_uniform_exact', test_uniform_exact), &
          new_unittest('body_local_shape_indices', test_body_shapes), &
          new_unittest('missing_file', test_missing_file), &
          new_unittest('expect_has_enough_entries', test_expect_count), &
@@ -479,15 +493,8 @@ contains
    subroutine test_contact(error)
       type(error_type), allocatable, intent(out) :: error
       type(scene_type) :: s
-      character(len=:), allocatable :: summary, text
-      text = "&scene analysis='plane_strain' levels=3 box_min=0,0 box_size=4 /"//nl// &
-         & "&body name='punch' young=1000 poisson=0.3 /"//nl// &
-         & "&body name='block' young=2000 poisson=0.25 /"//nl// &
-         & "&shape body='punch' op='add' kind='disk' name='tip' center=2,3 radius=1 /"//nl// &
-         & "&shape body='block' op='add' kind='box' name='top' lower=0,0 upper=4,2 /"//nl// &
-         & "&contact slave='punch' master='block' slave_surface='tip' master_surface='top'"//nl// &
-         & "         friction='coulomb' mu=0.3 kappa=10 /"//nl
-      call read_ok(text, s, error)
+      character(len=:), allocatable :: summary
+      call read_ok(contact_text, s, error)
       if (allocated(error)) return
       call check(error, size(s%contacts), 1, 'one contact')
       if (allocated(error)) return
@@ -508,10 +515,108 @@ contains
       if (allocated(error)) return
       call check_switch(error, summary, 'SPR-C contact', 'on (NOT AVAILABLE in this version)')
       if (allocated(error)) return
-      call check_switch(error, summary, 'contact', 'on (NOT AVAILABLE in this version: cannot run yet)')
+      call check_switch(error, summary, 'contact', "on (slave 'punch' on master 'block', friction coulomb; "// &
+         & 'NOT IMPLEMENTED in this version: sprc run refuses the scene)')
       if (allocated(error)) return
-      call check(error, index(summary, 'NOT RUNNABLE: this version cannot run contact') > 0, 'plain statement')
+      call check(error, index(summary, "contact: slave 'punch' surface 'tip', master 'block' surface 'top', "// &
+         & 'friction = coulomb, mu = 0.3, kappa = 10.0, steps = 1, stabilization = fe') > 0, 'the pair line')
+      if (allocated(error)) return
+      call check(error, index(summary, 'NOT RUNNABLE: the contact FE is not implemented in this version') > 0, &
+         & 'plain statement')
    end subroutine test_contact
+
+   !> A pair with only its required fields: the documented defaults.
+   subroutine test_contact_defaults(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: s
+      call read_ok(replaced(contact_text, "friction='coulomb' mu=0.3 kappa=10 /", '/'), s, error)
+      if (allocated(error)) return
+      associate (c => s%contacts(1))
+         call check(error, c%friction == 'frictionless' .and. .not. c%has_kappa .and. c%steps == 1 .and. &
+            & c%stabilization == 'fe', 'defaults: frictionless, kappa not given, steps 1, stabilization fe')
+         if (allocated(error)) return
+         call check(error, c%kappa, 100.0_wp, 0.0_wp, 'default kappa')
+         if (allocated(error)) return
+      end associate
+      call check(error, has_switch(scene_summary(s), 'contact', "on (slave 'punch' on master 'block', friction "// &
+         & 'frictionless; NOT IMPLEMENTED'), 'summary names the pair and the friction law')
+      if (allocated(error)) return
+      call check(error, index(scene_summary(s), 'kappa = 100.0 (default), steps = 1, stabilization = fe') > 0, &
+         & 'summary gives kappa, steps and stabilization with their defaults')
+   end subroutine test_contact_defaults
+
+   !> The shrink fit: bc stages, a body with its own level-0 cell, the compound exact kind.
+   subroutine test_shrink_fit(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: s
+      character(len=:), allocatable :: summary
+      call read_file_ok('test/data/scenes/valid/shrink_fit.nml', s, error)
+      if (allocated(error)) return
+      call check(error, s%bcs(1)%stage == 2 .and. all(s%bcs(2:)%stage == 1), 'stage 2 on the bore, default 1 elsewhere')
+      if (allocated(error)) return
+      call check(error, .not. s%bodies(1)%has_box .and. s%bodies(1)%box_size == s%box_size .and. &
+         & all(s%bodies(1)%box_min == s%box_min), 'shaft: the scene box')
+      if (allocated(error)) return
+      call check(error, s%bodies(2)%has_box .and. s%bodies(2)%box_size == 2.2_wp .and. &
+         & all(s%bodies(2)%box_min == 0.0_wp), 'hub: its own box')
+      if (allocated(error)) return
+      associate (e => s%exact)
+         call check(error, e%kind == 'compound_cylinder' .and. e%inner_index == 1 .and. e%outer_index == 2, &
+            & 'compound_cylinder between shaft (inner) and hub (outer)')
+         if (allocated(error)) return
+         call check(error, e%r_in == 1.0_wp .and. e%r_contact == 1.5_wp .and. e%r_out == 2.0_wp .and. &
+            & e%p_in == 1.0e-3_wp .and. e%interference == 1.0e-3_wp, 'radii, pressure, interference as written')
+         if (allocated(error)) return
+      end associate
+      call check(error, s%contacts(1)%kappa, 10.0_wp, 0.0_wp, 'kappa as written')
+      if (allocated(error)) return
+      summary = scene_summary(s)
+      call check(error, index(summary, "on 'bore': pressure, value = 0.001, stage = 2") > 0, 'stage in the bc line')
+      if (allocated(error)) return
+      call check(error, index(summary, 'box_min = 0.0, 0.0, box_size = 2.2 (its own level-0 cell)') > 0, 'body box')
+      if (allocated(error)) return
+      call check_switch(error, summary, 'load history', 'off (friction frictionless')
+      if (allocated(error)) return
+      call check_switch(error, summary, 'contact files', 'on (out/shrink_fit_contact.csv, out/shrink_fit_contact.svg)')
+      if (allocated(error)) return
+      call check(error, index(summary, 'NOT RUNNABLE: the contact FE is not implemented in this version') > 0, &
+         & 'says it cannot run')
+   end subroutine test_shrink_fit
+
+   !> Coulomb friction with steps and the recovered stabilization; the Hertz kind.
+   subroutine test_hertz_roller(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: s
+      character(len=:), allocatable :: summary
+      call read_file_ok('test/data/scenes/valid/hertz_roller.nml', s, error)
+      if (allocated(error)) return
+      associate (c => s%contacts(1), e => s%exact)
+         call check(error, c%friction == 'coulomb' .and. c%mu == 0.3_wp .and. c%steps == 4 .and. &
+            & c%stabilization == 'recovered', 'coulomb, mu, steps, stabilization as written')
+         if (allocated(error)) return
+         call check(error, e%kind == 'hertz_cylinder' .and. all(e%point == 0.0_wp) .and. &
+            & all(e%normal == [0.0_wp, 1.0_wp]) .and. e%radius == 1.0_wp .and. e%load == 2.0_wp, 'hertz fields')
+         if (allocated(error)) return
+      end associate
+      summary = scene_summary(s)
+      call check_switch(error, summary, 'load history', 'on (1 stage(s), 4 increment(s) each')
+      if (allocated(error)) return
+      call check_switch(error, summary, 'contact stabilization stress', 'recovered')
+      if (allocated(error)) return
+      call check_switch(error, summary, 'error columns (err_*, theta_*)', 'off (exact solution hertz_cylinder gives')
+   end subroutine test_hertz_roller
+
+   subroutine test_uniform_exact(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: s
+      call read_file_ok('test/data/scenes/valid/uniform_patch_3d.nml', s, error)
+      if (allocated(error)) return
+      call check(error, s%exact%kind == 'uniform' .and. size(s%exact%stress) == 6, 'uniform: 6 Voigt values in 3D')
+      if (allocated(error)) return
+      call check(error, s%exact%stress(3), -1.0_wp, 0.0_wp, 'sigma_zz')
+      if (allocated(error)) return
+      call check(error, s%contacts(1)%friction == 'stick', 'stick')
+   end subroutine test_uniform_exact
 
    !> Shapes of two bodies interleaved in the file: each shape's index among
    !> its own body's shapes (what the body's geometry and conditions use).
@@ -578,7 +683,7 @@ contains
       character(len=256), allocatable :: lines(:)
       call expect_lines(lines, error)
       if (allocated(error)) return
-      call check(error, size(lines) >= min_bad_files, 'EXPECT lists at least 35 malformed files')
+      call check(error, size(lines) >= min_bad_files, 'EXPECT lists at least '//itoa(min_bad_files)//' malformed files')
    end subroutine test_expect_count
 
    subroutine test_malformed(error)

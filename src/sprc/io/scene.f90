@@ -11,7 +11,7 @@ module sprc_io_scene
    use sprc_core_text, only: itoa, real_text
    use sprc_core_error, only: error_type, fatal_error, stat_unsupported
    use sprc_study_spec, only: scene_type, body_spec_type, shape_spec_type, bc_spec_type, exact_spec_type, &
-      & contact_spec_type, recovery_degree
+      & contact_spec_type, recovery_degree, default_stabilization
    use sprc_io_namelist, only: nml_group_type, parse_namelist, read_text_file, nml_get, nml_get_array, &
       & nml_has, nml_check_consumed, nml_field_error, nml_group_error, nml_item_text
    implicit none
@@ -24,14 +24,16 @@ module sprc_io_scene
       & 'exact', 'contact']
    character(len=*), parameter :: scene_keys = 'title analysis order levels refine_boundary box_min box_size '// &
       & 'recovery recovery_degree output dilatation nitsche_gamma'
-   character(len=*), parameter :: body_keys = 'name young poisson body_force'
+   character(len=*), parameter :: body_keys = 'name young poisson body_force box_min box_size'
    character(len=*), parameter :: shape_fields = 'center radius semi_axes lower upper point normal axis'
    character(len=*), parameter :: shape_keys = 'body op kind name '//shape_fields
    character(len=*), parameter :: bc_fields = 'value vector'
-   character(len=*), parameter :: bc_keys = 'on type '//bc_fields
-   character(len=*), parameter :: exact_fields = 'center r_in r_out p_in p_out radius s_inf'
+   character(len=*), parameter :: bc_keys = 'on type stage '//bc_fields
+   character(len=*), parameter :: exact_fields = 'center r_in r_out p_in p_out radius s_inf stress r_contact '// &
+      & 'inner outer interference point normal load'
    character(len=*), parameter :: exact_keys = 'kind '//exact_fields
-   character(len=*), parameter :: contact_keys = 'slave master slave_surface master_surface friction mu kappa'
+   character(len=*), parameter :: contact_keys = 'slave master slave_surface master_surface friction mu kappa '// &
+      & 'steps stabilization'
 
    character(len=*), parameter :: analyses = 'plane_stress plane_strain solid'
    character(len=*), parameter :: recoveries = 'none spr sprc both'
@@ -41,8 +43,10 @@ module sprc_io_scene
    character(len=*), parameter :: shape_kinds = 'disk sphere ellipse ellipsoid box halfspace cylinder'
    character(len=*), parameter :: bc_types = 'free pressure traction displacement symmetry exact_traction '// &
       & 'exact_displacement'
-   character(len=*), parameter :: exact_kinds = 'lame_cylinder lame_sphere kirsch hertz_cylinder hertz_sphere'
+   character(len=*), parameter :: exact_kinds = 'lame_cylinder lame_sphere kirsch uniform compound_cylinder '// &
+      & 'compound_sphere hertz_cylinder hertz_sphere'
    character(len=*), parameter :: frictions = 'frictionless coulomb stick'
+   character(len=*), parameter :: stabilizations = 'fe recovered'
 
    !> Deepest uniform level accepted, 2D and 3D: 4^14 and 8^9 cells are already
    !> far beyond what a direct solver handles.
@@ -58,8 +62,8 @@ module sprc_io_scene
 contains
 
    !> Read and validate a scene file. A missing or unreadable file is
-   !> `stat_io`; a bad scene `stat_invalid_input`; a valid request this
-   !> version cannot run (hertz_* exact solutions) `stat_unsupported`.
+   !> `stat_io`; a bad scene `stat_invalid_input`; a request this version
+   !> cannot take (a second &contact pair) `stat_unsupported`.
    subroutine read_scene(path, scene, error)
       !> Path of the scene file; messages name it.
       character(len=*), intent(in) :: path
@@ -279,11 +283,37 @@ contains
             allocate (body%body_force(scene%dim), source=0.0_wp)
             call get_vector(g, 'body_force', scene%dim, .false., body%body_force, error)
             if (allocated(error)) return
+            call read_body_box(g, scene, body, error)
+            if (allocated(error)) return
             call nml_check_consumed(g, error)
             if (allocated(error)) return
          end associate
       end do
    end subroutine read_bodies
+
+   !> The body's own level-0 cell (`box_min` and `box_size` together, validated
+   !> like the `&scene` ones), else the scene's.
+   subroutine read_body_box(g, scene, body, error)
+      type(nml_group_type), intent(inout) :: g
+      type(scene_type), intent(in) :: scene
+      type(body_spec_type), intent(inout) :: body
+      type(error_type), allocatable, intent(out) :: error
+
+      body%has_box = nml_has(g, 'box_min') .or. nml_has(g, 'box_size')
+      body%box_min = scene%box_min
+      body%box_size = scene%box_size
+      if (.not. body%has_box) return
+      if (.not. nml_has(g, 'box_min')) then
+         call nml_field_error(g, 'box_min', 'required with box_size (the body''s own level-0 cell needs both)', error)
+         return
+      end if
+      call get_vector(g, 'box_min', scene%dim, .true., body%box_min, error)
+      if (allocated(error)) return
+      call get_positive(g, 'box_size', .false., body%box_size, error)
+      if (allocated(error)) return
+      if (.not. nml_has(g, 'box_size')) &
+         & call nml_field_error(g, 'box_size', 'required with box_min (the body''s own level-0 cell needs both)', error)
+   end subroutine read_body_box
 
    ! ---------------------------------------------------------------- &shape
 
@@ -404,8 +434,8 @@ contains
    pure integer function kind_dim(kind)
       character(len=*), intent(in) :: kind
       select case (kind)
-      case ('disk', 'ellipse', 'lame_cylinder', 'kirsch'); kind_dim = 2
-      case ('sphere', 'ellipsoid', 'cylinder', 'lame_sphere'); kind_dim = 3
+      case ('disk', 'ellipse', 'lame_cylinder', 'kirsch', 'compound_cylinder', 'hertz_cylinder'); kind_dim = 2
+      case ('sphere', 'ellipsoid', 'cylinder', 'lame_sphere', 'compound_sphere', 'hertz_sphere'); kind_dim = 3
       case default; kind_dim = 0
       end select
    end function kind_dim
@@ -462,11 +492,34 @@ contains
                call nml_field_error(g, 'type', 'needs an &exact group (the exact solution it prescribes)', error)
                return
             end if
+            if (index(bc%type, 'exact_') == 1 .and. pressure_only(scene%exact)) then
+               call nml_field_error(g, 'type', "needs a displacement and stress field; &exact kind = '"// &
+                  & scene%exact%kind//"' gives the contact pressure only", error)
+               return
+            end if
+            call read_stage(g, bc, error)
+            if (allocated(error)) return
             call nml_check_consumed(g, error)
             if (allocated(error)) return
          end associate
       end do
    end subroutine read_bcs
+
+   !> `stage` (integer >= 1, default 1) of a condition that carries a load.
+   subroutine read_stage(g, bc, error)
+      type(nml_group_type), intent(inout) :: g
+      type(bc_spec_type), intent(inout) :: bc
+      type(error_type), allocatable, intent(out) :: error
+      logical :: found
+      call nml_get(g, 'stage', bc%stage, found, error)
+      if (allocated(error) .or. .not. found) return
+      if (bc%type == 'free' .or. bc%type == 'symmetry') then
+         call nml_field_error(g, 'stage', "does not apply to type = '"//bc%type// &
+            & "' (it holds in every stage; stages order loads)", error)
+      else if (bc%stage < 1) then
+         call nml_field_error(g, 'stage', 'must be >= 1 (stage 1 is applied first)', error)
+      end if
+   end subroutine read_stage
 
    ! ---------------------------------------------------------------- &exact
 
@@ -493,48 +546,131 @@ contains
          if (allocated(error)) return
          call get_choice(g, 'kind', exact_kinds, .true., exact%kind, error)
          if (allocated(error)) return
-         if (index(exact%kind, 'hertz_') == 1) then
-            call nml_field_error(g, 'kind', 'not available in this version (contact is not implemented yet)', &
-               & error, stat_unsupported)
-            return
-         end if
-         if (kind_dim(exact%kind) /= scene%dim) then
+         if (kind_dim(exact%kind) /= 0 .and. kind_dim(exact%kind) /= scene%dim) then
             call nml_field_error(g, 'kind', 'is a '//itoa(kind_dim(exact%kind))//'D solution; analysis = '''// &
                & scene%analysis//''' is '//itoa(scene%dim)//'D', error)
             return
          end if
-         if (exact%kind == 'kirsch') then
-            call check_fields(g, exact_fields, 'center radius s_inf', '', "kind = 'kirsch'", error)
+         select case (exact%kind)
+         case ('kirsch')
+            call read_kirsch(g, scene, exact, error)
+         case ('uniform')
+            call check_fields(g, exact_fields, 'stress', '', "kind = 'uniform'", error)
             if (allocated(error)) return
-            call get_vector(g, 'center', scene%dim, .true., exact%center, error)
-            if (allocated(error)) return
-            call get_positive(g, 'radius', .true., exact%radius, error)
-            if (allocated(error)) return
-            call nml_get(g, 's_inf', exact%s_inf, found, error)
-            if (allocated(error)) return
-         else
+            call get_vector(g, 'stress', 3*(scene%dim - 1), .true., exact%stress, error)
+         case ('compound_cylinder', 'compound_sphere')
+            call read_compound(g, scene, exact, error)
+         case ('hertz_cylinder', 'hertz_sphere')
+            call read_hertz(g, scene, exact, error)
+         case default
             call check_fields(g, exact_fields, 'center r_in r_out p_in', 'p_out', "kind = '"//exact%kind//"'", error)
             if (allocated(error)) return
-            call get_vector(g, 'center', scene%dim, .true., exact%center, error)
-            if (allocated(error)) return
-            call get_positive(g, 'r_in', .true., exact%r_in, error)
-            if (allocated(error)) return
-            call get_positive(g, 'r_out', .true., exact%r_out, error)
-            if (allocated(error)) return
-            if (exact%r_out <= exact%r_in) then
-               call nml_field_error(g, 'r_out', 'must exceed r_in = '//nml_item_text(g, 'r_in'), error)
-               return
-            end if
-            call nml_get(g, 'p_in', exact%p_in, found, error)
+            call read_radii(g, scene, 'r_in r_out', exact, error)
             if (allocated(error)) return
             call nml_get(g, 'p_out', exact%p_out, found, error)
-            if (allocated(error)) return
-         end if
+         end select
+         if (allocated(error)) return
          call nml_check_consumed(g, error)
          if (allocated(error)) return
          exact%present = .true.
       end associate
    end subroutine read_exact
+
+   subroutine read_kirsch(g, scene, exact, error)
+      type(nml_group_type), intent(inout) :: g
+      type(scene_type), intent(in) :: scene
+      type(exact_spec_type), intent(inout) :: exact
+      type(error_type), allocatable, intent(out) :: error
+      logical :: found
+      call check_fields(g, exact_fields, 'center radius s_inf', '', "kind = 'kirsch'", error)
+      if (allocated(error)) return
+      call get_vector(g, 'center', scene%dim, .true., exact%center, error)
+      if (allocated(error)) return
+      call get_positive(g, 'radius', .true., exact%radius, error)
+      if (allocated(error)) return
+      call nml_get(g, 's_inf', exact%s_inf, found, error)
+   end subroutine read_kirsch
+
+   !> `center`, the increasing positive radii named in `radii` (of r_in,
+   !> r_contact, r_out) and `p_in`: the Lame and compound kinds.
+   subroutine read_radii(g, scene, radii, exact, error)
+      type(nml_group_type), intent(inout) :: g
+      type(scene_type), intent(in) :: scene
+      character(len=*), intent(in) :: radii
+      type(exact_spec_type), intent(inout) :: exact
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: word, previous
+      real(wp) :: r, r_previous
+      integer :: pos
+      logical :: found
+
+      call get_vector(g, 'center', scene%dim, .true., exact%center, error)
+      if (allocated(error)) return
+      previous = ''
+      r_previous = 0.0_wp
+      pos = 1
+      do
+         call next_word(radii, pos, word)
+         if (len(word) == 0) exit
+         call get_positive(g, word, .true., r, error)
+         if (allocated(error)) return
+         if (len(previous) > 0 .and. r <= r_previous) then
+            call nml_field_error(g, word, 'must exceed '//previous//' = '//nml_item_text(g, previous), error)
+            return
+         end if
+         select case (word)
+         case ('r_in'); exact%r_in = r
+         case ('r_contact'); exact%r_contact = r
+         case default; exact%r_out = r
+         end select
+         previous = word
+         r_previous = r
+      end do
+      call nml_get(g, 'p_in', exact%p_in, found, error)
+   end subroutine read_radii
+
+   !> Two concentric rings or shells: the radii and the inner and outer bodies
+   !> (two different bodies; the &contact between them is checked with the pairs).
+   subroutine read_compound(g, scene, exact, error)
+      type(nml_group_type), intent(inout) :: g
+      type(scene_type), intent(in) :: scene
+      type(exact_spec_type), intent(inout) :: exact
+      type(error_type), allocatable, intent(out) :: error
+      logical :: found
+      call check_fields(g, exact_fields, 'center r_in r_contact r_out p_in inner outer', 'interference', &
+         & "kind = '"//exact%kind//"'", error)
+      if (allocated(error)) return
+      call read_radii(g, scene, 'r_in r_contact r_out', exact, error)
+      if (allocated(error)) return
+      call get_body_ref(g, 'inner', scene, exact%inner, exact%inner_index, error)
+      if (allocated(error)) return
+      call get_body_ref(g, 'outer', scene, exact%outer, exact%outer_index, error)
+      if (allocated(error)) return
+      if (exact%outer_index == exact%inner_index) then
+         call nml_field_error(g, 'outer', 'must differ from inner: the two rings are two bodies', error)
+         return
+      end if
+      call nml_get(g, 'interference', exact%interference, found, error)
+      if (allocated(error)) return
+      if (exact%interference < 0.0_wp) call nml_field_error(g, 'interference', &
+         & 'must be >= 0 (the radial overlap of the rings; a clearance has no closed-form solution here)', error)
+   end subroutine read_compound
+
+   subroutine read_hertz(g, scene, exact, error)
+      type(nml_group_type), intent(inout) :: g
+      type(scene_type), intent(in) :: scene
+      type(exact_spec_type), intent(inout) :: exact
+      type(error_type), allocatable, intent(out) :: error
+      call check_fields(g, exact_fields, 'point normal radius load', '', "kind = '"//exact%kind//"'", error)
+      if (allocated(error)) return
+      call get_vector(g, 'point', scene%dim, .true., exact%point, error)
+      if (allocated(error)) return
+      call get_direction(g, 'normal', scene%dim, exact%normal, error)
+      if (allocated(error)) return
+      call get_positive(g, 'radius', .true., exact%radius, error)
+      if (allocated(error)) return
+      call get_positive(g, 'load', .true., exact%load, error)
+   end subroutine read_hertz
 
    ! -------------------------------------------------------------- &contact
 
@@ -550,6 +686,12 @@ contains
       do ig = 1, size(groups)
          if (groups(ig)%name /= 'contact') cycle
          n = n + 1
+         if (n > 1) then
+            call nml_group_error(groups(ig), 'a second &contact group (the first is on line '// &
+               & itoa(groups(first_group(groups, 'contact'))%line)//'): this version takes one contact pair', &
+               & error, stat_unsupported)
+            return
+         end if
          associate (g => groups(ig), c => scene%contacts(n))
             call check_keys(g, contact_keys, error)
             if (allocated(error)) return
@@ -588,11 +730,51 @@ contains
             call get_positive(g, 'kappa', .false., c%kappa, error)
             if (allocated(error)) return
             c%has_kappa = nml_has(g, 'kappa')
+            call nml_get(g, 'steps', c%steps, found, error)
+            if (allocated(error)) return
+            if (c%steps < 1) then
+               call nml_field_error(g, 'steps', 'must be >= 1 (load increments per stage)', error)
+               return
+            end if
+            c%stabilization = default_stabilization
+            call get_choice(g, 'stabilization', stabilizations, .false., c%stabilization, error)
+            if (allocated(error)) return
             call nml_check_consumed(g, error)
             if (allocated(error)) return
          end associate
       end do
+      call check_exact_pair(groups, scene, error)
    end subroutine read_contacts
+
+   !> A compound exact solution needs a &contact between its inner and outer
+   !> bodies, a Hertz one a &contact at all: without it their fields do not hold.
+   subroutine check_exact_pair(groups, scene, error)
+      type(nml_group_type), intent(inout) :: groups(:)
+      type(scene_type), intent(in) :: scene
+      type(error_type), allocatable, intent(out) :: error
+      integer :: ig, i
+      logical :: paired
+
+      if (.not. scene%exact%present) return
+      associate (e => scene%exact)
+         if (index(e%kind, 'compound_') == 1) then
+            paired = .false.
+            do i = 1, size(scene%contacts)
+               associate (c => scene%contacts(i))
+                  paired = paired .or. (c%slave_index == e%inner_index .and. c%master_index == e%outer_index) &
+                     & .or. (c%slave_index == e%outer_index .and. c%master_index == e%inner_index)
+               end associate
+            end do
+            if (paired) return
+            ig = first_group(groups, 'exact')
+            call nml_field_error(groups(ig), 'outer', "no &contact between bodies '"//e%inner//"' and '"// &
+               & e%outer//"': kind = '"//e%kind//"' is the solution of their shrink fit", error)
+         else if (index(e%kind, 'hertz_') == 1 .and. size(scene%contacts) == 0) then
+            ig = first_group(groups, 'exact')
+            call nml_field_error(groups(ig), 'kind', 'needs a &contact (it is the pressure of a contact)', error)
+         end if
+      end associate
+   end subroutine check_exact_pair
 
    subroutine get_body_ref(g, key, scene, name, index, error)
       type(nml_group_type), intent(inout) :: g
@@ -626,6 +808,9 @@ contains
       else if (scene%shapes(index)%body_index /= ibody) then
          call nml_field_error(g, key, "is a surface of body '"//scene%shapes(index)%body//"', not of '"// &
             & scene%bodies(ibody)%name//"'", error)
+      else if (any(scene%bcs%shape_index == index)) then
+         call nml_field_error(g, key, "has a &bc (type = '"//scene%bcs(findloc(scene%bcs%shape_index, index, 1))%type// &
+            & "'): a contact surface takes its conditions from &contact alone", error)
       end if
    end subroutine get_surface_ref
 
@@ -774,6 +959,23 @@ contains
       end do
    end function count_groups
 
+   !> Whether the exact solution gives the contact pressure only (hertz_*).
+   pure logical function pressure_only(exact)
+      type(exact_spec_type), intent(in) :: exact
+      pressure_only = .false.
+      if (exact%present) pressure_only = index(exact%kind, 'hertz_') == 1
+   end function pressure_only
+
+   !> Index of the first group called `name` (0 if none).
+   pure integer function first_group(groups, name) result(ig)
+      type(nml_group_type), intent(in) :: groups(:)
+      character(len=*), intent(in) :: name
+      do ig = 1, size(groups)
+         if (groups(ig)%name == name) return
+      end do
+      ig = 0
+   end function first_group
+
    pure integer function body_index(scene, name) result(k)
       type(scene_type), intent(in) :: scene
       character(len=*), intent(in) :: name
@@ -843,7 +1045,10 @@ contains
       do i = 1, size(scene%bodies)
          associate (b => scene%bodies(i))
             text = text//"body '"//b%name//"': young = "//real_text(b%young)//', poisson = '// &
-               & real_text(b%poisson)//', body_force = '//real_list(b%body_force)//nl
+               & real_text(b%poisson)//', body_force = '//real_list(b%body_force)
+            if (b%has_box) text = text//', box_min = '//real_list(b%box_min)//', box_size = '// &
+               & real_text(b%box_size)//' (its own level-0 cell)'
+            text = text//nl
          end associate
          do j = 1, size(scene%shapes)
             if (scene%shapes(j)%body_index == i) text = text//'  '//shape_line(scene%shapes(j))//nl
@@ -865,8 +1070,8 @@ contains
       end do
       text = text//switches(scene)
       if (size(scene%contacts) > 0) then
-         text = text//'NOT RUNNABLE: this version cannot run contact (&contact) yet; the scene is valid '// &
-            & 'but cannot be run.'//nl
+         text = text//'NOT RUNNABLE: the contact FE is not implemented in this version; the scene is valid '// &
+            & 'but sprc run refuses it.'//nl
       end if
       ! Lines are separated, not terminated: the driver prints the text as one record.
       text = text(1:len(text) - 1)
@@ -912,12 +1117,11 @@ contains
       else
          text = text//"  SPR-C constraints: off (recovery = '"//scene%recovery//"')"//nl
       end if
-      if (size(scene%contacts) > 0) then
-         text = text//'  contact: on (NOT AVAILABLE in this version: cannot run yet)'//nl
-      else
-         text = text//'  contact: off (no &contact)'//nl
-      end if
-      if (scene%exact%present) then
+      text = text//contact_switches(scene)
+      if (pressure_only(scene%exact)) then
+         text = text//'  error columns (err_*, theta_*): off (exact solution '//scene%exact%kind// &
+            & ' gives the contact pressure only: p_max_exact and err_p_* on)'//nl
+      else if (scene%exact%present) then
          text = text//'  error columns (err_*, theta_*): on (exact solution '//scene%exact%kind//')'//nl
       else
          text = text//'  error columns (err_*, theta_*): off (no &exact)'//nl
@@ -1057,18 +1261,33 @@ contains
       text = "on '"//bc%on//"': "//bc%type
       if (bc%type == 'pressure') text = text//', value = '//real_text(bc%value)
       if (allocated(bc%vector)) text = text//', vector = '//real_list(bc%vector)
+      if (bc%stage > 1) text = text//', stage = '//itoa(bc%stage)
    end function bc_line
 
    function exact_line(exact) result(text)
       type(exact_spec_type), intent(in) :: exact
       character(len=:), allocatable :: text
-      text = exact%kind//', center = '//real_list(exact%center)
-      if (exact%kind == 'kirsch') then
-         text = text//', radius = '//real_text(exact%radius)//', s_inf = '//real_text(exact%s_inf)
-      else
-         text = text//', r_in = '//real_text(exact%r_in)//', r_out = '//real_text(exact%r_out)// &
-            & ', p_in = '//real_text(exact%p_in)//', p_out = '//real_text(exact%p_out)
-      end if
+      text = exact%kind
+      select case (exact%kind)
+      case ('kirsch')
+         text = text//', center = '//real_list(exact%center)//', radius = '//real_text(exact%radius)// &
+            & ', s_inf = '//real_text(exact%s_inf)
+      case ('uniform')
+         text = text//', stress = '//real_list(exact%stress)
+      case ('compound_cylinder', 'compound_sphere')
+         text = text//', center = '//real_list(exact%center)//', r_in = '//real_text(exact%r_in)// &
+            & ', r_contact = '//real_text(exact%r_contact)//', r_out = '//real_text(exact%r_out)// &
+            & ', p_in = '//real_text(exact%p_in)//", inner = '"//exact%inner//"', outer = '"//exact%outer// &
+            & "', interference = "//real_text(exact%interference)
+      case ('hertz_cylinder', 'hertz_sphere')
+         text = text//', point = '//real_list(exact%point)//', normal = '//real_list(exact%normal)// &
+            & ', radius = '//real_text(exact%radius)//', load = '//real_text(exact%load)// &
+            & ' (contact pressure only: the energy-norm columns stay empty)'
+      case default
+         text = text//', center = '//real_list(exact%center)//', r_in = '//real_text(exact%r_in)// &
+            & ', r_out = '//real_text(exact%r_out)//', p_in = '//real_text(exact%p_in)//', p_out = '// &
+            & real_text(exact%p_out)
+      end select
    end function exact_line
 
    function contact_line(c) result(text)
@@ -1077,9 +1296,42 @@ contains
       text = "slave '"//c%slave//"' surface '"//c%slave_surface//"', master '"//c%master//"' surface '"// &
          & c%master_surface//"', friction = "//c%friction
       if (c%friction == 'coulomb') text = text//', mu = '//real_text(c%mu)
-      if (c%has_kappa) text = text//', kappa = '//real_text(c%kappa)
-      text = text//' (NOT AVAILABLE in this version)'
+      text = text//', kappa = '//real_text(c%kappa)
+      if (.not. c%has_kappa) text = text//' (default)'
+      text = text//', steps = '//itoa(c%steps)//', stabilization = '//c%stabilization
    end function contact_line
+
+   !> The contact part of 'what a scene switches on' (SCENE.md).
+   function contact_switches(scene) result(text)
+      type(scene_type), intent(in) :: scene
+      character(len=:), allocatable :: text
+      character(len=*), parameter :: nl = new_line('a')
+      integer :: stages
+
+      if (size(scene%contacts) == 0) then
+         text = '  contact: off (no &contact)'//nl
+         return
+      end if
+      stages = 1
+      if (size(scene%bcs) > 0) stages = max(1, maxval(scene%bcs%stage))
+      associate (c => scene%contacts(1))
+         text = "  contact: on (slave '"//c%slave//"' on master '"//c%master//"', friction "//c%friction// &
+            & '; NOT IMPLEMENTED in this version: sprc run refuses the scene)'//nl
+         text = text//'  contact stabilization stress: '//c%stabilization//nl
+         if (c%friction == 'coulomb') then
+            text = text//'  load history: on ('//itoa(stages)//' stage(s), '//itoa(c%steps)// &
+               & ' increment(s) each: Coulomb friction depends on the load path)'//nl
+         else
+            text = text//'  load history: off (friction '//c%friction//': all stages are one linear load)'//nl
+         end if
+      end associate
+      text = text//'  contact columns (contact_iterations ... err_p_sprc): on'//nl
+      if (len(scene%output) > 0) then
+         text = text//'  contact files: on ('//scene%output//'_contact.csv, '//scene%output//'_contact.svg)'//nl
+      else
+         text = text//"  contact files: off (output = '')"//nl
+      end if
+   end function contact_switches
 
    ! ---------------------------------------------------------- text utils
 

@@ -56,6 +56,9 @@ module sprc_study_level
       type(analysis_units_type) :: units
       real(wp) :: young = 0.0_wp, poisson = 0.0_wp
       real(wp), allocatable :: body_force(:)
+      !> The level-0 cell of the body's grid.
+      real(wp), allocatable :: box_min(:)
+      real(wp) :: box_size = 0.0_wp
    end type study_body_type
 
    !> A prepared study: its bodies and the settings every level shares.
@@ -64,9 +67,6 @@ module sprc_study_level
       type(scene_type) :: scene
       type(study_body_type), allocatable :: bodies(:)
       integer :: dim = 0, order = 0, analysis = 0, refine_boundary = 0
-      !> The level-0 cell of every body's grid.
-      real(wp), allocatable :: box_min(:)
-      real(wp) :: box_size = 0.0_wp
       !> Gauss points per direction of the cut-cell rules; patch polynomial degree.
       integer :: points = 0, degree(2) = 0
       !> Nitsche penalty factor (the scene's `nitsche_gamma`) and volumetric formulation
@@ -121,8 +121,8 @@ contains
       integer :: b
 
       if (size(scene%contacts) > 0) then
-         call fatal_error(error, 'sprc run: &contact is not implemented in this version (bodies in contact '// &
-            & 'need the contact FE); scenes with several bodies and no &contact run', stat_unsupported)
+         call fatal_error(error, 'sprc run: &contact: the contact FE is not implemented in this version '// &
+            & '(sprc check validates the scene); scenes with several bodies and no &contact run', stat_unsupported)
          return
       end if
       call build_bodies(scene, bodies, error)
@@ -141,6 +141,8 @@ contains
             sb%young = scaled%bodies(b)%young
             sb%poisson = spec%poisson
             sb%body_force = scaled%bodies(b)%body_force
+            sb%box_min = spec%box_min
+            sb%box_size = spec%box_size
          end associate
       end do
       study%scene = scene
@@ -148,8 +150,6 @@ contains
       study%order = scene%order
       study%analysis = analysis_kind(scene)
       study%refine_boundary = scene%refine_boundary
-      study%box_min = scene%box_min
-      study%box_size = scene%box_size
       study%gamma = scene%nitsche_gamma
       study%dilatation = dilatation_choice(scene%dilatation)
       study%points = points
@@ -207,8 +207,7 @@ contains
       call check_level_memory(study%scene, sb%geometry, level, error)
       if (allocated(error)) return
       call t_mesh%start()
-      call bl%grid%build(sb%geometry, study%dim, study%box_min, study%box_size, level, study%refine_boundary, &
-         & error)
+      call bl%grid%build(sb%geometry, study%dim, sb%box_min, sb%box_size, level, study%refine_boundary, error)
       if (.not. allocated(error)) call bl%nodes%build(bl%grid, study%order, error)
       if (.not. allocated(error)) call bl%hanging%build(bl%grid, bl%nodes, error)
       call t_mesh%stop()
@@ -278,7 +277,8 @@ contains
       integer :: b, m
 
       row%level = result%level
-      row%h = study%box_size/real(2**result%level, wp)
+      ! The coarsest body's cell: with one box for all, that box's edge at this level.
+      row%h = maxval([(study%bodies(b)%box_size, b=1, size(study%bodies))])/real(2**result%level, wp)
       row%t_mesh = 0.0_wp
       row%t_quadrature = 0.0_wp
       row%t_assembly = 0.0_wp

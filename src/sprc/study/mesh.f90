@@ -89,8 +89,8 @@ contains
             if (.not. allocated(error)) then
                call timer%reset()
                call timer%start()
-               call grid%build(bodies(b), scene%dim, scene%box_min, scene%box_size, levels(l), &
-                  scene%refine_boundary, error)
+               call grid%build(bodies(b), scene%dim, scene%bodies(b)%box_min, scene%bodies(b)%box_size, &
+                  & levels(l), scene%refine_boundary, error)
                call timer%stop()
             end if
             if (allocated(error)) then

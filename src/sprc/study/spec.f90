@@ -11,6 +11,14 @@ module sprc_study_spec
 
    public :: scene_type, body_spec_type, shape_spec_type, bc_spec_type, exact_spec_type, contact_spec_type
    public :: recovery_degree
+   public :: default_kappa, default_stabilization
+
+   !> Default of `&contact kappa`, the dimensionless factor of the contact
+   !> stabilization (effective stiffness kappa*E/h, seed eq. 5); README documents it.
+   real(wp), parameter :: default_kappa = 100.0_wp
+   !> Default of `&contact stabilization`: the FE stress (the recovered-stress
+   !> variant needs the SPR-C contact patches).
+   character(len=*), parameter :: default_stabilization = 'fe'
 
    !> One elastic body.
    type :: body_spec_type
@@ -22,6 +30,11 @@ module sprc_study_spec
       real(wp) :: poisson = 0.0_wp
       !> Body force per unit volume, `dim` values.
       real(wp), allocatable :: body_force(:)
+      !> The body's level-0 cell: its own `box_min`, `box_size` when `has_box`,
+      !> else copies of the `&scene` ones.
+      real(wp), allocatable :: box_min(:)
+      real(wp) :: box_size = 0.0_wp
+      logical :: has_box = .false.
    end type body_spec_type
 
    !> One CSG primitive of a body; its surface keeps `name`.
@@ -69,20 +82,34 @@ module sprc_study_spec
       real(wp) :: value = 0.0_wp
       !> Traction or displacement (types 'traction', 'displacement'), `dim` values.
       real(wp), allocatable :: vector(:)
+      !> Load stage, >= 1: applied once the stages before it are (SCENE.md).
+      integer :: stage = 1
    end type bc_spec_type
 
    !> The analytical solution, if any.
    type :: exact_spec_type
       !> Whether the scene has an `&exact` group.
       logical :: present = .false.
-      !> 'lame_cylinder' | 'lame_sphere' | 'kirsch'.
+      !> 'lame_cylinder' | 'lame_sphere' | 'kirsch' | 'uniform' | 'compound_cylinder' |
+      !> 'compound_sphere' | 'hertz_cylinder' | 'hertz_sphere'.
       character(len=:), allocatable :: kind
       !> Centre, `dim` values.
       real(wp), allocatable :: center(:)
       !> Lamé: inner and outer radius, inner and outer pressure.
       real(wp) :: r_in = 0.0_wp, r_out = 0.0_wp, p_in = 0.0_wp, p_out = 0.0_wp
-      !> Kirsch: hole radius and remote uniaxial stress along x.
+      !> Kirsch: hole radius and remote uniaxial stress along x. Hertz: relative radius.
       real(wp) :: radius = 0.0_wp, s_inf = 0.0_wp
+      !> Uniform: the stress in Voigt order, 3 (2D) or 6 (3D) values.
+      real(wp), allocatable :: stress(:)
+      !> Compound: contact radius (r_in < r_contact < r_out) and radial interference, >= 0.
+      real(wp) :: r_contact = 0.0_wp, interference = 0.0_wp
+      !> Compound: the inner and outer bodies and their indices in `scene%bodies`.
+      character(len=:), allocatable :: inner, outer
+      integer :: inner_index = 0, outer_index = 0
+      !> Hertz: first-contact point and the unit normal of the contact plane, `dim` values.
+      real(wp), allocatable :: point(:), normal(:)
+      !> Hertz: the whole contact force (per unit thickness in 2D), > 0.
+      real(wp) :: load = 0.0_wp
    end type exact_spec_type
 
    !> A contact pair between two bodies.
@@ -97,9 +124,13 @@ module sprc_study_spec
       character(len=:), allocatable :: friction
       !> Friction coefficient (coulomb), >= 0.
       real(wp) :: mu = 0.0_wp
-      !> Stabilisation parameter, > 0 when given.
-      real(wp) :: kappa = 0.0_wp
+      !> Stabilization factor, > 0; `default_kappa` unless given (`has_kappa`).
+      real(wp) :: kappa = default_kappa
       logical :: has_kappa = .false.
+      !> Load increments per stage, >= 1.
+      integer :: steps = 1
+      !> Source of the stabilization stress: 'fe' | 'recovered'.
+      character(len=:), allocatable :: stabilization
    end type contact_spec_type
 
    !> A validated scene, defaults filled in.
