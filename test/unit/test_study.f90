@@ -170,8 +170,12 @@ contains
       type(level_type) :: result
       type(error_type), allocatable :: refused
       character(len=:), allocatable :: text
+      integer :: i
 
       text = two_body_scene(.true., .true., '3')
+      ! A contact surface takes no &bc: the rim is held by the contact alone.
+      i = index(text, "&bc on='rim'")
+      text = text(1:i - 1)//text(i + index(text(i:), nl):)
       text = text//"&contact slave='block' master='cylinder' slave_surface='rim' master_surface='outer' "// &
          & "friction='frictionless' /"//nl
       call run_text(text, 3, result, refused)
@@ -181,7 +185,7 @@ contains
       end if
       call check(error, refused%stat, stat_unsupported, 'status unsupported')
       if (allocated(error)) return
-      call check(error, index(refused%message, '&contact is not implemented') > 0, 'message: '//refused%message)
+      call check(error, index(refused%message, 'contact FE is not implemented in this version') > 0, 'message: '//refused%message)
    end subroutine test_contact_refused
 
    !> With several bodies a failure names the body: here the block without
