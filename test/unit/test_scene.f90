@@ -8,7 +8,7 @@ module sprc_test_scene
    use sprc_core_error, only: error_type, stat_invalid_input, stat_io, stat_unsupported
    use sprc_io_namelist, only: read_text_file
    use sprc_io_scene, only: scene_type, read_scene, read_scene_text, default_scene_text, scene_summary, recovery_degree
-   use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed
+   use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, replaced
    implicit none
    private
 
@@ -83,16 +83,6 @@ contains
       call read_scene(path, scene, e)
       if (allocated(e)) call test_failed(error, path//': unexpected error: '//e%message)
    end subroutine read_file_ok
-
-   !> `text` with the first `old` replaced by `new`.
-   function replaced(text, old, new) result(out)
-      character(len=*), intent(in) :: text, old, new
-      character(len=:), allocatable :: out
-      integer :: i
-      i = index(text, old)
-      out = text
-      if (i > 0) out = text(1:i - 1)//new//text(i + len(old):)
-   end function replaced
 
    !> Whether `summary` has the line `  label: state...`.
    logical function has_switch(summary, label, state)

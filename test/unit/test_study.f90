@@ -11,7 +11,7 @@ module sprc_test_study
    use sprc_study_spec, only: scene_type
    use sprc_io_scene, only: read_scene_text
    use sprc_study_level, only: study_type, prepare_study, run_level, level_type, body_level_type
-   use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed
+   use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, replaced
    implicit none
    private
 
@@ -25,6 +25,7 @@ contains
       type(unittest_type), allocatable, intent(out) :: testsuite(:)
       testsuite = [ &
          new_unittest('two_bodies_far_apart', test_two_bodies), &
+         new_unittest('body_own_box', test_body_box), &
          new_unittest('contact_refused', test_contact_refused), &
          new_unittest('body_error_names_body', test_body_error) &
          ]
@@ -164,18 +165,43 @@ contains
          & c(2)*one(2)%bodies(1)%est(1)%err**2)/sqrt(c(1)*e(1)**2 + c(2)*e(2)**2), 'theta_spr summed')
    end subroutine check_sums
 
+   !> A body on its own level-0 cell (&body box_min, box_size): bit for bit the
+   !> single-body run whose &scene box is that cell, next to a body on the
+   !> scene's cell; and not the run on the scene's cell (the box is used).
+   subroutine test_body_box(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: scene_box = ' box_min=0,0 box_size=25 ', own_box = ' box_min=20,20 box_size=5 '
+      character(len=*), parameter :: block = "&body name='block' young=2000 poisson=0.25"
+      type(level_type) :: both, one(2), scene_cell
+
+      call run_text(replaced(two_body_scene(.true., .true., '3'), block, block//own_box), 3, both, error)
+      if (allocated(error)) return
+      call run_text(two_body_scene(.true., .false., '3'), 3, one(1), error)
+      if (allocated(error)) return
+      call run_text(replaced(two_body_scene(.false., .true., '3'), scene_box, own_box), 3, one(2), error)
+      if (allocated(error)) return
+      call run_text(two_body_scene(.false., .true., '3'), 3, scene_cell, error)
+      if (allocated(error)) return
+      call same_body(both%bodies(1), one(1)%bodies(1), error)
+      if (allocated(error)) return
+      call same_body(both%bodies(2), one(2)%bodies(1), error)
+      if (allocated(error)) return
+      call check(error, both%bodies(2)%problem%n_dofs() /= scene_cell%bodies(1)%problem%n_dofs(), &
+         & 'the block on its own cell is meshed differently from the block on the scene cell')
+      if (allocated(error)) return
+      call check(error, both%row%h, 25.0_wp/8, 0.0_wp, 'h: the coarsest body cell at level 3')
+   end subroutine test_body_box
+
    !> &contact is refused before any computation, saying so.
    subroutine test_contact_refused(error)
       type(error_type), allocatable, intent(out) :: error
       type(level_type) :: result
       type(error_type), allocatable :: refused
       character(len=:), allocatable :: text
-      integer :: i
 
       text = two_body_scene(.true., .true., '3')
       ! A contact surface takes no &bc: the rim is held by the contact alone.
-      i = index(text, "&bc on='rim'")
-      text = text(1:i - 1)//text(i + index(text(i:), nl):)
+      text = replaced(text, "&bc on='rim' type='exact_displacement' /"//nl, '')
       text = text//"&contact slave='block' master='cylinder' slave_surface='rim' master_surface='outer' "// &
          & "friction='frictionless' /"//nl
       call run_text(text, 3, result, refused)

@@ -8,7 +8,7 @@ module sprc_testsuite
    private
 
    public :: unittest_type, testsuite_type, new_unittest, new_testsuite
-   public :: check, test_failed, run_testsuite, error_type, collect_interface
+   public :: check, test_failed, run_testsuite, error_type, collect_interface, replaced
 
    abstract interface
       !> A test: allocates `error` when it fails.
@@ -159,5 +159,15 @@ contains
          flush (unit)
       end do
    end subroutine run_testsuite
+
+   !> `text` with the first `old` replaced by `new`.
+   function replaced(text, old, new) result(out)
+      character(len=*), intent(in) :: text, old, new
+      character(len=:), allocatable :: out
+      integer :: i
+      i = index(text, old)
+      out = text
+      if (i > 0) out = text(1:i - 1)//new//text(i + len(old):)
+   end function replaced
 
 end module sprc_testsuite
