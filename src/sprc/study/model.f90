@@ -342,13 +342,12 @@ contains
                call new_kirsch(exact, spec%center, spec%radius, spec%s_inf, young, nu, analysis_kind(scene), error)
             end select
          case default
-            call fatal_error(error, '&exact: kind '''//spec%kind//''' is not available in this version', &
-               stat_unsupported)
+            call fatal_error(error, 'kind '''//spec%kind//''' is not available in this version', stat_unsupported)
          end select
       end associate
       if (allocated(error)) then
          error%message = '&exact: '//error%message
-         deallocate (exact)
+         if (allocated(exact)) deallocate (exact)
       end if
    end subroutine build_exact
 
