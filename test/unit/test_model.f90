@@ -92,6 +92,22 @@ contains
       if (allocated(error)) return
       call check(error, e%stat, stat_invalid_input, 'status')
       if (allocated(error)) return
+      ! The body's own box is the one it must fit: box 25 of its own inside the scene's
+      ! box 15 is accepted, its own box 15 inside the scene's 25 is refused naming it.
+      call read_scene_text(replaced(replaced(text, 'box_size = 25.0', 'box_size = 15.0'), "young=1000.0", &
+         & "box_min=0,0 box_size=25 young=1000.0"), 'own box', scene, error)
+      if (allocated(error)) return
+      call build_bodies(scene, bodies, error)
+      if (allocated(error)) return
+      call read_scene_text(replaced(text, "young=1000.0", "box_min=0,0 box_size=15 young=1000.0"), 'small own box', &
+         & scene, error)
+      if (allocated(error)) return
+      call build_bodies(scene, bodies, e)
+      call check(error, allocated(e), 'own box 15 around r = 20 rejected')
+      if (allocated(error)) return
+      call check(error, index(e%message, "body 'cylinder' extends beyond its own box 0..15 x 0..15 (&body: "// &
+         & 'box_min, box_size)') > 0, 'message names the body''s own box: '//e%message)
+      if (allocated(error)) return
       ! r = 20 shifted to touch x = 25: tangent, no material beyond
       call read_scene_text(replaced(replaced(text, 'center=0,0 radius=20', 'center=5,0 radius=20'), &
          & "point=0,0 normal=-1,0", "point=5,0 normal=-1,0"), 'tangent', scene, error)

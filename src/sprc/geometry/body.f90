@@ -406,14 +406,16 @@ contains
    !> with phi below minus the snapping tolerance). A body that crosses a face has material
    !> in the slab beyond it; one that only touches a face (a plane on the box boundary, a
    !> circle tangent to it) has none. A piece entirely outside the box and the slabs is
-   !> not searched for.
-   subroutine check_body_in_box(self, box_min, box_size, error)
+   !> not searched for. With `own_box`, the box is the body's own level-0 cell (`&body`
+   !> box_min, box_size) and the message says so.
+   subroutine check_body_in_box(self, box_min, box_size, error, own_box)
       type(body_type), intent(in) :: self
       real(wp), intent(in) :: box_min(:), box_size
       type(error_type), allocatable, intent(out) :: error
+      logical, intent(in), optional :: own_box
       integer, parameter :: depth_limit = 8
       real(wp) :: lo(3), hi(3), x(3)
-      character(len=:), allocatable :: where
+      character(len=:), allocatable :: where, whose, keys
       integer :: d, k, j, side
       logical :: found
 
@@ -436,8 +438,16 @@ contains
             do j = 2, d
                where = where//' x '//real_str(box_min(j))//'..'//real_str(box_min(j) + box_size)
             end do
-            call fatal_error(error, "body '"//body_name(self)//"' extends beyond the scene's box "//where// &
-               & ' (&scene: box_min, box_size): it has material at ('//real_list(x(1:d))//'), which the grid would '// &
+            whose = "the scene's box "
+            keys = '&scene'
+            if (present(own_box)) then
+               if (own_box) then
+                  whose = 'its own box '
+                  keys = '&body'
+               end if
+            end if
+            call fatal_error(error, "body '"//body_name(self)//"' extends beyond "//whose//where// &
+               & ' ('//keys//': box_min, box_size): it has material at ('//real_list(x(1:d))//'), which the grid would '// &
                & 'cut off; enlarge box_size or move box_min so that the box holds the whole body', &
                & stat_invalid_input)
             return

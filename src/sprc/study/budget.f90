@@ -59,14 +59,16 @@ contains
       logical, intent(in), optional :: grid_only
       type(grid_type) :: grid
       integer :: d, coarse, up
-      real(wp) :: active, cut, per_dof
+      real(wp) :: active, cut, per_dof, box_size
+      real(wp), allocatable :: box_min(:)
 
       cells = 0.0_wp
       dofs = 0.0_wp
       bytes = 0.0_wp
       d = scene%dim
       coarse = min(level, merge(6, 4, d == 2))
-      call grid%build(body, d, scene%box_min, scene%box_size, coarse, 0, error)
+      call body_box(scene, body, box_min, box_size)
+      call grid%build(body, d, box_min, box_size, coarse, 0, error)
       if (allocated(error)) return
       active = real(sum(grid%n_inside) + sum(grid%n_cut), wp)
       cut = real(sum(grid%n_cut), wp)
@@ -113,6 +115,27 @@ contains
          & gigabytes(real(avail, wp)), source
       call fatal_error(error, trim(buf), stat_out_of_memory)
    end subroutine check_level_memory
+
+   !> The level-0 cell of `body`'s grid: that of the scene's body of the same name
+   !> (`&body` box_min, box_size, the scene's when the body has none of its own).
+   subroutine body_box(scene, body, box_min, box_size)
+      type(scene_type), intent(in) :: scene
+      type(body_type), intent(in) :: body
+      real(wp), allocatable, intent(out) :: box_min(:)
+      real(wp), intent(out) :: box_size
+      integer :: b
+
+      box_min = scene%box_min
+      box_size = scene%box_size
+      if (.not. allocated(body%name)) return
+      do b = 1, size(scene%bodies)
+         if (.not. allocated(scene%bodies(b)%name) .or. .not. allocated(scene%bodies(b)%box_min)) cycle
+         if (scene%bodies(b)%name /= body%name) cycle
+         box_min = scene%bodies(b)%box_min
+         box_size = scene%bodies(b)%box_size
+         return
+      end do
+   end subroutine body_box
 
    pure function gigabytes(bytes) result(text)
       real(wp), intent(in) :: bytes

@@ -208,20 +208,30 @@ contains
       type(body_type), intent(in) :: body
       real(wp), intent(in) :: center(:)
       real(wp), intent(out) :: r(2), step
-      real(wp) :: x(3), h, dist
+      real(wp) :: x(3), h, dist, box_size
+      real(wp), allocatable :: box_min(:)
       integer :: n, i, j, k, d, nk
 
       d = scene%dim
       n = merge(64, 32, d == 2)
       nk = merge(1, n, d == 2)
-      h = scene%box_size/real(n, wp)
+      ! The body is the first: its own level-0 cell when it has one.
+      box_min = scene%box_min
+      box_size = scene%box_size
+      if (size(scene%bodies) > 0) then
+         if (allocated(scene%bodies(1)%box_min)) then
+            box_min = scene%bodies(1)%box_min
+            box_size = scene%bodies(1)%box_size
+         end if
+      end if
+      h = box_size/real(n, wp)
       step = h*sqrt(real(d, wp))
       r = [huge(1.0_wp), 0.0_wp]
       do k = 1, nk
          do j = 1, n
             do i = 1, n
                x = h*([real(i, wp), real(j, wp), real(k, wp)] - 0.5_wp)
-               x(1:d) = scene%box_min(1:d) + x(1:d)
+               x(1:d) = box_min(1:d) + x(1:d)
                if (.not. (body%phi(x(1:d)) < 0.0_wp)) cycle
                dist = norm2(x(1:d) - center(1:d))
                r = [min(r(1), dist), max(r(2), dist)]
@@ -265,7 +275,12 @@ contains
          end if
       end do
       do b = 1, size(bodies)
-         call check_body_in_box(bodies(b), scene%box_min, scene%box_size, error)
+         if (allocated(scene%bodies(b)%box_min)) then
+            call check_body_in_box(bodies(b), scene%bodies(b)%box_min, scene%bodies(b)%box_size, error, &
+               & own_box=scene%bodies(b)%has_box)
+         else
+            call check_body_in_box(bodies(b), scene%box_min, scene%box_size, error)
+         end if
          if (allocated(error)) return
       end do
    end subroutine build_bodies
