@@ -93,6 +93,7 @@ contains
          new_unittest('reserve_fewer_points_than_terms', test_reserve_few_points), &
          new_unittest('traction_weight_focus', test_traction_focus), &
          new_unittest('traction_rank_curved_face', test_traction_curved_rank), &
+         new_unittest('traction_face_off_node', test_traction_face_off_node), &
          new_unittest('flop_formulas', test_flop_formulas), &
          new_unittest('flop_count_spr', test_flop_count_spr), &
          new_unittest('flop_count_sprc', test_flop_count_sprc), &
@@ -1022,6 +1023,49 @@ contains
          end do
       end do
    end subroutine test_traction_curved_rank
+
+   !> Traction rows per face only where the node lies on that face (solve.f90 notes (c)): a
+   !> 2D patch left of the face x = 0 through its node, plus a short traction face y = 0.9
+   !> (another boundary piece, e.g. the arc left by a cut corner) whose tangent plane is
+   !> 0.9 h > traction_reach h from the node. Only the node's own face is imposed, with its
+   !> flat rank 2 (p + 1) for p = 1, 2. (Before: the far face added its own full-rank rows,
+   !> which on a Q2 grid pinned the patch to a 0.02 h arc and gave coefficients ~1e3.)
+   subroutine test_traction_face_off_node(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(patch_type) :: patch
+      type(recovery_workspace_type) :: ws
+      type(recovered_patch_type) :: rec
+      real(wp) :: xi(3), wt(3), x, y
+      integer :: i, j, k, p
+      character(len=20) :: tag
+
+      call gauss(3, xi, wt)
+      do p = 1, 2
+         call patch_reset(patch, 2, plane_stress, 1000.0_wp, 0.3_wp, [0.0_wp, 0.0_wp], 1.0_wp)
+         do k = 0, 1
+            do i = 1, 3
+               x = -0.5_wp*(xi(i) + 1.0_wp)
+               do j = 1, 3
+                  y = k - 1 + 0.5_wp*(xi(j) + 1.0_wp)
+                  call patch_add_point(patch, [x, y], 0.25_wp*wt(i)*wt(j), [0.1_wp*x, 0.2_wp*y, 0.0_wp])
+               end do
+               y = k - 1 + 0.5_wp*(xi(i) + 1.0_wp)
+               call patch_add_boundary_point(patch, [0.0_wp, y], 0.5_wp*wt(i), [1.0_wp, 0.0_wp], &
+                  & boundary_traction, [0.0_wp, 0.0_wp], piece=1)
+            end do
+         end do
+         do i = 1, 3
+            x = -0.15_wp + 0.05_wp*xi(i)
+            call patch_add_boundary_point(patch, [x, 0.9_wp], 0.05_wp*wt(i), [0.0_wp, 1.0_wp], &
+               & boundary_traction, [0.0_wp, 0.0_wp], piece=2)
+         end do
+         write (tag, '(" (p ",i0,")")') p
+         call recover_sprc(patch, p, ws, rec, error)
+         if (allocated(error)) return
+         call check(error, rec%ranks(kind_traction), 2*(p + 1), 'traction rank of the node''s face'//trim(tag))
+         if (allocated(error)) return
+      end do
+   end subroutine test_traction_face_off_node
 
    subroutine test_noisy(error)
       type(error_type), allocatable, intent(out) :: error

@@ -25,6 +25,14 @@
 !>       a cut grid, the traction rows of a patch whose node is a cell or more away from the
 !>       boundary pin the polynomial far from the node, and measured on Lame / Kirsch / sphere
 !>       FE solutions SPR-C then lost to SPR at several levels; reach 0.2 was worse than 0.1.)
+!>       The same test applies per face (`face_near_node`): a face of the patch on which the
+!>       node does not lie (e.g. the 0.02 h arc a cut corner leaves in a neighbouring cell)
+!>       adds no rows. Such a face's rows pin the polynomial far from the node just the same,
+!>       and with its own full rank (its rows are normalised and rank-decided face by face):
+!>       on a Q2 grid whose traction plane lay on a grid line, a 0.02 h arc of the outer
+!>       circle 3 h away gave 6 more rows, the 29 constraints of the 30 degree-3
+!>       coefficients left the data one degree of freedom, and the patch came out with
+!>       coefficients ~1e3 (Lame Q2 with a plane cut at x = 5 h: theta_sprc 1541 -> 1.24).
 !>       Per boundary face (traction points grouped by piece `bpiece`, and within a piece by
 !>       normal, so box corners give separate faces), E = rows sqrt(bw_j f_j) G(n_j) P(s_j) is
 !>       factored by QR with column pivoting, E Pi = Q R, and eq. 80, E^T E A = E^T t, becomes
@@ -415,6 +423,7 @@ contains
       lde = size(ws%estack, 1)
       call traction_faces(patch, ws, nfaces)
       do f = 1, nfaces
+         if (.not. face_near_node(patch, ws, f)) cycle
          cap = flat_traction_rank(d, ws%degree)
          if (face_is_curved(patch, ws, f)) cap = flat_traction_rank(d, ws%degree - 1)
          bsum = 0.0_wp
@@ -515,6 +524,31 @@ contains
          end if
       end do
    end function face_is_curved
+
+   !> True if the patch node lies on traction face f up to traction_reach h: its distance to the
+   !> tangent plane at the face's traction point nearest to it (module notes, (c), per face).
+   pure logical function face_near_node(patch, ws, f) result(near)
+      type(patch_type), intent(in) :: patch
+      type(recovery_workspace_type), intent(in) :: ws
+      integer, intent(in) :: f
+      integer :: j, jn, d
+      real(wp) :: dist, dmin
+
+      d = patch%dim
+      jn = 0
+      dmin = huge(1.0_wp)
+      do j = 1, patch%nbpoints
+         if (ws%bface(j) /= f) cycle
+         dist = norm2(patch%bx(1:d, j) - patch%x0(1:d))
+         if (dist < dmin) then
+            dmin = dist
+            jn = j
+         end if
+      end do
+      near = .false.
+      if (jn > 0) near = abs(dot_product(patch%bn(1:d, jn), patch%x0(1:d) - patch%bx(1:d, jn))) <= &
+         & traction_reach*patch%h
+   end function face_near_node
 
    !> True if the patch node lies on the traction boundary up to traction_reach h: its distance
    !> to the tangent plane at the nearest traction point (module notes).
