@@ -525,35 +525,26 @@ contains
       end do
    end function face_is_curved
 
-   !> True if the patch node lies on traction face f up to traction_reach h: its distance to the
-   !> tangent plane at the face's traction point nearest to it (module notes, (c), per face).
+   !> True if the patch node lies on traction face f up to traction_reach h (module notes).
    pure logical function face_near_node(patch, ws, f) result(near)
       type(patch_type), intent(in) :: patch
       type(recovery_workspace_type), intent(in) :: ws
       integer, intent(in) :: f
-      integer :: j, jn, d
-      real(wp) :: dist, dmin
-
-      d = patch%dim
-      jn = 0
-      dmin = huge(1.0_wp)
-      do j = 1, patch%nbpoints
-         if (ws%bface(j) /= f) cycle
-         dist = norm2(patch%bx(1:d, j) - patch%x0(1:d))
-         if (dist < dmin) then
-            dmin = dist
-            jn = j
-         end if
-      end do
-      near = .false.
-      if (jn > 0) near = abs(dot_product(patch%bn(1:d, jn), patch%x0(1:d) - patch%bx(1:d, jn))) <= &
-         & traction_reach*patch%h
+      near = node_near_points(patch, ws%bface, f)
    end function face_near_node
 
-   !> True if the patch node lies on the traction boundary up to traction_reach h: its distance
-   !> to the tangent plane at the nearest traction point (module notes).
+   !> True if the patch node lies on the traction boundary up to traction_reach h (module notes).
    pure logical function traction_near_node(patch) result(near)
       type(patch_type), intent(in) :: patch
+      near = node_near_points(patch)
+   end function traction_near_node
+
+   !> The node's distance to the tangent plane at the nearest of the chosen boundary points is
+   !> at most traction_reach h. Chosen: the points of face f (face_of(j) == f), or without
+   !> face_of every traction point of positive weight.
+   pure logical function node_near_points(patch, face_of, f) result(near)
+      type(patch_type), intent(in) :: patch
+      integer, intent(in), optional :: face_of(:), f
       integer :: j, jn, d
       real(wp) :: dist, dmin
 
@@ -561,7 +552,11 @@ contains
       jn = 0
       dmin = huge(1.0_wp)
       do j = 1, patch%nbpoints
-         if (patch%bkind(j) /= boundary_traction .or. .not. (patch%bw(j) > 0.0_wp)) cycle
+         if (present(face_of)) then
+            if (face_of(j) /= f) cycle
+         else if (patch%bkind(j) /= boundary_traction .or. .not. (patch%bw(j) > 0.0_wp)) then
+            cycle
+         end if
          dist = norm2(patch%bx(1:d, j) - patch%x0(1:d))
          if (dist < dmin) then
             dmin = dist
@@ -571,7 +566,7 @@ contains
       near = .false.
       if (jn > 0) near = abs(dot_product(patch%bn(1:d, jn), patch%x0(1:d) - patch%bx(1:d, jn))) <= &
          & traction_reach*patch%h
-   end function traction_near_node
+   end function node_near_points
 
    !> Rank of the traction rows of degree-`degree` stresses on a flat boundary piece: dim
    !> components, each a polynomial of degree p in dim - 1 variables, dim C(p + dim - 1, dim - 1).
