@@ -31,7 +31,7 @@ module sprc_contact_surface
    use sprc_core_kinds, only: wp
    use sprc_core_text, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_not_converged
-   use sprc_geometry_body, only: body_type, snap_tolerance
+   use sprc_geometry_body, only: body_type, snap_tolerance, body_name, shape_name
    use sprc_grid_tree, only: grid_type
    use sprc_grid_quadrature, only: cut_quadrature_type, cell_rule_type, cell_rule, boundary_face_rule
    use sprc_geometry_region, only: cell_inside
@@ -153,7 +153,7 @@ contains
          end do
       end do
       if (n == 0) then
-         call fatal_error(error, "contact surface: surface '"//shape_name(body, shape)//"' of body '"// &
+         call fatal_error(error, "contact surface: surface '"//shape_name(body%shapes(shape))//"' of body '"// &
             & body_name(body)//"' has no quadrature points on the grid (it does not bound the body)")
          return
       end if
@@ -306,21 +306,6 @@ contains
       nudge = 2.0_wp*tolerance + 4.0_wp*epsilon(1.0_wp)*(maxval(abs(x)) + grid%box_size)
       leaf = grid%locate_point(x - nudge*m)
    end function host_cell
-
-   pure function body_name(body) result(name)
-      type(body_type), intent(in) :: body
-      character(len=:), allocatable :: name
-      name = ''
-      if (allocated(body%name)) name = body%name
-   end function body_name
-
-   pure function shape_name(body, shape) result(name)
-      type(body_type), intent(in) :: body
-      integer, intent(in) :: shape
-      character(len=:), allocatable :: name
-      name = ''
-      if (allocated(body%shapes(shape)%name)) name = body%shapes(shape)%name
-   end function shape_name
 
    pure function real_list(v) result(s)
       real(wp), intent(in) :: v(:)

@@ -29,6 +29,7 @@ module sprc_geometry_body
    public :: body_type, new_body, check_body_in_box
    public :: csg_add, csg_subtract, csg_intersect, csg_op_name, csg_op_from_name
    public :: snap_ulps, snap_tolerance
+   public :: body_name, shape_name
 
    !> CSG operations (values are stable).
    integer, parameter :: csg_add = 1
