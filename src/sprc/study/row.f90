@@ -34,6 +34,18 @@ module sprc_study_row
       real(wp) :: eta_spr = report_empty, eta_sprc = report_empty
       !> Global effectivity indices.
       real(wp) :: theta_spr = report_empty, theta_sprc = report_empty
+      !> Contact columns (SCENE.md; only scenes with `&contact`, `has_contact`):
+      !> contact iterations summed over increments, contact time (search, gaps,
+      !> contact terms), measure of the closed slave surface, maximum pressures and
+      !> relative L2 pressure errors over the slave surface.
+      logical :: has_contact = .false.
+      integer :: contact_iterations = 0
+      real(wp) :: t_contact = report_empty, contact_measure = report_empty
+      real(wp) :: p_max_fe = report_empty, p_max_spr = report_empty, p_max_sprc = report_empty
+      real(wp) :: p_max_exact = report_empty
+      real(wp) :: err_p_fe = report_empty, err_p_spr = report_empty, err_p_sprc = report_empty
+      !> Krylov iterations of the level's solves (0 for a direct solve).
+      integer :: solver_iterations = 0
    end type report_row_type
 
 contains

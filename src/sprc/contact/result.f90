@@ -1,0 +1,77 @@
+!> What a contact solve gives at one level, per slave-surface point, for the
+!> report (SCENE.md contact columns), `PREFIX_contact.csv` / `.svg` and the
+!> HDF5/XDMF point set. Producers: the contact FE (p_fe, ts_fe, gap, state)
+!> and the recoveries (p_spr, p_sprc, ts_sprc); the exact solution gives
+!> p_exact. A real value that does not apply is empty (`report_empty`).
+module sprc_contact_result
+   use sprc_core_kinds, only: wp
+   use sprc_study_row, only: report_empty
+   implicit none
+   private
+
+   public :: contact_result_type, new_contact_result, state_name
+   public :: contact_open, contact_stick, contact_slip
+
+   !> States of a slave point (SCENE.md `state`: open, stick, slip). Frictionless
+   !> closed points are `contact_slip` (they slide freely).
+   integer, parameter :: contact_open = 0, contact_stick = 1, contact_slip = 2
+
+   !> Per slave point of one contact pair at one level, in scene units.
+   type :: contact_result_type
+      !> Space dimension and number of slave points.
+      integer :: dim = 0, npoint = 0
+      !> Slave and master body (1-based scene indices).
+      integer :: slave = 0, master = 0
+      !> Coordinates (dim, npoint), weights (surface measure), unit outward slave normals (dim, npoint).
+      real(wp), allocatable :: x(:, :), weight(:), normal(:, :)
+      !> Linearized gap of the solution (positive open, negative penetration).
+      real(wp), allocatable :: gap(:)
+      !> `contact_open`, `contact_stick` or `contact_slip`.
+      integer, allocatable :: state(:)
+      !> Contact pressure p = -n.sigma.n (positive in compression) from the FE contact
+      !> formulation, SPR, SPR-C and the exact solution.
+      real(wp), allocatable :: p_fe(:), p_spr(:), p_sprc(:), p_exact(:)
+      !> Magnitude of the tangential traction: FE formulation and SPR-C.
+      real(wp), allocatable :: ts_fe(:), ts_sprc(:)
+      !> Iterations of the contact nonlinearity summed over all increments.
+      integer :: iterations = 0
+   end type contact_result_type
+
+contains
+
+   !> A result for `npoint` slave points: geometry copied, every value empty,
+   !> every point open.
+   pure subroutine new_contact_result(self, x, weight, normal, slave, master)
+      type(contact_result_type), intent(out) :: self
+      real(wp), intent(in) :: x(:, :), weight(:), normal(:, :)
+      integer, intent(in) :: slave, master
+      integer :: n
+
+      n = size(weight)
+      self%dim = size(x, 1)
+      self%npoint = n
+      self%slave = slave
+      self%master = master
+      self%x = x
+      self%weight = weight
+      self%normal = normal
+      allocate (self%gap(n), self%p_fe(n), self%p_spr(n), self%p_sprc(n), self%p_exact(n), &
+         & self%ts_fe(n), self%ts_sprc(n), source=report_empty)
+      allocate (self%state(n), source=contact_open)
+   end subroutine new_contact_result
+
+   !> The SCENE.md name of a state.
+   pure function state_name(state) result(name)
+      integer, intent(in) :: state
+      character(len=:), allocatable :: name
+      select case (state)
+      case (contact_stick)
+         name = 'stick'
+      case (contact_slip)
+         name = 'slip'
+      case default
+         name = 'open'
+      end select
+   end function state_name
+
+end module sprc_contact_result
