@@ -37,6 +37,7 @@ module sprc_study_level
       & analysis_units, in_units
    use sprc_study_budget, only: check_level_memory
    use sprc_study_row, only: report_row_type
+   use sprc_contact_result, only: contact_result_type
    implicit none
    private
 
@@ -104,6 +105,8 @@ module sprc_study_level
       !> Which recoveries ran (1 SPR, 2 SPR-C).
       logical :: done(2) = .false.
       type(body_level_type), allocatable :: bodies(:)
+      !> One result per `&contact` pair (not allocated without `&contact`).
+      type(contact_result_type), allocatable :: contacts(:)
       type(report_row_type) :: row
    end type level_type
 
