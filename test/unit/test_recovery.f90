@@ -45,7 +45,7 @@ module sprc_test_recovery
 
    integer, parameter :: v_internal = 0, v_traction = 1, v_symmetry = 2, v_mixed = 3
 
-   !> Round-off tier of values that pass through the patch solves (QR, KKT by dsysv), relative
+   !> Round-off tier of values that pass through the patch solves (QR, constrained solve), relative
    !> to the stress scale: sqrt(eps). The solves are backward stable, but the conditioning of a
    !> patch system is not estimated (rank decisions keep pivots down to recovery_rank_tol, so
    !> it is not bounded by a small number either); sqrt(eps) admits condition numbers up to
@@ -1624,14 +1624,14 @@ contains
    end subroutine test_flop_count_spr
 
    !> SPR-C, 2D p=1, interior patch (equilibrium only; no compatibility below p=2): its
-   !> calls with their sizes, written out here; the kept-row counts come from the result
+   !> kernels, counted as the LAPACK/BLAS calls of the same operations, with their sizes, written out here; the kept-row counts come from the result
    !> (equilibrium rank 2 for linear stresses in 2D, checked first).
    subroutine test_flop_count_sprc(error)
       type(error_type), allocatable, intent(out) :: error
       type(patch_type) :: patch
       type(recovery_workspace_type) :: ws
       type(recovered_patch_type) :: rec
-      integer(i8) :: np, mr, mc, nk, expected
+      integer(i8) :: np, mr, mc, expected
       integer(i8), parameter :: d = 2, nt = 3, ns = 3, n = nt*ns
 
       call flop_patch(patch)
@@ -1643,14 +1643,15 @@ contains
       np = patch%npoints
       mr = rec%ranks(kind_equilibrium)
       mc = rec%rank_total
-      nk = n + mc
       expected = (2*np*nt**2 - 2*nt**3/3) &             ! dgeqp3 of the design matrix
          & + np*nt*(nt + 1) &                          ! dsyrk: Mp
          & + d*2*nt*n*nt + 2*n*n*(d*nt) + 2*(d*nt)*n & ! dgemm x d, dgemm, dgemv: equilibrium
          & + (2*n**3 - 2*n**3/3) &                     ! dgeqp3 of the n x n equilibrium rows
          & + nint(2.0_wp*n*mr**2 - 2.0_wp*mr**3/3.0_wp, i8) & ! dgeqp3 of the stacked rows
-         & + 2*nt*ns*np &                              ! dgemm: H
-         & + nint(real(nk, wp)**3/3.0_wp, i8) + 2*nk**2  ! dsysv of the KKT system
+         & + (4*np*ns*nt - 2*ns*nt**2) &               ! Q^T of the data (as dormqr)
+         & + ns*nt**2*mc + (6*n*mc**2 - 2*mc**3 + 1)/3 & ! constrained solve: R^-T per block, QR of W^T,
+         & + 2*(4*n*mc - 2*mc**2) + mc**2 &            ! its Q^T and Q on one vector, T^-T,
+         & + nt**2*ns                                  ! and R^-1 (as dtrtrs)
       call check(error, ws%flops, expected, 'SPR-C 2D p=1 LAPACK flops')
       if (allocated(error)) return
       ! Weighted: scaling 2 dim np, recurrence np (nt - 1), weights 3 np, row scaling np nt.
@@ -1658,16 +1659,16 @@ contains
    end subroutine test_flop_count_sprc
 
    !> SPR-C 2D p=1 with one straight traction face of nb points through the node: on top of
-   !> the equilibrium-only count (test above), the face's dgeqp3(2 nb, n) and dormqr(2 nb x 1,
+   !> the equilibrium-only count (test above), the face's QR (2 nb x n) and Q^T (2 nb x 1,
    !> min(2 nb, n) reflectors), a stacked reduction of mr = 2 + 4 rows instead of 2, and a
-   !> larger KKT system. The difference between the two solves is written out from the sizes.
+   !> constrained solve with more rows. The difference between the two solves is written out from the sizes.
    subroutine test_flop_count_traction(error)
       type(error_type), allocatable, intent(out) :: error
       type(patch_type) :: patch
       type(recovery_workspace_type) :: ws0, ws1
       type(recovered_patch_type) :: rec0, rec1
-      integer(i8) :: m, k, mr0, mr1, nk0, nk1, expected
-      integer(i8), parameter :: n = 9, nb = 5
+      integer(i8) :: m, k, mr0, mr1, expected
+      integer(i8), parameter :: n = 9, nb = 5, nt = 3, ns = 3
       integer :: j
 
       call flop_patch(patch)
@@ -1687,13 +1688,17 @@ contains
       k = min(m, n)
       mr0 = rec0%rank_total
       mr1 = rec1%rank_total
-      nk0 = n + mr0
-      nk1 = n + mr1
       expected = ws0%flops &
          & + (6*max(m, n)*min(m, n)**2 - 2*min(m, n)**3 + 1)/3 + (4*m*k - 2*k**2) & ! the face
          & + ((6*n*mr1**2 - 2*mr1**3 + 1)/3 - (6*n*mr0**2 - 2*mr0**3 + 1)/3) &        ! stacked rows
-         & + ((nk1**3 + 1)/3 + 2*nk1**2) - ((nk0**3 + 1)/3 + 2*nk0**2)                ! KKT dsysv
+         & + constrained(mr1) - constrained(mr0)                                      ! constrained solve
       call check(error, ws1%flops, expected, 'SPR-C 2D p=1 flops with a traction face')
+   contains
+      !> The constrained solve's count with mc rows (as in test_flop_count_sprc).
+      pure integer(i8) function constrained(mc)
+         integer(i8), intent(in) :: mc
+         constrained = ns*nt**2*mc + (6*n*mc**2 - 2*mc**3 + 1)/3 + 2*(4*n*mc - 2*mc**2) + mc**2
+      end function constrained
    end subroutine test_flop_count_traction
 
 end module sprc_test_recovery

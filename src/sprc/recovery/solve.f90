@@ -62,13 +62,18 @@
 !>       normal and offset) and each unit tangent t of the plane, n^T sigma*(s) t = 0 at the
 !>       principal lattice of degree p on the plane, which is unisolvent for the degree-p
 !>       restriction of sigma* to the plane, so the shear vanishes on the whole plane.
-!>   Each block's rows are rank-reduced by QR with column pivoting (dgeqp3 on the transposed
-!>   rows): rows jpvt(1:r) are kept, r = #{k : |R_kk| > recovery_rank_tol |R_11|}. The kept
+!>   Each block's rows are rank-reduced by QR with column pivoting (`qr_pivoted` on the
+!>   transposed rows): rows jpvt(1:r) are kept, r = #{k : |R_kk| > recovery_rank_tol |R_11|}. The kept
 !>   rows of all blocks are stacked, normalised to unit length and reduced once more the same
 !>   way (blocks can depend on each other, e.g. traction and symmetry rows at a corner).
-!>   The KKT system [M C^T; C 0][A; lambda] = [H; Lambda], M = I_ns x Mp, is scaled
-!>   symmetrically (A rows/columns by 1/sqrt(M_ii), lambda rows/columns by the inverse norm of
-!>   the scaled constraint row) and solved by dsysv. Without constraint rows SPR-C is the
+!>   Constrained least squares: the minimiser of the KKT system [M C^T; C 0][A; lambda] =
+!>   [H; Lambda] (M = I_ns x Mp, H = P^T W sigma) is computed without forming it, by
+!>   orthogonal transformations only (`project_constraints`): with the basis QR
+!>   sqrt(W) P Pi = Q R and z_c = R Pi^T A_c the objective is |z - g|^2, g_c = Q^T sqrt(W)
+!>   sigma_c, and the constraints W z = Lambda with W = C (I x Pi R^-1); a pivoted QR of W^T
+!>   gives the projection of g onto them. This solves with cond(sqrt(W) P) where the KKT
+!>   matrix had cond(P)^2, and without LAPACK (sprc_recovery_dense: the per-call overhead
+!>   and OpenBLAS's lock dominated the small dsysv). Without constraint rows SPR-C is the
 !>   weighted QR least squares (as SPR with weights).
 !>
 !> Rank tolerance: `recovery_rank_tol` = 1e-10, relative to the largest pivot (traction rows:
@@ -84,22 +89,19 @@
 !> neighbouring elements (seed Figure 15) and calls again. SPR-C requires the full rank too,
 !> even where constraints would fix the missing directions, so that its M is positive definite.
 !>
-!> Timing (ws%timing): each LAPACK/BLAS call adds its wall time to ws%lapack_seconds and its
-!> nominal flop count (sprc_recovery_flops, from the sizes passed) to ws%flops, also when it
-!> returns info /= 0 (the patch then fails). The one hand-written loop counted is forming the
-!> design matrix (ws%design_flops); the others (constraint rows, KKT assembly and scaling,
-!> row norms) are not counted.
+!> Timing (ws%timing): each dense kernel (QR, Q application, triangular solve, the Gram and
+!> equilibrium products) adds its wall time to ws%lapack_seconds and its nominal flop count
+!> (sprc_recovery_flops: that of the LAPACK/BLAS call doing the same, from the sizes) to
+!> ws%flops. Forming the design matrix is counted apart (ws%design_flops); the other loops
+!> (constraint rows, row norms) are not counted.
 !>
 !> Thread safety: no module state; everything a solve writes is in its arguments. Use one
-!> workspace per thread. A caller that runs the solves from its own threads should run
-!> OpenBLAS in one thread meanwhile (`sprc_core_blas_threads`: blas_serial_begin / _end), as
-!> sprc's own patch loops do: concurrent small calls with an OpenBLAS pool of 2 or more
-!> spin in the kernel (bench_recovery, 3D p = 2 SPR-C over 2 threads: 1.7e3 against
-!> 7.6e3 patches/s). The solves are not `pure` only because LAPACK externals are not.
+!> workspace per thread. The solves call no BLAS or LAPACK (sprc_recovery_dense), so they
+!> neither take OpenBLAS's lock nor depend on its thread count.
 module sprc_recovery_solve
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular
-   use sprc_core_lapack, only: dgeqp3, dormqr, dtrtrs, dsysv, dsyrk, dgemm, dgemv, lapack_info_error
+   use sprc_recovery_dense, only: qr_pivoted, apply_qt, apply_q, solve_upper, solve_upper_t
    use sprc_core_material, only: compliance_matrix
    use sprc_core_poly, only: poly_max_degree
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, check_patch, dominant_boundary_kind, &
@@ -109,7 +111,7 @@ module sprc_recovery_solve
       & ncompat_equations
    use sprc_recovery_workspace, only: recovery_workspace_type, workspace_reserve, workspace_tic, workspace_toc
    use sprc_recovery_flops, only: flops_gemm, flops_gemv, flops_syrk, flops_geqrf, flops_ormqr_left, flops_trtrs, &
-      & flops_sysv, design_matrix_flops
+      & design_matrix_flops
    implicit none
    private
 
@@ -147,7 +149,7 @@ contains
 
       call prepare(patch, degree, ws, rec, .false., 'recover_spr', error)
       if (allocated(error)) return
-      call qr_least_squares(patch, ws, rec, .false., 'recover_spr', error)
+      call least_squares(patch, ws, rec, .false., 0, 'recover_spr', error)
    end subroutine recover_spr
 
    !> SPR-C: integral least squares with the constraints switched on in `patch`
@@ -177,11 +179,7 @@ contains
          if (allocated(error)) return
       end if
       rec%rank_total = mc
-      if (mc == 0) then
-         call qr_least_squares(patch, ws, rec, .true., 'recover_sprc', error)
-      else
-         call solve_kkt(patch, ws, mc, rec, error)
-      end if
+      call least_squares(patch, ws, rec, .true., mc, 'recover_sprc', error)
    end subroutine recover_sprc
 
    !> Validate, reserve, scale the points, fill the (weighted) design matrix and decide its rank.
@@ -193,7 +191,7 @@ contains
       logical, intent(in) :: weighted
       character(len=*), intent(in) :: context
       type(error_type), allocatable, intent(out) :: error
-      integer :: i, np, nt, info, r
+      integer :: i, np, nt, r
       real(wp) :: wsum
       character(len=160) :: buf
 
@@ -234,14 +232,9 @@ contains
       if (ws%timing) ws%design_flops = ws%design_flops + design_matrix_flops(patch%dim, np, nt, weighted)
 
       ws%qr(1:np, 1:nt) = ws%pw(1:np, 1:nt)
-      ws%jpvt(1:nt) = 0
       call workspace_tic(ws)
-      call dgeqp3(np, nt, ws%qr, size(ws%qr, 1), ws%jpvt, ws%tau, ws%work, size(ws%work), info)
+      call qr_pivoted(np, nt, ws%qr, ws%jpvt_p, ws%tau_p)
       call workspace_toc(ws, flops_geqrf(np, nt))
-      if (info /= 0) then
-         call lapack_info_error('dgeqp3', info, context//' (basis rank)', error)
-         return
-      end if
       r = diag_rank(ws%qr, min(np, nt))
       rec%basis_rank = r
       if (r < min(np, nt)) call note_dropped(rec, abs(ws%qr(r + 1, r + 1))/abs(ws%qr(1, 1)))
@@ -278,15 +271,20 @@ contains
       rec%tolerance_bites = rec%max_dropped_ratio > recovery_bite_ratio
    end subroutine note_dropped
 
-   !> Least squares by the pivoted QR already in ws%qr: A = Pi R^-1 Q^T (sqrt(w) sigma).
-   subroutine qr_least_squares(patch, ws, rec, weighted, context, error)
+   !> Least squares by the pivoted QR of the (weighted) design matrix already in ws%qr
+   !> (Pw Pi = Q R), with the mc constraint rows ws%c(1:mc, :) A = ws%lam(1:mc) if mc > 0
+   !> (module notes, "Constrained least squares"): A = Pi R^-1 z, z = Q^T (sqrt(w) sigma)
+   !> projected onto the constraints.
+   subroutine least_squares(patch, ws, rec, weighted, mc, context, error)
       type(patch_type), intent(in) :: patch
       type(recovery_workspace_type), intent(inout) :: ws
       type(recovered_patch_type), intent(inout) :: rec
       logical, intent(in) :: weighted
+      integer, intent(in) :: mc
       character(len=*), intent(in) :: context
       type(error_type), allocatable, intent(out) :: error
-      integer :: np, nt, ns, c, info
+      integer :: np, nt, ns, c
+      logical :: ok
 
       np = patch%npoints
       nt = ws%nt
@@ -296,27 +294,84 @@ contains
          if (weighted) ws%rhs(1:np, c) = ws%wn(1:np)*ws%rhs(1:np, c)
       end do
       call workspace_tic(ws)
-      call dormqr('L', 'T', np, ns, nt, ws%qr, size(ws%qr, 1), ws%tau, ws%rhs, size(ws%rhs, 1), &
-         & ws%work, size(ws%work), info)
-      if (info == 0) call dtrtrs('U', 'N', 'N', nt, ns, ws%qr, size(ws%qr, 1), ws%rhs, size(ws%rhs, 1), info)
-      call workspace_toc(ws, flops_ormqr_left(np, ns, nt) + flops_trtrs(nt, ns))
-      if (info /= 0) then
-         call lapack_info_error('dormqr/dtrtrs', info, context//' (least squares)', error)
+      call apply_qt(np, nt, ws%qr, ws%tau_p, ns, ws%rhs)
+      call workspace_toc(ws, flops_ormqr_left(np, ns, nt))
+      if (mc > 0) then
+         call project_constraints(ws, mc, ok)
+         if (.not. ok) then
+            call fatal_error(error, context//': the stacked constraint rows are dependent in the norm of the '// &
+               & 'patch (singular constrained system)', stat_singular)
+            return
+         end if
+      end if
+      call workspace_tic(ws)
+      call solve_upper(nt, ws%qr, ns, ws%rhs, ok)
+      call workspace_toc(ws, flops_trtrs(nt, ns))
+      if (.not. ok) then
+         call fatal_error(error, context//': the triangular factor of the basis is singular (least squares)', &
+            & stat_singular)
          return
       end if
       call coef_storage(rec, nt, ns)
-      rec%coef(ws%jpvt(1:nt), 1:ns) = ws%rhs(1:nt, 1:ns)
-   end subroutine qr_least_squares
+      rec%coef(ws%jpvt_p(1:nt), 1:ns) = ws%rhs(1:nt, 1:ns)
+   end subroutine least_squares
+
+   !> The constrained minimum (module notes): with z_c = R Pi^T A_c the objective is
+   !> |z - g|^2 (g = ws%rhs(1:nt, :)) and the constraints W z = Lambda, W = C (I x Pi R^-1).
+   !> W^T Pi2 = U T (pivoted QR, U = the first mc columns of V = H_1 ... H_mc): the minimiser
+   !> is z = V [T^-T Pi2^T Lambda; (V^T g)(mc+1:n)]. Orthogonal transformations and
+   !> triangular solves only: no normal equations. ok = .false. if T is singular.
+   subroutine project_constraints(ws, mc, ok)
+      type(recovery_workspace_type), intent(inout) :: ws
+      integer, intent(in) :: mc
+      logical, intent(out) :: ok
+      real(wp) :: z(ws%n, 1)
+      integer :: nt, ns, n, c, i, b
+
+      nt = ws%nt
+      ns = ws%ns
+      n = ws%n
+      do i = 1, mc
+         do c = 1, ns
+            b = (c - 1)*nt
+            ws%cq(b + 1:b + nt, i) = ws%c(i, b + ws%jpvt_p(1:nt))
+         end do
+      end do
+      call workspace_tic(ws)
+      do c = 1, ns
+         b = (c - 1)*nt
+         call solve_upper_t(nt, ws%qr, mc, ws%cq(b + 1:b + nt, 1:mc), ok)
+         if (.not. ok) return
+      end do
+      call qr_pivoted(n, mc, ws%cq, ws%jpvt, ws%tau)
+      do c = 1, ns
+         z((c - 1)*nt + 1:c*nt, 1) = ws%rhs(1:nt, c)
+      end do
+      call apply_qt(n, mc, ws%cq, ws%tau, 1, z)
+      z(1:mc, 1) = ws%lam(ws%jpvt(1:mc))
+      call solve_upper_t(mc, ws%cq, 1, z, ok)
+      if (ok) call apply_q(n, mc, ws%cq, ws%tau, 1, z)
+      call workspace_toc(ws, ns*flops_trtrs(nt, mc) + flops_geqrf(n, mc) + 2*flops_ormqr_left(n, 1, mc) + &
+         & flops_trtrs(mc, 1))
+      if (.not. ok) return
+      do c = 1, ns
+         ws%rhs(1:nt, c) = z((c - 1)*nt + 1:c*nt, 1)
+      end do
+   end subroutine project_constraints
 
    !> Mp = P^T W P of one component (full symmetric).
    subroutine gram(ws, np)
       type(recovery_workspace_type), intent(inout) :: ws
       integer, intent(in) :: np
-      integer :: i, nt
+      integer :: i, j, nt
 
       nt = ws%nt
       call workspace_tic(ws)
-      call dsyrk('U', 'T', nt, np, 1.0_wp, ws%pw, size(ws%pw, 1), 0.0_wp, ws%mp, size(ws%mp, 1))
+      do j = 1, nt
+         do i = 1, j
+            ws%mp(i, j) = dot_product(ws%pw(1:np, i), ws%pw(1:np, j))
+         end do
+      end do
       call workspace_toc(ws, flops_syrk(nt, np))
       do i = 1, nt
          ws%mp(i + 1:nt, i) = ws%mp(i, i + 1:nt)
@@ -330,22 +385,31 @@ contains
       type(recovered_patch_type), intent(inout) :: rec
       integer, intent(inout) :: mc
       type(error_type), allocatable, intent(out) :: error
-      integer :: i, nt, n, d
+      integer :: i, j, k, b, nt, n, d
 
       nt = ws%nt
       n = ws%n
       d = patch%dim
       call workspace_tic(ws)
-      do i = 1, d
-         call dgemm('N', 'N', nt, n, nt, 1.0_wp, ws%mp, size(ws%mp, 1), ws%bdiv((i - 1)*nt + 1, 1), &
-            & size(ws%bdiv, 1), 0.0_wp, ws%tmp((i - 1)*nt + 1, 1), size(ws%tmp, 1))
+      ! Explicit loops: MATMUL of sections makes gfortran allocate temporaries per patch.
+      do j = 1, n
+         do i = 1, d
+            b = (i - 1)*nt
+            ws%tmp(b + 1:b + nt, j) = 0.0_wp
+            do k = 1, nt
+               ws%tmp(b + 1:b + nt, j) = ws%tmp(b + 1:b + nt, j) + ws%bdiv(b + k, j)*ws%mp(1:nt, k)
+            end do
+         end do
       end do
-      call dgemm('T', 'N', n, n, d*nt, 1.0_wp, ws%bdiv, size(ws%bdiv, 1), ws%tmp, size(ws%tmp, 1), &
-         & 0.0_wp, ws%blk, size(ws%blk, 1))
       do i = 1, d
          ws%erhs((i - 1)*nt + 1:i*nt) = -patch%h*patch%body_force(i)*ws%mp(1:nt, 1)
       end do
-      call dgemv('T', d*nt, n, 1.0_wp, ws%bdiv, size(ws%bdiv, 1), ws%erhs, 1, 0.0_wp, ws%brhs, 1)
+      do j = 1, n
+         do k = 1, n
+            ws%blk(k, j) = dot_product(ws%bdiv(1:d*nt, k), ws%tmp(1:d*nt, j))
+         end do
+         ws%brhs(j) = dot_product(ws%bdiv(1:d*nt, j), ws%erhs(1:d*nt))
+      end do
       call workspace_toc(ws, d*flops_gemm(nt, n, nt) + flops_gemm(n, n, d*nt) + flops_gemv(d*nt, n))
       call select_block(ws, n, kind_equilibrium, rec, mc, error)
    end subroutine equilibrium_block
@@ -415,12 +479,11 @@ contains
       integer, intent(inout) :: mc
       type(error_type), allocatable, intent(out) :: error
       real(wp) :: g(3, 6), p(20), s(3), bsum, sq
-      integer :: nfaces, f, j, i, k, c, d, nt, n, m, r, cap, kmax, info, lde
+      integer :: nfaces, f, j, i, k, c, d, nt, n, m, r, cap, kmax
 
       d = patch%dim
       nt = ws%nt
       n = ws%n
-      lde = size(ws%estack, 1)
       call traction_faces(patch, ws, nfaces)
       do f = 1, nfaces
          if (.not. face_near_node(patch, ws, f)) cycle
@@ -442,21 +505,15 @@ contains
                do c = 1, ws%ns
                   ws%estack(m, (c - 1)*nt + 1:c*nt) = (sq*g(i, c))*p(1:nt)
                end do
-               ws%erhs(m) = sq*patch%btraction(i, j)
+               ws%trhs(m, 1) = sq*patch%btraction(i, j)
             end do
          end do
          rec%rows(kind_traction) = rec%rows(kind_traction) + m
          kmax = min(m, n)
-         ws%jpvt(1:n) = 0
          call workspace_tic(ws)
-         call dgeqp3(m, n, ws%estack, lde, ws%jpvt, ws%tau, ws%work, size(ws%work), info)
-         if (info == 0) call dormqr('L', 'T', m, 1, kmax, ws%estack, lde, ws%tau, ws%erhs, size(ws%erhs), &
-            & ws%work, size(ws%work), info)
+         call qr_pivoted(m, n, ws%estack, ws%jpvt, ws%tau)
+         call apply_qt(m, kmax, ws%estack, ws%tau, 1, ws%trhs)
          call workspace_toc(ws, flops_geqrf(m, n) + flops_ormqr_left(m, 1, kmax))
-         if (info /= 0) then
-            call lapack_info_error('dgeqp3/dormqr', info, 'recover_sprc (traction rows)', error)
-            return
-         end if
          r = diag_rank(ws%estack, kmax, traction_rank_tol)
          if (r < min(kmax, cap) .and. r > 0) &
             & call note_dropped(rec, abs(ws%estack(r + 1, r + 1))/abs(ws%estack(1, 1)))
@@ -464,7 +521,7 @@ contains
          do k = 1, r
             ws%c(mc + k, 1:n) = 0.0_wp
             ws%c(mc + k, ws%jpvt(k:n)) = ws%estack(k, k:n)
-            ws%lam(mc + k) = ws%erhs(k)
+            ws%lam(mc + k) = ws%trhs(k, 1)
          end do
          mc = mc + r
          rec%ranks(kind_traction) = rec%ranks(kind_traction) + r
@@ -700,17 +757,10 @@ contains
       type(recovered_patch_type), intent(inout) :: rec
       integer, intent(out) :: r
       type(error_type), allocatable, intent(out) :: error
-      integer :: info
 
-      ws%jpvt(1:m) = 0
       call workspace_tic(ws)
-      call dgeqp3(n, m, ws%cq, size(ws%cq, 1), ws%jpvt, ws%tau, ws%work, size(ws%work), info)
+      call qr_pivoted(n, m, ws%cq, ws%jpvt, ws%tau)
       call workspace_toc(ws, flops_geqrf(n, m))
-      r = 0
-      if (info /= 0) then
-         call lapack_info_error('dgeqp3', info, 'recover_sprc (constraint rank)', error)
-         return
-      end if
       r = diag_rank(ws%cq, min(n, m))
       if (r < min(n, m) .and. r > 0) call note_dropped(rec, abs(ws%cq(r + 1, r + 1))/abs(ws%cq(1, 1)))
    end subroutine pivoted_rank
@@ -729,69 +779,6 @@ contains
          a(j + 1) = v
       end do
    end subroutine sort_int
-
-   !> Scaled KKT solve [M C^T; C 0][A; lambda] = [H; Lambda] with dsysv.
-   subroutine solve_kkt(patch, ws, mc, rec, error)
-      type(patch_type), intent(in) :: patch
-      type(recovery_workspace_type), intent(inout) :: ws
-      integer, intent(in) :: mc
-      type(recovered_patch_type), intent(inout) :: rec
-      type(error_type), allocatable, intent(out) :: error
-      integer :: np, nt, ns, n, nk, c, k, i, info, lk
-      real(wp) :: nrm
-
-      np = patch%npoints
-      nt = ws%nt
-      ns = ws%ns
-      n = ws%n
-      nk = n + mc
-      lk = size(ws%kkt, 1)
-      do c = 1, ns
-         ws%rhs(1:np, c) = ws%wn(1:np)*patch%stress(c, 1:np)
-      end do
-      call workspace_tic(ws)
-      call dgemm('T', 'N', nt, ns, np, 1.0_wp, ws%pw, size(ws%pw, 1), ws%rhs, size(ws%rhs, 1), 0.0_wp, &
-         & ws%hmat, size(ws%hmat, 1))
-      call workspace_toc(ws, flops_gemm(nt, ns, np))
-
-      ! Symmetric scaling: unknowns by 1/sqrt(Mp_kk), multipliers by 1/|scaled row|.
-      do c = 1, ns
-         do k = 1, nt
-            ws%dscale((c - 1)*nt + k) = 1.0_wp/sqrt(ws%mp(k, k))
-         end do
-      end do
-      do i = 1, mc
-         nrm = sqrt(sum((ws%c(i, 1:n)*ws%dscale(1:n))**2))
-         ws%dscale(n + i) = 1.0_wp/nrm
-      end do
-      ws%kkt(1:nk, 1:nk) = 0.0_wp
-      do c = 1, ns
-         do k = 1, nt
-            ws%kkt((c - 1)*nt + 1:c*nt, (c - 1)*nt + k) = ws%mp(1:nt, k)
-         end do
-         ws%sol((c - 1)*nt + 1:c*nt) = ws%hmat(1:nt, c)
-      end do
-      do k = 1, n
-         ws%kkt(k, n + 1:nk) = ws%c(1:mc, k)
-         ws%kkt(n + 1:nk, k) = ws%c(1:mc, k)
-      end do
-      ws%sol(n + 1:nk) = ws%lam(1:mc)
-      do k = 1, nk
-         ws%kkt(1:nk, k) = ws%kkt(1:nk, k)*(ws%dscale(1:nk)*ws%dscale(k))
-      end do
-      ws%sol(1:nk) = ws%sol(1:nk)*ws%dscale(1:nk)
-      call workspace_tic(ws)
-      call dsysv('U', nk, 1, ws%kkt, lk, ws%ipiv, ws%sol, lk, ws%work, size(ws%work), info)
-      call workspace_toc(ws, flops_sysv(nk, 1))
-      if (info /= 0) then
-         call lapack_info_error('dsysv', info, 'recover_sprc (KKT system)', error)
-         return
-      end if
-      call coef_storage(rec, nt, ns)
-      do c = 1, ns
-         rec%coef(1:nt, c) = ws%sol((c - 1)*nt + 1:c*nt)*ws%dscale((c - 1)*nt + 1:c*nt)
-      end do
-   end subroutine solve_kkt
 
    !> rec%coef allocated (nterms, nstress) and zero: storage of the patch's own size, so
    !> that a mesh of many patches holds only what its degree needs.

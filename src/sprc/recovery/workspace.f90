@@ -1,10 +1,9 @@
 !> Per-thread work storage of the SPR / SPR-C patch solves.
 !>
-!> One `recovery_workspace_type` per thread holds every work array and the
-!> LAPACK workspace. `workspace_reserve` (called by the solves) grows the arrays
-!> only when a patch needs more than the current capacity, and queries the
-!> optimal LAPACK `lwork` only then (once per size class), so a patch loop
-!> allocates nothing once its largest patch has been seen. The polynomial basis,
+!> One `recovery_workspace_type` per thread holds every work array.
+!> `workspace_reserve` (called by the solves) grows the arrays only when a patch
+!> needs more than the current capacity, so a patch loop allocates nothing once
+!> its largest patch has been seen. The polynomial basis,
 !> its derivative matrices and the divergence and incompatibility operators
 !> depend only on (dim, degree) and are rebuilt only when these change: keep one
 !> workspace per (dim, degree) in a loop that mixes them.
@@ -16,8 +15,8 @@
 !> OpenMP private copies, and a garbage capacity would be trusted.
 module sprc_recovery_workspace
    use sprc_core_kinds, only: wp, i8
-   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
-   use sprc_core_lapack, only: dgeqp3, dormqr, dsysv, lapack_info_error
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_out_of_memory
+   use sprc_core_text, only: itoa
    use sprc_core_poly, only: poly_basis_type, new_poly_basis, poly_nterms, poly_max_degree
    use sprc_core_timer, only: wall_time
    use sprc_recovery_operators, only: divergence_operator, incompatibility_operator, ncompat_equations, &
@@ -48,34 +47,31 @@ module sprc_recovery_workspace
       real(wp), allocatable :: s(:, :), wn(:)
       !> (Weighted) design matrix pw(cap_p, cap_nt), its QR copy, right-hand sides rhs(cap_p, 6).
       real(wp), allocatable :: pw(:, :), qr(:, :), rhs(:, :)
-      !> Gram matrix of one component mp(cap_nt, cap_nt) and H = P^T W sigma, hmat(cap_nt, 6).
-      real(wp), allocatable :: mp(:, :), hmat(:, :)
+      !> Gram matrix of one component mp(cap_nt, cap_nt).
+      real(wp), allocatable :: mp(:, :)
       !> One constraint block blk(cap_mr, cap_n) with right-hand side brhs(cap_mr).
       real(wp), allocatable :: blk(:, :), brhs(:)
       !> (I x Mp) B, tmp(3*cap_nt, cap_n).
       real(wp), allocatable :: tmp(:, :)
-      !> Weighted traction operator rows estack(3*cap_b, cap_n) and data erhs(3*cap_b).
-      real(wp), allocatable :: estack(:, :), erhs(:)
+      !> Weighted traction operator rows estack(3*cap_b, cap_n) and data trhs(3*cap_b, 1);
+      !> equilibrium right-hand side erhs(3*cap_nt).
+      real(wp), allocatable :: estack(:, :), trhs(:, :), erhs(:)
       !> Traction face of each boundary point bface(cap_b) and the first point of each face bfirst(cap_b).
       integer, allocatable :: bface(:), bfirst(:)
       !> Transposed rows for the pivoted QR, cq(cap_n, cap_mq).
       real(wp), allocatable :: cq(:, :)
       !> Accepted constraint rows c(cap_mq, cap_n) and right-hand side lam(cap_mq).
       real(wp), allocatable :: c(:, :), lam(:)
-      !> KKT matrix kkt(2*cap_n, 2*cap_n), solution sol and symmetric scaling dscale.
-      real(wp), allocatable :: kkt(:, :), sol(:), dscale(:)
-      !> Householder scalars and pivots.
-      real(wp), allocatable :: tau(:)
-      integer, allocatable :: jpvt(:), ipiv(:)
-      !> LAPACK workspace, lwork = size(work).
-      real(wp), allocatable :: work(:)
-      !> If true, the solves accumulate the wall time spent inside LAPACK/BLAS calls and
-      !> their nominal flop counts.
+      !> Householder scalars and pivots of the basis QR (tau_p, jpvt_p) and of the others.
+      real(wp), allocatable :: tau(:), tau_p(:)
+      integer, allocatable :: jpvt(:), jpvt_p(:)
+      !> If true, the solves accumulate the wall time spent inside the dense kernels
+      !> (sprc_recovery_dense and the small products) and their nominal flop counts.
       logical :: timing = .false.
-      !> Seconds spent in LAPACK/BLAS (only if `timing`).
+      !> Seconds spent in the dense kernels (only if `timing`).
       real(wp) :: lapack_seconds = 0.0_wp
-      !> Nominal flops of those LAPACK/BLAS calls (only if `timing`; LAWN 41 leading terms,
-      !> sprc_recovery_flops). Hand-written loops are not in it.
+      !> Nominal flops of those kernels (only if `timing`; counted as the LAPACK/BLAS call
+      !> of the same operation, LAWN 41 leading terms, sprc_recovery_flops).
       integer(i8) :: flops = 0
       !> Hand count of forming the design matrix at the integration points, the one counted
       !> hand-written loop (only if `timing`; `design_matrix_flops`), kept apart from `flops`.
@@ -159,8 +155,7 @@ contains
       type(recovery_workspace_type), intent(inout) :: ws
       integer, intent(in) :: cp, cb, cn, cnt
       type(error_type), allocatable, intent(out) :: error
-      integer :: info, lw
-      real(wp) :: q(1)
+      integer :: st
 
       ws%cap_p = cp
       ws%cap_b = cb
@@ -173,49 +168,23 @@ contains
       ! at most cn each, traction at most one per traction row (3 per boundary point).
       ws%cap_mq = max(ws%cap_mr, 4*cn, 3*cn + 3*cb)
       if (allocated(ws%s)) then
-         deallocate (ws%s, ws%wn, ws%pw, ws%qr, ws%rhs, ws%mp, ws%hmat, ws%blk, ws%brhs, ws%tmp)
-         deallocate (ws%estack, ws%erhs, ws%cq, ws%c, ws%lam, ws%kkt, ws%sol, ws%dscale, ws%bface, ws%bfirst)
-         deallocate (ws%tau, ws%jpvt, ws%ipiv, ws%work)
+         deallocate (ws%s, ws%wn, ws%pw, ws%qr, ws%rhs, ws%mp, ws%blk, ws%brhs, ws%tmp)
+         deallocate (ws%estack, ws%trhs, ws%erhs, ws%cq, ws%c, ws%lam, ws%bface, ws%bfirst)
+         deallocate (ws%tau, ws%jpvt, ws%tau_p, ws%jpvt_p)
       end if
-      allocate (ws%s(3, max(cp, 1)), ws%wn(max(cp, 1)))
-      ! At least cnt rows: the dormqr query needs m >= k even for a patch with
-      ! fewer points than basis terms (that patch is then reported rank deficient).
-      allocate (ws%pw(max(cp, cnt), cnt), ws%qr(max(cp, cnt), cnt), ws%rhs(max(cp, cnt), 6))
-      allocate (ws%mp(cnt, cnt), ws%hmat(cnt, 6))
-      allocate (ws%blk(ws%cap_mr, cn), ws%brhs(ws%cap_mr), ws%tmp(3*cnt, cn))
-      allocate (ws%estack(max(3*cb, 1), cn), ws%erhs(max(3*cb, 3*cnt)))
-      allocate (ws%cq(cn, ws%cap_mq), ws%c(ws%cap_mq, cn), ws%lam(ws%cap_mq))
-      allocate (ws%bface(max(cb, 1)), ws%bfirst(max(cb, 1)))
-      allocate (ws%kkt(2*cn, 2*cn), ws%sol(2*cn), ws%dscale(2*cn))
-      allocate (ws%tau(max(ws%cap_mq, cnt)), ws%jpvt(max(ws%cap_mq, cnt)), ws%ipiv(2*cn))
-
-      ! Workspace queries for the largest problem of each LAPACK call.
-      lw = 1
-      call dgeqp3(size(ws%qr, 1), cnt, ws%qr, size(ws%qr, 1), ws%jpvt, ws%tau, q, -1, info)
-      call check_query('dgeqp3')
-      call dgeqp3(cn, ws%cap_mq, ws%cq, cn, ws%jpvt, ws%tau, q, -1, info)
-      call check_query('dgeqp3')
-      call dgeqp3(size(ws%estack, 1), cn, ws%estack, size(ws%estack, 1), ws%jpvt, ws%tau, q, -1, info)
-      call check_query('dgeqp3')
-      call dormqr('L', 'T', size(ws%estack, 1), 1, min(size(ws%estack, 1), cn), ws%estack, size(ws%estack, 1), &
-         & ws%tau, ws%erhs, size(ws%erhs), q, -1, info)
-      call check_query('dormqr')
-      call dormqr('L', 'T', size(ws%qr, 1), 6, cnt, ws%qr, size(ws%qr, 1), ws%tau, ws%rhs, size(ws%rhs, 1), &
-         & q, -1, info)
-      call check_query('dormqr')
-      call dsysv('U', 2*cn, 1, ws%kkt, 2*cn, ws%ipiv, ws%sol, 2*cn, q, -1, info)
-      call check_query('dsysv')
-      allocate (ws%work(lw))
-   contains
-      subroutine check_query(name)
-         character(len=*), intent(in) :: name
-         if (allocated(error)) return
-         if (info /= 0) then
-            call lapack_info_error(name, info, 'recovery workspace query', error)
-            return
-         end if
-         lw = max(lw, int(q(1)), 3*max(cn, ws%cap_mq) + 1)
-      end subroutine check_query
+      allocate (ws%s(3, max(cp, 1)), ws%wn(max(cp, 1)), stat=st)
+      if (st == 0) allocate (ws%pw(max(cp, cnt), cnt), ws%qr(max(cp, cnt), cnt), ws%rhs(max(cp, cnt), 6), stat=st)
+      if (st == 0) allocate (ws%mp(cnt, cnt), ws%blk(ws%cap_mr, cn), ws%brhs(ws%cap_mr), ws%tmp(3*cnt, cn), stat=st)
+      if (st == 0) allocate (ws%estack(max(3*cb, 1), cn), ws%trhs(max(3*cb, 1), 1), ws%erhs(3*cnt), stat=st)
+      if (st == 0) allocate (ws%cq(cn, ws%cap_mq), ws%c(ws%cap_mq, cn), ws%lam(ws%cap_mq), stat=st)
+      if (st == 0) allocate (ws%bface(max(cb, 1)), ws%bfirst(max(cb, 1)), stat=st)
+      if (st == 0) allocate (ws%tau(max(ws%cap_mq, cn)), ws%jpvt(max(ws%cap_mq, cn)), ws%tau_p(cnt), &
+         & ws%jpvt_p(cnt), stat=st)
+      if (st /= 0) then
+         call workspace_init(ws)
+         call fatal_error(error, 'recovery workspace: out of memory for a patch of '//itoa(cp)//' points', &
+            & stat_out_of_memory)
+      end if
    end subroutine grow
 
    !> Start timing a LAPACK/BLAS call (no-op unless ws%timing).

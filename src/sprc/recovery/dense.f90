@@ -1,0 +1,180 @@
+!> Small dense kernels of the patch solves: Householder QR with column pivoting, the
+!> application of its Q, triangular solves.
+!>
+!> Why not LAPACK: a patch problem is tiny (2D p = 1 SPR: 16 x 3), and OpenBLAS 0.3.21 takes
+!> a global lock for its buffer in every level-3 call and in dtrsv, so the per-call overhead
+!> and the lock dominated the patch loop (perf, bench_mesh_recovery) and kept two threads
+!> from scaling. These loops are plain column-oriented Fortran: their results depend only
+!> on the values and sizes passed (not on leading dimensions, workspace sizes or threads).
+!>
+!> `qr_pivoted` is LAPACK's xGEQP3 in its unblocked form (xLAQP2): at step k the remaining
+!> column of largest norm is moved to position k (the first one of the largest norm), then
+!> annihilated below the diagonal by a Householder reflector H = I - tau v v^T (v(k) = 1,
+!> stored below the diagonal; xLARFG's conventions: beta = -sign(alpha) |x|, tau =
+!> (beta - alpha)/beta, and tau = 0 when the column below the diagonal is zero). The norms
+!> of the remaining columns are downdated and recomputed when cancellation has eaten more
+!> than half of their digits (the xLAQP2 test with tol3z = sqrt(eps)). Norms are plain
+!> sqrt(sum(x^2)) (`vnorm`), not the overflow-safe NORM2 (a division per entry): the solves
+!> pass patch-scaled rows of order one. |R_kk| is then
+!> non-increasing, so the rank decisions of the solves (|R_kk| > tol |R_11|) are those of
+!> dgeqp3.
+module sprc_recovery_dense
+   use sprc_core_kinds, only: wp
+   implicit none
+   private
+
+   public :: qr_pivoted, apply_qt, apply_q, solve_upper, solve_upper_t
+
+contains
+
+   !> Pivoted Householder QR of a(1:m, 1:n) (module notes): R in the upper triangle, the
+   !> reflectors below it with their tau(1:min(m, n)); column k of R is column jpvt(k) of a.
+   pure subroutine qr_pivoted(m, n, a, jpvt, tau)
+      integer, intent(in) :: m, n
+      real(wp), intent(inout) :: a(:, :)
+      integer, intent(out) :: jpvt(:)
+      real(wp), intent(out) :: tau(:)
+      real(wp), parameter :: tol3z = sqrt(epsilon(1.0_wp))
+      real(wp) :: vn1(n), vn2(n), tmp(m), t, t2
+      integer :: j, k, p, it
+
+      do j = 1, n
+         jpvt(j) = j
+         vn1(j) = vnorm(a(1:m, j))
+         vn2(j) = vn1(j)
+      end do
+      do k = 1, min(m, n)
+         p = k - 1 + maxloc(vn1(k:n), dim=1)
+         if (p /= k) then
+            tmp = a(1:m, p)
+            a(1:m, p) = a(1:m, k)
+            a(1:m, k) = tmp
+            it = jpvt(p)
+            jpvt(p) = jpvt(k)
+            jpvt(k) = it
+            vn1(p) = vn1(k)
+            vn2(p) = vn2(k)
+         end if
+         call reflector(a(k:m, k), tau(k))
+         call reflect(a(k:m, k), tau(k), a(k:m, k + 1:n))
+         do j = k + 1, n
+            if (vn1(j) == 0.0_wp) cycle
+            t = 1.0_wp - (abs(a(k, j))/vn1(j))**2
+            t = max(t, 0.0_wp)
+            t2 = t*(vn1(j)/vn2(j))**2
+            if (t2 <= tol3z) then
+               if (k < m) then
+                  vn1(j) = vnorm(a(k + 1:m, j))
+               else
+                  vn1(j) = 0.0_wp
+               end if
+               vn2(j) = vn1(j)
+            else
+               vn1(j) = vn1(j)*sqrt(t)
+            end if
+         end do
+      end do
+   end subroutine qr_pivoted
+
+   !> Euclidean norm of a patch-scaled vector (module notes).
+   pure real(wp) function vnorm(x)
+      real(wp), intent(in) :: x(:)
+      vnorm = sqrt(dot_product(x, x))
+   end function vnorm
+
+   !> Householder reflector of x (xLARFG): x(1) becomes beta, x(2:) the vector v(2:).
+   pure subroutine reflector(x, tau)
+      real(wp), intent(inout) :: x(:)
+      real(wp), intent(out) :: tau
+      real(wp) :: xnorm, alpha, beta
+
+      tau = 0.0_wp
+      if (size(x) < 2) return
+      xnorm = vnorm(x(2:))
+      if (xnorm == 0.0_wp) return
+      alpha = x(1)
+      beta = -sign(sqrt(alpha**2 + xnorm**2), alpha)
+      tau = (beta - alpha)/beta
+      x(2:) = x(2:)*(1.0_wp/(alpha - beta))
+      x(1) = beta
+   end subroutine reflector
+
+   !> c := H c, H = I - tau v v^T with v = [1, vtail(2:)] (vtail(1) is not read).
+   pure subroutine reflect(vtail, tau, c)
+      real(wp), intent(in) :: vtail(:), tau
+      real(wp), intent(inout) :: c(:, :)
+      real(wp) :: s
+      integer :: j, m
+
+      if (tau == 0.0_wp) return
+      m = size(vtail)
+      do j = 1, size(c, 2)
+         s = tau*(c(1, j) + dot_product(vtail(2:m), c(2:m, j)))
+         c(1, j) = c(1, j) - s
+         c(2:m, j) = c(2:m, j) - s*vtail(2:m)
+      end do
+   end subroutine reflect
+
+   !> b(1:m, 1:nrhs) := Q^T b with Q = H_1 ... H_k from `qr_pivoted` (a(1:m, 1:k), tau).
+   pure subroutine apply_qt(m, k, a, tau, nrhs, b)
+      integer, intent(in) :: m, k, nrhs
+      real(wp), intent(in) :: a(:, :), tau(:)
+      real(wp), intent(inout) :: b(:, :)
+      integer :: i
+
+      do i = 1, k
+         call reflect(a(i:m, i), tau(i), b(i:m, 1:nrhs))
+      end do
+   end subroutine apply_qt
+
+   !> b(1:m, 1:nrhs) := Q b with Q = H_1 ... H_k from `qr_pivoted`.
+   pure subroutine apply_q(m, k, a, tau, nrhs, b)
+      integer, intent(in) :: m, k, nrhs
+      real(wp), intent(in) :: a(:, :), tau(:)
+      real(wp), intent(inout) :: b(:, :)
+      integer :: i
+
+      do i = k, 1, -1
+         call reflect(a(i:m, i), tau(i), b(i:m, 1:nrhs))
+      end do
+   end subroutine apply_q
+
+   !> b(1:k, 1:nrhs) := R^-1 b, R = the upper triangle of a(1:k, 1:k). ok = .false. (b
+   !> partly overwritten) if a diagonal entry is zero or a result is not finite.
+   pure subroutine solve_upper(k, a, nrhs, b, ok)
+      integer, intent(in) :: k, nrhs
+      real(wp), intent(in) :: a(:, :)
+      real(wp), intent(inout) :: b(:, :)
+      logical, intent(out) :: ok
+      integer :: i, j
+
+      ok = all([(a(i, i) /= 0.0_wp, i=1, k)])
+      if (.not. ok) return
+      do j = 1, nrhs
+         do i = k, 1, -1
+            b(i, j) = b(i, j)/a(i, i)
+            b(1:i - 1, j) = b(1:i - 1, j) - b(i, j)*a(1:i - 1, i)
+         end do
+      end do
+      ok = all(abs(b(1:k, 1:nrhs)) <= huge(1.0_wp))
+   end subroutine solve_upper
+
+   !> b(1:k, 1:nrhs) := R^-T b, R = the upper triangle of a(1:k, 1:k); ok as `solve_upper`.
+   pure subroutine solve_upper_t(k, a, nrhs, b, ok)
+      integer, intent(in) :: k, nrhs
+      real(wp), intent(in) :: a(:, :)
+      real(wp), intent(inout) :: b(:, :)
+      logical, intent(out) :: ok
+      integer :: i, j
+
+      ok = all([(a(i, i) /= 0.0_wp, i=1, k)])
+      if (.not. ok) return
+      do j = 1, nrhs
+         do i = 1, k
+            b(i, j) = (b(i, j) - dot_product(a(1:i - 1, i), b(1:i - 1, j)))/a(i, i)
+         end do
+      end do
+      ok = all(abs(b(1:k, 1:nrhs)) <= huge(1.0_wp))
+   end subroutine solve_upper_t
+
+end module sprc_recovery_dense
