@@ -190,6 +190,20 @@ sprc_recovery sprc_recover(sprc_error error, int dim, int analysis, int nnode, c
                            int facet_nnode, const int *facet_nodes, const int *facet_kind,
                            const double *facet_traction);
 
+/* sprc_recover with the reference coordinates of the integration points in
+ * their elements, gauss_xi[nelem][ngp][dim] (the reference cells of the
+ * element library: [0,1]^dim for quads and hexes, the unit simplex for tri3 and tet4), as an FE
+ * code has them; NULL derives them (sprc_recover). Each is checked instead of
+ * derived by Newton's method: finite, inside the element (tolerance 1e-6) and
+ * mapped onto gauss_points[e][q] up to 1e-6 times the element's size (plus
+ * the map's round-off); else SPRC_STAT_INVALID_INPUT naming gauss_xi[e][q]. */
+sprc_recovery sprc_recover_xi(sprc_error error, int dim, int analysis, int nnode, const double *nodes,
+                              int element_type, int nen, int nelem, const int *connectivity, int ngp,
+                              const double *gauss_points, const double *gauss_weights, const double *gauss_stress,
+                              double young, double poisson, int method, const double *body_force, int nfacet,
+                              int facet_nnode, const int *facet_nodes, const int *facet_kind,
+                              const double *facet_traction, const double *gauss_xi);
+
 /* Recovered stresses at the nodes into out[nnode][nstress]; n must equal
  * nnode (nodes of no element get zero). On error out is left unchanged. */
 void sprc_get_recovery_nodal_stress(sprc_error error, sprc_recovery recovery, double *out, int n);

@@ -9,8 +9,11 @@
 !> 1- and 2-thread runs alternate, and the speedup is the median of the paired ratios, so
 !> that a load that comes and goes on a shared machine hits both alike.
 !>
-!> Run: fpm run --profile release --example bench_mesh_recovery [-- NREP [quad4|hex8 [spr|sprc]]]
-!> (the optional words restrict the runs to one mesh and one method).
+!> The caller's reference coordinates of the points are passed (gauss_xi), as an FE code has
+!> them; the word `newton` derives them instead (Newton's method per point, the 'points' phase).
+!>
+!> Run: fpm run --profile release --example bench_mesh_recovery [-- NREP [quad4|hex8|all [spr|sprc|all
+!> [newton]]]] (the optional words restrict the runs to one mesh and one method).
 program bench_mesh_recovery
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type
@@ -22,7 +25,7 @@ program bench_mesh_recovery
 
    type :: mesh_type
       integer :: dim = 0, etype = 0, analysis = 0
-      real(wp), allocatable :: x(:, :), gp(:, :, :), gw(:, :), gs(:, :, :)
+      real(wp), allocatable :: x(:, :), gp(:, :, :), gw(:, :), gs(:, :, :), gxi(:, :, :)
       integer, allocatable :: conn(:, :), fn(:, :), fk(:)
       real(wp), allocatable :: ft(:, :)
    end type mesh_type
@@ -30,6 +33,7 @@ program bench_mesh_recovery
    real(wp), parameter :: pi = acos(-1.0_wp), r_in = 5.0_wp, r_out = 20.0_wp, young = 1000.0_wp, nu = 0.3_wp
    type(mesh_type) :: quad, hex
    integer :: nrep, nmax
+   logical :: newton
    character(len=16) :: arg, only_mesh, only_method
 
    nrep = 3
@@ -41,12 +45,17 @@ program bench_mesh_recovery
    end if
    if (command_argument_count() > 1) call get_command_argument(2, only_mesh)
    if (command_argument_count() > 2) call get_command_argument(3, only_method)
+   newton = .false.
+   if (command_argument_count() > 3) then
+      call get_command_argument(4, arg)
+      newton = trim(arg) == 'newton'
+   end if
    nmax = 1
    !$ nmax = omp_get_max_threads()
    call annulus(512, 512, 0, quad)
    call annulus(48, 48, 46, hex)
    write (*, '(a,i0,a,i0,a)') 'bench_mesh_recovery: medians of ', nrep, ' runs, milliseconds; ', nmax, &
-      & ' threads available'
+      & ' threads available; reference coordinates '//trim(merge('by Newton  ', 'given (gxi)', newton))
    write (*, '(a)') 'mesh            elements  method  threads   check  topology  points  patches  nodal  '// &
       & 'estimate   total'
    call run(quad, 'quad4 annulus', mesh_method_spr)
@@ -67,22 +76,16 @@ contains
       real(wp) :: med(7)
       integer :: nt, k, i, ntmax
 
-      if (len_trim(only_mesh) > 0 .and. index(label, trim(only_mesh)) == 0) return
-      if (len_trim(only_method) > 0 .and. trim(only_method) /= trim(merge('spr ', 'sprc', &
-         & method == mesh_method_spr))) return
+      if (len_trim(only_mesh) > 0 .and. trim(only_mesh) /= 'all' .and. index(label, trim(only_mesh)) == 0) return
+      if (len_trim(only_method) > 0 .and. trim(only_method) /= 'all' .and. trim(only_method) /= trim(merge('spr ', &
+         & 'sprc', method == mesh_method_spr))) return
       ntmax = min(2, nmax)
       allocate (t(7, nrep, ntmax))
       ! 1 and 2 threads in turn, so that a change of the machine's load hits both alike.
       do k = 1, nrep
          do nt = 1, ntmax
             !$ call omp_set_num_threads(nt)
-            if (method == mesh_method_spr) then
-               call recover_on_mesh(m%dim, m%analysis, m%x, m%etype, m%conn, m%gp, m%gw, m%gs, young, nu, method, &
-                  & res, error)
-            else
-               call recover_on_mesh(m%dim, m%analysis, m%x, m%etype, m%conn, m%gp, m%gw, m%gs, young, nu, method, &
-                  & res, error, facet_nodes=m%fn, facet_kind=m%fk, facet_traction=m%ft)
-            end if
+            call recover(m, method, res, error)
             if (allocated(error)) then
                write (*, '(a)') 'bench_mesh_recovery: '//error%message
                stop 1
@@ -104,6 +107,27 @@ contains
          & median(t(7, :, 1)/t(7, :, 2)), ', patches', median(t(4, :, 1)/t(4, :, 2))
       write (*, '(a,es10.3,a,es10.3)') '   global error ', res%err, ', eta ', res%eta
    end subroutine run
+
+   !> One recovery: facets for SPR-C only, the reference coordinates unless `newton`.
+   subroutine recover(m, method, res, error)
+      type(mesh_type), intent(in) :: m
+      integer, intent(in) :: method
+      type(mesh_recovery_type), intent(out) :: res
+      type(error_type), allocatable, intent(out) :: error
+
+      if (method == mesh_method_spr .and. newton) then
+         call recover_on_mesh(m%dim, m%analysis, m%x, m%etype, m%conn, m%gp, m%gw, m%gs, young, nu, method, res, error)
+      else if (method == mesh_method_spr) then
+         call recover_on_mesh(m%dim, m%analysis, m%x, m%etype, m%conn, m%gp, m%gw, m%gs, young, nu, method, res, &
+            & error, gauss_xi=m%gxi)
+      else if (newton) then
+         call recover_on_mesh(m%dim, m%analysis, m%x, m%etype, m%conn, m%gp, m%gw, m%gs, young, nu, method, res, &
+            & error, facet_nodes=m%fn, facet_kind=m%fk, facet_traction=m%ft)
+      else
+         call recover_on_mesh(m%dim, m%analysis, m%x, m%etype, m%conn, m%gp, m%gw, m%gs, young, nu, method, res, &
+            & error, facet_nodes=m%fn, facet_kind=m%fk, facet_traction=m%ft, gauss_xi=m%gxi)
+      end if
+   end subroutine recover
 
    real(wp) function median(v)
       real(wp), intent(in) :: v(:)
@@ -142,6 +166,7 @@ contains
       ne = nr*nt*max(nz, 1)
       ngp = 2**d
       allocate (m%x(d, nn), m%conn(2**d, ne), m%gp(d, ngp, ne), m%gw(ngp, ne), m%gs(3*(d - 1), ngp, ne))
+      allocate (m%gxi(d, ngp, ne))
       do k = 0, nl - 1
          do j = 0, nt
             do i = 0, nr
@@ -167,6 +192,7 @@ contains
                   xi = [gx(1 + mod(g - 1, 2)), gx(1 + mod((g - 1)/2, 2)), gx(1 + (g - 1)/4)]
                   call multilinear(d, xi, shp, dshp)
                   m%gp(:, g, e) = matmul(xe(1:d, 1:2**d), shp(1:2**d))
+                  m%gxi(:, g, e) = xi(1:d)
                   jac(1:d, 1:d) = matmul(xe(1:d, 1:2**d), transpose(dshp(1:d, 1:2**d)))
                   m%gw(g, e) = abs(det(d, jac))/2**d
                   call lame(m%gp(:, g, e), m%gs(:, g, e))

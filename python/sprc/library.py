@@ -161,13 +161,14 @@ def get_report_values(report, column, nrows):
     _get_report_values(report, column.encode(), values.ctypes.data_as(_c_double_p), nrows)
     return values
 
-recover = error_check(_prototype(
-    "sprc_recover", _handle, _handle,
+_RECOVER_ARGS = (
     ctypes.c_int, ctypes.c_int, ctypes.c_int, _c_double_p,                  # dim, analysis, nnode, nodes
     ctypes.c_int, ctypes.c_int, ctypes.c_int, _c_int_p,                     # element_type, nen, nelem, connectivity
     ctypes.c_int, _c_double_p, _c_double_p, _c_double_p,                    # ngp, points, weights, stress
     ctypes.c_double, ctypes.c_double, ctypes.c_int, _c_double_p,            # young, poisson, method, body_force
-    ctypes.c_int, ctypes.c_int, _c_int_p, _c_int_p, _c_double_p))           # facets
+    ctypes.c_int, ctypes.c_int, _c_int_p, _c_int_p, _c_double_p)            # facets
+recover = error_check(_prototype("sprc_recover", _handle, _handle, *_RECOVER_ARGS))
+recover_xi = error_check(_prototype("sprc_recover_xi", _handle, _handle, *_RECOVER_ARGS, _c_double_p))  # gauss_xi
 get_recovery_nodal_stress = error_check(_prototype("sprc_get_recovery_nodal_stress", None, _handle, _handle,
                                                    _c_double_p, ctypes.c_int))
 get_recovery_element_error = error_check(_prototype("sprc_get_recovery_element_error", None, _handle, _handle,

@@ -1,5 +1,5 @@
 """SPR / SPR-C stress recovery and the ZZ error estimate on your own mesh
-(the C entry ``sprc_recover`` and friends, include/sprc.h).
+(the C entries ``sprc_recover_xi`` and friends, include/sprc.h).
 
 >>> rec = sprc.recover(nodes, elements, "quad4", gauss_points, gauss_weights,
 ...                    gauss_stress, young=210e3, poisson=0.3)   # doctest: +SKIP
@@ -198,7 +198,7 @@ def _facets(boundary, dim, nfn):
 
 
 def recover(nodes, elements, element_type, gauss_points, gauss_weights, gauss_stress, *, young, poisson,
-            analysis=None, method="sprc", body_force=None, boundary=None, degree="auto"):
+            analysis=None, method="sprc", body_force=None, boundary=None, degree="auto", gauss_xi=None):
     """Recover the stresses of a finite-element solution on your own mesh
     and estimate its error (SPR or SPR-C with the ZZ estimate).
 
@@ -236,6 +236,12 @@ def recover(nodes, elements, element_type, gauss_points, gauss_weights, gauss_st
                    "pressure" t = -p n with the facet's own outward normal at
                    each of its points (right on curved facets, where the
                    traction turns). Only the facets given are constrained.
+    gauss_xi       [nelem, ngp, dim] reference coordinates of the points in
+                   their elements ([0, 1]^dim for quads and hexes, the unit
+                   simplex for tri3 and tet4), as your FE code has them, or None
+                   (default: derived by Newton's method). Checked, not trusted:
+                   inside the element and mapped onto the point (tolerance 1e-6
+                   in reference units).
 
     Returns a :class:`Recovery`. Raises ValueError for arrays of the wrong
     shape or type and unknown names, :class:`SprcError` with the library's
@@ -260,6 +266,7 @@ def recover(nodes, elements, element_type, gauss_points, gauss_weights, gauss_st
     gw = _doubles("gauss_weights", gauss_weights, (nelem, ngp))
     gs = _doubles("gauss_stress", gauss_stress, (nelem, ngp, nstress))
     bf = None if body_force is None else _doubles("body_force", body_force, (edim,))
+    gxi = None if gauss_xi is None else _doubles("gauss_xi", gauss_xi, (nelem, ngp, edim))
     fn = fk = ft = None
     nfacet = 0
     if boundary is not None:
@@ -267,8 +274,8 @@ def recover(nodes, elements, element_type, gauss_points, gauss_weights, gauss_st
         nfacet = fn.shape[0]
         if nfacet == 0:
             fn = fk = ft = None
-    handle = library.recover(edim, acode, nnode, _ptr(x, _c_double_p), etype, nen, nelem, _ptr(conn, _c_int_p), ngp,
-                             _ptr(gp, _c_double_p), _ptr(gw, _c_double_p), _ptr(gs, _c_double_p), float(young),
-                             float(poisson), mcode, _ptr(bf, _c_double_p), nfacet, nfn, _ptr(fn, _c_int_p),
-                             _ptr(fk, _c_int_p), _ptr(ft, _c_double_p))
+    handle = library.recover_xi(edim, acode, nnode, _ptr(x, _c_double_p), etype, nen, nelem, _ptr(conn, _c_int_p),
+                                ngp, _ptr(gp, _c_double_p), _ptr(gw, _c_double_p), _ptr(gs, _c_double_p),
+                                float(young), float(poisson), mcode, _ptr(bf, _c_double_p), nfacet, nfn,
+                                _ptr(fn, _c_int_p), _ptr(fk, _c_int_p), _ptr(ft, _c_double_p), _ptr(gxi, _c_double_p))
     return Recovery(handle, element_type, edim, nstress, nnode, nelem)

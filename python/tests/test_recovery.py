@@ -127,7 +127,7 @@ def build_case(etype, m, field):
             x[nid(ijk)] = np.mean([x[nid(v)] for v in around], axis=0)
 
     cells = [c[::-1] for c in itertools.product(range(m), repeat=dim)]
-    conn, gp, gw = [], [], []
+    conn, gp, gw, gxi = [], [], [], []
     if etype in VTK:
         rx, rw = gauss_1d(q + 1)
         rule = [(np.array(p[::-1]), np.prod(w)) for p, w in
@@ -150,6 +150,7 @@ def build_case(etype, m, field):
                 wts.append(w * abs(np.linalg.det(jac)))
             gp.append(pts)
             gw.append(wts)
+            gxi.append([xi for xi, _ in rule])
     else:
         if dim == 2:
             splits = [[(0, 0), (1, 0), (1, 1)], [(0, 0), (1, 1), (0, 1)]]
@@ -177,7 +178,7 @@ def build_case(etype, m, field):
     gs = exact(field, gp)
     return dict(nodes=x, elements=np.array(conn), element_type=etype, gauss_points=gp,
                 gauss_weights=np.array(gw), gauss_stress=gs, body_force=body_force(field, dim),
-                field=field, dim=dim, scale=np.abs(gs).max())
+                field=field, dim=dim, scale=np.abs(gs).max(), gauss_xi=np.array(gxi) if gxi else None)
 
 
 def recover(case, **kw):
@@ -244,6 +245,21 @@ def test_degree_auto_default():
     quad["gauss_stress"] = quad["gauss_stress"] + 0.05 * np.sin(5 * quad["gauss_points"][..., :1])
     assert np.array_equal(recover(quad, method="sprc").nodal_stress,
                           recover(quad, method="sprc", degree="p").nodal_stress)
+
+
+@pytest.mark.parametrize("etype", ["quad4", "hex8"])
+def test_given_reference_coordinates(etype):
+    """gauss_xi (the rule's coordinates) gives the exact field as Newton's do; a moved one
+    is named in C notation; a wrong shape is a ValueError."""
+    case = build_case(etype, 3, "linear")
+    rec = recover(case, gauss_xi=case["gauss_xi"])
+    assert nodal_deviation(case, rec) <= TOL
+    bad = case["gauss_xi"].copy()
+    bad[4, 1, 0] += 1e-3
+    with pytest.raises(sprc.SprcError, match=r"gauss_xi\[4\]\[1\] = "):
+        recover(case, gauss_xi=bad)
+    with pytest.raises(ValueError, match="gauss_xi has shape"):
+        recover(case, gauss_xi=case["gauss_xi"][:, 1:])
 
 
 def test_inexact_data_gives_positive_estimate():

@@ -672,6 +672,43 @@ static void test_recovery_pressure_facets(void) {
   PASS();
 }
 
+/* sprc_recover_xi: the points' reference coordinates (the rule of build_quad_mesh)
+ * give the exact field; NULL derives them; a moved one is an error naming
+ * gauss_xi[e][q] 0-based. */
+static void test_recovery_given_xi(void) {
+  const char *name = "recovery_given_xi";
+  static quad_mesh m;
+  static double gxi[NELEM][NGP][2];
+  const double g = 0.5 / sqrt(3.0);
+  const double rule[NGP][2] = {{0.5 - g, 0.5 - g}, {0.5 + g, 0.5 - g}, {0.5 + g, 0.5 + g}, {0.5 - g, 0.5 + g}};
+  double nodal[NNODE][3];
+  int e, q, pass;
+  sprc_error err = sprc_new_error();
+  sprc_recovery rec;
+  build_quad_mesh(&m, 0);
+  for (e = 0; e < NELEM; e++)
+    for (q = 0; q < NGP; q++) {
+      gxi[e][q][0] = rule[q][0];
+      gxi[e][q][1] = rule[q][1];
+    }
+  for (pass = 0; pass < 2; pass++) {
+    rec = sprc_recover_xi(err, 2, SPRC_PLANE_STRESS, NNODE, &m.nodes[0][0], SPRC_QUAD4, 4, NELEM, &m.conn[0][0], NGP,
+                          &m.gp[0][0][0], &m.gw[0][0], &m.gs[0][0][0], 1000.0, 0.3, SPRC_METHOD_SPRC, m.body, 0, 2,
+                          NULL, NULL, NULL, pass == 0 ? &gxi[0][0][0] : NULL);
+    CHECK(rec != NULL && sprc_check_error(err) == 0, "recovery with the reference coordinates failed");
+    sprc_get_recovery_nodal_stress(err, rec, &nodal[0][0], NNODE);
+    CHECK(nodal_deviation(&m, nodal) <= 5e-10, "nodal stresses with given coordinates are not exact");
+    sprc_delete_recovery(&rec);
+  }
+  gxi[3][1][0] += 1e-3;
+  rec = sprc_recover_xi(err, 2, SPRC_PLANE_STRESS, NNODE, &m.nodes[0][0], SPRC_QUAD4, 4, NELEM, &m.conn[0][0], NGP,
+                        &m.gp[0][0][0], &m.gw[0][0], &m.gs[0][0][0], 1000.0, 0.3, SPRC_METHOD_SPRC, m.body, 0, 2,
+                        NULL, NULL, NULL, &gxi[0][0][0]);
+  CHECK(rec == NULL && has_error(err, "gauss_xi[3][1] = "), "a moved reference coordinate was accepted");
+  sprc_delete_error(&err);
+  PASS();
+}
+
 int main(int argc, char **argv) {
   /* `fpm test -- SUITE` passes the unit tests' suite name to every test
      program: take argv[1] as the root only if it holds example/scenes. */
@@ -696,6 +733,7 @@ int main(int argc, char **argv) {
   test_recovery_degree_flag();
   test_recovery_facets();
   test_recovery_pressure_facets();
+  test_recovery_given_xi();
   printf("%d passed, %d failed\n", passed, failed);
   return failed == 0 ? 0 : 1;
 }

@@ -24,7 +24,7 @@ module sprc_test_mesh_recovery
       & mesh_method_sprc, facet_traction, facet_symmetry, facet_free, facet_pressure, elem_tri3, elem_quad4, &
       & elem_tet4, elem_hex8, elem_quad9, elem_hex27
    use sprc_legacy, only: sprc_recover_mesh
-   use sprc_recovery_mesh_element, only: facet_points
+   use sprc_recovery_mesh_element, only: facet_points, element_inverse_map
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reset, patch_add_point
    use sprc_recovery_patch_loop, only: patch_source_type, patch_loop_type, run_patch_loop, patch_capacity
    !$ use omp_lib, only: omp_get_max_threads, omp_set_num_threads
@@ -98,7 +98,8 @@ contains
          new_unittest('c_index_messages', test_c_index_messages), &
          new_unittest('patch_loop_skip', test_patch_loop_skip), &
          new_unittest('degree_auto', test_degree_auto), &
-         new_unittest('legacy_wrapper', test_legacy) &
+         new_unittest('legacy_wrapper', test_legacy), &
+         new_unittest('given_reference_coordinates', test_given_xi) &
          ]
    end subroutine collect_mesh_recovery
 
@@ -1400,5 +1401,60 @@ contains
       if (allocated(error)) return
       call check(error, index(msg, 'mesh_recovery_eval') > 0, 'legacy errmsg from the evaluation: '//trim(msg))
    end subroutine test_legacy
+
+   !> The caller's reference coordinates (gauss_xi) instead of Newton's: on a distorted quad4
+   !> and hex8 mesh, the inverse map's coordinates give the same nodal stresses and error
+   !> (to round-off: the same points); coordinates moved by 1e-9 (below the 1e-6 tolerance)
+   !> pass; moved by 1e-3, outside the element, or of the wrong shape, they are rejected with
+   !> the entry named (Fortran and C notation).
+   subroutine test_given_xi(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(case_type) :: c
+      type(mesh_recovery_type) :: res0, res1
+      real(wp), allocatable :: gxi(:, :, :), bad(:, :, :)
+      integer, parameter :: etypes(2) = [elem_quad4, elem_hex8]
+      integer :: k, e, i
+      logical :: ok
+
+      do k = 1, size(etypes)
+         call build_case(c, etypes(k), 3, f_linear, 0.1_wp)
+         allocate (gxi(c%dim, size(c%gp, 2), size(c%gp, 3)))
+         do e = 1, size(c%gp, 3)
+            do i = 1, size(c%gp, 2)
+               call element_inverse_map(c%etype, c%x(:, c%conn(:, e)), c%gp(:, i, e), gxi(:, i, e), ok)
+               if (.not. ok) then
+                  call test_failed(error, 'inverse map of the test points')
+                  return
+               end if
+            end do
+         end do
+         call recover_on_mesh(c%dim, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
+            & mesh_method_sprc, res0, error)
+         if (allocated(error)) return
+         call recover_on_mesh(c%dim, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
+            & mesh_method_sprc, res1, error, gauss_xi=gxi + 1.0e-9_wp)
+         if (allocated(error)) return
+         call check(error, maxval(abs(res1%nodal - res0%nodal)) <= tol*c%scale .and. &
+            & abs(res1%err - res0%err) <= tol*res0%norm_h, 'given coordinates: same recovery')
+         if (allocated(error)) return
+         bad = gxi
+         bad(1, 2, 5) = bad(1, 2, 5) + 1.0e-3_wp
+         call recover_on_mesh(c%dim, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
+            & mesh_method_spr, res1, error, gauss_xi=bad)
+         call expect(error, stat_invalid_input, 'gxi(:, 2, 5) = ')
+         if (allocated(error)) return
+         bad = gxi
+         bad(2, 1, 3) = 1.5_wp
+         call recover_on_mesh(c%dim, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
+            & mesh_method_spr, res1, error, gauss_xi=bad, c_indices=.true.)
+         call expect(error, stat_invalid_input, 'gauss_xi[2][0] = ')
+         if (allocated(error)) return
+         call recover_on_mesh(c%dim, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
+            & mesh_method_spr, res1, error, gauss_xi=gxi(:, 2:, :))
+         call expect(error, stat_invalid_input, 'gxi has shape')
+         if (allocated(error)) return
+         deallocate (gxi)
+      end do
+   end subroutine test_given_xi
 
 end module sprc_test_mesh_recovery

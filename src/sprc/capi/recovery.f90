@@ -23,7 +23,7 @@ module sprc_capi_recovery
    private
 
    public :: capi_recovery_type
-   public :: sprc_recover, sprc_get_recovery_nodal_stress, sprc_get_recovery_element_error, &
+   public :: sprc_recover, sprc_recover_xi, sprc_get_recovery_nodal_stress, sprc_get_recovery_element_error, &
       & sprc_get_recovery_global_error, sprc_get_recovery_eta, sprc_eval_recovery, sprc_delete_recovery
 
    !> What an `sprc_recovery` handle points to.
@@ -55,7 +55,43 @@ contains
       integer(c_int), value :: method, nfacet, facet_nnode
       type(c_ptr), value :: body_force, facet_nodes, facet_kind, facet_traction
       type(c_ptr) :: rech
+
+      rech = recover_c(errh, dim, analysis, nnode, nodes, element_type, nen, nelem, connectivity, ngp, &
+         & gauss_points, gauss_weights, gauss_stress, young, poisson, method, body_force, nfacet, facet_nnode, &
+         & facet_nodes, facet_kind, facet_traction, c_null_ptr)
+   end function sprc_recover
+
+   !> `sprc_recover` with the reference coordinates of the points (gauss_xi [nelem][ngp][dim],
+   !> or NULL to derive them): checked instead of derived by Newton's method.
+   function sprc_recover_xi(errh, dim, analysis, nnode, nodes, element_type, nen, nelem, connectivity, ngp, &
+         & gauss_points, gauss_weights, gauss_stress, young, poisson, method, body_force, nfacet, facet_nnode, &
+         & facet_nodes, facet_kind, facet_traction, gauss_xi) result(rech) bind(C, name='sprc_recover_xi')
+      type(c_ptr), value :: errh
+      integer(c_int), value :: dim, analysis, nnode, element_type, nen, nelem, ngp
+      type(c_ptr), value :: nodes, connectivity, gauss_points, gauss_weights, gauss_stress
+      real(c_double), value :: young, poisson
+      integer(c_int), value :: method, nfacet, facet_nnode
+      type(c_ptr), value :: body_force, facet_nodes, facet_kind, facet_traction, gauss_xi
+      type(c_ptr) :: rech
+
+      rech = recover_c(errh, dim, analysis, nnode, nodes, element_type, nen, nelem, connectivity, ngp, &
+         & gauss_points, gauss_weights, gauss_stress, young, poisson, method, body_force, nfacet, facet_nnode, &
+         & facet_nodes, facet_kind, facet_traction, gauss_xi)
+   end function sprc_recover_xi
+
+   !> The one implementation of both entries (gauss_xi may be NULL).
+   function recover_c(errh, dim, analysis, nnode, nodes, element_type, nen, nelem, connectivity, ngp, &
+         & gauss_points, gauss_weights, gauss_stress, young, poisson, method, body_force, nfacet, facet_nnode, &
+         & facet_nodes, facet_kind, facet_traction, gauss_xi) result(rech)
+      type(c_ptr), value :: errh
+      integer(c_int), value :: dim, analysis, nnode, element_type, nen, nelem, ngp
+      type(c_ptr), value :: nodes, connectivity, gauss_points, gauss_weights, gauss_stress
+      real(c_double), value :: young, poisson
+      integer(c_int), value :: method, nfacet, facet_nnode
+      type(c_ptr), value :: body_force, facet_nodes, facet_kind, facet_traction, gauss_xi
+      type(c_ptr) :: rech
       character(len=*), parameter :: entry = 'sprc_recover'
+      real(c_double), pointer :: gxi(:, :, :)
       type(capi_error_type), pointer :: err
       type(capi_recovery_type), pointer :: rec
       type(mesh_sizes_type) :: sz
@@ -121,16 +157,23 @@ contains
       degree = auto_degree(iand(method, method_mask) == mesh_method_sprc, element_degree(element_type))
       if (iand(method, flag_p) /= 0) degree = element_degree(element_type)
       if (iand(method, flag_p_plus_1) /= 0) degree = element_degree(element_type) + 1
-      call recover_on_mesh(dim, analysis, x, element_type, conn, gp, gw, gs, young, poisson, &
-         & int(iand(method, method_mask)), rec%result, error, body_force=bf, facet_nodes=fn, facet_kind=fk, &
-         & facet_traction=ft, degree=degree, c_indices=.true.)
+      if (c_associated(gauss_xi)) then
+         call c_f_pointer(gauss_xi, gxi, [dim, ngp, nelem])
+         call recover_on_mesh(dim, analysis, x, element_type, conn, gp, gw, gs, young, poisson, &
+            & int(iand(method, method_mask)), rec%result, error, body_force=bf, facet_nodes=fn, facet_kind=fk, &
+            & facet_traction=ft, degree=degree, c_indices=.true., gauss_xi=gxi)
+      else
+         call recover_on_mesh(dim, analysis, x, element_type, conn, gp, gw, gs, young, poisson, &
+            & int(iand(method, method_mask)), rec%result, error, body_force=bf, facet_nodes=fn, facet_kind=fk, &
+            & facet_traction=ft, degree=degree, c_indices=.true.)
+      end if
       if (allocated(error)) then
          deallocate (rec)
          call set_capi_error(err, error)
          return
       end if
       rech = c_loc(rec)
-   end function sprc_recover
+   end function recover_c
 
    !> Counts and codes the array shapes depend on (the library checks the rest).
    subroutine check_sizes(sz, error)

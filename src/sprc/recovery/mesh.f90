@@ -10,7 +10,9 @@
 !> xx, yy, zz, xy, yz, xz); analysis (plane_stress 1, plane_strain 2, solid 3), E, nu;
 !> method (mesh_method_spr 1, mesh_method_sprc 2); optionally a constant body force
 !> (div sigma + b = 0) and boundary facets. Every point must lie in its element (checked by
-!> the inverse isoparametric map, tolerance 1e-6 in reference coordinates). Two used nodes
+!> the inverse isoparametric map, tolerance 1e-6 in reference coordinates). A caller that
+!> has the points' reference coordinates passes them (gauss_xi): they are checked (inside,
+!> and mapped onto the point) instead of derived by Newton's method. Two used nodes
 !> at one point and two elements on the same vertices are input errors.
 !>
 !> Facets: facet_nodes(nfn, nfacet) (a side of an element: line2 / line3 in 2D, tri3 /
@@ -60,7 +62,7 @@
 module sprc_recovery_mesh
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular, &
-      & stat_not_converged
+      & stat_not_converged, stat_out_of_memory
    use sprc_core_material, only: voigt_size, compliance_matrix
    use sprc_core_timer, only: wall_time
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reset, patch_reserve, &
@@ -149,7 +151,8 @@ contains
    !> inverse map does not converge (stat_not_converged), a patch still rank deficient after
    !> `max_rounds` expansions (stat_singular, naming the node).
    subroutine recover_on_mesh(dim, analysis, nodes, element_type, connectivity, gp, gw, gs, young, poisson, method, &
-         & result, error, body_force, facet_nodes, facet_kind, facet_traction, degree, max_rounds, c_indices)
+         & result, error, body_force, facet_nodes, facet_kind, facet_traction, degree, max_rounds, c_indices, &
+         & gauss_xi)
       integer, intent(in) :: dim, analysis
       !> Node coordinates (dim, nnode).
       real(wp), intent(in) :: nodes(:, :)
@@ -172,6 +175,10 @@ contains
       !> Name array entries in messages as C does (the C and Python entries): 0-based,
       !> row-major, C argument names (default false: Fortran's gw(i, e)).
       logical, intent(in), optional :: c_indices
+      !> Reference coordinates (dim, ngp, nelem) of the integration points in their elements
+      !> (the element library's reference cells), if the caller has them: then they are
+      !> checked (`given_coordinates`) instead of derived by Newton's method.
+      real(wp), intent(in), optional :: gauss_xi(:, :, :)
       type(topology_type), target :: topo
       real(wp), allocatable :: xi(:, :, :)
       integer :: deg, rounds
@@ -204,7 +211,11 @@ contains
       call boundary_points(result, topo, error, facet_nodes, facet_kind, facet_traction)
       if (allocated(error)) return
       t(2) = wall_time()
-      call point_coordinates(result, gp, xi, error)
+      if (present(gauss_xi)) then
+         call given_coordinates(result, gp, gauss_xi, xi, error)
+      else
+         call point_coordinates(result, gp, xi, error)
+      end if
       if (allocated(error)) return
       t(3) = wall_time()
       call recover_patches(result, topo, gp, gw, gs, rounds, error)
@@ -369,6 +380,78 @@ contains
          s = entry_name(r%c_indices, 'gp', 'gauss_points', [0, i, e])
       end function point_name
    end subroutine point_coordinates
+
+   !> The caller's reference coordinates gxi of the integration points, checked: finite,
+   !> inside the element (inside_tol, as a derived point must be) and mapped onto the point:
+   !> |x(gxi) - gp|_inf <= inside_tol h_e + (nen + 2) eps (|gp| + sum_a |N_a| |x_a|), with h_e
+   !> the largest extent of the element's box (inside_tol in reference units, which the map
+   !> stretches by about h_e) plus the round-off of evaluating the map (as in Newton's stopping
+   !> test, sprc_recovery_mesh_element). OpenMP over elements; the first bad point (element
+   !> order) is named.
+   subroutine given_coordinates(r, gp, gxi, xi, error)
+      type(mesh_recovery_type), intent(in) :: r
+      real(wp), intent(in) :: gp(:, :, :), gxi(:, :, :)
+      real(wp), allocatable, intent(out) :: xi(:, :, :)
+      type(error_type), allocatable, intent(out) :: error
+      integer, allocatable :: bad(:)
+      integer :: e, i, ngp, st
+
+      ngp = size(gp, 2)
+      if (any(shape(gxi) /= [r%dim, ngp, r%nelem])) then
+         call fatal_error(error, 'recover_on_mesh: '//trim(merge('gauss_xi', 'gxi     ', r%c_indices))//' has shape '// &
+            & shape_str(shape(gxi))//'; need '//shape_str([r%dim, ngp, r%nelem])//' as gp', stat_invalid_input)
+         return
+      end if
+      allocate (xi(r%dim, ngp, r%nelem), bad(r%nelem), stat=st)
+      if (st /= 0) then
+         call fatal_error(error, 'recover_on_mesh: out of memory for the reference coordinates', stat_out_of_memory)
+         return
+      end if
+      !$omp parallel do schedule(static)
+      do e = 1, r%nelem
+         bad(e) = check_element(e)
+      end do
+      !$omp end parallel do
+      if (all(bad == 0)) return
+      e = findloc(bad /= 0, .true., dim=1)
+      i = bad(e)
+      call fatal_error(error, 'recover_on_mesh: '//entry_name(r%c_indices, 'gxi', 'gauss_xi', [0, i, e])//' = '// &
+         & vec_str(gxi(:, i, e))//' is not finite, not inside element '//index_name(r%c_indices, e)// &
+         & ' or does not map onto '//entry_name(r%c_indices, 'gp', 'gauss_points', [0, i, e])//' = '// &
+         & vec_str(gp(:, i, e)), stat_invalid_input)
+   contains
+      !> 0, or the first point of e whose coordinates fail.
+      integer function check_element(e) result(status)
+         integer, intent(in) :: e
+         real(wp) :: xe(3, max_element_nodes), n(max_element_nodes), x(3), he, tol
+         integer :: a, j, d
+
+         d = r%dim
+         do a = 1, r%nen
+            xe(1:d, a) = r%x(:, r%connectivity(a, e))
+         end do
+         he = maxval(r%box_hi(:, e) - r%box_lo(:, e))
+         status = 0
+         do j = 1, ngp
+            xi(:, j, e) = gxi(:, j, e)
+            status = j
+            if (.not. all(abs(gxi(:, j, e)) <= huge(1.0_wp))) return
+            if (.not. element_inside(r%element_type, gxi(:, j, e), inside_tol)) return
+            call element_shape(r%element_type, gxi(:, j, e), n)
+            x(1:d) = matmul(xe(1:d, 1:r%nen), n(1:r%nen))
+            tol = inside_tol*he + real(r%nen + 2, wp)*epsilon(1.0_wp)*(maxval(abs(gp(:, j, e))) + &
+               & sum(abs(n(1:r%nen)))*maxval(abs(xe(1:d, 1:r%nen))))
+            if (.not. (maxval(abs(x(1:d) - gp(:, j, e))) <= tol)) return
+            status = 0
+         end do
+      end function check_element
+      pure function shape_str(v) result(s)
+         integer, intent(in) :: v(:)
+         character(len=:), allocatable :: s
+         s = '('//itoa(v(1))//', '//itoa(v(2))//', '//itoa(v(3))//')'
+         if (r%c_indices) s = '['//itoa(v(3))//']['//itoa(v(2))//']['//itoa(v(1))//']'
+      end function shape_str
+   end subroutine given_coordinates
 
    !> Quadrature points of the facets, gathered per owning element (CSR), normals outward.
    subroutine boundary_points(r, topo, error, facet_nodes, facet_kind, facet_traction_value)
