@@ -29,14 +29,21 @@ contains
 
    !> Pivoted Householder QR of a(1:m, 1:n) (module notes): R in the upper triangle, the
    !> reflectors below it with their tau(1:min(m, n)); column k of R is column jpvt(k) of a.
-   pure subroutine qr_pivoted(m, n, a, jpvt, tau)
+   !> With stop_ratio: once every remaining column's norm is at most stop_ratio |R_11|, the
+   !> factorisation stops (tau = 0 from there: Q^T leaves those rows alone). The trailing
+   !> block is then left unreduced, but each of its entries, diagonal ones included, is at
+   !> most its column's norm: a rank decision |R_kk| > tol |R_11| with tol >= stop_ratio
+   !> comes out as for the full factorisation. (Equilibrium rows of SPR-C have rank 2 of 9
+   !> in 2D p = 1, 3 of 24 in 3D: the rest of the factorisation was round-off.)
+   pure subroutine qr_pivoted(m, n, a, jpvt, tau, stop_ratio)
       integer, intent(in) :: m, n
-      real(wp), intent(inout) :: a(:, :)
+      real(wp), intent(inout), contiguous :: a(:, :)
       integer, intent(out) :: jpvt(:)
       real(wp), intent(out) :: tau(:)
+      real(wp), intent(in), optional :: stop_ratio
       real(wp), parameter :: tol3z = sqrt(epsilon(1.0_wp))
-      real(wp) :: vn1(n), vn2(n), tmp(m), t, t2
-      integer :: j, k, p, it
+      real(wp) :: vn1(n), vn2(n), t, t2
+      integer :: i, j, k, p, it
 
       do j = 1, n
          jpvt(j) = j
@@ -45,10 +52,18 @@ contains
       end do
       do k = 1, min(m, n)
          p = k - 1 + maxloc(vn1(k:n), dim=1)
+         if (present(stop_ratio) .and. k > 1) then
+            if (vn1(p) <= stop_ratio*abs(a(1, 1))) then
+               tau(k:min(m, n)) = 0.0_wp
+               return
+            end if
+         end if
          if (p /= k) then
-            tmp = a(1:m, p)
-            a(1:m, p) = a(1:m, k)
-            a(1:m, k) = tmp
+            do i = 1, m
+               t = a(i, p)
+               a(i, p) = a(i, k)
+               a(i, k) = t
+            end do
             it = jpvt(p)
             jpvt(p) = jpvt(k)
             jpvt(k) = it
@@ -56,7 +71,11 @@ contains
             vn2(p) = vn2(k)
          end if
          call reflector(a(k:m, k), tau(k))
-         call reflect(a(k:m, k), tau(k), a(k:m, k + 1:n))
+         if (tau(k) /= 0.0_wp) then
+            do j = k + 1, n
+               call reflect(a(k + 1:m, k), tau(k), a(k:m, j))
+            end do
+         end if
          do j = k + 1, n
             if (vn1(j) == 0.0_wp) cycle
             t = 1.0_wp - (abs(a(k, j))/vn1(j))**2
@@ -78,13 +97,13 @@ contains
 
    !> Euclidean norm of a patch-scaled vector (module notes).
    pure real(wp) function vnorm(x)
-      real(wp), intent(in) :: x(:)
+      real(wp), intent(in), contiguous :: x(:)
       vnorm = sqrt(dot_product(x, x))
    end function vnorm
 
    !> Householder reflector of x (xLARFG): x(1) becomes beta, x(2:) the vector v(2:).
    pure subroutine reflector(x, tau)
-      real(wp), intent(inout) :: x(:)
+      real(wp), intent(inout), contiguous :: x(:)
       real(wp), intent(out) :: tau
       real(wp) :: xnorm, alpha, beta
 
@@ -99,43 +118,45 @@ contains
       x(1) = beta
    end subroutine reflector
 
-   !> c := H c, H = I - tau v v^T with v = [1, vtail(2:)] (vtail(1) is not read).
-   pure subroutine reflect(vtail, tau, c)
-      real(wp), intent(in) :: vtail(:), tau
-      real(wp), intent(inout) :: c(:, :)
+   !> c := H c for one column, H = I - tau v v^T with v = [1, v2] (v2 = the stored tail).
+   pure subroutine reflect(v2, tau, c)
+      real(wp), intent(in), contiguous :: v2(:)
+      real(wp), intent(in) :: tau
+      real(wp), intent(inout), contiguous :: c(:)
       real(wp) :: s
-      integer :: j, m
 
-      if (tau == 0.0_wp) return
-      m = size(vtail)
-      do j = 1, size(c, 2)
-         s = tau*(c(1, j) + dot_product(vtail(2:m), c(2:m, j)))
-         c(1, j) = c(1, j) - s
-         c(2:m, j) = c(2:m, j) - s*vtail(2:m)
-      end do
+      s = tau*(c(1) + dot_product(v2, c(2:)))
+      c(1) = c(1) - s
+      c(2:) = c(2:) - s*v2
    end subroutine reflect
 
    !> b(1:m, 1:nrhs) := Q^T b with Q = H_1 ... H_k from `qr_pivoted` (a(1:m, 1:k), tau).
    pure subroutine apply_qt(m, k, a, tau, nrhs, b)
       integer, intent(in) :: m, k, nrhs
-      real(wp), intent(in) :: a(:, :), tau(:)
-      real(wp), intent(inout) :: b(:, :)
-      integer :: i
+      real(wp), intent(in), contiguous :: a(:, :)
+      real(wp), intent(in) :: tau(:)
+      real(wp), intent(inout), contiguous :: b(:, :)
+      integer :: i, j
 
-      do i = 1, k
-         call reflect(a(i:m, i), tau(i), b(i:m, 1:nrhs))
+      do j = 1, nrhs
+         do i = 1, k
+            if (tau(i) /= 0.0_wp) call reflect(a(i + 1:m, i), tau(i), b(i:m, j))
+         end do
       end do
    end subroutine apply_qt
 
    !> b(1:m, 1:nrhs) := Q b with Q = H_1 ... H_k from `qr_pivoted`.
    pure subroutine apply_q(m, k, a, tau, nrhs, b)
       integer, intent(in) :: m, k, nrhs
-      real(wp), intent(in) :: a(:, :), tau(:)
-      real(wp), intent(inout) :: b(:, :)
-      integer :: i
+      real(wp), intent(in), contiguous :: a(:, :)
+      real(wp), intent(in) :: tau(:)
+      real(wp), intent(inout), contiguous :: b(:, :)
+      integer :: i, j
 
-      do i = k, 1, -1
-         call reflect(a(i:m, i), tau(i), b(i:m, 1:nrhs))
+      do j = 1, nrhs
+         do i = k, 1, -1
+            if (tau(i) /= 0.0_wp) call reflect(a(i + 1:m, i), tau(i), b(i:m, j))
+         end do
       end do
    end subroutine apply_q
 

@@ -136,8 +136,9 @@ module sprc_recovery_mesh
       integer :: dim = 0, analysis = 0, nstress = 0, nen = 0
       logical :: sprc = .false.
       real(wp) :: young = 0.0_wp, poisson = 0.0_wp
-      real(wp), pointer :: x(:, :) => null(), gp(:, :, :) => null(), gw(:, :) => null(), gs(:, :, :) => null()
-      integer, pointer :: connectivity(:, :) => null()
+      real(wp), pointer, contiguous :: x(:, :) => null(), gp(:, :, :) => null(), gw(:, :) => null(), &
+         & gs(:, :, :) => null()
+      integer, pointer, contiguous :: connectivity(:, :) => null()
       type(topology_type), pointer :: topo => null()
    contains
       procedure :: fill => mesh_fill
@@ -160,7 +161,8 @@ contains
       !> Element nodes (nen, nelem), 1-based, VTK order.
       integer, intent(in) :: connectivity(:, :)
       !> Integration points (dim, ngp, nelem), weight*|J| (ngp, nelem), FE stress (nstress, ngp, nelem).
-      real(wp), intent(in), target :: gp(:, :, :), gw(:, :), gs(:, :, :)
+      !> (Contiguous: the patch loop reads them through contiguous pointers.)
+      real(wp), intent(in), target, contiguous :: gp(:, :, :), gw(:, :), gs(:, :, :)
       real(wp), intent(in) :: young, poisson
       integer, intent(in) :: method
       type(mesh_recovery_type), intent(out), target :: result
@@ -553,7 +555,7 @@ contains
    subroutine recover_patches(r, topo, gp, gw, gs, rounds, error)
       type(mesh_recovery_type), intent(inout), target :: r
       type(topology_type), intent(in), target :: topo
-      real(wp), intent(in), target :: gp(:, :, :), gw(:, :), gs(:, :, :)
+      real(wp), intent(in), target, contiguous :: gp(:, :, :), gw(:, :), gs(:, :, :)
       integer, intent(in) :: rounds
       type(error_type), allocatable, intent(out) :: error
       type(mesh_source_type) :: src
@@ -633,6 +635,8 @@ contains
       call patch_reset(patch, d, self%analysis, self%young, self%poisson, self%x(:, node), h)
       call patch_reserve(patch, np, nb)
       patch%body_force(1:d) = self%topo%body_force(1:d)
+      ! check_mesh_arrays validated the caller's points, weights and stresses.
+      patch%points_checked = .true.
       do i = 1, size(elements)
          e = elements(i)
          patch%x(1:d, patch%npoints + 1:patch%npoints + ngp) = self%gp(:, :, e)

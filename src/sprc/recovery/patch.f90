@@ -98,6 +98,11 @@ module sprc_recovery_patch
       !> measure in the patch is imposed (`dominant_boundary_kind`); if true, every kind
       !> present is imposed (dependent rows are dropped by the rank selection).
       logical :: all_boundary_kinds = .false.
+      !> Set by a producer that has validated every integration point it gathers (finite x
+      !> and stress, 0 < w < huge; the caller's-mesh producer checks the caller's arrays once):
+      !> `check_patch` then skips its per-point loop, which repeated that check for every
+      !> patch a point belongs to. patch_reset clears it.
+      logical :: points_checked = .false.
    end type patch_type
 
    !> Result of one patch recovery: sigma*(x) = P((x - x0)/h) A, plus diagnostics.
@@ -152,6 +157,7 @@ contains
       patch%use_compatibility = .true.
       patch%use_boundary = .true.
       patch%all_boundary_kinds = .false.
+      patch%points_checked = .false.
    end subroutine patch_reset
 
    !> Make room for at least `npoints` integration and `nbpoints` boundary points
@@ -317,7 +323,7 @@ contains
          call fail(error, trim(buf))
          return
       end if
-      do i = 1, patch%npoints
+      do i = 1, merge(0, patch%npoints, patch%points_checked)
          if (.not. all(abs(patch%x(1:d, i)) <= huge(1.0_wp))) then
             write (buf, '("x(:, ",i0,") is not finite")') i
             call fail(error, trim(buf))

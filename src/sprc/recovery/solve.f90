@@ -233,7 +233,7 @@ contains
 
       ws%qr(1:np, 1:nt) = ws%pw(1:np, 1:nt)
       call workspace_tic(ws)
-      call qr_pivoted(np, nt, ws%qr, ws%jpvt_p, ws%tau_p)
+      call qr_pivoted(np, nt, ws%qr, ws%jpvt_p, ws%tau_p, recovery_bite_ratio)
       call workspace_toc(ws, flops_geqrf(np, nt))
       r = diag_rank(ws%qr, min(np, nt))
       rec%basis_rank = r
@@ -511,7 +511,7 @@ contains
          rec%rows(kind_traction) = rec%rows(kind_traction) + m
          kmax = min(m, n)
          call workspace_tic(ws)
-         call qr_pivoted(m, n, ws%estack, ws%jpvt, ws%tau)
+         call qr_pivoted(m, n, ws%estack, ws%jpvt, ws%tau, recovery_bite_ratio)
          call apply_qt(m, kmax, ws%estack, ws%tau, 1, ws%trhs)
          call workspace_toc(ws, flops_geqrf(m, n) + flops_ormqr_left(m, 1, kmax))
          r = diag_rank(ws%estack, kmax, traction_rank_tol)
@@ -759,7 +759,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
 
       call workspace_tic(ws)
-      call qr_pivoted(n, m, ws%cq, ws%jpvt, ws%tau)
+      call qr_pivoted(n, m, ws%cq, ws%jpvt, ws%tau, recovery_bite_ratio)
       call workspace_toc(ws, flops_geqrf(n, m))
       r = diag_rank(ws%cq, min(n, m))
       if (r < min(n, m) .and. r > 0) call note_dropped(rec, abs(ws%cq(r + 1, r + 1))/abs(ws%cq(1, 1)))
