@@ -220,7 +220,7 @@ double sprc_get_recovery_eta(sprc_error error, sprc_recovery recovery);
 
 /* The recovered field sigma* at points[npts][dim] into stress[npts][nstress].
  * elements[npts] names the element of each point (0-based; -1 searches for
- * it); elements = NULL searches for every point (O(nelem) per point). A
+ * it); elements = NULL searches for every point (binned: O(nelem) once per call). A
  * point in no element (or not in the one named) is an error naming
  * points[i] and the element 0-based; on error the contents of stress are
  * unspecified. npts = 0 does nothing. */

@@ -99,7 +99,8 @@ contains
          new_unittest('patch_loop_skip', test_patch_loop_skip), &
          new_unittest('degree_auto', test_degree_auto), &
          new_unittest('legacy_wrapper', test_legacy), &
-         new_unittest('given_reference_coordinates', test_given_xi) &
+         new_unittest('given_reference_coordinates', test_given_xi), &
+         new_unittest('eval_binned_search', test_eval_binned) &
          ]
    end subroutine collect_mesh_recovery
 
@@ -1456,5 +1457,45 @@ contains
          deallocate (gxi)
       end do
    end subroutine test_given_xi
+
+   !> mesh_recovery_eval searches several points among the elements of their bin: the same
+   !> bits as one point at a time (a scan over all elements), on the nodes (shared by up to
+   !> 2^dim elements: the lowest index wins), the integration points and points between,
+   !> for quad4, tri3 and hex8; a point outside the mesh is named either way.
+   subroutine test_eval_binned(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(case_type) :: c
+      type(mesh_recovery_type) :: res
+      real(wp), allocatable :: pts(:, :), s_all(:, :), s_one(:, :)
+      integer, parameter :: etypes(3) = [elem_quad4, elem_tri3, elem_hex8]
+      integer :: k, i, n
+
+      do k = 1, size(etypes)
+         call build_case(c, etypes(k), 3, f_quadratic, 0.2_wp)
+         call recover_on_mesh(c%dim, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
+            & mesh_method_sprc, res, error)
+         if (allocated(error)) return
+         n = size(c%x, 2) + 2*size(c%gp, 2)*size(c%gp, 3)
+         allocate (pts(c%dim, n), s_all(res%nstress, n), s_one(res%nstress, n))
+         pts(:, 1:size(c%x, 2)) = c%x
+         pts(:, size(c%x, 2) + 1:size(c%x, 2) + size(c%gp, 2)*size(c%gp, 3)) = &
+            & reshape(c%gp, [c%dim, size(c%gp, 2)*size(c%gp, 3)])
+         pts(:, size(c%x, 2) + size(c%gp, 2)*size(c%gp, 3) + 1:) = &
+            & 0.5_wp*(reshape(c%gp, [c%dim, size(c%gp, 2)*size(c%gp, 3)]) + 0.5_wp)
+         call mesh_recovery_eval(res, pts, s_all, error)
+         if (allocated(error)) return
+         do i = 1, n
+            call mesh_recovery_eval(res, pts(:, i:i), s_one(:, i:i), error)
+            if (allocated(error)) return
+         end do
+         call check(error, same(s_all, s_one), 'binned search: same bits as point by point')
+         if (allocated(error)) return
+         pts(:, 7) = 1.5_wp
+         call mesh_recovery_eval(res, pts, s_all, error)
+         call expect(error, stat_invalid_input, 'x(:, 7) = ')
+         if (allocated(error)) return
+         deallocate (pts, s_all, s_one)
+      end do
+   end subroutine test_eval_binned
 
 end module sprc_test_mesh_recovery

@@ -55,7 +55,9 @@
 !>   any finite stresses give finite results (same bits as the plain formulas otherwise).
 !> Evaluation at points (`mesh_recovery_eval`): with the element of each point given, one
 !> inverse map per point; otherwise a search over the elements whose bounding box holds the
-!> point, one inverse map per candidate: O(nelem) box tests per point (no spatial index).
+!> point, one inverse map per candidate, the lowest-index element holding it: with 4 or more
+!> points to search, among the elements of the point's bin (sprc_recovery_mesh_bins, built
+!> per call in O(nelem)), else over all elements.
 !>
 !> Parallelism and determinism: the patch loop is sprc_recovery_patch_loop's (shared with
 !> the grid); the bits do not depend on the thread count.
@@ -74,6 +76,7 @@ module sprc_recovery_mesh
       & element_vertex_shape, element_node_xi, element_inside, element_inverse_map, element_name, &
       & facet_points, facet_npoints, max_facet_points, max_element_nodes
    use sprc_core_text, only: itoa
+   use sprc_recovery_mesh_bins, only: element_bins_type, build_element_bins, bin_of_point
    use sprc_recovery_mesh_check, only: check_mesh_options, check_mesh_arrays, check_mesh_facets, &
       & check_duplicate_nodes, check_duplicate_elements, vec_str, entry_name, index_name, &
       & mesh_method_spr, mesh_method_sprc, facet_traction, facet_symmetry, facet_free, facet_pressure
@@ -88,6 +91,9 @@ module sprc_recovery_mesh
    integer, parameter :: mesh_default_max_rounds = 3
    !> Tolerance (reference coordinates) for a point to count as inside an element.
    real(wp), parameter :: inside_tol = 1.0e-6_wp
+   !> mesh_recovery_eval bins the elements when at least this many points are searched
+   !> (building the bins costs about a few scans over the elements).
+   integer, parameter :: bins_min_points = 4
 
    !> Result of `recover_on_mesh` (module notes). Components are public plain data.
    type :: mesh_recovery_type
@@ -764,7 +770,7 @@ contains
    !> The recovered field sigma(nstress, npts) at points x(dim, npts) (SPR: nodal
    !> interpolation; SPR-C: union). elem(i) in 1..nelem names the element of point i (the
    !> point must lie in it); elem(i) = 0 or no `elem`: the element is searched (module
-   !> notes: O(nelem) per point). Errors: result not built, shapes, non-finite points, an
+   !> notes: binned when several points are searched). Errors: result not built, shapes, non-finite points, an
    !> element out of range, a point in no element (stat_invalid_input).
    subroutine mesh_recovery_eval(result, x, sigma, error, elem)
       type(mesh_recovery_type), intent(in) :: result
@@ -773,7 +779,8 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer, intent(in), optional :: elem(:)
       real(wp) :: xi(3)
-      integer :: i, e, npts
+      integer :: i, e, npts, nsearch
+      type(element_bins_type) :: bins
 
       npts = size(x, 2)
       if (.not. allocated(result%nodal)) then
@@ -785,6 +792,14 @@ contains
       if (allocated(error)) return
       if (present(elem)) then
          if (size(elem) /= npts) call fail('elem has '//itoa(size(elem))//' entries, x '//itoa(npts)//' points')
+         if (allocated(error)) return
+         nsearch = count(elem == 0)
+      else
+         nsearch = npts
+      end if
+      ! Several points to search: bins first (O(nelem) once instead of per point).
+      if (nsearch >= bins_min_points) then
+         call build_element_bins(result%box_lo, result%box_hi, inside_tol, bins, error)
          if (allocated(error)) return
       end if
       do i = 1, npts
@@ -806,7 +821,11 @@ contains
                return
             end if
          else
-            e = locate(result, x(:, i), xi)
+            if (allocated(bins%list)) then
+               e = locate(result, x(:, i), xi, bins)
+            else
+               e = locate(result, x(:, i), xi)
+            end if
             if (e == 0) then
                call fail(point(i)//' = '//vec_str(x(:, i))//' is in no element')
                return
@@ -839,23 +858,36 @@ contains
       if (ok) in_element = element_inside(r%element_type, xi, inside_tol)
    end function in_element
 
-   !> The first element (lowest index) holding x, 0 if none.
-   integer function locate(r, x, xi) result(found)
+   !> The first element (lowest index) holding x, 0 if none: among the candidates of x's bin
+   !> if `bins` is given (the same element: sprc_recovery_mesh_bins), else among all.
+   integer function locate(r, x, xi, bins) result(found)
       type(mesh_recovery_type), intent(in) :: r
       real(wp), intent(in) :: x(:)
       real(wp), intent(out) :: xi(:)
+      type(element_bins_type), intent(in), optional :: bins
       real(wp) :: pad
-      integer :: e
+      integer :: k, e, b
 
       found = 0
-      do e = 1, r%nelem
+      if (present(bins)) then
+         b = bin_of_point(bins, x)
+         do k = bins%ptr(b), bins%ptr(b + 1) - 1
+            if (try(bins%list(k))) return
+         end do
+      else
+         do e = 1, r%nelem
+            if (try(e)) return
+         end do
+      end if
+   contains
+      logical function try(e)
+         integer, intent(in) :: e
+         try = .false.
          pad = inside_tol*maxval(r%box_hi(:, e) - r%box_lo(:, e))
-         if (any(x(1:r%dim) < r%box_lo(:, e) - pad) .or. any(x(1:r%dim) > r%box_hi(:, e) + pad)) cycle
-         if (in_element(r, e, x, xi)) then
-            found = e
-            return
-         end if
-      end do
+         if (any(x(1:r%dim) < r%box_lo(:, e) - pad) .or. any(x(1:r%dim) > r%box_hi(:, e) + pad)) return
+         try = in_element(r, e, x, xi)
+         if (try) found = e
+      end function try
    end function locate
 
    pure function ivec_str(c_indices, v) result(s)
