@@ -385,20 +385,20 @@ contains
       type(recovered_patch_type), intent(inout) :: rec
       integer, intent(inout) :: mc
       type(error_type), allocatable, intent(out) :: error
-      integer :: i, j, k, b, nt, n, d
+      integer :: i, j, k, l, r, b, nt, n, d
 
       nt = ws%nt
       n = ws%n
       d = patch%dim
       call workspace_tic(ws)
-      ! Explicit loops: MATMUL of sections makes gfortran allocate temporaries per patch.
+      ! Over B's nonzeros by column (ws%bnz_*: one or two per column), not the dense B:
+      ! tmp(:, j) = (I x Mp) B(:, j), blk(k, j) = B(:, k)^T tmp(:, j).
       do j = 1, n
-         do i = 1, d
-            b = (i - 1)*nt
-            ws%tmp(b + 1:b + nt, j) = 0.0_wp
-            do k = 1, nt
-               ws%tmp(b + 1:b + nt, j) = ws%tmp(b + 1:b + nt, j) + ws%bdiv(b + k, j)*ws%mp(1:nt, k)
-            end do
+         ws%tmp(1:d*nt, j) = 0.0_wp
+         do l = ws%bnz_ptr(j), ws%bnz_ptr(j + 1) - 1
+            r = ws%bnz_row(l)
+            b = ((r - 1)/nt)*nt
+            ws%tmp(b + 1:b + nt, j) = ws%tmp(b + 1:b + nt, j) + ws%bnz_val(l)*ws%mp(1:nt, r - b)
          end do
       end do
       do i = 1, d
@@ -406,12 +406,23 @@ contains
       end do
       do j = 1, n
          do k = 1, n
-            ws%blk(k, j) = dot_product(ws%bdiv(1:d*nt, k), ws%tmp(1:d*nt, j))
+            ws%blk(k, j) = sparse_dot(k, ws%tmp(1:d*nt, j))
          end do
-         ws%brhs(j) = dot_product(ws%bdiv(1:d*nt, j), ws%erhs(1:d*nt))
+         ws%brhs(j) = sparse_dot(j, ws%erhs(1:d*nt))
       end do
       call workspace_toc(ws, d*flops_gemm(nt, n, nt) + flops_gemm(n, n, d*nt) + flops_gemv(d*nt, n))
       call select_block(ws, n, kind_equilibrium, rec, mc, error)
+   contains
+      !> B(:, k)^T v over the nonzeros of column k.
+      pure real(wp) function sparse_dot(k, v)
+         integer, intent(in) :: k
+         real(wp), intent(in) :: v(:)
+         integer :: l
+         sparse_dot = 0.0_wp
+         do l = ws%bnz_ptr(k), ws%bnz_ptr(k + 1) - 1
+            sparse_dot = sparse_dot + ws%bnz_val(l)*v(ws%bnz_row(l))
+         end do
+      end function sparse_dot
    end subroutine equilibrium_block
 
    !> (b) compatibility, exact: coefficient rows of L'C P A (compliance times E, which only scales).

@@ -37,8 +37,12 @@ module sprc_recovery_workspace
       type(poly_basis_type) :: basis
       !> Derivative matrices d/ds_k, dmat(nt, nt, dim); second-derivative matrices d2(nt, nt, nhess).
       real(wp), allocatable :: dmat(:, :, :), d2(:, :, :)
-      !> Coefficient-space divergence operator bdiv(dim*nt, n).
+      !> Coefficient-space divergence operator bdiv(dim*nt, n), and its nonzeros by column
+      !> (about one or two of dim*nt: a derivative maps a monomial to one monomial): column k
+      !> has rows bnz_row(bnz_ptr(k):bnz_ptr(k + 1) - 1) with values bnz_val(...).
       real(wp), allocatable :: bdiv(:, :)
+      integer, allocatable :: bnz_ptr(:), bnz_row(:)
+      real(wp), allocatable :: bnz_val(:)
       !> Incompatibility operator on strains, incomp(ncompat, ns, nhess).
       real(wp), allocatable :: incomp(:, :, :)
       !> Capacities: integration points, boundary points, unknowns, block rows, QR columns.
@@ -148,8 +152,30 @@ contains
          ws%d2(:, :, m) = matmul(ws%dmat(:, :, a), ws%dmat(:, :, b))
       end do
       call divergence_operator(dim, nt, ws%dmat, ws%bdiv)
+      call sparse_columns(ws%bdiv, ws%bnz_ptr, ws%bnz_row, ws%bnz_val)
       call incompatibility_operator(dim, ws%incomp)
    end subroutine build_operators
+
+   !> The nonzeros of a by column (CSC without the matrix's zeros).
+   pure subroutine sparse_columns(a, ptr, row, val)
+      real(wp), intent(in) :: a(:, :)
+      integer, allocatable, intent(out) :: ptr(:), row(:)
+      real(wp), allocatable, intent(out) :: val(:)
+      integer :: k, i, m
+
+      allocate (ptr(size(a, 2) + 1), row(count(a /= 0.0_wp)), val(count(a /= 0.0_wp)))
+      m = 0
+      ptr(1) = 1
+      do k = 1, size(a, 2)
+         do i = 1, size(a, 1)
+            if (a(i, k) == 0.0_wp) cycle
+            m = m + 1
+            row(m) = i
+            val(m) = a(i, k)
+         end do
+         ptr(k + 1) = m + 1
+      end do
+   end subroutine sparse_columns
 
    subroutine grow(ws, cp, cb, cn, cnt, error)
       type(recovery_workspace_type), intent(inout) :: ws
