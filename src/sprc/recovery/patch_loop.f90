@@ -16,15 +16,16 @@
 !>
 !> Parallelism and determinism: the loop is OpenMP-parallel over patches (dynamic
 !> schedule); each thread owns a patch object, two recovery workspaces, an element list
-!> and an element stamp array. LAPACK results depend on the workspace's capacities
-!> (leading dimensions, lwork and with it blocked or unblocked code), so every thread
-!> reserves the same capacity (`patch_capacity`: the largest unexpanded patch over the
-!> producer's nodes) and never grows it; a patch that outgrows it (only after expansion)
-!> is solved in the second workspace reset to its own size. Results depend on the patch
-!> alone and are stored per patch: the bits do not depend on the thread count or the
-!> schedule. Nothing is allocated per patch except for such outgrown patches. BLAS runs
-!> in one thread inside the loop (sprc_core_blas_threads). Errors are recorded per patch;
-!> after the loop the first failing patch is solved again serially for its message.
+!> and an element stamp array. Every thread reserves the same capacity (`patch_capacity`:
+!> the largest unexpanded patch over the producer's nodes) and never grows it, so that
+!> nothing is allocated per patch; a patch that outgrows it (only after expansion) is
+!> solved in the second workspace reset to its own size. The solves' kernels
+!> (sprc_recovery_dense) depend only on the patch's values and sizes, not on capacities,
+!> and results are stored per patch: the bits do not depend on the thread count or the
+!> schedule. The solves call no BLAS; OpenBLAS is held to one thread inside the loop all
+!> the same (sprc_core_blas_threads), for a producer's `fill` that might. Errors are
+!> recorded per patch; after the loop the first failing patch is solved again serially
+!> for its message.
 module sprc_recovery_patch_loop
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_singular, stat_internal
@@ -97,7 +98,7 @@ contains
    end function auto_degree
 
    !> [points, boundary points] of the largest unexpanded patch over `nodes` (at least
-   !> 4 nterms points: the LAPACK workspace queries need room for a full basis).
+   !> 4 nterms points: room for a full basis).
    function patch_capacity(source, dim, degree, ne_ptr, ne_list, nodes) result(cap)
       class(patch_source_type), intent(in) :: source
       integer, intent(in) :: dim, degree, ne_ptr(:), ne_list(:), nodes(:)
