@@ -73,7 +73,7 @@ contains
          call reflector(a(k:m, k), tau(k))
          if (tau(k) /= 0.0_wp) then
             do j = k + 1, n
-               call reflect(a(k + 1:m, k), tau(k), a(k:m, j))
+               call reflect(m - k + 1, a(k + 1:m, k), tau(k), a(k:m, j))
             end do
          end if
          do j = k + 1, n
@@ -118,16 +118,24 @@ contains
       x(1) = beta
    end subroutine reflector
 
-   !> c := H c for one column, H = I - tau v v^T with v = [1, v2] (v2 = the stored tail).
-   pure subroutine reflect(v2, tau, c)
-      real(wp), intent(in), contiguous :: v2(:)
-      real(wp), intent(in) :: tau
-      real(wp), intent(inout), contiguous :: c(:)
+   !> c(1:m) := H c for one column, H = I - tau v v^T with v = [1, v2(1:m-1)] (v2 = the
+   !> stored tail). Explicit-shape: called per column of tiny matrices, without descriptors.
+   pure subroutine reflect(m, v2, tau, c)
+      integer, intent(in) :: m
+      real(wp), intent(in) :: v2(m - 1), tau
+      real(wp), intent(inout) :: c(m)
       real(wp) :: s
+      integer :: i
 
-      s = tau*(c(1) + dot_product(v2, c(2:)))
+      s = c(1)
+      do i = 2, m
+         s = s + v2(i - 1)*c(i)
+      end do
+      s = tau*s
       c(1) = c(1) - s
-      c(2:) = c(2:) - s*v2
+      do i = 2, m
+         c(i) = c(i) - s*v2(i - 1)
+      end do
    end subroutine reflect
 
    !> b(1:m, 1:nrhs) := Q^T b with Q = H_1 ... H_k from `qr_pivoted` (a(1:m, 1:k), tau).
@@ -140,7 +148,7 @@ contains
 
       do j = 1, nrhs
          do i = 1, k
-            if (tau(i) /= 0.0_wp) call reflect(a(i + 1:m, i), tau(i), b(i:m, j))
+            if (tau(i) /= 0.0_wp) call reflect(m - i + 1, a(i + 1:m, i), tau(i), b(i:m, j))
          end do
       end do
    end subroutine apply_qt
@@ -155,7 +163,7 @@ contains
 
       do j = 1, nrhs
          do i = k, 1, -1
-            if (tau(i) /= 0.0_wp) call reflect(a(i + 1:m, i), tau(i), b(i:m, j))
+            if (tau(i) /= 0.0_wp) call reflect(m - i + 1, a(i + 1:m, i), tau(i), b(i:m, j))
          end do
       end do
    end subroutine apply_q
