@@ -37,6 +37,7 @@ module sprc_test_recovery
    use sprc_recovery_flops, only: flops_gemm, flops_gemv, flops_syrk, flops_geqrf, flops_ormqr_left, flops_trtrs, &
       & flops_sysv, design_matrix_flops
    use sprc_recovery_estimate, only: eval_recovered, eval_union, zz_error_integral
+   use sprc_recovery_dense, only: qr_pivoted, apply_qt, apply_q, solve_upper
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type
    implicit none
    private
@@ -95,6 +96,7 @@ contains
          new_unittest('traction_rank_curved_face', test_traction_curved_rank), &
          new_unittest('traction_face_off_node', test_traction_face_off_node), &
          new_unittest('flop_formulas', test_flop_formulas), &
+         new_unittest('dense_kernels', test_dense_kernels), &
          new_unittest('flop_count_spr', test_flop_count_spr), &
          new_unittest('flop_count_sprc', test_flop_count_sprc), &
          new_unittest('flop_count_sprc_traction', test_flop_count_traction) &
@@ -1700,5 +1702,83 @@ contains
          constrained = ns*nt**2*mc + (6*n*mc**2 - 2*mc**3 + 1)/3 + 2*(4*n*mc - 2*mc**2) + mc**2
       end function constrained
    end subroutine test_flop_count_traction
+
+   !> The dense kernels against what they must satisfy: for a 7 x 5 matrix of rank 3 (a
+   !> product of 7 x 3 and 3 x 5 factors), Q [R; 0] = A Pi (apply_q on R), Q^T Q = I on a
+   !> vector (apply_qt then apply_q), |R_kk| non-increasing to R_44, R_44 and R_55 at round-off
+   !> (rank 3 at the solves' 1e-10), the same rank when the factorisation stops at
+   !> 1e-12 |R_11|; R x = b and R^T x = b solved to round-off for the leading 3 x 3 R; a
+   !> zero diagonal is reported. Tolerances: 100 eps |A| (backward-stable Householder, a
+   !> handful of reflections of length 7).
+   subroutine test_dense_kernels(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: a(7, 5), f(7, 3), g(3, 5), qr(7, 5), r(7, 5), v(7, 1), v0(7, 1), tau(5), b(3, 2), x(3, 2)
+      real(wp) :: tol
+      integer :: jpvt(5), i, j
+      logical :: ok
+
+      do j = 1, 3
+         do i = 1, 7
+            f(i, j) = sin(1.3_wp*i*j + 0.7_wp*j)
+         end do
+         do i = 1, 5
+            g(j, i) = cos(0.9_wp*i*j + 0.4_wp*i)
+         end do
+      end do
+      a = matmul(f, g)
+      tol = 100.0_wp*epsilon(1.0_wp)*maxval(abs(a))
+      qr = a
+      call qr_pivoted(7, 5, qr, jpvt, tau)
+      r = 0.0_wp
+      do j = 1, 5
+         r(1:j, j) = qr(1:j, j)
+      end do
+      call apply_q(7, 5, qr, tau, 5, r)
+      call check(error, maxval(abs(r - a(:, jpvt))) <= tol, 'Q R = A Pi')
+      if (allocated(error)) return
+      call check(error, all([(abs(qr(i + 1, i + 1)) <= abs(qr(i, i)), i=1, 3)]) .and. abs(qr(5, 5)) <= tol .and. &
+         & abs(qr(4, 4)) <= tol .and. abs(qr(3, 3)) > 1.0e-10_wp*abs(qr(1, 1)), &
+         & '|R_kk| non-increasing, rank 3 revealed')
+      if (allocated(error)) return
+      v0(:, 1) = [(real(i, wp), i=1, 7)]
+      v = v0
+      call apply_qt(7, 5, qr, tau, 1, v)
+      call check(error, abs(norm2(v) - norm2(v0)) <= 10*epsilon(1.0_wp)*norm2(v0), 'Q^T keeps the norm')
+      if (allocated(error)) return
+      call apply_q(7, 5, qr, tau, 1, v)
+      call check(error, maxval(abs(v - v0)) <= 10*epsilon(1.0_wp)*norm2(v0), 'Q Q^T = I')
+      if (allocated(error)) return
+      r = a
+      call qr_pivoted(7, 5, r, jpvt, tau, 1.0e-12_wp)
+      call check(error, all(tau(4:5) == 0.0_wp) .and. abs(r(4, 4)) <= 1.0e-12_wp*abs(r(1, 1)) .and. &
+         & abs(r(5, 5)) <= 1.0e-12_wp*abs(r(1, 1)) .and. abs(r(3, 3)) > 1.0e-10_wp*abs(r(1, 1)), &
+         & 'stopped at the numerical rank: the same rank 3')
+      if (allocated(error)) return
+      x = reshape([1.0_wp, -2.0_wp, 0.5_wp, 3.0_wp, 0.25_wp, -1.0_wp], [3, 2])
+      b = 0.0_wp
+      do j = 1, 3
+         b(1:j, :) = b(1:j, :) + spread(qr(1:j, j), 2, 2)*spread(x(j, :), 1, j)
+      end do
+      call solve_upper(3, qr, 2, b, ok)
+      call check(error, ok .and. maxval(abs(b - x)) <= 1.0e6_wp*epsilon(1.0_wp), 'R x = b')
+      if (allocated(error)) return
+      b = matmul(transpose(upper(qr(1:3, 1:3))), x)
+      call solve_upper(3, qr, 2, b, ok, transposed=.true.)
+      call check(error, ok .and. maxval(abs(b - x)) <= 1.0e6_wp*epsilon(1.0_wp), 'R^T x = b')
+      if (allocated(error)) return
+      qr(2, 2) = 0.0_wp
+      call solve_upper(3, qr, 2, b, ok)
+      call check(error, .not. ok, 'a zero diagonal is reported')
+   contains
+      pure function upper(m) result(u)
+         real(wp), intent(in) :: m(:, :)
+         real(wp) :: u(size(m, 1), size(m, 2))
+         integer :: p
+         u = 0.0_wp
+         do p = 1, size(m, 2)
+            u(1:p, p) = m(1:p, p)
+         end do
+      end function upper
+   end subroutine test_dense_kernels
 
 end module sprc_test_recovery

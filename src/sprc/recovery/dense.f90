@@ -23,7 +23,7 @@ module sprc_recovery_dense
    implicit none
    private
 
-   public :: qr_pivoted, apply_qt, apply_q, solve_upper, solve_upper_t
+   public :: qr_pivoted, apply_qt, apply_q, solve_upper
 
 contains
 
@@ -168,18 +168,28 @@ contains
       end do
    end subroutine apply_q
 
-   !> b(1:k, 1:nrhs) := R^-1 b, R = the upper triangle of a(1:k, 1:k). ok = .false. (b
-   !> partly overwritten) if a diagonal entry is zero or a result is not finite.
-   pure subroutine solve_upper(k, a, nrhs, b, ok)
+   !> b(1:k, 1:nrhs) := R^-1 b, or R^-T b if `transposed`, R = the upper triangle of
+   !> a(1:k, 1:k). ok = .false. (b partly overwritten) if a diagonal entry is zero or a
+   !> result is not finite.
+   pure subroutine solve_upper(k, a, nrhs, b, ok, transposed)
       integer, intent(in) :: k, nrhs
       real(wp), intent(in) :: a(:, :)
       real(wp), intent(inout) :: b(:, :)
       logical, intent(out) :: ok
+      logical, intent(in), optional :: transposed
       integer :: i, j
 
       ok = all([(a(i, i) /= 0.0_wp, i=1, k)])
       if (.not. ok) return
       do j = 1, nrhs
+         if (present(transposed)) then
+            if (transposed) then
+               do i = 1, k
+                  b(i, j) = (b(i, j) - dot_product(a(1:i - 1, i), b(1:i - 1, j)))/a(i, i)
+               end do
+               cycle
+            end if
+         end if
          do i = k, 1, -1
             b(i, j) = b(i, j)/a(i, i)
             b(1:i - 1, j) = b(1:i - 1, j) - b(i, j)*a(1:i - 1, i)
@@ -187,23 +197,5 @@ contains
       end do
       ok = all(abs(b(1:k, 1:nrhs)) <= huge(1.0_wp))
    end subroutine solve_upper
-
-   !> b(1:k, 1:nrhs) := R^-T b, R = the upper triangle of a(1:k, 1:k); ok as `solve_upper`.
-   pure subroutine solve_upper_t(k, a, nrhs, b, ok)
-      integer, intent(in) :: k, nrhs
-      real(wp), intent(in) :: a(:, :)
-      real(wp), intent(inout) :: b(:, :)
-      logical, intent(out) :: ok
-      integer :: i, j
-
-      ok = all([(a(i, i) /= 0.0_wp, i=1, k)])
-      if (.not. ok) return
-      do j = 1, nrhs
-         do i = 1, k
-            b(i, j) = (b(i, j) - dot_product(a(1:i - 1, i), b(1:i - 1, j)))/a(i, i)
-         end do
-      end do
-      ok = all(abs(b(1:k, 1:nrhs)) <= huge(1.0_wp))
-   end subroutine solve_upper_t
 
 end module sprc_recovery_dense

@@ -101,7 +101,7 @@
 module sprc_recovery_solve
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular
-   use sprc_recovery_dense, only: qr_pivoted, apply_qt, apply_q, solve_upper, solve_upper_t
+   use sprc_recovery_dense, only: qr_pivoted, apply_qt, apply_q, solve_upper
    use sprc_core_material, only: compliance_matrix
    use sprc_core_poly, only: poly_max_degree
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, check_patch, dominant_boundary_kind, &
@@ -340,7 +340,7 @@ contains
       call workspace_tic(ws)
       do c = 1, ns
          b = (c - 1)*nt
-         call solve_upper_t(nt, ws%qr, mc, ws%cq(b + 1:b + nt, 1:mc), ok)
+         call solve_upper(nt, ws%qr, mc, ws%cq(b + 1:b + nt, 1:mc), ok, transposed=.true.)
          if (.not. ok) return
       end do
       call qr_pivoted(n, mc, ws%cq, ws%jpvt, ws%tau)
@@ -349,7 +349,7 @@ contains
       end do
       call apply_qt(n, mc, ws%cq, ws%tau, 1, z)
       z(1:mc, 1) = ws%lam(ws%jpvt(1:mc))
-      call solve_upper_t(mc, ws%cq, 1, z, ok)
+      call solve_upper(mc, ws%cq, 1, z, ok, transposed=.true.)
       if (ok) call apply_q(n, mc, ws%cq, ws%tau, 1, z)
       call workspace_toc(ws, ns*flops_trtrs(nt, mc) + flops_geqrf(n, mc) + 2*flops_ormqr_left(n, 1, mc) + &
          & flops_trtrs(mc, 1))
