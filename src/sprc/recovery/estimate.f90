@@ -6,7 +6,7 @@ module sprc_recovery_estimate
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_material, only: voigt_size, compliance_matrix
-   use sprc_core_poly, only: poly_exponents_2d, poly_exponents_3d, poly_max_degree
+   use sprc_core_poly, only: poly_exponents_2d, poly_exponents_3d, poly_max_degree, poly_max_terms
    use sprc_recovery_patch, only: recovered_patch_type
    implicit none
    private
@@ -35,11 +35,12 @@ contains
       type(recovered_patch_type), intent(in) :: rec
       real(wp), intent(in) :: x(:)
       real(wp), intent(out) :: sigma(:)
-      real(wp) :: s, pw(0:poly_max_degree, 3), p
-      integer :: i, k, e(3)
+      real(wp) :: s, pw(0:poly_max_degree, 3), p(poly_max_terms)
+      integer :: i, k, c, e(3)
 
-      ! Powers of each scaled coordinate once (s**e is a call per term); the products are
-      ! formed as s(1)**e(1) * s(2)**e(2) * s(3)**e(3), in that order.
+      ! Powers of each scaled coordinate once (s**e is a call per term); the terms as
+      ! s(1)**e(1) * s(2)**e(2) * s(3)**e(3), in that order; then each component as one
+      ! sum over the terms in term order (contiguous columns of coef).
       pw = 1.0_wp
       do k = 1, rec%dim
          s = (x(k) - rec%x0(k))/rec%h
@@ -47,15 +48,19 @@ contains
          pw(2, k) = s*s
          pw(3, k) = pw(2, k)*s
       end do
-      sigma(1:rec%nstress) = 0.0_wp
       do i = 1, rec%nterms
          if (rec%dim == 2) then
             e = poly_exponents_2d(:, i)
          else
             e = poly_exponents_3d(:, i)
          end if
-         p = pw(e(1), 1)*pw(e(2), 2)*pw(e(3), 3)
-         sigma(1:rec%nstress) = sigma(1:rec%nstress) + p*rec%coef(i, 1:rec%nstress)
+         p(i) = pw(e(1), 1)*pw(e(2), 2)*pw(e(3), 3)
+      end do
+      do c = 1, rec%nstress
+         sigma(c) = 0.0_wp
+         do i = 1, rec%nterms
+            sigma(c) = sigma(c) + p(i)*rec%coef(i, c)
+         end do
       end do
    end subroutine eval_recovered_unchecked
 
