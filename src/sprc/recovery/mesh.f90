@@ -142,9 +142,8 @@ module sprc_recovery_mesh
       integer :: dim = 0, analysis = 0, nstress = 0, nen = 0
       logical :: sprc = .false.
       real(wp) :: young = 0.0_wp, poisson = 0.0_wp
-      real(wp), pointer, contiguous :: x(:, :) => null(), gp(:, :, :) => null(), gw(:, :) => null(), &
-         & gs(:, :, :) => null()
-      integer, pointer, contiguous :: connectivity(:, :) => null()
+      real(wp), pointer :: x(:, :) => null(), gp(:, :, :) => null(), gw(:, :) => null(), gs(:, :, :) => null()
+      integer, pointer :: connectivity(:, :) => null()
       type(topology_type), pointer :: topo => null()
    contains
       procedure :: fill => mesh_fill
@@ -167,8 +166,7 @@ contains
       !> Element nodes (nen, nelem), 1-based, VTK order.
       integer, intent(in) :: connectivity(:, :)
       !> Integration points (dim, ngp, nelem), weight*|J| (ngp, nelem), FE stress (nstress, ngp, nelem).
-      !> (Contiguous: the patch loop reads them through contiguous pointers.)
-      real(wp), intent(in), target, contiguous :: gp(:, :, :), gw(:, :), gs(:, :, :)
+      real(wp), intent(in), target :: gp(:, :, :), gw(:, :), gs(:, :, :)
       real(wp), intent(in) :: young, poisson
       integer, intent(in) :: method
       type(mesh_recovery_type), intent(out), target :: result
@@ -561,7 +559,7 @@ contains
    subroutine recover_patches(r, topo, gp, gw, gs, rounds, error)
       type(mesh_recovery_type), intent(inout), target :: r
       type(topology_type), intent(in), target :: topo
-      real(wp), intent(in), target, contiguous :: gp(:, :, :), gw(:, :), gs(:, :, :)
+      real(wp), intent(in), target :: gp(:, :, :), gw(:, :), gs(:, :, :)
       integer, intent(in) :: rounds
       type(error_type), allocatable, intent(out) :: error
       type(mesh_source_type) :: src
