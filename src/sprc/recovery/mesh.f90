@@ -429,7 +429,7 @@ contains
       !> 0, or the first point of e whose coordinates fail.
       integer function check_element(e) result(status)
          integer, intent(in) :: e
-         real(wp) :: xe(3, max_element_nodes), n(max_element_nodes), x(3), he, tol
+         real(wp) :: xe(3, max_element_nodes), n(max_element_nodes), x(3), he, xmax, tol
          integer :: a, j, d
 
          d = r%dim
@@ -437,6 +437,7 @@ contains
             xe(1:d, a) = r%x(:, r%connectivity(a, e))
          end do
          he = maxval(r%box_hi(:, e) - r%box_lo(:, e))
+         xmax = maxval(abs(xe(1:d, 1:r%nen)))
          status = 0
          do j = 1, ngp
             xi(:, j, e) = gxi(:, j, e)
@@ -446,7 +447,7 @@ contains
             call element_shape(r%element_type, gxi(:, j, e), n)
             x(1:d) = matmul(xe(1:d, 1:r%nen), n(1:r%nen))
             tol = inside_tol*he + real(r%nen + 2, wp)*epsilon(1.0_wp)*(maxval(abs(gp(:, j, e))) + &
-               & sum(abs(n(1:r%nen)))*maxval(abs(xe(1:d, 1:r%nen))))
+               & sum(abs(n(1:r%nen)))*xmax)
             if (.not. (maxval(abs(x(1:d) - gp(:, j, e))) <= tol)) return
             status = 0
          end do
