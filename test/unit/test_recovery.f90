@@ -1713,7 +1713,7 @@ contains
    subroutine test_dense_kernels(error)
       type(error_type), allocatable, intent(out) :: error
       real(wp) :: a(7, 5), f(7, 3), g(3, 5), qr(7, 5), r(7, 5), v(7, 1), v0(7, 1), tau(5), b(3, 2), x(3, 2)
-      real(wp) :: tol
+      real(wp) :: tol, vn(5, 2)
       integer :: jpvt(5), i, j
       logical :: ok
 
@@ -1728,7 +1728,7 @@ contains
       a = matmul(f, g)
       tol = 100.0_wp*epsilon(1.0_wp)*maxval(abs(a))
       qr = a
-      call qr_pivoted(7, 5, qr, jpvt, tau)
+      call qr_pivoted(7, 5, qr, jpvt, tau, vn)
       r = 0.0_wp
       do j = 1, 5
          r(1:j, j) = qr(1:j, j)
@@ -1749,7 +1749,7 @@ contains
       call check(error, maxval(abs(v - v0)) <= 10*epsilon(1.0_wp)*norm2(v0), 'Q Q^T = I')
       if (allocated(error)) return
       r = a
-      call qr_pivoted(7, 5, r, jpvt, tau, 1.0e-12_wp)
+      call qr_pivoted(7, 5, r, jpvt, tau, vn, 1.0e-12_wp)
       call check(error, all(tau(4:5) == 0.0_wp) .and. abs(r(4, 4)) <= 1.0e-12_wp*abs(r(1, 1)) .and. &
          & abs(r(5, 5)) <= 1.0e-12_wp*abs(r(1, 1)) .and. abs(r(3, 3)) > 1.0e-10_wp*abs(r(1, 1)), &
          & 'stopped at the numerical rank: the same rank 3')

@@ -35,25 +35,28 @@ contains
    !> most its column's norm: a rank decision |R_kk| > tol |R_11| with tol >= stop_ratio
    !> comes out as for the full factorisation. (Equilibrium rows of SPR-C have rank 2 of 9
    !> in 2D p = 1, 3 of 24 in 3D: the rest of the factorisation was round-off.)
-   pure subroutine qr_pivoted(m, n, a, jpvt, tau, stop_ratio)
+   pure subroutine qr_pivoted(m, n, a, jpvt, tau, vn, stop_ratio)
       integer, intent(in) :: m, n
       real(wp), intent(inout), contiguous :: a(:, :)
       integer, intent(out) :: jpvt(:)
       real(wp), intent(out) :: tau(:)
+      !> Work space for the column norms, vn(n, 2) at least (the caller's: an automatic
+      !> array here would be a malloc per call in gfortran).
+      real(wp), intent(out) :: vn(:, :)
       real(wp), intent(in), optional :: stop_ratio
       real(wp), parameter :: tol3z = sqrt(epsilon(1.0_wp))
-      real(wp) :: vn1(n), vn2(n), t, t2
+      real(wp) :: t, t2
       integer :: i, j, k, p, it
 
       do j = 1, n
          jpvt(j) = j
-         vn1(j) = vnorm(a(1:m, j))
-         vn2(j) = vn1(j)
+         vn(j, 1) = vnorm(a(1:m, j))
+         vn(j, 2) = vn(j, 1)
       end do
       do k = 1, min(m, n)
-         p = k - 1 + maxloc(vn1(k:n), dim=1)
+         p = k - 1 + maxloc(vn(k:n, 1), dim=1)
          if (present(stop_ratio) .and. k > 1) then
-            if (vn1(p) <= stop_ratio*abs(a(1, 1))) then
+            if (vn(p, 1) <= stop_ratio*abs(a(1, 1))) then
                tau(k:min(m, n)) = 0.0_wp
                return
             end if
@@ -67,8 +70,8 @@ contains
             it = jpvt(p)
             jpvt(p) = jpvt(k)
             jpvt(k) = it
-            vn1(p) = vn1(k)
-            vn2(p) = vn2(k)
+            vn(p, 1) = vn(k, 1)
+            vn(p, 2) = vn(k, 2)
          end if
          call reflector(a(k:m, k), tau(k))
          if (tau(k) /= 0.0_wp) then
@@ -77,19 +80,19 @@ contains
             end do
          end if
          do j = k + 1, n
-            if (vn1(j) == 0.0_wp) cycle
-            t = 1.0_wp - (abs(a(k, j))/vn1(j))**2
+            if (vn(j, 1) == 0.0_wp) cycle
+            t = 1.0_wp - (abs(a(k, j))/vn(j, 1))**2
             t = max(t, 0.0_wp)
-            t2 = t*(vn1(j)/vn2(j))**2
+            t2 = t*(vn(j, 1)/vn(j, 2))**2
             if (t2 <= tol3z) then
                if (k < m) then
-                  vn1(j) = vnorm(a(k + 1:m, j))
+                  vn(j, 1) = vnorm(a(k + 1:m, j))
                else
-                  vn1(j) = 0.0_wp
+                  vn(j, 1) = 0.0_wp
                end if
-               vn2(j) = vn1(j)
+               vn(j, 2) = vn(j, 1)
             else
-               vn1(j) = vn1(j)*sqrt(t)
+               vn(j, 1) = vn(j, 1)*sqrt(t)
             end if
          end do
       end do

@@ -233,7 +233,7 @@ contains
 
       ws%qr(1:np, 1:nt) = ws%pw(1:np, 1:nt)
       call workspace_tic(ws)
-      call qr_pivoted(np, nt, ws%qr, ws%jpvt_p, ws%tau_p, recovery_bite_ratio)
+      call qr_pivoted(np, nt, ws%qr, ws%jpvt_p, ws%tau_p, ws%vn, recovery_bite_ratio)
       call workspace_toc(ws, flops_geqrf(np, nt))
       r = diag_rank(ws%qr, min(np, nt))
       rec%basis_rank = r
@@ -325,7 +325,6 @@ contains
       type(recovery_workspace_type), intent(inout) :: ws
       integer, intent(in) :: mc
       logical, intent(out) :: ok
-      real(wp) :: z(ws%n, 1)
       integer :: nt, ns, n, c, i, b
 
       nt = ws%nt
@@ -343,19 +342,19 @@ contains
          call solve_upper(nt, ws%qr, mc, ws%cq(b + 1:b + nt, 1:mc), ok, transposed=.true.)
          if (.not. ok) return
       end do
-      call qr_pivoted(n, mc, ws%cq, ws%jpvt, ws%tau)
+      call qr_pivoted(n, mc, ws%cq, ws%jpvt, ws%tau, ws%vn)
       do c = 1, ns
-         z((c - 1)*nt + 1:c*nt, 1) = ws%rhs(1:nt, c)
+         ws%z((c - 1)*nt + 1:c*nt, 1) = ws%rhs(1:nt, c)
       end do
-      call apply_qt(n, mc, ws%cq, ws%tau, 1, z)
-      z(1:mc, 1) = ws%lam(ws%jpvt(1:mc))
-      call solve_upper(mc, ws%cq, 1, z, ok, transposed=.true.)
-      if (ok) call apply_q(n, mc, ws%cq, ws%tau, 1, z)
+      call apply_qt(n, mc, ws%cq, ws%tau, 1, ws%z)
+      ws%z(1:mc, 1) = ws%lam(ws%jpvt(1:mc))
+      call solve_upper(mc, ws%cq, 1, ws%z, ok, transposed=.true.)
+      if (ok) call apply_q(n, mc, ws%cq, ws%tau, 1, ws%z)
       call workspace_toc(ws, ns*flops_trtrs(nt, mc) + flops_geqrf(n, mc) + 2*flops_ormqr_left(n, 1, mc) + &
          & flops_trtrs(mc, 1))
       if (.not. ok) return
       do c = 1, ns
-         ws%rhs(1:nt, c) = z((c - 1)*nt + 1:c*nt, 1)
+         ws%rhs(1:nt, c) = ws%z((c - 1)*nt + 1:c*nt, 1)
       end do
    end subroutine project_constraints
 
@@ -522,7 +521,7 @@ contains
          rec%rows(kind_traction) = rec%rows(kind_traction) + m
          kmax = min(m, n)
          call workspace_tic(ws)
-         call qr_pivoted(m, n, ws%estack, ws%jpvt, ws%tau, recovery_bite_ratio)
+         call qr_pivoted(m, n, ws%estack, ws%jpvt, ws%tau, ws%vn, recovery_bite_ratio)
          call apply_qt(m, kmax, ws%estack, ws%tau, 1, ws%trhs)
          call workspace_toc(ws, flops_geqrf(m, n) + flops_ormqr_left(m, 1, kmax))
          r = diag_rank(ws%estack, kmax, traction_rank_tol)
@@ -770,7 +769,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
 
       call workspace_tic(ws)
-      call qr_pivoted(n, m, ws%cq, ws%jpvt, ws%tau, recovery_bite_ratio)
+      call qr_pivoted(n, m, ws%cq, ws%jpvt, ws%tau, ws%vn, recovery_bite_ratio)
       call workspace_toc(ws, flops_geqrf(n, m))
       r = diag_rank(ws%cq, min(n, m))
       if (r < min(n, m) .and. r > 0) call note_dropped(rec, abs(ws%cq(r + 1, r + 1))/abs(ws%cq(1, 1)))

@@ -66,6 +66,9 @@ module sprc_recovery_workspace
       real(wp), allocatable :: cq(:, :)
       !> Accepted constraint rows c(cap_mq, cap_n) and right-hand side lam(cap_mq).
       real(wp), allocatable :: c(:, :), lam(:)
+      !> Column norms of the pivoted QRs vn(max(cap_mq, cap_n), 2); the constrained solve's
+      !> vector z(cap_n, 1).
+      real(wp), allocatable :: vn(:, :), z(:, :)
       !> Householder scalars and pivots of the basis QR (tau_p, jpvt_p) and of the others.
       real(wp), allocatable :: tau(:), tau_p(:)
       integer, allocatable :: jpvt(:), jpvt_p(:)
@@ -196,7 +199,7 @@ contains
       if (allocated(ws%s)) then
          deallocate (ws%s, ws%wn, ws%pw, ws%qr, ws%rhs, ws%mp, ws%blk, ws%brhs, ws%tmp)
          deallocate (ws%estack, ws%trhs, ws%erhs, ws%cq, ws%c, ws%lam, ws%bface, ws%bfirst)
-         deallocate (ws%tau, ws%jpvt, ws%tau_p, ws%jpvt_p)
+         deallocate (ws%tau, ws%jpvt, ws%tau_p, ws%jpvt_p, ws%vn, ws%z)
       end if
       allocate (ws%s(3, max(cp, 1)), ws%wn(max(cp, 1)), stat=st)
       if (st == 0) allocate (ws%pw(max(cp, cnt), cnt), ws%qr(max(cp, cnt), cnt), ws%rhs(max(cp, cnt), 6), stat=st)
@@ -206,6 +209,7 @@ contains
       if (st == 0) allocate (ws%bface(max(cb, 1)), ws%bfirst(max(cb, 1)), stat=st)
       if (st == 0) allocate (ws%tau(max(ws%cap_mq, cn)), ws%jpvt(max(ws%cap_mq, cn)), ws%tau_p(cnt), &
          & ws%jpvt_p(cnt), stat=st)
+      if (st == 0) allocate (ws%vn(max(ws%cap_mq, cn, cnt), 2), ws%z(cn, 1), stat=st)
       if (st /= 0) then
          call workspace_init(ws)
          call fatal_error(error, 'recovery workspace: out of memory for a patch of '//itoa(cp)//' points', &
