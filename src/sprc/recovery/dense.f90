@@ -147,12 +147,10 @@ contains
       real(wp), intent(in), contiguous :: a(:, :)
       real(wp), intent(in) :: tau(:)
       real(wp), intent(inout), contiguous :: b(:, :)
-      integer :: i, j
+      integer :: i
 
-      do j = 1, nrhs
-         do i = 1, k
-            if (tau(i) /= 0.0_wp) call reflect(m - i + 1, a(i + 1:m, i), tau(i), b(i:m, j))
-         end do
+      do i = 1, k
+         call reflect_columns(m, i, a, tau(i), nrhs, b)
       end do
    end subroutine apply_qt
 
@@ -162,14 +160,40 @@ contains
       real(wp), intent(in), contiguous :: a(:, :)
       real(wp), intent(in) :: tau(:)
       real(wp), intent(inout), contiguous :: b(:, :)
-      integer :: i, j
+      integer :: i
 
-      do j = 1, nrhs
-         do i = k, 1, -1
-            if (tau(i) /= 0.0_wp) call reflect(m - i + 1, a(i + 1:m, i), tau(i), b(i:m, j))
-         end do
+      do i = k, 1, -1
+         call reflect_columns(m, i, a, tau(i), nrhs, b)
       end do
    end subroutine apply_q
+
+   !> b(i:m, 1:nrhs) := H_i b(i:m, 1:nrhs), H_i = I - tau v v^T, v = [1, a(i+1:m, i)]. Up to
+   !> `chunk` columns at a time: their sums are independent chains (one column's sum alone
+   !> waits on each addition); each column's sum is still c(i) + v(i+1) c(i+1) + ... in
+   !> that order, as in `reflect`.
+   pure subroutine reflect_columns(m, i, a, tau, nrhs, b)
+      integer, intent(in) :: m, i, nrhs
+      real(wp), intent(in), contiguous :: a(:, :)
+      real(wp), intent(in) :: tau
+      real(wp), intent(inout), contiguous :: b(:, :)
+      integer, parameter :: chunk = 8
+      real(wp) :: s(chunk)
+      integer :: j0, nc, r
+
+      if (tau == 0.0_wp) return
+      do j0 = 1, nrhs, chunk
+         nc = min(chunk, nrhs - j0 + 1)
+         s(1:nc) = b(i, j0:j0 + nc - 1)
+         do r = i + 1, m
+            s(1:nc) = s(1:nc) + a(r, i)*b(r, j0:j0 + nc - 1)
+         end do
+         s(1:nc) = tau*s(1:nc)
+         b(i, j0:j0 + nc - 1) = b(i, j0:j0 + nc - 1) - s(1:nc)
+         do r = i + 1, m
+            b(r, j0:j0 + nc - 1) = b(r, j0:j0 + nc - 1) - s(1:nc)*a(r, i)
+         end do
+      end do
+   end subroutine reflect_columns
 
    !> b(1:k, 1:nrhs) := R^-1 b, or R^-T b if `transposed`, R = the upper triangle of
    !> a(1:k, 1:k). ok = .false. (b partly overwritten) if a diagonal entry is zero or a
