@@ -87,9 +87,12 @@ sprc_report sprc_run_scene(sprc_error error, const char *path, const int *levels
 /* A report has one row per level and the columns of the report CSV, in its
  * order: level, h, elements, cut_elements, dofs, t_mesh, t_quadrature,
  * t_assembly, t_solve, t_recovery, t_estimate, t_total, err_fe, err_spr,
- * err_sprc, eta_spr, eta_sprc, theta_spr, theta_sprc (more may follow in
- * later versions). Every value is a double; integer columns (level,
- * elements, cut_elements, dofs) are exact. A cell that does not apply (no
+ * err_sprc, eta_spr, eta_sprc, theta_spr, theta_sprc, then for a study
+ * with contact contact_iterations, t_contact, contact_measure, p_max_fe,
+ * p_max_spr, p_max_sprc, p_max_exact, err_p_fe, err_p_spr, err_p_sprc, then
+ * solver_iterations (more may follow in later versions; read columns by
+ * name). Every value is a double; integer columns (level, elements,
+ * cut_elements, dofs, contact_iterations, solver_iterations) are exact. A cell that does not apply (no
  * exact solution, recovery not run) is EMPTY and reads as a quiet NaN:
  * test it with isnan(). */
 

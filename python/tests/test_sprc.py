@@ -18,7 +18,7 @@ ROOT = Path(__file__).resolve().parents[2]
 LAME = ROOT / "example" / "scenes" / "lame_cylinder.nml"
 BAD = ROOT / "test" / "data" / "scenes" / "bad"
 COLUMNS = ("level,h,elements,cut_elements,dofs,t_mesh,t_quadrature,t_assembly,t_solve,t_recovery,t_estimate,"
-           "t_total,err_fe,err_spr,err_sprc,eta_spr,eta_sprc,theta_spr,theta_sprc").split(",")
+           "t_total,err_fe,err_spr,err_sprc,eta_spr,eta_sprc,theta_spr,theta_sprc,solver_iterations").split(",")
 
 
 def driver():

@@ -168,15 +168,20 @@ static void test_run_lame(void) {
   CHECK(rep != NULL, "sprc_run_scene failed on the Lame example");
   CHECK(sprc_check_error(err) == 0, "a successful run set the error");
   CHECK(sprc_get_report_rows(err, rep) == 2, "not 2 rows for levels 3,4");
-  CHECK(sprc_get_report_columns(err, rep) == 19, "not the 19 report columns");
+  /* No contact: the 19 columns of every report, then solver_iterations. */
+  CHECK(sprc_get_report_columns(err, rep) == 20, "not the 20 report columns");
   sprc_get_report_column(err, rep, 0, col, &size);
   CHECK(strcmp(col, "level") == 0, "column 0 is not 'level'");
   sprc_get_report_column(err, rep, 18, col, &size);
   CHECK(strcmp(col, "theta_sprc") == 0, "column 18 is not 'theta_sprc'");
+  sprc_get_report_column(err, rep, 19, col, &size);
+  CHECK(strcmp(col, "solver_iterations") == 0, "column 19 is not 'solver_iterations'");
   sprc_get_report_column(err, rep, 12, col, &tiny);
   CHECK(strcmp(col, "er") == 0, "a truncated column name is not 'er'");
-  sprc_get_report_column(err, rep, 19, col, &size);
-  CHECK(has_error(err, "out of range"), "no error for column index 19");
+  sprc_get_report_column(err, rep, 20, col, &size);
+  CHECK(has_error(err, "out of range"), "no error for column index 20");
+  CHECK(isnan(sprc_get_report_value(err, rep, 0, "p_max_fe")) && has_error(err, "p_max_fe"),
+        "a contact column of a report without contact is not refused");
   sprc_get_report_column(err, rep, -1, col, &size);
   CHECK(has_error(err, "out of range"), "no error for column index -1");
 

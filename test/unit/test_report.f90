@@ -6,7 +6,8 @@ module sprc_test_report
    use sprc_core_error, only: stat_io, stat_invalid_input
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type
    use sprc_io_report, only: report_row_type, report_table, write_report_csv, read_report_csv, &
-      & report_column, report_empty, is_empty, report_csv_header, report_columns, n_report_columns
+      & report_column, report_empty, is_empty, report_csv_header, report_columns, n_report_columns, &
+      & report_column_indices
    use sprc_io_svg, only: write_report_svg, report_svg
    implicit none
    private
@@ -21,7 +22,10 @@ contains
       type(unittest_type), allocatable, intent(out) :: testsuite(:)
       testsuite = [ &
          new_unittest('csv_header_exact', test_csv_header), &
+         new_unittest('csv_header_contact', test_csv_header_contact), &
          new_unittest('csv_round_trip_bitwise', test_csv_round_trip), &
+         new_unittest('csv_round_trip_contact', test_csv_round_trip_contact), &
+         new_unittest('csv_read_contract_columns_only', test_csv_read_base_only), &
          new_unittest('csv_empty_cells_empty', test_csv_empty_cells), &
          new_unittest('csv_no_rows', test_csv_no_rows), &
          new_unittest('csv_unwritable_path', test_csv_unwritable), &
@@ -31,6 +35,7 @@ contains
          new_unittest('csv_read_short_line', test_csv_read_short_line), &
          new_unittest('column_access', test_column_access), &
          new_unittest('table_levels_aligned', test_table), &
+         new_unittest('table_contact_columns', test_table_contact), &
          new_unittest('table_significant_digits', test_table_digits), &
          new_unittest('xml_checker_rejects_bad', test_xml_checker), &
          new_unittest('svg_well_formed', test_svg_well_formed), &
@@ -72,6 +77,29 @@ contains
       rows(2)%theta_spr = -0.0_wp
    end function sample_rows
 
+   !> The sample rows of a study with contact: every contact column set (a
+   !> Krylov solve, so solver_iterations too), err_p_spr empty in row 1.
+   function contact_rows() result(rows)
+      type(report_row_type) :: rows(3)
+      integer :: i
+      rows = sample_rows()
+      do i = 1, 3
+         rows(i)%has_contact = .true.
+         rows(i)%contact_iterations = 3*i + 1
+         rows(i)%t_contact = 0.25_wp*i
+         rows(i)%contact_measure = 1.0_wp/3.0_wp + i
+         rows(i)%p_max_fe = 1.1e-4_wp*i
+         rows(i)%p_max_spr = 1.2e-4_wp*i
+         rows(i)%p_max_sprc = 1.3e-4_wp*i
+         rows(i)%p_max_exact = 1.080247e-4_wp
+         rows(i)%err_p_fe = 0.1_wp/3.0_wp**i
+         rows(i)%err_p_spr = 0.2_wp/3.0_wp**i
+         rows(i)%err_p_sprc = 0.3_wp/3.0_wp**i
+         rows(i)%solver_iterations = 100*i + 7
+      end do
+      rows(1)%err_p_spr = report_empty
+   end function contact_rows
+
    !> Rows without an exact solution: err_* and theta_* empty.
    function no_exact_rows() result(rows)
       type(report_row_type) :: rows(3)
@@ -95,13 +123,97 @@ contains
       if (allocated(error)) return
       call read_text_file(path, text, error)
       if (allocated(error)) return
-      ! The header is copied from SCENE.md, independently of the module's constant.
-      call check(error, text(1:index(text, new_line('a')) - 1), contract, 'CSV header line')
+      ! The header is copied from SCENE.md, independently of the module's constant:
+      ! the columns of every report, then (no contact) solver_iterations.
+      call check(error, text(1:index(text, new_line('a')) - 1), contract//',solver_iterations', 'CSV header line')
       if (allocated(error)) return
       call check(error, report_csv_header, contract, 'report_csv_header')
       if (allocated(error)) return
       call check(error, count_char(text, new_line('a')), 4, 'header + 3 rows')
    end subroutine test_csv_header
+
+   !> A study with contact: the contact columns of SCENE.md after theta_sprc,
+   !> then solver_iterations; integers printed as integers.
+   subroutine test_csv_header_contact(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: text, line
+      character(len=*), parameter :: path = dir//'test_report_header_contact.csv'
+      character(len=*), parameter :: contract = 'level,h,elements,cut_elements,dofs,t_mesh,t_quadrature,'// &
+         't_assembly,t_solve,t_recovery,t_estimate,t_total,err_fe,err_spr,err_sprc,eta_spr,eta_sprc,'// &
+         'theta_spr,theta_sprc,'// &
+         'contact_iterations,t_contact,contact_measure,p_max_fe,p_max_spr,p_max_sprc,p_max_exact,err_p_fe,'// &
+         'err_p_spr,err_p_sprc,solver_iterations'
+
+      call write_report_csv(path, contact_rows(), error)
+      if (allocated(error)) return
+      call read_text_file(path, text, error)
+      if (allocated(error)) return
+      call check(error, text(1:index(text, new_line('a')) - 1), contract, 'CSV header line')
+      if (allocated(error)) return
+      line = text(index(text, new_line('a')) + 1:)
+      line = line(:index(line, new_line('a')) - 1)
+      call check(error, count_char(line, ','), 29, 'every row has 30 cells')
+      if (allocated(error)) return
+      call check(error, cell_of(line, 20), '4', 'contact_iterations an integer')
+      if (allocated(error)) return
+      call check(error, cell_of(line, 28), '', 'err_p_spr empty')
+      if (allocated(error)) return
+      call check(error, cell_of(line, 30), '107', 'solver_iterations an integer (last cell)')
+   end subroutine test_csv_header_contact
+
+   !> Every column of a study with contact reads back bit for bit, and the rows
+   !> read back have contact.
+   subroutine test_csv_round_trip_contact(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(report_row_type) :: rows(3)
+      type(report_row_type), allocatable :: back(:)
+      character(len=*), parameter :: path = dir//'test_report_round_trip_contact.csv'
+      integer :: i, j
+      real(wp) :: a(3), b(3)
+
+      rows = contact_rows()
+      call write_report_csv(path, rows, error)
+      if (allocated(error)) return
+      call read_report_csv(path, back, error)
+      if (allocated(error)) return
+      call check(error, size(back), 3, 'rows read back')
+      if (allocated(error)) return
+      call check(error, all(back%has_contact), 'rows read back have contact')
+      if (allocated(error)) return
+      do j = 1, n_report_columns
+         a = report_column(rows, trim(report_columns(j)))
+         b = report_column(back, trim(report_columns(j)))
+         do i = 1, 3
+            if (transfer(a(i), 1_i8) /= transfer(b(i), 1_i8)) then
+               call test_failed(error, 'column '//trim(report_columns(j))//' row '//itoa(i)//' differs in bits')
+               return
+            end if
+         end do
+      end do
+      call check(error, all(back%solver_iterations == rows%solver_iterations) .and. &
+         & all(back%contact_iterations == rows%contact_iterations), 'iteration counts')
+   end subroutine test_csv_round_trip_contact
+
+   !> A file with only the 19 columns of every report (an older sprc) reads:
+   !> no contact, solver_iterations 0; an unknown further column is ignored.
+   subroutine test_csv_read_base_only(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(report_row_type), allocatable :: back(:)
+      character(len=*), parameter :: path = dir//'test_report_base_only.csv'
+      character(len=*), parameter :: nl = new_line('a')
+
+      call write_text_file(path, report_csv_header//',future_column'//nl//'1,0.5,4,0,18,,,,,,,,0.25,,,,,,,x'//nl, &
+         & error)
+      if (allocated(error)) return
+      call read_report_csv(path, back, error)
+      if (allocated(error)) return
+      call check(error, size(back), 1, 'one row')
+      if (allocated(error)) return
+      call check(error, .not. back(1)%has_contact .and. back(1)%solver_iterations == 0 .and. &
+         & .not. (abs(back(1)%err_fe - 0.25_wp) > 0.0_wp) .and. back(1)%dofs == 18, 'row read by the header names')
+      if (allocated(error)) return
+      call check(error, all(is_empty(report_column(back, 'p_max_fe'))), 'contact column empty without contact')
+   end subroutine test_csv_read_base_only
 
    subroutine test_csv_round_trip(error)
       type(error_type), allocatable, intent(out) :: error
@@ -148,18 +260,20 @@ contains
       if (allocated(error)) return
       call check(error, index(lower(text), 'nan') == 0, 'no NaN anywhere in the CSV')
       if (allocated(error)) return
-      ! Second data line: columns 13..15 and 18..19 empty -> ",,," and a trailing ",".
+      ! Second data line: columns 13..15 and 18..19 empty, then solver_iterations.
       pos = index(text, new_line('a'))
       do i = 1, 2
          line = text(pos + 1:)
          line = line(:index(line, new_line('a')) - 1)
          pos = pos + len(line) + 1
       end do
-      call check(error, count_char(line, ','), n_report_columns - 1, 'every row has 19 cells')
+      call check(error, count_char(line, ','), 19, 'every row has 20 cells')
       if (allocated(error)) return
       call check(error, cell_of(line, 13), '', 'err_fe empty')
       if (allocated(error)) return
-      call check(error, cell_of(line, 19), '', 'theta_sprc empty (last cell)')
+      call check(error, cell_of(line, 19), '', 'theta_sprc empty')
+      if (allocated(error)) return
+      call check(error, cell_of(line, 20), '0', 'solver_iterations 0 (a direct solve; last cell)')
       if (allocated(error)) return
       call check(error, len(cell_of(line, 16)) > 0, 'eta_spr present')
       if (allocated(error)) return
@@ -274,14 +388,30 @@ contains
    !> exactly where its run ends, and nothing may stick out of a run.
    subroutine test_table(error)
       type(error_type), allocatable, intent(out) :: error
-      type(report_row_type) :: rows(3)
+      call check_table(no_exact_rows(), 20, error)
+   end subroutine test_table
+
+   !> With contact the table has all 30 columns, contact ones included.
+   subroutine test_table_contact(error)
+      type(error_type), allocatable, intent(out) :: error
+      call check_table(contact_rows(), 30, error)
+   end subroutine test_table_contact
+
+   subroutine check_table(rows, ncolumns, error)
+      type(report_row_type), intent(in) :: rows(3)
+      integer, intent(in) :: ncolumns
+      type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: table
-      character(len=400) :: lines(5)
+      character(len=600) :: lines(5)
       integer :: i, j, n, first(n_report_columns), last(n_report_columns), ncol, pos
+      integer, allocatable :: columns(:)
+      character(len=:), allocatable :: name
       real(wp) :: v(3)
 
-      rows = no_exact_rows()
       table = report_table(rows)
+      columns = report_column_indices(rows)
+      call check(error, size(columns), ncolumns, 'columns of the rows')
+      if (allocated(error)) return
       call split_lines(table, lines, n)
       call check(error, n, 5, 'header, rule, 3 rows')
       if (allocated(error)) return
@@ -304,33 +434,37 @@ contains
             pos = pos + 1
          end if
       end do
-      call check(error, ncol, n_report_columns, 'dash runs in the rule')
+      call check(error, ncol, ncolumns, 'dash runs in the rule')
       if (allocated(error)) return
-      do j = 1, n_report_columns
-         call check(error, lines(1)(first(j):last(j)), right_in(trim(report_columns(j)), last(j) - first(j) + 1), &
+      do j = 1, ncolumns
+         name = trim(report_columns(columns(j)))
+         call check(error, lines(1)(first(j):last(j)), right_in(name, last(j) - first(j) + 1), &
             'header of column '//itoa(j))
          if (allocated(error)) return
-         v = report_column(rows, trim(report_columns(j)))
+         v = report_column(rows, name)
          do i = 1, 3
             if (is_empty(v(i))) then
                call check(error, len_trim(lines(i + 2)(first(j):last(j))) == 0, &
-                  'empty '//trim(report_columns(j))//' blank in row '//itoa(i))
+                  'empty '//name//' blank in row '//itoa(i))
             else
                call check(error, lines(i + 2)(last(j):last(j)) /= ' ' .and. lines(i + 2)(first(j):first(j)) /= '-', &
-                  trim(report_columns(j))//' right-aligned in row '//itoa(i))
+                  name//' right-aligned in row '//itoa(i))
             end if
             if (allocated(error)) return
          end do
       end do
-      call check(error, all(first(2:) - last(:n_report_columns - 1) == 3), 'two blanks between columns')
+      call check(error, all(first(2:ncolumns) - last(:ncolumns - 1) == 3), 'two blanks between columns')
       if (allocated(error)) return
       do i = 1, 3
          call check(error, adjustl(lines(i + 2)(first(1):last(1))), itoa(rows(i)%level), 'level of row '//itoa(i))
          if (allocated(error)) return
          call check(error, adjustl(lines(i + 2)(first(5):last(5))), itoa(int(rows(i)%dofs)), 'dofs of row '//itoa(i))
          if (allocated(error)) return
+         call check(error, adjustl(lines(i + 2)(first(ncolumns):last(ncolumns))), itoa(rows(i)%solver_iterations), &
+            & 'solver_iterations (last) of row '//itoa(i))
+         if (allocated(error)) return
       end do
-   end subroutine test_table
+   end subroutine check_table
 
    pure function right_in(s, w) result(r)
       character(len=*), intent(in) :: s

@@ -7,7 +7,7 @@ module sprc_capi_report
    use, intrinsic :: iso_c_binding, only: c_ptr, c_int, c_double, c_null_ptr, c_associated, c_f_pointer
    use sprc_core_error, only: stat_invalid_input
    use sprc_core_text, only: itoa
-   use sprc_io_report, only: report_row_type, report_column, report_columns, n_report_columns, report_empty
+   use sprc_io_report, only: report_row_type, report_column, report_columns, report_column_indices, report_empty
    use sprc_capi_error, only: capi_error_type, get_capi_error, set_capi_error
    use sprc_capi_string, only: c_string, copy_to_buffer
    implicit none
@@ -36,7 +36,8 @@ contains
       n = size(rep%rows)
    end function sprc_get_report_rows
 
-   !> Number of columns; -1 on error.
+   !> Number of columns (the contact columns count only in a report with
+   !> contact); -1 on error.
    function sprc_get_report_columns(errh, reph) result(n) bind(C, name='sprc_get_report_columns')
       type(c_ptr), value :: errh, reph
       integer(c_int) :: n
@@ -45,7 +46,7 @@ contains
 
       n = -1
       if (.not. get_handles(errh, reph, 'sprc_get_report_columns', err, rep)) return
-      n = n_report_columns
+      n = size(report_column_indices(rep%rows))
    end function sprc_get_report_columns
 
    !> The name of column `index` (0-based) into `buf` of `*size` bytes,
@@ -56,14 +57,17 @@ contains
       type(c_ptr), value :: buf, size
       type(capi_error_type), pointer :: err
       type(capi_report_type), pointer :: rep
+      integer, allocatable :: columns(:)
 
       if (.not. get_handles(errh, reph, 'sprc_get_report_column', err, rep)) return
-      if (index < 0 .or. index >= n_report_columns) then
+      columns = report_column_indices(rep%rows)
+      ! (`size` is a dummy argument here: the intrinsic is not reachable)
+      if (index < 0 .or. index >= n_columns(columns)) then
          call set_capi_error(err, message='sprc_get_report_column: column index '//itoa(index)// &
-            ' is out of range 0..'//itoa(n_report_columns - 1), stat=stat_invalid_input)
+            ' is out of range 0..'//itoa(n_columns(columns) - 1), stat=stat_invalid_input)
          return
       end if
-      call copy_to_buffer(trim(report_columns(index + 1)), buf, size)
+      call copy_to_buffer(trim(report_columns(columns(index + 1))), buf, size)
    end subroutine sprc_get_report_column
 
    !> The cell of row `row` (0-based) in the column named `column`; NaN for
@@ -80,7 +84,7 @@ contains
 
       x = report_empty
       if (.not. get_handles(errh, reph, 'sprc_get_report_value', err, rep)) return
-      if (.not. get_column(err, column, 'sprc_get_report_value', name)) return
+      if (.not. get_column(err, rep, column, 'sprc_get_report_value', name)) return
       if (row < 0 .or. row >= size(rep%rows)) then
          call set_capi_error(err, message='sprc_get_report_value: row '//itoa(row)//' is out of range 0..'// &
             itoa(size(rep%rows) - 1), stat=stat_invalid_input)
@@ -101,7 +105,7 @@ contains
       real(c_double), pointer :: out(:)
 
       if (.not. get_handles(errh, reph, 'sprc_get_report_values', err, rep)) return
-      if (.not. get_column(err, column, 'sprc_get_report_values', name)) return
+      if (.not. get_column(err, rep, column, 'sprc_get_report_values', name)) return
       if (n /= size(rep%rows)) then
          call set_capi_error(err, message='sprc_get_report_values: n = '//itoa(n)//' but the report has '// &
             itoa(size(rep%rows))//' rows', stat=stat_invalid_input)
@@ -150,11 +154,13 @@ contains
    end function get_handles
 
    !> The column name behind a C string, checked against the report's columns.
-   logical function get_column(err, column, entry, name) result(ok)
+   logical function get_column(err, rep, column, entry, name) result(ok)
       type(capi_error_type), intent(inout) :: err
+      type(capi_report_type), intent(in) :: rep
       type(c_ptr), intent(in) :: column
       character(len=*), intent(in) :: entry
       character(len=:), allocatable, intent(out) :: name
+      integer, allocatable :: columns(:)
       integer :: j
 
       call c_string(column, name, ok)
@@ -164,20 +170,27 @@ contains
       end if
       ! Not findloc: gfortran 12 finds nothing when the value is a deferred-length dummy.
       ok = .false.
-      do j = 1, n_report_columns
-         ok = len(name) == len_trim(report_columns(j)) .and. trim(report_columns(j)) == name
+      columns = report_column_indices(rep%rows)
+      do j = 1, size(columns)
+         ok = len(name) == len_trim(report_columns(columns(j))) .and. trim(report_columns(columns(j))) == name
          if (ok) exit
       end do
       if (.not. ok) call set_capi_error(err, message=entry//': no report column is named "'//name// &
-         '" (columns: '//column_list()//')', stat=stat_invalid_input)
+         '" (columns: '//column_list(columns)//')', stat=stat_invalid_input)
    end function get_column
 
-   function column_list() result(s)
+   pure integer function n_columns(columns)
+      integer, intent(in) :: columns(:)
+      n_columns = size(columns)
+   end function n_columns
+
+   function column_list(columns) result(s)
+      integer, intent(in) :: columns(:)
       character(len=:), allocatable :: s
       integer :: j
-      s = trim(report_columns(1))
-      do j = 2, n_report_columns
-         s = s//', '//trim(report_columns(j))
+      s = trim(report_columns(columns(1)))
+      do j = 2, size(columns)
+         s = s//', '//trim(report_columns(columns(j)))
       end do
    end function column_list
 

@@ -19,18 +19,27 @@ module sprc_io_report
 
    public :: report_row_type, report_table, write_report_csv, read_report_csv, format_mesh_row
    public :: report_column, report_empty, is_empty
-   public :: n_report_columns, report_columns, report_csv_header
+   public :: n_report_columns, report_columns, report_csv_header, report_column_indices, report_header
 
-   !> Number of contract columns.
-   integer, parameter :: n_report_columns = 19
+   !> Number of columns a report may have: the 19 of every study, the 10
+   !> contact columns and `solver_iterations`.
+   integer, parameter :: n_report_columns = 30
 
-   !> Column names, in the contract's order.
-   character(len=12), parameter :: report_columns(n_report_columns) = [character(len=12) :: &
+   !> Column names, in the contract's order (SCENE.md "Report").
+   character(len=18), parameter :: report_columns(n_report_columns) = [character(len=18) :: &
       & 'level', 'h', 'elements', 'cut_elements', 'dofs', 't_mesh', 't_quadrature', 't_assembly', &
       & 't_solve', 't_recovery', 't_estimate', 't_total', 'err_fe', 'err_spr', 'err_sprc', &
-      & 'eta_spr', 'eta_sprc', 'theta_spr', 'theta_sprc']
+      & 'eta_spr', 'eta_sprc', 'theta_spr', 'theta_sprc', &
+      & 'contact_iterations', 't_contact', 'contact_measure', 'p_max_fe', 'p_max_spr', 'p_max_sprc', &
+      & 'p_max_exact', 'err_p_fe', 'err_p_spr', 'err_p_sprc', 'solver_iterations']
 
-   !> The CSV header line, exactly as SCENE.md states it.
+   !> Columns 1..n_base_columns are in every report, in this order, first; the
+   !> contact columns (first_contact_column..last_contact_column) only in a
+   !> study with contact; `solver_iterations` (the last) in every report.
+   integer, parameter :: n_base_columns = 19, first_contact_column = 20, last_contact_column = 29
+
+   !> The CSV header of the columns every report starts with, exactly as SCENE.md
+   !> states it (`report_header` gives a report's whole header).
    character(len=*), parameter :: report_csv_header = 'level,h,elements,cut_elements,dofs,t_mesh,'// &
       & 't_quadrature,t_assembly,t_solve,t_recovery,t_estimate,t_total,err_fe,err_spr,err_sprc,'// &
       & 'eta_spr,eta_sprc,theta_spr,theta_sprc'
@@ -39,12 +48,44 @@ module sprc_io_report
    integer, parameter :: kind_integer = 1, kind_sig3 = 2, kind_error = 3
    integer, parameter :: column_kind(n_report_columns) = [kind_integer, kind_sig3, kind_integer, &
       & kind_integer, kind_integer, kind_sig3, kind_sig3, kind_sig3, kind_sig3, kind_sig3, kind_sig3, &
-      & kind_sig3, kind_error, kind_error, kind_error, kind_error, kind_error, kind_sig3, kind_sig3]
+      & kind_sig3, kind_error, kind_error, kind_error, kind_error, kind_error, kind_sig3, kind_sig3, &
+      & kind_integer, kind_sig3, kind_error, kind_error, kind_error, kind_error, kind_error, kind_error, &
+      & kind_error, kind_error, kind_integer]
 
 contains
 
+   !> The columns `rows` carry, as indices into `report_columns`: every column
+   !> but the contact ones, which come (after theta_sprc, before
+   !> solver_iterations) when any row has contact.
+   pure function report_column_indices(rows) result(indices)
+      type(report_row_type), intent(in) :: rows(:)
+      integer, allocatable :: indices(:)
+      integer :: j
+
+      if (any(rows%has_contact)) then
+         indices = [(j, j=1, n_report_columns)]
+      else
+         indices = [(j, j=1, n_base_columns), (j, j=last_contact_column + 1, n_report_columns)]
+      end if
+   end function report_column_indices
+
+   !> The CSV header line of `rows`: their columns' names, comma-separated.
+   pure function report_header(rows) result(header)
+      type(report_row_type), intent(in) :: rows(:)
+      character(len=:), allocatable :: header
+      integer, allocatable :: indices(:)
+      integer :: j
+
+      indices = report_column_indices(rows)
+      header = trim(report_columns(indices(1)))
+      do j = 2, size(indices)
+         header = header//','//trim(report_columns(indices(j)))
+      end do
+   end function report_header
+
    !> The values of column `name` over `rows` (integers converted to real;
-   !> empty cells stay empty). An unknown name gives all-empty values.
+   !> empty cells stay empty; the contact columns are empty in a row without
+   !> contact). An unknown name gives all-empty values.
    pure function report_column(rows, name) result(values)
       type(report_row_type), intent(in) :: rows(:)
       character(len=*), intent(in) :: name
@@ -64,6 +105,10 @@ contains
       type(report_row_type), intent(in) :: row
       integer, intent(in) :: j
 
+      if (j >= first_contact_column .and. j <= last_contact_column .and. .not. row%has_contact) then
+         x = report_empty
+         return
+      end if
       select case (j)
       case (1); x = real(row%level, wp)
       case (2); x = row%h
@@ -83,7 +128,18 @@ contains
       case (16); x = row%eta_spr
       case (17); x = row%eta_sprc
       case (18); x = row%theta_spr
-      case default; x = row%theta_sprc
+      case (19); x = row%theta_sprc
+      case (20); x = real(row%contact_iterations, wp)
+      case (21); x = row%t_contact
+      case (22); x = row%contact_measure
+      case (23); x = row%p_max_fe
+      case (24); x = row%p_max_spr
+      case (25); x = row%p_max_sprc
+      case (26); x = row%p_max_exact
+      case (27); x = row%err_p_fe
+      case (28); x = row%err_p_spr
+      case (29); x = row%err_p_sprc
+      case default; x = real(row%solver_iterations, wp)
       end select
    end function row_values
 
@@ -109,6 +165,15 @@ contains
       case (17); row%eta_sprc = x
       case (18); row%theta_spr = x
       case (19); row%theta_sprc = x
+      case (21); row%t_contact = x
+      case (22); row%contact_measure = x
+      case (23); row%p_max_fe = x
+      case (24); row%p_max_spr = x
+      case (25); row%p_max_sprc = x
+      case (26); row%p_max_exact = x
+      case (27); row%err_p_fe = x
+      case (28); row%err_p_spr = x
+      case (29); row%err_p_sprc = x
       end select
    end subroutine set_real
 
@@ -123,6 +188,8 @@ contains
       case (3); row%elements = n
       case (4); row%cut_elements = n
       case (5); row%dofs = n
+      case (20); row%contact_iterations = int(n)
+      case (30); row%solver_iterations = int(n)
       end select
    end subroutine set_integer
 
@@ -135,7 +202,9 @@ contains
       case (1); n = int(row%level, i8)
       case (3); n = row%elements
       case (4); n = row%cut_elements
-      case default; n = row%dofs
+      case (5); n = row%dofs
+      case (20); n = int(row%contact_iterations, i8)
+      case default; n = int(row%solver_iterations, i8)
       end select
    end function row_integer
 
@@ -149,32 +218,36 @@ contains
       type :: cell_type
          character(len=:), allocatable :: s
       end type cell_type
-      type(cell_type) :: cells(n_report_columns, size(rows))
-      integer :: width(n_report_columns), i, j
+      type(cell_type), allocatable :: cells(:, :)
+      integer, allocatable :: columns(:), width(:)
+      integer :: i, j, n
       character(len=:), allocatable :: line
       character, parameter :: nl = new_line('a')
 
-      do j = 1, n_report_columns
-         width(j) = len_trim(report_columns(j))
+      columns = report_column_indices(rows)
+      n = size(columns)
+      allocate (cells(n, size(rows)), width(n))
+      do j = 1, n
+         width(j) = len_trim(report_columns(columns(j)))
          do i = 1, size(rows)
-            cells(j, i)%s = table_cell(rows(i), j)
+            cells(j, i)%s = table_cell(rows(i), columns(j))
             width(j) = max(width(j), len(cells(j, i)%s))
          end do
       end do
 
       line = ''
-      do j = 1, n_report_columns
-         line = line//'  '//right(trim(report_columns(j)), width(j))
+      do j = 1, n
+         line = line//'  '//right(trim(report_columns(columns(j))), width(j))
       end do
       table = line(3:)//nl
       line = ''
-      do j = 1, n_report_columns
+      do j = 1, n
          line = line//'  '//repeat('-', width(j))
       end do
       table = table//line(3:)//nl
       do i = 1, size(rows)
          line = ''
-         do j = 1, n_report_columns
+         do j = 1, n
             line = line//'  '//right(cells(j, i)%s, width(j))
          end do
          table = table//trim(line(3:))//nl
@@ -197,12 +270,12 @@ contains
       character(len=32) :: buf
       real(wp) :: x
 
-      if (column_kind(j) == kind_integer) then
+      x = row_values(row, j)
+      if (column_kind(j) == kind_integer .and. .not. is_empty(x)) then
          write (buf, '(i0)') row_integer(row, j)
          s = trim(buf)
          return
       end if
-      x = row_values(row, j)
       if (is_empty(x)) then
          s = ''
       else if (column_kind(j) == kind_error) then
@@ -259,21 +332,21 @@ contains
       character(len=32) :: buf
       real(wp) :: x
 
+      x = row_values(row, j)
+      if (is_empty(x)) then
+         s = ''
+         return
+      end if
       if (column_kind(j) == kind_integer) then
          write (buf, '(i0)') row_integer(row, j)
       else
-         x = row_values(row, j)
-         if (is_empty(x)) then
-            s = ''
-            return
-         end if
          write (buf, '(es25.16e3)') x
       end if
       s = trim(adjustl(buf))
    end function csv_cell
 
-   !> Write `rows` as CSV to `path` (replacing it): the contract header, then
-   !> one line per row. Fails with stat_io naming the path.
+   !> Write `rows` as CSV to `path` (replacing it): the header of their columns
+   !> (`report_header`), then one line per row. Fails with stat_io naming the path.
    subroutine write_report_csv(path, rows, error)
       character(len=*), intent(in) :: path
       type(report_row_type), intent(in) :: rows(:)
@@ -281,6 +354,7 @@ contains
       integer :: unit, stat, i, j
       character(len=256) :: msg
       character(len=:), allocatable :: line
+      integer, allocatable :: columns(:)
 
       open (newunit=unit, file=path, status='replace', action='write', form='formatted', &
          iostat=stat, iomsg=msg)
@@ -288,12 +362,13 @@ contains
          call fatal_error(error, 'report CSV: cannot open "'//path//'" for writing: '//trim(msg), stat_io)
          return
       end if
-      write (unit, '(a)', iostat=stat, iomsg=msg) report_csv_header
+      columns = report_column_indices(rows)
+      write (unit, '(a)', iostat=stat, iomsg=msg) report_header(rows)
       do i = 1, size(rows)
          if (stat /= 0) exit
-         line = csv_cell(rows(i), 1)
-         do j = 2, n_report_columns
-            line = line//','//csv_cell(rows(i), j)
+         line = csv_cell(rows(i), columns(1))
+         do j = 2, size(columns)
+            line = line//','//csv_cell(rows(i), columns(j))
          end do
          write (unit, '(a)', iostat=stat, iomsg=msg) line
       end do
@@ -307,10 +382,13 @@ contains
    end subroutine write_report_csv
 
    !> Read a report CSV written by `write_report_csv` (or by anything that
-   !> follows the contract). The header must start with the contract columns
-   !> in order; further columns are ignored. Empty real cells become empty;
-   !> "NaN" is refused (the contract never writes it). A missing file is
-   !> stat_io; a malformed line is stat_invalid_input naming path and line.
+   !> follows the contract). The header must start with the 19 columns every
+   !> report has, in order; the columns after them are read by their names
+   !> (the contact columns, which mark the rows as `has_contact`, and
+   !> `solver_iterations`, 0 when absent), unknown ones ignored. Empty real
+   !> cells become empty; "NaN" is refused (the contract never writes it). A
+   !> missing file is stat_io; a malformed line is stat_invalid_input naming
+   !> path and line.
    subroutine read_report_csv(path, rows, error)
       character(len=*), intent(in) :: path
       type(report_row_type), allocatable, intent(out) :: rows(:)
@@ -320,6 +398,7 @@ contains
       character(len=:), allocatable :: line
       type(report_row_type) :: row
       type(report_row_type), allocatable :: buffer(:)
+      integer, allocatable :: columns(:)
       integer :: nrows
 
       allocate (rows(0))
@@ -334,7 +413,7 @@ contains
          call fatal_error(error, 'report CSV "'//path//'": no header line', stat_invalid_input)
          return
       end if
-      call check_header(line, path, error)
+      call header_columns(line, path, columns, error)
       if (allocated(error)) then
          close (unit)
          return
@@ -347,7 +426,7 @@ contains
          if (stat /= 0) exit
          nline = nline + 1
          if (len_trim(line) == 0) cycle
-         call parse_row(line, path, nline, row, error)
+         call parse_row(line, path, nline, columns, row, error)
          if (allocated(error)) exit
          if (nrows == size(buffer)) buffer = [buffer, buffer]
          nrows = nrows + 1
@@ -362,50 +441,67 @@ contains
       rows = buffer(:nrows)
    end subroutine read_report_csv
 
-   !> Check that a header line starts with the contract columns.
-   subroutine check_header(line, path, error)
+   !> The column (index into `report_columns`, 0 if unknown) of each field of
+   !> a header line, which must start with the 19 columns of every report.
+   subroutine header_columns(line, path, columns, error)
       character(len=*), intent(in) :: line, path
+      integer, allocatable, intent(out) :: columns(:)
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: field
-      integer :: pos, j
+      integer :: pos, j, k
 
+      allocate (columns(0))
       pos = 1
-      do j = 1, n_report_columns
+      do j = 1, n_base_columns
          call next_field(line, pos, field)
          if (field /= trim(report_columns(j))) then
             call fatal_error(error, 'report CSV "'//path//'": header column '//itoa(j)//' is "'//field// &
                '", expected "'//trim(report_columns(j))//'"', stat_invalid_input)
             return
          end if
+         columns = [columns, j]
       end do
-   end subroutine check_header
+      do while (pos <= len(line) + 1)
+         call next_field(line, pos, field)
+         k = 0
+         do j = n_base_columns + 1, n_report_columns
+            if (field == trim(report_columns(j))) k = j
+         end do
+         columns = [columns, k]
+      end do
+   end subroutine header_columns
 
-   !> Parse one data line into a row.
-   subroutine parse_row(line, path, nline, row, error)
+   !> Parse one data line into a row; `columns` as from `header_columns`.
+   subroutine parse_row(line, path, nline, columns, row, error)
       character(len=*), intent(in) :: line, path
-      integer, intent(in) :: nline
+      integer, intent(in) :: nline, columns(:)
       type(report_row_type), intent(out) :: row
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: field
       character(len=64) :: buf
-      integer :: pos, j, stat
+      integer :: pos, k, j, stat
       integer(i8) :: n
       real(wp) :: x
 
+      row%has_contact = any(columns >= first_contact_column .and. columns <= last_contact_column)
       pos = 1
-      do j = 1, n_report_columns
+      do k = 1, size(columns)
          if (pos > len(line) + 1) then
-            call fatal_error(error, 'report CSV "'//path//'" line '//itoa(nline)//': '//itoa(j - 1)// &
-               ' columns, expected '//itoa(n_report_columns), stat_invalid_input)
+            call fatal_error(error, 'report CSV "'//path//'" line '//itoa(nline)//': '//itoa(k - 1)// &
+               ' columns, expected '//itoa(size(columns)), stat_invalid_input)
             return
          end if
          call next_field(line, pos, field)
+         j = columns(k)
+         if (j == 0) cycle
          stat = 0
          if (len(field) > len(buf)) stat = 1
          buf = field
          if (column_kind(j) == kind_integer) then
             if (len(field) == 0) stat = 1
             if (stat == 0) read (buf, '(i64)', iostat=stat) n
+            ! every integer column but elements, cut_elements and dofs is a default integer
+            if (stat == 0 .and. (j < 3 .or. j > 5) .and. abs(n) > huge(1)) stat = 1
             if (stat == 0) call set_integer(row, j, n)
          else if (len(field) > 0) then
             if (stat == 0) read (buf, '(f64.0)', iostat=stat) x
