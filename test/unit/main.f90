@@ -24,6 +24,7 @@ program sprc_unit_tests
    use sprc_test_mesh_recovery, only: collect_mesh_recovery
    use sprc_test_stiff, only: collect_stiff
    use sprc_test_study, only: collect_study
+   use sprc_test_contact_model, only: collect_contact_model
    implicit none
 
    type(testsuite_type), allocatable :: suites(:)
@@ -50,7 +51,8 @@ program sprc_unit_tests
       new_testsuite('fem', collect_fem), &
       new_testsuite('mesh_recovery', collect_mesh_recovery), &
       new_testsuite('stiff', collect_stiff), &
-      new_testsuite('study', collect_study) &
+      new_testsuite('study', collect_study), &
+      new_testsuite('contact_model', collect_contact_model) &
       ]
 
    call get_arg(1, suite_name)

@@ -1,6 +1,8 @@
 !> From a validated scene to the objects the analysis works with: geometry
 !> bodies (one per `&body`, shapes in file order), each body's FE conditions
-!> on its own shape indices, and the exact solution with a body's material.
+!> on its own shape indices, the exact solution as it holds in each body
+!> (with that body's material), and the exact contact pressure of a
+!> `&contact` pair.
 !>
 !> The scene reader has already validated every field; errors here are the
 !> constructors' own checks, prefixed with the scene group they came from.
@@ -14,6 +16,10 @@ module sprc_study_model
    use sprc_exact_solution, only: exact_solution_type
    use sprc_exact_lame, only: lame_cylinder_type, lame_sphere_type, new_lame_cylinder, new_lame_sphere
    use sprc_exact_kirsch, only: kirsch_type, new_kirsch
+   use sprc_exact_uniform, only: uniform_type, new_uniform
+   use sprc_exact_compound, only: compound_type, new_compound_cylinder, new_compound_sphere
+   use sprc_exact_pressure, only: exact_pressure_type, field_pressure_type, new_field_pressure
+   use sprc_exact_hertz, only: hertz_type, new_hertz_cylinder, new_hertz_sphere
    use sprc_core_text, only: itoa, real_text
    use sprc_study_spec, only: scene_type, shape_spec_type
    use sprc_fem_bc, only: fe_bc_type, new_fe_bc, bc_kind_from_name
@@ -22,6 +28,7 @@ module sprc_study_model
    private
 
    public :: build_bodies, build_exact, body_conditions, analysis_kind, analysis_units, in_units, scene_warnings
+   public :: build_exact_pressure, exact_has_field
 
    !> Units of an analysis: moduli divided by `modulus`, displacements by `strain`
    !> (lengths unchanged), stresses and loads by modulus*strain. Both are powers of two, so
@@ -83,8 +90,11 @@ contains
             load = max(load, maxval([0.0_wp, abs(scene%bcs(i)%vector)]))
          end if
       end do
-      if (scene%exact%present) load = max(load, abs(scene%exact%p_in), abs(scene%exact%p_out), &
-         & abs(scene%exact%s_inf))
+      if (scene%exact%present) then
+         load = max(load, abs(scene%exact%p_in), abs(scene%exact%p_out), abs(scene%exact%s_inf))
+         if (allocated(scene%exact%stress)) load = max(load, maxval([0.0_wp, abs(scene%exact%stress)]))
+         disp = max(disp, abs(scene%exact%interference)/scene%box_size)
+      end if
       k = -huge(1)
       if (load > 0.0_wp) k = exponent(load) - exponent(units%modulus)
       if (disp > 0.0_wp) k = max(k, exponent(disp))
@@ -101,9 +111,13 @@ contains
    end subroutine analysis_units
 
    !> The scene in `units` (analysis_units_type): moduli divided by units%modulus; body
-   !> forces, pressures, tractions and the exact solution's pressures and remote stress by
-   !> units%modulus*units%strain (in two steps, so no intermediate overflows); prescribed
-   !> displacements by units%strain. Poisson's ratios and lengths stay.
+   !> forces, pressures, tractions and the exact solution's pressures, remote stress,
+   !> uniform stress and Hertz load by units%modulus*units%strain (in two steps, so no
+   !> intermediate overflows; lengths stay, so a force per length or area scales as a
+   !> stress); prescribed displacements and the exact solution's interference by
+   !> units%strain. Poisson's ratios and lengths stay. Every body's modulus is scaled by
+   !> the same units: a closed form spanning two bodies (compound_*) built from the
+   !> scaled scene is the scene's solution in these units.
    function in_units(scene, units) result(scaled)
       type(scene_type), intent(in) :: scene
       type(analysis_units_type), intent(in) :: units
@@ -127,6 +141,9 @@ contains
       scaled%exact%p_in = stress1(scene%exact%p_in)
       scaled%exact%p_out = stress1(scene%exact%p_out)
       scaled%exact%s_inf = stress1(scene%exact%s_inf)
+      scaled%exact%load = stress1(scene%exact%load)
+      scaled%exact%interference = scene%exact%interference/units%strain
+      if (allocated(scene%exact%stress)) scaled%exact%stress = stress(scene%exact%stress)
    contains
       pure function stress(v) result(w)
          real(wp), intent(in) :: v(:)
@@ -329,9 +346,25 @@ contains
       end do
    end subroutine body_conditions
 
+   !> Whether the scene's exact solution has a stress field (every kind but
+   !> hertz_*, which give the contact pressure only): the energy-norm error
+   !> columns apply only then.
+   pure logical function exact_has_field(scene)
+      type(scene_type), intent(in) :: scene
+      exact_has_field = .false.
+      if (scene%exact%present) exact_has_field = index(scene%exact%kind, 'hertz_') /= 1
+   end function exact_has_field
+
    !> The scene's exact solution as it holds in body `b`, with that body's
-   !> material (the closed forms are single-body solutions). Not allocated
-   !> without `&exact`.
+   !> material, in the units of `scene` (pass `in_units(scene, units)` for a
+   !> body's analysis units). Not allocated without `&exact`, for hertz_*
+   !> (pressure only: `build_exact_pressure`) and, for compound_*, for a body
+   !> that is neither `inner` nor `outer`.
+   !>
+   !> - lame_cylinder, lame_sphere, kirsch: the single-body closed form.
+   !> - uniform: sigma = `stress` in every body, u = D_b^-1 sigma x with body b's material.
+   !> - compound_cylinder / compound_sphere: the inner ring's field in body `inner`,
+   !>   the outer ring's in body `outer` (both materials enter the interface pressure).
    subroutine build_exact(scene, b, exact, error)
       type(scene_type), intent(in) :: scene
       !> Index of the body in `scene%bodies`.
@@ -362,6 +395,15 @@ contains
             type is (kirsch_type)
                call new_kirsch(exact, spec%center, spec%radius, spec%s_inf, young, nu, analysis_kind(scene), error)
             end select
+         case ('uniform')
+            allocate (uniform_type :: exact)
+            select type (exact)
+            type is (uniform_type)
+               call new_uniform(exact, spec%stress, young, nu, analysis_kind(scene), error)
+            end select
+         case ('compound_cylinder', 'compound_sphere')
+            call build_compound_ring(scene, b, exact, error)
+         case ('hertz_cylinder', 'hertz_sphere')
          case default
             call fatal_error(error, 'kind '''//spec%kind//''' is not available in this version', stat_unsupported)
          end select
@@ -371,5 +413,73 @@ contains
          if (allocated(exact)) deallocate (exact)
       end if
    end subroutine build_exact
+
+   !> Body b's ring of the scene's compound solution, with the materials of the
+   !> bodies `inner` and `outer` (not allocated for another body).
+   subroutine build_compound_ring(scene, b, exact, error)
+      type(scene_type), intent(in) :: scene
+      integer, intent(in) :: b
+      class(exact_solution_type), allocatable, intent(out) :: exact
+      type(error_type), allocatable, intent(out) :: error
+      type(compound_type) :: compound
+
+      if (b /= scene%exact%inner_index .and. b /= scene%exact%outer_index) return
+      associate (spec => scene%exact, inner => scene%bodies(scene%exact%inner_index), &
+         & outer => scene%bodies(scene%exact%outer_index))
+         if (spec%kind == 'compound_cylinder') then
+            call new_compound_cylinder(compound, spec%center, spec%r_in, spec%r_contact, spec%r_out, spec%p_in, &
+               & spec%interference, inner%young, inner%poisson, outer%young, outer%poisson, analysis_kind(scene), &
+               & error)
+         else
+            call new_compound_sphere(compound, spec%center, spec%r_in, spec%r_contact, spec%r_out, spec%p_in, &
+               & spec%interference, inner%young, inner%poisson, outer%young, outer%poisson, error)
+         end if
+      end associate
+      if (allocated(error)) return
+      if (b == scene%exact%inner_index) then
+         call move_alloc(compound%inner, exact)
+      else
+         call move_alloc(compound%outer, exact)
+      end if
+   end subroutine build_compound_ring
+
+   !> The exact contact pressure on the slave surface of `&contact` pair `k`,
+   !> in the units of `scene` (the scene's own for a contact result): hertz_*
+   !> from the closed form with E* of the pair's two bodies; every other kind
+   !> from the slave body's exact field (p = -n.sigma.n). Not allocated
+   !> without `&exact` or when the slave body has no exact field (a compound
+   !> scene's third body).
+   subroutine build_exact_pressure(scene, k, pressure, error)
+      type(scene_type), intent(in) :: scene
+      !> Index of the pair in `scene%contacts`.
+      integer, intent(in) :: k
+      class(exact_pressure_type), allocatable, intent(out) :: pressure
+      type(error_type), allocatable, intent(out) :: error
+      class(exact_solution_type), allocatable :: field
+      type(hertz_type) :: hertz
+      type(field_pressure_type) :: from_field
+
+      if (.not. scene%exact%present) return
+      associate (spec => scene%exact, slave => scene%bodies(scene%contacts(k)%slave_index), &
+         & master => scene%bodies(scene%contacts(k)%master_index))
+         select case (spec%kind)
+         case ('hertz_cylinder')
+            call new_hertz_cylinder(hertz, spec%point, spec%normal, spec%radius, spec%load, slave%young, &
+               & slave%poisson, master%young, master%poisson, analysis_kind(scene), error)
+            if (.not. allocated(error)) allocate (pressure, source=hertz)
+         case ('hertz_sphere')
+            call new_hertz_sphere(hertz, spec%point, spec%normal, spec%radius, spec%load, slave%young, &
+               & slave%poisson, master%young, master%poisson, error)
+            if (.not. allocated(error)) allocate (pressure, source=hertz)
+         case default
+            call build_exact(scene, scene%contacts(k)%slave_index, field, error)
+            if (allocated(error) .or. .not. allocated(field)) return
+            call new_field_pressure(from_field, field)
+            allocate (pressure, source=from_field)
+            return
+         end select
+      end associate
+      if (allocated(error)) error%message = '&exact: '//error%message
+   end subroutine build_exact_pressure
 
 end module sprc_study_model

@@ -1,0 +1,94 @@
+!> The contact columns of a level's report row (SCENE.md "Report") from the
+!> level's contact results, and the exact pressure of a contact result.
+!>
+!> Over the slave points i of every pair, with weights w_i (surface measure):
+!> - contact_measure = sum of w_i over the closed points (state /= open);
+!> - p_max_X = max_i p_X,i (X = fe, spr, sprc, exact);
+!> - err_p_X = sqrt(sum w_i (p_X,i - p_ex,i)^2) / sqrt(sum w_i p_ex,i^2), the
+!>   relative L2 error over the whole slave surface (the exact pressure is 0
+!>   where the exact solution is open, as `exact_pressure_type` gives it).
+!> A column is empty where it does not apply: p_max_X when p_X is empty at
+!> some point (not computed), err_p_X also without an exact pressure or when
+!> the exact pressure is zero everywhere (a relative error of nothing).
+!> The row's iteration count and contact time are the contact solve's to set.
+module sprc_study_contact_row
+   use sprc_core_kinds, only: wp
+   use sprc_exact_pressure, only: exact_pressure_type
+   use sprc_contact_result, only: contact_result_type, contact_open
+   use sprc_study_row, only: report_row_type, report_empty, is_empty
+   implicit none
+   private
+
+   public :: fill_contact_row, fill_exact_pressure
+
+contains
+
+   !> Set p_exact of `result` at every slave point from `pressure` (same units
+   !> as the result: the scene's).
+   subroutine fill_exact_pressure(pressure, result)
+      class(exact_pressure_type), intent(in) :: pressure
+      type(contact_result_type), intent(inout) :: result
+      integer :: i
+
+      do i = 1, result%npoint
+         result%p_exact(i) = pressure%pressure(result%x(:, i), result%normal(:, i))
+      end do
+   end subroutine fill_exact_pressure
+
+   !> The contact columns of `row` from the level's contact results; `has_contact` set.
+   subroutine fill_contact_row(contacts, row)
+      type(contact_result_type), intent(in) :: contacts(:)
+      type(report_row_type), intent(inout) :: row
+      real(wp), allocatable :: w(:), p_fe(:), p_spr(:), p_sprc(:), p_ex(:)
+      logical, allocatable :: closed(:)
+      integer :: k
+
+      allocate (w(0), p_fe(0), p_spr(0), p_sprc(0), p_ex(0), closed(0))
+      do k = 1, size(contacts)
+         associate (c => contacts(k))
+            w = [w, c%weight]
+            p_fe = [p_fe, c%p_fe]
+            p_spr = [p_spr, c%p_spr]
+            p_sprc = [p_sprc, c%p_sprc]
+            p_ex = [p_ex, c%p_exact]
+            closed = [closed, c%state /= contact_open]
+         end associate
+      end do
+      row%has_contact = .true.
+      row%contact_measure = sum(w, mask=closed)
+      row%p_max_fe = maximum(p_fe)
+      row%p_max_spr = maximum(p_spr)
+      row%p_max_sprc = maximum(p_sprc)
+      row%p_max_exact = maximum(p_ex)
+      row%err_p_fe = relative_l2(p_fe, p_ex, w)
+      row%err_p_spr = relative_l2(p_spr, p_ex, w)
+      row%err_p_sprc = relative_l2(p_sprc, p_ex, w)
+   end subroutine fill_contact_row
+
+   !> Largest value; empty if there is none or any is empty.
+   pure real(wp) function maximum(p)
+      real(wp), intent(in) :: p(:)
+      maximum = report_empty
+      if (size(p) == 0) return
+      if (any(is_empty(p))) return
+      maximum = maxval(p)
+   end function maximum
+
+   !> ||p - p_ex|| / ||p_ex|| in the weighted L2 norm; empty if either has an
+   !> empty value or ||p_ex|| = 0. Pressures are divided by the largest |p_ex|
+   !> first, so squares neither overflow nor underflow whatever the units.
+   pure real(wp) function relative_l2(p, p_ex, w)
+      real(wp), intent(in) :: p(:), p_ex(:), w(:)
+      real(wp) :: norm_ex, unit
+
+      relative_l2 = report_empty
+      if (size(p) == 0) return
+      if (any(is_empty(p)) .or. any(is_empty(p_ex))) return
+      unit = maxval(abs(p_ex))
+      if (.not. (unit > 0.0_wp)) return
+      norm_ex = sqrt(sum(w*(p_ex/unit)**2))
+      if (.not. (norm_ex > 0.0_wp)) return
+      relative_l2 = sqrt(sum(w*((p - p_ex)/unit)**2))/norm_ex
+   end function relative_l2
+
+end module sprc_study_contact_row
