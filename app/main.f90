@@ -5,7 +5,7 @@ program sprc_main
    use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
    use omp_lib, only: omp_set_num_threads, omp_get_max_threads
    use sprc_core_kinds, only: wp
-   use sprc_core_text, only: fixed_text
+   use sprc_core_text, only: fixed_text, itoa
    use sprc_core_error, only: error_type, stat_invalid_input, stat_io
    use sprc_version, only: sprc_version_string
    use sprc_io_scene, only: scene_type, read_scene, read_scene_text, scene_summary, default_scene_text
@@ -16,7 +16,8 @@ program sprc_main
    use sprc_study_level, only: study_type, prepare_study, run_level, level_type
    use sprc_io_report, only: report_row_type, report_table, write_report_csv, format_mesh_row
    use sprc_io_fields, only: write_level_fields
-   use sprc_io_svg, only: write_report_svg
+   use sprc_io_svg, only: write_report_svg, write_contact_svg
+   use sprc_io_contact, only: contact_level_type, write_contact_csv
    use sprc_io_hdf5, only: h5_output_type
    use sprc_app_cli, only: cli_type, parse_cli, usage_text
    implicit none
@@ -26,8 +27,9 @@ program sprc_main
    !> Output prefix of the run in progress: its files are written as
    !> PREFIX.EXT.partial and renamed when all are complete; `fail` removes them.
    character(len=:), allocatable :: partial_prefix
-   !> The output files, in the order they are published.
-   character(len=*), parameter :: output_exts(4) = [character(len=5) :: '.csv', '.svg', '.h5', '.xdmf']
+   !> The output files, in the order they are published; the last two only for a study with contact.
+   character(len=*), parameter :: output_exts(6) = [character(len=12) :: '.csv', '.svg', '.h5', '.xdmf', &
+      & '_contact.csv', '_contact.svg']
    character(len=*), parameter :: partial = '.partial'
    !> With the default thread count, a level estimated below this many dofs runs on one
    !> thread: its parallel regions are too short to pay for the threads' synchronisation,
@@ -89,20 +91,22 @@ contains
    end subroutine run_scene_file
 
    !> One analysis per level; the report on standard output and, with an
-   !> output prefix, PREFIX.csv, .svg, .h5 and .xdmf: written under temporary
-   !> names and renamed when all four are complete, so a run that fails
-   !> leaves the results of an earlier run as they were.
+   !> output prefix, PREFIX.csv, .svg, .h5 and .xdmf (and for a study with
+   !> contact PREFIX_contact.csv and _contact.svg): written under temporary
+   !> names and renamed when all are complete, so a run that fails leaves the
+   !> results of an earlier run as they were.
    subroutine run_study(scene, cli)
       type(scene_type), intent(in) :: scene
       type(cli_type), intent(in) :: cli
       type(study_type) :: study
       type(level_type) :: result
       type(report_row_type), allocatable :: rows(:)
+      type(contact_level_type), allocatable :: contact_levels(:)
       type(h5_output_type) :: h5
       type(error_type), allocatable :: error
       character(len=:), allocatable :: prefix
       integer, allocatable :: levels(:)
-      integer :: i, b, threads
+      integer :: i, b, threads, n_outputs
       character(len=16) :: buf
       real(wp) :: cells, dofs, bytes, total_dofs
 
@@ -120,7 +124,7 @@ contains
          call h5%create(prefix//'.h5'//partial, error)
          if (allocated(error)) call fail_with(error)
       end if
-      allocate (rows(size(levels)))
+      allocate (rows(size(levels)), contact_levels(0))
       threads = omp_get_max_threads()
       do i = 1, size(levels)
          if (cli%threads == 0) then
@@ -137,6 +141,7 @@ contains
          call run_level(study, levels(i), result, error)
          if (.not. allocated(error)) then
             rows(i) = result%row
+            if (allocated(result%contacts)) contact_levels = [contact_levels, contact_level_type(levels(i), result%contacts)]
             if (h5%opened()) call write_level_fields(h5, study, result, error)
          end if
          if (allocated(error)) then
@@ -154,15 +159,25 @@ contains
       if (.not. allocated(error)) call write_report_svg(prefix//'.svg'//partial, rows, scene%title, error)
       if (.not. allocated(error)) call h5%close(error)
       if (.not. allocated(error)) call h5%write_xdmf(prefix//'.xdmf'//partial, error, data_path=prefix//'.h5')
+      n_outputs = 4
+      if (size(contact_levels) > 0 .and. .not. allocated(error)) then
+         n_outputs = 6
+         call write_contact_csv(prefix//'_contact.csv'//partial, contact_levels, error)
+         associate (finest => contact_levels(size(contact_levels)))
+            if (.not. allocated(error)) call write_contact_svg(prefix//'_contact.svg'//partial, finest%contacts, &
+               & scene%title//', contact pressure at level '//itoa(finest%level), error)
+         end associate
+      end if
       if (allocated(error)) call fail_with(error)
-      do i = 1, size(output_exts)
+      do i = 1, n_outputs
          if (c_rename(prefix//trim(output_exts(i))//partial//c_null_char, &
             & prefix//trim(output_exts(i))//c_null_char) /= 0) &
             & call fail(2, 'cannot rename '//prefix//trim(output_exts(i))//partial//' to '// &
             & prefix//trim(output_exts(i)))
       end do
       deallocate (partial_prefix)
-      if (.not. cli%quiet) write (error_unit, '(a)') 'sprc: wrote '//prefix//'.csv, .svg, .h5, .xdmf'
+      if (.not. cli%quiet) write (error_unit, '(a)') 'sprc: wrote '//prefix//'.csv, .svg, .h5, .xdmf'// &
+         & trim(merge(', _contact.csv, _contact.svg', '                            ', n_outputs == 6))
    end subroutine run_study
 
    !> mkdir -p of the directory part of an output prefix (the library does no

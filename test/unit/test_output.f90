@@ -53,7 +53,8 @@ contains
          new_unittest('field_errors', test_field_errors), &
          new_unittest('xdmf_errors', test_xdmf_errors), &
          new_unittest('run_fields_resolve', test_run_fields), &
-         new_unittest('run_fields_two_bodies', test_run_fields_bodies) &
+         new_unittest('run_fields_two_bodies', test_run_fields_bodies), &
+         new_unittest('contact_point_sets', test_contact_point_sets) &
          ]
    end subroutine collect_output
 
@@ -640,6 +641,73 @@ contains
       end associate
       call h5fclose_f(file, hdferr)
    end subroutine test_run_fields_bodies
+
+   !> The slave points of a level's contact pairs (synthetic results: the 2D
+   !> sample's two pairs) as point sets `/level_LL/contact_<k>/`, a '_' in
+   !> front while a body has that name; every XDMF reference resolves, the
+   !> topology is Polyvertex, and coordinates, pressures (empty: NaN) and
+   !> states read back bit for bit.
+   subroutine test_contact_point_sets(error)
+      use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
+      use sprc_study_level, only: study_type, level_type
+      use sprc_io_fields, only: write_level_fields
+      use sprc_test_contact_model, only: contact_sample
+      type(error_type), allocatable, intent(out) :: error
+      type(study_type) :: study
+      type(level_type) :: result
+      type(h5_output_type) :: h5
+      character(len=:), allocatable :: text
+      real(wp), allocatable :: v(:, :)
+      integer, allocatable :: iv(:, :)
+      integer(hid_t) :: file
+      integer :: hdferr
+
+      study%dim = 2
+      study%order = 1
+      allocate (study%bodies(1))
+      study%bodies(1)%name = 'contact_1'
+      result%level = 5
+      allocate (result%bodies(0))
+      result%contacts = contact_sample()
+      call h5%create('build/test_output_contact.h5', error)
+      if (allocated(error)) return
+      call write_level_fields(h5, study, result, error)
+      if (allocated(error)) return
+      call h5%close(error)
+      if (allocated(error)) return
+      call h5%write_xdmf('build/test_output_contact.xdmf', error)
+      if (allocated(error)) return
+      call check_xdmf('build/test_output_contact.xdmf', 'test_output_contact.h5', -1, error)
+      if (allocated(error)) return
+      call read_text_file('build/test_output_contact.xdmf', text, error)
+      if (allocated(error)) return
+      call check(error, count_sub(text, 'TopologyType="Polyvertex" NumberOfElements="3" NodesPerElement="1"'), 1, &
+         & 'pair 1: a point set of 3 points')
+      if (allocated(error)) return
+      call check(error, index(text, '<Grid Name="_contact_1" GridType="Uniform">') > 0 .and. &
+         & index(text, '<Grid Name="contact_2" GridType="Uniform">') > 0, 'named contact_<k>, clear of body names')
+      if (allocated(error)) return
+      call h5fopen_f('build/test_output_contact.h5', H5F_ACC_RDONLY_F, file, hdferr)
+      call check(error, hdferr >= 0, 'open the HDF5 file')
+      if (allocated(error)) return
+      associate (c => result%contacts(1))
+         call read_real(file, '/level_05/_contact_1/mesh/x', [2, 3], v, error)
+         if (.not. allocated(error)) call check(error, all(same_bits(v, c%x)), 'coordinates')
+         if (.not. allocated(error)) call read_real(file, '/level_05/_contact_1/node/p_fe', [3], v, error)
+         if (.not. allocated(error)) call check(error, all(same_bits(v(:, 1), c%p_fe)), 'p_fe')
+         if (.not. allocated(error)) call read_real(file, '/level_05/_contact_1/node/p_spr', [3], v, error)
+         if (.not. allocated(error)) call check(error, all(ieee_is_nan(v)), 'p_spr not computed: NaN')
+         if (.not. allocated(error)) call read_real(file, '/level_05/_contact_1/node/normal', [3, 3], v, error)
+         if (.not. allocated(error)) call check(error, all(same_bits(v(1:2, :), c%normal)), 'normal')
+         if (.not. allocated(error)) call read_int(file, '/level_05/_contact_1/node/state', [3], iv, error)
+         if (.not. allocated(error)) call check(error, all(iv(:, 1) == c%state), 'state')
+         if (.not. allocated(error)) call read_int(file, '/level_05/_contact_1/mesh/connectivity', [1, 3], iv, error)
+         if (.not. allocated(error)) call check(error, all(iv(1, :) == [0, 1, 2]), 'one vertex per point, 0-based')
+      end associate
+      if (.not. allocated(error)) call read_real(file, '/level_05/contact_2/node/gap', [1], v, error)
+      if (.not. allocated(error)) call check(error, all(same_bits(v(:, 1), result%contacts(2)%gap)), 'gap of pair 2')
+      call h5fclose_f(file, hdferr)
+   end subroutine test_contact_point_sets
 
    !> Every `<DataItem ... Format="HDF">FILE:/PATH</DataItem>` of the XDMF file
    !> must name `h5_name`, and PATH must be a dataset whose dimensions (C

@@ -12,7 +12,8 @@ module sprc_test_report
    implicit none
    private
 
-   public :: collect_report, xml_well_formed, read_text_file, python_xml_check
+   public :: collect_report, xml_well_formed, read_text_file, python_xml_check, attribute_real, cell_of, count_sub, &
+      & split_lines
 
    character(len=*), parameter :: dir = 'build/'
 

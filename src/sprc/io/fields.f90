@@ -2,7 +2,10 @@
 !> `sprc_io_xdmf`): per body, under `/level_LL/<body>/`, its mesh,
 !> displacement, FE nodal stresses (average of the elements at each node),
 !> recovered nodal stresses, element error indicators (ZZ per method; exact
-!> where known) and cell class.
+!> where known) and cell class; per `&contact` pair, under
+!> `/level_LL/contact_<k>/`, its slave-surface points as a point set with
+!> the contact pressures, gap, state, tangential tractions, weights and
+!> normals (scene units; an empty value, not computed, is NaN).
 module sprc_io_fields
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type
@@ -10,7 +13,9 @@ module sprc_io_fields
    use sprc_study_level, only: study_type, level_type, body_level_type, nodal_fe_stress
    use sprc_study_model, only: analysis_units_type
    use sprc_io_hdf5, only: h5_output_type
-   use sprc_io_xdmf, only: cell_quad4, cell_quad9, cell_hex8, cell_hex27
+   use sprc_io_xdmf, only: cell_quad4, cell_quad9, cell_hex8, cell_hex27, cell_vertex
+   use sprc_core_text, only: itoa
+   use sprc_contact_result, only: contact_result_type
    implicit none
    private
 
@@ -36,7 +41,61 @@ contains
             & result%bodies(b), result%done, error)
          if (allocated(error)) return
       end do
+      if (.not. allocated(result%contacts)) return
+      do b = 1, size(result%contacts)
+         call write_contact(h5, result%level, contact_grid_name(b, study), result%contacts(b), error)
+         if (allocated(error)) return
+      end do
    end subroutine write_level_fields
+
+   !> `contact_<k>`, with '_' put in front while a body has that name.
+   function contact_grid_name(k, study) result(name)
+      integer, intent(in) :: k
+      type(study_type), intent(in) :: study
+      character(len=:), allocatable :: name
+      integer :: b
+      name = 'contact_'//itoa(k)
+      b = 1
+      do while (b <= size(study%bodies))
+         if (study%bodies(b)%name == name) then
+            name = '_'//name
+            b = 1
+         else
+            b = b + 1
+         end if
+      end do
+   end function contact_grid_name
+
+   !> The slave points of one pair as a point set named `name` (none without points).
+   subroutine write_contact(h5, level, name, c, error)
+      type(h5_output_type), intent(inout) :: h5
+      integer, intent(in) :: level
+      character(len=*), intent(in) :: name
+      type(contact_result_type), intent(in) :: c
+      type(error_type), allocatable, intent(out) :: error
+      integer :: i
+
+      if (c%npoint == 0) return
+      call h5%write_level(level, c%x, reshape([(i, i=1, c%npoint)], [1, c%npoint]), cell_vertex, error, body=name)
+      if (.not. allocated(error)) call scalar('p_fe', c%p_fe)
+      if (.not. allocated(error)) call scalar('p_spr', c%p_spr)
+      if (.not. allocated(error)) call scalar('p_sprc', c%p_sprc)
+      if (.not. allocated(error)) call scalar('p_exact', c%p_exact)
+      if (.not. allocated(error)) call scalar('gap', c%gap)
+      if (.not. allocated(error)) call scalar('ts_fe', c%ts_fe)
+      if (.not. allocated(error)) call scalar('ts_sprc', c%ts_sprc)
+      if (.not. allocated(error)) call scalar('weight', c%weight)
+      if (.not. allocated(error)) call h5%write_node_field(level, 'normal', c%normal, error, body=name)
+      ! 0 open, 1 stick, 2 slip (sprc_contact_result)
+      if (.not. allocated(error)) call h5%write_node_field(level, 'state', reshape(c%state, [1, c%npoint]), error, &
+         & body=name)
+   contains
+      subroutine scalar(field, values)
+         character(len=*), intent(in) :: field
+         real(wp), intent(in) :: values(:)
+         call h5%write_node_field(level, field, reshape(values, [1, size(values)]), error, body=name)
+      end subroutine scalar
+   end subroutine write_contact
 
    !> One body's fields, in the scene's units (the analysis ran in `units`).
    subroutine write_body(h5, level, body, units, cell_type, bl, done, error)

@@ -51,8 +51,10 @@ module sprc_io_hdf5
       procedure :: create => h5_create
       !> Write one level's mesh.
       procedure :: write_level => h5_write_level
-      !> Write a node field of a level.
-      procedure :: write_node_field => h5_write_node_field
+      procedure, private :: write_node_field_real => h5_write_node_field
+      procedure, private :: write_node_field_int => h5_write_node_field_int
+      !> Write a node field (real or integer) of a level.
+      generic :: write_node_field => write_node_field_real, write_node_field_int
       procedure, private :: write_cell_field_real => h5_write_cell_field_real
       procedure, private :: write_cell_field_int => h5_write_cell_field_int
       !> Write a cell field (real or integer) of a level.
@@ -123,7 +125,8 @@ contains
    !> Write the mesh of one level: node coordinates `nodes_x(dim, n_nodes)`
    !> (dim 2 or 3) and `connectivity(nodes_per_cell, n_cells)` with 1-based
    !> node numbers in VTK local order (stored 0-based). `cell_type` is one of
-   !> `cell_quad4`, `cell_quad9`, `cell_hex8`, `cell_hex27` (`sprc_io_xdmf`).
+   !> `cell_quad4`, `cell_quad9`, `cell_hex8`, `cell_hex27`, or `cell_vertex`
+   !> for a point set (connectivity (1, n_points)) (`sprc_io_xdmf`).
    !> Each level (0..99) is written once; with `body` (a name as for fields),
    !> each body of each level once, under `/level_LL/<body>/`. A level holds
    !> either one unnamed grid or named ones.
@@ -171,9 +174,9 @@ contains
          call fatal_error(error, where//'unknown cell type '//itoa(cell_type), stat_invalid_input)
          return
       end if
-      if (size(nodes_x, 1) < cell_dim(cell_type) .or. size(nodes_x, 1) > 3) then
+      if (size(nodes_x, 1) < max(2, cell_dim(cell_type)) .or. size(nodes_x, 1) > 3) then
          call fatal_error(error, where//topology_name(cell_type)//' cells need '// &
-            trim(merge('2 or 3', '3     ', cell_dim(cell_type) == 2))//' coordinates per node, got '// &
+            trim(merge('2 or 3', '3     ', cell_dim(cell_type) <= 2))//' coordinates per node, got '// &
             itoa(size(nodes_x, 1)), stat_invalid_input)
          return
       end if
@@ -252,6 +255,22 @@ contains
       call write_field(self, center_node, level, name, size(values, 1), size(values, 2), error, components, body, &
          real_values=values)
    end subroutine h5_write_node_field
+
+   !> Write an integer node field `values(ncomp, n_nodes)` (e.g. the state of
+   !> a contact point), stored as int32; components as for real node fields.
+   subroutine h5_write_node_field_int(self, level, name, values, error, components, body)
+      class(h5_output_type), intent(inout) :: self
+      integer, intent(in) :: level
+      character(len=*), intent(in) :: name
+      integer, intent(in) :: values(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), intent(in), optional :: components(:)
+      !> The body of the level's grid (as given to write_level).
+      character(len=*), intent(in), optional :: body
+
+      call write_field(self, center_node, level, name, size(values, 1), size(values, 2), error, components, body, &
+         int_values=values)
+   end subroutine h5_write_node_field_int
 
    !> Write a real cell field `values(ncomp, n_cells)` (e.g. element error
    !> indicators); components as for node fields.

@@ -19,7 +19,7 @@ module sprc_io_report
 
    public :: report_row_type, report_table, write_report_csv, read_report_csv, format_mesh_row
    public :: report_column, report_empty, is_empty
-   public :: n_report_columns, report_columns, report_csv_header, report_column_indices, report_header
+   public :: n_report_columns, report_columns, report_csv_header, report_column_indices, report_header, csv_real
 
    !> Number of columns a report may have: the 19 of every study, the 10
    !> contact columns and `solver_iterations`.
@@ -333,17 +333,25 @@ contains
       real(wp) :: x
 
       x = row_values(row, j)
-      if (is_empty(x)) then
-         s = ''
-         return
-      end if
-      if (column_kind(j) == kind_integer) then
+      if (column_kind(j) == kind_integer .and. .not. is_empty(x)) then
          write (buf, '(i0)') row_integer(row, j)
+         s = trim(buf)
       else
-         write (buf, '(es25.16e3)') x
+         s = csv_real(x)
       end if
-      s = trim(adjustl(buf))
    end function csv_cell
+
+   !> A real as a CSV cell: 17 significant digits and a 3-digit exponent (read
+   !> back bit for bit, by Fortran and by Python's float); '' when empty.
+   function csv_real(x) result(s)
+      real(wp), intent(in) :: x
+      character(len=:), allocatable :: s
+      character(len=32) :: buf
+      s = ''
+      if (is_empty(x)) return
+      write (buf, '(es25.16e3)') x
+      s = trim(adjustl(buf))
+   end function csv_real
 
    !> Write `rows` as CSV to `path` (replacing it): the header of their columns
    !> (`report_header`), then one line per row. Fails with stat_io naming the path.

@@ -10,15 +10,25 @@
 !> show empty cells or values <= 0: such points are skipped and listed in a
 !> comment in the file. A series with one point gets a marker, no line.
 !> No scripts, no external fonts or references (generic `sans-serif`).
+!>
+!> The contact plot (`contact_svg`, PREFIX_contact.svg) is one panel with
+!> linear axes: the contact pressure p_fe, p_spr, p_sprc and p_exact at the
+!> slave points of a level, against the coordinate along the slave surface
+!> (2D: the projection on the principal direction of the points, which is
+!> monotone along a flat or gently curved surface and along a quarter
+!> circle; points joined in that order) or, in 3D, against the distance
+!> from the point of peak pressure (exact, else FE; markers only, a surface
+!> has no order). Same page layout, markers and legend as the report plot.
 module sprc_io_svg
    use sprc_core_kinds, only: wp
    use sprc_core_text, only: fixed_text
    use sprc_core_error, only: error_type, fatal_error, stat_io
    use sprc_io_report, only: report_row_type, report_column, is_empty
+   use sprc_contact_result, only: contact_result_type
    implicit none
    private
 
-   public :: write_report_svg, report_svg
+   public :: write_report_svg, report_svg, write_contact_svg, contact_svg
 
    integer, parameter :: n_series = 5
    character(len=8), parameter :: series_name(n_series) = [character(len=8) :: &
@@ -38,6 +48,25 @@ module sprc_io_svg
       integer :: lo = 0, hi = 1
    end type axis_type
 
+   !> A linear axis from lo to hi with ticks every `step`.
+   type :: linear_axis_type
+      real(wp) :: lo = 0.0_wp, hi = 1.0_wp, step = 0.5_wp
+   end type linear_axis_type
+
+   !> Markers: pale wide disc (a reference drawn as a band), filled circle, open square, none.
+   integer, parameter :: marker_band = 1, marker_dot = 2, marker_square = 3, marker_none = 4
+
+   !> How a series is drawn: its name (legend, class), colour, stroke attributes and marker.
+   type :: series_style_type
+      character(len=:), allocatable :: name, colour, stroke
+      integer :: marker = marker_dot
+   end type series_style_type
+
+   !> The contact plot's series: FE, SPR, SPR-C and the exact pressure.
+   integer, parameter :: n_contact_series = 4
+   !> Extent of the contact plot's panel (one panel across the page).
+   real(wp), parameter :: contact_right = page_width - 25.0_wp
+
 contains
 
    !> Write the plot of `rows` to `path` (replacing it). Fails with stat_io naming the path.
@@ -47,24 +76,62 @@ contains
       !> Title on top of the picture (plain text; escaped here).
       character(len=*), intent(in) :: title
       type(error_type), allocatable, intent(out) :: error
+
+      call write_text(path, 'report SVG', report_svg(rows, title), error)
+   end subroutine write_report_svg
+
+   !> Write the contact plot of `contacts` (one level's pairs) to `path`
+   !> (replacing it). Fails with stat_io naming the path.
+   subroutine write_contact_svg(path, contacts, title, error)
+      character(len=*), intent(in) :: path
+      type(contact_result_type), intent(in) :: contacts(:)
+      !> Title on top of the picture (plain text; escaped here).
+      character(len=*), intent(in) :: title
+      type(error_type), allocatable, intent(out) :: error
+
+      call write_text(path, 'contact SVG', contact_svg(contacts, title), error)
+   end subroutine write_contact_svg
+
+   !> Write `text` to `path` (replacing it); `what` names the file in messages.
+   subroutine write_text(path, what, text, error)
+      character(len=*), intent(in) :: path, what, text
+      type(error_type), allocatable, intent(out) :: error
       integer :: unit, stat
       character(len=256) :: msg
 
       open (newunit=unit, file=path, status='replace', action='write', access='stream', form='unformatted', &
          iostat=stat, iomsg=msg)
       if (stat /= 0) then
-         call fatal_error(error, 'report SVG: cannot open "'//path//'" for writing: '//trim(msg), stat_io)
+         call fatal_error(error, what//': cannot open "'//path//'" for writing: '//trim(msg), stat_io)
          return
       end if
-      write (unit, iostat=stat, iomsg=msg) report_svg(rows, title)
+      write (unit, iostat=stat, iomsg=msg) text
       if (stat /= 0) then
          close (unit)
-         call fatal_error(error, 'report SVG: cannot write "'//path//'": '//trim(msg), stat_io)
+         call fatal_error(error, what//': cannot write "'//path//'": '//trim(msg), stat_io)
          return
       end if
       close (unit, iostat=stat, iomsg=msg)
-      if (stat /= 0) call fatal_error(error, 'report SVG: cannot close "'//path//'": '//trim(msg), stat_io)
-   end subroutine write_report_svg
+      if (stat /= 0) call fatal_error(error, what//': cannot close "'//path//'": '//trim(msg), stat_io)
+   end subroutine write_text
+
+   !> The report plot's series, from the constants above.
+   function report_styles() result(styles)
+      type(series_style_type) :: styles(n_series)
+      integer :: k
+      do k = 1, n_series
+         styles(k)%name = trim(series_name(k))
+         styles(k)%colour = series_colour(k)
+         styles(k)%stroke = series_stroke(k)
+         if (k == 1) then
+            styles(k)%marker = marker_band
+         else if (series_estimate(k)) then
+            styles(k)%marker = marker_square
+         else
+            styles(k)%marker = marker_dot
+         end if
+      end do
+   end function report_styles
 
    !> The SVG text of the plot of `rows`.
    function report_svg(rows, title) result(svg)
@@ -83,22 +150,270 @@ contains
          active(k) = any(.not. is_empty(y(:, k)))
       end do
 
+      svg = page_open('sprc report: relative errors (err_*) and estimated relative errors (eta_*) on log-log '// &
+         'axes. Empty cells and values <= 0 are skipped: a log scale cannot show them.', &
+         skipped_comment(x, y, active, levels), title)
+      do p = 1, 2
+         svg = svg//panel(p, x(:, p), y, active)
+      end do
+      svg = svg//legend(report_styles(), active)//'</g>'//nl//'</svg>'//nl
+   end function report_svg
+
+   !> The start of a page: XML declaration, svg element, a comment, `extra`
+   !> (comments), title, white background, the group of text defaults, the
+   !> title line. `page_close` ends it.
+   function page_open(comment, extra, title) result(svg)
+      character(len=*), intent(in) :: comment, extra, title
+      character(len=:), allocatable :: svg
       svg = '<?xml version="1.0" encoding="UTF-8" standalone="no"?>'//nl// &
          '<svg xmlns="http://www.w3.org/2000/svg" version="1.1" width="'//num(page_width)//'" height="'// &
          num(page_height)//'" viewBox="0 0 '//num(page_width)//' '//num(page_height)//'">'//nl// &
-         '<!-- sprc report: relative errors (err_*) and estimated relative errors (eta_*) on log-log axes. '// &
-         'Empty cells and values <= 0 are skipped: a log scale cannot show them. -->'//nl
-      svg = svg//skipped_comment(x, y, active, levels)
-      svg = svg//'<title>'//escape(title)//'</title>'//nl// &
+         '<!-- '//comment//' -->'//nl//extra// &
+         '<title>'//escape(title)//'</title>'//nl// &
          '<rect x="0" y="0" width="'//num(page_width)//'" height="'//num(page_height)//'" fill="white"/>'//nl// &
          '<g font-family="sans-serif" font-size="12" fill="black">'//nl// &
          '<text x="'//num(page_width/2)//'" y="30" font-size="18" text-anchor="middle">'//escape(title)// &
          '</text>'//nl
-      do p = 1, 2
-         svg = svg//panel(p, x(:, p), y, active)
+   end function page_open
+
+   !> The SVG text of the contact plot of `contacts` (one level's pairs).
+   function contact_svg(contacts, title) result(svg)
+      type(contact_result_type), intent(in) :: contacts(:)
+      character(len=*), intent(in) :: title
+      character(len=:), allocatable :: svg
+      type(series_style_type) :: styles(n_contact_series)
+      real(wp), allocatable :: x(:, :), p(:, :), s(:)
+      integer, allocatable :: order(:)
+      logical :: active(n_contact_series)
+      integer :: dim, k, n
+
+      styles = contact_styles()
+      call gather_points(contacts, x, p)
+      n = size(p, 1)
+      dim = 2
+      if (size(contacts) > 0) dim = contacts(1)%dim
+      if (dim == 2) then
+         s = along_surface(x)
+      else
+         s = from_peak(x, p)
+      end if
+      order = sorted(s)
+      do k = 1, n_contact_series
+         active(k) = any(.not. is_empty(p(:, k)))
       end do
-      svg = svg//legend(active)//'</g>'//nl//'</svg>'//nl
-   end function report_svg
+      svg = page_open('sprc contact pressure along the slave surface (p = -n.sigma.n, positive in compression). '// &
+         'Empty values (not computed) are left out.', '', title)
+      svg = svg//contact_panel(s(order), p(order, :), styles, active, dim == 2)
+      svg = svg//legend(styles, active)//'</g>'//nl//'</svg>'//nl
+   end function contact_svg
+
+   !> The contact plot's series: FE dots, SPR dashed squares, SPR-C dots, exact a black line.
+   function contact_styles() result(styles)
+      type(series_style_type) :: styles(n_contact_series)
+      styles(1) = series_style_type('p_fe', '#1f77b4', ' stroke-width="1.8"', marker_dot)
+      styles(2) = series_style_type('p_spr', '#ff7f0e', ' stroke-width="1.8" stroke-dasharray="6,4"', marker_square)
+      styles(3) = series_style_type('p_sprc', '#2ca02c', ' stroke-width="1.8"', marker_dot)
+      styles(4) = series_style_type('p_exact', '#000000', ' stroke-width="1.5"', marker_none)
+   end function contact_styles
+
+   !> Every slave point of every pair: coordinates x(dim, n) and pressures
+   !> p(n, 4) in the order of `contact_styles`.
+   subroutine gather_points(contacts, x, p)
+      type(contact_result_type), intent(in) :: contacts(:)
+      real(wp), allocatable, intent(out) :: x(:, :), p(:, :)
+      integer :: k, n, m, dim
+
+      dim = 2
+      if (size(contacts) > 0) dim = contacts(1)%dim
+      allocate (x(dim, sum(contacts%npoint)), p(sum(contacts%npoint), n_contact_series))
+      n = 0
+      do k = 1, size(contacts)
+         m = contacts(k)%npoint
+         x(:, n + 1:n + m) = contacts(k)%x
+         p(n + 1:n + m, 1) = contacts(k)%p_fe
+         p(n + 1:n + m, 2) = contacts(k)%p_spr
+         p(n + 1:n + m, 3) = contacts(k)%p_sprc
+         p(n + 1:n + m, 4) = contacts(k)%p_exact
+         n = n + m
+      end do
+   end subroutine gather_points
+
+   !> 2D: the coordinate of each point along the principal direction of the
+   !> points (largest spread), from their centroid, the direction's first
+   !> nonzero component positive.
+   pure function along_surface(x) result(s)
+      real(wp), intent(in) :: x(:, :)
+      real(wp) :: s(size(x, 2))
+      real(wp) :: c(2), d(2, size(x, 2)), t(2), theta
+
+      if (size(x, 2) == 0) return
+      c = sum(x, dim=2)/size(x, 2)
+      d = x - spread(c, 2, size(x, 2))
+      theta = 0.5_wp*atan2(2.0_wp*sum(d(1, :)*d(2, :)), sum(d(1, :)**2) - sum(d(2, :)**2))
+      t = [cos(theta), sin(theta)]
+      if (t(1) < 0.0_wp .or. (.not. (abs(t(1)) > 0.0_wp) .and. t(2) < 0.0_wp)) t = -t
+      s = matmul(t, d)
+   end function along_surface
+
+   !> 3D: the distance of each point from the point of largest exact pressure
+   !> (largest FE pressure without an exact one; the first point without either).
+   pure function from_peak(x, p) result(s)
+      real(wp), intent(in) :: x(:, :), p(:, :)
+      real(wp) :: s(size(x, 2))
+      integer :: i, peak, k
+
+      if (size(x, 2) == 0) return
+      peak = 1
+      do k = 4, 1, -3
+         if (all(is_empty(p(:, k)))) cycle
+         peak = maxloc(p(:, k), dim=1, mask=.not. is_empty(p(:, k)))
+         exit
+      end do
+      do i = 1, size(x, 2)
+         s(i) = norm2(x(:, i) - x(:, peak))
+      end do
+   end function from_peak
+
+   !> The permutation sorting `v` ascending (stable insertion sort: the point
+   !> sets are a few thousand at most).
+   pure function sorted(v) result(order)
+      real(wp), intent(in) :: v(:)
+      integer :: order(size(v))
+      integer :: i, j, t
+      order = [(i, i=1, size(v))]
+      do i = 2, size(v)
+         t = order(i)
+         j = i - 1
+         do while (j >= 1)
+            if (.not. (v(order(j)) > v(t))) exit
+            order(j + 1) = order(j)
+            j = j - 1
+         end do
+         order(j + 1) = t
+      end do
+   end function sorted
+
+   !> The one panel of the contact plot: frame, grid, ticks, axis titles, one
+   !> series per active column of p (joined by lines when `lines`).
+   function contact_panel(s, p, styles, active, lines) result(text)
+      real(wp), intent(in) :: s(:), p(:, :)
+      type(series_style_type), intent(in) :: styles(:)
+      logical, intent(in) :: active(:), lines
+      character(len=:), allocatable :: text
+      type(linear_axis_type) :: ax, ay
+      logical :: valid(size(s), size(styles))
+      real(wp) :: xs(size(s)), ys(size(s))
+      integer :: k, i, m
+
+      do k = 1, size(styles)
+         valid(:, k) = active(k) .and. .not. is_empty(p(:, k))
+      end do
+      text = '<g>'//nl//'<text x="'//num((plot_left + contact_right)/2)//'" y="'//num(plot_bottom + 42)// &
+         '" text-anchor="middle">'//pick(lines, 'coordinate along the slave surface', &
+         'distance from the point of peak pressure')//'</text>'//nl// &
+         '<text x="22" y="'//num((plot_top + plot_bottom)/2)//'" text-anchor="middle" '// &
+         'transform="rotate(-90 22 '//num((plot_top + plot_bottom)/2)//')">contact pressure p</text>'//nl
+      if (.not. any(valid)) then
+         text = text//frame(plot_left, contact_right)//'<text x="'//num((plot_left + contact_right)/2)//'" y="'// &
+            num((plot_top + plot_bottom)/2)//'" text-anchor="middle" fill="#888888">no data</text>'//nl//'</g>'//nl
+         return
+      end if
+      ax = linear_axis(pack(spread(s, 2, size(styles)), valid))
+      ay = linear_axis([pack(p, valid), 0.0_wp])
+      text = text//linear_ticks(ax, .true.)//linear_ticks(ay, .false.)//frame(plot_left, contact_right)
+      do k = 1, size(styles)
+         m = 0
+         do i = 1, size(s)
+            if (.not. valid(i, k)) cycle
+            m = m + 1
+            xs(m) = linear_map(ax, s(i), plot_left, contact_right)
+            ys(m) = linear_map(ay, p(i, k), plot_bottom, plot_top)
+         end do
+         if (lines .and. m >= 2) text = text//polyline(styles(k), xs(:m), ys(:m))
+         do i = 1, m
+            text = text//marker(styles(k), xs(i), ys(i), 'point '//styles(k)%name)
+         end do
+      end do
+      text = text//'</g>'//nl
+   end function contact_panel
+
+   !> An axis from a multiple of a round step (1, 2 or 5 times a power of ten,
+   !> about five steps) below the values to one above them; a single value
+   !> gets a range around it.
+   pure function linear_axis(v) result(axis)
+      real(wp), intent(in) :: v(:)
+      type(linear_axis_type) :: axis
+      real(wp), parameter :: nice(3) = [1.0_wp, 2.0_wp, 5.0_wp]
+      real(wp) :: lo, hi, raw, unit
+      integer :: k
+
+      lo = minval(v)
+      hi = maxval(v)
+      if (.not. (hi > lo)) then
+         raw = max(abs(lo), tiny(1.0_wp))
+         lo = lo - 0.5_wp*raw
+         hi = hi + 0.5_wp*raw
+      end if
+      raw = (hi - lo)/5.0_wp
+      unit = 10.0_wp**floor(log10(raw))
+      axis%step = 10.0_wp*unit
+      do k = 3, 1, -1
+         if (raw <= nice(k)*unit) axis%step = nice(k)*unit
+      end do
+      axis%lo = floor(lo/axis%step)*axis%step
+      axis%hi = ceiling(hi/axis%step)*axis%step
+   end function linear_axis
+
+   !> Pixel position of v on a linear axis running from pixel a (lo) to b (hi).
+   pure real(wp) function linear_map(axis, v, a, b)
+      type(linear_axis_type), intent(in) :: axis
+      real(wp), intent(in) :: v, a, b
+      linear_map = a + (v - axis%lo)/(axis%hi - axis%lo)*(b - a)
+   end function linear_map
+
+   !> Grid lines, ticks and labels at every step of a linear axis of the contact panel.
+   function linear_ticks(axis, horizontal) result(text)
+      type(linear_axis_type), intent(in) :: axis
+      logical, intent(in) :: horizontal
+      character(len=:), allocatable :: text, label
+      real(wp) :: t, v
+      integer :: k, n
+
+      text = ''
+      n = nint((axis%hi - axis%lo)/axis%step)
+      do k = 0, n
+         v = axis%lo + k*axis%step
+         label = tick_label(v, axis%step)
+         if (horizontal) then
+            t = linear_map(axis, v, plot_left, contact_right)
+            text = text//line(t, plot_top, t, plot_bottom, '#dddddd')//line(t, plot_bottom, t, plot_bottom + 6, 'black')// &
+               '<text x="'//num(t)//'" y="'//num(plot_bottom + 22)//'" text-anchor="middle">'//label//'</text>'//nl
+         else
+            t = linear_map(axis, v, plot_bottom, plot_top)
+            text = text//line(plot_left, t, contact_right, t, '#dddddd')//line(plot_left - 6, t, plot_left, t, 'black')// &
+               '<text x="'//num(plot_left - 10)//'" y="'//num(t + 4)//'" text-anchor="end">'//label//'</text>'//nl
+         end if
+      end do
+   end function linear_ticks
+
+   !> A tick value with the decimals its step needs (fixed point for steps
+   !> 1e-4 .. 1e5, es notation outside); a value within round-off of 0 is '0'.
+   function tick_label(v, step) result(label)
+      real(wp), intent(in) :: v, step
+      character(len=:), allocatable :: label
+      character(len=32) :: buf
+
+      if (abs(v) < 1.0e-9_wp*step) then
+         label = '0'
+      else if (step >= 1.0e-4_wp .and. step < 1.0e5_wp) then
+         label = fixed_text(v, max(0, -floor(log10(step) + 1.0e-9_wp)))
+         ! f0.0 ends in a point: "3." is 3
+         if (label(len(label):) == '.') label = label(:len(label) - 1)
+      else
+         write (buf, '(es10.2)') v
+         label = trim(adjustl(buf))
+      end if
+   end function tick_label
 
    !> A comment listing every skipped non-positive value, or nothing.
    function skipped_comment(x, y, active, levels) result(text)
@@ -130,10 +445,12 @@ contains
       character(len=:), allocatable :: text
       logical :: valid(size(x), n_series)
       type(axis_type) :: ax, ay
+      type(series_style_type) :: styles(n_series)
       real(wp) :: x0, left, right, xs(size(x)), ys(size(x))
       integer :: k, i, m
       character(len=:), allocatable :: pts
 
+      styles = report_styles()
       x0 = (p - 1)*panel_width
       left = x0 + plot_left
       right = x0 + plot_right
@@ -163,16 +480,9 @@ contains
             xs(m) = map(ax, x(i), left, right)
             ys(m) = map(ay, y(i, k), plot_bottom, plot_top)
          end do
-         if (m >= 2) then
-            pts = ''
-            do i = 1, m
-               pts = pts//' '//num(xs(i))//','//num(ys(i))
-            end do
-            text = text//'<polyline class="line '//trim(series_name(k))//'" points="'//pts(2:)// &
-               '" fill="none" stroke="'//series_colour(k)//'"'//series_stroke(k)//'/>'//nl
-         end if
+         if (m >= 2) text = text//polyline(styles(k), xs(:m), ys(:m))
          do i = 1, m
-            text = text//marker(k, xs(i), ys(i), 'point '//trim(series_name(k)))
+            text = text//marker(styles(k), xs(i), ys(i), 'point '//trim(series_name(k)))
          end do
       end do
       text = text//'</g>'//nl
@@ -255,25 +565,43 @@ contains
          '" stroke="'//colour//'" stroke-width="1"/>'//nl
    end function line
 
-   !> Filled circle (err_*) or open square (eta_*) centred at (x, y).
-   function marker(k, x, y, class) result(text)
-      integer, intent(in) :: k
+   !> The line of a series through the points (xs, ys).
+   function polyline(style, xs, ys) result(text)
+      type(series_style_type), intent(in) :: style
+      real(wp), intent(in) :: xs(:), ys(:)
+      character(len=:), allocatable :: text, pts
+      integer :: i
+      pts = ''
+      do i = 1, size(xs)
+         pts = pts//' '//num(xs(i))//','//num(ys(i))
+      end do
+      text = '<polyline class="line '//style%name//'" points="'//pts(2:)// &
+         '" fill="none" stroke="'//style%colour//'"'//style%stroke//'/>'//nl
+   end function polyline
+
+   !> The marker of a series centred at (x, y): a pale wide disc, a filled
+   !> circle, an open square, or nothing.
+   function marker(style, x, y, class) result(text)
+      type(series_style_type), intent(in) :: style
       real(wp), intent(in) :: x, y
       character(len=*), intent(in) :: class
       character(len=:), allocatable :: text
-      if (series_estimate(k)) then
+      select case (style%marker)
+      case (marker_square)
          text = '<rect class="'//class//'" x="'//num(x - 3.5_wp)//'" y="'//num(y - 3.5_wp)// &
-            '" width="7" height="7" fill="white" stroke="'//series_colour(k)//'" stroke-width="1.5"/>'//nl
-      else if (k == 1) then
+            '" width="7" height="7" fill="white" stroke="'//style%colour//'" stroke-width="1.5"/>'//nl
+      case (marker_band)
          text = '<circle class="'//class//'" cx="'//num(x)//'" cy="'//num(y)//'" r="6" fill="'// &
-            series_colour(k)//'" fill-opacity="0.35"/>'//nl
-      else
+            style%colour//'" fill-opacity="0.35"/>'//nl
+      case (marker_dot)
          text = '<circle class="'//class//'" cx="'//num(x)//'" cy="'//num(y)//'" r="4" fill="'// &
-            series_colour(k)//'"/>'//nl
-      end if
+            style%colour//'"/>'//nl
+      case default
+         text = ''
+      end select
    end function marker
 
-   !> Stroke attributes of series k: err_fe (k = 1) a wide pale band, estimates dashed.
+   !> Stroke attributes of report series k: err_fe (k = 1) a wide pale band, estimates dashed.
    pure function series_stroke(k) result(text)
       integer, intent(in) :: k
       character(len=:), allocatable :: text
@@ -284,8 +612,9 @@ contains
       end if
    end function series_stroke
 
-   !> One row of legend entries under the panels, centred.
-   function legend(active) result(text)
+   !> One row of legend entries under the panels, centred: the active series.
+   function legend(styles, active) result(text)
+      type(series_style_type), intent(in) :: styles(:)
       logical, intent(in) :: active(:)
       character(len=:), allocatable :: text
       real(wp), parameter :: entry_width = 130.0_wp, y = 450.0_wp
@@ -295,12 +624,12 @@ contains
       text = ''
       if (.not. any(active)) return
       x = (page_width - count(active)*entry_width)/2
-      do k = 1, n_series
+      do k = 1, size(styles)
          if (.not. active(k)) cycle
          text = text//'<line x1="'//num(x)//'" y1="'//num(y)//'" x2="'//num(x + 36)//'" y2="'//num(y)// &
-            '" stroke="'//series_colour(k)//'"'//series_stroke(k)//'/>'//nl// &
-            marker(k, x + 18, y, 'legend')// &
-            '<text x="'//num(x + 44)//'" y="'//num(y + 4)//'">'//trim(series_name(k))//'</text>'//nl
+            '" stroke="'//styles(k)%colour//'"'//styles(k)%stroke//'/>'//nl// &
+            marker(styles(k), x + 18, y, 'legend')// &
+            '<text x="'//num(x + 44)//'" y="'//num(y + 4)//'">'//styles(k)%name//'</text>'//nl
          x = x + entry_width
       end do
    end function legend

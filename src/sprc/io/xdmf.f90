@@ -7,11 +7,18 @@
 !> /level_LL/<body>/mesh/connectivity  int32   (n_cells, nodes_per_cell)  0-based, VTK order
 !> /level_LL/<body>/node/<name>        float64 (n_nodes) | (n_nodes, ncomp)
 !> /level_LL/<body>/cell/<name>        float64 or int32 (n_cells) | (n_cells, ncomp)
+!> /level_LL/contact_<k>/mesh/x        float64 (n_points, dim)   slave points of &contact pair k
+!> /level_LL/contact_<k>/node/<name>   float64 or int32 (n_points) | (n_points, 3)
 !> ```
 !> LL is the level with two digits (`/level_04`), <body> the body's name
 !> (`sprc run` writes every body so, even a scene's only one); a writer that
 !> gives no body name gets `/level_LL/mesh/x` etc. A field with one component
-!> is a 1-D dataset. A vector field is stored with 3 components (a 2-D vector
+!> is a 1-D dataset. The slave-surface points of a contact pair are a grid
+!> of Polyvertex cells (one point each, connectivity (n_points, 1)) beside
+!> the bodies' grids of the level, named `contact_<k>` (with leading `_`
+!> added while a body has that name); its node fields are the contact
+!> pressures, gap, state, tangential tractions, weights and normals
+!> (`sprc_io_fields`). A vector field is stored with 3 components (a 2-D vector
 !> gets z = 0) because ParaView only treats 3-component arrays as vectors
 !> (warp, glyphs). A field with named components (e.g. Voigt stresses
 !> xx, yy, xy) is one (n, ncomp) dataset.
@@ -49,15 +56,15 @@ module sprc_io_xdmf
    implicit none
    private
 
-   public :: cell_quad4, cell_quad9, cell_hex8, cell_hex27, cell_nodes, cell_dim, topology_name
+   public :: cell_quad4, cell_quad9, cell_hex8, cell_hex27, cell_vertex, cell_nodes, cell_dim, topology_name
    public :: center_node, center_cell, field_scalar, field_vector, field_components
    public :: xdmf_field_type, xdmf_grid_type, xdmf_text, write_xdmf
    public :: level_group, grid_group, mesh_x_path, mesh_connectivity_path, field_path, n_attributes, attribute_name, &
       & valid_name
    public :: max_name_length
 
-   !> Cell types.
-   integer, parameter :: cell_quad4 = 1, cell_quad9 = 2, cell_hex8 = 3, cell_hex27 = 4
+   !> Cell types; `cell_vertex` is one point (a point set: XDMF Polyvertex).
+   integer, parameter :: cell_quad4 = 1, cell_quad9 = 2, cell_hex8 = 3, cell_hex27 = 4, cell_vertex = 5
    !> Where a field lives.
    integer, parameter :: center_node = 1, center_cell = 2
    !> How a field is shown: one scalar, a 3-vector, or one scalar per named component.
@@ -103,6 +110,7 @@ contains
       case (cell_quad9); cell_nodes = 9
       case (cell_hex8); cell_nodes = 8
       case (cell_hex27); cell_nodes = 27
+      case (cell_vertex); cell_nodes = 1
       case default; cell_nodes = 0
       end select
    end function cell_nodes
@@ -113,7 +121,7 @@ contains
       select case (cell_type)
       case (cell_quad4, cell_quad9); cell_dim = 2
       case (cell_hex8, cell_hex27); cell_dim = 3
-      case default; cell_dim = 0
+      case default; cell_dim = 0 ! a vertex, or unknown
       end select
    end function cell_dim
 
@@ -126,6 +134,7 @@ contains
       case (cell_quad9); name = 'Quadrilateral_9'
       case (cell_hex8); name = 'Hexahedron'
       case (cell_hex27); name = 'Hexahedron_27'
+      case (cell_vertex); name = 'Polyvertex'
       case default; name = 'unknown'
       end select
    end function topology_name
@@ -292,7 +301,7 @@ contains
       if (with_time) text = text//'    <Time Value="'//itoa(grid%level)//'"/>'//nl
       text = text// &
          '    <Topology TopologyType="'//topology_name(grid%cell_type)//'" NumberOfElements="'// &
-         itoa(grid%n_cells)//'">'//nl// &
+         itoa(grid%n_cells)//'"'//nodes_per_element(grid%cell_type)//'>'//nl// &
          '     '//data_item(h5, mesh_connectivity_path(grid), [grid%n_cells, cell_nodes(grid%cell_type)], &
          .true.)//nl// &
          '    </Topology>'//nl// &
@@ -336,6 +345,14 @@ contains
          end do
       end select
    end function attribute_text
+
+   !> XDMF needs the nodes per element of a Polyvertex topology (the other types fix it).
+   pure function nodes_per_element(cell_type) result(text)
+      integer, intent(in) :: cell_type
+      character(len=:), allocatable :: text
+      text = ''
+      if (cell_type == cell_vertex) text = ' NodesPerElement="1"'
+   end function nodes_per_element
 
    function attribute_open(name, type, center) result(text)
       character(len=*), intent(in) :: name, type, center
