@@ -39,8 +39,10 @@ contains
          new_unittest('compound_two_materials_scene', test_compound_two_materials), &
          new_unittest('compound_one_material_scenes', test_compound_one_material), &
          new_unittest('compound_units_scaled', test_compound_scaled), &
+         new_unittest('shrink_fit_example', test_shrink_fit_example), &
          new_unittest('uniform_scene_per_body', test_uniform_scene), &
          new_unittest('hertz_scene_pressure_only', test_hertz_scene), &
+         new_unittest('hertz_examples', test_hertz_examples), &
          new_unittest('contact_row_hand_values', test_contact_row), &
          new_unittest('contact_row_without_exact', test_contact_row_no_exact), &
          new_unittest('fill_exact_pressure', test_fill_exact_pressure) &
@@ -98,6 +100,19 @@ contains
       if (allocated(error)) return
       call check_compound(scene, 3.000113e-4_wp, 1.0e5_wp, error)
    end subroutine test_compound_scaled
+
+   !> example/scenes/shrink_fit.nml (steel in aluminium, MPa, bore pressure
+   !> 10): its comment's p_c = 3.923350 MPa, from the plane-strain closed form
+   !> by hand (f_o, f_i, u_i of sprc_exact_compound's documentation, E' =
+   !> E/(1 - nu^2), nu' = nu/(1 - nu)).
+   subroutine test_shrink_fit_example(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+
+      call read_scene('example/scenes/shrink_fit.nml', scene, error)
+      if (allocated(error)) return
+      call check_compound(scene, 3.923350e-4_wp, 1.0e4_wp, error)
+   end subroutine test_shrink_fit_example
 
    !> For both rings, built in their own analysis units and converted back to
    !> the scene's: sigma_rr(c) = -p_c with p_c = `reference`*`scale` (within
@@ -235,6 +250,36 @@ contains
       if (allocated(error)) return
       call check(error, pressure%pressure([1.01_wp*a, 0.0_wp], [0.0_wp, -1.0_wp]), 0.0_wp, 0.0_wp, 'open beyond a')
    end subroutine test_hertz_scene
+
+   !> The peak pressures the example scenes state (hertz_cylinder: p0 =
+   !> 13.74, a = 0.05003; hertz_sphere: p0 = 36.02, a = 0.10298), to their
+   !> digits, at the first point of contact with the slave's normal.
+   subroutine test_hertz_examples(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      class(exact_pressure_type), allocatable :: pressure
+
+      call read_scene('example/scenes/hertz_cylinder.nml', scene, error)
+      if (allocated(error)) return
+      call build_exact_pressure(scene, 1, pressure, error)
+      if (allocated(error)) return
+      call check(error, abs(pressure%pressure([0.0_wp, 0.0_wp], [0.0_wp, -1.0_wp]) - 13.74_wp) <= 0.005_wp, &
+         & 'hertz_cylinder example: p0 = 13.74')
+      if (allocated(error)) return
+      call check(error, pressure%pressure([0.05003_wp, 0.0_wp], [0.0_wp, -1.0_wp]) < 0.3_wp .and. &
+         & pressure%pressure([0.05002_wp, 0.0_wp], [0.0_wp, -1.0_wp]) > 0.0_wp, 'hertz_cylinder example: a = 0.05003')
+      if (allocated(error)) return
+      call read_scene('example/scenes/hertz_sphere.nml', scene, error)
+      if (allocated(error)) return
+      call build_exact_pressure(scene, 1, pressure, error)
+      if (allocated(error)) return
+      call check(error, abs(pressure%pressure([0.0_wp, 0.0_wp, 0.0_wp], [0.0_wp, 0.0_wp, -1.0_wp]) - 36.02_wp) <= &
+         & 0.005_wp, 'hertz_sphere example: p0 = 36.02')
+      if (allocated(error)) return
+      call check(error, pressure%pressure([0.0_wp, 0.102975_wp, 0.0_wp], [0.0_wp, 0.0_wp, -1.0_wp]) > 0.0_wp .and. &
+         & .not. (pressure%pressure([0.0_wp, 0.102985_wp, 0.0_wp], [0.0_wp, 0.0_wp, -1.0_wp]) > 0.0_wp), &
+         & 'hertz_sphere example: a = 0.10298')
+   end subroutine test_hertz_examples
 
    ! ---------------------------------------------------------- contact row
 

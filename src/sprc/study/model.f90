@@ -180,7 +180,9 @@ contains
          case ('traction', 'displacement')
             load = max(load, maxval([0.0_wp, abs(scene%bcs(i)%vector)]))
          case ('exact_traction', 'exact_displacement')
-            load = max(load, abs(scene%exact%p_in), abs(scene%exact%p_out), abs(scene%exact%s_inf))
+            load = max(load, abs(scene%exact%p_in), abs(scene%exact%p_out), abs(scene%exact%s_inf), &
+               & abs(scene%exact%interference))
+            if (allocated(scene%exact%stress)) load = max(load, maxval([0.0_wp, abs(scene%exact%stress)]))
          end select
       end do
       if (.not. (load > 0.0_wp) .and. size(scene%contacts) == 0) text = text//'warning: no load: every '// &
