@@ -17,7 +17,7 @@ module sprc_test_contact_model
    use sprc_study_model, only: build_exact, build_exact_pressure, exact_has_field, analysis_units, &
       & analysis_units_type, in_units
    use sprc_study_row, only: report_row_type, is_empty, report_empty
-   use sprc_study_contact_row, only: fill_contact_row, fill_exact_pressure
+   use sprc_study_contact_row, only: fill_contact_row, fill_exact_pressure, fill_contact_exact
    use sprc_contact_result, only: contact_result_type, new_contact_result, contact_open, contact_stick, &
       & contact_slip
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed
@@ -45,7 +45,8 @@ contains
          new_unittest('hertz_examples', test_hertz_examples), &
          new_unittest('contact_row_hand_values', test_contact_row), &
          new_unittest('contact_row_without_exact', test_contact_row_no_exact), &
-         new_unittest('fill_exact_pressure', test_fill_exact_pressure) &
+         new_unittest('fill_exact_pressure', test_fill_exact_pressure), &
+         new_unittest('fill_contact_exact_scene', test_fill_contact_exact) &
          ]
    end subroutine collect_contact_model
 
@@ -363,6 +364,32 @@ contains
       call fill_exact_pressure(pressure, result)
       call check(error, maxval(abs(result%p_exact - [5.0_wp, 2.0_wp])), 0.0_wp, roundoff, 'p_exact at both points')
    end subroutine test_fill_exact_pressure
+
+   !> Through the scene: the shrink fit example's pair (slave = shaft, its
+   !> outward normal radial) gets p_c at two points of the interface; a scene
+   !> without &exact leaves p_exact empty.
+   subroutine test_fill_contact_exact(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(contact_result_type) :: contacts(1)
+      real(wp) :: x(2, 2), normal(2, 2)
+
+      call read_scene('example/scenes/shrink_fit.nml', scene, error)
+      if (allocated(error)) return
+      normal = reshape([1.0_wp, 0.0_wp, sqrt(0.5_wp), sqrt(0.5_wp)], [2, 2])
+      x = 20.0_wp*normal
+      call new_contact_result(contacts(1), x, [1.0_wp, 1.0_wp], normal, 1, 2)
+      call fill_contact_exact(scene, contacts, error)
+      if (allocated(error)) return
+      call check(error, maxval(abs(contacts(1)%p_exact - 3.923350_wp)) <= 0.5e-6_wp, 'p_c at both points')
+      if (allocated(error)) return
+      call read_scene('test/data/scenes/valid/contact_punch.nml', scene, error)
+      if (allocated(error)) return
+      call new_contact_result(contacts(1), x, [1.0_wp, 1.0_wp], normal, 1, 2)
+      call fill_contact_exact(scene, contacts, error)
+      if (allocated(error)) return
+      call check(error, all(is_empty(contacts(1)%p_exact)), 'no &exact: p_exact empty')
+   end subroutine test_fill_contact_exact
 
    !> Two pairs of synthetic results (2D): pair 1 with 3 points (slip, stick,
    !> open; weights 0.5, 1, 0.25), pair 2 with one slipping point (weight

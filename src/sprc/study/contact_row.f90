@@ -11,17 +11,43 @@
 !> some point (not computed), err_p_X also without an exact pressure or when
 !> the exact pressure is zero everywhere (a relative error of nothing).
 !> The row's iteration count and contact time are the contact solve's to set.
+!>
+!> After a level's contact solve and recoveries:
+!> ```fortran
+!> call fill_contact_exact(study%scene, result%contacts, error)   ! p_exact where &exact gives it
+!> call fill_contact_row(result%contacts, result%row)
+!> ```
 module sprc_study_contact_row
    use sprc_core_kinds, only: wp
+   use sprc_core_error, only: error_type
    use sprc_exact_pressure, only: exact_pressure_type
    use sprc_contact_result, only: contact_result_type, contact_open
    use sprc_study_row, only: report_row_type, report_empty, is_empty
+   use sprc_study_spec, only: scene_type
+   use sprc_study_model, only: build_exact_pressure
    implicit none
    private
 
-   public :: fill_contact_row, fill_exact_pressure
+   public :: fill_contact_row, fill_exact_pressure, fill_contact_exact
 
 contains
+
+   !> p_exact of every pair's result (`contacts(k)` is `&contact` pair k of
+   !> `scene`, in scene units) from the scene's exact solution; left empty
+   !> where there is none (no `&exact`, or no field in the slave body).
+   subroutine fill_contact_exact(scene, contacts, error)
+      type(scene_type), intent(in) :: scene
+      type(contact_result_type), intent(inout) :: contacts(:)
+      type(error_type), allocatable, intent(out) :: error
+      class(exact_pressure_type), allocatable :: pressure
+      integer :: k
+
+      do k = 1, size(contacts)
+         call build_exact_pressure(scene, k, pressure, error)
+         if (allocated(error)) return
+         if (allocated(pressure)) call fill_exact_pressure(pressure, contacts(k))
+      end do
+   end subroutine fill_contact_exact
 
    !> Set p_exact of `result` at every slave point from `pressure` (same units
    !> as the result: the scene's).
