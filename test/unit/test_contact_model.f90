@@ -21,6 +21,8 @@ module sprc_test_contact_model
    use sprc_contact_result, only: contact_result_type, new_contact_result, contact_open, contact_stick, &
       & contact_slip
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed
+   use sprc_test_model, only: replaced
+   use sprc_test_report, only: read_text_file
    implicit none
    private
 
@@ -89,7 +91,7 @@ contains
       type(scene_type) :: scene
       character(len=:), allocatable :: text
 
-      call read_text(shrink_fit, text, error)
+      call read_text_file(shrink_fit, text, error)
       if (allocated(error)) return
       text = replaced(text, "young=2.0", "young=2.0e5")
       text = replaced(text, "young=1.0", "young=1.0e5")
@@ -168,7 +170,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       character(len=32) :: e
 
-      call read_text(shrink_fit, text, error)
+      call read_text_file(shrink_fit, text, error)
       if (allocated(error)) return
       write (e, '(es12.5)') young
       text = replaced(text, "'plane_strain'", "'"//analysis//"'")
@@ -443,36 +445,5 @@ contains
       s_unit = units%modulus*units%strain
       u_unit = units%strain
    end subroutine body_exact
-
-   subroutine read_text(path, text, error)
-      character(len=*), intent(in) :: path
-      character(len=:), allocatable, intent(out) :: text
-      type(error_type), allocatable, intent(out) :: error
-      integer :: unit, stat, n
-
-      open (newunit=unit, file=path, access='stream', form='unformatted', status='old', action='read', iostat=stat)
-      if (stat /= 0) then
-         call test_failed(error, 'cannot open '//path)
-         return
-      end if
-      inquire (unit=unit, size=n)
-      allocate (character(len=n) :: text)
-      read (unit, iostat=stat) text
-      close (unit)
-      if (stat /= 0) call test_failed(error, 'cannot read '//path)
-   end subroutine read_text
-
-   !> `text` with the first `old` replaced by `new` (the test fails later if absent).
-   pure function replaced(text, old, new) result(out)
-      character(len=*), intent(in) :: text, old, new
-      character(len=:), allocatable :: out
-      integer :: i
-      i = index(text, old)
-      if (i == 0) then
-         out = text
-      else
-         out = text(1:i - 1)//new//text(i + len(old):)
-      end if
-   end function replaced
 
 end module sprc_test_contact_model

@@ -6,6 +6,7 @@
 module sprc_test_contact_output
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: stat_io
+   use sprc_core_text, only: itoa
    use sprc_contact_result, only: contact_result_type, new_contact_result, contact_stick
    use sprc_io_contact, only: contact_level_type, contact_csv_header, write_contact_csv
    use sprc_io_svg, only: write_contact_svg, contact_svg
@@ -297,13 +298,5 @@ contains
       call check(error, err%stat == stat_io .and. index(err%message, part) > 0, 'stat_io naming the path: '// &
          & err%message)
    end subroutine expect_io_error
-
-   pure function itoa(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=16) :: buf
-      write (buf, '(i0)') i
-      s = trim(buf)
-   end function itoa
 
 end module sprc_test_contact_output

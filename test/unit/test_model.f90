@@ -14,7 +14,7 @@ module sprc_test_model
    implicit none
    private
 
-   public :: collect_model
+   public :: collect_model, replaced
 
 contains
 
