@@ -176,8 +176,12 @@ contains
             & prefix//trim(output_exts(i)))
       end do
       deallocate (partial_prefix)
-      if (.not. cli%quiet) write (error_unit, '(a)') 'sprc: wrote '//prefix//'.csv, .svg, .h5, .xdmf'// &
-         & trim(merge(', _contact.csv, _contact.svg', '                            ', n_outputs == 6))
+      if (cli%quiet) return
+      if (n_outputs == 6) then
+         write (error_unit, '(a)') 'sprc: wrote '//prefix//'.csv, .svg, .h5, .xdmf, _contact.csv, _contact.svg'
+      else
+         write (error_unit, '(a)') 'sprc: wrote '//prefix//'.csv, .svg, .h5, .xdmf'
+      end if
    end subroutine run_study
 
    !> mkdir -p of the directory part of an output prefix (the library does no
