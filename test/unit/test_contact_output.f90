@@ -32,6 +32,7 @@ contains
          new_unittest('svg_well_formed_series', test_svg_series), &
          new_unittest('svg_points_in_order', test_svg_order), &
          new_unittest('svg_3d_and_empty', test_svg_3d_empty), &
+         new_unittest('svg_many_points', test_svg_many_points), &
          new_unittest('svg_unwritable_path', test_svg_unwritable) &
          ]
    end subroutine collect_contact_output
@@ -257,6 +258,30 @@ contains
       if (allocated(error)) return
       call check(error, index(text, 'no data') > 0, 'says no data')
    end subroutine test_svg_3d_empty
+
+   !> 20000 slave points (a fine 3D level): at most 2000 markers per series,
+   !> every 10th point; the exact series (no markers) still a polyline in 2D.
+   subroutine test_svg_many_points(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_result_type) :: c(1)
+      character(len=:), allocatable :: text, msg
+      real(wp), allocatable :: x(:, :)
+      integer :: i, n
+
+      n = 20000
+      allocate (x(2, n))
+      x(1, :) = [(real(i, wp)/n, i=1, n)]
+      x(2, :) = 0.0_wp
+      call new_contact_result(c(1), x, spread(1.0_wp/n, 1, n), spread([0.0_wp, -1.0_wp], 2, n), 1, 2)
+      c(1)%p_fe = 1.0_wp - x(1, :)**2
+      c(1)%p_exact = 1.0_wp - x(1, :)**2
+      text = contact_svg(c, 'many')
+      call check(error, xml_well_formed(text, 'svg', msg), 'SVG well-formed: '//msg)
+      if (allocated(error)) return
+      call check(error, count_sub(text, 'class="point p_fe"'), 2000, 'every 10th FE point')
+      if (allocated(error)) return
+      call check(error, count_sub(text, 'class="line p_exact"'), 1, 'the exact line')
+   end subroutine test_svg_many_points
 
    subroutine test_svg_unwritable(error)
       type(error_type), allocatable, intent(out) :: error

@@ -64,6 +64,18 @@ module sprc_io_svg
 
    !> The contact plot's series: FE, SPR, SPR-C and the exact pressure.
    integer, parameter :: n_contact_series = 4
+   !> At most this many markers per series in the contact plot: a 3D slave
+   !> surface has tens of thousands of points; more markers only blacken the
+   !> picture and bloat the file. Every k-th point (in abscissa order) is drawn.
+   integer, parameter :: max_markers = 2000
+
+   !> Text built piece by piece in amortized linear time (a plot of many
+   !> points made by repeated concatenation took quadratic time: 23 s for
+   !> the 22k slave points of a 3D level).
+   type :: text_buffer_type
+      character(len=:), allocatable :: text
+      integer :: n = 0
+   end type text_buffer_type
    !> Extent of the contact plot's panel (one panel across the page).
    real(wp), parameter :: contact_right = page_width - 25.0_wp
 
@@ -274,22 +286,40 @@ contains
       end do
    end function from_peak
 
-   !> The permutation sorting `v` ascending (stable insertion sort: the point
-   !> sets are a few thousand at most).
+   !> The permutation sorting `v` ascending: a stable bottom-up merge sort
+   !> (a 3D slave surface has tens of thousands of points in no order).
    pure function sorted(v) result(order)
       real(wp), intent(in) :: v(:)
       integer :: order(size(v))
-      integer :: i, j, t
-      order = [(i, i=1, size(v))]
-      do i = 2, size(v)
-         t = order(i)
-         j = i - 1
-         do while (j >= 1)
-            if (.not. (v(order(j)) > v(t))) exit
-            order(j + 1) = order(j)
-            j = j - 1
+      integer :: work(size(v)), width, lo, mid, hi, i, j, k, n
+
+      n = size(v)
+      order = [(i, i=1, n)]
+      width = 1
+      do while (width < n)
+         do lo = 1, n, 2*width
+            mid = min(lo + width - 1, n)
+            hi = min(lo + 2*width - 1, n)
+            i = lo
+            j = mid + 1
+            do k = lo, hi
+               if (j > hi) then
+                  work(k) = order(i)
+                  i = i + 1
+               else if (i > mid) then
+                  work(k) = order(j)
+                  j = j + 1
+               else if (v(order(j)) < v(order(i))) then
+                  work(k) = order(j)
+                  j = j + 1
+               else
+                  work(k) = order(i)
+                  i = i + 1
+               end if
+            end do
          end do
-         order(j + 1) = t
+         order = work
+         width = 2*width
       end do
    end function sorted
 
@@ -303,6 +333,7 @@ contains
       type(linear_axis_type) :: ax, ay
       logical :: valid(size(s), size(styles))
       real(wp) :: xs(size(s)), ys(size(s))
+      type(text_buffer_type) :: buf
       integer :: k, i, m
 
       do k = 1, size(styles)
@@ -320,7 +351,7 @@ contains
       end if
       ax = linear_axis(pack(spread(s, 2, size(styles)), valid))
       ay = linear_axis([pack(p, valid), 0.0_wp])
-      text = text//linear_ticks(ax, .true.)//linear_ticks(ay, .false.)//frame(plot_left, contact_right)
+      call append(buf, text//linear_ticks(ax, .true.)//linear_ticks(ay, .false.)//frame(plot_left, contact_right))
       do k = 1, size(styles)
          m = 0
          do i = 1, size(s)
@@ -329,13 +360,29 @@ contains
             xs(m) = linear_map(ax, s(i), plot_left, contact_right)
             ys(m) = linear_map(ay, p(i, k), plot_bottom, plot_top)
          end do
-         if (lines .and. m >= 2) text = text//polyline(styles(k), xs(:m), ys(:m))
-         do i = 1, m
-            text = text//marker(styles(k), xs(i), ys(i), 'point '//styles(k)%name)
+         if (lines .and. m >= 2) call append(buf, polyline(styles(k), xs(:m), ys(:m)))
+         do i = 1, m, max(1, (m + max_markers - 1)/max_markers)
+            call append(buf, marker(styles(k), xs(i), ys(i), 'point '//styles(k)%name))
          end do
       end do
-      text = text//'</g>'//nl
+      text = buf%text(:buf%n)//'</g>'//nl
    end function contact_panel
+
+   !> Add `piece` to the end of `buf`, doubling its room when full.
+   pure subroutine append(buf, piece)
+      type(text_buffer_type), intent(inout) :: buf
+      character(len=*), intent(in) :: piece
+      character(len=:), allocatable :: larger
+
+      if (.not. allocated(buf%text)) allocate (character(len=max(4096, 2*len(piece))) :: buf%text)
+      if (buf%n + len(piece) > len(buf%text)) then
+         allocate (character(len=max(2*len(buf%text), buf%n + len(piece))) :: larger)
+         larger(:buf%n) = buf%text(:buf%n)
+         call move_alloc(larger, buf%text)
+      end if
+      buf%text(buf%n + 1:buf%n + len(piece)) = piece
+      buf%n = buf%n + len(piece)
+   end subroutine append
 
    !> An axis from a multiple of a round step (1, 2 or 5 times a power of ten,
    !> about five steps) below the values to one above them; a single value
@@ -569,13 +616,14 @@ contains
    function polyline(style, xs, ys) result(text)
       type(series_style_type), intent(in) :: style
       real(wp), intent(in) :: xs(:), ys(:)
-      character(len=:), allocatable :: text, pts
+      character(len=:), allocatable :: text
+      type(text_buffer_type) :: pts
       integer :: i
-      pts = ''
+      call append(pts, '')
       do i = 1, size(xs)
-         pts = pts//' '//num(xs(i))//','//num(ys(i))
+         call append(pts, ' '//num(xs(i))//','//num(ys(i)))
       end do
-      text = '<polyline class="line '//style%name//'" points="'//pts(2:)// &
+      text = '<polyline class="line '//style%name//'" points="'//pts%text(2:pts%n)// &
          '" fill="none" stroke="'//style%colour//'"'//style%stroke//'/>'//nl
    end function polyline
 
