@@ -33,6 +33,7 @@ contains
          new_unittest('svg_points_in_order', test_svg_order), &
          new_unittest('svg_3d_and_empty', test_svg_3d_empty), &
          new_unittest('svg_many_points', test_svg_many_points), &
+         new_unittest('svg_loaded_window', test_svg_window), &
          new_unittest('svg_unwritable_path', test_svg_unwritable) &
          ]
    end subroutine collect_contact_output
@@ -196,7 +197,7 @@ contains
       if (allocated(error)) return
       call check(error, count_sub(text, 'class="line p_exact"'), 1, 'the exact pressure a line')
       if (allocated(error)) return
-      call check(error, index(text, 'coordinate along the slave surface') > 0, '2D abscissa')
+      call check(error, index(text, 'arc length along the slave surface') > 0, '2D abscissa')
       if (allocated(error)) return
       call check(error, index(text, 'NaN') == 0 .and. index(text, 'nan') == 0, 'no NaN')
       if (allocated(error)) return
@@ -282,6 +283,34 @@ contains
       if (allocated(error)) return
       call check(error, count_sub(text, 'class="line p_exact"'), 1, 'the exact line')
    end subroutine test_svg_many_points
+
+   !> A Hertz-like load on phi < 0.1 of a quarter circle (101 points 0.01
+   !> apart in angle): loaded are the points 0 .. 0.09, so the plot shows
+   !> s <= 0.09 + 0.09/4 (points 0 .. 0.11: 12 markers); the abscissa is the
+   !> arc length, so equal angle steps are equal pixel steps.
+   subroutine test_svg_window(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_result_type) :: c(1)
+      character(len=:), allocatable :: text
+      real(wp) :: x(2, 101), phi(101), cx(12)
+      integer :: i, pos, k
+
+      phi = [(0.01_wp*(i - 1), i=1, 101)]
+      x(1, :) = sin(phi)
+      x(2, :) = 1.0_wp - cos(phi)
+      call new_contact_result(c(1), x, spread(0.01_wp, 1, 101), x, 1, 2)
+      c(1)%p_fe = merge(1.0_wp - (phi/0.1_wp)**2, 0.0_wp, phi < 0.1_wp)
+      text = contact_svg(c, 'window')
+      call check(error, count_sub(text, 'class="point p_fe"'), 12, 'markers of the loaded stretch and margins')
+      if (allocated(error)) return
+      pos = 1
+      do k = 1, 12
+         i = index(text(pos:), 'class="point p_fe"')
+         pos = pos + i
+         cx(k) = attribute_real(text(pos:), 'cx')
+      end do
+      call check(error, (cx(12) - cx(11)) - (cx(2) - cx(1)), 0.0_wp, 0.05_wp, 'arc length abscissa')
+   end subroutine test_svg_window
 
    subroutine test_svg_unwritable(error)
       type(error_type), allocatable, intent(out) :: error

@@ -13,12 +13,14 @@
 !>
 !> The contact plot (`contact_svg`, PREFIX_contact.svg) is one panel with
 !> linear axes: the contact pressure p_fe, p_spr, p_sprc and p_exact at the
-!> slave points of a level, against the coordinate along the slave surface
-!> (2D: the projection on the principal direction of the points, which is
-!> monotone along a flat or gently curved surface and along a quarter
-!> circle; points joined in that order) or, in 3D, against the distance
-!> from the point of peak pressure (exact, else FE; markers only, a surface
-!> has no order). Same page layout, markers and legend as the report plot.
+!> slave points of a level, in 2D against the arc length along the slave
+!> surface (points ordered by their projection on the principal direction
+!> of the points, which is monotone along a flat or gently curved surface
+!> and along a quarter circle, and joined in that order) or, in 3D, against
+!> the distance from the point of peak pressure (exact, else FE; markers
+!> only, a surface has no order). The abscissa spans the loaded part of the
+!> surface with a margin. Same page layout, markers and legend as the report
+!> plot.
 module sprc_io_svg
    use sprc_core_kinds, only: wp
    use sprc_core_text, only: fixed_text
@@ -195,13 +197,12 @@ contains
       character(len=:), allocatable :: svg
       type(series_style_type) :: styles(n_contact_series)
       real(wp), allocatable :: x(:, :), p(:, :), s(:)
-      integer, allocatable :: order(:)
+      integer, allocatable :: order(:), shown(:)
       logical :: active(n_contact_series)
-      integer :: dim, k, n
+      integer :: dim, k
 
       styles = contact_styles()
       call gather_points(contacts, x, p)
-      n = size(p, 1)
       dim = 2
       if (size(contacts) > 0) dim = contacts(1)%dim
       if (dim == 2) then
@@ -210,12 +211,15 @@ contains
          s = from_peak(x, p)
       end if
       order = sorted(s)
+      if (dim == 2) s(order) = arc_length(x(:, order))
+      shown = pack(order, loaded_window(s(order), p(order, :)))
       do k = 1, n_contact_series
          active(k) = any(.not. is_empty(p(:, k)))
       end do
       svg = page_open('sprc contact pressure along the slave surface (p = -n.sigma.n, positive in compression). '// &
-         'Empty values (not computed) are left out.', '', title)
-      svg = svg//contact_panel(s(order), p(order, :), styles, active, dim == 2)
+         'Empty values (not computed) are left out; the abscissa spans the loaded part of the surface and a '// &
+         'quarter of it on either side.', '', title)
+      svg = svg//contact_panel(s(shown), p(shown, :), styles, active, dim == 2)
       svg = svg//legend(styles, active)//'</g>'//nl//'</svg>'//nl
    end function contact_svg
 
@@ -266,6 +270,47 @@ contains
       if (t(1) < 0.0_wp .or. (.not. (abs(t(1)) > 0.0_wp) .and. t(2) < 0.0_wp)) t = -t
       s = matmul(t, d)
    end function along_surface
+
+   !> Arc length at each of the points `x(dim, n)` (in order along a curve):
+   !> the sum of the distances between consecutive points, 0 at the first.
+   pure function arc_length(x) result(s)
+      real(wp), intent(in) :: x(:, :)
+      real(wp) :: s(size(x, 2))
+      integer :: i
+
+      if (size(x, 2) == 0) return
+      s(1) = 0.0_wp
+      do i = 2, size(x, 2)
+         s(i) = s(i - 1) + norm2(x(:, i) - x(:, i - 1))
+      end do
+   end function arc_length
+
+   !> The points to plot, `s` ascending: those within a quarter of the loaded
+   !> stretch (where some pressure exceeds 1e-3 of the largest) on either side
+   !> of it, so that a Hertz contact a few per cent of the surface long fills
+   !> the picture; every point when nothing is loaded.
+   pure function loaded_window(s, p) result(keep)
+      real(wp), intent(in) :: s(:), p(:, :)
+      logical :: keep(size(s))
+      logical :: loaded(size(s))
+      real(wp) :: p_max, lo, hi, margin
+      integer :: i
+
+      keep = .true.
+      p_max = 0.0_wp
+      do i = 1, size(s)
+         p_max = max(p_max, maxval(abs(p(i, :)), mask=.not. is_empty(p(i, :))))
+      end do
+      if (.not. (p_max > 0.0_wp)) return
+      do i = 1, size(s)
+         loaded(i) = any(abs(p(i, :)) > 1.0e-3_wp*p_max .and. .not. is_empty(p(i, :)))
+      end do
+      lo = minval(s, mask=loaded)
+      hi = maxval(s, mask=loaded)
+      margin = 0.25_wp*(hi - lo)
+      if (.not. (margin > 0.0_wp)) margin = 0.05_wp*(s(size(s)) - s(1))
+      keep = s >= lo - margin .and. s <= hi + margin
+   end function loaded_window
 
    !> 3D: the distance of each point from the point of largest exact pressure
    !> (largest FE pressure without an exact one; the first point without either).
@@ -340,7 +385,7 @@ contains
          valid(:, k) = active(k) .and. .not. is_empty(p(:, k))
       end do
       text = '<g>'//nl//'<text x="'//num((plot_left + contact_right)/2)//'" y="'//num(plot_bottom + 42)// &
-         '" text-anchor="middle">'//pick(lines, 'coordinate along the slave surface', &
+         '" text-anchor="middle">'//pick(lines, 'arc length along the slave surface', &
          'distance from the point of peak pressure')//'</text>'//nl// &
          '<text x="22" y="'//num((plot_top + plot_bottom)/2)//'" text-anchor="middle" '// &
          'transform="rotate(-90 22 '//num((plot_top + plot_bottom)/2)//')">contact pressure p</text>'//nl
