@@ -130,8 +130,8 @@ def test_malformed_scene_raises_with_message(name, substrings, stat):
 
 
 def test_unrunnable_scene_is_unsupported():
-    with pytest.raises(sprc.SprcError, match="contact") as info:
-        sprc.run_scene(ROOT / "test" / "data" / "scenes" / "valid" / "contact_punch.nml")
+    with pytest.raises(sprc.SprcError, match="coulomb") as info:
+        sprc.run_scene(ROOT / "test" / "data" / "scenes" / "valid" / "hertz_roller.nml")
     assert info.value.status_name == "unsupported"
 
 

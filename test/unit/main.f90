@@ -26,6 +26,7 @@ program sprc_unit_tests
    use sprc_test_study, only: collect_study
    use sprc_test_contact_model, only: collect_contact_model
    use sprc_test_contact_output, only: collect_contact_output
+   use sprc_test_contact_fe, only: collect_contact_fe
    implicit none
 
    type(testsuite_type), allocatable :: suites(:)
@@ -54,7 +55,8 @@ program sprc_unit_tests
       new_testsuite('stiff', collect_stiff), &
       new_testsuite('study', collect_study), &
       new_testsuite('contact_model', collect_contact_model), &
-      new_testsuite('contact_output', collect_contact_output) &
+      new_testsuite('contact_output', collect_contact_output), &
+      new_testsuite('contact_fe', collect_contact_fe) &
       ]
 
    call get_arg(1, suite_name)

@@ -41,6 +41,11 @@ module sprc_contact_surface
 
    public :: contact_surface_type, new_contact_surface, slave_surface_points, initial_gaps, linearized_gap
 
+   !> Split planes along one axis.
+   type :: planes_type
+      real(wp), allocatable :: p(:)
+   end type planes_type
+
    !> Slave-surface points and their initial gaps.
    type :: contact_surface_type
       !> Space dimension and number of slave points.
@@ -108,19 +113,28 @@ contains
    end subroutine new_contact_surface
 
    !> The surface points of shape `shape` of `body` from the cut-cell rules of
-   !> every leaf of its grid, in leaf order.
-   subroutine slave_surface_points(self, grid, body, quad, shape, error)
+   !> every leaf of its grid, in leaf order. With `split_grid` (the master
+   !> body's grid) each leaf holding such points is cut into sub-boxes at the
+   !> planes of that grid's finest lattice (every master leaf face lies on
+   !> one), and the rules are taken on the sub-boxes: then no part of the
+   !> slave surface between two points straddles a master cell face where the
+   !> surfaces touch, and a master displacement piecewise polynomial over the
+   !> master cells is integrated exactly (the contact patch test; without it
+   !> the Gauss points of a slave cell integrate across the master's kinks).
+   subroutine slave_surface_points(self, grid, body, quad, shape, error, split_grid)
       type(contact_surface_type), intent(out) :: self
       type(grid_type), intent(in) :: grid
       type(body_type), intent(in) :: body
       type(cut_quadrature_type), intent(in) :: quad
       integer, intent(in) :: shape
       type(error_type), allocatable, intent(out) :: error
+      type(grid_type), intent(in), optional :: split_grid
       type(cell_rule_type) :: rule
       real(wp), allocatable :: x(:, :), w(:), nrm(:, :)
       integer, allocatable :: cell(:)
-      real(wp) :: lo(3), hi(3)
-      integer :: leaf, k, n, d
+      real(wp) :: lo(3), hi(3), sub_lo(3), sub_hi(3)
+      type(planes_type) :: planes(3)
+      integer :: leaf, n, d, j(3), k
 
       if (shape < 1 .or. shape > body%nshape) then
          call fatal_error(error, "contact surface: shape "//itoa(shape)//" of body '"//body_name(body)// &
@@ -132,24 +146,34 @@ contains
       allocate (x(d, 64), w(64), nrm(d, 64), cell(64))
       do leaf = 1, grid%n_leaves
          call grid%leaf_box(leaf, lo(1:d), hi(1:d))
-         ! An inside leaf has surface points only on grid-plane boundaries: skip its volume rule.
-         if (grid%leaf_class(leaf) == cell_inside) then
-            call boundary_face_rule(quad, body, lo(1:d), hi(1:d), rule, error)
-         else
-            call cell_rule(quad, body, lo(1:d), hi(1:d), rule, error)
+         call leaf_rule(grid%leaf_class(leaf) == cell_inside, lo(1:d), hi(1:d), rule, error)
+         if (allocated(error)) return
+         if (count(rule%surf_shape(1:rule%nsurf) == shape) == 0) cycle
+         if (.not. present(split_grid)) then
+            call collect(leaf, rule)
+            cycle
          end if
-         if (allocated(error)) then
-            error%message = 'contact surface, leaf '//itoa(leaf)//': '//error%message
-            return
-         end if
-         do k = 1, rule%nsurf
-            if (rule%surf_shape(k) /= shape) cycle
-            if (n == size(w)) call grow(x, w, nrm, cell)
-            n = n + 1
-            x(:, n) = rule%surf_x(1:d, k)
-            w(n) = rule%surf_w(k)
-            nrm(:, n) = rule%surf_n(1:d, k)
-            cell(n) = leaf
+         do k = 1, d
+            call lattice_planes(split_grid, k, lo(k), hi(k), planes(k)%p)
+         end do
+         j = 1
+         do
+            do k = 1, d
+               sub_lo(k) = planes(k)%p(j(k))
+               sub_hi(k) = planes(k)%p(j(k) + 1)
+            end do
+            call leaf_rule(grid%leaf_class(leaf) == cell_inside, sub_lo(1:d), sub_hi(1:d), rule, error)
+            if (allocated(error)) return
+            call collect(leaf, rule)
+            ! next sub-box (odometer over the dimensions)
+            k = 1
+            do while (k <= d)
+               j(k) = j(k) + 1
+               if (j(k) < size(planes(k)%p)) exit
+               j(k) = 1
+               k = k + 1
+            end do
+            if (k > d) exit
          end do
       end do
       if (n == 0) then
@@ -158,7 +182,60 @@ contains
          return
       end if
       call new_contact_surface(self, x(:, 1:n), w(1:n), nrm(:, 1:n), cell(1:n), error)
+   contains
+      !> The rule of a box of a leaf: an inside leaf has surface points only on
+      !> grid-plane boundaries, so its volume rule is skipped.
+      subroutine leaf_rule(inside, lo, hi, rule, error)
+         logical, intent(in) :: inside
+         real(wp), intent(in) :: lo(:), hi(:)
+         type(cell_rule_type), intent(inout) :: rule
+         type(error_type), allocatable, intent(out) :: error
+         if (inside) then
+            call boundary_face_rule(quad, body, lo, hi, rule, error)
+         else
+            call cell_rule(quad, body, lo, hi, rule, error)
+         end if
+         if (allocated(error)) error%message = 'contact surface, leaf '//itoa(leaf)//': '//error%message
+      end subroutine leaf_rule
+
+      subroutine collect(leaf, rule)
+         integer, intent(in) :: leaf
+         type(cell_rule_type), intent(in) :: rule
+         integer :: q
+         do q = 1, rule%nsurf
+            if (rule%surf_shape(q) /= shape) cycle
+            if (n == size(w)) call grow(x, w, nrm, cell)
+            n = n + 1
+            x(:, n) = rule%surf_x(1:d, q)
+            w(n) = rule%surf_w(q)
+            nrm(:, n) = rule%surf_n(1:d, q)
+            cell(n) = leaf
+         end do
+      end subroutine collect
    end subroutine slave_surface_points
+
+   !> lo, the planes of `grid`'s finest lattice along axis k strictly inside
+   !> (lo, hi) (farther than a relative 1e-9 of the lattice step from both, so
+   !> no sliver boxes), and hi.
+   pure subroutine lattice_planes(grid, k, lo, hi, p)
+      type(grid_type), intent(in) :: grid
+      integer, intent(in) :: k
+      real(wp), intent(in) :: lo, hi
+      real(wp), allocatable, intent(out) :: p(:)
+      real(wp) :: step, c, margin
+      integer :: i, i0, i1
+
+      step = grid%box_size/real(2, wp)**grid%max_level
+      margin = 1.0e-9_wp*step
+      i0 = ceiling((lo - grid%box_min(k))/step)
+      i1 = floor((hi - grid%box_min(k))/step)
+      p = [lo]
+      do i = i0, i1
+         c = grid%box_min(k) + real(i, wp)*step
+         if (c > lo + margin .and. c < hi - margin) p = [p, c]
+      end do
+      p = [p, hi]
+   end subroutine lattice_planes
 
    subroutine grow(x, w, nrm, cell)
       real(wp), allocatable, intent(inout) :: x(:, :), w(:), nrm(:, :)

@@ -92,6 +92,7 @@ module sprc_fem_problem
    private
 
    public :: elasticity_problem_type, default_gamma, rigid_tol, solve_on_grid, gamma_range, gamma_note
+   public :: free_motions, motion_names, solve_spd_or_lu
 
    !> Elements per chunk of the parallel assembly (bounds the buffer of reduced matrices).
    integer, parameter :: chunk_size = 256
@@ -168,6 +169,7 @@ module sprc_fem_problem
       procedure :: element_points
       procedure :: energy_error
       procedure :: scaled_rcond
+      procedure :: rigid_modes
    end type elasticity_problem_type
 
 contains
@@ -885,41 +887,77 @@ contains
       end do
    end subroutine element_system
 
-   !> Rigid-body modes the conditions leave free. The 3 (2D) / 6 (3D) modes
-   !> r_i (translations; rotations about the grid box centre, scaled by 1/box
-   !> size so all have unit magnitude) are taken to the reduced space
-   !> (restrict_field: nodal values at the masters, zeroed components
-   !> dropped), and G = R^T K R is normalised by the diagonal energies
-   !> s_i = sum_j K_jj R_ji^2. An eigenvalue of the normalised G below
-   !> `rigid_tol` is a motion the system does not resist.
+   !> Rigid-body modes the conditions leave free: `rigid_modes` gives the 3
+   !> (2D) / 6 (3D) modes in the reduced space, `free_motions` the motions K
+   !> does not resist among them. An error names the free motions.
    subroutine check_rigid_modes(self, error)
       type(elasticity_problem_type), intent(inout) :: self
       type(error_type), allocatable, intent(out) :: error
-      character(len=*), parameter :: names2(3) = [character(len=16) :: 'translation x', 'translation y', &
-         & 'rotation about z']
-      character(len=*), parameter :: names3(6) = [character(len=16) :: 'translation x', 'translation y', &
-         & 'translation z', 'rotation about x', 'rotation about y', 'rotation about z']
-      real(wp), allocatable :: field(:, :), r(:, :), kr(:, :), diag(:), work(:)
-      real(wp) :: g(6, 6), s(6), lam(6), xc(3), y(3), kmax
-      integer :: nm, i, j, nn, nd, info, d, nfree
-      integer(kind(self%k%rowptr)) :: q
+      real(wp), allocatable :: r(:, :), vec(:, :)
+      integer :: nfree, i
       logical :: involved(6)
       character(len=:), allocatable :: what
       character(len=32) :: count
 
-      d = self%dim
-      nm = merge(3, 6, d == 2)
-      nd = self%constraints%n_dofs
-      nn = self%nodes%n_nodes
-      if (nd == 0) then
+      if (self%constraints%n_dofs == 0) then
          call fatal_error(error, 'elasticity solve: no unknowns are left (every dof is constrained)', &
             & stat_invalid_input)
          return
       end if
+      call self%rigid_modes(r)
+      call free_motions(self%k, r, vec, nfree, error)
+      if (allocated(error) .or. nfree == 0) return
+      ! Name every basic motion with a significant share in a free one, once.
+      involved = .false.
+      do i = 1, nfree
+         involved(1:size(r, 2)) = involved(1:size(r, 2)) .or. abs(vec(:, i)) >= 0.2_wp*maxval(abs(vec(:, i)))
+      end do
+      what = motion_names(self%dim, involved(1:size(r, 2)))
+      write (count, '(i0," independent motion",a)') nfree, trim(merge('s', ' ', nfree > 1))
+      call fatal_error(error, 'the boundary conditions leave rigid-body motion free: '//what//' ('// &
+         & trim(count)//'); add displacement or symmetry conditions that restrain it', stat_singular)
+   end subroutine check_rigid_modes
+
+   !> Comma-separated names of the basic rigid motions flagged in `involved`
+   !> (3 in 2D, 6 in 3D, in the order of `rigid_modes`).
+   pure function motion_names(dim, involved) result(what)
+      integer, intent(in) :: dim
+      logical, intent(in) :: involved(:)
+      character(len=:), allocatable :: what
+      character(len=*), parameter :: names2(3) = [character(len=16) :: 'translation x', 'translation y', &
+         & 'rotation about z']
+      character(len=*), parameter :: names3(6) = [character(len=16) :: 'translation x', 'translation y', &
+         & 'translation z', 'rotation about x', 'rotation about y', 'rotation about z']
+      integer :: i
+      what = ''
+      do i = 1, size(involved)
+         if (.not. involved(i)) cycle
+         if (len(what) > 0) what = what//', '
+         if (dim == 2) then
+            what = what//trim(names2(i))
+         else
+            what = what//trim(names3(i))
+         end if
+      end do
+   end function motion_names
+
+   !> The 3 (2D) / 6 (3D) rigid-body modes r(n_dofs, nm) in the reduced space:
+   !> translations, rotations about the grid box centre scaled by 1/box size
+   !> (all of unit magnitude), taken to the reduced space by restrict_field
+   !> (nodal values at the masters, zeroed components dropped).
+   pure subroutine rigid_modes(self, r)
+      class(elasticity_problem_type), intent(in) :: self
+      real(wp), allocatable, intent(out) :: r(:, :)
+      real(wp), allocatable :: field(:, :)
+      real(wp) :: xc(3), y(3)
+      integer :: nm, i, j, d
+
+      d = self%dim
+      nm = merge(3, 6, d == 2)
       xc(1:d) = self%grid%box_min(1:d) + 0.5_wp*self%grid%box_size
-      allocate (field(d, nn), r(nd, nm), kr(nd, nm), diag(nd))
+      allocate (field(d, self%nodes%n_nodes), r(self%constraints%n_dofs, nm))
       do i = 1, nm
-         do j = 1, nn
+         do j = 1, self%nodes%n_nodes
             y(1:d) = (self%nodes%x(:, j) - xc(1:d))/self%grid%box_size
             field(:, j) = 0.0_wp
             if (i <= d) then
@@ -935,17 +973,40 @@ contains
             end if
          end do
          call self%constraints%restrict_field(field, r(:, i))
-         call self%k%matvec(r(:, i), kr(:, i), error)
+      end do
+   end subroutine rigid_modes
+
+   !> The motions among the columns of r (n, nm) that k does not resist:
+   !> G = R^T K R normalised by the diagonal energies s_i = sum_j K_jj R_ji^2
+   !> (K first divided by its largest diagonal entry, so that the energies
+   !> neither overflow nor underflow for any representable E); the
+   !> eigenvectors of G with eigenvalue below `rigid_tol` are the free motions,
+   !> vec(nm, nfree) in the basis of the columns of r.
+   subroutine free_motions(k, r, vec, nfree, error)
+      type(csr_type), intent(in) :: k
+      real(wp), intent(in) :: r(:, :)
+      real(wp), allocatable, intent(out) :: vec(:, :)
+      integer, intent(out) :: nfree
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: kr(:, :), diag(:), work(:), g(:, :), s(:), lam(:)
+      real(wp) :: kmax
+      integer :: nm, nd, i, j, info
+      integer(kind(k%rowptr)) :: q
+
+      nd = size(r, 1)
+      nm = size(r, 2)
+      nfree = 0
+      allocate (kr(nd, nm), diag(nd), g(nm, nm), s(nm), lam(nm), vec(nm, 0))
+      do i = 1, nm
+         call k%matvec(r(:, i), kr(:, i), error)
          if (allocated(error)) return
       end do
       diag = 0.0_wp
       do i = 1, nd
-         do q = self%k%rowptr(i), self%k%rowptr(i + 1) - 1
-            if (self%k%col(q) == i) diag(i) = self%k%val(q)
+         do q = k%rowptr(i), k%rowptr(i + 1) - 1
+            if (k%col(q) == i) diag(i) = k%val(q)
          end do
       end do
-      ! K scales with Young's modulus: divide by its largest diagonal entry so that
-      ! the energies neither overflow nor underflow for any representable E.
       kmax = maxval(abs(diag))
       if (.not. (kmax > 0.0_wp)) kmax = 1.0_wp
       diag = diag/kmax
@@ -958,59 +1019,58 @@ contains
             g(i, j) = dot_product(r(:, i), kr(:, j))/s(i)/s(j)
          end do
       end do
-      g(1:nm, 1:nm) = 0.5_wp*(g(1:nm, 1:nm) + transpose(g(1:nm, 1:nm)))
-      allocate (work(64))
-      call dsyev('V', 'U', nm, g, 6, lam, work, size(work), info)
+      g = 0.5_wp*(g + transpose(g))
+      allocate (work(max(64, 3*nm)))
+      call dsyev('V', 'U', nm, g, nm, lam, work, size(work), info)
       if (info /= 0) return
-      if (lam(1) >= rigid_tol) return
-      ! The free motions span the eigenvectors below rigid_tol; name every basic
-      ! motion with a significant share in one of them, once.
-      involved = .false.
-      nfree = 0
       do j = 1, nm
          if (lam(j) >= rigid_tol) exit
          nfree = nfree + 1
-         involved(1:nm) = involved(1:nm) .or. abs(g(1:nm, j)) >= 0.2_wp*maxval(abs(g(1:nm, j)))
       end do
-      what = ''
-      do i = 1, nm
-         if (.not. involved(i)) cycle
-         if (len(what) > 0) what = what//', '
-         if (d == 2) then
-            what = what//trim(names2(i))
-         else
-            what = what//trim(names3(i))
-         end if
-      end do
-      write (count, '(i0," independent motion",a)') nfree, trim(merge('s', ' ', nfree > 1))
-      call fatal_error(error, 'the boundary conditions leave rigid-body motion free: '//what//' ('// &
-         & trim(count)//'); add displacement or symmetry conditions that restrain it', stat_singular)
-   end subroutine check_rigid_modes
+      vec = g(:, 1:nfree)
+   end subroutine free_motions
 
    !> CHOLMOD, or UMFPACK when CHOLMOD finds K not positive definite.
    subroutine factor_and_solve(self, error)
       type(elasticity_problem_type), intent(inout) :: self
       type(error_type), allocatable, intent(out) :: error
-      type(cholmod_solver_type) :: chol
-      type(umfpack_solver_type) :: lu
 
       if (allocated(self%ubar)) deallocate (self%ubar)
       allocate (self%ubar(self%constraints%n_dofs))
-      self%solver_name = 'cholmod'
-      self%solver_note = ''
-      call direct_solve(chol, self%k, self%f, self%ubar, self%rcond, error)
+      call solve_spd_or_lu(self%k, self%f, self%ubar, self%rcond, self%solver_name, self%solver_note, error)
+      if (allocated(error)) error%message = 'elasticity solve'//error%message
+   end subroutine factor_and_solve
+
+   !> Solve k x = f with CHOLMOD, or with UMFPACK (LU) when CHOLMOD finds k
+   !> not positive definite: `solver_name` 'cholmod' or 'umfpack', `note` why
+   !> the fallback was taken ('' if not), `rcond` the solver's reciprocal
+   !> condition estimate. An error message starts with the solver's part
+   !> (': ...' or ' (UMFPACK fallback): ...') for the caller to prefix.
+   subroutine solve_spd_or_lu(k, f, x, rcond, solver_name, note, error)
+      type(csr_type), intent(in) :: k
+      real(wp), intent(in) :: f(:)
+      real(wp), intent(inout) :: x(:)
+      real(wp), intent(inout) :: rcond
+      character(len=:), allocatable, intent(out) :: solver_name, note
+      type(error_type), allocatable, intent(out) :: error
+      type(cholmod_solver_type) :: chol
+      type(umfpack_solver_type) :: lu
+
+      solver_name = 'cholmod'
+      note = ''
+      call direct_solve(chol, k, f, x, rcond, error)
       if (.not. allocated(error)) return
       if (error%stat /= stat_not_positive_definite) then
-         error%message = 'elasticity solve: '//error%message
+         error%message = ': '//error%message
          return
       end if
-      self%solver_name = 'umfpack'
-      self%solver_note = 'CHOLMOD found the stiffness not positive definite ('//error%message// &
+      solver_name = 'umfpack'
+      note = 'CHOLMOD found the stiffness not positive definite ('//error%message// &
          & '); solved by UMFPACK (LU). Raise gamma for an SPD system.'
       deallocate (error)
-      call direct_solve(lu, self%k, self%f, self%ubar, self%rcond, error)
-      if (allocated(error)) error%message = 'elasticity solve (UMFPACK fallback): '//error%message
-   end subroutine factor_and_solve
+      call direct_solve(lu, k, f, x, rcond, error)
+      if (allocated(error)) error%message = ' (UMFPACK fallback): '//error%message
+   end subroutine solve_spd_or_lu
 
    !> theta_bar on every aggregate from the nodal displacements (projected dilatation only).
    subroutine dilatation_coefficients(self)

@@ -11,7 +11,7 @@ module sprc_io_scene
    use sprc_core_text, only: itoa, real_text
    use sprc_core_error, only: error_type, fatal_error, stat_unsupported
    use sprc_study_spec, only: scene_type, body_spec_type, shape_spec_type, bc_spec_type, exact_spec_type, &
-      & contact_spec_type, recovery_degree, default_stabilization
+      & contact_spec_type, recovery_degree, default_stabilization, contact_unsupported
    use sprc_io_namelist, only: nml_group_type, parse_namelist, read_text_file, nml_get, nml_get_array, &
       & nml_has, nml_check_consumed, nml_field_error, nml_group_error, nml_item_text
    implicit none
@@ -1069,9 +1069,9 @@ contains
          text = text//'contact: '//contact_line(scene%contacts(i))//nl
       end do
       text = text//switches(scene)
-      if (size(scene%contacts) > 0) then
-         text = text//'NOT RUNNABLE: the contact FE is not implemented in this version; the scene is valid '// &
-            & 'but sprc run refuses it.'//nl
+      if (len(contact_unsupported(scene)) > 0) then
+         text = text//'NOT RUNNABLE: '//contact_unsupported(scene)//'; the scene is valid but sprc run '// &
+            & 'refuses it.'//nl
       end if
       ! Lines are separated, not terminated: the driver prints the text as one record.
       text = text(1:len(text) - 1)
@@ -1315,8 +1315,12 @@ contains
       stages = 1
       if (size(scene%bcs) > 0) stages = max(1, maxval(scene%bcs%stage))
       associate (c => scene%contacts(1))
-         text = "  contact: on (slave '"//c%slave//"' on master '"//c%master//"', friction "//c%friction// &
-            & '; NOT IMPLEMENTED in this version: sprc run refuses the scene)'//nl
+         text = "  contact: on (slave '"//c%slave//"' on master '"//c%master//"', friction "//c%friction
+         if (len(contact_unsupported(scene)) > 0) then
+            text = text//'; NOT IMPLEMENTED in this version: sprc run refuses the scene)'//nl
+         else
+            text = text//'; coupled solve of both bodies, active-set iteration)'//nl
+         end if
          text = text//'  contact stabilization stress: '//c%stabilization//nl
          if (c%friction == 'coulomb') then
             text = text//'  load history: on ('//itoa(stages)//' stage(s), '//itoa(c%steps)// &

@@ -9,8 +9,13 @@
 !> ```
 !> Bodies without `&contact` between them are independent problems: each
 !> body's results are exactly those of a scene holding that body alone.
-!> Scenes with `&contact` are refused (stat_unsupported) before any
-!> computation: the contact FE is not implemented in this version.
+!> The two bodies of a `&contact` pair are solved together
+!> (sprc_contact_solve: one block system, active-set iteration) in one unit
+!> system (the slave body's modulus unit, the larger strain unit of the two),
+!> and their contact result (`contacts`) comes in scene units. This version
+!> runs one pair, frictionless or stick, with the FE stabilization stress;
+!> more pairs, 'coulomb' and 'recovered' are refused (stat_unsupported)
+!> before any computation.
 !>
 !> With an `&exact` group the closed form applies to every body, with that
 !> body's material.
@@ -32,12 +37,15 @@ module sprc_study_level
    use sprc_fem_problem, only: elasticity_problem_type
    use sprc_fem_recovery_input, only: fe_recovery_input
    use sprc_fem_dilatation, only: dilatation_choice
-   use sprc_study_spec, only: scene_type, recovery_degree
+   use sprc_study_spec, only: scene_type, contact_spec_type, recovery_degree, contact_unsupported
    use sprc_study_model, only: build_bodies, build_exact, body_conditions, analysis_kind, analysis_units_type, &
       & analysis_units, in_units
    use sprc_study_budget, only: check_level_memory
    use sprc_study_row, only: report_row_type
-   use sprc_contact_result, only: contact_result_type
+   use sprc_contact_result, only: contact_result_type, new_contact_result, contact_open, contact_stick, &
+      & contact_slip
+   use sprc_contact_surface, only: contact_surface_type, slave_surface_points, initial_gaps
+   use sprc_contact_solve, only: contact_solution_type, solve_contact_pair, friction_kind, friction_stick
    implicit none
    private
 
@@ -123,20 +131,22 @@ contains
       type(scene_type) :: scaled
       integer :: b
 
-      if (size(scene%contacts) > 0) then
-         call fatal_error(error, 'sprc run: &contact: the contact FE is not implemented in this version '// &
-            & '(sprc check validates the scene); scenes with several bodies and no &contact run', stat_unsupported)
+      if (len(contact_unsupported(scene)) > 0) then
+         call fatal_error(error, contact_unsupported(scene), stat_unsupported)
          return
       end if
       call build_bodies(scene, bodies, error)
       if (allocated(error)) return
       allocate (study%bodies(size(bodies)))
       do b = 1, size(bodies)
+         call analysis_units(scene, study%bodies(b)%units, error, b)
+         if (allocated(error)) return
+      end do
+      call shared_units(scene, study%bodies)
+      do b = 1, size(bodies)
          associate (sb => study%bodies(b), spec => scene%bodies(b))
             sb%name = spec%name
             sb%geometry = bodies(b)
-            call analysis_units(scene, sb%units, error, b)
-            if (allocated(error)) return
             scaled = in_units(scene, sb%units)
             call build_exact(scaled, b, sb%exact, error)
             if (allocated(error)) return
@@ -163,6 +173,25 @@ contains
       study%have_exact = scene%exact%present
    end subroutine prepare_study
 
+   !> Bodies in contact share one unit system: the slave body's modulus unit
+   !> and the larger of the two strain units expressed in it (powers of two,
+   !> so exact). Other bodies keep their own units.
+   subroutine shared_units(scene, bodies)
+      type(scene_type), intent(in) :: scene
+      type(study_body_type), intent(inout) :: bodies(:)
+      type(analysis_units_type) :: u
+      integer :: k, s, m
+
+      do k = 1, size(scene%contacts)
+         s = scene%contacts(k)%slave_index
+         m = scene%contacts(k)%master_index
+         u%modulus = bodies(s)%units%modulus
+         u%strain = max(bodies(s)%units%strain, bodies(m)%units%strain*(bodies(m)%units%modulus/u%modulus))
+         bodies(s)%units = u
+         bodies(m)%units = u
+      end do
+   end subroutine shared_units
+
    !> One level of the study: every body analysed, the report row summed.
    subroutine run_level(study, level, result, error)
       type(study_type), intent(in) :: study
@@ -170,8 +199,8 @@ contains
       type(level_type), intent(out) :: result
       type(error_type), allocatable, intent(out) :: error
       type(cut_quadrature_type) :: quad
-      real(wp) :: t_start
-      integer :: b
+      real(wp) :: t_start, t_contact
+      integer :: b, k
 
       t_start = wall_time()
       result%level = level
@@ -183,29 +212,41 @@ contains
          associate (u => study%bodies(b)%units, u1 => study%bodies(1)%units)
             result%bodies(b)%norm2_scale = (u%modulus/u1%modulus)*(u%strain/u1%strain)**2
          end associate
-         call run_body(study, study%bodies(b), level, quad, result%bodies(b), error)
+         call run_body(study, study%bodies(b), level, quad, result%bodies(b), in_contact(study, b), error)
          if (allocated(error)) then
             if (size(study%bodies) > 1) error%message = 'body '''//study%bodies(b)%name//''': '//error%message
             return
          end if
       end do
+      t_contact = 0.0_wp
+      if (size(study%scene%contacts) > 0) allocate (result%contacts(size(study%scene%contacts)))
+      do k = 1, size(study%scene%contacts)
+         call run_contact(study, study%scene%contacts(k), quad, result%bodies, result%contacts(k), t_contact, error)
+         if (allocated(error)) return
+      end do
       call sum_row(study, result, result%row)
+      if (allocated(result%contacts)) then
+         result%row%has_contact = .true.
+         result%row%contact_iterations = sum(result%contacts%iterations)
+         result%row%t_contact = t_contact
+         ! TODO(lead): call fill_contact_row(result%contacts, result%row) (sprc_study_contact_row, contact-out)
+      end if
       result%row%t_total = wall_time() - t_start
       call check_row(result%row, study%have_exact, result%done, error)
    end subroutine run_level
 
-   !> Mesh, FE solve, recoveries and estimates of one body at `level`.
-   subroutine run_body(study, sb, level, quad, bl, error)
+   !> Mesh, FE solve, recoveries and estimates of one body at `level`; a
+   !> body `in_contact` is only meshed and assembled (its pair solves it,
+   !> `run_contact`).
+   subroutine run_body(study, sb, level, quad, bl, in_contact, error)
       type(study_type), intent(in) :: study
       type(study_body_type), intent(in) :: sb
       integer, intent(in) :: level
       type(cut_quadrature_type), intent(in) :: quad
       type(body_level_type), intent(inout) :: bl
+      logical, intent(in) :: in_contact
       type(error_type), allocatable, intent(out) :: error
-      type(recovery_input_type) :: input
       type(timer_type) :: t_mesh
-      real(wp) :: err_fe, norm_fe
-      integer :: m
 
       call check_level_memory(study%scene, sb%geometry, level, error)
       if (allocated(error)) return
@@ -231,8 +272,25 @@ contains
             & sb%poisson, sb%body_force, sb%bcs, error, gamma=study%gamma, dilatation=study%dilatation)
       end if
       if (allocated(error)) return
+      if (in_contact) then
+         call bl%problem%assemble(error)
+         return
+      end if
       call bl%problem%solve(error)
       if (allocated(error)) return
+      call finish_body(study, sb, bl, error)
+   end subroutine run_body
+
+   !> After the FE solve: the exact error, the recoveries and estimates.
+   subroutine finish_body(study, sb, bl, error)
+      type(study_type), intent(in) :: study
+      type(study_body_type), intent(in) :: sb
+      type(body_level_type), intent(inout) :: bl
+      type(error_type), allocatable, intent(out) :: error
+      type(recovery_input_type) :: input
+      real(wp) :: err_fe, norm_fe
+      integer :: m
+
       if (allocated(sb%exact)) then
          call bl%problem%energy_error(err_fe, bl%element_error, norm_fe, bl%norm_exact, error, bl%err_norm)
          if (allocated(error)) return
@@ -245,7 +303,97 @@ contains
          call recover_and_estimate(sb, input, bl, m, study%degree(m), error)
          if (allocated(error)) return
       end do
-   end subroutine run_body
+   end subroutine finish_body
+
+   !> Whether body b belongs to a `&contact` pair.
+   pure logical function in_contact(study, b)
+      type(study_type), intent(in) :: study
+      integer, intent(in) :: b
+      integer :: k
+      in_contact = .false.
+      do k = 1, size(study%scene%contacts)
+         in_contact = in_contact .or. study%scene%contacts(k)%slave_index == b .or. &
+            & study%scene%contacts(k)%master_index == b
+      end do
+   end function in_contact
+
+   !> One contact pair at this level: slave points and gaps, the coupled
+   !> solve (sprc_contact_solve), then each body's errors and recoveries; the
+   !> contact result in scene units. The block solves count in the slave
+   !> body's t_solve; points, gaps and contact terms add to `t_contact`.
+   subroutine run_contact(study, spec, quad, bodies, result, t_contact, error)
+      type(study_type), intent(in) :: study
+      type(contact_spec_type), intent(in) :: spec
+      type(cut_quadrature_type), intent(in) :: quad
+      type(body_level_type), intent(inout) :: bodies(:)
+      type(contact_result_type), intent(out) :: result
+      real(wp), intent(inout) :: t_contact
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_surface_type) :: surface
+      type(contact_solution_type) :: sol
+      type(timer_type) :: timer
+      character(len=:), allocatable :: names(:)
+      integer :: s, m, b, k
+
+      s = spec%slave_index
+      m = spec%master_index
+      call timer%start()
+      call slave_surface_points(surface, bodies(s)%grid, study%bodies(s)%geometry, quad, &
+         & study%scene%shapes(spec%slave_surface_index)%body_shape, error, split_grid=bodies(m)%grid)
+      if (.not. allocated(error)) call initial_gaps(surface, study%bodies(m)%geometry, &
+         & study%scene%shapes(spec%master_surface_index)%body_shape, bodies(m)%grid, &
+         & max(study%bodies(s)%box_size, study%bodies(m)%box_size), error)
+      call timer%stop()
+      if (allocated(error)) then
+         error%message = "&contact '"//spec%slave//"' on '"//spec%master//"': "//error%message
+         return
+      end if
+      ! The gaps are displacements: into the pair's units.
+      where (surface%has_master) surface%g0 = surface%g0/study%bodies(s)%units%strain
+      allocate (character(len=max(len(spec%slave), len(spec%master))) :: names(2))
+      names(1) = spec%slave
+      names(2) = spec%master
+      call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, friction_kind(spec%friction), &
+         & spec%kappa, names, sol, error)
+      if (allocated(error)) return
+      bodies(s)%problem%t_solve = sol%t_solve
+      bodies(m)%problem%t_solve = 0.0_wp
+      ! Both bodies were solved in the block system: its solver and condition estimate.
+      do b = 1, 2
+         k = merge(s, m, b == 1)
+         bodies(k)%problem%rcond = sol%rcond
+         bodies(k)%problem%solver_name = sol%solver_name
+      end do
+      do b = 1, 2
+         k = merge(s, m, b == 1)
+         call finish_body(study, study%bodies(k), bodies(k), error)
+         if (allocated(error)) then
+            error%message = 'body '''//study%bodies(k)%name//''': '//error%message
+            return
+         end if
+      end do
+      call contact_result(surface, sol, spec, study%bodies(s)%units, result)
+      t_contact = t_contact + timer%elapsed + sol%t_contact
+   end subroutine run_contact
+
+   !> The contact result of a pair in scene units (pressures times the stress
+   !> unit, gaps times the displacement unit).
+   subroutine contact_result(surface, sol, spec, units, result)
+      type(contact_surface_type), intent(in) :: surface
+      type(contact_solution_type), intent(in) :: sol
+      type(contact_spec_type), intent(in) :: spec
+      type(analysis_units_type), intent(in) :: units
+      type(contact_result_type), intent(out) :: result
+      integer :: closed_state
+
+      call new_contact_result(result, surface%x, surface%weight, surface%normal, spec%slave_index, spec%master_index)
+      closed_state = merge(contact_stick, contact_slip, friction_kind(spec%friction) == friction_stick)
+      where (surface%has_master) result%gap = sol%gap*units%strain
+      result%state = merge(closed_state, contact_open, sol%closed)
+      result%p_fe = (sol%pressure*units%modulus)*units%strain
+      result%ts_fe = (sol%tangential*units%modulus)*units%strain
+      result%iterations = sol%iterations
+   end subroutine contact_result
 
    !> Recovery and estimate with one method (1 SPR, 2 SPR-C) at the patch degree `degree`.
    subroutine recover_and_estimate(sb, input, bl, m, degree, error)

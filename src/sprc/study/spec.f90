@@ -10,7 +10,7 @@ module sprc_study_spec
    private
 
    public :: scene_type, body_spec_type, shape_spec_type, bc_spec_type, exact_spec_type, contact_spec_type
-   public :: recovery_degree
+   public :: recovery_degree, contact_unsupported
    public :: default_kappa, default_stabilization
 
    !> Default of `&contact kappa`, the dimensionless factor of the contact
@@ -182,5 +182,27 @@ contains
       if (scene%recovery_degree == 'p') recovery_degree = scene%order
       if (scene%recovery_degree == 'p+1') recovery_degree = scene%order + 1
    end function recovery_degree
+
+   !> What of the scene's `&contact` this version's contact FE does not run,
+   !> as a sentence ('' when it runs the scene): one pair, frictionless or
+   !> stick, the FE stabilization stress (sprc_contact_solve).
+   pure function contact_unsupported(scene) result(why)
+      type(scene_type), intent(in) :: scene
+      character(len=:), allocatable :: why
+      character(len=12) :: buf
+
+      why = ''
+      if (.not. allocated(scene%contacts)) return
+      if (size(scene%contacts) == 0) return
+      if (size(scene%contacts) > 1) then
+         write (buf, '(i0)') size(scene%contacts)
+         why = '&contact: '//trim(buf)//' contact pairs; this version runs one pair per scene'
+      else if (scene%contacts(1)%friction == 'coulomb') then
+         why = "&contact: friction = 'coulomb' is not implemented in this version (frictionless and stick are)"
+      else if (scene%contacts(1)%stabilization /= 'fe') then
+         why = "&contact: stabilization = '"//scene%contacts(1)%stabilization// &
+            & "' needs the SPR-C contact patches, not in this version (use 'fe')"
+      end if
+   end function contact_unsupported
 
 end module sprc_study_spec

@@ -1,0 +1,463 @@
+!> The coupled FE solve of one contact pair: both bodies' reduced systems in
+!> one block system plus the contact terms on the slave surface points
+!> (seed eqs. 2-5, Tur et al. 2015; SCENE.md `&contact`).
+!>
+!> Formulation. Seed eq. 5 adds to the potential energy of both bodies
+!>   int_Gc lambda.g  -  int_Gc 1/(2 gamma) |lambda - p_N(u)|^2,   gamma = kappa E/h,
+!> with the multiplier lambda the contact traction on the slave body (its
+!> normal part lambda_n <= 0 in compression), p_N the stabilization traction
+!> and g the gap (normal: g_n = g0 + (u_m - u_s).n; for stick the vector
+!> g = g0 n + u_m - u_s). Here p_N is the slave body's FE traction
+!> sigma(u_s) n, and the multiplier is eliminated point by point: stationarity
+!> in lambda gives lambda = sigma(u_s) n + gamma g. There is no discrete
+!> multiplier space; lambda lives at the slave quadrature points. On the
+!> closed (active) points this leaves the symmetric Nitsche terms for the
+!> constraint g = 0,
+!>   a_s(u, v) + a_m(u, v) + int_A [sigma(v_s)n.g(u) + sigma(u_s)n.dg(v) + gamma g(u).dg(v)] = l(v),
+!> with dg(v) = v_m - v_s (its normal part for frictionless contact, the
+!> vector for stick), the same terms as the Dirichlet Nitsche terms of
+!> sprc_fem_problem with the master surface as the moving support. On the open
+!> points lambda = 0 and nothing is added: the term -int 1/(2 gamma) |p_N|^2
+!> that the elimination leaves there vanishes for the exact solution and
+!> would make the system indefinite, so it is dropped. The contact pressure
+!> reported (`p_fe`) is p = -lambda_n = -(n.sigma(u_s)n + gamma g_n) on closed
+!> points and 0 on open ones; `ts_fe` is |lambda_t| (0 frictionless).
+!>
+!> kappa. The penalty gamma = kappa E_s/h (SCENE.md: effective stiffness
+!> kappa E/h), with E_s the slave body's Young's modulus and h the smallest
+!> edge of the slave cell holding the point. The terms are coercive (the
+!> block system SPD) when gamma exceeds the trace-inverse bound of the slave
+!> body's traction, C_I dmax/h, the bound of the Dirichlet Nitsche terms
+!> (sprc_fem_problem: about (p+1)^2 times a geometric factor, with cell
+!> aggregation keeping it independent of the cut; dmax = 1.35 E for nu = 0.3
+!> in plane strain). The default `default_kappa` = 100 (sprc_study_spec)
+!> exceeds that bound for Q1 and Q2 (Dirichlet default gamma dmax = 54 E for
+!> Q1, 122 E for Q2 with its margin of 2); within the consistent method the
+!> results move only within the discretization error as kappa varies.
+!>
+!> Points. The slave surface's cut-cell quadrature points with their exact
+!> normals and initial gaps (sprc_contact_surface). The slave traction and
+!> displacement at a point are the slave cell's polynomial there; the master
+!> displacement the master host cell's polynomial at the master point; both
+!> reduced through the bodies' constraints (hanging nodes, aggregation,
+!> strong symmetry), like every element matrix.
+!>
+!> Active set (primal-dual / semi-smooth Newton). First active set: the points
+!> with a master point and g0 <= h (one slave cell: touching and near
+!> surfaces, every point of an interference fit); this holds a load-controlled
+!> body from the start. Each iteration assembles and factorizes the block
+!> system once (CHOLMOD; UMFPACK if CHOLMOD finds it not positive definite),
+!> solves, and takes as the next set the points with lambda_n < 0. The
+!> iteration ends when the set repeats; after `max_iterations` it is
+!> stat_not_converged with the count of the points that still switched.
+!> Before each factorization the rigid-body modes of both bodies are checked
+!> on the block system: a body that the closed points and its own conditions
+!> leave free is an error naming the body (stat_singular).
+!>
+!> Friction: 'frictionless' and 'stick' (the closed zone tied: the vector
+!> gap) are symmetric. 'coulomb' is refused in this version (stat_unsupported).
+module sprc_contact_solve
+   use sprc_core_kinds, only: wp, i8
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_not_converged, stat_singular, &
+      & stat_unsupported
+   use sprc_core_text, only: itoa
+   use sprc_core_timer, only: timer_type
+   use sprc_fem_sparse, only: coo_type, csr_type
+   use sprc_fem_element, only: shape_functions, strain_matrix, traction_matrix, displacement_matrix
+   use sprc_fem_problem, only: elasticity_problem_type, free_motions, motion_names, solve_spd_or_lu
+   use sprc_contact_surface, only: contact_surface_type
+   implicit none
+   private
+
+   public :: contact_solution_type, solve_contact_pair, friction_kind
+   public :: friction_frictionless, friction_stick, friction_coulomb, default_max_iterations
+
+   !> Friction laws (SCENE.md `friction`).
+   integer, parameter :: friction_frictionless = 0, friction_stick = 1, friction_coulomb = 2
+   !> Active-set iterations before giving up.
+   integer, parameter :: default_max_iterations = 50
+
+   !> The contact operators of the closed-able points (those with a master
+   !> point): local dofs in the block numbering, gap and traction operators.
+   type :: point_operators_type
+      integer, allocatable :: ptr(:), dofs(:)
+      !> g(u) - g0 n = gop(:, ptr(i):ptr(i+1)-1) u(dofs(...)); slave traction sigma(u_s) n likewise with top.
+      real(wp), allocatable :: gop(:, :), top(:, :)
+      !> Penalty gamma = kappa E_s/h of each point.
+      real(wp), allocatable :: gamma(:)
+   end type point_operators_type
+
+   !> One point's operators of both bodies while they are built.
+   type :: local_type
+      integer :: ms = 0, mm = 0
+      integer, allocatable :: ds(:), dm(:)
+      real(wp), allocatable :: ns(:, :), ts(:, :), nm(:, :), tm(:, :)
+   end type local_type
+
+   !> What the coupled solve gives per slave point (in the problems' units).
+   type :: contact_solution_type
+      !> Active-set iterations (factorizations).
+      integer :: iterations = 0
+      !> Closed points of the final set.
+      logical, allocatable :: closed(:)
+      !> Linearized normal gap of the solution (huge where the point has no master point).
+      real(wp), allocatable :: gap(:)
+      !> Contact pressure p = -lambda_n (0 open) and |lambda_t| (module notes).
+      real(wp), allocatable :: pressure(:), tangential(:)
+      !> lambda_n = n.sigma(u_s)n + gamma g_n at every point with a master point
+      !> (0 elsewhere): negative where the point carries compression when closed.
+      real(wp), allocatable :: lambda_n(:)
+      !> Reciprocal condition estimate of the last block system and the solver used.
+      real(wp) :: rcond = -1.0_wp
+      character(len=:), allocatable :: solver_name
+      !> Seconds of the contact operators and active-set evaluation, and of the
+      !> block assemblies and solves.
+      real(wp) :: t_contact = 0.0_wp, t_solve = 0.0_wp
+   end type contact_solution_type
+
+contains
+
+   !> The friction constant of a SCENE.md `friction` name (-1 if unknown).
+   pure integer function friction_kind(name)
+      character(len=*), intent(in) :: name
+      select case (name)
+      case ('frictionless'); friction_kind = friction_frictionless
+      case ('stick'); friction_kind = friction_stick
+      case ('coulomb'); friction_kind = friction_coulomb
+      case default; friction_kind = -1
+      end select
+   end function friction_kind
+
+   !> Solve the pair (module notes): `slave` and `master` assembled
+   !> (`assemble`), `surface` with its initial gaps to the master; on success
+   !> both problems hold their solution (`set_solution`). `names` are the slave
+   !> and master body names for messages.
+   subroutine solve_contact_pair(slave, master, surface, friction, kappa, names, sol, error, max_iterations)
+      type(elasticity_problem_type), intent(inout) :: slave, master
+      type(contact_surface_type), intent(in) :: surface
+      integer, intent(in) :: friction
+      real(wp), intent(in) :: kappa
+      character(len=*), intent(in) :: names(2)
+      type(contact_solution_type), intent(out) :: sol
+      type(error_type), allocatable, intent(out) :: error
+      integer, intent(in), optional :: max_iterations
+      type(point_operators_type) :: ops
+      type(csr_type) :: k
+      type(timer_type) :: timer
+      real(wp), allocatable :: f(:), x(:)
+      logical, allocatable :: next(:)
+      integer :: it, maxit, n, switched
+
+      call check_pair(slave, master, surface, friction, kappa, error)
+      if (allocated(error)) return
+      maxit = default_max_iterations
+      if (present(max_iterations)) maxit = max_iterations
+      call timer%start()
+      call point_operators(slave, master, surface, kappa, ops)
+      allocate (sol%closed(surface%npoint))
+      sol%closed = surface%has_master .and. surface%g0 <= first_gap(slave, surface)
+      call timer%stop()
+      sol%t_contact = timer%elapsed
+      n = slave%n_dofs() + master%n_dofs()
+      allocate (x(n), next(surface%npoint))
+      do it = 1, maxit
+         sol%iterations = it
+         call timer%reset()
+         call timer%start()
+         call block_system(slave, master, surface, ops, friction, sol%closed, k, f, error)
+         if (.not. allocated(error)) call check_held(slave, master, k, names, count(sol%closed), it, error)
+         if (.not. allocated(error)) call solve_block(k, f, x, sol, error)
+         call timer%stop()
+         sol%t_solve = sol%t_solve + timer%elapsed
+         if (allocated(error)) return
+         call timer%reset()
+         call timer%start()
+         call evaluate(surface, ops, friction, x, sol)
+         next = surface%has_master .and. sol%lambda_n < 0.0_wp
+         switched = count(next .neqv. sol%closed)
+         call timer%stop()
+         sol%t_contact = sol%t_contact + timer%elapsed
+         if (switched == 0) exit
+         sol%closed = next
+         if (it == maxit) then
+            call fatal_error(error, "contact '"//trim(names(1))//"' on '"//trim(names(2))// &
+               & "': the active set did not settle in "//itoa(maxit)//' iterations; '//itoa(switched)//' of '// &
+               & itoa(count(surface%has_master))//' points still switched in the last one', stat_not_converged)
+            return
+         end if
+      end do
+      call slave%set_solution(x(1:slave%n_dofs()), error)
+      if (.not. allocated(error)) call master%set_solution(x(slave%n_dofs() + 1:), error)
+   end subroutine solve_contact_pair
+
+   !> The distance below which a point starts closed: its slave cell's
+   !> smallest edge (module notes), per point.
+   function first_gap(slave, surface) result(h)
+      type(elasticity_problem_type), intent(in) :: slave
+      type(contact_surface_type), intent(in) :: surface
+      real(wp) :: h(surface%npoint)
+      integer :: i
+      do i = 1, surface%npoint
+         h(i) = cell_size(slave, surface%slave_cell(i))
+      end do
+   end function first_gap
+
+   pure real(wp) function cell_size(problem, e)
+      type(elasticity_problem_type), intent(in) :: problem
+      integer, intent(in) :: e
+      real(wp) :: lo(3), hi(3)
+      call problem%element_box(e, lo(1:problem%dim), hi(1:problem%dim))
+      cell_size = minval(hi(1:problem%dim) - lo(1:problem%dim))
+   end function cell_size
+
+   subroutine check_pair(slave, master, surface, friction, kappa, error)
+      type(elasticity_problem_type), intent(in) :: slave, master
+      type(contact_surface_type), intent(in) :: surface
+      integer, intent(in) :: friction
+      real(wp), intent(in) :: kappa
+      type(error_type), allocatable, intent(out) :: error
+
+      if (.not. (allocated(slave%f) .and. allocated(master%f))) then
+         call fatal_error(error, 'contact solve: both bodies must be assembled first', stat_invalid_input)
+      else if (.not. allocated(surface%g0)) then
+         call fatal_error(error, 'contact solve: the contact surface has no initial gaps', stat_invalid_input)
+      else if (slave%dim /= master%dim .or. surface%dim /= slave%dim .or. slave%analysis /= master%analysis) then
+         call fatal_error(error, 'contact solve: the two bodies and the surface differ in dimension or analysis', &
+            & stat_invalid_input)
+      else if (.not. (kappa > 0.0_wp .and. kappa < huge(1.0_wp))) then
+         call fatal_error(error, 'contact solve: kappa must be finite and > 0', stat_invalid_input)
+      else if (friction == friction_coulomb) then
+         call fatal_error(error, "contact: friction = 'coulomb' is not implemented in this version "// &
+            & "(frictionless and stick are)", stat_unsupported)
+      else if (friction /= friction_frictionless .and. friction /= friction_stick) then
+         call fatal_error(error, 'contact solve: unknown friction law '//itoa(friction), stat_invalid_input)
+      else if (slave%dilatation%active) then
+         call fatal_error(error, 'contact: the projected dilatation (nearly incompressible slave body) is not '// &
+            & 'combined with contact in this version; set dilatation = ''full''', stat_unsupported)
+      end if
+   end subroutine check_pair
+
+   !> Gap and traction operators of every point with a master point.
+   subroutine point_operators(slave, master, surface, kappa, ops)
+      type(elasticity_problem_type), intent(in) :: slave, master
+      type(contact_surface_type), intent(in) :: surface
+      real(wp), intent(in) :: kappa
+      type(point_operators_type), intent(out) :: ops
+      type(local_type), allocatable :: loc(:)
+      integer :: i, q0, q1, d
+
+      d = surface%dim
+      allocate (loc(surface%npoint), ops%ptr(surface%npoint + 1), ops%gamma(surface%npoint))
+      ops%ptr(1) = 1
+      ops%gamma = 0.0_wp
+      do i = 1, surface%npoint
+         ops%ptr(i + 1) = ops%ptr(i)
+         if (.not. surface%has_master(i)) cycle
+         call body_operators(slave, surface%slave_cell(i), surface%x(:, i), surface%normal(:, i), loc(i)%ds, &
+            & loc(i)%ns, loc(i)%ts, loc(i)%ms)
+         call body_operators(master, surface%master_cell(i), surface%master_x(:, i), surface%normal(:, i), &
+            & loc(i)%dm, loc(i)%nm, loc(i)%tm, loc(i)%mm)
+         ops%ptr(i + 1) = ops%ptr(i) + loc(i)%ms + loc(i)%mm
+         ops%gamma(i) = kappa*slave%young/cell_size(slave, surface%slave_cell(i))
+      end do
+      allocate (ops%dofs(ops%ptr(surface%npoint + 1) - 1), ops%gop(d, size(ops%dofs)), ops%top(d, size(ops%dofs)))
+      do i = 1, surface%npoint
+         if (.not. surface%has_master(i)) cycle
+         associate (p => loc(i))
+            q0 = ops%ptr(i)
+            q1 = q0 + p%ms - 1
+            ops%dofs(q0:q1) = p%ds(1:p%ms)
+            ops%gop(:, q0:q1) = -p%ns
+            ops%top(:, q0:q1) = p%ts
+            q0 = q1 + 1
+            q1 = ops%ptr(i + 1) - 1
+            ops%dofs(q0:q1) = slave%n_dofs() + p%dm(1:p%mm)
+            ops%gop(:, q0:q1) = p%nm
+            ops%top(:, q0:q1) = 0.0_wp
+         end associate
+      end do
+   end subroutine point_operators
+
+   !> Reduced operators of `problem` at x in element e: dofs(1:m), the
+   !> displacement n(dim, m) and the traction sigma(u) nrm, t(dim, m).
+   subroutine body_operators(problem, e, x, nrm, dofs, n, t, m)
+      type(elasticity_problem_type), intent(in) :: problem
+      integer, intent(in) :: e
+      real(wp), intent(in) :: x(:), nrm(:)
+      integer, allocatable, intent(out) :: dofs(:)
+      real(wp), allocatable, intent(out) :: n(:, :), t(:, :)
+      integer, intent(out) :: m
+      real(wp) :: lo(3), hi(3)
+      real(wp) :: sh(problem%nen), dndx(problem%dim, problem%nen), b(problem%nstress, problem%dim*problem%nen)
+      real(wp) :: nmat(problem%dim, problem%dim*problem%nen), tn(problem%dim, problem%nstress)
+      real(wp), allocatable :: tmat(:, :)
+      integer :: d, nd, ns
+
+      d = problem%dim
+      nd = d*problem%nen
+      ns = problem%nstress
+      allocate (dofs(nd*32), tmat(nd, nd*32))
+      call problem%constraints%element_map(problem%nodes%connectivity(:, e), dofs, tmat, m)
+      call problem%element_box(e, lo(1:d), hi(1:d))
+      call shape_functions(d, problem%degree, lo(1:d), hi(1:d), x, sh, dndx)
+      call strain_matrix(d, dndx, b)
+      call displacement_matrix(d, sh, nmat)
+      call traction_matrix(d, nrm, tn)
+      n = matmul(nmat, tmat(:, 1:m))
+      t = matmul(matmul(tn, matmul(problem%d(1:ns, 1:ns), b)), tmat(:, 1:m))
+   end subroutine body_operators
+
+   !> The block system [K_s 0; 0 K_m] + contact terms of the closed points,
+   !> and its load.
+   subroutine block_system(slave, master, surface, ops, friction, closed, k, f, error)
+      type(elasticity_problem_type), intent(in) :: slave, master
+      type(contact_surface_type), intent(in) :: surface
+      type(point_operators_type), intent(in) :: ops
+      integer, intent(in) :: friction
+      logical, intent(in) :: closed(:)
+      type(csr_type), intent(out) :: k
+      real(wp), allocatable, intent(out) :: f(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(coo_type) :: coo
+      real(wp), allocatable :: g(:, :), t(:, :), kc(:, :), fc(:)
+      real(wp) :: nrm(surface%dim)
+      integer(i8) :: capacity
+      integer :: ns, i, q0, q1
+
+      ns = slave%n_dofs()
+      capacity = slave%k%nnz() + master%k%nnz()
+      do i = 1, surface%npoint
+         if (closed(i)) capacity = capacity + int(ops%ptr(i + 1) - ops%ptr(i), i8)**2
+      end do
+      call coo%init(ns + master%n_dofs(), ns + master%n_dofs(), error, capacity=capacity)
+      if (allocated(error)) return
+      call add_csr(coo, slave%k, 0, error)
+      if (.not. allocated(error)) call add_csr(coo, master%k, ns, error)
+      if (allocated(error)) return
+      f = [slave%f, master%f]
+      do i = 1, surface%npoint
+         if (.not. closed(i)) cycle
+         q0 = ops%ptr(i)
+         q1 = ops%ptr(i + 1) - 1
+         nrm = surface%normal(:, i)
+         if (friction == friction_stick) then
+            g = ops%gop(:, q0:q1)
+            t = ops%top(:, q0:q1)
+         else
+            g = reshape(matmul(nrm, ops%gop(:, q0:q1)), [1, q1 - q0 + 1])
+            t = reshape(matmul(nrm, ops%top(:, q0:q1)), [1, q1 - q0 + 1])
+         end if
+         ! w [T^T G + G^T T + gamma G^T G] u = -w [T^T + gamma G^T] g0 (n or 1)
+         kc = surface%weight(i)*(matmul(transpose(t), g) + matmul(transpose(g), t) + &
+            & ops%gamma(i)*matmul(transpose(g), g))
+         if (friction == friction_stick) then
+            fc = -surface%weight(i)*surface%g0(i)*matmul(nrm, t + ops%gamma(i)*g)
+         else
+            fc = -surface%weight(i)*surface%g0(i)*(t(1, :) + ops%gamma(i)*g(1, :))
+         end if
+         call coo%add(ops%dofs(q0:q1), kc, error)
+         if (allocated(error)) return
+         f(ops%dofs(q0:q1)) = f(ops%dofs(q0:q1)) + fc
+      end do
+      call coo%to_csr(k, error)
+   end subroutine block_system
+
+   !> Add the entries of a (rows and columns shifted by `shift`) to coo.
+   subroutine add_csr(coo, a, shift, error)
+      type(coo_type), intent(inout) :: coo
+      type(csr_type), intent(in) :: a
+      integer, intent(in) :: shift
+      type(error_type), allocatable, intent(out) :: error
+      integer :: i
+      integer(i8) :: q
+      do i = 1, a%nrows
+         do q = a%rowptr(i), a%rowptr(i + 1) - 1
+            call coo%add(i + shift, a%col(q) + shift, a%val(q), error)
+            if (allocated(error)) return
+         end do
+      end do
+   end subroutine add_csr
+
+   !> Every rigid-body mode of both bodies must be resisted by the block
+   !> system; a free one is an error naming the body (module notes).
+   subroutine check_held(slave, master, k, names, nclosed, iteration, error)
+      type(elasticity_problem_type), intent(in) :: slave, master
+      type(csr_type), intent(in) :: k
+      character(len=*), intent(in) :: names(2)
+      integer, intent(in) :: nclosed, iteration
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: rs(:, :), rm(:, :), r(:, :), vec(:, :)
+      logical :: involved(12)
+      integer :: nfree, j, ns, ms, b
+      character(len=:), allocatable :: what
+
+      call slave%rigid_modes(rs)
+      call master%rigid_modes(rm)
+      ns = size(rs, 2)
+      ms = size(rm, 2)
+      allocate (r(size(rs, 1) + size(rm, 1), ns + ms), source=0.0_wp)
+      r(1:size(rs, 1), 1:ns) = rs
+      r(size(rs, 1) + 1:, ns + 1:) = rm
+      call free_motions(k, r, vec, nfree, error)
+      if (allocated(error) .or. nfree == 0) return
+      involved = .false.
+      do j = 1, nfree
+         involved(1:ns + ms) = involved(1:ns + ms) .or. abs(vec(:, j)) >= 0.2_wp*maxval(abs(vec(:, j)))
+      end do
+      what = ''
+      do b = 1, 2
+         associate (flags => involved((b - 1)*ns + 1:b*ns))
+            if (.not. any(flags)) cycle
+            if (len(what) > 0) what = what//'; '
+            what = what//"body '"//trim(names(b))//"' is not held: "//motion_names(slave%dim, flags)//' free'
+         end associate
+      end do
+      call fatal_error(error, what//' (contact '''//trim(names(1))//''' on '''//trim(names(2))// &
+         & ''', active-set iteration '//itoa(iteration)//', '//itoa(nclosed)//' closed points): a body held '// &
+         & 'only by contact has lost it, or its conditions leave it free', stat_singular)
+   end subroutine check_held
+
+   subroutine solve_block(k, f, x, sol, error)
+      type(csr_type), intent(in) :: k
+      real(wp), intent(in) :: f(:)
+      real(wp), intent(inout) :: x(:)
+      type(contact_solution_type), intent(inout) :: sol
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: note
+      call solve_spd_or_lu(k, f, x, sol%rcond, sol%solver_name, note, error)
+      if (allocated(error)) error%message = 'contact solve'//error%message
+   end subroutine solve_block
+
+   !> Gaps, pressures and tangential tractions of the solution x (module notes).
+   subroutine evaluate(surface, ops, friction, x, sol)
+      type(contact_surface_type), intent(in) :: surface
+      type(point_operators_type), intent(in) :: ops
+      integer, intent(in) :: friction
+      real(wp), intent(in) :: x(:)
+      type(contact_solution_type), intent(inout) :: sol
+      real(wp) :: gv(surface%dim), tv(surface%dim), lam(surface%dim), nrm(surface%dim)
+      integer :: i, q0, q1
+
+      if (.not. allocated(sol%gap)) allocate (sol%gap(surface%npoint), sol%pressure(surface%npoint), &
+         & sol%tangential(surface%npoint), sol%lambda_n(surface%npoint))
+      sol%gap = huge(1.0_wp)
+      sol%lambda_n = 0.0_wp
+      sol%pressure = 0.0_wp
+      sol%tangential = 0.0_wp
+      do i = 1, surface%npoint
+         if (.not. surface%has_master(i)) cycle
+         q0 = ops%ptr(i)
+         q1 = ops%ptr(i + 1) - 1
+         nrm = surface%normal(:, i)
+         gv = matmul(ops%gop(:, q0:q1), x(ops%dofs(q0:q1))) + surface%g0(i)*nrm
+         tv = matmul(ops%top(:, q0:q1), x(ops%dofs(q0:q1)))
+         sol%gap(i) = dot_product(gv, nrm)
+         lam = tv + ops%gamma(i)*gv
+         sol%lambda_n(i) = dot_product(lam, nrm)
+         if (.not. sol%closed(i)) cycle
+         sol%pressure(i) = -sol%lambda_n(i)
+         if (friction == friction_stick) sol%tangential(i) = norm2(lam - dot_product(lam, nrm)*nrm)
+      end do
+   end subroutine evaluate
+
+end module sprc_contact_solve
