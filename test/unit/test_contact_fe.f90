@@ -14,7 +14,9 @@ module sprc_test_contact_fe
    use sprc_io_namelist, only: read_text_file
    use sprc_study_level, only: study_type, level_type
    use sprc_test_study, only: run_text
-   use sprc_contact_result, only: contact_open
+   use sprc_contact_result, only: contact_open, contact_result_type
+   use sprc_core_material, only: plane_stress, plane_strain, compliance_matrix
+   use sprc_exact_compound, only: compound_type, new_compound_cylinder
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, replaced
    implicit none
    private
@@ -23,6 +25,7 @@ module sprc_test_contact_fe
 
    character(len=*), parameter :: patch_2d = 'test/data/contact/patch_2d.nml'
    character(len=*), parameter :: patch_3d = 'test/data/contact/patch_3d.nml'
+   character(len=*), parameter :: nl = new_line('a')
 
 contains
 
@@ -34,7 +37,9 @@ contains
          new_unittest('patch_2d_stick_same_material', test_patch_2d_stick), &
          new_unittest('patch_3d_q1', test_patch_3d_q1), &
          new_unittest('patch_3d_q2', test_patch_3d_q2), &
-         new_unittest('lost_contact_names_body', test_lost_contact) &
+         new_unittest('lost_contact_names_body', test_lost_contact), &
+         new_unittest('shrink_fit_q1_plane_strain', test_shrink_q1), &
+         new_unittest('shrink_fit_q2_plane_stress_ratio_1000', test_shrink_q2) &
          ]
    end subroutine collect_contact_fe
 
@@ -135,6 +140,123 @@ contains
       call check(error, index(failed%message, "body 'upper' is not held: translation y") > 0, &
          & 'message: '//failed%message)
    end subroutine test_lost_contact
+
+   !> Shrink fit (compound cylinder, quarter model): shaft 1 < r < 1.5 + delta
+   !> pressed into a hub 1.5 < r < 2 (radial interference delta = 1e-5, small so
+   !> that the geometry matches the exact solution's, modelled at r = 1.5, to
+   !> 7e-6), bore pressure 1e-3, frictionless. Q1, plane strain, E 2 / 1.
+   subroutine test_shrink_q1(error)
+      type(error_type), allocatable, intent(out) :: error
+      call shrink_case(1, 'plane_strain', 2.0_wp, [4, 5, 6], error)
+   end subroutine test_shrink_q1
+
+   !> The same, Q2, plane stress, the shaft 1000 times stiffer than the hub.
+   subroutine test_shrink_q2(error)
+      type(error_type), allocatable, intent(out) :: error
+      call shrink_case(2, 'plane_stress', 1000.0_wp, [3, 4, 5], error)
+   end subroutine test_shrink_q2
+
+   !> err_fe over three `levels` against the compound cylinder: the rate over
+   !> them is at least 0.95 p (issue 11), the pressure error at the finest
+   !> level at most err_fe, and every slave point closed.
+   subroutine shrink_case(order, analysis, young_shaft, levels, error, kappa)
+      integer, intent(in) :: order
+      character(len=*), intent(in) :: analysis
+      real(wp), intent(in) :: young_shaft
+      integer, intent(in) :: levels(:)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), intent(in), optional :: kappa
+      real(wp), parameter :: delta = 1.0e-5_wp, p_in = 1.0e-3_wp
+      type(compound_type) :: exact
+      type(level_type) :: result
+      type(study_type) :: study
+      character(len=:), allocatable :: text
+      character(len=32) :: buf
+      real(wp) :: err(size(levels)), perr(size(levels)), rate
+      integer :: i, kind, n
+
+      kind = merge(plane_stress, plane_strain, analysis == 'plane_stress')
+      call new_compound_cylinder(exact, [0.0_wp, 0.0_wp], 1.0_wp, 1.5_wp, 2.0_wp, p_in, delta, young_shaft, 0.3_wp, &
+         & 1.0_wp, 0.25_wp, kind, error)
+      if (allocated(error)) return
+      write (buf, '(es23.16)') young_shaft
+      text = "&scene title='shrink fit' analysis='"//analysis//"' order="//achar(48 + order)// &
+         & " levels=3 box_min=0,0 box_size=2.5 recovery='none' output='' /"//nl// &
+         & "&body name='shaft' young="//trim(buf)//" poisson=0.3 /"//nl// &
+         & "&body name='hub' young=1.0 poisson=0.25 box_min=0.0,0.0 box_size=2.2 /"//nl// &
+         & "&shape body='shaft' op='add' kind='disk' name='shaft_out' center=0,0 radius=1.50001 /"//nl// &
+         & "&shape body='shaft' op='subtract' kind='disk' name='bore' center=0,0 radius=1 /"//nl// &
+         & "&shape body='shaft' op='intersect' kind='halfspace' name='shaft_sx' point=0,0 normal=-1,0 /"//nl// &
+         & "&shape body='shaft' op='intersect' kind='halfspace' name='shaft_sy' point=0,0 normal=0,-1 /"//nl// &
+         & "&shape body='hub' op='add' kind='disk' name='hub_out' center=0,0 radius=2 /"//nl// &
+         & "&shape body='hub' op='subtract' kind='disk' name='hub_in' center=0,0 radius=1.5 /"//nl// &
+         & "&shape body='hub' op='intersect' kind='halfspace' name='hub_sx' point=0,0 normal=-1,0 /"//nl// &
+         & "&shape body='hub' op='intersect' kind='halfspace' name='hub_sy' point=0,0 normal=0,-1 /"//nl// &
+         & "&bc on='bore' type='pressure' value=1.0e-3 /"//nl// &
+         & "&bc on='shaft_sx' type='symmetry' /"//nl//"&bc on='shaft_sy' type='symmetry' /"//nl// &
+         & "&bc on='hub_sx' type='symmetry' /"//nl//"&bc on='hub_sy' type='symmetry' /"//nl// &
+         & "&contact slave='shaft' master='hub' slave_surface='shaft_out' master_surface='hub_in'"
+      if (present(kappa)) text = text//" kappa="//real_text(kappa)
+      text = text//" /"//nl
+      do i = 1, size(levels)
+         call run_text(text, levels(i), result, error, study)
+         if (allocated(error)) return
+         err(i) = energy_error_pair(study, result, exact)
+         perr(i) = pressure_error(result%contacts(1), exact%contact_pressure)
+         call check(error, all(result%contacts(1)%state /= contact_open), 'every slave point closed')
+         if (allocated(error)) return
+      end do
+      n = size(levels)
+      rate = log(err(n - 2)/err(n))/log(real(2**(levels(n) - levels(n - 2)), wp))
+      write (buf, '(f6.3)') rate
+      call check(error, rate >= 0.95_wp*order, 'err_fe rate '//trim(buf)//' < 0.95 p')
+      if (allocated(error)) return
+      ! The relative L2 pressure error is no larger than the relative energy
+      ! error of the stresses (measured: 0.5 and 0.4 times it at the finest level).
+      call check(error, perr(n) <= err(n), 'pressure error '//real_text(perr(n))//' > err_fe '//real_text(err(n)))
+   end subroutine shrink_case
+
+   !> ||sigma_ex - sigma_h||_E / ||sigma_ex||_E over both bodies of a level in
+   !> scene units; body 1 is the inner shell of `exact`, body 2 the outer.
+   real(wp) function energy_error_pair(study, result, exact) result(rel)
+      type(study_type), intent(in) :: study
+      type(level_type), intent(in) :: result
+      type(compound_type), intent(in) :: exact
+      real(wp) :: c(6, 6), sh(6), se(6), d(6), unit, e2, x2
+      type(error_type), allocatable :: error
+      integer :: b, e, q, ns
+
+      e2 = 0.0_wp
+      x2 = 0.0_wp
+      do b = 1, size(result%bodies)
+         associate (p => result%bodies(b)%problem, u => study%bodies(b)%units)
+            ns = p%nstress
+            unit = u%modulus*u%strain
+            call compliance_matrix(p%analysis, p%young*u%modulus, p%poisson, c(1:ns, 1:ns), error)
+            do e = 1, p%grid%n_leaves
+               do q = p%vol_ptr(e), p%vol_ptr(e + 1) - 1
+                  call p%stress_in_element(e, p%vol_x(:, q), sh(1:ns))
+                  if (b == 1) then
+                     call exact%inner%stress(p%vol_x(:, q), se(1:ns))
+                  else
+                     call exact%outer%stress(p%vol_x(:, q), se(1:ns))
+                  end if
+                  d(1:ns) = se(1:ns) - unit*sh(1:ns)
+                  e2 = e2 + p%vol_w(q)*dot_product(d(1:ns), matmul(c(1:ns, 1:ns), d(1:ns)))
+                  x2 = x2 + p%vol_w(q)*dot_product(se(1:ns), matmul(c(1:ns, 1:ns), se(1:ns)))
+               end do
+            end do
+         end associate
+      end do
+      rel = sqrt(e2/x2)
+   end function energy_error_pair
+
+   !> ||p_fe - p_ex|| / ||p_ex|| in L2 over the slave surface, p_ex constant.
+   pure real(wp) function pressure_error(c, p_exact) result(rel)
+      type(contact_result_type), intent(in) :: c
+      real(wp), intent(in) :: p_exact
+      rel = sqrt(sum(c%weight*(c%p_fe - p_exact)**2)/sum(c%weight*p_exact**2))
+   end function pressure_error
 
    function real_text(x) result(s)
       real(wp), intent(in) :: x

@@ -6,53 +6,64 @@
 !>   int_Gc lambda.g  -  int_Gc 1/(2 gamma) |lambda - p_N(u)|^2,   gamma = kappa E/h,
 !> with the multiplier lambda the contact traction on the slave body (its
 !> normal part lambda_n <= 0 in compression), p_N the stabilization traction
-!> and g the gap (normal: g_n = g0 + (u_m - u_s).n; for stick the vector
-!> g = g0 n + u_m - u_s). Here p_N is the slave body's FE traction
-!> sigma(u_s) n, and the multiplier is eliminated point by point: stationarity
-!> in lambda gives lambda = sigma(u_s) n + gamma g. There is no discrete
-!> multiplier space; lambda lives at the slave quadrature points. On the
-!> closed (active) points this leaves the symmetric Nitsche terms for the
-!> constraint g = 0,
-!>   a_s(u, v) + a_m(u, v) + int_A [sigma(v_s)n.g(u) + sigma(u_s)n.dg(v) + gamma g(u).dg(v)] = l(v),
-!> with dg(v) = v_m - v_s (its normal part for frictionless contact, the
-!> vector for stick), the same terms as the Dirichlet Nitsche terms of
-!> sprc_fem_problem with the master surface as the moving support. On the open
-!> points lambda = 0 and nothing is added: the term -int 1/(2 gamma) |p_N|^2
-!> that the elimination leaves there vanishes for the exact solution and
-!> would make the system indefinite, so it is dropped. The contact pressure
-!> reported (`p_fe`) is p = -lambda_n = -(n.sigma(u_s)n + gamma g_n) on closed
-!> points and 0 on open ones; `ts_fe` is |lambda_t| (0 frictionless).
+!> and g the gap (frictionless: the normal gap g_n = g0 + (u_m - u_s).n, with
+!> lambda and p_N their normal parts; stick: the vector g = g0 n + u_m - u_s).
+!> Here p_N is the slave body's FE traction sigma(u_s) n (a Nitsche-type
+!> method; the recovered traction is Tur's variant, not in this version).
 !>
-!> kappa. The penalty gamma = kappa E_s/h (SCENE.md: effective stiffness
-!> kappa E/h), with E_s the slave body's Young's modulus and h the smallest
-!> edge of the slave cell holding the point. The terms are coercive (the
-!> block system SPD) when gamma exceeds the trace-inverse bound of the slave
-!> body's traction, C_I dmax/h, the bound of the Dirichlet Nitsche terms
-!> (sprc_fem_problem: about (p+1)^2 times a geometric factor, with cell
+!> Discrete multiplier space: lambda constant on the part of the contact
+!> surface in each slave cell (P0 per slave cell, "contact cell" c with the
+!> slave points of that cell that have a master point, measure W_c). It is
+!> eliminated cell by cell: stationarity in lambda_c gives
+!>   lambda_c = pbar + gamma gbar,
+!> with pbar, gbar the means over the cell's points of p_N and g, and the
+!> cell's contribution to the energy becomes
+!>   W_c [pbar.gbar + gamma/2 |gbar|^2] - 1/(2 gamma) sum_i w_i |p_N,i - pbar|^2.
+!> Its second variation is the cell's block of the system (symmetric); the
+!> first two terms are the symmetric Nitsche terms of sprc_fem_problem's
+!> Dirichlet conditions with the mean gap as the constraint, the last one
+!> the stabilization's variance term. One constraint per cell and direction
+!> matches the displacement space: enforcing g = 0 at every quadrature point
+!> instead (multipliers eliminated point by point) over-constrains the
+!> interface, and the pressure oscillates between points and falsely opens
+!> points of a closed interface (shrink fit, Q1: 35 of 57 points open at
+!> level 3, pressure error 150 %; more so as kappa grows). On open cells
+!> lambda = 0 and nothing is added. The pressure reported per point (`p_fe`)
+!> is that of its cell, p = -n_i.lambda_c (0 open); `ts_fe` the magnitude of
+!> the tangential part of lambda_c (0 frictionless).
+!>
+!> kappa. gamma = kappa E_s/h (SCENE.md: effective stiffness kappa E/h), with
+!> E_s the slave body's Young's modulus and h the smallest edge of the slave
+!> cell. The block system is SPD when gamma exceeds the trace-inverse bound of
+!> the slave traction, C_I dmax/h (the bound of the Dirichlet Nitsche terms,
+!> sprc_fem_problem: about (p+1)^2 times a geometric factor, with cell
 !> aggregation keeping it independent of the cut; dmax = 1.35 E for nu = 0.3
-!> in plane strain). The default `default_kappa` = 100 (sprc_study_spec)
-!> exceeds that bound for Q1 and Q2 (Dirichlet default gamma dmax = 54 E for
-!> Q1, 122 E for Q2 with its margin of 2); within the consistent method the
-!> results move only within the discretization error as kappa varies.
+!> in plane strain), with a margin for the variance term (bounded by C_I/kappa
+!> times the energy). The default `default_kappa` = 100 (sprc_study_spec) is
+!> above the Dirichlet default gamma dmax (54 E for Q1, 122 E / 2 margin for
+!> Q2); within the consistent method the results move only within the
+!> discretization error as kappa varies.
 !>
 !> Points. The slave surface's cut-cell quadrature points with their exact
-!> normals and initial gaps (sprc_contact_surface). The slave traction and
-!> displacement at a point are the slave cell's polynomial there; the master
-!> displacement the master host cell's polynomial at the master point; both
-!> reduced through the bodies' constraints (hanging nodes, aggregation,
-!> strong symmetry), like every element matrix.
+!> normals and initial gaps (sprc_contact_surface), cut at the master grid's
+!> planes. The slave traction and displacement at a point are the slave
+!> cell's polynomial there; the master displacement the master host cell's
+!> polynomial at the master point; both reduced through the bodies'
+!> constraints (hanging nodes, aggregation, strong symmetry), like every
+!> element matrix.
 !>
-!> Active set (primal-dual / semi-smooth Newton). First active set: the points
-!> with a master point and g0 <= h (one slave cell: touching and near
-!> surfaces, every point of an interference fit); this holds a load-controlled
-!> body from the start. Each iteration assembles and factorizes the block
-!> system once (CHOLMOD; UMFPACK if CHOLMOD finds it not positive definite),
-!> solves, and takes as the next set the points with lambda_n < 0. The
-!> iteration ends when the set repeats; after `max_iterations` it is
-!> stat_not_converged with the count of the points that still switched.
-!> Before each factorization the rigid-body modes of both bodies are checked
-!> on the block system: a body that the closed points and its own conditions
-!> leave free is an error naming the body (stat_singular).
+!> Active set (primal-dual / semi-smooth Newton), per contact cell. First
+!> active set: the cells with a point with g0 <= h (one slave cell: touching
+!> and near surfaces, every cell of an interference fit); this holds a
+!> load-controlled body from the start. Each iteration assembles and
+!> factorizes the block system once (CHOLMOD; UMFPACK if CHOLMOD finds it not
+!> positive definite), solves, and takes as the next set the cells with
+!> nbar.lambda_c < 0 (nbar the cell's mean normal). The iteration ends when
+!> the set repeats; after `max_iterations` it is stat_not_converged with the
+!> count of the points whose cells still switched. Before each factorization
+!> the rigid-body modes of both bodies are checked on the block system: a
+!> body that the closed cells and its own conditions leave free is an error
+!> naming the body (stat_singular).
 !>
 !> Friction: 'frictionless' and 'stick' (the closed zone tied: the vector
 !> gap) are symmetric. 'coulomb' is refused in this version (stat_unsupported).
@@ -77,15 +88,30 @@ module sprc_contact_solve
    !> Active-set iterations before giving up.
    integer, parameter :: default_max_iterations = 50
 
-   !> The contact operators of the closed-able points (those with a master
-   !> point): local dofs in the block numbering, gap and traction operators.
+   !> The contact operators of the points with a master point (local dofs in
+   !> the block numbering, gap and traction operators) and their contact cells.
    type :: point_operators_type
       integer, allocatable :: ptr(:), dofs(:)
       !> g(u) - g0 n = gop(:, ptr(i):ptr(i+1)-1) u(dofs(...)); slave traction sigma(u_s) n likewise with top.
       real(wp), allocatable :: gop(:, :), top(:, :)
-      !> Penalty gamma = kappa E_s/h of each point.
+      !> Contact cells: points cell_point(cell_ptr(c) : cell_ptr(c+1)-1); the cell of each point (0: none).
+      integer :: ncell = 0
+      integer, allocatable :: cell_ptr(:), cell_point(:), cell_of_point(:)
+      !> Penalty gamma = kappa E_s/h of each contact cell.
       real(wp), allocatable :: gamma(:)
    end type point_operators_type
+
+   !> One contact cell's operators on the union of its points' dofs: rows are
+   !> the normal direction (frictionless) or the dim components (stick).
+   type :: cell_operators_type
+      integer :: nu = 0, rows = 0
+      integer, allocatable :: dofs(:)
+      real(wp) :: measure = 0.0_wp
+      !> Means of the gap operator, its constant part and the traction operator.
+      real(wp), allocatable :: gbar(:, :), g0bar(:), tbar(:, :)
+      !> Per point: the traction operator minus its mean, (rows, nu, npoints), and the weights.
+      real(wp), allocatable :: tdev(:, :, :), w(:)
+   end type cell_operators_type
 
    !> One point's operators of both bodies while they are built.
    type :: local_type
@@ -98,14 +124,14 @@ module sprc_contact_solve
    type :: contact_solution_type
       !> Active-set iterations (factorizations).
       integer :: iterations = 0
-      !> Closed points of the final set.
+      !> Closed points of the final set (their cell is closed).
       logical, allocatable :: closed(:)
       !> Linearized normal gap of the solution (huge where the point has no master point).
       real(wp), allocatable :: gap(:)
       !> Contact pressure p = -lambda_n (0 open) and |lambda_t| (module notes).
       real(wp), allocatable :: pressure(:), tangential(:)
-      !> lambda_n = n.sigma(u_s)n + gamma g_n at every point with a master point
-      !> (0 elsewhere): negative where the point carries compression when closed.
+      !> nbar.lambda_c of every contact cell: negative where the cell carries
+      !> compression when closed.
       real(wp), allocatable :: lambda_n(:)
       !> Reciprocal condition estimate of the last block system and the solver used.
       real(wp) :: rcond = -1.0_wp
@@ -142,11 +168,12 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer, intent(in), optional :: max_iterations
       type(point_operators_type) :: ops
+      type(cell_operators_type), allocatable :: cells(:)
       type(csr_type) :: k
       type(timer_type) :: timer
       real(wp), allocatable :: f(:), x(:)
-      logical, allocatable :: next(:)
-      integer :: it, maxit, n, switched
+      logical, allocatable :: closed(:), next(:)
+      integer :: it, maxit, n, c, switched
 
       call check_pair(slave, master, surface, friction, kappa, error)
       if (allocated(error)) return
@@ -154,31 +181,38 @@ contains
       if (present(max_iterations)) maxit = max_iterations
       call timer%start()
       call point_operators(slave, master, surface, kappa, ops)
-      allocate (sol%closed(surface%npoint))
-      sol%closed = surface%has_master .and. surface%g0 <= first_gap(slave, surface)
+      allocate (cells(ops%ncell), closed(ops%ncell), next(ops%ncell))
+      do c = 1, ops%ncell
+         call cell_operators(surface, ops, c, friction, cells(c))
+         closed(c) = any(surface%g0(ops%cell_point(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1)) <= &
+            & cell_size(slave, slave%root(surface%slave_cell(ops%cell_point(ops%cell_ptr(c))))))
+      end do
       call timer%stop()
       sol%t_contact = timer%elapsed
       n = slave%n_dofs() + master%n_dofs()
-      allocate (x(n), next(surface%npoint))
+      allocate (x(n))
       do it = 1, maxit
          sol%iterations = it
          call timer%reset()
          call timer%start()
-         call block_system(slave, master, surface, ops, friction, sol%closed, k, f, error)
-         if (.not. allocated(error)) call check_held(slave, master, k, names, count(sol%closed), it, error)
+         call block_system(slave, master, ops, cells, closed, k, f, error)
+         if (.not. allocated(error)) call check_held(slave, master, k, names, count(closed), it, error)
          if (.not. allocated(error)) call solve_block(k, f, x, sol, error)
          call timer%stop()
          sol%t_solve = sol%t_solve + timer%elapsed
          if (allocated(error)) return
          call timer%reset()
          call timer%start()
-         call evaluate(surface, ops, friction, x, sol)
-         next = surface%has_master .and. sol%lambda_n < 0.0_wp
-         switched = count(next .neqv. sol%closed)
+         call evaluate(surface, ops, cells, closed, x, sol)
+         next = sol%lambda_n < 0.0_wp
+         switched = 0
+         do c = 1, ops%ncell
+            if (next(c) .neqv. closed(c)) switched = switched + ops%cell_ptr(c + 1) - ops%cell_ptr(c)
+         end do
          call timer%stop()
          sol%t_contact = sol%t_contact + timer%elapsed
          if (switched == 0) exit
-         sol%closed = next
+         closed = next
          if (it == maxit) then
             call fatal_error(error, "contact '"//trim(names(1))//"' on '"//trim(names(2))// &
                & "': the active set did not settle in "//itoa(maxit)//' iterations; '//itoa(switched)//' of '// &
@@ -189,18 +223,6 @@ contains
       call slave%set_solution(x(1:slave%n_dofs()), error)
       if (.not. allocated(error)) call master%set_solution(x(slave%n_dofs() + 1:), error)
    end subroutine solve_contact_pair
-
-   !> The distance below which a point starts closed: its slave cell's
-   !> smallest edge (module notes), per point.
-   function first_gap(slave, surface) result(h)
-      type(elasticity_problem_type), intent(in) :: slave
-      type(contact_surface_type), intent(in) :: surface
-      real(wp) :: h(surface%npoint)
-      integer :: i
-      do i = 1, surface%npoint
-         h(i) = cell_size(slave, surface%slave_cell(i))
-      end do
-   end function first_gap
 
    pure real(wp) function cell_size(problem, e)
       type(elasticity_problem_type), intent(in) :: problem
@@ -244,12 +266,15 @@ contains
       real(wp), intent(in) :: kappa
       type(point_operators_type), intent(out) :: ops
       type(local_type), allocatable :: loc(:)
-      integer :: i, q0, q1, d
+      integer :: i, q0, q1, d, c
 
       d = surface%dim
-      allocate (loc(surface%npoint), ops%ptr(surface%npoint + 1), ops%gamma(surface%npoint))
+      call group_cells(surface, slave%root, ops)
+      allocate (loc(surface%npoint), ops%ptr(surface%npoint + 1), ops%gamma(ops%ncell))
+      do c = 1, ops%ncell
+         ops%gamma(c) = kappa*slave%young/cell_size(slave, slave%root(surface%slave_cell(ops%cell_point(ops%cell_ptr(c)))))
+      end do
       ops%ptr(1) = 1
-      ops%gamma = 0.0_wp
       do i = 1, surface%npoint
          ops%ptr(i + 1) = ops%ptr(i)
          if (.not. surface%has_master(i)) cycle
@@ -258,7 +283,6 @@ contains
          call body_operators(master, surface%master_cell(i), surface%master_x(:, i), surface%normal(:, i), &
             & loc(i)%dm, loc(i)%nm, loc(i)%tm, loc(i)%mm)
          ops%ptr(i + 1) = ops%ptr(i) + loc(i)%ms + loc(i)%mm
-         ops%gamma(i) = kappa*slave%young/cell_size(slave, surface%slave_cell(i))
       end do
       allocate (ops%dofs(ops%ptr(surface%npoint + 1) - 1), ops%gop(d, size(ops%dofs)), ops%top(d, size(ops%dofs)))
       do i = 1, surface%npoint
@@ -277,6 +301,103 @@ contains
          end associate
       end do
    end subroutine point_operators
+
+   !> The contact cells: the aggregates (`root`, sprc_fem_aggregation) of the
+   !> slave leaves holding points with a master point, in root order, each
+   !> with its points in point order. A small cut cell's segment thus shares
+   !> its root's multiplier, as its displacement is the root's polynomial.
+   pure subroutine group_cells(surface, root, ops)
+      type(contact_surface_type), intent(in) :: surface
+      integer, intent(in) :: root(:)
+      type(point_operators_type), intent(inout) :: ops
+      integer :: cell_of_leaf(size(root)), fill(size(root)), i, e, c, n_leaves
+
+      n_leaves = size(root)
+      cell_of_leaf = 0
+      fill = 0
+      do i = 1, surface%npoint
+         if (surface%has_master(i)) fill(root(surface%slave_cell(i))) = fill(root(surface%slave_cell(i))) + 1
+      end do
+      ops%ncell = count(fill > 0)
+      allocate (ops%cell_ptr(ops%ncell + 1), ops%cell_point(count(surface%has_master)), &
+         & ops%cell_of_point(surface%npoint))
+      ops%cell_ptr(1) = 1
+      c = 0
+      do e = 1, n_leaves
+         if (fill(e) == 0) cycle
+         c = c + 1
+         cell_of_leaf(e) = c
+         ops%cell_ptr(c + 1) = ops%cell_ptr(c) + fill(e)
+      end do
+      fill = 0
+      ops%cell_of_point = 0
+      do i = 1, surface%npoint
+         if (.not. surface%has_master(i)) cycle
+         c = cell_of_leaf(root(surface%slave_cell(i)))
+         ops%cell_of_point(i) = c
+         ops%cell_point(ops%cell_ptr(c) + fill(c)) = i
+         fill(c) = fill(c) + 1
+      end do
+   end subroutine group_cells
+
+   !> The means and deviations of cell c's operators on the union of its
+   !> points' dofs (module notes): normal rows (frictionless) or all
+   !> components (stick).
+   pure subroutine cell_operators(surface, ops, c, friction, cell)
+      type(contact_surface_type), intent(in) :: surface
+      type(point_operators_type), intent(in) :: ops
+      integer, intent(in) :: c, friction
+      type(cell_operators_type), intent(out) :: cell
+      integer, allocatable :: pos(:)
+      real(wp), allocatable :: g(:, :)
+      integer :: j, i, q, q0, q1, np, d
+      real(wp) :: nrm(surface%dim)
+
+      d = surface%dim
+      np = ops%cell_ptr(c + 1) - ops%cell_ptr(c)
+      cell%rows = merge(d, 1, friction == friction_stick)
+      allocate (cell%dofs(0))
+      do j = ops%cell_ptr(c), ops%cell_ptr(c + 1) - 1
+         i = ops%cell_point(j)
+         do q = ops%ptr(i), ops%ptr(i + 1) - 1
+            if (.not. any(cell%dofs == ops%dofs(q))) cell%dofs = [cell%dofs, ops%dofs(q)]
+         end do
+      end do
+      cell%nu = size(cell%dofs)
+      allocate (cell%gbar(cell%rows, cell%nu), cell%tbar(cell%rows, cell%nu), cell%g0bar(cell%rows), &
+         & cell%tdev(cell%rows, cell%nu, np), cell%w(np), g(cell%rows, cell%nu))
+      cell%gbar = 0.0_wp
+      cell%tbar = 0.0_wp
+      cell%g0bar = 0.0_wp
+      cell%tdev = 0.0_wp
+      do j = 1, np
+         i = ops%cell_point(ops%cell_ptr(c) + j - 1)
+         q0 = ops%ptr(i)
+         q1 = ops%ptr(i + 1) - 1
+         nrm = surface%normal(:, i)
+         pos = [(findloc(cell%dofs, ops%dofs(q), 1), q = q0, q1)]
+         g = 0.0_wp
+         if (friction == friction_stick) then
+            g(:, pos) = ops%gop(:, q0:q1)
+            cell%tdev(:, pos, j) = ops%top(:, q0:q1)
+            cell%g0bar = cell%g0bar + surface%weight(i)*surface%g0(i)*nrm
+         else
+            g(1, pos) = matmul(nrm, ops%gop(:, q0:q1))
+            cell%tdev(1, pos, j) = matmul(nrm, ops%top(:, q0:q1))
+            cell%g0bar = cell%g0bar + surface%weight(i)*surface%g0(i)
+         end if
+         cell%w(j) = surface%weight(i)
+         cell%gbar = cell%gbar + surface%weight(i)*g
+         cell%tbar = cell%tbar + surface%weight(i)*cell%tdev(:, :, j)
+      end do
+      cell%measure = sum(cell%w)
+      cell%gbar = cell%gbar/cell%measure
+      cell%tbar = cell%tbar/cell%measure
+      cell%g0bar = cell%g0bar/cell%measure
+      do j = 1, np
+         cell%tdev(:, :, j) = cell%tdev(:, :, j) - cell%tbar
+      end do
+   end subroutine cell_operators
 
    !> Reduced operators of `problem` at x in element e: dofs(1:m), the
    !> displacement n(dim, m) and the traction sigma(u) nrm, t(dim, m).
@@ -307,27 +428,25 @@ contains
       t = matmul(matmul(tn, matmul(problem%d(1:ns, 1:ns), b)), tmat(:, 1:m))
    end subroutine body_operators
 
-   !> The block system [K_s 0; 0 K_m] + contact terms of the closed points,
-   !> and its load.
-   subroutine block_system(slave, master, surface, ops, friction, closed, k, f, error)
+   !> The block system [K_s 0; 0 K_m] + contact terms of the closed cells,
+   !> and its load (module notes).
+   subroutine block_system(slave, master, ops, cells, closed, k, f, error)
       type(elasticity_problem_type), intent(in) :: slave, master
-      type(contact_surface_type), intent(in) :: surface
       type(point_operators_type), intent(in) :: ops
-      integer, intent(in) :: friction
+      type(cell_operators_type), intent(in) :: cells(:)
       logical, intent(in) :: closed(:)
       type(csr_type), intent(out) :: k
       real(wp), allocatable, intent(out) :: f(:)
       type(error_type), allocatable, intent(out) :: error
       type(coo_type) :: coo
-      real(wp), allocatable :: g(:, :), t(:, :), kc(:, :), fc(:)
-      real(wp) :: nrm(surface%dim)
+      real(wp), allocatable :: kc(:, :)
       integer(i8) :: capacity
-      integer :: ns, i, q0, q1
+      integer :: ns, c, j
 
       ns = slave%n_dofs()
       capacity = slave%k%nnz() + master%k%nnz()
-      do i = 1, surface%npoint
-         if (closed(i)) capacity = capacity + int(ops%ptr(i + 1) - ops%ptr(i), i8)**2
+      do c = 1, size(cells)
+         if (closed(c)) capacity = capacity + int(cells(c)%nu, i8)**2
       end do
       call coo%init(ns + master%n_dofs(), ns + master%n_dofs(), error, capacity=capacity)
       if (allocated(error)) return
@@ -335,29 +454,19 @@ contains
       if (.not. allocated(error)) call add_csr(coo, master%k, ns, error)
       if (allocated(error)) return
       f = [slave%f, master%f]
-      do i = 1, surface%npoint
-         if (.not. closed(i)) cycle
-         q0 = ops%ptr(i)
-         q1 = ops%ptr(i + 1) - 1
-         nrm = surface%normal(:, i)
-         if (friction == friction_stick) then
-            g = ops%gop(:, q0:q1)
-            t = ops%top(:, q0:q1)
-         else
-            g = reshape(matmul(nrm, ops%gop(:, q0:q1)), [1, q1 - q0 + 1])
-            t = reshape(matmul(nrm, ops%top(:, q0:q1)), [1, q1 - q0 + 1])
-         end if
-         ! w [T^T G + G^T T + gamma G^T G] u = -w [T^T + gamma G^T] g0 (n or 1)
-         kc = surface%weight(i)*(matmul(transpose(t), g) + matmul(transpose(g), t) + &
-            & ops%gamma(i)*matmul(transpose(g), g))
-         if (friction == friction_stick) then
-            fc = -surface%weight(i)*surface%g0(i)*matmul(nrm, t + ops%gamma(i)*g)
-         else
-            fc = -surface%weight(i)*surface%g0(i)*(t(1, :) + ops%gamma(i)*g(1, :))
-         end if
-         call coo%add(ops%dofs(q0:q1), kc, error)
-         if (allocated(error)) return
-         f(ops%dofs(q0:q1)) = f(ops%dofs(q0:q1)) + fc
+      do c = 1, size(cells)
+         if (.not. closed(c)) cycle
+         associate (cell => cells(c), gamma => ops%gamma(c))
+            ! W [T^T G + G^T T + gamma G^T G] - 1/gamma sum_i w_i dT_i^T dT_i;  load -W (T + gamma G)^T g0
+            kc = cell%measure*(matmul(transpose(cell%tbar), cell%gbar) + matmul(transpose(cell%gbar), cell%tbar) &
+               & + gamma*matmul(transpose(cell%gbar), cell%gbar))
+            do j = 1, size(cell%w)
+               kc = kc - (cell%w(j)/gamma)*matmul(transpose(cell%tdev(:, :, j)), cell%tdev(:, :, j))
+            end do
+            call coo%add(cell%dofs, kc, error)
+            if (allocated(error)) return
+            f(cell%dofs) = f(cell%dofs) - cell%measure*matmul(cell%g0bar, cell%tbar + gamma*cell%gbar)
+         end associate
       end do
       call coo%to_csr(k, error)
    end subroutine block_system
@@ -428,35 +537,56 @@ contains
       if (allocated(error)) error%message = 'contact solve'//error%message
    end subroutine solve_block
 
-   !> Gaps, pressures and tangential tractions of the solution x (module notes).
-   subroutine evaluate(surface, ops, friction, x, sol)
+   !> Gaps, cell multipliers, pressures and tangential tractions of the
+   !> solution x (module notes).
+   subroutine evaluate(surface, ops, cells, closed, x, sol)
       type(contact_surface_type), intent(in) :: surface
       type(point_operators_type), intent(in) :: ops
-      integer, intent(in) :: friction
+      type(cell_operators_type), intent(in) :: cells(:)
+      logical, intent(in) :: closed(:)
       real(wp), intent(in) :: x(:)
       type(contact_solution_type), intent(inout) :: sol
-      real(wp) :: gv(surface%dim), tv(surface%dim), lam(surface%dim), nrm(surface%dim)
-      integer :: i, q0, q1
+      real(wp) :: lam(surface%dim), nbar(surface%dim), nrm(surface%dim)
+      integer :: i, c, j, q0, q1
 
       if (.not. allocated(sol%gap)) allocate (sol%gap(surface%npoint), sol%pressure(surface%npoint), &
-         & sol%tangential(surface%npoint), sol%lambda_n(surface%npoint))
+         & sol%tangential(surface%npoint), sol%lambda_n(size(cells)), sol%closed(surface%npoint))
       sol%gap = huge(1.0_wp)
-      sol%lambda_n = 0.0_wp
       sol%pressure = 0.0_wp
       sol%tangential = 0.0_wp
+      sol%closed = .false.
       do i = 1, surface%npoint
          if (.not. surface%has_master(i)) cycle
          q0 = ops%ptr(i)
          q1 = ops%ptr(i + 1) - 1
-         nrm = surface%normal(:, i)
-         gv = matmul(ops%gop(:, q0:q1), x(ops%dofs(q0:q1))) + surface%g0(i)*nrm
-         tv = matmul(ops%top(:, q0:q1), x(ops%dofs(q0:q1)))
-         sol%gap(i) = dot_product(gv, nrm)
-         lam = tv + ops%gamma(i)*gv
-         sol%lambda_n(i) = dot_product(lam, nrm)
-         if (.not. sol%closed(i)) cycle
-         sol%pressure(i) = -sol%lambda_n(i)
-         if (friction == friction_stick) sol%tangential(i) = norm2(lam - dot_product(lam, nrm)*nrm)
+         sol%gap(i) = surface%g0(i) + dot_product(surface%normal(:, i), matmul(ops%gop(:, q0:q1), x(ops%dofs(q0:q1))))
+      end do
+      do c = 1, size(cells)
+         associate (cell => cells(c), pts => ops%cell_point(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1))
+            lam = 0.0_wp
+            lam(1:cell%rows) = matmul(cell%tbar + ops%gamma(c)*cell%gbar, x(cell%dofs)) + ops%gamma(c)*cell%g0bar
+            nbar = 0.0_wp
+            do j = 1, size(pts)
+               nbar = nbar + surface%weight(pts(j))*surface%normal(:, pts(j))
+            end do
+            if (cell%rows == 1) then
+               sol%lambda_n(c) = lam(1)
+            else
+               sol%lambda_n(c) = dot_product(lam, nbar/norm2(nbar))
+            end if
+            if (.not. closed(c)) cycle
+            do j = 1, size(pts)
+               i = pts(j)
+               nrm = surface%normal(:, i)
+               sol%closed(i) = .true.
+               if (cell%rows == 1) then
+                  sol%pressure(i) = -lam(1)
+               else
+                  sol%pressure(i) = -dot_product(lam, nrm)
+                  sol%tangential(i) = norm2(lam - dot_product(lam, nrm)*nrm)
+               end if
+            end do
+         end associate
       end do
    end subroutine evaluate
 
