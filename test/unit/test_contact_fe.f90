@@ -25,6 +25,7 @@ module sprc_test_contact_fe
 
    character(len=*), parameter :: patch_2d = 'test/data/contact/patch_2d.nml'
    character(len=*), parameter :: patch_3d = 'test/data/contact/patch_3d.nml'
+   character(len=*), parameter :: hertz_2d = 'test/data/contact/hertz_2d.nml'
    character(len=*), parameter :: nl = new_line('a')
 
 contains
@@ -39,7 +40,8 @@ contains
          new_unittest('patch_3d_q2', test_patch_3d_q2), &
          new_unittest('lost_contact_names_body', test_lost_contact), &
          new_unittest('shrink_fit_q1_plane_strain', test_shrink_q1), &
-         new_unittest('shrink_fit_q2_plane_stress_ratio_1000', test_shrink_q2) &
+         new_unittest('shrink_fit_q2_plane_stress_ratio_1000', test_shrink_q2), &
+         new_unittest('hertz_2d', test_hertz_2d) &
          ]
    end subroutine collect_contact_fe
 
@@ -215,6 +217,30 @@ contains
       ! error of the stresses (measured: 0.5 and 0.4 times it at the finest level).
       call check(error, perr(n) <= err(n), 'pressure error '//real_text(perr(n))//' > err_fe '//real_text(err(n)))
    end subroutine shrink_case
+
+   !> Hertz line contact (test/data/contact/hertz_2d.nml, a = 0.05, p0 =
+   !> 2P/(pi a)): at h = a/25.6 on the contact the peak FE pressure is within
+   !> 3 % of p0 and the contact half-width within one cell of a (issue 11).
+   subroutine test_hertz_2d(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), parameter :: a = 0.05_wp, load = 1.0788436_wp, pi = acos(-1.0_wp), h = 2.0_wp/1024
+      type(level_type) :: result
+      character(len=:), allocatable :: text
+      real(wp) :: p0, pmax, width
+
+      call read_text_file(hertz_2d, text, error)
+      if (allocated(error)) return
+      call run_text(text, 4, result, error)
+      if (allocated(error)) return
+      p0 = 2.0_wp*load/(pi*a)
+      associate (c => result%contacts(1))
+         pmax = maxval(c%p_fe)
+         width = maxval(c%x(1, :), c%state /= contact_open)
+      end associate
+      call check(error, abs(pmax/p0 - 1.0_wp) <= 0.03_wp, 'p_max/p0 = '//real_text(pmax/p0))
+      if (allocated(error)) return
+      call check(error, abs(width - a) <= h, 'half-width '//real_text(width)//', a = 0.05, h = '//real_text(h))
+   end subroutine test_hertz_2d
 
    !> ||sigma_ex - sigma_h||_E / ||sigma_ex||_E over both bodies of a level in
    !> scene units; body 1 is the inner shell of `exact`, body 2 the outer.

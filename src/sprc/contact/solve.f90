@@ -34,15 +34,17 @@
 !>
 !> kappa. gamma = kappa E_s/h (SCENE.md: effective stiffness kappa E/h), with
 !> E_s the slave body's Young's modulus and h the smallest edge of the slave
-!> cell. The block system is SPD when gamma exceeds the trace-inverse bound of
-!> the slave traction, C_I dmax/h (the bound of the Dirichlet Nitsche terms,
-!> sprc_fem_problem: about (p+1)^2 times a geometric factor, with cell
-!> aggregation keeping it independent of the cut; dmax = 1.35 E for nu = 0.3
-!> in plane strain), with a margin for the variance term (bounded by C_I/kappa
-!> times the energy). The default `default_kappa` = 100 (sprc_study_spec) is
-!> above the Dirichlet default gamma dmax (54 E for Q1, 122 E / 2 margin for
-!> Q2); within the consistent method the results move only within the
-!> discretization error as kappa varies.
+!> cell (of its aggregate's root). The block system is SPD when gamma exceeds
+!> the trace-inverse bound of the slave traction, C_I dmax/h (the bound of the
+!> Dirichlet Nitsche terms, sprc_fem_problem: about (p+1)^2 times a geometric
+!> factor, cell aggregation keeping it independent of the cut; dmax = 1.35 E
+!> for nu = 0.3 in plane strain), with a margin for the variance term (at
+!> most C_I/kappa times the energy). Measured (shrink fit Q1 level 7 and Q2
+!> level 6, Hertz Q1 at h = a/12.8): from kappa = 100 to 1e6 err_fe moves by
+!> less than 1e-4 relative, p_max by 0.3 %; at kappa = 10 err_fe moves by 2 %
+!> (Q1) and 11 % (Q2), at kappa = 1 the active set cycles (coercivity lost).
+!> The default `default_kappa` = 1000 (sprc_study_spec) sits a decade inside
+!> that plateau.
 !>
 !> Points. The slave surface's cut-cell quadrature points with their exact
 !> normals and initial gaps (sprc_contact_surface), cut at the master grid's

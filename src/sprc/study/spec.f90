@@ -14,8 +14,10 @@ module sprc_study_spec
    public :: default_kappa, default_stabilization
 
    !> Default of `&contact kappa`, the dimensionless factor of the contact
-   !> stabilization (effective stiffness kappa*E/h, seed eq. 5); README documents it.
-   real(wp), parameter :: default_kappa = 100.0_wp
+   !> stabilization (effective stiffness kappa*E/h, seed eq. 5), chosen by a
+   !> sweep (sprc_contact_solve notes: results flat from 100 to 1e6); README
+   !> documents it.
+   real(wp), parameter :: default_kappa = 1000.0_wp
    !> Default of `&contact stabilization`: the FE stress (the recovered-stress
    !> variant needs the SPR-C contact patches).
    character(len=*), parameter :: default_stabilization = 'fe'
