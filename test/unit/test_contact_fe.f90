@@ -26,6 +26,7 @@ module sprc_test_contact_fe
    character(len=*), parameter :: patch_2d = 'test/data/contact/patch_2d.nml'
    character(len=*), parameter :: patch_3d = 'test/data/contact/patch_3d.nml'
    character(len=*), parameter :: hertz_2d = 'test/data/contact/hertz_2d.nml'
+   character(len=*), parameter :: incline_2d = 'test/data/contact/incline_2d.nml'
    character(len=*), parameter :: nl = new_line('a')
 
 contains
@@ -41,7 +42,9 @@ contains
          new_unittest('lost_contact_names_body', test_lost_contact), &
          new_unittest('shrink_fit_q1_plane_strain', test_shrink_q1), &
          new_unittest('shrink_fit_q2_plane_stress_ratio_1000', test_shrink_q2), &
-         new_unittest('hertz_2d', test_hertz_2d) &
+         new_unittest('hertz_2d', test_hertz_2d), &
+         new_unittest('incline_stick_exact_frictionless_not', test_incline), &
+         new_unittest('bodies_in_contact_share_units', test_units) &
          ]
    end subroutine collect_contact_fe
 
@@ -64,51 +67,124 @@ contains
 
    !> The patch scene at `order` and `level` (optionally one body's material
    !> replaced), checked against the uniform state of normal stress -1 across
-   !> the interface (2D sigma_yy, 3D sigma_zz; `ns` Voigt components).
-   subroutine patch_case(path, order, level, old, new, ns, error, stick)
+   !> the interface (2D sigma_yy, 3D sigma_zz; `ns` Voigt components) and the
+   !> contact pressure `p_exact` (default 1) at every closed slave point.
+   subroutine patch_case(path, order, level, old, new, ns, error, stick, p_exact)
       character(len=*), intent(in) :: path, old, new
       integer, intent(in) :: order, level, ns
       type(error_type), allocatable, intent(out) :: error
       logical, intent(in), optional :: stick
+      real(wp), intent(in), optional :: p_exact
       type(level_type) :: result
-      type(study_type) :: study
+      real(wp) :: worst, pworst, tol
       character(len=:), allocatable :: text
-      real(wp) :: expected(6), worst, tol, unit, sigma(6), pworst
-      integer :: b, e, q
 
       call read_text_file(path, text, error)
       if (allocated(error)) return
       text = replaced(text, 'order    = 1', 'order    = '//achar(48 + order))
       if (len(old) > 0) text = replaced(text, old, new)
       if (present(stick)) text = replaced(text, "friction='frictionless'", "friction='stick'")
+      call uniform_errors(text, level, ns, result, worst, pworst, tol, error, p_exact)
+      if (allocated(error)) return
+      call check(error, worst <= tol, 'uniform stress: max error '//real_text(worst)//' > '//real_text(tol))
+      if (allocated(error)) return
+      call check(error, all(result%contacts(1)%state /= contact_open), 'every slave point is closed')
+      if (allocated(error)) return
+      call check(error, pworst <= tol, 'contact pressure: max error '//real_text(pworst)//' > '//real_text(tol))
+   end subroutine patch_case
+
+   !> Run the scene `text` at `level`; the largest deviation of the stresses
+   !> (scene units) from the uniform state of normal stress -1 across the
+   !> x/y plane (`ns` Voigt components), of the closed points' pressures from
+   !> `p_exact` (default 1), and the tolerance C eps/rcond (module notes);
+   !> with `scale` the stresses and pressures are divided by it first.
+   subroutine uniform_errors(text, level, ns, result, worst, pworst, tol, error, p_exact, scale)
+      character(len=*), intent(in) :: text
+      integer, intent(in) :: level, ns
+      type(level_type), intent(out) :: result
+      real(wp), intent(out) :: worst, pworst, tol
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), intent(in), optional :: p_exact, scale
+      type(study_type) :: study
+      real(wp) :: expected(6), unit, sigma(6), p, s
+      integer :: b, e, q
+
       call run_text(text, level, result, error, study)
       if (allocated(error)) return
+      s = 1.0_wp
+      if (present(scale)) s = scale
       expected = 0.0_wp
       expected(merge(2, 3, ns == 3)) = -1.0_wp
       worst = 0.0_wp
       tol = 0.0_wp
       do b = 1, size(result%bodies)
-         associate (p => result%bodies(b)%problem)
+         associate (pb => result%bodies(b)%problem)
             ! stresses in the body's units: sigma_scene = sigma*unit
-            unit = study%bodies(b)%units%modulus*study%bodies(b)%units%strain
-            tol = max(tol, 10.0_wp*epsilon(1.0_wp)/p%rcond)
-            do e = 1, p%grid%n_leaves
-               do q = p%vol_ptr(e), p%vol_ptr(e + 1) - 1
-                  call p%stress_in_element(e, p%vol_x(:, q), sigma(1:ns))
+            unit = (study%bodies(b)%units%modulus/s)*study%bodies(b)%units%strain
+            tol = max(tol, 10.0_wp*epsilon(1.0_wp)/pb%rcond)
+            do e = 1, pb%grid%n_leaves
+               do q = pb%vol_ptr(e), pb%vol_ptr(e + 1) - 1
+                  call pb%stress_in_element(e, pb%vol_x(:, q), sigma(1:ns))
                   worst = max(worst, maxval(abs(sigma(1:ns)*unit - expected(1:ns))))
                end do
             end do
          end associate
       end do
-      call check(error, worst <= tol, 'uniform stress: max error '//real_text(worst)//' > '//real_text(tol))
-      if (allocated(error)) return
+      p = 1.0_wp
+      if (present(p_exact)) p = p_exact
       associate (c => result%contacts(1))
-         call check(error, all(c%state /= contact_open), 'every slave point is closed')
-         if (allocated(error)) return
-         pworst = maxval(abs(c%p_fe - 1.0_wp))
-         call check(error, pworst <= tol, 'contact pressure: max error '//real_text(pworst)//' > '//real_text(tol))
+         pworst = maxval(abs(c%p_fe/s - p), c%state /= contact_open)
       end associate
-   end subroutine patch_case
+   end subroutine uniform_errors
+
+   !> The block on the inclined interface (tan theta = 0.5): with stick the
+   !> uniform stress and the pressure cos^2 theta = 0.8 are exact; frictionless
+   !> contact cannot carry the tangential traction 0.4 and is not (its stress
+   !> error exceeds a hundred times the round-off tolerance).
+   subroutine test_incline(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(level_type) :: result
+      character(len=:), allocatable :: text
+      real(wp) :: worst, pworst, tol
+
+      call read_text_file(incline_2d, text, error)
+      if (allocated(error)) return
+      call uniform_errors(text, 3, 3, result, worst, pworst, tol, error, p_exact=0.8_wp)
+      if (allocated(error)) return
+      call check(error, worst <= tol .and. pworst <= tol, 'stick: stress error '//real_text(worst)// &
+         & ', pressure error '//real_text(pworst)//', tolerance '//real_text(tol))
+      if (allocated(error)) return
+      call check(error, abs(maxval(result%contacts(1)%ts_fe) - 0.4_wp) <= tol, 'stick: tangential traction '// &
+         & real_text(maxval(result%contacts(1)%ts_fe))//', expected 0.4')
+      if (allocated(error)) return
+      call uniform_errors(replaced(text, "friction='stick'", "friction='frictionless'"), 3, 3, result, worst, &
+         & pworst, tol, error, p_exact=0.8_wp)
+      if (allocated(error)) return
+      call check(error, worst > 100.0_wp*tol, 'frictionless: stress error '//real_text(worst)//' is round-off')
+   end subroutine test_incline
+
+   !> Bodies in contact share one unit system: the inclined-interface stick
+   !> test with the modulus scaled by 1e200 and the pressure by 4e200 (alone,
+   !> the lower body, which carries no load of its own, would get a
+   !> displacement unit 4 times the upper one's, and the tied interface would
+   !> mix them) gives the uniform stress and the pressure, 4e200 times those
+   !> of the unscaled test, to round-off.
+   subroutine test_units(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(level_type) :: result
+      character(len=:), allocatable :: text
+      real(wp) :: worst, pworst, tol
+
+      call read_text_file(incline_2d, text, error)
+      if (allocated(error)) return
+      text = replaced(text, "young=1.0 poisson=0.3 box_min=-0.1", "young=1.0e200 poisson=0.3 box_min=-0.1")
+      text = replaced(text, "young=1.0 poisson=0.3 box_min=-0.2", "young=1.0e200 poisson=0.3 box_min=-0.2")
+      text = replaced(text, "type='pressure' value=1.0", "type='pressure' value=4.0e200")
+      call uniform_errors(text, 3, 3, result, worst, pworst, tol, error, p_exact=0.8_wp, scale=4.0e200_wp)
+      if (allocated(error)) return
+      call check(error, worst <= tol .and. pworst <= tol, 'stress error '//real_text(worst)//', pressure error '// &
+         & real_text(pworst)//' (relative to 4e200) > '//real_text(tol))
+   end subroutine test_units
 
    subroutine test_patch_3d_q1(error)
       type(error_type), allocatable, intent(out) :: error
