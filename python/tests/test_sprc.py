@@ -130,7 +130,7 @@ def test_malformed_scene_raises_with_message(name, substrings, stat):
 
 
 def test_unrunnable_scene_is_unsupported():
-    with pytest.raises(sprc.SprcError, match="coulomb") as info:
+    with pytest.raises(sprc.SprcError, match="recovered") as info:
         sprc.run_scene(ROOT / "test" / "data" / "scenes" / "valid" / "hertz_roller.nml")
     assert info.value.status_name == "unsupported"
 

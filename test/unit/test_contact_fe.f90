@@ -14,7 +14,7 @@ module sprc_test_contact_fe
    use sprc_io_namelist, only: read_text_file
    use sprc_study_level, only: study_type, level_type
    use sprc_test_study, only: run_text
-   use sprc_contact_result, only: contact_open, contact_result_type
+   use sprc_contact_result, only: contact_open, contact_stick, contact_slip, contact_result_type
    use sprc_core_material, only: plane_stress, plane_strain, compliance_matrix
    use sprc_exact_compound, only: compound_type, new_compound_cylinder
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, replaced
@@ -44,7 +44,8 @@ contains
          new_unittest('shrink_fit_q2_plane_stress_ratio_1000', test_shrink_q2), &
          new_unittest('hertz_2d', test_hertz_2d), &
          new_unittest('incline_stick_exact_frictionless_not', test_incline), &
-         new_unittest('bodies_in_contact_share_units', test_units) &
+         new_unittest('bodies_in_contact_share_units', test_units), &
+         new_unittest('coulomb_proportional_steps', test_coulomb_steps) &
          ]
    end subroutine collect_contact_fe
 
@@ -137,10 +138,11 @@ contains
       end associate
    end subroutine uniform_errors
 
-   !> The block on the inclined interface (tan theta = 0.5): with stick the
-   !> uniform stress and the pressure cos^2 theta = 0.8 are exact; frictionless
-   !> contact cannot carry the tangential traction 0.4 and is not (its stress
-   !> error exceeds a hundred times the round-off tolerance).
+   !> The block on the inclined interface (tan theta = 0.5): with stick and
+   !> with Coulomb mu = 0.6 the uniform stress and the pressure cos^2 theta =
+   !> 0.8 are exact; frictionless contact and Coulomb mu = 0.4 cannot carry
+   !> the tangential traction 0.4 and are not (their stress error exceeds a
+   !> hundred times the round-off tolerance), and mu = 0.4 has slipping points.
    subroutine test_incline(error)
       type(error_type), allocatable, intent(out) :: error
       type(level_type) :: result
@@ -161,7 +163,47 @@ contains
          & pworst, tol, error, p_exact=0.8_wp)
       if (allocated(error)) return
       call check(error, worst > 100.0_wp*tol, 'frictionless: stress error '//real_text(worst)//' is round-off')
+      if (allocated(error)) return
+      ! Coulomb, mu = 0.6 >= tan(theta): every cell sticks, the uniform state is exact.
+      call uniform_errors(replaced(text, "friction='stick'", "friction='coulomb' mu=0.6"), 3, 3, result, worst, &
+         & pworst, tol, error, p_exact=0.8_wp)
+      if (allocated(error)) return
+      call check(error, worst <= tol .and. pworst <= tol .and. all(result%contacts(1)%state == contact_stick), &
+         & 'coulomb 0.6: stress error '//real_text(worst)//', pressure error '//real_text(pworst)//', tolerance '// &
+         & real_text(tol)//' (all stick)')
+      if (allocated(error)) return
+      ! mu = 0.4 < tan(theta): the interface slips, the uniform state is not the solution.
+      call uniform_errors(replaced(text, "friction='stick'", "friction='coulomb' mu=0.4"), 3, 3, result, worst, &
+         & pworst, tol, error, p_exact=0.8_wp)
+      if (allocated(error)) return
+      call check(error, worst > 100.0_wp*tol .and. any(result%contacts(1)%state == contact_slip), &
+         & 'coulomb 0.4: stress error '//real_text(worst)//' is round-off, or no point slips')
    end subroutine test_incline
+
+   !> Coulomb friction under proportional loading does not depend on the
+   !> increments: the slipping incline (mu = 0.4) in 1 and in 4 steps gives
+   !> the same pressures and tangential tractions (to round-off: C eps/rcond
+   !> times the pressure scale 1) and the same states.
+   subroutine test_coulomb_steps(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(level_type) :: one, four
+      character(len=:), allocatable :: text
+      real(wp) :: tol, diff
+
+      call read_text_file(incline_2d, text, error)
+      if (allocated(error)) return
+      text = replaced(text, "friction='stick'", "friction='coulomb' mu=0.4")
+      call run_text(text, 3, one, error)
+      if (allocated(error)) return
+      call run_text(replaced(text, "mu=0.4", "mu=0.4 steps=4"), 3, four, error)
+      if (allocated(error)) return
+      tol = 10.0_wp*epsilon(1.0_wp)/min(one%bodies(1)%problem%rcond, four%bodies(1)%problem%rcond)
+      diff = max(maxval(abs(one%contacts(1)%p_fe - four%contacts(1)%p_fe)), &
+         & maxval(abs(one%contacts(1)%ts_fe - four%contacts(1)%ts_fe)))
+      call check(error, all(one%contacts(1)%state == four%contacts(1)%state), 'states differ')
+      if (allocated(error)) return
+      call check(error, diff <= tol, 'pressures or tractions differ by '//real_text(diff)//' > '//real_text(tol))
+   end subroutine test_coulomb_steps
 
    !> Bodies in contact share one unit system: the inclined-interface stick
    !> test with the modulus scaled by 1e200 and the pressure by 4e200 (alone,

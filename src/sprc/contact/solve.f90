@@ -68,7 +68,20 @@
 !> naming the body (stat_singular).
 !>
 !> Friction: 'frictionless' and 'stick' (the closed zone tied: the vector
-!> gap) are symmetric. 'coulomb' is refused in this version (stat_unsupported).
+!> gap) are symmetric. 'coulomb': the vector multiplier of a cell less its
+!> slip s_c (history), lambda_c = tbar + gamma (gbar - s_c), split along the
+!> cell's mean normal nbar into lambda_n and lambda_t; a closed cell sticks
+!> (the stick terms with the gap shifted by s_c) while |lambda_t| <= mu
+!> (-lambda_n), else it slips along tau = lambda_t/|lambda_t|: the normal
+!> terms plus the friction traction lambda_t = -mu lambda_n tau, whose
+!> linearization -mu W (gbar^T tau)(nbar^T (tbar + gamma gbar)) makes the
+!> system unsymmetric (UMFPACK). The load path comes in increments (`&bc
+!> stage` and `&contact steps`, the caller's `loads`); in each the states
+!> and slip directions are iterated until they repeat (directions within
+!> `direction_tol`), then the slips are updated: a slipping cell's so that
+!> its trial traction is the friction traction, an open cell's to its
+!> current tangential position. The rigid-mode check uses the system
+!> without the friction terms.
 module sprc_contact_solve
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_not_converged, stat_singular, &
@@ -78,6 +91,7 @@ module sprc_contact_solve
    use sprc_fem_sparse, only: coo_type, csr_type
    use sprc_fem_element, only: shape_functions, strain_matrix, traction_matrix, displacement_matrix
    use sprc_fem_problem, only: elasticity_problem_type, free_motions, motion_names, solve_spd_or_lu
+   use sprc_fem_umfpack, only: umfpack_solver_type
    use sprc_contact_surface, only: contact_surface_type
    implicit none
    private
@@ -89,6 +103,11 @@ module sprc_contact_solve
    integer, parameter :: friction_frictionless = 0, friction_stick = 1, friction_coulomb = 2
    !> Active-set iterations before giving up.
    integer, parameter :: default_max_iterations = 50
+   !> States of a contact cell under Coulomb friction.
+   integer, parameter :: state_open = 0, state_stick = 1, state_slip = 2
+   !> A slip direction counts as settled when it moves by less than this
+   !> between iterations (unit vectors; in 2D it only flips).
+   real(wp), parameter :: direction_tol = 1.0e-8_wp
 
    !> The contact operators of the points with a master point (local dofs in
    !> the block numbering, gap and traction operators) and their contact cells.
@@ -109,6 +128,8 @@ module sprc_contact_solve
       integer :: nu = 0, rows = 0
       integer, allocatable :: dofs(:)
       real(wp) :: measure = 0.0_wp
+      !> Unit mean normal of the cell's points.
+      real(wp), allocatable :: nbar(:)
       !> Means of the gap operator, its constant part and the traction operator.
       real(wp), allocatable :: gbar(:, :), g0bar(:), tbar(:, :)
       !> Per point: the traction operator minus its mean, (rows, nu, npoints), and the weights.
@@ -126,8 +147,8 @@ module sprc_contact_solve
    type :: contact_solution_type
       !> Active-set iterations (factorizations).
       integer :: iterations = 0
-      !> Closed points of the final set (their cell is closed).
-      logical, allocatable :: closed(:)
+      !> Closed points of the final set (their cell is closed), and those slipping (Coulomb).
+      logical, allocatable :: closed(:), slipping(:)
       !> Linearized normal gap of the solution (huge where the point has no master point).
       real(wp), allocatable :: gap(:)
       !> Contact pressure p = -lambda_n (0 open) and |lambda_t| (module notes).
@@ -160,7 +181,8 @@ contains
    !> (`assemble`), `surface` with its initial gaps to the master; on success
    !> both problems hold their solution (`set_solution`). `names` are the slave
    !> and master body names for messages.
-   subroutine solve_contact_pair(slave, master, surface, friction, kappa, names, sol, error, max_iterations)
+   subroutine solve_contact_pair(slave, master, surface, friction, kappa, names, sol, error, max_iterations, mu, &
+         & loads)
       type(elasticity_problem_type), intent(inout) :: slave, master
       type(contact_surface_type), intent(in) :: surface
       integer, intent(in) :: friction
@@ -169,12 +191,18 @@ contains
       type(contact_solution_type), intent(out) :: sol
       type(error_type), allocatable, intent(out) :: error
       integer, intent(in), optional :: max_iterations
+      !> Coulomb: the friction coefficient and the load path (block loads at the
+      !> end of each increment, one column each; default one increment, the
+      !> assembled loads).
+      real(wp), intent(in), optional :: mu, loads(:, :)
       type(point_operators_type) :: ops
       type(cell_operators_type), allocatable :: cells(:)
       type(csr_type) :: k
       type(timer_type) :: timer
       real(wp), allocatable :: f(:), x(:)
       logical, allocatable :: closed(:), next(:)
+      integer, allocatable :: state(:)
+      real(wp), allocatable :: slip(:, :)
       integer :: it, maxit, n, c, switched
 
       call check_pair(slave, master, surface, friction, kappa, error)
@@ -185,7 +213,7 @@ contains
       call point_operators(slave, master, surface, kappa, ops)
       allocate (cells(ops%ncell), closed(ops%ncell), next(ops%ncell))
       do c = 1, ops%ncell
-         call cell_operators(surface, ops, c, friction, cells(c))
+         call cell_operators(surface, ops, c, merge(friction_stick, friction, friction == friction_coulomb), cells(c))
          closed(c) = any(surface%g0(ops%cell_point(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1)) <= &
             & cell_size(slave, slave%root(surface%slave_cell(ops%cell_point(ops%cell_ptr(c))))))
       end do
@@ -193,7 +221,22 @@ contains
       sol%t_contact = timer%elapsed
       n = slave%n_dofs() + master%n_dofs()
       allocate (x(n))
-      do it = 1, maxit
+      if (friction == friction_coulomb) then
+         if (.not. present(mu)) then
+            call fatal_error(error, 'contact solve: Coulomb friction needs mu', stat_invalid_input)
+            return
+         end if
+         if (present(loads)) then
+            call solve_coulomb(slave, master, ops, cells, closed, mu, loads, names, maxit, x, sol, state, slip, error)
+         else
+            call solve_coulomb(slave, master, ops, cells, closed, mu, reshape([slave%f, master%f], [n, 1]), names, &
+               & maxit, x, sol, state, slip, error)
+         end if
+         if (allocated(error)) return
+         call point_gaps(surface, ops, ops%ncell, x, sol)
+         call coulomb_output(ops, cells, mu, state, slip, x, sol)
+      end if
+      do it = 1, merge(0, maxit, friction == friction_coulomb)
          sol%iterations = it
          call timer%reset()
          call timer%start()
@@ -250,10 +293,8 @@ contains
             & stat_invalid_input)
       else if (.not. (kappa > 0.0_wp .and. kappa < huge(1.0_wp))) then
          call fatal_error(error, 'contact solve: kappa must be finite and > 0', stat_invalid_input)
-      else if (friction == friction_coulomb) then
-         call fatal_error(error, "contact: friction = 'coulomb' is not implemented in this version "// &
-            & "(frictionless and stick are)", stat_unsupported)
-      else if (friction /= friction_frictionless .and. friction /= friction_stick) then
+      else if (friction /= friction_frictionless .and. friction /= friction_stick .and. &
+         & friction /= friction_coulomb) then
          call fatal_error(error, 'contact solve: unknown friction law '//itoa(friction), stat_invalid_input)
       else if (slave%dilatation%active) then
          call fatal_error(error, 'contact: the projected dilatation (nearly incompressible slave body) is not '// &
@@ -393,6 +434,8 @@ contains
          cell%tbar = cell%tbar + surface%weight(i)*cell%tdev(:, :, j)
       end do
       cell%measure = sum(cell%w)
+      cell%nbar = matmul(surface%normal(:, ops%cell_point(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1)), cell%w)
+      cell%nbar = cell%nbar/norm2(cell%nbar)
       cell%gbar = cell%gbar/cell%measure
       cell%tbar = cell%tbar/cell%measure
       cell%g0bar = cell%g0bar/cell%measure
@@ -489,6 +532,244 @@ contains
       end do
    end subroutine add_csr
 
+   !> Coulomb friction (module notes): for each increment (column n of the
+   !> load path `loads`, the block system's load at the end of the increment)
+   !> an iteration on the cells' states (open, stick, slip) and slip
+   !> directions, solved with UMFPACK (the slip terms are unsymmetric); the
+   !> slip of each cell is history.
+   subroutine solve_coulomb(slave, master, ops, cells, closed, mu, loads, names, maxit, x, sol, state, slip, error)
+      type(elasticity_problem_type), intent(in) :: slave, master
+      type(point_operators_type), intent(in) :: ops
+      type(cell_operators_type), intent(in) :: cells(:)
+      logical, intent(in) :: closed(:)
+      real(wp), intent(in) :: mu, loads(:, :)
+      character(len=*), intent(in) :: names(2)
+      integer, intent(in) :: maxit
+      real(wp), intent(inout) :: x(:)
+      type(contact_solution_type), intent(inout) :: sol
+      !> Final state of each cell and its slip (history).
+      integer, allocatable, intent(out) :: state(:)
+      real(wp), allocatable, intent(out) :: slip(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      type(csr_type) :: k
+      type(timer_type) :: timer
+      real(wp), allocatable :: tau(:, :), tau_new(:, :), f(:)
+      integer, allocatable :: state_new(:)
+      integer :: n, it, c, d, changed
+
+      d = slave%dim
+      allocate (slip(d, size(cells)), tau(d, size(cells)), tau_new(d, size(cells)))
+      slip = 0.0_wp
+      tau = 0.0_wp
+      state = merge(state_stick, state_open, closed)
+      state_new = state
+      do n = 1, size(loads, 2)
+         do it = 1, maxit
+            sol%iterations = sol%iterations + 1
+            call timer%reset()
+            call timer%start()
+            ! The rigid-mode check on the symmetric part without the friction
+            ! terms (which resist no rigid motion): the system with mu = 0.
+            call coulomb_system(slave, master, ops, cells, state, tau, slip, 0.0_wp, loads(:, n), k, f, error)
+            if (.not. allocated(error)) call check_held(slave, master, k, names, count(state /= state_open), &
+               & sol%iterations, error)
+            if (.not. allocated(error) .and. any(state == state_slip)) &
+               & call coulomb_system(slave, master, ops, cells, state, tau, slip, mu, loads(:, n), k, f, error)
+            if (.not. allocated(error)) call solve_unsymmetric(k, f, x, sol, error)
+            call timer%stop()
+            sol%t_solve = sol%t_solve + timer%elapsed
+            if (allocated(error)) return
+            call coulomb_states(ops, cells, mu, slip, x, state_new, tau_new)
+            changed = count(state_new /= state)
+            do c = 1, size(cells)
+               if (state_new(c) == state_slip .and. state(c) == state_slip) then
+                  if (norm2(tau_new(:, c) - tau(:, c)) > direction_tol) changed = changed + 1
+               end if
+            end do
+            state = state_new
+            tau = tau_new
+            if (changed == 0) exit
+            if (it == maxit) then
+               call fatal_error(error, "contact '"//trim(names(1))//"' on '"//trim(names(2))//"', increment "// &
+                  & itoa(n)//': the stick/slip states did not settle in '//itoa(maxit)//' iterations; '// &
+                  & itoa(changed)//' of '//itoa(size(cells))//' contact cells still changed in the last one', &
+                  & stat_not_converged)
+               return
+            end if
+         end do
+         call update_slip(ops, cells, mu, state, tau, x, slip)
+      end do
+   end subroutine solve_coulomb
+
+   !> The block system with the Coulomb terms of the closed cells: stick
+   !> cells tied (vector gap less the cell's slip), slip cells the normal
+   !> terms and the friction traction -mu lambda_n tau (module notes).
+   subroutine coulomb_system(slave, master, ops, cells, state, tau, slip, mu, load, k, f, error)
+      type(elasticity_problem_type), intent(in) :: slave, master
+      type(point_operators_type), intent(in) :: ops
+      type(cell_operators_type), intent(in) :: cells(:)
+      integer, intent(in) :: state(:)
+      real(wp), intent(in) :: tau(:, :), slip(:, :), mu, load(:)
+      type(csr_type), intent(out) :: k
+      real(wp), allocatable, intent(out) :: f(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(coo_type) :: coo
+      real(wp), allocatable :: kc(:, :), gn(:), tn(:), gt(:)
+      integer(i8) :: capacity
+      integer :: ns, c, j
+
+      ns = slave%n_dofs()
+      capacity = slave%k%nnz() + master%k%nnz()
+      do c = 1, size(cells)
+         if (state(c) /= state_open) capacity = capacity + int(cells(c)%nu, i8)**2
+      end do
+      call coo%init(ns + master%n_dofs(), ns + master%n_dofs(), error, capacity=capacity)
+      if (allocated(error)) return
+      call add_csr(coo, slave%k, 0, error)
+      if (.not. allocated(error)) call add_csr(coo, master%k, ns, error)
+      if (allocated(error)) return
+      f = load
+      do c = 1, size(cells)
+         if (state(c) == state_open) cycle
+         associate (cell => cells(c), gamma => ops%gamma(c), nb => cells(c)%nbar)
+            if (state(c) == state_stick) then
+               kc = cell%measure*(matmul(transpose(cell%tbar), cell%gbar) + matmul(transpose(cell%gbar), cell%tbar) &
+                  & + gamma*matmul(transpose(cell%gbar), cell%gbar))
+               do j = 1, size(cell%w)
+                  kc = kc - (cell%w(j)/gamma)*matmul(transpose(cell%tdev(:, :, j)), cell%tdev(:, :, j))
+               end do
+               f(cell%dofs) = f(cell%dofs) - cell%measure*matmul(cell%g0bar - slip(:, c), cell%tbar + gamma*cell%gbar)
+            else
+               gn = matmul(nb, cell%gbar)
+               tn = matmul(nb, cell%tbar)
+               gt = matmul(tau(:, c), cell%gbar)
+               kc = cell%measure*(outer(tn, gn) + outer(gn, tn) + gamma*outer(gn, gn) - mu*outer(gt, tn + gamma*gn))
+               do j = 1, size(cell%w)
+                  kc = kc - (cell%w(j)/gamma)*outer(matmul(nb, cell%tdev(:, :, j)), matmul(nb, cell%tdev(:, :, j)))
+               end do
+               f(cell%dofs) = f(cell%dofs) - cell%measure*dot_product(nb, cell%g0bar)*(tn + gamma*gn - mu*gamma*gt)
+            end if
+            call coo%add(cell%dofs, kc, error)
+            if (allocated(error)) return
+         end associate
+      end do
+      call coo%to_csr(k, error)
+   end subroutine coulomb_system
+
+   pure function outer(a, b) result(m)
+      real(wp), intent(in) :: a(:), b(:)
+      real(wp) :: m(size(a), size(b))
+      m = spread(a, 2, size(b))*spread(b, 1, size(a))
+   end function outer
+
+   !> The cells' multiplier lambda = tbar u + gamma (gbar u + g0bar - slip),
+   !> its normal part along nbar and tangential part.
+   pure subroutine cell_multiplier(ops, cells, c, slip, x, lam_n, lam_t)
+      type(point_operators_type), intent(in) :: ops
+      type(cell_operators_type), intent(in) :: cells(:)
+      integer, intent(in) :: c
+      real(wp), intent(in) :: slip(:), x(:)
+      real(wp), intent(out) :: lam_n, lam_t(:)
+      real(wp) :: lam(size(slip))
+      associate (cell => cells(c))
+         lam = matmul(cell%tbar + ops%gamma(c)*cell%gbar, x(cell%dofs)) + ops%gamma(c)*(cell%g0bar - slip)
+         lam_n = dot_product(lam, cell%nbar)
+         lam_t = lam - lam_n*cell%nbar
+      end associate
+   end subroutine cell_multiplier
+
+   !> Trial states: open where lambda_n >= 0, stick where |lambda_t| <= mu
+   !> (-lambda_n), else slip along tau = lambda_t/|lambda_t|.
+   pure subroutine coulomb_states(ops, cells, mu, slip, x, state, tau)
+      type(point_operators_type), intent(in) :: ops
+      type(cell_operators_type), intent(in) :: cells(:)
+      real(wp), intent(in) :: mu, slip(:, :), x(:)
+      integer, intent(out) :: state(:)
+      real(wp), intent(out) :: tau(:, :)
+      real(wp) :: lam_n, lam_t(size(slip, 1))
+      integer :: c
+      tau = 0.0_wp
+      do c = 1, size(cells)
+         call cell_multiplier(ops, cells, c, slip(:, c), x, lam_n, lam_t)
+         if (lam_n >= 0.0_wp) then
+            state(c) = state_open
+         else if (norm2(lam_t) <= -mu*lam_n) then
+            state(c) = state_stick
+         else
+            state(c) = state_slip
+            tau(:, c) = lam_t/norm2(lam_t)
+         end if
+      end do
+   end subroutine coulomb_states
+
+   !> History at the end of an increment: a slipping cell's slip moves so that
+   !> its trial tangential multiplier is the friction traction mu p tau; an
+   !> open cell's slip follows the relative tangential displacement (it
+   !> closes stuck where it is); a stuck cell keeps its slip.
+   pure subroutine update_slip(ops, cells, mu, state, tau, x, slip)
+      type(point_operators_type), intent(in) :: ops
+      type(cell_operators_type), intent(in) :: cells(:)
+      real(wp), intent(in) :: mu, tau(:, :), x(:)
+      integer, intent(in) :: state(:)
+      real(wp), intent(inout) :: slip(:, :)
+      real(wp) :: lam_n, lam_t(size(slip, 1))
+      integer :: c
+      do c = 1, size(cells)
+         if (state(c) == state_stick) cycle
+         call cell_multiplier(ops, cells, c, slip(:, c), x, lam_n, lam_t)
+         if (state(c) == state_slip) then
+            slip(:, c) = slip(:, c) + (lam_t + mu*lam_n*tau(:, c))/ops%gamma(c)
+         else
+            slip(:, c) = slip(:, c) + lam_t/ops%gamma(c)
+         end if
+      end do
+   end subroutine update_slip
+
+   !> Per point: closed, slipping, pressure and tangential traction of its cell.
+   subroutine coulomb_output(ops, cells, mu, state, slip, x, sol)
+      type(point_operators_type), intent(in) :: ops
+      type(cell_operators_type), intent(in) :: cells(:)
+      real(wp), intent(in) :: mu, slip(:, :), x(:)
+      integer, intent(in) :: state(:)
+      type(contact_solution_type), intent(inout) :: sol
+      real(wp) :: lam_n, lam_t(size(slip, 1))
+      integer :: c, i, j
+
+      do c = 1, size(cells)
+         call cell_multiplier(ops, cells, c, slip(:, c), x, lam_n, lam_t)
+         sol%lambda_n(c) = lam_n
+         do j = ops%cell_ptr(c), ops%cell_ptr(c + 1) - 1
+            i = ops%cell_point(j)
+            sol%closed(i) = state(c) /= state_open
+            sol%slipping(i) = state(c) == state_slip
+            sol%pressure(i) = 0.0_wp
+            sol%tangential(i) = 0.0_wp
+            if (state(c) == state_open) cycle
+            sol%pressure(i) = -lam_n
+            sol%tangential(i) = merge(-mu*lam_n, norm2(lam_t), state(c) == state_slip)
+         end do
+      end do
+   end subroutine coulomb_output
+
+   !> Solve the unsymmetric block system with UMFPACK.
+   subroutine solve_unsymmetric(k, f, x, sol, error)
+      type(csr_type), intent(in) :: k
+      real(wp), intent(in) :: f(:)
+      real(wp), intent(inout) :: x(:)
+      type(contact_solution_type), intent(inout) :: sol
+      type(error_type), allocatable, intent(out) :: error
+      type(umfpack_solver_type) :: lu
+
+      sol%solver_name = 'umfpack'
+      call lu%factorize(k, error)
+      if (.not. allocated(error)) then
+         sol%rcond = lu%rcond_estimate
+         call lu%solve(f, x, error)
+      end if
+      call lu%destroy()
+      if (allocated(error)) error%message = 'contact solve (UMFPACK): '//error%message
+   end subroutine solve_unsymmetric
+
    !> Every rigid-body mode of both bodies must be resisted by the block
    !> system; a free one is an error naming the body (module notes).
    subroutine check_held(slave, master, k, names, nclosed, iteration, error)
@@ -539,6 +820,32 @@ contains
       if (allocated(error)) error%message = 'contact solve'//error%message
    end subroutine solve_block
 
+   !> The outputs allocated and reset (every point open); the linearized
+   !> normal gap of every point with a master point (huge elsewhere).
+   subroutine point_gaps(surface, ops, ncell, x, sol)
+      type(contact_surface_type), intent(in) :: surface
+      type(point_operators_type), intent(in) :: ops
+      integer, intent(in) :: ncell
+      real(wp), intent(in) :: x(:)
+      type(contact_solution_type), intent(inout) :: sol
+      integer :: i, q0, q1
+
+      if (.not. allocated(sol%gap)) allocate (sol%gap(surface%npoint), sol%pressure(surface%npoint), &
+         & sol%tangential(surface%npoint), sol%lambda_n(ncell), sol%closed(surface%npoint), &
+         & sol%slipping(surface%npoint))
+      sol%gap = huge(1.0_wp)
+      sol%pressure = 0.0_wp
+      sol%tangential = 0.0_wp
+      sol%closed = .false.
+      sol%slipping = .false.
+      do i = 1, surface%npoint
+         if (.not. surface%has_master(i)) cycle
+         q0 = ops%ptr(i)
+         q1 = ops%ptr(i + 1) - 1
+         sol%gap(i) = surface%g0(i) + dot_product(surface%normal(:, i), matmul(ops%gop(:, q0:q1), x(ops%dofs(q0:q1))))
+      end do
+   end subroutine point_gaps
+
    !> Gaps, cell multipliers, pressures and tangential tractions of the
    !> solution x (module notes).
    subroutine evaluate(surface, ops, cells, closed, x, sol)
@@ -548,33 +855,18 @@ contains
       logical, intent(in) :: closed(:)
       real(wp), intent(in) :: x(:)
       type(contact_solution_type), intent(inout) :: sol
-      real(wp) :: lam(surface%dim), nbar(surface%dim), nrm(surface%dim)
-      integer :: i, c, j, q0, q1
+      real(wp) :: lam(surface%dim), nrm(surface%dim)
+      integer :: i, c, j
 
-      if (.not. allocated(sol%gap)) allocate (sol%gap(surface%npoint), sol%pressure(surface%npoint), &
-         & sol%tangential(surface%npoint), sol%lambda_n(size(cells)), sol%closed(surface%npoint))
-      sol%gap = huge(1.0_wp)
-      sol%pressure = 0.0_wp
-      sol%tangential = 0.0_wp
-      sol%closed = .false.
-      do i = 1, surface%npoint
-         if (.not. surface%has_master(i)) cycle
-         q0 = ops%ptr(i)
-         q1 = ops%ptr(i + 1) - 1
-         sol%gap(i) = surface%g0(i) + dot_product(surface%normal(:, i), matmul(ops%gop(:, q0:q1), x(ops%dofs(q0:q1))))
-      end do
+      call point_gaps(surface, ops, size(cells), x, sol)
       do c = 1, size(cells)
          associate (cell => cells(c), pts => ops%cell_point(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1))
             lam = 0.0_wp
             lam(1:cell%rows) = matmul(cell%tbar + ops%gamma(c)*cell%gbar, x(cell%dofs)) + ops%gamma(c)*cell%g0bar
-            nbar = 0.0_wp
-            do j = 1, size(pts)
-               nbar = nbar + surface%weight(pts(j))*surface%normal(:, pts(j))
-            end do
             if (cell%rows == 1) then
                sol%lambda_n(c) = lam(1)
             else
-               sol%lambda_n(c) = dot_product(lam, nbar/norm2(nbar))
+               sol%lambda_n(c) = dot_product(lam, cell%nbar)
             end if
             if (.not. closed(c)) cycle
             do j = 1, size(pts)

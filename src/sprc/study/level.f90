@@ -13,9 +13,10 @@
 !> (sprc_contact_solve: one block system, active-set iteration) in one unit
 !> system (the slave body's modulus unit, the larger strain unit of the two),
 !> and their contact result (`contacts`) comes in scene units. This version
-!> runs one pair, frictionless or stick, with the FE stabilization stress;
-!> more pairs, 'coulomb' and 'recovered' are refused (stat_unsupported)
-!> before any computation.
+!> runs one pair with the FE stabilization stress; more pairs and
+!> 'recovered' are refused (stat_unsupported) before any computation.
+!> Coulomb friction follows the load path of `&bc stage` and `&contact
+!> steps` (`load_path`); other friction laws take all stages as one load.
 !>
 !> With an `&exact` group the closed form applies to every body, with that
 !> body's material.
@@ -33,7 +34,7 @@ module sprc_study_level
    use sprc_grid_patches, only: recovery_input_type, recover_grid
    use sprc_grid_recovered_field, only: recovered_field_type, method_spr, method_sprc
    use sprc_grid_recovered_estimate, only: zz_estimate_type, estimate_error
-   use sprc_fem_bc, only: fe_bc_type
+   use sprc_fem_bc, only: fe_bc_type, bc_pressure, bc_traction, bc_displacement
    use sprc_fem_problem, only: elasticity_problem_type
    use sprc_fem_recovery_input, only: fe_recovery_input
    use sprc_fem_dilatation, only: dilatation_choice
@@ -45,7 +46,8 @@ module sprc_study_level
    use sprc_contact_result, only: contact_result_type, new_contact_result, contact_open, contact_stick, &
       & contact_slip
    use sprc_contact_surface, only: contact_surface_type, slave_surface_points, initial_gaps
-   use sprc_contact_solve, only: contact_solution_type, solve_contact_pair, friction_kind, friction_stick
+   use sprc_contact_solve, only: contact_solution_type, solve_contact_pair, friction_kind, friction_coulomb, &
+      & friction_frictionless
    implicit none
    private
 
@@ -333,6 +335,7 @@ contains
       type(contact_solution_type) :: sol
       type(timer_type) :: timer
       character(len=:), allocatable :: names(:)
+      real(wp), allocatable :: loads(:, :)
       integer :: s, m, b, k
 
       s = spec%slave_index
@@ -353,8 +356,15 @@ contains
       allocate (character(len=max(len(spec%slave), len(spec%master))) :: names(2))
       names(1) = spec%slave
       names(2) = spec%master
-      call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, friction_kind(spec%friction), &
-         & spec%kappa, names, sol, error)
+      if (friction_kind(spec%friction) == friction_coulomb) then
+         call load_path(study, spec, bodies(s)%problem, bodies(m)%problem, loads, error)
+         if (allocated(error)) return
+         call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, friction_coulomb, spec%kappa, names, &
+            & sol, error, mu=spec%mu, loads=loads)
+      else
+         call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, friction_kind(spec%friction), &
+            & spec%kappa, names, sol, error)
+      end if
       if (allocated(error)) return
       bodies(s)%problem%t_solve = sol%t_solve
       bodies(m)%problem%t_solve = 0.0_wp
@@ -376,6 +386,70 @@ contains
       t_contact = t_contact + timer%elapsed + sol%t_contact
    end subroutine run_contact
 
+   !> The load path of a Coulomb pair (SCENE.md `&bc stage`, `&contact
+   !> steps`): the block load at the end of each increment, stage k's loads
+   !> applied in `steps` equal increments once the stages before it are
+   !> applied. Stage k's cumulative loads come from an assembly of each body
+   !> with the loads of later stages set to zero (pressures, tractions and
+   !> prescribed displacements; exact_* conditions belong to stage 1); the
+   !> last assembly holds every load.
+   subroutine load_path(study, spec, slave, master, loads, error)
+      type(study_type), intent(in) :: study
+      type(contact_spec_type), intent(in) :: spec
+      type(elasticity_problem_type), intent(inout) :: slave, master
+      real(wp), allocatable, intent(out) :: loads(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: previous(:), current(:)
+      integer :: stages, k, j, n, ns
+
+      stages = 1
+      do k = 1, size(study%scene%bcs)
+         stages = max(stages, study%scene%bcs(k)%stage)
+      end do
+      ns = slave%n_dofs()
+      allocate (loads(ns + master%n_dofs(), stages*spec%steps), previous(ns + master%n_dofs()))
+      previous = 0.0_wp
+      n = 0
+      do k = 1, stages
+         call stage_load(study, spec%slave_index, k, slave, error)
+         if (.not. allocated(error)) call stage_load(study, spec%master_index, k, master, error)
+         if (allocated(error)) return
+         current = [slave%f, master%f]
+         do j = 1, spec%steps
+            n = n + 1
+            loads(:, n) = previous + (real(j, wp)/real(spec%steps, wp))*(current - previous)
+         end do
+         previous = current
+      end do
+   end subroutine load_path
+
+   !> Assemble body b with the loads of the stages after `stage` set to zero
+   !> (its conditions restored afterwards).
+   subroutine stage_load(study, b, stage, problem, error)
+      type(study_type), intent(in) :: study
+      integer, intent(in) :: b, stage
+      type(elasticity_problem_type), intent(inout) :: problem
+      type(error_type), allocatable, intent(out) :: error
+      type(fe_bc_type), allocatable :: saved(:)
+      integer :: i, j
+
+      saved = problem%bcs
+      j = 0
+      do i = 1, size(study%scene%bcs)
+         if (study%scene%shapes(study%scene%bcs(i)%shape_index)%body_index /= b) cycle
+         j = j + 1
+         if (study%scene%bcs(i)%stage <= stage) cycle
+         select case (problem%bcs(j)%kind)
+         case (bc_pressure)
+            problem%bcs(j)%value = 0.0_wp
+         case (bc_traction, bc_displacement)
+            problem%bcs(j)%vector = 0.0_wp
+         end select
+      end do
+      call problem%assemble(error)
+      problem%bcs = saved
+   end subroutine stage_load
+
    !> The contact result of a pair in scene units (pressures times the stress
    !> unit, gaps times the displacement unit).
    subroutine contact_result(surface, sol, spec, units, result)
@@ -387,9 +461,10 @@ contains
       integer :: closed_state
 
       call new_contact_result(result, surface%x, surface%weight, surface%normal, spec%slave_index, spec%master_index)
-      closed_state = merge(contact_stick, contact_slip, friction_kind(spec%friction) == friction_stick)
+      closed_state = merge(contact_slip, contact_stick, friction_kind(spec%friction) == friction_frictionless)
       where (surface%has_master) result%gap = sol%gap*units%strain
       result%state = merge(closed_state, contact_open, sol%closed)
+      where (sol%slipping) result%state = contact_slip
       result%p_fe = (sol%pressure*units%modulus)*units%strain
       result%ts_fe = (sol%tangential*units%modulus)*units%strain
       result%iterations = sol%iterations

@@ -186,8 +186,8 @@ contains
    end function recovery_degree
 
    !> What of the scene's `&contact` this version's contact FE does not run,
-   !> as a sentence ('' when it runs the scene): one pair, frictionless or
-   !> stick, the FE stabilization stress (sprc_contact_solve).
+   !> as a sentence ('' when it runs the scene): one pair with the FE
+   !> stabilization stress (sprc_contact_solve).
    pure function contact_unsupported(scene) result(why)
       type(scene_type), intent(in) :: scene
       character(len=:), allocatable :: why
@@ -199,8 +199,6 @@ contains
       if (size(scene%contacts) > 1) then
          write (buf, '(i0)') size(scene%contacts)
          why = '&contact: '//trim(buf)//' contact pairs; this version runs one pair per scene'
-      else if (scene%contacts(1)%friction == 'coulomb') then
-         why = "&contact: friction = 'coulomb' is not implemented in this version (frictionless and stick are)"
       else if (scene%contacts(1)%stabilization /= 'fe') then
          why = "&contact: stabilization = '"//scene%contacts(1)%stabilization// &
             & "' needs the SPR-C contact patches, not in this version (use 'fe')"
