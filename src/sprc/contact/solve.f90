@@ -486,7 +486,7 @@ contains
       type(coo_type) :: coo
       real(wp), allocatable :: kc(:, :)
       integer(i8) :: capacity
-      integer :: ns, c, j
+      integer :: ns, c
 
       ns = slave%n_dofs()
       capacity = slave%k%nnz() + master%k%nnz()
@@ -502,12 +502,7 @@ contains
       do c = 1, size(cells)
          if (.not. closed(c)) cycle
          associate (cell => cells(c), gamma => ops%gamma(c))
-            ! W [T^T G + G^T T + gamma G^T G] - 1/gamma sum_i w_i dT_i^T dT_i;  load -W (T + gamma G)^T g0
-            kc = cell%measure*(matmul(transpose(cell%tbar), cell%gbar) + matmul(transpose(cell%gbar), cell%tbar) &
-               & + gamma*matmul(transpose(cell%gbar), cell%gbar))
-            do j = 1, size(cell%w)
-               kc = kc - (cell%w(j)/gamma)*matmul(transpose(cell%tdev(:, :, j)), cell%tdev(:, :, j))
-            end do
+            call tied_block(cell, gamma, kc)
             call coo%add(cell%dofs, kc, error)
             if (allocated(error)) return
             f(cell%dofs) = f(cell%dofs) - cell%measure*matmul(cell%g0bar, cell%tbar + gamma*cell%gbar)
@@ -515,6 +510,22 @@ contains
       end do
       call coo%to_csr(k, error)
    end subroutine block_system
+
+   !> The block of a closed cell whose rows are all tied (frictionless: the
+   !> normal row; stick: every component): W [T^T G + G^T T + gamma G^T G] -
+   !> 1/gamma sum_i w_i dT_i^T dT_i (module notes); its load is
+   !> -W (T + gamma G)^T g0.
+   pure subroutine tied_block(cell, gamma, kc)
+      type(cell_operators_type), intent(in) :: cell
+      real(wp), intent(in) :: gamma
+      real(wp), allocatable, intent(out) :: kc(:, :)
+      integer :: j
+      kc = cell%measure*(matmul(transpose(cell%tbar), cell%gbar) + matmul(transpose(cell%gbar), cell%tbar) &
+         & + gamma*matmul(transpose(cell%gbar), cell%gbar))
+      do j = 1, size(cell%w)
+         kc = kc - (cell%w(j)/gamma)*matmul(transpose(cell%tdev(:, :, j)), cell%tdev(:, :, j))
+      end do
+   end subroutine tied_block
 
    !> Add the entries of a (rows and columns shifted by `shift`) to coo.
    subroutine add_csr(coo, a, shift, error)
@@ -633,11 +644,7 @@ contains
          if (state(c) == state_open) cycle
          associate (cell => cells(c), gamma => ops%gamma(c), nb => cells(c)%nbar)
             if (state(c) == state_stick) then
-               kc = cell%measure*(matmul(transpose(cell%tbar), cell%gbar) + matmul(transpose(cell%gbar), cell%tbar) &
-                  & + gamma*matmul(transpose(cell%gbar), cell%gbar))
-               do j = 1, size(cell%w)
-                  kc = kc - (cell%w(j)/gamma)*matmul(transpose(cell%tdev(:, :, j)), cell%tdev(:, :, j))
-               end do
+               call tied_block(cell, gamma, kc)
                f(cell%dofs) = f(cell%dofs) - cell%measure*matmul(cell%g0bar - slip(:, c), cell%tbar + gamma*cell%gbar)
             else
                gn = matmul(nb, cell%gbar)

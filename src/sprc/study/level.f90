@@ -334,7 +334,6 @@ contains
       type(contact_surface_type) :: surface
       type(contact_solution_type) :: sol
       type(timer_type) :: timer
-      character(len=:), allocatable :: names(:)
       real(wp), allocatable :: loads(:, :)
       integer :: s, m, b, k
 
@@ -353,18 +352,22 @@ contains
       end if
       ! The gaps are displacements: into the pair's units.
       where (surface%has_master) surface%g0 = surface%g0/study%bodies(s)%units%strain
-      allocate (character(len=max(len(spec%slave), len(spec%master))) :: names(2))
-      names(1) = spec%slave
-      names(2) = spec%master
       if (friction_kind(spec%friction) == friction_coulomb) then
          call load_path(study, spec, bodies(s)%problem, bodies(m)%problem, loads, error)
          if (allocated(error)) return
-         call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, friction_coulomb, spec%kappa, names, &
-            & sol, error, mu=spec%mu, loads=loads)
-      else
-         call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, friction_kind(spec%friction), &
-            & spec%kappa, names, sol, error)
       end if
+      block
+         character(len=max(len(spec%slave), len(spec%master))) :: names(2)
+         names(1) = spec%slave
+         names(2) = spec%master
+         if (friction_kind(spec%friction) == friction_coulomb) then
+            call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, friction_coulomb, spec%kappa, &
+               & names, sol, error, mu=spec%mu, loads=loads)
+         else
+            call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, friction_kind(spec%friction), &
+               & spec%kappa, names, sol, error)
+         end if
+      end block
       if (allocated(error)) return
       bodies(s)%problem%t_solve = sol%t_solve
       bodies(m)%problem%t_solve = 0.0_wp
@@ -430,15 +433,22 @@ contains
       integer, intent(in) :: b, stage
       type(elasticity_problem_type), intent(inout) :: problem
       type(error_type), allocatable, intent(out) :: error
-      type(fe_bc_type), allocatable :: saved(:)
+      logical :: later(size(problem%bcs))
+      real(wp) :: value(size(problem%bcs)), vector(3, size(problem%bcs))
       integer :: i, j
 
-      saved = problem%bcs
+      later = .false.
       j = 0
       do i = 1, size(study%scene%bcs)
          if (study%scene%shapes(study%scene%bcs(i)%shape_index)%body_index /= b) cycle
          j = j + 1
-         if (study%scene%bcs(i)%stage <= stage) cycle
+         later(j) = study%scene%bcs(i)%stage > stage
+      end do
+      do j = 1, size(problem%bcs)
+         value(j) = problem%bcs(j)%value
+         vector(:, j) = 0.0_wp
+         if (allocated(problem%bcs(j)%vector)) vector(1:size(problem%bcs(j)%vector), j) = problem%bcs(j)%vector
+         if (.not. later(j)) cycle
          select case (problem%bcs(j)%kind)
          case (bc_pressure)
             problem%bcs(j)%value = 0.0_wp
@@ -447,7 +457,10 @@ contains
          end select
       end do
       call problem%assemble(error)
-      problem%bcs = saved
+      do j = 1, size(problem%bcs)
+         problem%bcs(j)%value = value(j)
+         if (allocated(problem%bcs(j)%vector)) problem%bcs(j)%vector = vector(1:size(problem%bcs(j)%vector), j)
+      end do
    end subroutine stage_load
 
    !> The contact result of a pair in scene units (pressures times the stress
