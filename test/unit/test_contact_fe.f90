@@ -16,7 +16,7 @@ module sprc_test_contact_fe
    use sprc_test_study, only: run_text
    use sprc_contact_result, only: contact_open, contact_stick, contact_slip, contact_result_type
    use sprc_core_material, only: plane_stress, plane_strain, compliance_matrix
-   use sprc_exact_compound, only: compound_type, new_compound_cylinder
+   use sprc_exact_compound, only: compound_type, new_compound_cylinder, new_compound_sphere
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, replaced
    implicit none
    private
@@ -45,7 +45,8 @@ contains
          new_unittest('hertz_2d', test_hertz_2d), &
          new_unittest('incline_stick_exact_frictionless_not', test_incline), &
          new_unittest('bodies_in_contact_share_units', test_units), &
-         new_unittest('coulomb_proportional_steps', test_coulomb_steps) &
+         new_unittest('coulomb_proportional_steps', test_coulomb_steps), &
+         new_unittest('shrink_fit_sphere_q1', test_sphere) &
          ]
    end subroutine collect_contact_fe
 
@@ -359,6 +360,61 @@ contains
       if (allocated(error)) return
       call check(error, abs(width - a) <= h, 'half-width '//real_text(width)//', a = 0.05, h = '//real_text(h))
    end subroutine test_hertz_2d
+
+   !> Compound sphere (octant): the shrink fit's rings as spherical shells,
+   !> Q1: err_fe over levels 2, 3, 4 at a rate of at least 0.95, the pressure
+   !> error at level 4 at most err_fe, every point closed.
+   subroutine test_sphere(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), parameter :: delta = 1.0e-5_wp, p_in = 1.0e-3_wp
+      integer, parameter :: levels(3) = [2, 3, 4]
+      type(compound_type) :: exact
+      type(level_type) :: result
+      type(study_type) :: study
+      character(len=:), allocatable :: text
+      real(wp) :: err(3), perr, rate
+      integer :: i
+
+      call new_compound_sphere(exact, [0.0_wp, 0.0_wp, 0.0_wp], 1.0_wp, 1.5_wp, 2.0_wp, p_in, delta, 2.0_wp, 0.3_wp, &
+         & 1.0_wp, 0.25_wp, error)
+      if (allocated(error)) return
+      text = "&scene title='shrink fit 3d' analysis='solid' order=1 levels=3 box_min=0,0,0 box_size=2.5 "// &
+         & "recovery='none' output='' /"//nl// &
+         & "&body name='shaft' young=2.0 poisson=0.3 /"//nl// &
+         & "&body name='hub' young=1.0 poisson=0.25 box_min=0.0,0.0,0.0 box_size=2.2 /"//nl// &
+         & "&shape body='shaft' op='add' kind='sphere' name='shaft_out' center=0,0,0 radius=1.50001 /"//nl// &
+         & "&shape body='shaft' op='subtract' kind='sphere' name='bore' center=0,0,0 radius=1 /"//nl// &
+         & "&shape body='hub' op='add' kind='sphere' name='hub_out' center=0,0,0 radius=2 /"//nl// &
+         & "&shape body='hub' op='subtract' kind='sphere' name='hub_in' center=0,0,0 radius=1.5 /"//nl// &
+         & "&bc on='bore' type='pressure' value=1.0e-3 /"//nl// &
+         & "&contact slave='shaft' master='hub' slave_surface='shaft_out' master_surface='hub_in' /"//nl
+      text = text//octant_planes('shaft')//octant_planes('hub')
+      do i = 1, 3
+         call run_text(text, levels(i), result, error, study)
+         if (allocated(error)) return
+         err(i) = energy_error_pair(study, result, exact)
+         call check(error, all(result%contacts(1)%state /= contact_open), 'every slave point closed')
+         if (allocated(error)) return
+      end do
+      perr = pressure_error(result%contacts(1), exact%contact_pressure)
+      rate = log(err(1)/err(3))/log(4.0_wp)
+      call check(error, rate >= 0.95_wp, 'err_fe rate '//real_text(rate)//' < 0.95')
+      if (allocated(error)) return
+      call check(error, perr <= err(3), 'pressure error '//real_text(perr)//' > err_fe '//real_text(err(3)))
+   end subroutine test_sphere
+
+   !> The three symmetry planes of an octant model of `body` with their conditions.
+   function octant_planes(body) result(text)
+      character(len=*), intent(in) :: body
+      character(len=:), allocatable :: text
+      character(len=*), parameter :: axis(3) = ['x', 'y', 'z'], normal(3) = ['-1,0,0', '0,-1,0', '0,0,-1']
+      integer :: k
+      text = ''
+      do k = 1, 3
+         text = text//"&shape body='"//body//"' op='intersect' kind='halfspace' name='"//body//"_s"//axis(k)// &
+            & "' point=0,0,0 normal="//normal(k)//" /"//nl//"&bc on='"//body//"_s"//axis(k)//"' type='symmetry' /"//nl
+      end do
+   end function octant_planes
 
    !> ||sigma_ex - sigma_h||_E / ||sigma_ex||_E over both bodies of a level in
    !> scene units; body 1 is the inner shell of `exact`, body 2 the outer.
