@@ -11,9 +11,10 @@
 !> Here p_N is the slave body's FE traction sigma(u_s) n (a Nitsche-type
 !> method; the recovered traction is Tur's variant, not in this version).
 !>
-!> Discrete multiplier space: lambda constant on the part of the contact
-!> surface in each slave cell (P0 per slave cell, "contact cell" c with the
-!> slave points of that cell that have a master point, measure W_c). It is
+!> Discrete multiplier space: lambda constant on each contact cell c (P0): the
+!> slave points with a master point of one slave aggregate (cell aggregation's
+!> root), a sliver of surface joined to the nearest full cell (`group_cells`),
+!> measure W_c. It is
 !> eliminated cell by cell: stationarity in lambda_c gives
 !>   lambda_c = pbar + gamma gbar,
 !> with pbar, gbar the means over the cell's points of p_N and g, and the
@@ -25,9 +26,8 @@
 !> the stabilization's variance term. One constraint per cell and direction
 !> matches the displacement space: enforcing g = 0 at every quadrature point
 !> instead (multipliers eliminated point by point) over-constrains the
-!> interface, and the pressure oscillates between points and falsely opens
-!> points of a closed interface (shrink fit, Q1: 35 of 57 points open at
-!> level 3, pressure error 150 %; more so as kappa grows). On open cells
+!> interface: the pressure oscillates between points and falsely opens
+!> points of a closed interface, the more so the larger kappa. On open cells
 !> lambda = 0 and nothing is added. The pressure reported per point (`p_fe`)
 !> is that of its cell, p = -n_i.lambda_c (0 open); `ts_fe` the magnitude of
 !> the tangential part of lambda_c (0 frictionless).
@@ -39,12 +39,10 @@
 !> Dirichlet Nitsche terms, sprc_fem_problem: about (p+1)^2 times a geometric
 !> factor, cell aggregation keeping it independent of the cut; dmax = 1.35 E
 !> for nu = 0.3 in plane strain), with a margin for the variance term (at
-!> most C_I/kappa times the energy). Measured (shrink fit Q1 level 7 and Q2
-!> level 6, Hertz Q1 at h = a/12.8): from kappa = 100 to 1e6 err_fe moves by
-!> less than 1e-4 relative, p_max by 0.3 %; at kappa = 10 err_fe moves by 2 %
-!> (Q1) and 11 % (Q2), at kappa = 1 the active set cycles (coercivity lost).
-!> The default `default_kappa` = 1000 (sprc_study_spec) sits a decade inside
-!> that plateau.
+!> most C_I/kappa times the energy). A sweep (shrink fit, Hertz; figures in
+!> the commit that set the default) found err_fe and p_max flat from kappa =
+!> 100 to 1e6 and moving below it, where coercivity is lost; the default
+!> `default_kappa` = 1000 (sprc_study_spec) sits a decade inside that plateau.
 !>
 !> Points. The slave surface's cut-cell quadrature points with their exact
 !> normals and initial gaps (sprc_contact_surface), cut at the master grid's
@@ -353,8 +351,7 @@ contains
    !> (the surface clips a corner of a cell that aggregation keeps, as its
    !> volume is not small) joins the group of at least that measure whose
    !> centroid is nearest: a multiplier on a sliver is barely constrained by
-   !> the displacements (measured, compound sphere Q1 level 5 without this:
-   !> 162 of the points of a closed interface open, p_max 19.6 p_c).
+   !> the displacements, and its pressure is noise that can open it falsely.
    subroutine group_cells(surface, slave, ops)
       type(contact_surface_type), intent(in) :: surface
       type(elasticity_problem_type), intent(in) :: slave
