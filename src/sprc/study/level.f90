@@ -231,7 +231,8 @@ contains
          result%row%has_contact = .true.
          result%row%contact_iterations = sum(result%contacts%iterations)
          result%row%t_contact = t_contact
-         ! TODO(lead): call fill_contact_row(result%contacts, result%row) (sprc_study_contact_row, contact-out)
+         ! TODO(lead): fill_contact_exact(study%scene, result%contacts, error), then
+         ! fill_contact_row(result%contacts, result%row) (sprc_study_contact_row, branch contact-out)
       end if
       result%row%t_total = wall_time() - t_start
       call check_row(result%row, study%have_exact, result%done, error)
