@@ -43,6 +43,7 @@ module sprc_study_level
       & analysis_units, in_units
    use sprc_study_budget, only: check_level_memory
    use sprc_study_row, only: report_row_type
+   use sprc_study_contact_row, only: fill_contact_exact, fill_contact_row
    use sprc_contact_result, only: contact_result_type, new_contact_result, contact_open, contact_stick, &
       & contact_slip
    use sprc_contact_surface, only: contact_surface_type, slave_surface_points, initial_gaps
@@ -236,8 +237,9 @@ contains
          result%row%has_contact = .true.
          result%row%contact_iterations = sum(result%contacts%iterations)
          result%row%t_contact = t_contact
-         ! TODO(lead): fill_contact_exact(study%scene, result%contacts, error), then
-         ! fill_contact_row(result%contacts, result%row) (sprc_study_contact_row, branch contact-out)
+         call fill_contact_exact(study%scene, result%contacts, error)
+         if (allocated(error)) return
+         call fill_contact_row(result%contacts, result%row)
       end if
       result%row%t_total = wall_time() - t_start
       call check_row(result%row, study%have_exact, result%done, error)
