@@ -43,6 +43,7 @@ module sprc_study_level
       & analysis_units, in_units
    use sprc_study_budget, only: check_level_memory
    use sprc_study_row, only: report_row_type
+   use sprc_core_boundary, only: bc_none
    use sprc_study_contact_row, only: fill_contact_exact, fill_contact_row
    use sprc_contact_result, only: contact_result_type, new_contact_result, contact_open, contact_stick, &
       & contact_slip
@@ -288,14 +289,16 @@ contains
       end if
       call bl%problem%solve(error)
       if (allocated(error)) return
-      call finish_body(study, sb, bl, error)
+      call finish_body(study, sb, bl, 0, error)
    end subroutine run_body
 
    !> After the FE solve: the exact error, the recoveries and estimates.
-   subroutine finish_body(study, sb, bl, error)
+   !> `b` is the body's scene index when it is in contact (else 0).
+   subroutine finish_body(study, sb, bl, b, error)
       type(study_type), intent(in) :: study
       type(study_body_type), intent(in) :: sb
       type(body_level_type), intent(inout) :: bl
+      integer, intent(in) :: b
       type(error_type), allocatable, intent(out) :: error
       type(recovery_input_type) :: input
       real(wp) :: err_fe, norm_fe
@@ -308,12 +311,31 @@ contains
       if (.not. any(study%run)) return
       call fe_recovery_input(bl%problem, input, error)
       if (allocated(error)) return
+      if (b > 0) call free_contact_surfaces(study, b, input)
       do m = 1, 2
          if (.not. study%run(m)) cycle
          call recover_and_estimate(sb, input, bl, m, study%degree(m), error)
          if (allocated(error)) return
       end do
    end subroutine finish_body
+
+   !> SPR-C imposes nothing on body b's contact surfaces: they carry the
+   !> contact traction, not the zero traction of a free surface (the default
+   !> of a surface without `&bc`). Contact constraints in the patches (seed
+   !> eqs. 103-138) are not in this version.
+   subroutine free_contact_surfaces(study, b, input)
+      type(study_type), intent(in) :: study
+      integer, intent(in) :: b
+      type(recovery_input_type), intent(inout) :: input
+      integer :: k
+
+      do k = 1, size(study%scene%contacts)
+         associate (c => study%scene%contacts(k), shapes => study%scene%shapes)
+            if (c%slave_index == b) input%bc_kind(shapes(c%slave_surface_index)%body_shape) = bc_none
+            if (c%master_index == b) input%bc_kind(shapes(c%master_surface_index)%body_shape) = bc_none
+         end associate
+      end do
+   end subroutine free_contact_surfaces
 
    !> Whether body b belongs to a `&contact` pair.
    pure logical function in_contact(study, b)
@@ -387,7 +409,7 @@ contains
       end do
       do b = 1, 2
          k = merge(s, m, b == 1)
-         call finish_body(study, study%bodies(k), bodies(k), error)
+         call finish_body(study, study%bodies(k), bodies(k), k, error)
          if (allocated(error)) then
             error%message = 'body '''//study%bodies(k)%name//''': '//error%message
             return
