@@ -10,7 +10,7 @@
 module sprc_test_sparse
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_positive_inf
    use sprc_core_kinds, only: wp, i8
-   use sprc_core_error, only: stat_invalid_input, stat_singular, stat_not_positive_definite
+   use sprc_core_error, only: stat_invalid_input, stat_singular, stat_not_positive_definite, stat_out_of_memory
    use sprc_core_lapack, only: dgesv, dgetrf, dgecon, dlange
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type
    use sprc_fem_sparse, only: coo_type, csr_type
@@ -35,6 +35,7 @@ contains
          new_unittest('coo_blocks', test_coo_blocks), &
          new_unittest('coo_rejects', test_coo_rejects), &
          new_unittest('coo_zero_size', test_coo_zero_size), &
+         new_unittest('coo_out_of_memory', test_coo_out_of_memory), &
          new_unittest('csr_matvec_norm', test_csr_matvec_norm), &
          new_unittest('csr_invalid', test_csr_invalid), &
          new_unittest('elasticity_rigid_modes', test_elasticity_rigid_modes), &
@@ -63,6 +64,29 @@ contains
    end subroutine collect_sparse
 
    ! ------------------------------------------------------------------ COO / CSR
+
+   !> A capacity no machine has (2**60 triplets, 18 EB) is an out-of-memory error that
+   !> names the routine, the array and its size, not a crash; the list stays usable.
+   subroutine test_coo_out_of_memory(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(error_type), allocatable :: e
+      type(coo_type) :: coo
+      type(csr_type) :: a
+
+      call coo%init(3, 3, e, capacity=2_i8**60)
+      call check(error, allocated(e), 'an absurd capacity fails')
+      if (allocated(error)) return
+      call check(error, e%stat, stat_out_of_memory, 'status')
+      if (allocated(error)) return
+      call check(error, e%message, 'coo_type%reserve: out of memory: cannot allocate the triplet list '// &
+         & '(1152921504606846976 entries of 16 bytes, 1.8E+10 GB)')
+      if (allocated(error)) return
+      call add(coo, 2, 3, 1.5_wp, error)
+      if (allocated(error)) return
+      call coo%to_csr(a, error)
+      if (allocated(error)) return
+      call check(error, a%nnz() == 1_i8 .and. a%val(1) == 1.5_wp, 'the list still works after the failure')
+   end subroutine test_coo_out_of_memory
 
    !> Unsorted input with duplicates and an empty row, checked entry by entry.
    subroutine test_coo_duplicates_sorted(error)

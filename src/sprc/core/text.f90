@@ -6,7 +6,7 @@ module sprc_core_text
    implicit none
    private
 
-   public :: fixed_text, itoa, rtoa, real_text
+   public :: fixed_text, itoa, rtoa, real_text, byte_text
 
    !> An integer in its shortest decimal form (`i0`); with `digits`, padded
    !> with leading zeros to at least that many digits (`itoa(4, 2)` = '04',
@@ -35,6 +35,23 @@ contains
          if (text(1:2) == '-.') text = '-0'//text(2:)
       end if
    end function fixed_text
+
+   !> A byte count for people, in decimal units: '850 kB', '171 MB', '6.9 GB'.
+   pure function byte_text(bytes) result(text)
+      real(wp), intent(in) :: bytes
+      character(len=:), allocatable :: text
+      character(len=24) :: buf
+      if (bytes < 1.0e6_wp) then
+         write (buf, '(i0," kB")') nint(bytes/1.0e3_wp)
+      else if (bytes < 1.0e9_wp) then
+         write (buf, '(i0," MB")') nint(bytes/1.0e6_wp)
+      else if (bytes < 1.0e6_wp*huge(1)) then
+         write (buf, '(f0.1," GB")') bytes/1.0e9_wp
+      else
+         write (buf, '(es8.1," GB")') bytes/1.0e9_wp
+      end if
+      text = trim(adjustl(buf))
+   end function byte_text
 
    pure function itoa_i4(i, digits) result(s)
       integer(i4), intent(in) :: i

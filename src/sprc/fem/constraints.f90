@@ -25,6 +25,7 @@
 module sprc_fem_constraints
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_internal
+   use sprc_core_alloc, only: check_allocation
    use sprc_grid_tree, only: grid_type
    use sprc_grid_nodes, only: grid_nodes_type, element_shape
    use sprc_grid_hanging, only: hanging_type
@@ -72,8 +73,9 @@ contains
       logical, allocatable :: supported(:)
       integer, allocatable :: master_of(:), a_ptr(:), a_col(:), marker(:), row_col(:)
       real(wp), allocatable :: a_val(:), acc(:)
-      integer :: d, e, j, k, i, m, c, nfree, p, q, nrow, r, na, nt
+      integer :: d, e, j, k, i, m, c, nfree, p, q, nrow, r, na, nt, stat
       real(wp) :: lo(3), hi(3), xi(3), shape(27)
+      character(len=*), parameter :: who = 'constraints'
 
       d = nodes%dim
       if (size(root) /= nodes%n_elements .or. hanging%n_all /= nodes%n_nodes) then
@@ -85,7 +87,9 @@ contains
       nfree = hanging%n_free
 
       ! Free nodes used by a well-posed cell.
-      allocate (supported(nfree))
+      allocate (supported(nfree), master_of(nfree), stat=stat)
+      call check_allocation(stat, who, 'the master flags of the free nodes', nfree, 8, error)
+      if (allocated(error)) return
       supported = .false.
       do e = 1, nodes%n_elements
          if (root(e) /= e) cycle
@@ -94,7 +98,6 @@ contains
             supported(hanging%t_col(hanging%t_ptr(i):hanging%t_ptr(i + 1) - 1)) = .true.
          end do
       end do
-      allocate (master_of(nfree))
       m = 0
       do k = 1, nfree
          master_of(k) = 0
@@ -103,14 +106,18 @@ contains
          master_of(k) = m
       end do
       self%n_masters = m
-      allocate (self%master_node(m))
+      allocate (self%master_node(m), stat=stat)
+      call check_allocation(stat, who, 'the master nodes', m, 4, error)
+      if (allocated(error)) return
       do k = 1, nfree
          if (master_of(k) > 0) self%master_node(master_of(k)) = hanging%free_node(k)
       end do
       self%n_outlaw = nfree - m
 
       ! Outlaw rows A(k, :) over masters: the root polynomial at the outlaw's position.
-      allocate (a_ptr(nfree + 1), marker(m), acc(m), row_col(m))
+      allocate (a_ptr(nfree + 1), marker(m), acc(m), row_col(m), stat=stat)
+      call check_allocation(stat, who, 'the outlaw rows', m, 20, error)
+      if (allocated(error)) return
       marker = 0
       allocate (a_col(16), a_val(16))
       na = 0
@@ -138,13 +145,18 @@ contains
             end do
          end if
          call flush_row(a_col, a_val, na)
+         if (allocated(error)) return
          a_ptr(k + 1) = na + 1
       end do
 
       ! Node rows: hanging rows with outlaws replaced by their A rows.
       nt = 0
-      allocate (self%t_ptr(self%n_nodes + 1), self%t_col(size(hanging%t_col) + 16), &
-         & self%t_val(size(hanging%t_col) + 16))
+      allocate (self%t_ptr(self%n_nodes + 1), stat=stat)
+      call check_allocation(stat, who, 'the row pointers of T', self%n_nodes + 1, 4, error)
+      if (allocated(error)) return
+      allocate (self%t_col(size(hanging%t_col) + 16), self%t_val(size(hanging%t_col) + 16), stat=stat)
+      call check_allocation(stat, who, 'the entries of T', size(hanging%t_col) + 16, 12, error)
+      if (allocated(error)) return
       self%t_ptr(1) = 1
       do i = 1, self%n_nodes
          nrow = 0
@@ -159,13 +171,16 @@ contains
             end if
          end do
          call flush_row(self%t_col, self%t_val, nt)
+         if (allocated(error)) return
          self%t_ptr(i + 1) = nt + 1
       end do
-      self%t_col = self%t_col(1:nt)
-      self%t_val = self%t_val(1:nt)
+      call resize(self%t_col, self%t_val, nt, error)
+      if (allocated(error)) return
 
       ! Strong zero components and the reduced dof numbers.
-      allocate (self%zero(d, self%n_nodes), self%dof(d, m))
+      allocate (self%zero(d, self%n_nodes), self%dof(d, m), stat=stat)
+      call check_allocation(stat, who, 'the dof numbers', self%n_nodes, 8*d, error)
+      if (allocated(error)) return
       self%zero = .false.
       do k = 1, size(plane_axis)
          do i = 1, self%n_nodes
@@ -220,8 +235,8 @@ contains
             marker(row_col(a)) = 0
          end do
          if (count + nrow > size(cols)) then
-            cols = [cols, spread(0, 1, max(count + nrow, 2*size(cols)) - size(cols))]
-            vals = [vals, spread(0.0_wp, 1, size(cols) - size(vals))]
+            call resize(cols, vals, max(count + nrow, 2*size(cols)), error)
+            if (allocated(error)) return
          end if
          do a = 1, nrow
             if (acc(a) == 0.0_wp) cycle
@@ -233,6 +248,26 @@ contains
       end subroutine flush_row
 
    end subroutine constraints_build
+
+   !> Resize the entries (cols, vals) of T to `n`, keeping the first min(n, size) of them.
+   subroutine resize(cols, vals, n, error)
+      integer, allocatable, intent(inout) :: cols(:)
+      real(wp), allocatable, intent(inout) :: vals(:)
+      integer, intent(in) :: n
+      type(error_type), allocatable, intent(out) :: error
+      integer, allocatable :: c(:)
+      real(wp), allocatable :: v(:)
+      integer :: keep, stat
+
+      allocate (c(n), v(n), stat=stat)
+      call check_allocation(stat, 'constraints', 'the entries of T', n, 12, error)
+      if (allocated(error)) return
+      keep = min(n, size(cols))
+      c(1:keep) = cols(1:keep)
+      v(1:keep) = vals(1:keep)
+      call move_alloc(c, cols)
+      call move_alloc(v, vals)
+   end subroutine resize
 
    !> Reduced dofs dofs(1:m) (ascending) of an element with nodes `conn` and the
    !> block tmat(1:dim*size(conn), 1:m) with u_e = tmat ubar(dofs). `dofs` and

@@ -10,7 +10,8 @@
 module sprc_fem_sparse
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use sprc_core_kinds, only: wp, i8
-   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_out_of_memory
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
+   use sprc_core_alloc, only: check_allocation
    implicit none
    private
 
@@ -89,10 +90,8 @@ contains
       end if
       if (capacity <= 0) return
       allocate (irow(capacity), icol(capacity), v(capacity), stat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, 'coo_type%reserve: cannot allocate the triplet list', stat_out_of_memory)
-         return
-      end if
+      call check_allocation(stat, 'coo_type%reserve', 'the triplet list', capacity, 16, error)
+      if (allocated(error)) return
       if (self%nnz > 0) then
          irow(1:self%nnz) = self%row(1:self%nnz)
          icol(1:self%nnz) = self%col(1:self%nnz)
@@ -245,12 +244,12 @@ contains
 
       a%nrows = self%nrows
       a%ncols = self%ncols
-      allocate (a%rowptr(self%nrows + 1), next(self%nrows + 1), marker(self%ncols), &
-         tcol(self%nnz), tval(self%nnz), stat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, 'coo_type%to_csr: cannot allocate work arrays', stat_out_of_memory)
-         return
-      end if
+      allocate (a%rowptr(self%nrows + 1), next(self%nrows + 1), marker(self%ncols), stat=stat)
+      call check_allocation(stat, 'coo_type%to_csr', 'the row pointers', max(self%nrows + 1, self%ncols), 24, error)
+      if (allocated(error)) return
+      allocate (tcol(self%nnz), tval(self%nnz), stat=stat)
+      call check_allocation(stat, 'coo_type%to_csr', 'the sorted triplets', self%nnz, 12, error)
+      if (allocated(error)) return
 
       ! Stable counting sort by row: within a row, triplets keep insertion order.
       next = 0
@@ -261,7 +260,7 @@ contains
       do i = 1, self%nrows
          next(i + 1) = next(i + 1) + next(i)
       end do
-      a%rowptr = next
+      a%rowptr(:) = next
       do k = 1, self%nnz
          i = self%row(k)
          tcol(next(i)) = self%col(k)
@@ -294,12 +293,10 @@ contains
       deallocate (next, marker)
 
       allocate (a%col(nnz), a%val(nnz), stat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, 'coo_type%to_csr: cannot allocate the CSR matrix', stat_out_of_memory)
-         return
-      end if
-      a%col = tcol(1:nnz)
-      a%val = tval(1:nnz)
+      call check_allocation(stat, 'coo_type%to_csr', 'the CSR matrix', nnz, 12, error)
+      if (allocated(error)) return
+      a%col(:) = tcol(1:nnz)
+      a%val(:) = tval(1:nnz)
    end subroutine coo_to_csr
 
    !> Sort distinct columns ascending, carrying the values: insertion sort for
@@ -408,13 +405,24 @@ contains
    end subroutine csr_matvec
 
    !> Matrix 1-norm: the largest column sum of magnitudes (0 for an empty matrix).
-   function csr_norm1(self) result(norm)
+   !> With `error`, a failed allocation of the column sums returns it (norm 0);
+   !> without, it stops the program as before.
+   function csr_norm1(self, error) result(norm)
       class(csr_type), intent(in) :: self
+      type(error_type), allocatable, intent(out), optional :: error
       real(wp) :: norm
       real(wp), allocatable :: colsum(:)
       integer(i8) :: k
+      integer :: stat
 
-      allocate (colsum(self%ncols))
+      norm = 0.0_wp
+      if (present(error)) then
+         allocate (colsum(self%ncols), stat=stat)
+         call check_allocation(stat, 'csr_type%norm1', 'the column sums', self%ncols, 8, error)
+         if (allocated(error)) return
+      else
+         allocate (colsum(self%ncols))
+      end if
       colsum = 0.0_wp
       do k = 1, self%nnz()
          colsum(self%col(k)) = colsum(self%col(k)) + abs(self%val(k))

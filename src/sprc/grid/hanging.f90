@@ -18,6 +18,7 @@
 module sprc_grid_hanging
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_internal
+   use sprc_core_alloc, only: check_allocation
    use sprc_grid_tree, only: grid_type, grid_max_level
    use sprc_grid_nodes, only: grid_nodes_type, element_node_index, element_shape
    implicit none
@@ -50,6 +51,9 @@ module sprc_grid_hanging
       real(wp), allocatable :: val(:)
    end type rows_type
 
+   !> The routine named in messages.
+   character(len=*), parameter :: who = 'hanging nodes'
+
 contains
 
    !> Find the hanging nodes of `nodes` on `grid` and build T.
@@ -60,7 +64,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       logical, allocatable :: hanging(:)
       type(rows_type) :: rows
-      integer :: i, round
+      integer :: i, round, stat
 
       if (nodes%n_elements /= grid%n_leaves .or. nodes%dim /= grid%dim .or. &
          & nodes%lattice_level /= grid%max_level + 1) then
@@ -73,7 +77,9 @@ contains
 
       self%n_hanging = count(hanging)
       self%n_free = self%n_all - self%n_hanging
-      allocate (self%free_index(self%n_all), self%free_node(self%n_free))
+      allocate (self%free_index(self%n_all), self%free_node(self%n_free), stat=stat)
+      call check_allocation(stat, who, 'the free-node numbering', self%n_all, 8, error)
+      if (allocated(error)) return
       self%n_free = 0
       do i = 1, self%n_all
          self%free_index(i) = 0
@@ -84,19 +90,38 @@ contains
       end do
 
       do round = 1, grid_max_level + 1
-         if (.not. any(hanging(rows%col))) exit
+         if (.not. any_hanging(rows, hanging)) exit
          self%chain_rounds = round
-         call substitute(rows, hanging)
+         call substitute(rows, hanging, error)
+         if (allocated(error)) return
       end do
-      if (any(hanging(rows%col))) then
+      if (any_hanging(rows, hanging)) then
          call fatal_error(error, 'hanging nodes: constraint chains did not resolve', stat_internal)
          return
       end if
       call move_alloc(rows%ptr, self%t_ptr)
       call move_alloc(rows%val, self%t_val)
-      allocate (self%t_col(size(rows%col)))
-      self%t_col = self%free_index(rows%col)
+      allocate (self%t_col(size(rows%col)), stat=stat)
+      call check_allocation(stat, who, 'the columns of T', size(rows%col), 4, error)
+      if (allocated(error)) return
+      do i = 1, size(rows%col)
+         self%t_col(i) = self%free_index(rows%col(i))
+      end do
    end subroutine hanging_build
+
+   !> Does a row of `rows` name a hanging node (a chain still to substitute)?
+   pure logical function any_hanging(rows, hanging)
+      type(rows_type), intent(in) :: rows
+      logical, intent(in) :: hanging(:)
+      integer :: k
+      any_hanging = .false.
+      do k = 1, size(rows%col)
+         if (hanging(rows%col(k))) then
+            any_hanging = .true.
+            return
+         end if
+      end do
+   end function any_hanging
 
    !> u = T ubar (ubar: n_free values; u: n_all values).
    pure subroutine hanging_expand(self, ubar, u)
@@ -123,14 +148,17 @@ contains
       integer, allocatable :: idx(:, :), owner(:), side_nodes(:, :), n_side(:)
       real(wp), allocatable :: shape(:)
       integer :: d, p, nen, e, c, k, j, m, n, first, last, dir(3, 26), ndir, r(3), sc, pos
-      integer :: coarse(0:26), parent(grid%dim), dir_p(3), slot
+      integer :: coarse(0:26), parent(grid%dim), dir_p(3), slot, stat
 
       d = grid%dim
       p = nodes%degree
       nen = nodes%nodes_per_element
       allocate (idx, source=element_node_index(d, p))
       call side_tables(d, p, idx, dir, ndir, side_nodes, n_side)
-      allocate (shape(nen), hanging(nodes%n_nodes), owner(nodes%n_nodes))
+      allocate (shape(nen))
+      allocate (hanging(nodes%n_nodes), owner(nodes%n_nodes), stat=stat)
+      call check_allocation(stat, who, 'the hanging flags', nodes%n_nodes, 8, error)
+      if (allocated(error)) return
       hanging = .false.
       owner = 0
       r = 0
@@ -174,7 +202,9 @@ contains
 
       ! Second pass: the rows. A master whose shape function vanishes on the hanging
       ! node's face or edge is left out (decided on the integer lattice).
-      allocate (rows%ptr(nodes%n_nodes + 1))
+      allocate (rows%ptr(nodes%n_nodes + 1), stat=stat)
+      call check_allocation(stat, who, 'the row pointers of T', nodes%n_nodes + 1, 4, error)
+      if (allocated(error)) return
       rows%ptr(1) = 1
       do n = 1, nodes%n_nodes
          pos = 1
@@ -187,7 +217,9 @@ contains
          end if
          rows%ptr(n + 1) = rows%ptr(n) + pos
       end do
-      allocate (rows%col(rows%ptr(nodes%n_nodes + 1) - 1), rows%val(rows%ptr(nodes%n_nodes + 1) - 1))
+      allocate (rows%col(rows%ptr(nodes%n_nodes + 1) - 1), rows%val(rows%ptr(nodes%n_nodes + 1) - 1), stat=stat)
+      call check_allocation(stat, who, 'the entries of T', rows%ptr(nodes%n_nodes + 1) - 1, 12, error)
+      if (allocated(error)) return
       do n = 1, nodes%n_nodes
          pos = rows%ptr(n)
          if (.not. hanging(n)) then
@@ -205,7 +237,7 @@ contains
             pos = pos + 1
          end do
       end do
-      call compress(rows)
+      call compress(rows, error)
 
    contains
 
@@ -257,14 +289,17 @@ contains
    end subroutine side_tables
 
    !> Replace every hanging column by its own row (one round of chain substitution).
-   subroutine substitute(rows, hanging)
+   subroutine substitute(rows, hanging, error)
       type(rows_type), intent(inout) :: rows
       logical, intent(in) :: hanging(:)
+      type(error_type), allocatable, intent(out) :: error
       type(rows_type) :: new
-      integer :: n, i, k, m, pos, nrow
+      integer :: n, i, k, m, pos, nrow, stat
 
       nrow = size(rows%ptr) - 1
-      allocate (new%ptr(nrow + 1))
+      allocate (new%ptr(nrow + 1), stat=stat)
+      call check_allocation(stat, who, 'the row pointers of T', nrow + 1, 4, error)
+      if (allocated(error)) return
       new%ptr(1) = 1
       do n = 1, nrow
          pos = 0
@@ -278,7 +313,9 @@ contains
          end do
          new%ptr(n + 1) = new%ptr(n) + pos
       end do
-      allocate (new%col(new%ptr(nrow + 1) - 1), new%val(new%ptr(nrow + 1) - 1))
+      allocate (new%col(new%ptr(nrow + 1) - 1), new%val(new%ptr(nrow + 1) - 1), stat=stat)
+      call check_allocation(stat, who, 'the entries of T', new%ptr(nrow + 1) - 1, 12, error)
+      if (allocated(error)) return
       do n = 1, nrow
          pos = new%ptr(n)
          do k = rows%ptr(n), rows%ptr(n + 1) - 1
@@ -296,16 +333,20 @@ contains
             end if
          end do
       end do
-      call compress(new)
+      call compress(new, error)
+      if (allocated(error)) return
       call move_alloc(new%ptr, rows%ptr)
       call move_alloc(new%col, rows%col)
       call move_alloc(new%val, rows%val)
    end subroutine substitute
 
    !> Sort each row by column and sum duplicates, in place.
-   subroutine compress(rows)
+   subroutine compress(rows, error)
       type(rows_type), intent(inout) :: rows
-      integer :: n, k, i, pos, start, col_k
+      type(error_type), allocatable, intent(out) :: error
+      integer, allocatable :: col(:)
+      real(wp), allocatable :: val(:)
+      integer :: n, k, i, pos, start, col_k, stat
       real(wp) :: val_k
 
       pos = 1
@@ -335,8 +376,13 @@ contains
          rows%ptr(n) = start
       end do
       rows%ptr(size(rows%ptr)) = pos
-      rows%col = rows%col(1:pos - 1)
-      rows%val = rows%val(1:pos - 1)
+      allocate (col(pos - 1), val(pos - 1), stat=stat)
+      call check_allocation(stat, who, 'the entries of T', pos - 1, 12, error)
+      if (allocated(error)) return
+      col(:) = rows%col(1:pos - 1)
+      val(:) = rows%val(1:pos - 1)
+      call move_alloc(col, rows%col)
+      call move_alloc(val, rows%val)
    end subroutine compress
 
 end module sprc_grid_hanging

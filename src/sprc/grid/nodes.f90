@@ -20,6 +20,7 @@
 module sprc_grid_nodes
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
+   use sprc_core_alloc, only: check_allocation
    use sprc_grid_tree, only: grid_type
    implicit none
    private
@@ -28,6 +29,8 @@ module sprc_grid_nodes
 
    integer(i8), parameter :: hash_prime = 2147483647_i8
    integer(i8), parameter :: hash_mult = 1103515245_i8
+   !> The routine named in messages.
+   character(len=*), parameter :: who = 'grid nodes'
 
    !> Node numbering, coordinates, connectivity and node-to-element adjacency.
    type :: grid_nodes_type
@@ -123,8 +126,8 @@ contains
       type(grid_type), intent(in) :: grid
       integer, intent(in) :: degree
       type(error_type), allocatable, intent(out) :: error
-      integer, allocatable :: idx(:, :), table(:)
-      integer :: d, nen, e, j, size_e, step, g(3), node, cap, estimate
+      integer, allocatable :: idx(:, :), table(:), lattice(:, :)
+      integer :: d, nen, e, j, size_e, step, g(3), node, cap, estimate, stat
       real(wp) :: h
 
       if (degree /= 1 .and. degree /= 2) then
@@ -150,7 +153,15 @@ contains
       do while (cap < 2*estimate)
          cap = 2*cap
       end do
-      allocate (table(0:cap - 1), self%lattice(d, estimate), self%connectivity(nen, grid%n_leaves))
+      allocate (table(0:cap - 1), stat=stat)
+      call check_allocation(stat, who, 'the node hash table', cap, 4, error)
+      if (allocated(error)) return
+      allocate (self%lattice(d, estimate), stat=stat)
+      call check_allocation(stat, who, 'the node lattice points', estimate, 4*d, error)
+      if (allocated(error)) return
+      allocate (self%connectivity(nen, grid%n_leaves), stat=stat)
+      call check_allocation(stat, who, 'the element connectivity', grid%n_leaves, 4*nen, error)
+      if (allocated(error)) return
       table = 0
       g = 0
       do e = 1, grid%n_leaves
@@ -158,30 +169,39 @@ contains
          step = size_e/degree
          do j = 1, nen
             g(1:d) = grid%leaf_coord(:, e)*size_e + idx(:, j)*step
-            call find_or_add(self, table, g, node)
+            call find_or_add(self, table, g, node, error)
+            if (allocated(error)) return
             self%connectivity(j, e) = node
          end do
       end do
       deallocate (table)
-      self%lattice = self%lattice(:, 1:self%n_nodes)
+      allocate (lattice(d, self%n_nodes), stat=stat)
+      call check_allocation(stat, who, 'the node lattice points', self%n_nodes, 4*d, error)
+      if (allocated(error)) return
+      lattice(:, :) = self%lattice(:, 1:self%n_nodes)
+      call move_alloc(lattice, self%lattice)
 
       h = grid%box_size*2.0_wp**(-self%lattice_level)
-      allocate (self%x(d, self%n_nodes))
+      allocate (self%x(d, self%n_nodes), stat=stat)
+      call check_allocation(stat, who, 'the node coordinates', self%n_nodes, 8*d, error)
+      if (allocated(error)) return
       do j = 1, self%n_nodes
          self%x(:, j) = grid%box_min(1:d) + real(self%lattice(:, j), wp)*h
       end do
-      call node_elements(self)
+      call node_elements(self, error)
    end subroutine nodes_build
 
    !> Node at lattice point g, added if new. `table` holds node numbers (0: empty)
    !> and is kept at most half full.
-   subroutine find_or_add(self, table, g, node)
+   subroutine find_or_add(self, table, g, node, error)
       type(grid_nodes_type), intent(inout) :: self
       integer, allocatable, intent(inout) :: table(:)
       integer, intent(in) :: g(3)
       integer, intent(out) :: node
+      type(error_type), allocatable, intent(out) :: error
       integer(i8) :: s, mask
       integer, allocatable :: tmp(:, :)
+      integer :: stat
 
       mask = int(size(table), i8) - 1_i8
       s = lattice_slot(g, mask)
@@ -195,23 +215,29 @@ contains
       self%n_nodes = self%n_nodes + 1
       node = self%n_nodes
       if (node > size(self%lattice, 2)) then
-         allocate (tmp(self%dim, 2*size(self%lattice, 2)))
+         allocate (tmp(self%dim, 2*size(self%lattice, 2)), stat=stat)
+         call check_allocation(stat, who, 'the node lattice points', 2*size(self%lattice, 2), &
+            & 4*self%dim, error)
+         if (allocated(error)) return
          tmp(:, 1:node - 1) = self%lattice(:, 1:node - 1)
          call move_alloc(tmp, self%lattice)
       end if
       self%lattice(:, node) = g(1:self%dim)
       table(s) = node
-      if (2*self%n_nodes > size(table)) call rehash(self, table)
+      if (2*self%n_nodes > size(table)) call rehash(self, table, error)
    end subroutine find_or_add
 
-   subroutine rehash(self, table)
+   subroutine rehash(self, table, error)
       type(grid_nodes_type), intent(in) :: self
       integer, allocatable, intent(inout) :: table(:)
+      type(error_type), allocatable, intent(out) :: error
       integer(i8) :: s, mask
-      integer :: i, g(3), size_old
+      integer :: i, g(3), size_old, stat
       size_old = size(table)
       deallocate (table)
-      allocate (table(0:2*size_old - 1))
+      allocate (table(0:2*size_old - 1), stat=stat)
+      call check_allocation(stat, who, 'the node hash table', 2*size_old, 4, error)
+      if (allocated(error)) return
       table = 0
       mask = int(size(table), i8) - 1_i8
       g = 0
@@ -237,12 +263,15 @@ contains
    end function lattice_slot
 
    !> Node -> elements adjacency (CSR), elements ascending.
-   subroutine node_elements(self)
+   subroutine node_elements(self, error)
       type(grid_nodes_type), intent(inout) :: self
+      type(error_type), allocatable, intent(out) :: error
       integer, allocatable :: fill(:)
-      integer :: e, j, n
+      integer :: e, j, n, stat
 
-      allocate (self%node_element_ptr(self%n_nodes + 1), fill(self%n_nodes))
+      allocate (self%node_element_ptr(self%n_nodes + 1), fill(self%n_nodes), stat=stat)
+      call check_allocation(stat, who, 'the node-to-element pointers', self%n_nodes, 8, error)
+      if (allocated(error)) return
       self%node_element_ptr = 0
       do e = 1, self%n_elements
          do j = 1, self%nodes_per_element
@@ -254,8 +283,11 @@ contains
       do n = 1, self%n_nodes
          self%node_element_ptr(n + 1) = self%node_element_ptr(n + 1) + self%node_element_ptr(n)
       end do
-      allocate (self%node_element(self%node_element_ptr(self%n_nodes + 1) - 1))
-      fill = self%node_element_ptr(1:self%n_nodes)
+      allocate (self%node_element(self%node_element_ptr(self%n_nodes + 1) - 1), stat=stat)
+      call check_allocation(stat, who, 'the node-to-element lists', self%node_element_ptr(self%n_nodes + 1) - 1, &
+         & 4, error)
+      if (allocated(error)) return
+      fill(:) = self%node_element_ptr(1:self%n_nodes)
       do e = 1, self%n_elements
          do j = 1, self%nodes_per_element
             n = self%connectivity(j, e)

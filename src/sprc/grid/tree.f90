@@ -22,6 +22,7 @@
 module sprc_grid_tree
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
+   use sprc_core_alloc, only: check_allocation
    use sprc_geometry_region, only: region_type, cell_outside, cell_inside, cell_cut
    use sprc_grid_morton, only: morton_encode
    implicit none
@@ -84,6 +85,8 @@ module sprc_grid_tree
       integer, allocatable :: hval(:)
       integer :: hcount = 0
       integer(i8) :: n_outside(0:grid_max_level) = 0_i8
+      !> Set when an array could not grow: the build stops and returns it.
+      type(error_type), allocatable :: error
    end type builder_type
 
 contains
@@ -114,7 +117,11 @@ contains
       root = 0
       root_class = classify(b, region, 0, root)
       call descend(b, region, 0, root, root_class)
-      call balance(b, region)
+      if (.not. allocated(b%error)) call balance(b, region)
+      if (allocated(b%error)) then
+         call move_alloc(b%error, error)
+         return
+      end if
       if (b%bad_class) then
          call fatal_error(error, 'grid build: the region returned a class other than cell_outside, '// &
             & 'cell_inside or cell_cut', stat_invalid_input)
@@ -128,7 +135,7 @@ contains
       self%refine_boundary = refine_boundary
       self%n_outside = b%n_outside
       self%n_balance_splits = b%n_splits
-      call finalize(self, b)
+      call finalize(self, b, error)
    end subroutine grid_build
 
    subroutine check_input(dim, box_min, box_size, level, refine_boundary, error)
@@ -327,6 +334,7 @@ contains
       integer, intent(in) :: level, coord(3), cls
       integer :: k, child(3), child_class
 
+      if (allocated(b%error)) return
       if (cls == cell_outside) then
          call add_outside(b, level)
       else if (level < b%level .or. (cls == cell_cut .and. level < b%top)) then
@@ -359,6 +367,7 @@ contains
       type(builder_type), intent(inout) :: b
       integer, intent(in) :: level, coord(3), cls
       if (b%n == size(b%lev)) call grow_leaves(b)
+      if (allocated(b%error)) return
       b%n = b%n + 1
       b%lev(b%n) = level
       b%crd(:, b%n) = coord
@@ -371,9 +380,11 @@ contains
       type(builder_type), intent(inout) :: b
       integer, allocatable :: ilev(:), icrd(:, :), icls(:)
       logical, allocatable :: ialive(:)
-      integer :: cap
+      integer :: cap, stat
       cap = 2*size(b%lev)
-      allocate (ilev(cap), icrd(3, cap), icls(cap), ialive(cap))
+      allocate (ilev(cap), icrd(3, cap), icls(cap), ialive(cap), stat=stat)
+      call check_allocation(stat, 'grid build', 'the leaf arrays', cap, 6*storage_size(cap)/8, b%error)
+      if (allocated(b%error)) return
       ilev(1:b%n) = b%lev(1:b%n)
       icrd(:, 1:b%n) = b%crd(:, 1:b%n)
       icls(1:b%n) = b%cls(1:b%n)
@@ -426,6 +437,7 @@ contains
          n0 = b%n
          last_parent = -1_i8
          do i = 1, n0
+            if (allocated(b%error)) return
             if (.not. b%alive(i) .or. b%lev(i) /= l) cycle
             parent = b%crd(:, i)/2
             pkey = cell_key(b%dim, l - 1, parent)
@@ -467,17 +479,20 @@ contains
    end subroutine ensure_cell
 
    !> Move the live leaves into `grid`, sorted by Morton key, and count them per level.
-   subroutine finalize(grid, b)
+   subroutine finalize(grid, b, error)
       type(grid_type), intent(inout) :: grid
       type(builder_type), intent(inout) :: b
+      type(error_type), allocatable, intent(out) :: error
       integer(i8), allocatable :: keys(:)
       integer, allocatable :: idx(:), perm(:)
-      integer :: n, i, j, d
+      integer :: n, i, j, d, stat
 
       deallocate (b%hkey, b%hval)
       d = b%dim
       n = count(b%alive(1:b%n))
-      allocate (keys(n), idx(n))
+      allocate (keys(n), idx(n), stat=stat)
+      call check_allocation(stat, 'grid build', 'the sort keys of the leaves', n, 12, error)
+      if (allocated(error)) return
       j = 0
       do i = 1, b%n
          if (.not. b%alive(i)) cycle
@@ -485,9 +500,12 @@ contains
          idx(j) = i
          keys(j) = morton_encode(ishft(b%crd(1:d, i), grid_max_level - b%lev(i)))
       end do
-      call radix_sort(keys, perm)
+      call radix_sort(keys, perm, error)
+      if (allocated(error)) return
+      allocate (grid%leaf_level(n), grid%leaf_coord(d, n), grid%leaf_class(n), grid%leaf_key(n), stat=stat)
+      call check_allocation(stat, 'grid build', 'the leaves of the grid', n, 4*(d + 2) + 8, error)
+      if (allocated(error)) return
       grid%n_leaves = n
-      allocate (grid%leaf_level(n), grid%leaf_coord(d, n), grid%leaf_class(n), grid%leaf_key(n))
       grid%max_level = b%level
       do j = 1, n
          i = idx(perm(j))
@@ -505,16 +523,21 @@ contains
    end subroutine finalize
 
    !> Ascending permutation of non-negative keys: LSD radix sort, 16-bit digits.
-   subroutine radix_sort(keys, perm)
+   subroutine radix_sort(keys, perm, error)
       integer(i8), intent(in) :: keys(:)
       integer, allocatable, intent(out) :: perm(:)
+      type(error_type), allocatable, intent(out) :: error
       integer, allocatable :: tmp(:), cnt(:)
-      integer :: n, i, pass, digit, npass
+      integer :: n, i, pass, digit, npass, stat
       integer(i8) :: kmax
 
       n = size(keys)
-      allocate (perm(n), tmp(n), cnt(0:65536))
-      perm = [(i, i=1, n)]
+      allocate (perm(n), tmp(n), cnt(0:65536), stat=stat)
+      call check_allocation(stat, 'grid build', 'the sort permutation of the leaves', n, 8, error)
+      if (allocated(error)) return
+      do i = 1, n
+         perm(i) = i
+      end do
       kmax = 0_i8
       if (n > 0) kmax = maxval(keys)
       npass = 0
@@ -536,7 +559,7 @@ contains
             cnt(digit) = cnt(digit) + 1
             tmp(cnt(digit)) = perm(i)
          end do
-         perm = tmp
+         perm(1:n) = tmp(1:n)
       end do
    end subroutine radix_sort
 
@@ -576,6 +599,7 @@ contains
       integer, intent(in) :: val
       integer(i8) :: s, mask
       if (2*(b%hcount + 1) > size(b%hkey)) call hash_grow(b)
+      if (allocated(b%error)) return
       mask = int(size(b%hkey), i8) - 1_i8
       s = hash_slot(key, mask)
       do while (b%hkey(s) /= 0_i8)
@@ -595,9 +619,16 @@ contains
       integer(i8), allocatable :: okey(:)
       integer, allocatable :: oval(:)
       integer(i8) :: i, s, mask
+      integer :: stat
       call move_alloc(b%hkey, okey)
       call move_alloc(b%hval, oval)
-      allocate (b%hkey(0:2*size(okey) - 1), b%hval(0:2*size(okey) - 1))
+      allocate (b%hkey(0:2*size(okey) - 1), b%hval(0:2*size(okey) - 1), stat=stat)
+      call check_allocation(stat, 'grid build', 'the cell hash table', 2*size(okey), 12, b%error)
+      if (allocated(b%error)) then
+         call move_alloc(okey, b%hkey)
+         call move_alloc(oval, b%hval)
+         return
+      end if
       b%hkey = 0_i8
       b%hval = 0
       mask = int(size(b%hkey), i8) - 1_i8

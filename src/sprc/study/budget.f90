@@ -29,8 +29,9 @@
 module sprc_study_budget
    !$ use omp_lib, only: omp_get_max_threads
    use sprc_core_kinds, only: wp, i8
-   use sprc_core_error, only: error_type, fatal_error, stat_out_of_memory
+   use sprc_core_error, only: error_type, fatal_error, stat_out_of_memory, stat_invalid_input
    use sprc_core_memory, only: available_memory
+   use sprc_core_text, only: byte_text
    use sprc_geometry_body, only: body_type
    use sprc_grid_tree, only: grid_type
    use sprc_study_spec, only: scene_type
@@ -44,6 +45,8 @@ module sprc_study_budget
    !> Address space OpenBLAS reserves per calling thread (module notes).
    real(wp), parameter :: blas_buffer_bytes = 134221824.0_wp
    !> Grid and quadrature only (module notes).
+   !> Environment variable that switches the estimate off (memory_check_wanted).
+   character(len=*), parameter :: memory_check_variable = 'SPRC_MEMORY_CHECK'
    real(wp), parameter :: grid_base_bytes = 16.0e6_wp, per_cell_grid = 128.0_wp
 
 contains
@@ -102,7 +105,10 @@ contains
       character(len=:), allocatable :: source
       character(len=256) :: buf
       integer :: threads
+      logical :: wanted
 
+      call memory_check_wanted(wanted, error)
+      if (allocated(error) .or. .not. wanted) return
       call level_memory(scene, body, level, cells, dofs, bytes, error, grid_only)
       if (allocated(error)) return
       call available_memory(avail, source)
@@ -111,10 +117,34 @@ contains
       if (source == 'ulimit -v') bytes = bytes + real(threads + 1, wp)*blas_buffer_bytes
       if (avail < 0 .or. bytes <= real(avail, wp)) return
       write (buf, '("needs about ",a," of memory (an estimate for ",es7.1," cells, ",es7.1, &
-         & " dofs), but ",a," is available (",a,"); use a lower level")') gigabytes(bytes), cells, dofs, &
-         & gigabytes(real(avail, wp)), source
+         & " dofs), but ",a," is available (",a,"); use a lower level")') byte_text(bytes), cells, dofs, &
+         & byte_text(real(avail, wp)), source
       call fatal_error(error, trim(buf), stat_out_of_memory)
    end subroutine check_level_memory
+
+   !> False when the environment variable SPRC_MEMORY_CHECK is 'off': the estimate
+   !> above is then skipped (it is an upper estimate; a user who knows a level fits,
+   !> or who tests the allocation errors underneath, may run it anyway). Unset, empty
+   !> or 'on': the check is made; any other value is an input error.
+   subroutine memory_check_wanted(wanted, error)
+      logical, intent(out) :: wanted
+      type(error_type), allocatable, intent(out) :: error
+      character(len=16) :: value
+      integer :: length, stat
+
+      wanted = .true.
+      call get_environment_variable(memory_check_variable, value, length, stat)
+      if (stat == 1 .or. length == 0) return
+      if (stat == 0) then
+         if (value == 'on') return
+         if (value == 'off') then
+            wanted = .false.
+            return
+         end if
+      end if
+      call fatal_error(error, 'environment variable '//memory_check_variable//' = "'//value(1:min(length, len(value)))// &
+         & trim(merge('...', '   ', length > len(value)))//'": expected on or off', stat_invalid_input)
+   end subroutine memory_check_wanted
 
    !> The level-0 cell of `body`'s grid: that of the scene's body of the same name
    !> (`&body` box_min, box_size, the scene's when the body has none of its own).
@@ -136,19 +166,5 @@ contains
          return
       end do
    end subroutine body_box
-
-   pure function gigabytes(bytes) result(text)
-      real(wp), intent(in) :: bytes
-      character(len=:), allocatable :: text
-      character(len=24) :: buf
-      if (bytes < 1.0e9_wp) then
-         write (buf, '(i0," MB")') nint(bytes/1.0e6_wp)
-      else if (bytes < 1.0e6_wp*huge(1)) then
-         write (buf, '(f0.1," GB")') bytes/1.0e9_wp
-      else
-         write (buf, '(es8.1," GB")') bytes/1.0e9_wp
-      end if
-      text = trim(adjustl(buf))
-   end function gigabytes
 
 end module sprc_study_budget
