@@ -13,6 +13,7 @@ module sprc_capi_recovery
    use sprc_core_kinds, only: wp
    use sprc_core_text, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_out_of_memory
+   use sprc_core_alloc, only: check_allocation
    use sprc_core_material, only: voigt_size
    use sprc_recovery_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, mesh_method_sprc
    use sprc_recovery_patch_loop, only: auto_degree
@@ -232,7 +233,7 @@ contains
       character(len=*), intent(in) :: what
       integer, allocatable, intent(out) :: out(:, :)
       type(error_type), allocatable, intent(out) :: error
-      integer :: a, e
+      integer :: a, e, stat
 
       do e = 1, size(idx, 2)
          do a = 1, size(idx, 1)
@@ -243,7 +244,10 @@ contains
             end if
          end do
       end do
-      out = int(idx) + 1
+      allocate (out(size(idx, 1), size(idx, 2)), stat=stat)
+      call check_allocation(stat, 'sprc_recover', 'a 1-based copy of '//what, size(idx), 4, error)
+      if (allocated(error)) return
+      out(:, :) = int(idx) + 1
    end subroutine one_based
 
    !> Recovered nodal stresses into out[n][nstress]; n must be the node count.
@@ -313,7 +317,7 @@ contains
       real(c_double), pointer :: x(:, :), sigma(:, :)
       integer(c_int), pointer :: elem_c(:)
       integer, allocatable :: elem(:)
-      integer :: i, nelem
+      integer :: i, nelem, stat
 
       if (.not. get_handles(errh, rech, entry, err, rec)) return
       if (npts < 0) then
@@ -338,7 +342,13 @@ contains
             end if
          end do
          ! 0-based with -1 = search is the library's 1-based with 0 = search.
-         elem = int(elem_c) + 1
+         allocate (elem(npts), stat=stat)
+         call check_allocation(stat, entry, 'a 1-based copy of elements', npts, 4, error)
+         if (allocated(error)) then
+            call set_capi_error(err, error)
+            return
+         end if
+         elem(:) = int(elem_c) + 1
          call mesh_recovery_eval(rec%result, x, sigma, error, elem)
       else
          call mesh_recovery_eval(rec%result, x, sigma, error)

@@ -22,6 +22,7 @@
 module sprc_fem_aggregation
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
+   use sprc_core_alloc, only: check_allocation
    use sprc_grid_tree, only: grid_type
    implicit none
    private
@@ -44,21 +45,23 @@ contains
       integer, allocatable, intent(out) :: root(:)
       type(error_type), allocatable, intent(out) :: error
       integer, allocatable :: next(:)
-      integer :: e, n, d, k, first, last, nb, best, dir(3)
+      integer :: e, n, d, k, first, last, nb, best, dir(3), stat
       real(wp) :: lo(3), hi(3), c(3), dist, best_dist
       logical :: changed
       character(len=400) :: buf
 
       n = grid%n_leaves
       d = grid%dim
-      allocate (root(n))
+      allocate (root(n), next(n), stat=stat)
+      call check_allocation(stat, 'cell aggregation', 'the root of each cell', n, 8, error)
+      if (allocated(error)) return
       do e = 1, n
          root(e) = 0
          if (inside(e) .or. fraction(e) >= eta) root(e) = e
       end do
       do
          changed = .false.
-         next = root
+         next(:) = root
          do e = 1, n
             if (root(e) /= 0) cycle
             call grid%leaf_box(e, lo(1:d), hi(1:d))
@@ -84,7 +87,7 @@ contains
                changed = .true.
             end if
          end do
-         root = next
+         root(:) = next
          if (.not. changed) exit
       end do
       do e = 1, n

@@ -43,6 +43,7 @@
 module sprc_fem_dilatation
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_singular
+   use sprc_core_alloc, only: check_allocation
    use sprc_core_lapack, only: dpotrf, dpotrs, dgemm
    use sprc_core_material, only: plane_stress, solid
    use sprc_grid_tree, only: grid_type
@@ -146,8 +147,9 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer, allocatable :: fill(:)
       real(wp) :: p(4), lo(3), hi(3)
-      integer :: e, a, q, k, ns, info, n, j
+      integer :: e, a, q, k, ns, info, n, j, stat
       character(len=160) :: buf
+      character(len=*), parameter :: who = 'projected dilatation'
 
       self%active = .true.
       self%dim = grid%dim
@@ -163,7 +165,9 @@ contains
       if (degree >= 2) self%np = self%dim + 1
 
       n = size(root)
-      allocate (self%aggregate(n))
+      allocate (self%aggregate(n), self%member(n), stat=stat)
+      call check_allocation(stat, who, 'the aggregate of each cell', n, 8, error)
+      if (allocated(error)) return
       self%aggregate = 0
       self%n_aggregates = 0
       do e = 1, n
@@ -174,7 +178,9 @@ contains
       do e = 1, n
          self%aggregate(e) = self%aggregate(root(e))
       end do
-      allocate (self%ptr(self%n_aggregates + 1), fill(self%n_aggregates), self%member(n))
+      allocate (self%ptr(self%n_aggregates + 1), fill(self%n_aggregates), stat=stat)
+      call check_allocation(stat, who, 'the aggregate members', self%n_aggregates + 1, 8, error)
+      if (allocated(error)) return
       fill = 0
       do e = 1, n
          fill(self%aggregate(e)) = fill(self%aggregate(e)) + 1
@@ -198,7 +204,10 @@ contains
       end do
 
       allocate (self%centre(self%dim, self%n_aggregates), self%length(self%n_aggregates), &
-         & self%gram(self%np, self%np, self%n_aggregates), self%coef(self%np, self%n_aggregates))
+         & self%gram(self%np, self%np, self%n_aggregates), self%coef(self%np, self%n_aggregates), stat=stat)
+      call check_allocation(stat, who, 'the aggregate Gram matrices', self%n_aggregates, &
+         & 8*(self%dim + 1 + self%np*(self%np + 1)), error)
+      if (allocated(error)) return
       self%coef = 0.0_wp
       do a = 1, self%n_aggregates
          e = self%member(self%ptr(a))

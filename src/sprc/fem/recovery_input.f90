@@ -12,6 +12,7 @@
 module sprc_fem_recovery_input
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
+   use sprc_core_alloc, only: check_allocation
    use sprc_core_boundary, only: bc_none, bc_free, bc_pressure, bc_traction, bc_symmetry, bc_exact_traction
    use sprc_grid_patches, only: recovery_input_type
    use sprc_fem_problem, only: elasticity_problem_type
@@ -28,7 +29,8 @@ contains
       type(elasticity_problem_type), intent(in) :: problem
       type(recovery_input_type), intent(out) :: input
       type(error_type), allocatable, intent(out) :: error
-      integer :: e, q, d
+      integer :: e, q, d, nq, nb, ns, stat
+      character(len=*), parameter :: who = 'FE recovery input'
 
       if (.not. problem%solved) then
          call fatal_error(error, 'FE recovery input: the problem is not solved', stat_invalid_input)
@@ -39,20 +41,29 @@ contains
       input%young = problem%young
       input%poisson = problem%poisson
       input%body_force(1:d) = problem%body_force(1:d)
-      input%elem_ptr = problem%vol_ptr
-      input%x = problem%vol_x(1:d, :)
-      input%w = problem%vol_w
-      allocate (input%stress(problem%nstress, size(problem%vol_w)))
+      nq = size(problem%vol_w)
+      nb = size(problem%surf_w)
+      ns = problem%nstress
+      allocate (input%elem_ptr(size(problem%vol_ptr)), input%x(d, nq), input%w(nq), input%stress(ns, nq), stat=stat)
+      call check_allocation(stat, who, 'the volume quadrature points and their stresses', nq, 8*(d + 1 + ns) + 4, error)
+      if (allocated(error)) return
+      allocate (input%belem_ptr(size(problem%surf_ptr)), input%bx(d, nb), input%bw(nb), input%bn(d, nb), &
+         & input%bshape(nb), stat=stat)
+      call check_allocation(stat, who, 'the boundary quadrature points', nb, 8*(2*d + 1) + 8, error)
+      if (allocated(error)) return
+      input%elem_ptr(:) = problem%vol_ptr
+      input%x(:, :) = problem%vol_x(1:d, :)
+      input%w(:) = problem%vol_w
       do e = 1, problem%grid%n_leaves
          do q = problem%vol_ptr(e), problem%vol_ptr(e + 1) - 1
             call problem%stress_in_element(e, problem%vol_x(1:d, q), input%stress(:, q))
          end do
       end do
-      input%belem_ptr = problem%surf_ptr
-      input%bx = problem%surf_x(1:d, :)
-      input%bw = problem%surf_w
-      input%bn = problem%surf_n(1:d, :)
-      input%bshape = problem%surf_shape
+      input%belem_ptr(:) = problem%surf_ptr
+      input%bx(:, :) = problem%surf_x(1:d, :)
+      input%bw(:) = problem%surf_w
+      input%bn(:, :) = problem%surf_n(1:d, :)
+      input%bshape(:) = problem%surf_shape
       call boundary_kinds(problem, input)
    end subroutine fe_recovery_input
 

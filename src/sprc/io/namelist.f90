@@ -22,6 +22,7 @@ module sprc_io_namelist
    use sprc_core_kinds, only: wp, i8
    use sprc_core_text, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_io
+   use sprc_core_alloc, only: check_allocation
    implicit none
    private
 
@@ -118,7 +119,7 @@ contains
       character(len=:), allocatable, intent(out) :: text
       type(error_type), allocatable, intent(out) :: error
       logical :: exists
-      integer :: unit, ios
+      integer :: unit, ios, stat
       integer(i8) :: size
       character(len=256) :: msg
 
@@ -140,8 +141,9 @@ contains
          call fatal_error(error, "'"//path//"': "//itoa(int(size / 1024_i8))// &
             & ' KiB is too large for a text input file (limit '//itoa(max_text_size / 1024)//' KiB)')
       else
-         allocate (character(len=int(size)) :: text)
-         if (size > 0_i8) then
+         allocate (character(len=int(size)) :: text, stat=stat)
+         call check_allocation(stat, 'read '''//path//'''', 'the text of the file', size, 1, error)
+         if (size > 0_i8 .and. .not. allocated(error)) then
             read (unit, iostat=ios, iomsg=msg) text
             if (ios /= 0) call fatal_error(error, "cannot read '"//path//"': "//trim(msg), stat_io)
          end if
