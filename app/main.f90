@@ -11,6 +11,7 @@ program sprc_main
    use sprc_io_scene, only: scene_type, read_scene, read_scene_text, scene_summary, default_scene_text
    use sprc_study_model, only: build_bodies, scene_warnings
    use sprc_study_budget, only: level_memory
+   use sprc_core_blas_threads, only: blas_reserve_buffers
    use sprc_geometry_body, only: body_type
    use sprc_study_mesh, only: mesh_row_type, mesh_study, study_levels
    use sprc_study_level, only: study_type, prepare_study, run_level, level_type
@@ -126,6 +127,8 @@ contains
       end if
       allocate (rows(size(levels)), contact_levels(0))
       threads = omp_get_max_threads()
+      call blas_reserve_buffers(error)
+      if (allocated(error)) call fail_with(error)
       do i = 1, size(levels)
          if (cli%threads == 0) then
             total_dofs = 0.0_wp

@@ -23,14 +23,16 @@
 !> 128 bytes per cell.
 !> Under an address-space limit (ulimit -v) the virtual size counts, and
 !> OpenBLAS reserves a buffer of 128 MiB for each thread that calls it, when it
-!> first does (malloc(134221824) per thread, seen in a debugger); without that
-!> reserve a level that passed the check hung in OpenBLAS's retry loop of
-!> blas_memory_alloc (3D level 5 under ulimit -v 600000).
+!> first does (sprc_core_blas_threads); without that reserve a level that
+!> passed the check hung in OpenBLAS's retry loop of blas_memory_alloc (3D
+!> level 5 under ulimit -v 600000). Buffers already taken
+!> (blas_reserve_buffers) are in the virtual size and do not count again.
 module sprc_study_budget
    !$ use omp_lib, only: omp_get_max_threads
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_out_of_memory, stat_invalid_input
    use sprc_core_memory, only: available_memory
+   use sprc_core_blas_threads, only: blas_buffer_bytes, blas_reserved_threads
    use sprc_core_text, only: byte_text
    use sprc_geometry_body, only: body_type
    use sprc_grid_tree, only: grid_type
@@ -42,8 +44,6 @@ module sprc_study_budget
 
    real(wp), parameter :: base_bytes = 32.0e6_wp, per_dof_2d = 2.5e3_wp, per_dof_3d = 1.0e4_wp, &
       & dofs_3d = 3.0e4_wp, q2_factor_3d = 1.75_wp
-   !> Address space OpenBLAS reserves per calling thread (module notes).
-   real(wp), parameter :: blas_buffer_bytes = 134221824.0_wp
    !> Grid and quadrature only (module notes).
    !> Environment variable that switches the estimate off (memory_check_wanted).
    character(len=*), parameter :: memory_check_variable = 'SPRC_MEMORY_CHECK'
@@ -114,7 +114,8 @@ contains
       call available_memory(avail, source)
       threads = 1
       !$ threads = omp_get_max_threads()
-      if (source == 'ulimit -v') bytes = bytes + real(threads + 1, wp)*blas_buffer_bytes
+      if (source == 'ulimit -v') bytes = bytes + real(max(0, threads + 1 - blas_reserved_threads()), wp)* &
+         & real(blas_buffer_bytes, wp)
       if (avail < 0 .or. bytes <= real(avail, wp)) return
       write (buf, '("needs about ",a," of memory (an estimate for ",es7.1," cells, ",es7.1, &
          & " dofs), but ",a," is available (",a,"); use a lower level")') byte_text(bytes), cells, dofs, &
