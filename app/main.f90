@@ -4,8 +4,9 @@ program sprc_main
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
    use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
    use omp_lib, only: omp_set_num_threads, omp_get_max_threads
-   use sprc_core_kinds, only: wp
-   use sprc_core_text, only: fixed_text, itoa
+   use sprc_core_kinds, only: wp, i8
+   use sprc_core_text, only: fixed_text, itoa, byte_text
+   use sprc_core_memory, only: peak_memory
    use sprc_core_error, only: error_type, stat_invalid_input, stat_io
    use sprc_version, only: sprc_version_string
    use sprc_io_scene, only: scene_type, read_scene, read_scene_text, scene_summary, default_scene_text
@@ -153,7 +154,7 @@ contains
             call fail_with(error)
          end if
          if (.not. cli%quiet) write (error_unit, '(a,i0,a)') 'sprc: level ', levels(i), ' done in '// &
-            fixed_text(rows(i)%t_total, 3)//' s'
+            fixed_text(rows(i)%t_total, 3)//' s'//peak_text()
       end do
       write (output_unit, '(a)') scene%title
       write (output_unit, '(a)', advance='no') report_table(rows)
@@ -186,6 +187,16 @@ contains
          write (error_unit, '(a)') 'sprc: wrote '//prefix//'.csv, .svg, .h5, .xdmf'
       end if
    end subroutine run_study
+
+   !> ', peak memory 171 MB': the peak resident memory of the run so far (with levels
+   !> in increasing order, that of the level just done); '' where unknown.
+   function peak_text() result(text)
+      character(len=:), allocatable :: text
+      integer(i8) :: bytes
+      text = ''
+      bytes = peak_memory()
+      if (bytes >= 0) text = ', peak memory '//byte_text(real(bytes, wp))
+   end function peak_text
 
    !> mkdir -p of the directory part of an output prefix (the library does no
    !> file-system management); a path with quotes is left to fail on open.

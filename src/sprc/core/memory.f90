@@ -10,7 +10,7 @@ module sprc_core_memory
    implicit none
    private
 
-   public :: available_memory
+   public :: available_memory, peak_memory
 
    !> struct rlimit of Linux (rlim_t is unsigned long; RLIM_INFINITY reads as -1).
    type, bind(C) :: rlimit_type
@@ -52,6 +52,15 @@ contains
          source = name
       end subroutine take
    end subroutine available_memory
+
+   !> Peak resident memory of this process since it started, in bytes (VmHWM of
+   !> /proc/self/status; what getrusage's ru_maxrss and `time -f %M` report), -1
+   !> if unknown. It is never reset here: resetting it (/proc/self/clear_refs)
+   !> would also reset what `time` reports for the whole run.
+   integer(i8) function peak_memory() result(bytes)
+      bytes = file_value('/proc/self/status', 'VmHWM:')
+      if (bytes >= 0) bytes = 1024_i8*bytes
+   end function peak_memory
 
    !> Soft limit `resource` less the current use (kB line `key` of
    !> /proc/self/status), -1 if unlimited or unknown.
