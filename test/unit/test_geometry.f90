@@ -16,7 +16,7 @@ module sprc_test_geometry
       & shape_box, shape_halfspace, shape_cylinder, new_disk, new_sphere, new_ellipse, new_ellipsoid, &
       & new_box, new_halfspace, new_cylinder, shape_kind_name, shape_kind_from_name
    use sprc_geometry_body, only: body_type, new_body, csg_add, csg_subtract, csg_intersect, csg_op_name, &
-      & csg_op_from_name
+      & csg_op_from_name, check_body_in_box
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type
    implicit none
    private
@@ -57,6 +57,8 @@ contains
          new_unittest('csg_corners', test_csg_corners), &
          new_unittest('body_normals_outward', test_body_normals), &
          new_unittest('kind_and_op_names', test_names), &
+         new_unittest('shape_bounds_hold_and_tight', test_shape_bounds), &
+         new_unittest('piece_outside_the_box', test_piece_outside_box), &
          new_unittest('shape_constructor_errors', test_constructor_errors), &
          new_unittest('body_errors', test_body_errors) &
          ]
@@ -1152,6 +1154,128 @@ contains
    end subroutine single
 
    !> One shape of every kind, with oblique and axis-aligned directions.
+   !> Every point of a catalogue shape sampled on a lattice over [-4, 4]^dim (inside:
+   !> phi < 0) lies in its bounds; a bounded side is attained (the sample nearest to it
+   !> lies within one lattice step, up to the rounding of the lattice coordinates); an
+   !> unbounded side is one the shape really extends along: on the lattice over
+   !> [-400, 400]^dim it has inside samples beyond 40 that way (every bounded
+   !> catalogue shape lies within 3 of the origin).
+   subroutine test_shape_bounds(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(shape_type) :: shapes(ncatalogue)
+      integer, parameter :: n = 40
+      real(wp), parameter :: span = 4.0_wp, far = 400.0_wp, step = 2.0_wp*span/n
+      !> One lattice step, and the rounding of the lattice coordinates.
+      real(wp), parameter :: reach = step + sample_slack*span
+      real(wp) :: lo(3), hi(3), seen_lo(3), seen_hi(3), far_lo(3), far_hi(3)
+      integer :: i, d, k
+      logical :: attained
+      character(len=160) :: buf
+
+      call catalogue(shapes, error)
+      if (allocated(error)) return
+      do i = 1, ncatalogue
+         d = shapes(i)%dim
+         call shapes(i)%bounds(lo(1:d), hi(1:d))
+         call sample(shapes(i), span, seen_lo, seen_hi)
+         call sample(shapes(i), far, far_lo, far_hi)
+         do k = 1, d
+            write (buf, '(a," axis ",i0,": bounds ",2es10.2,", inside samples ",2es10.2)') &
+               & shapes(i)%name, k, lo(k), hi(k), seen_lo(k), seen_hi(k)
+            call check(error, lo(k) <= seen_lo(k) .and. seen_hi(k) <= hi(k), 'samples within the bounds: '//trim(buf))
+            if (allocated(error)) return
+            attained = merge(far_lo(k) < -0.1_wp*far, seen_lo(k) - lo(k) <= reach, lo(k) == -huge(1.0_wp)) .and. &
+               & merge(far_hi(k) > 0.1_wp*far, hi(k) - seen_hi(k) <= reach, hi(k) == huge(1.0_wp))
+            call check(error, attained, 'bounds attained: '//trim(buf))
+            if (allocated(error)) return
+         end do
+      end do
+   contains
+      subroutine sample(shape, half, smin, smax)
+         type(shape_type), intent(in) :: shape
+         real(wp), intent(in) :: half
+         real(wp), intent(out) :: smin(3), smax(3)
+         real(wp) :: x(3)
+         integer :: total, idx(3), d
+         d = shape%dim
+         smin = huge(1.0_wp)
+         smax = -huge(1.0_wp)
+         do total = 0, (n + 1)**d - 1
+            idx = 0
+            idx(1) = mod(total, n + 1)
+            idx(2) = mod(total/(n + 1), n + 1)
+            if (d == 3) idx(3) = total/(n + 1)**2
+            x(1:d) = -half + (2.0_wp*half/n)*real(idx(1:d), wp)
+            if (.not. (shape%phi(x(1:d)) < 0.0_wp)) cycle
+            smin(1:d) = min(smin(1:d), x(1:d))
+            smax(1:d) = max(smax(1:d), x(1:d))
+         end do
+      end subroutine sample
+   end subroutine test_shape_bounds
+
+   !> A separate piece of a body wholly outside the box, beyond the slabs next to its
+   !> faces, is an input error naming the body and the piece (issue 15 defect 3: it was
+   !> cut off silently): a disk at x = 1000, a sphere at z = -500, a halfspace x >= 1000
+   !> (unbounded). Material that a later shape removes again is none: no error.
+   subroutine test_piece_outside_box(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(error_type), allocatable :: e
+      type(body_type) :: body
+      type(shape_type) :: near, far, cover
+
+      call new_disk(near, 'near', [5.0_wp, 5.0_wp], 3.0_wp, error)
+      if (allocated(error)) return
+      call new_disk(far, 'far', [1000.0_wp, 0.0_wp], 2.0_wp, error)
+      if (allocated(error)) return
+      call two_shapes(body, 'two_disks', near, csg_add, far, error)
+      if (allocated(error)) return
+      call check_body_in_box(body, [0.0_wp, 0.0_wp], 15.0_wp, e)
+      call check(error, allocated(e), 'a disk at x = 1000 outside the box 0..15 is found')
+      if (allocated(error)) return
+      call check(error, e%stat, stat_invalid_input, 'status')
+      if (allocated(error)) return
+      call check(error, index(e%message, "body 'two_disks' extends beyond the scene's box 0..15 x 0..15") > 0 .and. &
+         & index(e%message, "(shape 'far')") > 0, 'message names body, box and piece: '//e%message)
+      if (allocated(error)) return
+      ! the far disk removed again by a larger one: no material outside
+      call new_disk(cover, 'cover', [1000.0_wp, 0.0_wp], 5.0_wp, error)
+      if (allocated(error)) return
+      call body%add_shape(csg_subtract, cover, error)
+      if (allocated(error)) return
+      call check_body_in_box(body, [0.0_wp, 0.0_wp], 15.0_wp, e)
+      call check(error, .not. allocated(e), 'a piece subtracted again is no material')
+      if (allocated(error)) return
+      call new_halfspace(far, 'far_half', [1000.0_wp, 0.0_wp], [-1.0_wp, 0.0_wp], error)
+      if (allocated(error)) return
+      call two_shapes(body, 'half', near, csg_add, far, error)
+      if (allocated(error)) return
+      call check_body_in_box(body, [0.0_wp, 0.0_wp], 15.0_wp, e)
+      call check(error, allocated(e), 'an unbounded piece x >= 1000 is found')
+      if (allocated(error)) return
+      call new_sphere(near, 'near', [5.0_wp, 5.0_wp, 5.0_wp], 3.0_wp, error)
+      if (allocated(error)) return
+      call new_sphere(far, 'far', [5.0_wp, 5.0_wp, -500.0_wp], 1.0_wp, error)
+      if (allocated(error)) return
+      call two_shapes(body, 'two_spheres', near, csg_add, far, error)
+      if (allocated(error)) return
+      call check_body_in_box(body, [0.0_wp, 0.0_wp, 0.0_wp], 15.0_wp, e)
+      call check(error, allocated(e), 'a sphere at z = -500 outside the box is found')
+      if (allocated(error)) return
+      call check(error, index(e%message, "(shape 'far')") > 0, 'names the sphere: '//e%message)
+   end subroutine test_piece_outside_box
+
+   subroutine two_shapes(body, name, first, op, second, error)
+      type(body_type), intent(out) :: body
+      character(len=*), intent(in) :: name
+      type(shape_type), intent(in) :: first, second
+      integer, intent(in) :: op
+      type(error_type), allocatable, intent(out) :: error
+      call new_body(body, name)
+      call body%add_shape(csg_add, first, error)
+      if (allocated(error)) return
+      call body%add_shape(op, second, error)
+   end subroutine two_shapes
+
    subroutine catalogue(shapes, error)
       type(shape_type), intent(out) :: shapes(ncatalogue)
       type(error_type), allocatable, intent(out) :: error

@@ -40,6 +40,8 @@ module sprc_geometry_body
 
    !> Snapping tolerance in ulps of the coordinate magnitude (module notes).
    real(wp), parameter :: snap_ulps = 4.0_wp
+   !> Halvings of a box searched for material outside the scene's box (check_body_in_box).
+   integer, parameter :: depth_limit = 8
 
    !> A named body: its shapes and their CSG operations, in file order.
    type, extends(region_type) :: body_type
@@ -406,23 +408,24 @@ contains
    !> certified inside sub-box, or the centre of a cut one after `depth_limit` halvings
    !> with phi below minus the snapping tolerance). A body that crosses a face has material
    !> in the slab beyond it; one that only touches a face (a plane on the box boundary, a
-   !> circle tangent to it) has none. A piece entirely outside the box and the slabs is
-   !> not searched for. With `own_box`, the box is the body's own level-0 cell (`&body`
-   !> box_min, box_size) and the message says so.
+   !> circle tangent to it) has none. Then a piece anywhere outside the box
+   !> (`find_outside_piece`): a separate part of the body beyond the slabs. With
+   !> `own_box`, the box is the body's own level-0 cell (`&body` box_min, box_size)
+   !> and the message says so.
    subroutine check_body_in_box(self, box_min, box_size, error, own_box)
       type(body_type), intent(in) :: self
       real(wp), intent(in) :: box_min(:), box_size
       type(error_type), allocatable, intent(out) :: error
       logical, intent(in), optional :: own_box
-      integer, parameter :: depth_limit = 8
       real(wp) :: lo(3), hi(3), x(3)
-      character(len=:), allocatable :: where, whose, keys
-      integer :: d, k, j, side
+      integer :: d, k, side, piece
       logical :: found
 
       d = self%dim
       if (d < 2 .or. size(box_min) < d) return
-      do k = 1, d
+      piece = 0
+      found = .false.
+      slabs: do k = 1, d
          do side = 0, 1
             lo(1:d) = box_min(1:d)
             hi(1:d) = box_min(1:d) + box_size
@@ -434,27 +437,102 @@ contains
                hi(k) = hi(k) + box_size/16.0_wp
             end if
             call find_inside(self, lo(1:d), hi(1:d), depth_limit, found, x(1:d))
-            if (.not. found) cycle
-            where = real_str(box_min(1))//'..'//real_str(box_min(1) + box_size)
-            do j = 2, d
-               where = where//' x '//real_str(box_min(j))//'..'//real_str(box_min(j) + box_size)
-            end do
-            whose = "the scene's box "
-            keys = '&scene'
-            if (present(own_box)) then
-               if (own_box) then
-                  whose = 'its own box '
-                  keys = '&body'
+            if (found) exit slabs
+         end do
+      end do slabs
+      if (.not. found) then
+         lo(1:d) = box_min(1:d)
+         hi(1:d) = box_min(1:d) + box_size
+         call find_outside_piece(self, lo(1:d), hi(1:d), found, x(1:d), piece)
+      end if
+      if (.not. found) return
+      call outside_box_error(self, box_min(1:d), box_size, x(1:d), piece, error, own_box)
+   end subroutine check_body_in_box
+
+   !> The error of `check_body_in_box`: the body, the box, the point x of material
+   !> outside it and, when known, the added shape `piece` it belongs to.
+   subroutine outside_box_error(self, box_min, box_size, x, piece, error, own_box)
+      type(body_type), intent(in) :: self
+      real(wp), intent(in) :: box_min(:), box_size, x(:)
+      integer, intent(in) :: piece
+      type(error_type), allocatable, intent(out) :: error
+      logical, intent(in), optional :: own_box
+      character(len=:), allocatable :: where, whose, keys, piece_text
+      integer :: j, d
+
+      d = size(box_min)
+      where = real_str(box_min(1))//'..'//real_str(box_min(1) + box_size)
+      do j = 2, d
+         where = where//' x '//real_str(box_min(j))//'..'//real_str(box_min(j) + box_size)
+      end do
+      whose = "the scene's box "
+      keys = '&scene'
+      if (present(own_box)) then
+         if (own_box) then
+            whose = 'its own box '
+            keys = '&body'
+         end if
+      end if
+      piece_text = ''
+      if (piece > 0) piece_text = " (shape '"//shape_name(self%shapes(piece))//"')"
+      call fatal_error(error, "body '"//body_name(self)//"' extends beyond "//whose//where// &
+         & ' ('//keys//': box_min, box_size): it has material at ('//real_list(x)//')'//piece_text// &
+         & ', which the grid would cut off; enlarge box_size or move box_min so that the box holds the '// &
+         & 'whole body', stat_invalid_input)
+   end subroutine outside_box_error
+
+   !> A point x of the body outside the box [box_lo, box_hi], anywhere. The body lies in
+   !> the union over its added shapes i (the first included) of the piece P_i: the bounds
+   !> of shape i (`shape_type%bounds`) cut by those of every shape intersected after it
+   !> (subtracting only removes material). Each P_i less the box is the union of up to
+   !> 2 dim boxes (along axis k below or above the box, inside it along the axes before
+   !> k), each searched with `find_inside`; `piece` is i. An unbounded side of P_i is
+   !> cut at `far_boxes` box widths from the box.
+   subroutine find_outside_piece(self, box_lo, box_hi, found, x, piece)
+      type(body_type), intent(in) :: self
+      real(wp), intent(in) :: box_lo(:), box_hi(:)
+      logical, intent(out) :: found
+      real(wp), intent(out) :: x(:)
+      integer, intent(out) :: piece
+      real(wp), parameter :: far_boxes = 1024.0_wp
+      real(wp) :: plo(3), phi(3), slo(3), shi(3), far
+      integer :: d, i, j, k, side
+
+      d = size(box_lo)
+      found = .false.
+      far = far_boxes*maxval(box_hi - box_lo)
+      do piece = 1, self%nshape
+         if (self%ops(piece) /= csg_add .and. piece > 1) cycle
+         call self%shapes(piece)%bounds(plo(1:d), phi(1:d))
+         do i = piece + 1, self%nshape
+            if (self%ops(i) /= csg_intersect) cycle
+            call self%shapes(i)%bounds(slo(1:d), shi(1:d))
+            plo(1:d) = max(plo(1:d), slo(1:d))
+            phi(1:d) = min(phi(1:d), shi(1:d))
+         end do
+         plo(1:d) = max(plo(1:d), box_lo - far)
+         phi(1:d) = min(phi(1:d), box_hi + far)
+         do k = 1, d
+            do side = 0, 1
+               slo(1:d) = plo(1:d)
+               shi(1:d) = phi(1:d)
+               do j = 1, k - 1
+                  slo(j) = max(slo(j), box_lo(j))
+                  shi(j) = min(shi(j), box_hi(j))
+               end do
+               if (side == 0) then
+                  shi(k) = min(shi(k), box_lo(k))
+               else
+                  slo(k) = max(slo(k), box_hi(k))
                end if
-            end if
-            call fatal_error(error, "body '"//body_name(self)//"' extends beyond "//whose//where// &
-               & ' ('//keys//': box_min, box_size): it has material at ('//real_list(x(1:d))//'), which the grid would '// &
-               & 'cut off; enlarge box_size or move box_min so that the box holds the whole body', &
-               & stat_invalid_input)
-            return
+               if (any(slo(1:d) >= shi(1:d))) cycle
+               call find_inside(self, slo(1:d), shi(1:d), depth_limit, found, x)
+               if (found) return
+            end do
          end do
       end do
-   end subroutine check_body_in_box
+      piece = 0
+   end subroutine find_outside_piece
 
    !> A point x of the body in the box [lo, hi], by bisection of the cut boxes (module
    !> notes on the snapping tolerance).

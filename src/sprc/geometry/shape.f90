@@ -80,6 +80,7 @@ module sprc_geometry_shape
       procedure :: gradient => shape_gradient
       procedure :: phi_range => shape_phi_range
       procedure :: gradient_range => shape_gradient_range
+      procedure :: bounds => shape_bounds
    end type shape_type
 
 contains
@@ -291,6 +292,50 @@ contains
    end function shape_kind_from_name
 
    ! ------------------------------------------------------------ level set
+
+   !> Axis-aligned box [lo, hi] (size dim) that holds the shape, exact for the
+   !> bounded kinds; an unbounded side is -huge / +huge. A halfspace is bounded
+   !> only along an axis its normal is parallel to, a cylinder only across the
+   !> axes its direction has no component along.
+   pure subroutine shape_bounds(self, lo, hi)
+      class(shape_type), intent(in) :: self
+      real(wp), intent(out) :: lo(:), hi(:)
+      integer :: d, k
+
+      d = self%dim
+      lo(1:d) = -huge(1.0_wp)
+      hi(1:d) = huge(1.0_wp)
+      select case (self%kind)
+      case (shape_disk, shape_sphere)
+         lo(1:d) = self%center(1:d) - self%radius
+         hi(1:d) = self%center(1:d) + self%radius
+      case (shape_ellipse, shape_ellipsoid)
+         lo(1:d) = self%center(1:d) - self%semi_axes(1:d)
+         hi(1:d) = self%center(1:d) + self%semi_axes(1:d)
+      case (shape_box)
+         lo(1:d) = self%lower(1:d)
+         hi(1:d) = self%upper(1:d)
+      case (shape_halfspace)
+         do k = 1, d
+            if (count(self%normal(1:d) /= 0.0_wp) /= 1 .or. self%normal(k) == 0.0_wp) cycle
+            if (self%normal(k) > 0.0_wp) then
+               hi(k) = self%point(k)
+            else
+               lo(k) = self%point(k)
+            end if
+         end do
+      case (shape_cylinder)
+         do k = 1, d
+            if (self%axis(k) /= 0.0_wp) cycle
+            lo(k) = self%point(k) - self%radius
+            hi(k) = self%point(k) + self%radius
+         end do
+      case default
+         ! A shape never constructed is empty.
+         lo(1:d) = huge(1.0_wp)
+         hi(1:d) = -huge(1.0_wp)
+      end select
+   end subroutine shape_bounds
 
    !> Level set at x (size dim): negative inside, zero on the surface.
    pure real(wp) function shape_phi(self, x) result(f)
