@@ -16,9 +16,14 @@
 !>   allocates on the heap and aborts when it cannot) of about one value per
 !>   cell, node, dof or nonzero is written as an explicit allocation;
 !> - allocations of a fixed or dimension-bounded size stay as they are: the
-!>   dim, 3, 6, 2**dim, 3**dim sized ones, a quadrature rule's initial slots,
-!>   an error object or a short message string. Their failure would mean the
-!>   process has no memory left at all, which no message can report.
+!>   dim, 3, 6, 2**dim, 3**dim sized ones, an element's nodes or dofs, an
+!>   error object or a short message string; so do the per-cell scratch
+!>   arrays of the cut-cell quadrature (bounded by the quadrature order and
+!>   depth, not by the size of the problem), per-patch work arrays (bounded
+!>   by the patch size), and the parsed groups of a scene file (bounded by
+!>   its 16 MB limit and max_groups, max_items, max_values of io/namelist).
+!>   Their failure would mean the process has almost no memory left, which a
+!>   message could not report either.
 module sprc_core_alloc
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_out_of_memory
