@@ -142,10 +142,20 @@ contains
             call set_capi_error(err, error)
             return
          end if
-         fk = int(fk_c)
+         allocate (fk(nfacet), stat=stat)
+         call check_allocation(stat, 'sprc_recover', 'a copy of facet_kind', nfacet, 4, error)
+         if (.not. allocated(error) .and. c_associated(facet_traction)) then
+            allocate (ft(dim, nfacet), stat=stat)
+            call check_allocation(stat, 'sprc_recover', 'a copy of facet_traction', nfacet, 8*dim, error)
+         end if
+         if (allocated(error)) then
+            call set_capi_error(err, error)
+            return
+         end if
+         fk(:) = int(fk_c)
          if (c_associated(facet_traction)) then
             call c_f_pointer(facet_traction, ft_ptr, [dim, nfacet])
-            ft = ft_ptr
+            ft(:, :) = ft_ptr
          end if
       end if
 
