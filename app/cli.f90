@@ -32,7 +32,8 @@ contains
          '  sprc mesh SCENE.nml [--levels 3,4] [--points Q]   grid, classification, quadrature per level'//nl// &
          '  sprc --help | --version'//nl//nl// &
          'exit status: 0 success; 2 bad input (the message names the group, field and value);'//nl// &
-         '             1 numerical failure, or a capability this version does not have yet'
+         '             1 numerical failure, or a capability this version does not have yet'//nl// &
+         'environment: SPRC_MEMORY_CHECK=off runs a level that its memory estimate would refuse'
    end function usage_text
 
    !> Parse the command line. On error, `message` is allocated (exit status 2).
