@@ -76,6 +76,7 @@ contains
          new_unittest('shape-functions', test_shape_functions), &
          new_unittest('nodes-uniform', test_nodes_uniform), &
          new_unittest('nodes-refined', test_nodes_refined), &
+         new_unittest('grid-nodes-copy', test_grid_nodes_copy), &
          new_unittest('hanging-q1-2d', test_hanging_q1_2d), &
          new_unittest('hanging-q2-2d', test_hanging_q2_2d), &
          new_unittest('hanging-q1-3d', test_hanging_q1_3d), &
@@ -660,6 +661,53 @@ contains
          end do
       end do
    end subroutine test_nodes_refined
+
+   !> grid%copy and nodes%copy (the deep copies that report a failed allocation) give
+   !> what the intrinsic assignment gives, field by field, and copies that stand alone:
+   !> the copied nodes pass the node checks on the copied grid after the originals are
+   !> rebuilt as something else.
+   subroutine test_grid_nodes_copy(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(grid_type) :: grid, copy, assigned
+      type(grid_nodes_type) :: nodes, ncopy, nassigned
+      integer :: dim
+
+      do dim = 2, 3
+         call grid%build(ball(dim, 0.3_wp), dim, [0.0_wp, 0.0_wp, 0.0_wp], 1.0_wp, 2, 2, error)
+         if (allocated(error)) return
+         call nodes%build(grid, 2, error)
+         if (allocated(error)) return
+         call grid%copy(copy, error)
+         if (allocated(error)) return
+         call nodes%copy(ncopy, error)
+         if (allocated(error)) return
+         assigned = grid
+         nassigned = nodes
+         call check(error, copy%dim == assigned%dim .and. all(copy%box_min == assigned%box_min) .and. &
+            & copy%box_size == assigned%box_size .and. copy%level == assigned%level .and. &
+            & copy%refine_boundary == assigned%refine_boundary .and. copy%max_level == assigned%max_level .and. &
+            & copy%n_leaves == assigned%n_leaves .and. all(copy%leaf_level == assigned%leaf_level) .and. &
+            & all(copy%leaf_coord == assigned%leaf_coord) .and. all(copy%leaf_class == assigned%leaf_class) .and. &
+            & all(copy%leaf_key == assigned%leaf_key) .and. all(copy%n_inside == assigned%n_inside) .and. &
+            & all(copy%n_cut == assigned%n_cut) .and. all(copy%n_outside == assigned%n_outside) .and. &
+            & copy%n_balance_splits == assigned%n_balance_splits, 'grid copy = grid assignment')
+         if (allocated(error)) return
+         call check(error, ncopy%dim == nassigned%dim .and. ncopy%degree == nassigned%degree .and. &
+            & ncopy%n_nodes == nassigned%n_nodes .and. ncopy%n_elements == nassigned%n_elements .and. &
+            & ncopy%nodes_per_element == nassigned%nodes_per_element .and. &
+            & ncopy%lattice_level == nassigned%lattice_level .and. all(ncopy%lattice == nassigned%lattice) .and. &
+            & all(ncopy%x == nassigned%x) .and. all(ncopy%connectivity == nassigned%connectivity) .and. &
+            & all(ncopy%node_element_ptr == nassigned%node_element_ptr) .and. &
+            & all(ncopy%node_element == nassigned%node_element), 'nodes copy = nodes assignment')
+         if (allocated(error)) return
+         call grid%build(ball(dim, 0.4_wp), dim, [0.0_wp, 0.0_wp, 0.0_wp], 1.0_wp, 3, 0, error)
+         if (allocated(error)) return
+         call nodes%build(grid, 1, error)
+         if (allocated(error)) return
+         call check_nodes(error, copy, ncopy)
+         if (allocated(error)) return
+      end do
+   end subroutine test_grid_nodes_copy
 
    ! ------------------------------------------------------------------ hanging
 

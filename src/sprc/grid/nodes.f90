@@ -49,6 +49,7 @@ module sprc_grid_nodes
       integer, allocatable :: node_element_ptr(:), node_element(:)
    contains
       procedure :: build => nodes_build
+      procedure :: copy => nodes_copy
    end type grid_nodes_type
 
 contains
@@ -190,6 +191,34 @@ contains
       end do
       call node_elements(self, error)
    end subroutine nodes_build
+
+   !> `copy` = the nodes, with a failed allocation returned as an error (the intrinsic
+   !> assignment copy = nodes stops the program when it cannot allocate, or crashes).
+   subroutine nodes_copy(self, copy, error)
+      class(grid_nodes_type), intent(in) :: self
+      type(grid_nodes_type), intent(out) :: copy
+      type(error_type), allocatable, intent(out) :: error
+      integer :: stat
+
+      stat = 0
+      if (allocated(self%lattice)) allocate (copy%lattice, source=self%lattice, stat=stat)
+      if (stat == 0 .and. allocated(self%x)) allocate (copy%x, source=self%x, stat=stat)
+      if (stat == 0 .and. allocated(self%connectivity)) &
+         & allocate (copy%connectivity, source=self%connectivity, stat=stat)
+      if (stat == 0 .and. allocated(self%node_element_ptr)) &
+         & allocate (copy%node_element_ptr, source=self%node_element_ptr, stat=stat)
+      if (stat == 0 .and. allocated(self%node_element)) &
+         & allocate (copy%node_element, source=self%node_element, stat=stat)
+      call check_allocation(stat, 'grid nodes copy', 'the nodes', self%n_nodes, &
+         & 12*self%dim + 4*(2 + 2*self%nodes_per_element), error)
+      if (allocated(error)) return
+      copy%dim = self%dim
+      copy%degree = self%degree
+      copy%n_nodes = self%n_nodes
+      copy%n_elements = self%n_elements
+      copy%nodes_per_element = self%nodes_per_element
+      copy%lattice_level = self%lattice_level
+   end subroutine nodes_copy
 
    !> Node at lattice point g, added if new. `table` holds node numbers (0: empty)
    !> and is kept at most half full.

@@ -65,6 +65,7 @@ module sprc_grid_tree
       integer :: n_balance_splits = 0
    contains
       procedure :: build => grid_build
+      procedure :: copy => grid_copy
       procedure :: cell_width => grid_cell_width
       procedure :: leaf_box => grid_leaf_box
       procedure :: find_cell => grid_find_cell
@@ -137,6 +138,34 @@ contains
       self%n_balance_splits = b%n_splits
       call finalize(self, b, error)
    end subroutine grid_build
+
+   !> `copy` = the grid, with a failed allocation returned as an error (the intrinsic
+   !> assignment copy = grid stops the program when it cannot allocate, or crashes).
+   subroutine grid_copy(self, copy, error)
+      class(grid_type), intent(in) :: self
+      type(grid_type), intent(out) :: copy
+      type(error_type), allocatable, intent(out) :: error
+      integer :: stat
+
+      stat = 0
+      if (allocated(self%leaf_level)) allocate (copy%leaf_level, source=self%leaf_level, stat=stat)
+      if (stat == 0 .and. allocated(self%leaf_coord)) allocate (copy%leaf_coord, source=self%leaf_coord, stat=stat)
+      if (stat == 0 .and. allocated(self%leaf_class)) allocate (copy%leaf_class, source=self%leaf_class, stat=stat)
+      if (stat == 0 .and. allocated(self%leaf_key)) allocate (copy%leaf_key, source=self%leaf_key, stat=stat)
+      call check_allocation(stat, 'grid copy', 'the leaves of the grid', self%n_leaves, 4*(self%dim + 2) + 8, error)
+      if (allocated(error)) return
+      copy%dim = self%dim
+      copy%box_min = self%box_min
+      copy%box_size = self%box_size
+      copy%level = self%level
+      copy%refine_boundary = self%refine_boundary
+      copy%max_level = self%max_level
+      copy%n_leaves = self%n_leaves
+      copy%n_inside = self%n_inside
+      copy%n_cut = self%n_cut
+      copy%n_outside = self%n_outside
+      copy%n_balance_splits = self%n_balance_splits
+   end subroutine grid_copy
 
    subroutine check_input(dim, box_min, box_size, level, refine_boundary, error)
       integer, intent(in) :: dim
