@@ -16,6 +16,7 @@ VERSION := $(shell sed -n 's/^version *= *"\(.*\)"/\1/p' fpm.toml)
 HDF5_LDIR := $(shell pkg-config --libs-only-L hdf5 2>/dev/null || echo -L/usr/lib/x86_64-linux-gnu/hdf5/serial)
 # Everything libsprc needs at link time: HDF5 (Fortran), SuiteSparse,
 # LAPACK/BLAS (fpm.toml's link list), the gfortran and OpenMP run times.
+# PETSc is not linked: src/shim/sprc_petsc.c loads it when first used.
 DEP_LIBS := $(HDF5_LDIR) -lhdf5_fortran -lhdf5 -lcholmod -lumfpack -lsuitesparseconfig -llapack -lblas \
             -lgfortran -lgomp -lm
 

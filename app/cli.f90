@@ -1,6 +1,7 @@
 !> Command line of the sprc driver (SCENE.md, "Driver"): parsed and validated
 !> before any scene is read, so a bad option exits 2 at once.
 module sprc_app_cli
+   use sprc_fem_linear_solver, only: solver_choice, solver_names
    implicit none
    private
 
@@ -17,6 +18,8 @@ module sprc_app_cli
       integer :: threads = 0
       !> 0: from the FE order
       integer :: points = 0
+      !> --solver: overrides the scene's `solver` ('' when not given)
+      character(len=:), allocatable :: solver
       logical :: quiet = .false.
    end type cli_type
 
@@ -27,7 +30,8 @@ contains
       character(len=*), parameter :: nl = new_line('a')
       text = 'usage:'//nl// &
          '  sprc                          run the built-in default scene (Lame cylinder study)'//nl// &
-         '  sprc run SCENE.nml [--output PREFIX] [--levels 3,4,5] [--threads N] [--points Q] [--quiet]'//nl// &
+         '  sprc run SCENE.nml [--output PREFIX] [--levels 3,4,5] [--threads N] [--points Q]'//nl// &
+         '                     [--solver auto|direct|iterative] [--quiet]'//nl// &
          '  sprc check SCENE.nml          validate; print the scene and what it switches on and off'//nl// &
          '  sprc mesh SCENE.nml [--levels 3,4] [--points Q]   grid, classification, quadrature per level'//nl// &
          '  sprc --help | --version'//nl//nl// &
@@ -45,6 +49,7 @@ contains
 
       nargs = command_argument_count()
       cli%output = ''
+      cli%solver = ''
       if (nargs == 0) then
          cli%command = 'default'
          return
@@ -122,6 +127,12 @@ contains
          call parse_positive(arg, value, 10, cli%points, message)
       case ('--levels')
          call parse_levels(value, cli%levels, message)
+      case ('--solver')
+         if (solver_choice(value) == 0) then
+            message = 'sprc '//cli%command//': --solver "'//value//'" is not one of: '//solver_names
+            return
+         end if
+         cli%solver = value
       end select
    end subroutine parse_option
 
@@ -129,7 +140,7 @@ contains
       character(len=*), intent(in) :: command, option
       select case (command)
       case ('run')
-         allowed = any(option == [character(len=9) :: '--output', '--levels', '--threads', '--points'])
+         allowed = any(option == [character(len=9) :: '--output', '--levels', '--threads', '--points', '--solver'])
       case ('mesh')
          allowed = option == '--points' .or. option == '--levels'
       case default

@@ -89,6 +89,7 @@ contains
 
       call read_scene(cli%scene_path, scene, error)
       if (allocated(error)) call fail(2, error%message)
+      if (len(cli%solver) > 0) scene%solver = cli%solver
       call run_study(scene, cli)
    end subroutine run_scene_file
 

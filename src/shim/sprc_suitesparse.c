@@ -9,37 +9,18 @@
  * 64-bit SuiteSparse interfaces (cholmod_l_*, umfpack_dl_*) throughout, so
  * factors beyond 2^31 nonzeros work.
  */
-#include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "sprc_shim.h"
+
 #include <suitesparse/cholmod.h>
 #include <suitesparse/umfpack.h>
 
-/* Mirror sprc_core_error: never renumber. */
-enum {
-    SPRC_OK = 0,
-    SPRC_INVALID = 1,
-    SPRC_SINGULAR = 2,
-    SPRC_NOT_POSDEF = 3,
-    SPRC_NO_MEMORY = 6,
-    SPRC_INTERNAL = 8
-};
 
 _Static_assert(sizeof(SuiteSparse_long) == sizeof(int64_t), "SuiteSparse_long must be 64-bit");
-
-static int report(int status, char *msg, int64_t len, const char *fmt, ...)
-{
-    if (msg != NULL && len > 0) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(msg, (size_t)len, fmt, ap);
-        va_end(ap);
-    }
-    return status;
-}
 
 /* ------------------------------------------------------- BLAS thread count
  *

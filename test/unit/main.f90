@@ -27,6 +27,7 @@ program sprc_unit_tests
    use sprc_test_contact_model, only: collect_contact_model
    use sprc_test_contact_output, only: collect_contact_output
    use sprc_test_contact_fe, only: collect_contact_fe
+   use sprc_test_petsc, only: collect_petsc
    implicit none
 
    type(testsuite_type), allocatable :: suites(:)
@@ -56,7 +57,8 @@ program sprc_unit_tests
       new_testsuite('study', collect_study), &
       new_testsuite('contact_model', collect_contact_model), &
       new_testsuite('contact_output', collect_contact_output), &
-      new_testsuite('contact_fe', collect_contact_fe) &
+      new_testsuite('contact_fe', collect_contact_fe), &
+      new_testsuite('petsc', collect_petsc) &
       ]
 
    call get_arg(1, suite_name)

@@ -61,6 +61,7 @@ contains
          new_unittest('expect_has_enough_entries', test_expect_count), &
          new_unittest('malformed_files', test_malformed), &
          new_unittest('dilatation_key', test_dilatation_key), &
+         new_unittest('solver_key', test_solver_key), &
          new_unittest('nitsche_gamma_key', test_nitsche_gamma_key) &
          ]
    end subroutine collect_scene
@@ -331,6 +332,25 @@ contains
       call check(error, index(scene_summary(s), "dilatation      = projected") > 0 .and. &
          & index(scene_summary(s), "body 'b': on (dilatation = 'projected')") > 0, 'summary: projected on request')
    end subroutine test_dilatation_key
+
+   !> &scene solver: default 'auto', which check explains per dimension; a
+   !> choice is kept as given (case folded like every choice).
+   subroutine test_solver_key(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: s
+      call read_ok(minimal, s, error)
+      if (allocated(error)) return
+      call check(error, s%solver, 'auto', 'solver default')
+      if (allocated(error)) return
+      call check(error, index(scene_summary(s), 'solver          = auto (2D: CHOLMOD)') > 0, 'summary: 2D auto')
+      if (allocated(error)) return
+      call read_ok(replaced(minimal, 'box_size=4', "box_size=4 solver='Iterative'"), s, error)
+      if (allocated(error)) return
+      call check(error, s%solver, 'iterative', 'solver given')
+      if (allocated(error)) return
+      call check(error, index(scene_summary(s), 'solver          = iterative'//new_line('a')) > 0, &
+         & 'summary: iterative')
+   end subroutine test_solver_key
 
    !> &scene nitsche_gamma: default 10 (p+1)^2; outside the safe range the
    !> summary carries a warning (and the driver prints it on standard error).

@@ -14,7 +14,7 @@ module sprc_fem_linear_solver
    use, intrinsic :: iso_c_binding, only: c_char, c_null_char, c_int
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular, &
-      & stat_not_positive_definite, stat_out_of_memory, stat_internal
+      & stat_not_positive_definite, stat_not_converged, stat_out_of_memory, stat_internal
    use sprc_core_lapack, only: dlacn2
    use sprc_core_blas_threads, only: blas_threads, set_blas_threads
    use sprc_fem_sparse, only: csr_type, csr_validate
@@ -22,6 +22,18 @@ module sprc_fem_linear_solver
    private
 
    public :: linear_solver_type, backend_error, message_length, blas_threads, set_blas_threads
+   public :: solver_auto, solver_direct, solver_iterative, solver_names, solver_choice, use_iterative, &
+      & auto_iterative_min_dofs
+
+   !> The scene's `solver`: 'auto', 'direct' (CHOLMOD, UMFPACK) or 'iterative'
+   !> (Krylov + algebraic multigrid, `sprc_fem_petsc`); codes in `solver_names` order.
+   integer, parameter :: solver_auto = 1, solver_direct = 2, solver_iterative = 3
+   character(len=*), parameter :: solver_names = 'auto direct iterative'
+
+   !> 'auto' solves a 3D system iteratively from this many unknowns on (the
+   !> crossover of the two solve times on a 2-core machine, README); 2D
+   !> systems stay direct (CHOLMOD's fill is mild there).
+   integer, parameter :: auto_iterative_min_dofs = 50000
 
    !> Length of the message buffer the C shim fills.
    integer, parameter :: message_length = 512
@@ -265,7 +277,7 @@ contains
 
    !> The one translation of a C-shim status into an `error_type`: `status` is
    !> one of the shim's codes (which mirror `stat_*`: 0 success, 1 invalid
-   !> input, 2 singular, 3 not positive definite, 6 out of memory, 8
+   !> input, 2 singular, 3 not positive definite, 4 not converged, 6 out of memory, 8
    !> internal), `message` the NUL-terminated text the shim wrote.
    subroutine backend_error(status, message, error)
       integer, intent(in) :: status
@@ -282,6 +294,8 @@ contains
          stat = stat_singular
       case (3)
          stat = stat_not_positive_definite
+      case (4)
+         stat = stat_not_converged
       case (6)
          stat = stat_out_of_memory
       case default
@@ -291,5 +305,28 @@ contains
       if (last < 0) last = len(message)
       call fatal_error(error, message(1:last), stat)
    end subroutine backend_error
+
+   !> The code of a `solver_names` entry; 0 for any other name.
+   pure integer function solver_choice(name) result(code)
+      character(len=*), intent(in) :: name
+      select case (name)
+      case ('auto')
+         code = solver_auto
+      case ('direct')
+         code = solver_direct
+      case ('iterative')
+         code = solver_iterative
+      case default
+         code = 0
+      end select
+   end function solver_choice
+
+   !> Whether the solver `choice` means the iterative solver for a system of
+   !> `n` unknowns in dimension `dim`.
+   pure logical function use_iterative(choice, dim, n)
+      integer, intent(in) :: choice, dim, n
+      use_iterative = choice == solver_iterative .or. &
+         & (choice == solver_auto .and. dim == 3 .and. n >= auto_iterative_min_dofs)
+   end function use_iterative
 
 end module sprc_fem_linear_solver

@@ -1,5 +1,5 @@
 !> Linear elasticity on one body's cut Cartesian grid: Q1 / Q2 elements,
-!> immersed boundary conditions, small-cut robustness, sparse direct solve and
+!> immersed boundary conditions, small-cut robustness, sparse direct or iterative solve and
 !> the post-processing the recovery and the report need.
 !>
 !> Use:
@@ -80,7 +80,8 @@ module sprc_fem_problem
    use sprc_fem_sparse, only: coo_type, csr_type
    use sprc_fem_cholmod, only: cholmod_solver_type
    use sprc_fem_umfpack, only: umfpack_solver_type
-   use sprc_fem_linear_solver, only: linear_solver_type
+   use sprc_fem_linear_solver, only: linear_solver_type, solver_auto, use_iterative
+   use sprc_fem_petsc, only: petsc_solver_type, iteration_tolerance
    use sprc_fem_element, only: shape_functions, strain_matrix, traction_matrix, displacement_matrix, &
       & add_stiffness, element_stress, element_strain
    use sprc_fem_bc, only: fe_bc_type, check_bcs, bc_free, bc_pressure, bc_traction, bc_displacement, &
@@ -149,8 +150,13 @@ module sprc_fem_problem
       !> Reduced solution and nodal displacements (dim, n_nodes).
       real(wp), allocatable :: ubar(:), u(:, :)
       logical :: solved = .false.
-      !> 'cholmod' or 'umfpack'; why the fallback was taken ('' if not).
+      !> Linear solver choice (`sprc_fem_linear_solver`: solver_auto, solver_direct,
+      !> solver_iterative); a setting, read by `solve_reduced`.
+      integer :: solver = solver_auto
+      !> 'cholmod', 'umfpack', 'cg+gamg' or 'gmres+gamg'; why the fallback was taken ('' if not).
       character(len=:), allocatable :: solver_name, solver_note
+      !> Krylov iterations of the last solve (0 for a direct solve).
+      integer :: solver_iterations = 0
       !> Reciprocal 1-norm condition estimate of the reduced stiffness (from the solver).
       real(wp) :: rcond = -1.0_wp
       !> Wall-clock seconds of the phases.
@@ -1030,13 +1036,19 @@ contains
       vec = g(:, 1:nfree)
    end subroutine free_motions
 
-   !> CHOLMOD, or UMFPACK when CHOLMOD finds K not positive definite.
+   !> The iterative solver when `solver` asks for it at this size (`use_iterative`);
+   !> else CHOLMOD, or UMFPACK when CHOLMOD finds K not positive definite.
    subroutine factor_and_solve(self, error)
       type(elasticity_problem_type), intent(inout) :: self
       type(error_type), allocatable, intent(out) :: error
 
       if (allocated(self%ubar)) deallocate (self%ubar)
       allocate (self%ubar(self%constraints%n_dofs))
+      self%solver_iterations = 0
+      if (use_iterative(self%solver, self%dim, self%constraints%n_dofs)) then
+         call iterative_solve(self, error)
+         return
+      end if
       call solve_spd_or_lu(self%k, self%f, self%ubar, self%rcond, self%solver_name, self%solver_note, error)
       if (allocated(error)) error%message = 'elasticity solve'//error%message
    end subroutine factor_and_solve
@@ -1058,7 +1070,7 @@ contains
 
       solver_name = 'cholmod'
       note = ''
-      call direct_solve(chol, k, f, x, rcond, error)
+      call solve_with(chol, k, f, x, rcond, error)
       if (.not. allocated(error)) return
       if (error%stat /= stat_not_positive_definite) then
          error%message = ': '//error%message
@@ -1068,9 +1080,39 @@ contains
       note = 'CHOLMOD found the stiffness not positive definite ('//error%message// &
          & '); solved by UMFPACK (LU). Raise gamma for an SPD system.'
       deallocate (error)
-      call direct_solve(lu, k, f, x, rcond, error)
+      call solve_with(lu, k, f, x, rcond, error)
       if (allocated(error)) error%message = ' (UMFPACK fallback): '//error%message
    end subroutine solve_spd_or_lu
+
+   !> CG + GAMG (`sprc_fem_petsc`) on the masters' blocks, stopped at
+   !> `iteration_tolerance` of the finest cell; GMRES + GAMG when CG finds K
+   !> indefinite (the iterative counterpart of the UMFPACK fallback).
+   subroutine iterative_solve(self, error)
+      type(elasticity_problem_type), intent(inout) :: self
+      type(error_type), allocatable, intent(out) :: error
+      type(petsc_solver_type) :: krylov
+
+      call krylov%set_blocks(self%constraints%dof, self%nodes%x(:, self%constraints%master_node), error)
+      if (allocated(error)) return
+      krylov%tolerance = iteration_tolerance(0.5_wp**self%grid%max_level, self%degree)
+      self%solver_name = 'cg+gamg'
+      self%solver_note = ''
+      call solve_with(krylov, self%k, self%f, self%ubar, self%rcond, error)
+      self%solver_iterations = krylov%iterations
+      if (.not. allocated(error)) return
+      if (error%stat /= stat_not_positive_definite) then
+         error%message = 'elasticity solve (iterative): '//error%message
+         return
+      end if
+      self%solver_name = 'gmres+gamg'
+      self%solver_note = 'CG found the stiffness not positive definite ('//error%message// &
+         & '); solved by GMRES. Raise gamma for an SPD system.'
+      deallocate (error)
+      krylov%symmetric = .false.
+      call solve_with(krylov, self%k, self%f, self%ubar, self%rcond, error)
+      self%solver_iterations = self%solver_iterations + krylov%iterations
+      if (allocated(error)) error%message = 'elasticity solve (GMRES fallback): '//error%message
+   end subroutine iterative_solve
 
    !> theta_bar on every aggregate from the nodal displacements (projected dilatation only).
    subroutine dilatation_coefficients(self)
@@ -1095,9 +1137,9 @@ contains
       end do
    end subroutine dilatation_coefficients
 
-   !> Factorize k with `solver`, solve k x = f, release the factor; `rcond`
-   !> gets the solver's condition estimate.
-   subroutine direct_solve(solver, k, f, x, rcond, error)
+   !> Factorize (or set up) k with `solver`, solve k x = f, release the factor;
+   !> `rcond` gets the solver's condition estimate (-1 when it makes none).
+   subroutine solve_with(solver, k, f, x, rcond, error)
       class(linear_solver_type), intent(inout) :: solver
       type(csr_type), intent(in) :: k
       real(wp), intent(in) :: f(:)
@@ -1111,7 +1153,7 @@ contains
          call solver%solve(f, x, error)
       end if
       call solver%destroy()
-   end subroutine direct_solve
+   end subroutine solve_with
 
    !> Nodal displacements ue(dim*nen) of element e, node-major.
    pure subroutine element_displacements(self, e, ue)

@@ -7,6 +7,7 @@ module sprc_io_scene
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
    use sprc_core_kinds, only: wp, i8
    use sprc_fem_dilatation, only: projected_poisson
+   use sprc_fem_linear_solver, only: solver_names, auto_iterative_min_dofs
    use sprc_fem_problem, only: default_gamma, gamma_note
    use sprc_core_text, only: itoa, real_text
    use sprc_core_error, only: error_type, fatal_error, stat_unsupported
@@ -23,7 +24,7 @@ module sprc_io_scene
    character(len=*), parameter :: known_groups(6) = [character(len=7) :: 'scene', 'body', 'shape', 'bc', &
       & 'exact', 'contact']
    character(len=*), parameter :: scene_keys = 'title analysis order levels refine_boundary box_min box_size '// &
-      & 'recovery recovery_degree output dilatation nitsche_gamma'
+      & 'recovery recovery_degree output dilatation nitsche_gamma solver'
    character(len=*), parameter :: body_keys = 'name young poisson body_force box_min box_size'
    character(len=*), parameter :: shape_fields = 'center radius semi_axes lower upper point normal axis'
    character(len=*), parameter :: shape_keys = 'body op kind name '//shape_fields
@@ -230,6 +231,9 @@ contains
          if (allocated(error)) return
          scene%nitsche_gamma = default_gamma(scene%order)
          call get_positive(g, 'nitsche_gamma', .false., scene%nitsche_gamma, error)
+         if (allocated(error)) return
+         scene%solver = 'auto'
+         call get_choice(g, 'solver', solver_names, .false., scene%solver, error)
          if (allocated(error)) return
          call nml_check_consumed(g, error)
       end associate
@@ -1042,6 +1046,7 @@ contains
       text = text//"  output          = '"//scene%output//"'"//nl
       text = text//'  dilatation      = '//scene%dilatation//nl
       text = text//'  nitsche_gamma   = '//real_text(scene%nitsche_gamma)//nl
+      text = text//'  solver          = '//scene%solver//solver_line(scene)//nl
       do i = 1, size(scene%bodies)
          associate (b => scene%bodies(i))
             text = text//"body '"//b%name//"': young = "//real_text(b%young)//', poisson = '// &
@@ -1137,6 +1142,19 @@ contains
          text = text//"  output files: off (output = '')"//nl
       end if
    end function switches
+
+   !> What `solver` means for this scene's dimension (for `sprc check`).
+   function solver_line(scene) result(text)
+      type(scene_type), intent(in) :: scene
+      character(len=:), allocatable :: text
+      text = ''
+      if (scene%solver /= 'auto') return
+      if (scene%analysis == 'solid') then
+         text = ' (3D: CG + algebraic multigrid from '//itoa(auto_iterative_min_dofs)//' unknowns, CHOLMOD below)'
+      else
+         text = ' (2D: CHOLMOD)'
+      end if
+   end function solver_line
 
    !> Per body: whether the locking-free formulation (projected dilatation) is on, and why.
    function dilatation_lines(scene) result(text)

@@ -38,6 +38,7 @@ module sprc_study_level
    use sprc_fem_problem, only: elasticity_problem_type
    use sprc_fem_recovery_input, only: fe_recovery_input
    use sprc_fem_dilatation, only: dilatation_choice
+   use sprc_fem_linear_solver, only: solver_choice
    use sprc_study_spec, only: scene_type, contact_spec_type, recovery_degree, contact_unsupported
    use sprc_study_model, only: build_bodies, build_exact, body_conditions, analysis_kind, analysis_units_type, &
       & analysis_units, in_units
@@ -287,6 +288,7 @@ contains
          call bl%problem%assemble(error)
          return
       end if
+      if (allocated(study%scene%solver)) bl%problem%solver = solver_choice(study%scene%solver)
       call bl%problem%solve(error)
       if (allocated(error)) return
       call finish_body(study, sb, bl, 0, error)
@@ -561,6 +563,7 @@ contains
             row%t_quadrature = row%t_quadrature + bl%problem%t_quadrature
             row%t_assembly = row%t_assembly + bl%problem%t_assembly
             row%t_solve = row%t_solve + bl%problem%t_solve
+            row%solver_iterations = row%solver_iterations + bl%problem%solver_iterations
          end associate
       end do
       if (study%have_exact) then

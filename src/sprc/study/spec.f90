@@ -165,6 +165,8 @@ module sprc_study_spec
       character(len=:), allocatable :: dilatation
       !> Nitsche penalty factor, > 0 (default `default_gamma(order)`).
       real(wp) :: nitsche_gamma = 0.0_wp
+      !> Linear solver: 'auto' | 'direct' | 'iterative' (`sprc_fem_linear_solver`).
+      character(len=:), allocatable :: solver
       type(body_spec_type), allocatable :: bodies(:)
       type(shape_spec_type), allocatable :: shapes(:)
       type(bc_spec_type), allocatable :: bcs(:)

@@ -1,0 +1,467 @@
+/* Thin shim over PETSc (KSP CG or GMRES, PCGAMG) for sprc's iterative back end
+ * (src/sprc/fem/petsc.f90 is its only caller).
+ *
+ * The Fortran side passes a square matrix in 0-based CSR with PetscInt (int32)
+ * indices, already padded to whole blocks of `dim` unknowns, and the
+ * coordinates of each block's node, from which the rigid-body near-null space
+ * is built. Every function returns a status mirroring sprc's stat_* codes and
+ * writes a NUL-terminated message into the caller's buffer; nothing here
+ * prints: PETSc's error handler is the one that only returns codes, and its
+ * signal handler is off.
+ *
+ * Loading. PETSc (with Open MPI, hypre, MUMPS, ... and the Open MPI build of
+ * HDF5) is loaded with dlopen when the iterative solver is first used, not
+ * linked: a direct solve never pays its start-up (about 20 MB of resident
+ * memory, and exit-time work), and the MPI build of HDF5 enters the process
+ * only then, after the serial HDF5 that sprc uses has bound every H5 symbol.
+ * The functions are called through pointers found by dlsym.
+ *
+ * Declarations. Debian's pkg-config file for PETSc carries no MPI flags and
+ * fpm 0.12 has no per-file C flags, so this file does not include PETSc's or
+ * MPI's headers in the build: the few declarations it needs are below, for
+ * PETSc 3.18 as Debian builds it (32-bit PetscInt, double PetscScalar, Open
+ * MPI). `make test` compiles this file once more with -DSPRC_PETSC_HEADERS
+ * and PETSc's and MPI's own headers: every prototype below is then checked
+ * for compatibility by the compiler and every constant by a static assert, so
+ * a PETSc that differs fails the suite instead of the run.
+ *
+ * Not thread-safe: one solve at a time per process (PETSc's own rule).
+ */
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sprc_shim.h"
+#include <math.h>
+#include <dlfcn.h>
+
+/* The constants used, with their PETSc 3.18 values. */
+#define SPRC_PETSC_CONSTANTS(X)         \
+    X(PETSC_DEFAULT, -2)                \
+    X(KSP_NORM_PRECONDITIONED, 1)       \
+    X(KSP_NORM_NATURAL, 3)              \
+    X(KSP_CONVERGED_ITERATING, 0)       \
+    X(KSP_CONVERGED_ATOL, 3)            \
+    X(KSP_DIVERGED_ITS, -3)             \
+    X(KSP_DIVERGED_NANORINF, -9)        \
+    X(KSP_DIVERGED_INDEFINITE_PC, -8)   \
+    X(KSP_DIVERGED_INDEFINITE_MAT, -10) \
+    X(PETSC_ERR_MEM, 55)
+
+#ifdef SPRC_PETSC_HEADERS
+#include <petscksp.h>
+#define SPRC_CHECK_CONSTANT(name, value) _Static_assert((name) == (value), #name " differs in this PETSc");
+SPRC_PETSC_CONSTANTS(SPRC_CHECK_CONSTANT)
+_Static_assert(sizeof(PetscInt) == 4 && sizeof(PetscScalar) == 8 && sizeof(PetscReal) == 8,
+               "this PETSc's scalar types differ from Debian's libpetsc-real-dev");
+_Static_assert(NORM_2 == 1, "NORM_2 differs in this PETSc");
+#else
+typedef int PetscErrorCode;
+typedef int PetscInt;
+typedef double PetscScalar;
+typedef double PetscReal;
+typedef enum { PETSC_FALSE, PETSC_TRUE } PetscBool;
+typedef enum { PETSC_ERROR_INITIAL, PETSC_ERROR_REPEAT, PETSC_ERROR_IN_CXX } PetscErrorType;
+typedef enum { NORM_1 = 0, NORM_2 = 1 } NormType;
+typedef int KSPNormType;
+typedef int KSPConvergedReason;
+typedef struct ompi_communicator_t *MPI_Comm;
+typedef struct _p_Mat *Mat;
+typedef struct _p_Vec *Vec;
+typedef struct _p_KSP *KSP;
+typedef struct _p_PC *PC;
+typedef struct _p_MatNullSpace *MatNullSpace;
+typedef struct _p_PetscOptions *PetscOptions;
+typedef const char *MatType;
+typedef const char *KSPType;
+typedef const char *PCType;
+#define SPRC_DEFINE_CONSTANT(name, value) enum { name = (value) };
+SPRC_PETSC_CONSTANTS(SPRC_DEFINE_CONSTANT)
+#endif
+
+/* Open MPI's MPI_COMM_SELF (PETSc's PETSC_COMM_SELF) is this object. */
+extern struct ompi_predefined_communicator_t ompi_mpi_comm_self;
+extern PetscErrorCode PetscInitializeNoArguments(void);
+extern PetscErrorCode PetscInitialized(PetscBool *);
+extern PetscErrorCode PetscOptionsSetValue(PetscOptions, const char[], const char[]);
+extern PetscErrorCode PetscReturnErrorHandler(MPI_Comm, int, const char *, const char *, PetscErrorCode,
+                                              PetscErrorType, const char *, void *);
+extern PetscErrorCode PetscPushErrorHandler(PetscErrorCode (*)(MPI_Comm, int, const char *, const char *,
+                                                               PetscErrorCode, PetscErrorType, const char *, void *),
+                                            void *);
+extern PetscErrorCode PetscErrorMessage(int, const char *[], char **);
+extern PetscErrorCode MatCreate(MPI_Comm, Mat *);
+extern PetscErrorCode MatSetSizes(Mat, PetscInt, PetscInt, PetscInt, PetscInt);
+extern PetscErrorCode MatSetType(Mat, MatType);
+extern PetscErrorCode MatSetBlockSize(Mat, PetscInt);
+extern PetscErrorCode MatSeqAIJSetPreallocationCSR(Mat, const PetscInt[], const PetscInt[], const PetscScalar[]);
+extern PetscErrorCode MatSetNearNullSpace(Mat, MatNullSpace);
+extern PetscErrorCode MatDestroy(Mat *);
+extern PetscErrorCode MatNullSpaceCreateRigidBody(Vec, MatNullSpace *);
+extern PetscErrorCode MatNullSpaceDestroy(MatNullSpace *);
+extern PetscErrorCode VecCreateSeq(MPI_Comm, PetscInt, Vec *);
+extern PetscErrorCode VecSetBlockSize(Vec, PetscInt);
+extern PetscErrorCode VecGetArray(Vec, PetscScalar **);
+extern PetscErrorCode VecRestoreArray(Vec, PetscScalar **);
+extern PetscErrorCode VecDot(Vec, Vec, PetscScalar *);
+extern PetscErrorCode VecNorm(Vec, NormType, PetscReal *);
+extern PetscErrorCode VecDuplicate(Vec, Vec *);
+extern PetscErrorCode VecDestroy(Vec *);
+extern PetscErrorCode KSPCreate(MPI_Comm, KSP *);
+extern PetscErrorCode KSPSetOperators(KSP, Mat, Mat);
+extern PetscErrorCode KSPSetType(KSP, KSPType);
+extern PetscErrorCode KSPGetPC(KSP, PC *);
+extern PetscErrorCode KSPSetNormType(KSP, KSPNormType);
+extern PetscErrorCode KSPSetComputeSingularValues(KSP, PetscBool);
+extern PetscErrorCode KSPSetFromOptions(KSP);
+extern PetscErrorCode KSPSetUp(KSP);
+extern PetscErrorCode KSPSetTolerances(KSP, PetscReal, PetscReal, PetscReal, PetscInt);
+extern PetscErrorCode KSPSetConvergenceTest(KSP, PetscErrorCode (*)(KSP, PetscInt, PetscReal, KSPConvergedReason *,
+                                                                    void *),
+                                            void *, PetscErrorCode (*)(void *));
+extern PetscErrorCode KSPSolve(KSP, Vec, Vec);
+extern PetscErrorCode KSPGetConvergedReason(KSP, KSPConvergedReason *);
+extern PetscErrorCode KSPGetIterationNumber(KSP, PetscInt *);
+extern PetscErrorCode KSPComputeExtremeSingularValues(KSP, PetscReal *, PetscReal *);
+extern PetscErrorCode KSPDestroy(KSP *);
+extern PetscErrorCode PCSetType(PC, PCType);
+extern PetscErrorCode PCApply(PC, Vec, Vec);
+extern PetscErrorCode KSPGetConvergedReasonString(KSP, const char **);
+
+/* The soname of Debian's PETSc 3.18 (real scalars, 32-bit indices). */
+#define SPRC_PETSC_LIBRARY "libpetsc_real.so.3.18"
+
+#define SPRC_PETSC_FUNCTIONS(X)                                                                              \
+    X(PetscInitializeNoArguments) X(PetscInitialized) X(PetscOptionsSetValue) X(PetscReturnErrorHandler)    \
+    X(PetscPushErrorHandler) X(PetscErrorMessage) X(MatCreate) X(MatSetSizes) X(MatSetType)                 \
+    X(MatSetBlockSize) X(MatSeqAIJSetPreallocationCSR) X(MatSetNearNullSpace) X(MatDestroy)                  \
+    X(MatNullSpaceCreateRigidBody) X(MatNullSpaceDestroy) X(VecCreateSeq) X(VecSetBlockSize) X(VecGetArray)  \
+    X(VecRestoreArray) X(VecDot) X(VecNorm) X(VecDuplicate) X(VecDestroy) X(KSPCreate) X(KSPSetOperators)    \
+    X(KSPSetType) X(KSPGetPC) X(KSPSetNormType) X(KSPSetComputeSingularValues) X(KSPSetFromOptions)          \
+    X(KSPSetUp) X(KSPSetTolerances) X(KSPSetConvergenceTest) X(KSPSolve) X(KSPGetConvergedReason)           \
+    X(KSPGetIterationNumber) X(KSPComputeExtremeSingularValues) X(KSPDestroy) X(PCSetType) X(PCApply)       \
+    X(KSPGetConvergedReasonString)
+
+/* One pointer per function, set by load_petsc; from here on every call of
+ * such a function goes through its pointer. */
+#define SPRC_DECLARE_POINTER(f) static __typeof__(f) *p_##f;
+SPRC_PETSC_FUNCTIONS(SPRC_DECLARE_POINTER)
+static struct ompi_predefined_communicator_t *p_comm_self;
+#define PetscInitializeNoArguments (*p_PetscInitializeNoArguments)
+#define PetscInitialized (*p_PetscInitialized)
+#define PetscOptionsSetValue (*p_PetscOptionsSetValue)
+#define PetscReturnErrorHandler (*p_PetscReturnErrorHandler)
+#define PetscPushErrorHandler (*p_PetscPushErrorHandler)
+#define PetscErrorMessage (*p_PetscErrorMessage)
+#define MatCreate (*p_MatCreate)
+#define MatSetSizes (*p_MatSetSizes)
+#define MatSetType (*p_MatSetType)
+#define MatSetBlockSize (*p_MatSetBlockSize)
+#define MatSeqAIJSetPreallocationCSR (*p_MatSeqAIJSetPreallocationCSR)
+#define MatSetNearNullSpace (*p_MatSetNearNullSpace)
+#define MatDestroy (*p_MatDestroy)
+#define MatNullSpaceCreateRigidBody (*p_MatNullSpaceCreateRigidBody)
+#define MatNullSpaceDestroy (*p_MatNullSpaceDestroy)
+#define VecCreateSeq (*p_VecCreateSeq)
+#define VecSetBlockSize (*p_VecSetBlockSize)
+#define VecGetArray (*p_VecGetArray)
+#define VecRestoreArray (*p_VecRestoreArray)
+#define VecDot (*p_VecDot)
+#define VecNorm (*p_VecNorm)
+#define VecDuplicate (*p_VecDuplicate)
+#define VecDestroy (*p_VecDestroy)
+#define KSPCreate (*p_KSPCreate)
+#define KSPSetOperators (*p_KSPSetOperators)
+#define KSPSetType (*p_KSPSetType)
+#define KSPGetPC (*p_KSPGetPC)
+#define KSPSetNormType (*p_KSPSetNormType)
+#define KSPSetComputeSingularValues (*p_KSPSetComputeSingularValues)
+#define KSPSetFromOptions (*p_KSPSetFromOptions)
+#define KSPSetUp (*p_KSPSetUp)
+#define KSPSetTolerances (*p_KSPSetTolerances)
+#define KSPSetConvergenceTest (*p_KSPSetConvergenceTest)
+#define KSPSolve (*p_KSPSolve)
+#define KSPGetConvergedReason (*p_KSPGetConvergedReason)
+#define KSPGetIterationNumber (*p_KSPGetIterationNumber)
+#define KSPComputeExtremeSingularValues (*p_KSPComputeExtremeSingularValues)
+#define KSPDestroy (*p_KSPDestroy)
+#define PCSetType (*p_PCSetType)
+#define PCApply (*p_PCApply)
+#define KSPGetConvergedReasonString (*p_KSPGetConvergedReasonString)
+#undef PETSC_COMM_SELF
+#define PETSC_COMM_SELF ((MPI_Comm)(void *)p_comm_self)
+
+
+/* A PETSc error code as a status and a message naming the call that failed. */
+static int petsc_failure(PetscErrorCode ierr, const char *call, char *msg, int64_t len)
+{
+    const char *text = NULL;
+    if (PetscErrorMessage(ierr, &text, NULL) != 0 || text == NULL) text = "unknown error";
+    return report(ierr == PETSC_ERR_MEM ? SPRC_NO_MEMORY : SPRC_INTERNAL, msg, len,
+                  "PETSc %s failed: %s (error %d)", call, text, (int)ierr);
+}
+
+#define TRY(call)                                                  \
+    do {                                                           \
+        PetscErrorCode ierr_ = (call);                             \
+        if (ierr_ != 0) return petsc_failure(ierr_, #call, msg, len); \
+    } while (0)
+
+/* dlopen PETSc and find every function (once per process). */
+static int load_petsc(char *msg, int64_t len)
+{
+    static void *lib = NULL;
+    void *h;
+    if (lib != NULL) return SPRC_OK;
+    h = dlopen(SPRC_PETSC_LIBRARY, RTLD_NOW | RTLD_GLOBAL);
+    if (h == NULL)
+        return report(SPRC_INTERNAL, msg, len, "PETSc: cannot load %s (%s); install libpetsc-real-dev "
+                      "(tools/ensure-deps) or use solver = 'direct'", SPRC_PETSC_LIBRARY, dlerror());
+#define SPRC_FIND(f)                                                                                          \
+    if ((*(void **)&p_##f = dlsym(h, #f)) == NULL)                                                             \
+        return report(SPRC_INTERNAL, msg, len, "PETSc: %s has no %s", SPRC_PETSC_LIBRARY, #f);
+    SPRC_PETSC_FUNCTIONS(SPRC_FIND)
+#undef SPRC_FIND
+    p_comm_self = dlsym(h, "ompi_mpi_comm_self");
+    if (p_comm_self == NULL)
+        return report(SPRC_INTERNAL, msg, len, "PETSc: %s is not built on Open MPI", SPRC_PETSC_LIBRARY);
+    lib = h;
+    return SPRC_OK;
+}
+
+/* PETSc (and MPI, as a singleton when not under mpirun) once per process. */
+static int ensure_petsc(char *msg, int64_t len)
+{
+    PetscBool up = PETSC_FALSE;
+    int status = load_petsc(msg, len);
+    if (status != SPRC_OK) return status;
+    TRY(PetscInitialized(&up));
+    if (up) return SPRC_OK;
+    /* before PetscInitialize: a library does not take over the signals */
+    TRY(PetscOptionsSetValue(NULL, "-no_signal_handler", NULL));
+    TRY(PetscInitializeNoArguments());
+    TRY(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+    return SPRC_OK;
+}
+
+typedef struct {
+    Mat a;
+    KSP ksp;
+    Vec b, x, w;
+    int symmetric;
+    double tau, bnorm; /* the solve's tolerance and size of b (energy_test) */
+    double kappa;      /* condition estimate of B A (CG), 1 for GMRES */
+    double bound;      /* the stopping quantity at the last iteration */
+} sprc_petsc;
+
+void sprc_petsc_free(void **handle)
+{
+    sprc_petsc *s = *handle;
+    if (s == NULL) return;
+    KSPDestroy(&s->ksp);
+    MatDestroy(&s->a);
+    VecDestroy(&s->b);
+    VecDestroy(&s->x);
+    VecDestroy(&s->w);
+    free(s);
+    *handle = NULL;
+}
+
+/* Matrix with block size `dim` and its rigid-body near-null space from the
+ * node coordinates coords(dim, n/dim). */
+static int build_matrix(sprc_petsc *s, PetscInt n, PetscInt dim, const PetscInt *rowptr, const PetscInt *col,
+                        const double *val, const double *coords, char *msg, int64_t len)
+{
+    Vec xyz = NULL;
+    MatNullSpace nearnull = NULL;
+    PetscScalar *p;
+
+    TRY(MatCreate(PETSC_COMM_SELF, &s->a));
+    TRY(MatSetSizes(s->a, n, n, n, n));
+    TRY(MatSetType(s->a, "seqaij"));
+    TRY(MatSetBlockSize(s->a, dim));
+    TRY(MatSeqAIJSetPreallocationCSR(s->a, rowptr, col, val));
+    TRY(VecCreateSeq(PETSC_COMM_SELF, n, &xyz));
+    TRY(VecSetBlockSize(xyz, dim));
+    TRY(VecGetArray(xyz, &p));
+    memcpy(p, coords, (size_t)n * sizeof(double));
+    TRY(VecRestoreArray(xyz, &p));
+    TRY(MatNullSpaceCreateRigidBody(xyz, &nearnull));
+    TRY(MatSetNearNullSpace(s->a, nearnull));
+    TRY(MatNullSpaceDestroy(&nearnull));
+    TRY(VecDestroy(&xyz));
+    return SPRC_OK;
+}
+
+/* CG (symmetric) or GMRES with GAMG; the algebraic-multigrid hierarchy is
+ * built here (KSPSetUp). PETSc options given in PETSC_OPTIONS are applied
+ * (-ksp_view and the like, for experiments). */
+static int build_solver(sprc_petsc *s, char *msg, int64_t len)
+{
+    PC pc;
+    TRY(KSPCreate(PETSC_COMM_SELF, &s->ksp));
+    TRY(KSPSetOperators(s->ksp, s->a, s->a));
+    TRY(KSPSetType(s->ksp, s->symmetric ? "cg" : "gmres"));
+    TRY(KSPGetPC(s->ksp, &pc));
+    TRY(PCSetType(pc, "gamg"));
+    TRY(KSPSetNormType(s->ksp, s->symmetric ? KSP_NORM_NATURAL : KSP_NORM_PRECONDITIONED));
+    TRY(KSPSetComputeSingularValues(s->ksp, s->symmetric ? PETSC_TRUE : PETSC_FALSE));
+    TRY(KSPSetFromOptions(s->ksp));
+    TRY(KSPSetUp(s->ksp));
+    return SPRC_OK;
+}
+
+static int create_vectors(sprc_petsc *s, PetscInt n, PetscInt dim, char *msg, int64_t len)
+{
+    TRY(VecCreateSeq(PETSC_COMM_SELF, n, &s->b));
+    TRY(VecSetBlockSize(s->b, dim));
+    TRY(VecDuplicate(s->b, &s->x));
+    TRY(VecDuplicate(s->b, &s->w));
+    return SPRC_OK;
+}
+
+int sprc_petsc_setup(void **handle, int64_t n, int dim, const int32_t *rowptr, const int32_t *col,
+                     const double *val, const double *coords, int symmetric, char *msg, int64_t len)
+{
+    sprc_petsc *s;
+    int status;
+
+    *handle = NULL;
+    if (n < 1 || n > INT32_MAX || rowptr[n] < 0 || (dim != 2 && dim != 3) || n % dim != 0)
+        return report(SPRC_INVALID, msg, len, "PETSc setup: order %lld with block size %d does not fit", (long long)n,
+                      dim);
+    status = ensure_petsc(msg, len);
+    if (status != SPRC_OK) return status;
+    s = calloc(1, sizeof(*s));
+    if (s == NULL) return report(SPRC_NO_MEMORY, msg, len, "PETSc setup: cannot allocate a handle");
+    s->symmetric = symmetric;
+    *handle = s;
+    status = build_matrix(s, (PetscInt)n, dim, rowptr, col, val, coords, msg, len);
+    if (status == SPRC_OK) status = build_solver(s, msg, len);
+    if (status == SPRC_OK) status = create_vectors(s, (PetscInt)n, dim, msg, len);
+    if (status != SPRC_OK) sprc_petsc_free(handle);
+    return status;
+}
+
+static int copy_in(Vec v, const double *a, PetscInt n, char *msg, int64_t len)
+{
+    PetscScalar *p;
+    TRY(VecGetArray(v, &p));
+    memcpy(p, a, (size_t)n * sizeof(double));
+    TRY(VecRestoreArray(v, &p));
+    return SPRC_OK;
+}
+
+static int copy_out(Vec v, double *a, PetscInt n, char *msg, int64_t len)
+{
+    PetscScalar *p;
+    TRY(VecGetArray(v, &p));
+    memcpy(a, p, (size_t)n * sizeof(double));
+    TRY(VecRestoreArray(v, &p));
+    return SPRC_OK;
+}
+
+/* The size of b the stopping test measures against: the natural norm
+ * sqrt(b^T B b) for CG (B the GAMG preconditioner), ||B b||_2 for GMRES. */
+static int rhs_norm(sprc_petsc *s, double *bnorm, char *msg, int64_t len)
+{
+    PC pc;
+    PetscScalar bb;
+    PetscReal nrm;
+    TRY(KSPGetPC(s->ksp, &pc));
+    TRY(PCApply(pc, s->b, s->w));
+    if (s->symmetric) {
+        TRY(VecDot(s->b, s->w, &bb));
+        *bnorm = bb > 0.0 ? sqrt(bb) : 0.0;
+    } else {
+        TRY(VecNorm(s->w, NORM_2, &nrm));
+        *bnorm = nrm;
+    }
+    return SPRC_OK;
+}
+
+/* The stopping test (KSPSetConvergenceTest), run at every iteration. With e
+ * the iteration error, r = A e and B the preconditioner,
+ *   ||e||_A^2 = r^T A^-1 r <= r^T B r / lambda_min(BA),
+ *   ||x_h||_A^2 = b^T A^-1 b >= b^T B b / lambda_max(BA),
+ * so ||e||_A / ||x_h||_A <= sqrt(kappa(BA)) ||r||_B / ||b||_B =: bound. CG
+ * works in the natural norm ||r||_B, and its Lanczos process estimates
+ * kappa(BA) from its iterations (from inside: the extreme Ritz values
+ * converge to the extreme eigenvalues first, long before ||r||_B reaches the
+ * tolerance). The solve stops when bound <= tau. GMRES (unsymmetric A) has no
+ * such bound: it stops at ||B r||_2 <= tau ||B b||_2. */
+static PetscErrorCode energy_test(KSP ksp, PetscInt it, PetscReal rnorm, KSPConvergedReason *reason, void *ctx)
+{
+    sprc_petsc *s = ctx;
+    PetscReal emax, emin;
+
+    *reason = KSP_CONVERGED_ITERATING;
+    if (isnan(rnorm) || isinf(rnorm)) {
+        *reason = KSP_DIVERGED_NANORINF;
+        return 0;
+    }
+    if (s->symmetric && it > 0 && KSPComputeExtremeSingularValues(ksp, &emax, &emin) == 0 && emin > 0.0 &&
+        emax >= emin)
+        s->kappa = emax / emin;
+    s->bound = rnorm / s->bnorm * sqrt(s->kappa);
+    if (s->bound <= s->tau && (it > 0 || rnorm == 0.0)) *reason = KSP_CONVERGED_ATOL;
+    return 0;
+}
+
+static int run_ksp(sprc_petsc *s, int max_it, char *msg, int64_t len)
+{
+    TRY(KSPSetTolerances(s->ksp, 0.0, 0.0, PETSC_DEFAULT, max_it));
+    TRY(KSPSetConvergenceTest(s->ksp, energy_test, s, NULL));
+    TRY(KSPSolve(s->ksp, s->b, s->x));
+    return SPRC_OK;
+}
+
+static int ksp_outcome(sprc_petsc *s, int *iterations, char *msg, int64_t len)
+{
+    KSPConvergedReason reason;
+    PetscInt n_it;
+    const char *why = "unknown reason";
+    TRY(KSPGetConvergedReason(s->ksp, &reason));
+    TRY(KSPGetIterationNumber(s->ksp, &n_it));
+    *iterations = (int)n_it;
+    if (reason > 0) return SPRC_OK;
+    TRY(KSPGetConvergedReasonString(s->ksp, &why));
+    return report(reason == KSP_DIVERGED_INDEFINITE_PC || reason == KSP_DIVERGED_INDEFINITE_MAT ? SPRC_NOT_POSDEF
+                                                                                                : SPRC_NOT_CONVERGED,
+                  msg, len, "%s + GAMG stopped (%s) after %d iterations: relative residual bound %.3e, target %.3e",
+                  s->symmetric ? "CG" : "GMRES", why, *iterations, s->bound, s->tau);
+}
+
+/* Solve A x = b (b, x of order n) to the tolerance `tau` of energy_test in
+ * at most `max_it` iterations. `iterations` gets the Krylov iterations and
+ * `bound` the stopping quantity reached; a solve that ends otherwise is
+ * SPRC_NOT_CONVERGED (SPRC_NOT_POSDEF when CG meets an indefinite system)
+ * with the count and the bound in the message. */
+int sprc_petsc_solve(void *handle, int64_t n, const double *b, double *x, double tau, int max_it,
+                     int *iterations, double *bound, char *msg, int64_t len)
+{
+    sprc_petsc *s = handle;
+    double bnorm = 0.0;
+    int status;
+
+    *iterations = 0;
+    *bound = 0.0;
+    if (s == NULL) return report(SPRC_INVALID, msg, len, "PETSc solve: no solver was set up");
+    status = copy_in(s->b, b, (PetscInt)n, msg, len);
+    if (status == SPRC_OK) status = rhs_norm(s, &bnorm, msg, len);
+    if (status != SPRC_OK) return status;
+    if (!(bnorm > 0.0)) {
+        memset(x, 0, (size_t)n * sizeof(double));
+        return SPRC_OK;
+    }
+    s->tau = tau;
+    s->bnorm = bnorm;
+    s->kappa = 1.0;
+    s->bound = 1.0;
+    status = run_ksp(s, max_it, msg, len);
+    if (status == SPRC_OK) status = ksp_outcome(s, iterations, msg, len);
+    *bound = s->bound;
+    if (status != SPRC_OK) return status;
+    return copy_out(s->x, x, (PetscInt)n, msg, len);
+}

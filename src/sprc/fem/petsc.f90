@@ -1,0 +1,274 @@
+!> Iterative solver for the reduced elasticity system: PETSc's conjugate
+!> gradients (GMRES when the system is not symmetric) preconditioned by
+!> smoothed-aggregation algebraic multigrid (GAMG) with the rigid-body
+!> near-null space, through the C shim src/shim/sprc_petsc.c.
+!>
+!> Blocks. GAMG aggregates whole nodes (block size = dim) and interpolates the
+!> rigid-body modes exactly, so it needs each unknown's node and component.
+!> The reduced unknowns of `sprc_fem_constraints` are nodal values: the pair
+!> (master node m, component c) is unknown `dof(c, m)`, numbered master by
+!> master, and a hanging or aggregated node is a combination of masters,
+!> u_slave = sum_k t_k u_master_k. Hanging-node and aggregation constraints
+!> interpolate linear fields exactly, so a rigid mode r(x) = a + W x of the
+!> whole grid is T applied to r evaluated at the masters: the near-null space
+!> of the reduced system is the rigid modes at the master nodes' coordinates
+!> (what MatNullSpaceCreateRigidBody builds from them), with no term from the
+!> eliminated nodes. A component fixed at zero by a strong symmetry plane is
+!> not an unknown; it keeps its place in its node's block as an identity row
+!> (scaled to the mean diagonal, right-hand side 0, solution 0) so every block
+!> has dim rows; its rigid-mode entry is a harmless extra in the prolongation.
+!>
+!> Factorize is the multigrid setup, solve a Krylov solve per right-hand side.
+!> There is no condition estimate (`rcond_tol` is set to 0 by `set_blocks`).
+!> PETSc's indices are 32-bit in Debian's build: larger systems are refused.
+module sprc_fem_petsc
+   use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_associated, c_int, c_int32_t, c_int64_t, &
+      & c_double, c_char
+   use sprc_core_kinds, only: wp, i8
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_unsupported
+   use sprc_core_blas_threads, only: blas_serial_begin, blas_serial_end
+   use sprc_fem_sparse, only: csr_type
+   use sprc_fem_linear_solver, only: linear_solver_type, backend_error, message_length
+   implicit none
+   private
+
+   public :: petsc_solver_type, iteration_tolerance
+
+   !> Krylov solver with GAMG (module notes). Set the blocks (`set_blocks`)
+   !> before `factorize`; `tolerance`, `max_iterations` and `symmetric` are
+   !> settings, `iterations` and `residual_bound` results.
+   type, extends(linear_solver_type) :: petsc_solver_type
+      private
+      type(c_ptr) :: handle = c_null_ptr
+      integer :: dim = 0, n_padded = 0
+      !> Position (1-based) of each reduced unknown in the padded, blocked system.
+      integer, allocatable :: slot(:)
+      !> Coordinates of each block's node, dim values per block.
+      real(wp), allocatable :: coords(:)
+      !> Bound of the relative energy norm of the iteration error (CG; see
+      !> energy_test in the shim) at which a solve stops.
+      real(wp), public :: tolerance = 1.0e-8_wp
+      integer, public :: max_iterations = 1000
+      !> False: GMRES instead of CG (an unsymmetric system).
+      logical, public :: symmetric = .true.
+      !> Krylov iterations of all solves since `factorize`.
+      integer, public :: iterations = 0
+      !> The stopping quantity reached by the last solve (<= tolerance).
+      real(wp), public :: residual_bound = 0.0_wp
+   contains
+      procedure :: set_blocks
+      procedure :: factorize_backend => petsc_factorize
+      procedure :: solve_backend => petsc_solve
+      procedure :: destroy_backend => petsc_destroy
+   end type petsc_solver_type
+
+   interface
+      integer(c_int) function sprc_petsc_setup(handle, n, dim, rowptr, col, val, coords, symmetric, msg, len) &
+            & bind(c)
+         import :: c_ptr, c_int, c_int32_t, c_int64_t, c_double, c_char
+         type(c_ptr), intent(out) :: handle
+         integer(c_int64_t), value :: n
+         integer(c_int), value :: dim
+         integer(c_int32_t), intent(in) :: rowptr(*), col(*)
+         real(c_double), intent(in) :: val(*), coords(*)
+         integer(c_int), value :: symmetric
+         character(kind=c_char), intent(inout) :: msg(*)
+         integer(c_int64_t), value :: len
+      end function sprc_petsc_setup
+
+      integer(c_int) function sprc_petsc_solve(handle, n, b, x, tau, max_it, iterations, bound, msg, len) bind(c)
+         import :: c_ptr, c_int, c_int64_t, c_double, c_char
+         type(c_ptr), value :: handle
+         integer(c_int64_t), value :: n
+         real(c_double), intent(in) :: b(*)
+         real(c_double), intent(out) :: x(*)
+         real(c_double), value :: tau
+         integer(c_int), value :: max_it
+         integer(c_int), intent(out) :: iterations
+         real(c_double), intent(out) :: bound
+         character(kind=c_char), intent(inout) :: msg(*)
+         integer(c_int64_t), value :: len
+      end function sprc_petsc_solve
+
+      subroutine sprc_petsc_free(handle) bind(c)
+         import :: c_ptr
+         type(c_ptr), intent(inout) :: handle
+      end subroutine sprc_petsc_free
+   end interface
+
+contains
+
+   !> Stopping tolerance tied to the discretization: the iteration error in the
+   !> energy norm, relative to the solution's, at most 1e-7 (h/L)^p (h the
+   !> finest cell, L the grid box, p the element degree), and not below 1e-12
+   !> (round-off of the solve itself, ~eps sqrt(cond K)). The FE energy error
+   !> of a field that is not a polynomial of degree p is at least of order
+   !> 0.1 (h/L)^p relative (a priori estimate c h^p |u|_(p+1) with its
+   !> constant seldom below 0.1 on these bodies), so the iteration moves each
+   !> error and estimate of the report by about 1e-6 of its size or less: the
+   !> first six digits are the direct solve's. The FE error itself moves
+   !> only at second order (Galerkin orthogonality: the iteration error is
+   !> in the FE space).
+   pure real(wp) function iteration_tolerance(h_over_l, degree) result(tau)
+      real(wp), intent(in) :: h_over_l
+      integer, intent(in) :: degree
+      tau = max(1.0e-7_wp*h_over_l**degree, 1.0e-12_wp)
+   end function iteration_tolerance
+
+   !> The block layout: `dof(c, m)` is the reduced unknown of component c at
+   !> block m (0: the component is fixed at zero), `x(:, m)` that block's node.
+   !> Every reduced unknown 1..n must occur exactly once.
+   subroutine set_blocks(self, dof, x, error)
+      class(petsc_solver_type), intent(inout) :: self
+      integer, intent(in) :: dof(:, :)
+      real(wp), intent(in) :: x(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: m, c, n
+
+      self%dim = size(dof, 1)
+      self%rcond_tol = 0.0_wp
+      if (size(x, 1) /= self%dim .or. size(x, 2) /= size(dof, 2) .or. (self%dim /= 2 .and. self%dim /= 3)) then
+         call fatal_error(error, 'iterative solver: block layout and coordinates do not match', stat_invalid_input)
+         return
+      end if
+      n = count(dof > 0)
+      if (allocated(self%slot)) deallocate (self%slot)
+      allocate (self%slot(n))
+      self%slot = 0
+      do m = 1, size(dof, 2)
+         do c = 1, self%dim
+            if (dof(c, m) < 0 .or. dof(c, m) > n) exit
+            if (dof(c, m) > 0) self%slot(dof(c, m)) = (m - 1)*self%dim + c
+         end do
+      end do
+      if (any(self%slot == 0) .or. any(dof < 0) .or. any(dof > n)) then
+         deallocate (self%slot)
+         call fatal_error(error, 'iterative solver: the block layout does not number each unknown once', &
+            & stat_invalid_input)
+         return
+      end if
+      self%n_padded = self%dim*size(dof, 2)
+      self%coords = reshape(x, [self%n_padded])
+   end subroutine set_blocks
+
+   subroutine petsc_factorize(self, a, error)
+      class(petsc_solver_type), intent(inout) :: self
+      type(csr_type), intent(in) :: a
+      type(error_type), allocatable, intent(out) :: error
+      character(kind=c_char, len=message_length) :: msg
+      integer(c_int32_t), allocatable :: rowptr(:), col(:)
+      real(wp), allocatable :: val(:)
+      integer(c_int) :: status
+      integer :: saved
+
+      call petsc_destroy(self)
+      if (.not. allocated(self%slot)) then
+         call fatal_error(error, 'iterative solver: set_blocks was not called', stat_invalid_input)
+         return
+      else if (size(self%slot) /= a%nrows) then
+         call fatal_error(error, 'iterative solver: the matrix order differs from the block layout''s unknowns', &
+            & stat_invalid_input)
+         return
+      end if
+      call padded_csr(self, a, rowptr, col, val, error)
+      if (allocated(error)) return
+      msg = ''
+      saved = blas_serial_begin()
+      status = sprc_petsc_setup(self%handle, int(self%n_padded, c_int64_t), int(self%dim, c_int), rowptr, col, &
+         & val, self%coords, merge(1_c_int, 0_c_int, self%symmetric), msg, int(len(msg), c_int64_t))
+      call blas_serial_end(saved)
+      call backend_error(status, msg, error)
+      self%iterations = 0
+   end subroutine petsc_factorize
+
+   !> `a` in blocked order with identity rows (the mean diagonal) at the
+   !> fixed components; 0-based 32-bit CSR, refused if PETSc's 32-bit
+   !> indices cannot hold it.
+   subroutine padded_csr(self, a, rowptr, col, val, error)
+      class(petsc_solver_type), intent(in) :: self
+      type(csr_type), intent(in) :: a
+      integer(c_int32_t), allocatable, intent(out) :: rowptr(:), col(:)
+      real(wp), allocatable, intent(out) :: val(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer, allocatable :: row_of(:)
+      integer(i8) :: nnz, q, k
+      integer :: p, i
+      real(wp) :: mean_diag
+      character(len=200) :: buf
+
+      nnz = a%rowptr(a%nrows + 1) - 1 + int(self%n_padded - a%nrows, i8)
+      if (nnz > int(huge(1_c_int32_t), i8)) then
+         write (buf, '("iterative solver: ",i0," nonzeros exceed the 32-bit indices of this PETSc build ", &
+            & "(Debian libpetsc-real-dev); use solver = ''direct'' or a PETSc with 64-bit indices")') nnz
+         call fatal_error(error, trim(buf), stat_unsupported)
+         return
+      end if
+      allocate (row_of(self%n_padded), rowptr(self%n_padded + 1), col(nnz), val(nnz))
+      row_of = 0
+      row_of(self%slot) = [(i, i = 1, a%nrows)]
+      mean_diag = 0.0_wp
+      do i = 1, a%nrows
+         do q = a%rowptr(i), a%rowptr(i + 1) - 1
+            if (a%col(q) == i) mean_diag = mean_diag + abs(a%val(q))
+         end do
+      end do
+      mean_diag = max(mean_diag/real(max(a%nrows, 1), wp), tiny(1.0_wp))
+      k = 0
+      do p = 1, self%n_padded
+         rowptr(p) = int(k, c_int32_t)
+         i = row_of(p)
+         if (i == 0) then
+            k = k + 1
+            col(k) = int(p - 1, c_int32_t)
+            val(k) = mean_diag
+            cycle
+         end if
+         do q = a%rowptr(i), a%rowptr(i + 1) - 1
+            k = k + 1
+            col(k) = int(self%slot(a%col(q)) - 1, c_int32_t)
+            val(k) = a%val(q)
+         end do
+      end do
+      rowptr(self%n_padded + 1) = int(k, c_int32_t)
+   end subroutine padded_csr
+
+   subroutine petsc_solve(self, n, nrhs, b, x, transposed, error)
+      class(petsc_solver_type), intent(inout) :: self
+      integer, intent(in) :: n, nrhs
+      real(wp), intent(in) :: b(n, nrhs)
+      real(wp), intent(out) :: x(n, nrhs)
+      logical, intent(in) :: transposed
+      type(error_type), allocatable, intent(out) :: error
+      character(kind=c_char, len=message_length) :: msg
+      real(wp), allocatable :: bp(:), xp(:)
+      integer(c_int) :: status, its
+      integer :: j, saved
+
+      if (transposed .and. .not. self%symmetric) then
+         call fatal_error(error, 'iterative solver: transposed solves of an unsymmetric system are not supported', &
+            & stat_unsupported)
+         return
+      end if
+      allocate (bp(self%n_padded), xp(self%n_padded))
+      do j = 1, nrhs
+         bp = 0.0_wp
+         bp(self%slot) = b(:, j)
+         msg = ''
+         saved = blas_serial_begin()
+         status = sprc_petsc_solve(self%handle, int(self%n_padded, c_int64_t), bp, xp, &
+            & real(self%tolerance, c_double), int(self%max_iterations, c_int), its, self%residual_bound, msg, &
+            & int(len(msg), c_int64_t))
+         call blas_serial_end(saved)
+         self%iterations = self%iterations + its
+         call backend_error(status, msg, error)
+         if (allocated(error)) return
+         x(:, j) = xp(self%slot)
+      end do
+   end subroutine petsc_solve
+
+   subroutine petsc_destroy(self)
+      class(petsc_solver_type), intent(inout) :: self
+      if (c_associated(self%handle)) call sprc_petsc_free(self%handle)
+   end subroutine petsc_destroy
+
+end module sprc_fem_petsc

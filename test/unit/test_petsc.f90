@@ -1,0 +1,244 @@
+!> Tests of the iterative back end (`sprc_fem_petsc`: CG / GMRES + GAMG through
+!> PETSc) against the direct one on the same assembled systems.
+!>
+!> Independent reference: CHOLMOD's solution of the same reduced system. The
+!> iterative solve stops when its bound of the relative energy-norm error is
+!> below tau (`iteration_tolerance`); the bound uses a condition estimate
+!> from CG's Lanczos process, which approaches kappa(BA) from below, so the
+!> check allows 2 tau. The direct solution itself is off by at most
+!> c_backward eps / rcond relative in the same norm (backward stability:
+!> ||e||_K / ||u||_K <= c eps kappa(K)).
+module sprc_test_petsc
+   use sprc_core_kinds, only: wp
+   use sprc_core_error, only: stat_invalid_input, stat_not_converged
+   use sprc_core_material, only: plane_strain, solid
+   use sprc_geometry_body, only: body_type
+   use sprc_exact_lame, only: lame_cylinder_type, lame_sphere_type
+   use sprc_fem_bc, only: fe_bc_type
+   use sprc_fem_problem, only: elasticity_problem_type, solve_on_grid
+   use sprc_fem_linear_solver, only: solver_direct, solver_iterative, solver_auto, use_iterative, &
+      & auto_iterative_min_dofs, solver_choice
+   use sprc_fem_petsc, only: petsc_solver_type, iteration_tolerance
+   use sprc_test_fem, only: sphere_octant, lame_quarter, young
+   use sprc_testsuite, only: unittest_type, new_unittest, check, error_type
+   implicit none
+   private
+
+   public :: collect_petsc
+
+   real(wp), parameter :: poisson = 0.3_wp
+   !> Backward-error constant of the direct solve (as in test_fem).
+   real(wp), parameter :: c_backward = 10.0_wp
+
+contains
+
+   subroutine collect_petsc(testsuite)
+      type(unittest_type), allocatable, intent(out) :: testsuite(:)
+      testsuite = [ &
+         new_unittest('choice', test_choice), &
+         new_unittest('sphere_weak_symmetry_hanging', test_sphere_weak), &
+         new_unittest('sphere_strong_symmetry', test_sphere_strong), &
+         new_unittest('lame_2d', test_lame_2d), &
+         new_unittest('gmres', test_gmres), &
+         new_unittest('not_converged', test_not_converged), &
+         new_unittest('bad_layout', test_bad_layout) &
+         ]
+   end subroutine collect_petsc
+
+   !> 'auto' is direct in 2D and for small 3D systems, iterative from the threshold on.
+   subroutine test_choice(error)
+      type(error_type), allocatable, intent(out) :: error
+      call check(error, solver_choice('iterative') == solver_iterative .and. solver_choice('direct') == &
+         & solver_direct .and. solver_choice('auto') == solver_auto .and. solver_choice('cg') == 0, 'names')
+      if (allocated(error)) return
+      call check(error, .not. use_iterative(solver_auto, 2, 10*auto_iterative_min_dofs), '2D stays direct')
+      if (allocated(error)) return
+      call check(error, .not. use_iterative(solver_auto, 3, auto_iterative_min_dofs - 1) .and. &
+         & use_iterative(solver_auto, 3, auto_iterative_min_dofs), '3D threshold')
+      if (allocated(error)) return
+      call check(error, use_iterative(solver_iterative, 2, 1) .and. .not. use_iterative(solver_direct, 3, 10**8), &
+         & 'explicit choices')
+   end subroutine test_choice
+
+   !> Sphere octant, symmetry planes off the grid (Nitsche), one boundary
+   !> refinement (hanging nodes) and aggregated small cuts.
+   subroutine test_sphere_weak(error)
+      type(error_type), allocatable, intent(out) :: error
+      call sphere_case([-0.37_wp, -0.37_wp, -0.37_wp], 27.0_wp, 2, 1, 'weak symmetry', error)
+   end subroutine test_sphere_weak
+
+   !> Sphere octant with its planes on grid planes: strong symmetry, so some
+   !> blocks have fixed components (identity rows in the padded system).
+   subroutine test_sphere_strong(error)
+      type(error_type), allocatable, intent(out) :: error
+      call sphere_case([0.0_wp, 0.0_wp, 0.0_wp], 25.0_wp, 3, 0, 'strong symmetry', error)
+   end subroutine test_sphere_strong
+
+   subroutine sphere_case(box_min, box_size, level, refine, what, error)
+      real(wp), intent(in) :: box_min(3), box_size
+      integer, intent(in) :: level, refine
+      character(len=*), intent(in) :: what
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: body
+      type(fe_bc_type), allocatable :: bcs(:)
+      type(lame_sphere_type) :: exact
+      call sphere_octant(body, bcs, exact, error)
+      if (allocated(error)) return
+      call compare_solvers(body, bcs, box_min, box_size, level, refine, solid, what, error)
+   end subroutine sphere_case
+
+   !> Lame quarter in plane strain: block size 2, three rigid modes.
+   subroutine test_lame_2d(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: body
+      type(fe_bc_type), allocatable :: bcs(:)
+      type(lame_cylinder_type) :: exact
+      call lame_quarter(body, bcs, exact, plane_strain, error)
+      if (allocated(error)) return
+      call compare_solvers(body, bcs, [0.0_wp, 0.0_wp], 25.0_wp, 4, 1, plane_strain, 'Lame 2D', error)
+   end subroutine test_lame_2d
+
+   !> Solve directly, then iteratively on the same K and f: energy-norm
+   !> difference within the bound of the module notes, Krylov iterations
+   !> counted, and the same bits when the iterative solve is repeated.
+   subroutine compare_solvers(body, bcs, box_min, box_size, level, refine, analysis, what, error)
+      type(body_type), intent(in) :: body
+      type(fe_bc_type), intent(in) :: bcs(:)
+      real(wp), intent(in) :: box_min(:), box_size
+      integer, intent(in) :: level, refine, analysis
+      character(len=*), intent(in) :: what
+      type(error_type), allocatable, intent(out) :: error
+      type(elasticity_problem_type) :: problem
+      real(wp), allocatable :: u_direct(:), u_iter(:), e(:), ke(:), ku(:)
+      real(wp) :: tau, tol, rel
+      integer :: its
+
+      call solve_on_grid(problem, body, box_min, box_size, level, refine, 1, analysis, young, poisson, &
+         & [(0.0_wp, its = 1, size(box_min))], bcs, error)
+      if (allocated(error)) return
+      call check(error, problem%solver_name == 'cholmod' .and. problem%solver_iterations == 0, &
+         & what//': small systems are solved directly under auto')
+      if (allocated(error)) return
+      u_direct = problem%ubar
+      tol = c_backward*epsilon(1.0_wp)/problem%rcond
+      problem%solver = solver_iterative
+      call problem%solve_reduced(error)
+      if (allocated(error)) return
+      call check(error, problem%solver_name == 'cg+gamg' .and. problem%solver_iterations > 0, &
+         & what//': solved by CG + GAMG, iterations counted')
+      if (allocated(error)) return
+      u_iter = problem%ubar
+      its = problem%solver_iterations
+      tau = iteration_tolerance(0.5_wp**(level + refine), 1)
+      e = u_iter - u_direct
+      allocate (ke(size(e)), ku(size(e)))
+      call problem%k%matvec(e, ke, error)
+      if (allocated(error)) return
+      call problem%k%matvec(u_direct, ku, error)
+      if (allocated(error)) return
+      rel = sqrt(dot_product(e, ke)/dot_product(u_direct, ku))
+      call check(error, rel, 0.0_wp, 2.0_wp*tau + tol, what//': energy-norm difference to CHOLMOD')
+      if (allocated(error)) return
+      call problem%solve_reduced(error)
+      if (allocated(error)) return
+      call check(error, all(problem%ubar == u_iter) .and. problem%solver_iterations == its, &
+         & what//': the same bits and iterations when repeated')
+   end subroutine compare_solvers
+
+   !> GMRES + GAMG (the unsymmetric configuration) on an SPD system: the
+   !> solution of CHOLMOD within 100 tau in the energy norm (GMRES bounds
+   !> ||B r|| / ||B b|| by tau, and the error by about kappa(BA) times that;
+   !> CG measures kappa(BA) near 4 on these systems, so 100 leaves margin), and
+   !> a transposed solve, which this configuration cannot do, is refused.
+   subroutine test_gmres(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: body
+      type(fe_bc_type), allocatable :: bcs(:)
+      type(lame_sphere_type) :: exact
+      type(elasticity_problem_type) :: problem
+      type(petsc_solver_type) :: krylov
+      type(error_type), allocatable :: refused
+      real(wp), allocatable :: x(:), e(:), ke(:), ku(:)
+      real(wp) :: tau, rel
+
+      call sphere_octant(body, bcs, exact, error)
+      if (allocated(error)) return
+      call solve_on_grid(problem, body, [0.0_wp, 0.0_wp, 0.0_wp], 25.0_wp, 3, 0, 1, solid, young, poisson, &
+         & [0.0_wp, 0.0_wp, 0.0_wp], bcs, error)
+      if (allocated(error)) return
+      call krylov%set_blocks(problem%constraints%dof, problem%nodes%x(:, problem%constraints%master_node), error)
+      if (allocated(error)) return
+      tau = iteration_tolerance(0.5_wp**3, 1)
+      krylov%tolerance = tau
+      krylov%symmetric = .false.
+      call krylov%factorize(problem%k, error)
+      if (allocated(error)) return
+      allocate (x(size(problem%f)), ke(size(problem%f)), ku(size(problem%f)))
+      call krylov%solve(problem%f, x, error)
+      if (allocated(error)) return
+      call krylov%solve(problem%f, x, refused, transposed=.true.)
+      call krylov%destroy()
+      call check(error, allocated(refused), 'a transposed GMRES solve is refused')
+      if (allocated(error)) return
+      e = x - problem%ubar
+      call problem%k%matvec(e, ke, error)
+      if (allocated(error)) return
+      call problem%k%matvec(problem%ubar, ku, error)
+      if (allocated(error)) return
+      rel = sqrt(dot_product(e, ke)/dot_product(problem%ubar, ku))
+      call check(error, rel, 0.0_wp, 100.0_wp*tau + c_backward*epsilon(1.0_wp)/problem%rcond, &
+         & 'GMRES: energy-norm difference to CHOLMOD')
+   end subroutine test_gmres
+
+   !> Too few iterations: stat_not_converged with the count and the residual.
+   subroutine test_not_converged(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: body
+      type(fe_bc_type), allocatable :: bcs(:)
+      type(lame_sphere_type) :: exact
+      type(elasticity_problem_type) :: problem
+      type(petsc_solver_type) :: krylov
+      type(error_type), allocatable :: failure
+      real(wp), allocatable :: x(:)
+
+      call sphere_octant(body, bcs, exact, error)
+      if (allocated(error)) return
+      call solve_on_grid(problem, body, [0.0_wp, 0.0_wp, 0.0_wp], 25.0_wp, 3, 0, 1, solid, young, poisson, &
+         & [0.0_wp, 0.0_wp, 0.0_wp], bcs, error)
+      if (allocated(error)) return
+      call krylov%set_blocks(problem%constraints%dof, problem%nodes%x(:, problem%constraints%master_node), error)
+      if (allocated(error)) return
+      krylov%max_iterations = 2
+      krylov%tolerance = 1.0e-12_wp
+      call krylov%factorize(problem%k, error)
+      if (allocated(error)) return
+      allocate (x(size(problem%f)))
+      call krylov%solve(problem%f, x, failure)
+      call krylov%destroy()
+      call check(error, allocated(failure), 'two iterations do not reach 1e-12')
+      if (allocated(error)) return
+      call check(error, failure%stat == stat_not_converged, 'status: '//failure%message)
+      if (allocated(error)) return
+      call check(error, index(failure%message, 'after 2 iterations') > 0 .and. &
+         & index(failure%message, 'relative residual') > 0, 'message: '//failure%message)
+   end subroutine test_not_converged
+
+   !> A layout that does not number every unknown once is refused.
+   subroutine test_bad_layout(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(petsc_solver_type) :: krylov
+      type(error_type), allocatable :: refused
+      real(wp) :: x(3, 2)
+
+      x = 0.0_wp
+      call krylov%set_blocks(reshape([1, 2, 3, 3, 4, 5], [3, 2]), x, refused)
+      call check(error, allocated(refused), 'a repeated unknown is refused')
+      if (allocated(error)) return
+      call check(error, refused%stat == stat_invalid_input, 'status: '//refused%message)
+      if (allocated(error)) return
+      deallocate (refused)
+      call krylov%set_blocks(reshape([1, 2, 3, 4, 5, 7], [3, 2]), x, refused)
+      call check(error, allocated(refused), 'a gap in the numbering is refused')
+   end subroutine test_bad_layout
+
+end module sprc_test_petsc
