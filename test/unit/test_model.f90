@@ -30,7 +30,8 @@ contains
          new_unittest('grid_quarter_annulus', test_grid_annulus), &
          new_unittest('grid_sphere_octant', test_grid_octant), &
          new_unittest('body_beyond_box', test_body_beyond_box), &
-         new_unittest('level_memory_estimate', test_level_memory) &
+         new_unittest('level_memory_estimate', test_level_memory), &
+         new_unittest('level_memory_follows_solver', test_level_memory_solver) &
          ]
    end subroutine collect_model
 
@@ -173,6 +174,36 @@ contains
       call check(error, index(e%message, 'needs about') > 0 .and. index(e%message, 'is available') > 0 .and. &
          & index(e%message, 'use a lower level') > 0, 'message: '//e%message)
    end subroutine test_level_memory
+
+   !> A 3D level sent to the iterative solver is estimated without a Cholesky
+   !> factor (sprc_study_budget: 32 MB + 8 kB per dof for Q1), a direct one with
+   !> it (larger from 3e4 dofs on); 'auto' follows the size (iterative here).
+   subroutine test_level_memory_solver(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(body_type), allocatable :: bodies(:)
+      real(wp) :: cells, dofs, bytes(3)
+      integer :: k
+      character(len=9), parameter :: choice(3) = [character(len=9) :: 'direct', 'iterative', 'auto']
+
+      call load('example/scenes/lame_sphere.nml', scene, error)
+      if (allocated(error)) return
+      call build_bodies(scene, bodies, error)
+      if (allocated(error)) return
+      do k = 1, 3
+         scene%solver = trim(choice(k))
+         call level_memory(scene, bodies(1), 7, cells, dofs, bytes(k), error)
+         if (allocated(error)) return
+      end do
+      call check(error, dofs > 1.0e5_wp, '3D level 7 above the auto threshold')
+      if (allocated(error)) return
+      call check(error, abs(bytes(2) - (32.0e6_wp + 8.0e3_wp*dofs)) <= 1.0e-12_wp*bytes(2), &
+         & 'iterative: 32 MB + 8 kB per dof')
+      if (allocated(error)) return
+      call check(error, bytes(1) > 2.0_wp*bytes(2), 'direct estimate with the Cholesky fill')
+      if (allocated(error)) return
+      call check(error, bytes(3) == bytes(2), 'auto takes the iterative estimate at this size')
+   end subroutine test_level_memory_solver
 
    pure function replaced(text, old, new) result(out)
       character(len=*), intent(in) :: text, old, new

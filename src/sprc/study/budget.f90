@@ -17,6 +17,10 @@
 !> as dofs^(1/3), and 1.2-1.75 times that for Q2 (levels 3, 4: 69 MB, 373 MB).
 !> The estimate below takes the upper figures: 32 MB + dofs * 2.5 kB (2D) or
 !> 10 kB (dofs / 3e4)^(1/3) (3D; times 1.75 for Q2).
+!> A 3D level that the solver choice sends to the iterative solver (PETSc CG +
+!> GAMG, `use_iterative`) has no Cholesky factor: measured 7.2 kB per dof at
+!> 1.5e5 dofs (1.1 GB) and 7.0 kB at 1.16e6 (8.17 GB) on the Q1 sphere
+!> octant; the estimate takes 8 kB per dof (times 1.75 for Q2).
 !> The grid and its quadrature alone (`sprc mesh`, `grid_only`): about 12 MB
 !> plus 105 bytes per active cell (sphere octant level 7: 5.1e5 cells, 66 MB;
 !> cylinder quarter level 10: 5.0e5 cells, 64 MB); the estimate takes 16 MB +
@@ -37,13 +41,14 @@ module sprc_study_budget
    use sprc_geometry_body, only: body_type
    use sprc_grid_tree, only: grid_type
    use sprc_study_spec, only: scene_type
+   use sprc_fem_linear_solver, only: solver_auto, solver_choice, use_iterative
    implicit none
    private
 
    public :: level_memory, check_level_memory
 
    real(wp), parameter :: base_bytes = 32.0e6_wp, per_dof_2d = 2.5e3_wp, per_dof_3d = 1.0e4_wp, &
-      & dofs_3d = 3.0e4_wp, q2_factor_3d = 1.75_wp
+      & dofs_3d = 3.0e4_wp, q2_factor_3d = 1.75_wp, per_dof_3d_iterative = 8.0e3_wp
    !> Grid and quadrature only (module notes).
    !> Environment variable that switches the estimate off (memory_check_wanted).
    character(len=*), parameter :: memory_check_variable = 'SPRC_MEMORY_CHECK'
@@ -80,6 +85,9 @@ contains
       dofs = real(d*scene%order**d, wp)*cells
       if (d == 2) then
          per_dof = per_dof_2d
+      else if (iterative(scene, dofs)) then
+         per_dof = per_dof_3d_iterative
+         if (scene%order == 2) per_dof = q2_factor_3d*per_dof
       else
          per_dof = per_dof_3d*(dofs/dofs_3d)**(1.0_wp/3.0_wp)
          if (scene%order == 2) per_dof = q2_factor_3d*per_dof
@@ -89,6 +97,21 @@ contains
          if (grid_only) bytes = grid_base_bytes + per_cell_grid*cells
       end if
    end subroutine level_memory
+
+   !> Whether the scene's solver choice takes the iterative solver for `dofs`
+   !> unknowns (the estimate's dofs, capped below the default integer's range).
+   logical function iterative(scene, dofs)
+      type(scene_type), intent(in) :: scene
+      real(wp), intent(in) :: dofs
+      integer :: choice, n
+
+      choice = solver_auto
+      if (allocated(scene%solver)) then
+         if (len(scene%solver) > 0) choice = solver_choice(scene%solver)
+      end if
+      n = int(min(dofs, real(huge(n), wp)))
+      iterative = use_iterative(choice, scene%dim, n)
+   end function iterative
 
    !> stat_out_of_memory when the estimate of `level` exceeds the memory this process
    !> may still use (sprc_core_memory); the message names the estimate, what is available
