@@ -28,6 +28,7 @@ program sprc_unit_tests
    use sprc_test_contact_output, only: collect_contact_output
    use sprc_test_contact_fe, only: collect_contact_fe
    use sprc_test_petsc, only: collect_petsc
+   use sprc_test_contact_recovery, only: collect_contact_recovery
    implicit none
 
    type(testsuite_type), allocatable :: suites(:)
@@ -58,7 +59,8 @@ program sprc_unit_tests
       new_testsuite('contact_model', collect_contact_model), &
       new_testsuite('contact_output', collect_contact_output), &
       new_testsuite('contact_fe', collect_contact_fe), &
-      new_testsuite('petsc', collect_petsc) &
+      new_testsuite('petsc', collect_petsc), &
+      new_testsuite('contact_recovery', collect_contact_recovery) &
       ]
 
    call get_arg(1, suite_name)
