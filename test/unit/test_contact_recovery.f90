@@ -13,6 +13,13 @@ module sprc_test_contact_recovery
    use sprc_recovery_contact_operators, only: contact_frame, contact_operator, contact_law_operator, &
       & contact_rows, contact_law_frictionless, contact_law_slip, contact_law_stick
    use sprc_recovery_contact_aux, only: aux_domain_type, new_aux_domain, aux_contains, aux_select
+   use sprc_recovery_contact_solve, only: recover_sprc_contact
+   use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reset, patch_add_point, &
+      & patch_add_boundary_point, boundary_contact
+   use sprc_recovery_workspace, only: recovery_workspace_type
+   use sprc_core_material, only: plane_strain, solid
+   use sprc_core_poly, only: poly_basis_type, new_poly_basis
+   use sprc_core_text, only: itoa
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type
    implicit none
    private
@@ -24,6 +31,22 @@ module sprc_test_contact_recovery
    !> at most 6 products of 3 rounded factors, each step within a few eps; 64 eps covers the
    !> sum of these bounds with room (a wrong row or sign gives an O(1) residual).
    real(wp), parameter :: tol_roundoff = 64*epsilon(1.0_wp)
+   !> Round-off tier of values that pass through the coupled patch solve, relative to the
+   !> stress scale: sqrt(eps), the tier of the single-patch solves (test_recovery's tol_exact,
+   !> which states why): the solve is backward stable, its conditioning is not estimated, and
+   !> sqrt(eps) is still 1e5 below the error a wrong contact row makes.
+   real(wp), parameter :: tol_exact = sqrt(epsilon(1.0_wp))
+
+   !> A linear stress field in coordinates (x, y, z) with the contact plane z = 0 (the last
+   !> coordinate; 2D uses (x, z) as (x, y)): sxz = tx + a.x, syz = ty + b.x,
+   !> szz = e + f x + g y + h z, sxy = q0 + q.x, sxx = p0 + px x + py y + pz z,
+   !> syy = r0 + rx x + ry y + rz z, with h, px, ry fixed by div sigma + bf = 0 (constant body
+   !> force bf, so that the equilibrium rows have a nonzero right-hand side); linear stresses
+   !> are compatible.
+   type :: linear_field_t
+      real(wp) :: tx = 0, a(3) = 0, ty = 0, b(3) = 0, e = 0, f = 0, g = 0, q0 = 0, q(3) = 0
+      real(wp) :: p0 = 0, py = 0, pz = 0, r0 = 0, rx = 0, rz = 0, bf(3) = 0
+   end type linear_field_t
 
 contains
 
@@ -38,7 +61,11 @@ contains
          new_unittest('operator_errors', test_operator_errors), &
          new_unittest('aux_flat_3d', test_aux_flat_3d), &
          new_unittest('aux_curved_2d', test_aux_curved_2d), &
-         new_unittest('aux_errors', test_aux_errors) &
+         new_unittest('aux_errors', test_aux_errors), &
+         new_unittest('coupled_exact_2d', test_coupled_exact_2d), &
+         new_unittest('coupled_exact_3d', test_coupled_exact_3d), &
+         new_unittest('coupled_wrong_law', test_coupled_wrong_law), &
+         new_unittest('coupled_errors', test_coupled_errors) &
          ]
    end subroutine collect_contact_recovery
 
@@ -378,5 +405,337 @@ contains
          if (allocated(err)) deallocate (err)
       end subroutine expect_invalid
    end subroutine test_aux_errors
+
+   ! ------------------------------------------------------------------ coupled solve
+
+   !> Exactness (issue 12): two bodies carrying linear fields that satisfy equilibrium,
+   !> compatibility and the contact law, sampled at Gauss points of a patch of body (1) (below
+   !> the contact plane) and of a non-matching grid of body (2) selected by Omega_aux: the
+   !> coupled SPR-C recovers both fields and the contact residual at round-off, p = 1 and 2,
+   !> frictionless, slip and stick.
+   subroutine test_coupled_exact_2d(error)
+      type(error_type), allocatable, intent(out) :: error
+      call coupled_laws(2, error)
+   end subroutine test_coupled_exact_2d
+
+   subroutine test_coupled_exact_3d(error)
+      type(error_type), allocatable, intent(out) :: error
+      call coupled_laws(3, error)
+   end subroutine test_coupled_exact_3d
+
+   subroutine coupled_laws(dim, error)
+      integer, intent(in) :: dim
+      type(error_type), allocatable, intent(out) :: error
+      type(linear_field_t) :: f1, f2
+      real(wp) :: err1, err2, res
+      integer :: law, p
+      real(wp), parameter :: mu = 0.35_wp
+      character(len=160) :: buf
+
+      do p = 1, 2
+         do law = contact_law_frictionless, contact_law_stick
+            call law_fields(dim, law, mu, f1, f2)
+            call coupled_case(dim, p, law, mu, f1, f2, err1, err2, res, error)
+            if (allocated(error)) return
+            write (buf, '("dim ",i0,", p = ",i0,", law ",i0,": errors ",es9.2,", ",es9.2,", contact residual ",es9.2, &
+               & " (tier ",es9.2,")")') dim, p, law, err1, err2, res, tol_exact
+            call check(error, max(err1, err2, res) <= tol_exact, trim(buf))
+            if (allocated(error)) return
+         end do
+      end do
+   end subroutine coupled_laws
+
+   !> Stick data recovered as frictionless: the contact rows force body (1)'s shear traction
+   !> to zero, so the recovery cannot be exact (the contact rows act).
+   subroutine test_coupled_wrong_law(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(linear_field_t) :: f1, f2
+      real(wp) :: err1, err2, res
+      integer :: dim
+      character(len=120) :: buf
+
+      do dim = 2, 3
+         call law_fields(dim, contact_law_stick, 0.0_wp, f1, f2)
+         call coupled_case(dim, 1, contact_law_frictionless, 0.0_wp, f1, f2, err1, err2, res, error)
+         if (allocated(error)) return
+         write (buf, '("dim ",i0,": error ",es9.2," with the wrong law")') dim, err1
+         call check(error, err1 > 1.0e-3_wp, trim(buf))
+         if (allocated(error)) return
+      end do
+   end subroutine test_coupled_wrong_law
+
+   !> Bad input of the coupled solve: clear errors, no crash.
+   subroutine test_coupled_errors(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(error_type), allocatable :: err
+      type(patch_type) :: p1, p2, p3
+      type(recovery_workspace_type) :: ws1, ws2
+      type(recovered_patch_type) :: rec1, rec2
+      real(wp) :: sl(2, 4)
+      integer :: i, j
+
+      call patch_reset(p1, 2, plane_strain, 1.0_wp, 0.3_wp, [0.0_wp, 0.0_wp], 1.0_wp)
+      call patch_reset(p2, 2, plane_strain, 1.0_wp, 0.3_wp, [0.0_wp, 0.5_wp], 1.0_wp)
+      do i = 0, 2
+         do j = 0, 2
+            call patch_add_point(p1, [0.4_wp*i - 0.4_wp, -0.4_wp*j - 0.1_wp], 1.0_wp, [1.0_wp, 2.0_wp, 0.0_wp])
+            call patch_add_point(p2, [0.4_wp*i - 0.4_wp, 0.4_wp*j + 0.1_wp], 1.0_wp, [1.0_wp, 2.0_wp, 0.0_wp])
+         end do
+      end do
+      p3 = p1
+      call recover_sprc_contact(p1, p2, 1, [contact_law_stick], 0.0_wp, sl, ws1, ws2, rec1, rec2, err)
+      call expect_invalid('no contact points', 'no contact points')
+      do i = 1, 2
+         call patch_add_boundary_point(p1, [0.3_wp*i - 0.45_wp, 0.0_wp], 0.5_wp, [0.0_wp, 1.0_wp], boundary_contact)
+      end do
+      sl = 0.0_wp
+      sl(2, :) = 1.0_wp
+      call recover_sprc_contact(p1, p2, 1, [contact_law_stick], 0.0_wp, sl, ws1, ws2, rec1, rec2, err)
+      call expect_invalid('law too short', 'law and slip')
+      call recover_sprc_contact(p1, p2, 1, [contact_law_slip, contact_law_slip], 0.3_wp, sl, ws1, ws2, rec1, rec2, err)
+      call expect_invalid('slip along the normal', 'boundary point 1 (law slip)')
+      call recover_sprc_contact(p1, p1, 1, [contact_law_stick, contact_law_stick], 0.0_wp, sl, ws1, ws2, rec1, &
+         & rec2, err)
+      call expect_invalid('Omega_aux with contact points', 'patch2')
+      call recover_sprc_contact(p1, p2, 1, [contact_law_stick, 9], 0.0_wp, sl, ws1, ws2, rec1, rec2, err)
+      call expect_invalid('unknown law', 'law = 9')
+      call recover_sprc_contact(p3, p2, 1, [contact_law_stick], 0.0_wp, sl, ws1, ws2, rec1, rec2, err)
+      call expect_invalid('patch without contact', 'no contact points')
+   contains
+      subroutine expect_invalid(what, word)
+         character(len=*), intent(in) :: what, word
+         if (allocated(error)) return
+         if (.not. allocated(err)) then
+            call test_failed(error, what//': accepted')
+         else if (err%stat /= stat_invalid_input .or. index(err%message, word) == 0) then
+            call test_failed(error, what//': wrong status or message: '//err%message)
+         end if
+         if (allocated(err)) deallocate (err)
+      end subroutine expect_invalid
+   end subroutine test_coupled_errors
+
+   !> Fields of the two bodies that satisfy `law` on z = 0 (body (1) below, its outward
+   !> normal +z, slip along +x): shared traction coefficients, different free ones.
+   pure subroutine law_fields(dim, law, mu, f1, f2)
+      integer, intent(in) :: dim, law
+      real(wp), intent(in) :: mu
+      type(linear_field_t), intent(out) :: f1, f2
+
+      f1%e = -2.0_wp
+      f1%f = 0.3_wp
+      f1%tx = 0.5_wp
+      f1%a = [0.2_wp, 0.0_wp, 0.7_wp]
+      f1%p0 = 1.1_wp
+      f1%pz = -0.4_wp
+      f1%bf = [0.3_wp, 0.0_wp, 0.5_wp]
+      if (dim == 3) then
+         f1%bf(2) = -0.2_wp
+         f1%g = -0.25_wp
+         f1%a(2) = 0.15_wp
+         f1%ty = -0.3_wp
+         f1%b = [0.1_wp, 0.35_wp, -0.6_wp]
+         f1%q0 = 0.45_wp
+         f1%q = [0.2_wp, -0.1_wp, 0.3_wp]
+         f1%py = 0.25_wp
+         f1%r0 = -0.8_wp
+         f1%rx = 0.6_wp
+         f1%rz = 0.2_wp
+      end if
+      select case (law)
+      case (contact_law_frictionless)
+         f1%tx = 0.0_wp
+         f1%a(1:2) = 0.0_wp
+         f1%ty = 0.0_wp
+         f1%b(1:2) = 0.0_wp
+      case (contact_law_slip)
+         f1%tx = mu*f1%e
+         f1%a(1) = mu*f1%f
+         f1%a(2) = mu*f1%g
+         f1%ty = 0.0_wp
+         f1%b(1:2) = 0.0_wp
+      end select
+      ! Body (2): the same traction on z = 0, different free coefficients.
+      f2 = f1
+      f2%a(3) = -0.9_wp
+      f2%p0 = -0.5_wp
+      f2%pz = 0.8_wp
+      f2%bf = [-0.4_wp, 0.0_wp, 0.25_wp]
+      if (dim == 3) then
+         f2%bf(2) = 0.1_wp
+         f2%b(3) = 0.4_wp
+         f2%q0 = -0.2_wp
+         f2%q = [-0.3_wp, 0.25_wp, 0.1_wp]
+         f2%py = -0.15_wp
+         f2%r0 = 0.9_wp
+         f2%rx = -0.4_wp
+         f2%rz = 0.5_wp
+      end if
+   end subroutine law_fields
+
+   !> Voigt stress of a field at x (dim coordinates; the last is normal to the contact plane).
+   pure function field_stress(dim, fl, x) result(sig)
+      integer, intent(in) :: dim
+      type(linear_field_t), intent(in) :: fl
+      real(wp), intent(in) :: x(:)
+      real(wp) :: sig(6), y(3), sxx, syy, szz, sxy, syz, sxz, h, px, ry
+
+      y = 0.0_wp
+      if (dim == 2) then
+         y(1) = x(1)
+         y(3) = x(2)
+      else
+         y = x(1:3)
+      end if
+      h = -fl%a(1) - fl%b(2) - fl%bf(3)
+      px = -fl%a(3) - fl%q(2) - fl%bf(1)
+      ry = -fl%b(3) - fl%q(1) - fl%bf(2)
+      sxz = fl%tx + dot_product(fl%a, y)
+      syz = fl%ty + dot_product(fl%b, y)
+      szz = fl%e + fl%f*y(1) + fl%g*y(2) + h*y(3)
+      sxy = fl%q0 + dot_product(fl%q, y)
+      sxx = fl%p0 + px*y(1) + fl%py*y(2) + fl%pz*y(3)
+      syy = fl%r0 + fl%rx*y(1) + ry*y(2) + fl%rz*y(3)
+      sig = 0.0_wp
+      if (dim == 2) then
+         sig(1:3) = [sxx, szz, sxz]
+      else
+         sig = [sxx, syy, szz, sxy, syz, sxz]
+      end if
+   end function field_stress
+
+   !> One coupled recovery on hand-made sampling data (see coupled_laws); errors relative to the
+   !> largest stress: err1 over body (1)'s points, err2 over Omega_aux's, res the contact residual.
+   subroutine coupled_case(dim, degree, law, mu, f1, f2, err1, err2, res, error)
+      integer, intent(in) :: dim, degree, law
+      real(wp), intent(in) :: mu
+      type(linear_field_t), intent(in) :: f1, f2
+      real(wp), intent(out) :: err1, err2, res
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), parameter :: gx(3) = [-sqrt(0.6_wp), 0.0_wp, sqrt(0.6_wp)], gw(3) = [5, 8, 5]/9.0_wp
+      real(wp), parameter :: h2cell = 0.6_wp, off2 = -1.33_wp, depth = 1.5_wp
+      type(patch_type) :: p1, p2
+      type(recovery_workspace_type) :: ws1, ws2
+      type(recovered_patch_type) :: rec1, rec2
+      type(aux_domain_type) :: aux
+      type(poly_basis_type) :: basis
+      real(wp) :: x(3), wgt, cx(3, 200), cn(3, 200), cw(200), smax, nrm(3), sl(3, 200), frame(3, 3)
+      real(wp) :: hh(3, 6), hp(3, 6), s1(6), s2(6)
+      integer :: laws(200), nc, ns, ncell1, ncell2, c, i, j, k, nq, ijk(3), top, rank, want_rank
+
+      ns = merge(3, 6, dim == 2)
+      nq = 3**dim
+      call new_poly_basis(basis, dim, degree, error)
+      if (allocated(error)) return
+      ! Body (1): cells of size 1 below z = 0 around the node at the origin.
+      call patch_reset(p1, dim, merge(plane_strain, solid, dim == 2), 1.0_wp, 0.3_wp, [0.0_wp, 0.0_wp, 0.0_wp], &
+         & 1.5_wp)
+      p1%body_force(1:dim) = body_force(f1)
+      ncell1 = 2**(dim - 1)
+      nc = 0
+      nrm = 0.0_wp
+      nrm(dim) = 1.0_wp
+      smax = 0.0_wp
+      do c = 0, ncell1 - 1
+         do k = 0, nq - 1
+            ijk = [mod(k, 3), mod(k/3, 3), k/9]
+            x = 0.0_wp
+            wgt = 1.0_wp
+            do i = 1, dim - 1
+               x(i) = merge(-1.0_wp, 0.0_wp, .not. btest(c, i - 1)) + 0.5_wp*(1.0_wp + gx(ijk(i) + 1))
+               wgt = wgt*0.5_wp*gw(ijk(i) + 1)
+            end do
+            x(dim) = -0.5_wp*(1.0_wp - gx(ijk(dim) + 1))
+            wgt = wgt*0.5_wp*gw(ijk(dim) + 1)
+            s1 = field_stress(dim, f1, x(1:dim))
+            call patch_add_point(p1, x(1:dim), wgt, s1(1:ns))
+            smax = max(smax, maxval(abs(s1)))
+            ! The Gauss points of the top face (z = 0) are the contact points.
+            if (ijk(dim) == 0) then
+               x(dim) = 0.0_wp
+               nc = nc + 1
+               cx(:, nc) = x
+               cn(:, nc) = nrm
+               cw(nc) = wgt/(0.5_wp*gw(1))
+               call patch_add_boundary_point(p1, x(1:dim), cw(nc), nrm(1:dim), boundary_contact)
+            end if
+         end do
+      end do
+      laws = law
+      sl = 0.0_wp
+      sl(1, :) = 1.0_wp
+      ! Body (2): a non-matching grid (cells 0.6, offset) above z = 0; its Gauss points in Omega_aux.
+      call new_aux_domain(aux, dim, cx(1:dim, 1:nc), cn(1:dim, 1:nc), cw(1:nc), depth, 0.0_wp, error)
+      if (allocated(error)) return
+      call patch_reset(p2, dim, merge(plane_strain, solid, dim == 2), 1.0_wp, 0.3_wp, aux%centre(1:dim), depth)
+      p2%body_force(1:dim) = body_force(f2)
+      ncell2 = 5
+      top = merge(ncell2, 1, dim == 3)
+      do c = 0, ncell2**(dim - 1)*4 - 1
+         do k = 0, nq - 1
+            ijk = [mod(k, 3), mod(k/3, 3), k/9]
+            x = 0.0_wp
+            x(1) = off2 + h2cell*(mod(c, ncell2) + 0.5_wp*(1.0_wp + gx(ijk(1) + 1)))
+            if (dim == 3) x(2) = off2 + h2cell*(mod(c/ncell2, top) + 0.5_wp*(1.0_wp + gx(ijk(2) + 1)))
+            j = c/(ncell2*top)
+            x(dim) = h2cell*(j + 0.5_wp*(1.0_wp + gx(ijk(dim) + 1)))
+            if (.not. aux_contains(aux, x(1:dim))) cycle
+            wgt = (0.5_wp*h2cell)**dim*product(gw(ijk(1:dim) + 1))
+            s2 = field_stress(dim, f2, x(1:dim))
+            call patch_add_point(p2, x(1:dim), wgt, s2(1:ns))
+            smax = max(smax, maxval(abs(s2)))
+         end do
+      end do
+      call recover_sprc_contact(p1, p2, degree, laws, mu, sl, ws1, ws2, rec1, rec2, error, contact_rank=rank)
+      if (allocated(error)) return
+      ! A flat contact surface: the residual's dim components are degree-p polynomials along it.
+      want_rank = merge(2*(degree + 1), 3*((degree + 1)*(degree + 2))/2, dim == 2)
+      if (rank /= want_rank .or. rank < 1) then
+         call test_failed(error, 'contact rank '//itoa(rank)//', expected the flat-surface rank '//itoa(want_rank))
+         return
+      end if
+      err1 = 0.0_wp
+      do i = 1, p1%npoints
+         err1 = max(err1, maxval(abs(eval(rec1, p1%x(1:dim, i)) - p1%stress(1:ns, i))))
+      end do
+      err2 = 0.0_wp
+      do i = 1, p2%npoints
+         err2 = max(err2, maxval(abs(eval(rec2, p2%x(1:dim, i)) - p2%stress(1:ns, i))))
+      end do
+      res = 0.0_wp
+      do i = 1, nc
+         call contact_frame(dim, cn(1:dim, i), frame, error, slip=sl(1:dim, i))
+         if (allocated(error)) return
+         call contact_operator(dim, frame, hh)
+         call contact_law_operator(dim, law, mu, hh, hp, error)
+         if (allocated(error)) return
+         s1(1:ns) = eval(rec1, cx(1:dim, i))
+         s2(1:ns) = eval(rec2, cx(1:dim, i))
+         res = max(res, maxval(abs(matmul(hh(1:dim, 1:ns), s1(1:ns)) - matmul(hp(1:dim, 1:ns), s2(1:ns)))))
+      end do
+      err1 = err1/smax
+      err2 = err2/smax
+      res = res/smax
+   contains
+      pure function body_force(fl) result(b)
+         type(linear_field_t), intent(in) :: fl
+         real(wp) :: b(dim)
+         if (dim == 2) then
+            b = [fl%bf(1), fl%bf(3)]
+         else
+            b = fl%bf
+         end if
+      end function body_force
+
+      function eval(rec, xp) result(sig)
+         type(recovered_patch_type), intent(in) :: rec
+         real(wp), intent(in) :: xp(:)
+         real(wp) :: sig(ns), pv(20)
+         integer :: cc
+         call basis%eval((xp - rec%x0(1:dim))/rec%h, pv)
+         do cc = 1, ns
+            sig(cc) = dot_product(pv(1:basis%nterms), rec%coef(1:basis%nterms, cc))
+         end do
+      end function eval
+   end subroutine coupled_case
 
 end module sprc_test_contact_recovery

@@ -115,7 +115,7 @@ module sprc_recovery_solve
    implicit none
    private
 
-   public :: recover_spr, recover_sprc, recovery_rank_tol, recovery_bite_ratio, traction_rank_tol
+   public :: recover_spr, recover_sprc, sprc_constraints, recovery_rank_tol, recovery_bite_ratio, traction_rank_tol
    public :: flat_traction_rank, traction_reach
 
    !> Relative tolerance of every rank decision (pivoted QR): |R_kk| > tol |R_11| counts.
@@ -164,23 +164,41 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer :: mc
 
+      call sprc_constraints(patch, degree, ws, rec, mc, .false., error)
+      if (allocated(error)) return
+      call least_squares(patch, ws, rec, .true., mc, 'recover_sprc', error)
+   end subroutine recover_sprc
+
+   !> SPR-C up to its solve: the validated patch's weighted basis QR (ws%qr, ws%jpvt_p, ws%tau_p,
+   !> the weights ws%wn) and the rank-selected constraint rows ws%c(1:mc, 1:ws%n) A = ws%lam(1:mc)
+   !> of the kinds switched on in `patch`. With contact_by_caller, contact boundary points are
+   !> accepted and add no rows here (a patch with contact imposes contact only, seed): the
+   !> coupled contact solve (sprc_recovery_contact_solve) adds them. Errors as recover_sprc.
+   subroutine sprc_constraints(patch, degree, ws, rec, mc, contact_by_caller, error)
+      type(patch_type), intent(in) :: patch
+      integer, intent(in) :: degree
+      type(recovery_workspace_type), intent(inout) :: ws
+      type(recovered_patch_type), intent(out) :: rec
+      integer, intent(out) :: mc
+      logical, intent(in) :: contact_by_caller
+      type(error_type), allocatable, intent(out) :: error
+
+      mc = 0
       call prepare(patch, degree, ws, rec, .true., 'recover_sprc', error)
       if (allocated(error)) return
       call gram(ws, patch%npoints)
-      mc = 0
       if (patch%use_equilibrium) call equilibrium_block(patch, ws, rec, mc, error)
       if (allocated(error)) return
       if (patch%use_compatibility .and. degree >= 2) call compatibility_block(patch, ws, rec, mc, error)
       if (allocated(error)) return
-      if (patch%use_boundary) call boundary_blocks(patch, ws, rec, mc, error)
+      if (patch%use_boundary) call boundary_blocks(patch, ws, rec, mc, contact_by_caller, error)
       if (allocated(error)) return
       if (mc > 0) then
          call select_stacked(ws, mc, rec, error)
          if (allocated(error)) return
       end if
       rec%rank_total = mc
-      call least_squares(patch, ws, rec, .true., mc, 'recover_sprc', error)
-   end subroutine recover_sprc
+   end subroutine sprc_constraints
 
    !> Validate, reserve, scale the points, fill the (weighted) design matrix and decide its rank.
    subroutine prepare(patch, degree, ws, rec, weighted, context, error)
@@ -445,19 +463,21 @@ contains
    end subroutine compatibility_block
 
    !> (c), (d): boundary constraints of the dominant kind (or of every kind present).
-   subroutine boundary_blocks(patch, ws, rec, mc, error)
+   subroutine boundary_blocks(patch, ws, rec, mc, contact_by_caller, error)
       type(patch_type), intent(in) :: patch
       type(recovery_workspace_type), intent(inout) :: ws
       type(recovered_patch_type), intent(inout) :: rec
       integer, intent(inout) :: mc
+      logical, intent(in) :: contact_by_caller
       type(error_type), allocatable, intent(out) :: error
       integer :: kind
 
       kind = dominant_boundary_kind(patch)
       rec%boundary_kind = kind
       if (kind == boundary_none) return
-      if (any(patch%bkind(1:patch%nbpoints) == boundary_contact)) then
-         call fatal_error(error, 'recover_sprc: contact boundary points are not supported yet', stat_invalid_input)
+      if (kind == boundary_contact) then
+         if (.not. contact_by_caller) call fatal_error(error, 'recover_sprc: a patch with contact boundary points '// &
+            & 'needs the coupled contact solve (recover_sprc_contact)', stat_invalid_input)
          return
       end if
       if ((kind == boundary_traction .or. patch%all_boundary_kinds) .and. traction_near_node(patch)) then
