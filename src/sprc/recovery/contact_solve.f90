@@ -32,7 +32,8 @@ module sprc_recovery_contact_solve
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular
    use sprc_core_text, only: itoa
-   use sprc_recovery_patch, only: patch_type, recovered_patch_type, boundary_contact
+   use sprc_recovery_patch, only: patch_type, recovered_patch_type, boundary_contact, patch_reset, patch_reserve
+   use sprc_recovery_contact_aux, only: aux_domain_type, new_aux_domain, aux_contains
    use sprc_recovery_workspace, only: recovery_workspace_type
    use sprc_recovery_solve, only: sprc_constraints, recovery_rank_tol, traction_rank_tol, flat_traction_rank
    use sprc_recovery_dense, only: qr_pivoted, apply_qt, apply_q, solve_upper
@@ -41,10 +42,12 @@ module sprc_recovery_contact_solve
    implicit none
    private
 
-   public :: recover_sprc_contact, contact_curved_tol
+   public :: recover_sprc_contact, recover_contact_patch, contact_curved_tol, aux_max_doublings
 
    !> A contact surface whose unit normals differ by more than this (1 - cos) is curved.
    real(wp), parameter :: contact_curved_tol = 1.0e-10_wp
+   !> recover_contact_patch doubles a rank-deficient Omega_aux's depth at most this often.
+   integer, parameter :: aux_max_doublings = 4
 
 contains
 
@@ -68,7 +71,7 @@ contains
       real(wp), allocatable :: c(:, :), lam(:)
       integer :: mc1, mc2, mz, r, n1, n2
 
-      call check_contact_input(patch1, patch2, law, slip, error)
+      call check_contact_input(patch1, law, slip, error, patch2)
       if (allocated(error)) return
       call sprc_constraints(patch1, degree, ws1, rec1, mc1, .true., error)
       if (allocated(error)) return
@@ -94,17 +97,16 @@ contains
       call coupled_solve(patch1, patch2, ws1, ws2, c(1:mc1 + mc2 + r, :), lam(1:mc1 + mc2 + r), rec1, rec2, error)
    end subroutine recover_sprc_contact
 
-   pure subroutine check_contact_input(patch1, patch2, law, slip, error)
-      type(patch_type), intent(in) :: patch1, patch2
+   pure subroutine check_contact_input(patch1, law, slip, error, patch2)
+      type(patch_type), intent(in) :: patch1
       integer, intent(in) :: law(:)
       real(wp), intent(in) :: slip(:, :)
       type(error_type), allocatable, intent(out) :: error
+      type(patch_type), intent(in), optional :: patch2
       character(len=120) :: buf
 
       buf = ''
-      if (patch2%dim /= patch1%dim) then
-         write (buf, '("patch2%dim = ",i0," differs from patch1%dim = ",i0)') patch2%dim, patch1%dim
-      else if (patch1%nbpoints < 1) then
+      if (patch1%nbpoints < 1) then
          buf = 'patch1 has no contact points'
       else if (.not. allocated(patch1%bkind)) then
          buf = 'patch1 boundary arrays are not allocated'
@@ -112,8 +114,12 @@ contains
          buf = 'patch1 has no contact points'
       else if (size(law) < patch1%nbpoints .or. size(slip, 2) < patch1%nbpoints .or. size(slip, 1) < patch1%dim) then
          write (buf, '("law and slip need ",i0," boundary points")') patch1%nbpoints
-      else if (patch2%nbpoints > 0) then
-         if (any(patch2%bkind(1:patch2%nbpoints) == boundary_contact)) buf = 'patch2 (Omega_aux) has contact points'
+      else if (present(patch2)) then
+         if (patch2%dim /= patch1%dim) then
+            write (buf, '("patch2%dim = ",i0," differs from patch1%dim = ",i0)') patch2%dim, patch1%dim
+         else if (patch2%nbpoints > 0) then
+            if (any(patch2%bkind(1:patch2%nbpoints) == boundary_contact)) buf = 'patch2 (Omega_aux) has contact points'
+         end if
       end if
       if (len_trim(buf) > 0) call fatal_error(error, 'recover_sprc_contact: '//trim(buf), stat_invalid_input)
    end subroutine check_contact_input
@@ -308,5 +314,107 @@ contains
       allocate (rec%coef(ws%nt, ws%ns))
       rec%coef(ws%jpvt_p(1:ws%nt), :) = b
    end subroutine body_coef
+
+   !> One contact patch from the other body's sampling points (mesh-agnostic): Omega_aux of
+   !> patch1's contact points (sprc_recovery_contact_aux, margin 0) with depth `depth`, patch2
+   !> filled with body (2)'s points y2(1:dim, j), weights w2(j), Voigt stresses stress2(:, j)
+   !> inside it (x0 the Omega_aux centre, h the largest distance from it to a chosen point;
+   !> material young2, poisson2, body force body_force2 if given; the analysis of patch1), then
+   !> recover_sprc_contact. While the Omega_aux fit is rank deficient (too few or coplanar
+   !> points of body (2)) the depth is doubled, at most aux_max_doublings times; depth_used
+   !> returns the depth of the solve. patch2 is storage reused between calls.
+   subroutine recover_contact_patch(patch1, degree, law, mu, slip, y2, w2, stress2, young2, poisson2, depth, &
+      & ws1, ws2, patch2, rec1, rec2, error, body_force2, depth_used)
+      type(patch_type), intent(in) :: patch1
+      integer, intent(in) :: degree, law(:)
+      real(wp), intent(in) :: mu, slip(:, :), y2(:, :), w2(:), stress2(:, :), young2, poisson2, depth
+      type(recovery_workspace_type), intent(inout) :: ws1, ws2
+      type(patch_type), intent(inout) :: patch2
+      type(recovered_patch_type), intent(out) :: rec1, rec2
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), intent(in), optional :: body_force2(:)
+      real(wp), intent(out), optional :: depth_used
+      type(aux_domain_type) :: aux
+      real(wp), allocatable :: cx(:, :), cn(:, :), cw(:)
+      real(wp) :: dep
+      integer :: d, k
+
+      d = patch1%dim
+      call check_contact_input(patch1, law, slip, error)
+      if (allocated(error)) return
+      if (size(y2, 1) < d .or. size(w2) > size(y2, 2) .or. size(stress2, 2) < size(w2)) then
+         call fatal_error(error, 'recover_contact_patch: y2, w2 and stress2 disagree in size', stat_invalid_input)
+         return
+      end if
+      call contact_points(patch1, cx, cn, cw)
+      dep = depth
+      do k = 0, aux_max_doublings
+         call new_aux_domain(aux, d, cx, cn, cw, dep, 0.0_wp, error)
+         if (allocated(error)) then
+            error%message = 'recover_contact_patch: '//error%message
+            return
+         end if
+         call fill_aux_patch(patch1, aux, y2, w2, stress2, young2, poisson2, patch2)
+         if (present(body_force2)) patch2%body_force(1:d) = body_force2(1:d)
+         if (present(depth_used)) depth_used = dep
+         dep = 2*dep
+         if (patch2%npoints == 0 .and. k < aux_max_doublings) cycle
+         call recover_sprc_contact(patch1, patch2, degree, law, mu, slip, ws1, ws2, rec1, rec2, error)
+         if (.not. allocated(error)) return
+         if (error%stat /= stat_singular .or. index(error%message, 'Omega_aux fit') == 0) return
+      end do
+   end subroutine recover_contact_patch
+
+   !> The contact points of patch1: coordinates, normals, weights.
+   pure subroutine contact_points(patch1, cx, cn, cw)
+      type(patch_type), intent(in) :: patch1
+      real(wp), allocatable, intent(out) :: cx(:, :), cn(:, :), cw(:)
+      integer :: j, m, d
+
+      d = patch1%dim
+      m = count(patch1%bkind(1:patch1%nbpoints) == boundary_contact)
+      allocate (cx(d, m), cn(d, m), cw(m))
+      m = 0
+      do j = 1, patch1%nbpoints
+         if (patch1%bkind(j) /= boundary_contact) cycle
+         m = m + 1
+         cx(:, m) = patch1%bx(1:d, j)
+         cn(:, m) = patch1%bn(1:d, j)
+         cw(m) = patch1%bw(j)
+      end do
+   end subroutine contact_points
+
+   !> patch2 := body (2)'s points inside Omega_aux (recover_contact_patch).
+   pure subroutine fill_aux_patch(patch1, aux, y2, w2, stress2, young2, poisson2, patch2)
+      type(patch_type), intent(in) :: patch1
+      type(aux_domain_type), intent(in) :: aux
+      real(wp), intent(in) :: y2(:, :), w2(:), stress2(:, :), young2, poisson2
+      type(patch_type), intent(inout) :: patch2
+      integer :: j, n, d, ns
+      real(wp) :: h
+
+      d = patch1%dim
+      ns = merge(3, 6, d == 2)
+      h = 0.0_wp
+      n = 0
+      do j = 1, size(w2)
+         if (.not. aux_contains(aux, y2(:, j))) cycle
+         n = n + 1
+         h = max(h, norm2(y2(1:d, j) - aux%centre(1:d)))
+      end do
+      call patch_reset(patch2, d, patch1%analysis, young2, poisson2, aux%centre(1:d), max(h, tiny(1.0_wp)))
+      call patch_reserve(patch2, n, 0)
+      n = 0
+      do j = 1, size(w2)
+         if (.not. aux_contains(aux, y2(:, j))) cycle
+         n = n + 1
+         patch2%x(:, n) = 0.0_wp
+         patch2%x(1:d, n) = y2(1:d, j)
+         patch2%w(n) = w2(j)
+         patch2%stress(:, n) = 0.0_wp
+         patch2%stress(1:ns, n) = stress2(1:ns, j)
+      end do
+      patch2%npoints = n
+   end subroutine fill_aux_patch
 
 end module sprc_recovery_contact_solve
