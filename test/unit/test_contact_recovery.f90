@@ -11,7 +11,7 @@ module sprc_test_contact_recovery
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: stat_invalid_input
    use sprc_recovery_contact_operators, only: contact_frame, contact_operator, contact_law_operator, &
-      & contact_rows, contact_law_frictionless, contact_law_slip, contact_law_stick
+      & contact_rows, contact_law_frictionless, contact_law_slip, contact_law_stick, contact_traction
    use sprc_recovery_contact_aux, only: aux_domain_type, new_aux_domain, aux_contains, aux_select
    use sprc_recovery_contact_solve, only: recover_sprc_contact, recover_contact_patch
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reset, patch_add_point, &
@@ -58,6 +58,7 @@ contains
          new_unittest('laws_2d', test_laws_2d), &
          new_unittest('laws_3d', test_laws_3d), &
          new_unittest('rows', test_rows), &
+         new_unittest('traction_p_ts', test_traction_p_ts), &
          new_unittest('operator_errors', test_operator_errors), &
          new_unittest('aux_flat_3d', test_aux_flat_3d), &
          new_unittest('aux_curved_2d', test_aux_curved_2d), &
@@ -240,6 +241,21 @@ contains
       call check(error, maxval(abs(matmul(rows(1:2, 1:9), reshape(a, [9])) - want(1:2))) <= tol_roundoff*scale, &
          & 'rows (op x p) A = factor op (P A)')
    end subroutine test_rows
+
+   !> p and ts by hand: n = (0.6, 0.8), sigma = (1, 2, 0.5): sigma n = (1.0, 1.9), t_n = 2.12,
+   !> tangential part (-0.272, 0.204) of length 0.34; 3D: sigma = diag(1, 2, -3) at n = e_z:
+   !> p = 3, ts = 0.
+   subroutine test_traction_p_ts(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: p, ts
+
+      call contact_traction(2, [0.6_wp, 0.8_wp], [1.0_wp, 2.0_wp, 0.5_wp], p, ts)
+      call check(error, abs(p + 2.12_wp) <= 8*epsilon(1.0_wp) .and. abs(ts - 0.34_wp) <= 8*epsilon(1.0_wp), &
+         & 'p, ts in 2D by hand')
+      if (allocated(error)) return
+      call contact_traction(3, [0.0_wp, 0.0_wp, 1.0_wp], [1.0_wp, 2.0_wp, -3.0_wp, 0.4_wp, 0.0_wp, 0.0_wp], p, ts)
+      call check(error, abs(p - 3.0_wp) <= 4*epsilon(1.0_wp) .and. ts <= 4*epsilon(1.0_wp), 'p, ts in 3D by hand')
+   end subroutine test_traction_p_ts
 
    subroutine test_operator_errors(error)
       use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan

@@ -47,7 +47,7 @@ module sprc_recovery_contact_operators
 
    public :: contact_law_frictionless, contact_law_slip, contact_law_stick, contact_law_name
    public :: contact_frame, contact_operator, contact_law_matrix, contact_law_operator, contact_rows
-   public :: contact_normal_tol
+   public :: contact_normal_tol, contact_traction
 
    !> Contact law at a closed contact point: frictionless, Coulomb slip (sliding at
    !> |t_t| = mu p) and stick (Coulomb below the limit, or friction 'stick').
@@ -188,5 +188,22 @@ contains
          end do
       end do
    end subroutine contact_rows
+
+   !> Contact pressure p = -n^T sigma n (positive in compression) and magnitude ts of the
+   !> tangential traction |sigma n - (n^T sigma n) n| of the Voigt stress sigma at a point with
+   !> unit normal n: the p and ts of a contact result (sprc_contact_result).
+   pure subroutine contact_traction(dim, n, sigma, p, ts)
+      integer, intent(in) :: dim
+      real(wp), intent(in) :: n(:), sigma(:)
+      real(wp), intent(out) :: p, ts
+      real(wp) :: g(3, 6), t(3)
+      integer :: ns
+
+      ns = merge(3, 6, dim == 2)
+      call traction_operator(dim, n, g)
+      t(1:dim) = matmul(g(1:dim, 1:ns), sigma(1:ns))
+      p = -dot_product(n(1:dim), t(1:dim))
+      ts = norm2(t(1:dim) + p*n(1:dim))
+   end subroutine contact_traction
 
 end module sprc_recovery_contact_operators

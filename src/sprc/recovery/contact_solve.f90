@@ -27,6 +27,9 @@
 !> ordinary patch (no contact points), e.g. body (2)'s sampling points in Omega_aux with its
 !> other boundaries' traction points there.
 !>
+!> Rank decisions are reported as recover_sprc's (rec%max_dropped_ratio, tolerance_bites):
+!> the contact rows' in rec1, the stacked selection's in both.
+!>
 !> Storage: the coupled rows are allocated per call (a contact patch is one of few).
 module sprc_recovery_contact_solve
    use sprc_core_kinds, only: wp
@@ -35,7 +38,7 @@ module sprc_recovery_contact_solve
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, boundary_contact, patch_reset, patch_reserve
    use sprc_recovery_contact_aux, only: aux_domain_type, new_aux_domain, aux_contains
    use sprc_recovery_workspace, only: recovery_workspace_type
-   use sprc_recovery_solve, only: sprc_constraints, recovery_rank_tol, traction_rank_tol, flat_traction_rank
+   use sprc_recovery_solve, only: sprc_constraints, note_dropped, recovery_rank_tol, traction_rank_tol, flat_traction_rank
    use sprc_recovery_dense, only: qr_pivoted, apply_qt, apply_q, solve_upper
    use sprc_recovery_contact_operators, only: contact_frame, contact_operator, contact_law_operator, contact_rows, &
       & contact_law_slip, contact_law_name
@@ -90,7 +93,7 @@ contains
       lam(1:mc1) = ws1%lam(1:mc1)
       c(mc1 + 1:mc1 + mc2, n1 + 1:n1 + n2) = ws2%c(1:mc2, 1:n2)
       lam(mc1 + 1:mc1 + mc2) = ws2%lam(1:mc2)
-      call contact_block(patch1, patch2, degree, law, mu, slip, ws1, ws2, mz, c(mc1 + mc2 + 1:, :), r, error)
+      call contact_block(patch1, patch2, degree, law, mu, slip, ws1, ws2, mz, c(mc1 + mc2 + 1:, :), r, rec1, error)
       if (allocated(error)) return
       if (present(ncontact_rows)) ncontact_rows = mz
       if (present(contact_rank)) contact_rank = r
@@ -125,13 +128,14 @@ contains
    end subroutine check_contact_input
 
    !> The contact rows (module notes): rows(1:r, :) of R Pi^T, r the kept rank.
-   subroutine contact_block(patch1, patch2, degree, law, mu, slip, ws1, ws2, mz, rows, r, error)
+   subroutine contact_block(patch1, patch2, degree, law, mu, slip, ws1, ws2, mz, rows, r, rec1, error)
       type(patch_type), intent(in) :: patch1, patch2
       integer, intent(in) :: degree, law(:), mz
       real(wp), intent(in) :: mu, slip(:, :)
       type(recovery_workspace_type), intent(in) :: ws1, ws2
       real(wp), intent(inout) :: rows(:, :)
       integer, intent(out) :: r
+      type(recovered_patch_type), intent(inout) :: rec1
       type(error_type), allocatable, intent(out) :: error
       real(wp) :: frame(3, 3), h(3, 6), hp(3, 6), p(20), s(3), sq, wsum, z(3, 120), nref(3)
       real(wp), allocatable :: e(:, :), tau(:), vn(:, :)
@@ -193,6 +197,7 @@ contains
       do k = 1, min(mz, n1 + n2, cap)
          if (abs(e(k, k)) > traction_rank_tol*abs(e(1, 1))) r = k
       end do
+      if (r < min(mz, n1 + n2, cap) .and. r > 0) call note_dropped(rec1, abs(e(r + 1, r + 1))/abs(e(1, 1)))
       do k = 1, r
          rows(k, :) = 0.0_wp
          rows(k, jpvt(k:n1 + n2)) = e(k, k:n1 + n2)
@@ -228,6 +233,10 @@ contains
          do k = 1, min(nn, mc)
             if (abs(wt(k, k)) > recovery_rank_tol*abs(wt(1, 1))) r = k
          end do
+         if (r < min(nn, mc) .and. r > 0) then
+            call note_dropped(rec1, abs(wt(r + 1, r + 1))/abs(wt(1, 1)))
+            call note_dropped(rec2, abs(wt(r + 1, r + 1))/abs(wt(1, 1)))
+         end if
       end if
       keep(1:r) = jpvt(1:r)
       ! W^T = blockdiag(I x R_b^-T Pi_b^T) C^T of the kept rows.

@@ -115,7 +115,7 @@ module sprc_recovery_solve
    implicit none
    private
 
-   public :: recover_spr, recover_sprc, sprc_constraints, recovery_rank_tol, recovery_bite_ratio, traction_rank_tol
+   public :: recover_spr, recover_sprc, sprc_constraints, note_dropped, recovery_rank_tol, recovery_bite_ratio, traction_rank_tol
    public :: flat_traction_rank, traction_reach
 
    !> Relative tolerance of every rank decision (pivoted QR): |R_kk| > tol |R_11| counts.
@@ -282,6 +282,7 @@ contains
       end do
    end function diag_rank
 
+   !> Record a discarded pivot ratio |R_kk|/|R_11| of a rank decision in `rec`.
    pure subroutine note_dropped(rec, ratio)
       type(recovered_patch_type), intent(inout) :: rec
       real(wp), intent(in) :: ratio
