@@ -429,7 +429,7 @@ contains
    !> compatibility and the contact law, sampled at Gauss points of a patch of body (1) (below
    !> the contact plane) and of a non-matching grid of body (2) selected by Omega_aux: the
    !> coupled SPR-C recovers both fields and the contact residual at round-off, p = 1 and 2,
-   !> frictionless, slip and stick.
+   !> frictionless, slip and stick; side 2 is the mirrored (master-side) patch.
    subroutine test_coupled_exact_2d(error)
       type(error_type), allocatable, intent(out) :: error
       call coupled_laws(2, error)
@@ -445,19 +445,21 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(linear_field_t) :: f1, f2
       real(wp) :: err1, err2, res
-      integer :: law, p
+      integer :: law, p, side
       real(wp), parameter :: mu = 0.35_wp
       character(len=160) :: buf
 
-      do p = 1, 2
-         do law = contact_law_frictionless, contact_law_stick
-            call law_fields(dim, law, mu, f1, f2)
-            call coupled_case(dim, p, law, mu, f1, f2, err1, err2, res, error)
-            if (allocated(error)) return
-            write (buf, '("dim ",i0,", p = ",i0,", law ",i0,": errors ",es9.2,", ",es9.2,", contact residual ",es9.2, &
-               & " (tier ",es9.2,")")') dim, p, law, err1, err2, res, tol_exact
-            call check(error, max(err1, err2, res) <= tol_exact, trim(buf))
-            if (allocated(error)) return
+      do side = 1, 2
+         do p = 1, 2
+            do law = contact_law_frictionless, contact_law_stick
+               call law_fields(dim, law, mu, f1, f2)
+               call coupled_case(dim, p, law, mu, f1, f2, err1, err2, res, error, mirror=side == 2)
+               if (allocated(error)) return
+               write (buf, '("dim ",i0,", side ",i0,", p = ",i0,", law ",i0,": errors ",es9.2,", ",es9.2, &
+                  & ", contact residual ",es9.2," (tier ",es9.2,")")') dim, side, p, law, err1, err2, res, tol_exact
+               call check(error, max(err1, err2, res) <= tol_exact, trim(buf))
+               if (allocated(error)) return
+            end do
          end do
       end do
    end subroutine coupled_laws
@@ -649,7 +651,7 @@ contains
    !> largest stress: err1 over body (1)'s points, err2 over Omega_aux's, res the contact residual.
    !> With depth0, Omega_aux and its points come from recover_contact_patch (all of body (2)'s
    !> points passed, depth0 its first depth; depth_used returned).
-   subroutine coupled_case(dim, degree, law, mu, f1, f2, err1, err2, res, error, depth0, depth_used)
+   subroutine coupled_case(dim, degree, law, mu, f1, f2, err1, err2, res, error, depth0, depth_used, mirror)
       integer, intent(in) :: dim, degree, law
       real(wp), intent(in) :: mu
       type(linear_field_t), intent(in) :: f1, f2
@@ -657,6 +659,11 @@ contains
       type(error_type), allocatable, intent(out) :: error
       real(wp), intent(in), optional :: depth0
       real(wp), intent(out), optional :: depth_used
+      !> Mirrored: the patch is body (2)'s (above z = 0, contact normal -z, slip -x) and Omega_aux
+      !> lies in body (1) (the master-side treatment); errors are then body (2)'s, body (1)'s.
+      logical, intent(in), optional :: mirror
+      type(linear_field_t) :: fa, fb
+      real(wp) :: sgn
       real(wp), parameter :: gx(3) = [-sqrt(0.6_wp), 0.0_wp, sqrt(0.6_wp)], gw(3) = [5, 8, 5]/9.0_wp
       real(wp), parameter :: h2cell = 0.6_wp, off2 = -1.33_wp, depth = 1.5_wp
       type(patch_type) :: p1, p2
@@ -670,17 +677,27 @@ contains
       real(wp) :: y2(3, 3000), w2(3000), st2(6, 3000)
 
       ns = merge(3, 6, dim == 2)
+      fa = f1
+      fb = f2
+      sgn = 1.0_wp
+      if (present(mirror)) then
+         if (mirror) then
+            fa = f2
+            fb = f1
+            sgn = -1.0_wp
+         end if
+      end if
       nq = 3**dim
       call new_poly_basis(basis, dim, degree, error)
       if (allocated(error)) return
       ! Body (1): cells of size 1 below z = 0 around the node at the origin.
       call patch_reset(p1, dim, merge(plane_strain, solid, dim == 2), 1.0_wp, 0.3_wp, [0.0_wp, 0.0_wp, 0.0_wp], &
          & 1.5_wp)
-      p1%body_force(1:dim) = body_force(f1)
+      p1%body_force(1:dim) = body_force(fa)
       ncell1 = 2**(dim - 1)
       nc = 0
       nrm = 0.0_wp
-      nrm(dim) = 1.0_wp
+      nrm(dim) = sgn
       smax = 0.0_wp
       do c = 0, ncell1 - 1
          do k = 0, nq - 1
@@ -691,9 +708,9 @@ contains
                x(i) = merge(-1.0_wp, 0.0_wp, .not. btest(c, i - 1)) + 0.5_wp*(1.0_wp + gx(ijk(i) + 1))
                wgt = wgt*0.5_wp*gw(ijk(i) + 1)
             end do
-            x(dim) = -0.5_wp*(1.0_wp - gx(ijk(dim) + 1))
+            x(dim) = -sgn*0.5_wp*(1.0_wp - gx(ijk(dim) + 1))
             wgt = wgt*0.5_wp*gw(ijk(dim) + 1)
-            s1 = field_stress(dim, f1, x(1:dim))
+            s1 = field_stress(dim, fa, x(1:dim))
             call patch_add_point(p1, x(1:dim), wgt, s1(1:ns))
             smax = max(smax, maxval(abs(s1)))
             ! The Gauss points of the top face (z = 0) are the contact points.
@@ -709,12 +726,12 @@ contains
       end do
       laws = law
       sl = 0.0_wp
-      sl(1, :) = 1.0_wp
+      sl(1, :) = sgn
       ! Body (2): a non-matching grid (cells 0.6, offset) above z = 0; its Gauss points in Omega_aux.
       call new_aux_domain(aux, dim, cx(1:dim, 1:nc), cn(1:dim, 1:nc), cw(1:nc), depth, 0.0_wp, error)
       if (allocated(error)) return
       call patch_reset(p2, dim, merge(plane_strain, solid, dim == 2), 1.0_wp, 0.3_wp, aux%centre(1:dim), depth)
-      p2%body_force(1:dim) = body_force(f2)
+      p2%body_force(1:dim) = body_force(fb)
       ncell2 = 5
       n2 = 0
       top = merge(ncell2, 1, dim == 3)
@@ -725,9 +742,9 @@ contains
             x(1) = off2 + h2cell*(mod(c, ncell2) + 0.5_wp*(1.0_wp + gx(ijk(1) + 1)))
             if (dim == 3) x(2) = off2 + h2cell*(mod(c/ncell2, top) + 0.5_wp*(1.0_wp + gx(ijk(2) + 1)))
             j = c/(ncell2*top)
-            x(dim) = h2cell*(j + 0.5_wp*(1.0_wp + gx(ijk(dim) + 1)))
+            x(dim) = sgn*h2cell*(j + 0.5_wp*(1.0_wp + gx(ijk(dim) + 1)))
             wgt = (0.5_wp*h2cell)**dim*product(gw(ijk(1:dim) + 1))
-            s2 = field_stress(dim, f2, x(1:dim))
+            s2 = field_stress(dim, fb, x(1:dim))
             n2 = n2 + 1
             y2(:, n2) = x
             w2(n2) = wgt
@@ -740,7 +757,7 @@ contains
       if (present(depth0)) then
          call recover_contact_patch(p1, degree, laws(1:p1%nbpoints), mu, sl(1:dim, 1:p1%nbpoints), y2(1:dim, 1:n2), &
             & w2(1:n2), st2(1:ns, 1:n2), 1.0_wp, 0.3_wp, depth0, ws1, ws2, p2, rec1, rec2, error, &
-            & body_force2=body_force(f2), depth_used=depth_used)
+            & body_force2=body_force(fb), depth_used=depth_used)
          if (allocated(error)) return
          rank = -1
       else
