@@ -264,11 +264,11 @@ contains
       real(wp) :: frame(3, 3), h(3, 6), hp(3, 6)
 
       call contact_frame(2, [0.6_wp, 0.7_wp], frame, err)
-      call expect_invalid('non-unit normal')
+      call expect_invalid(error, err, 'non-unit normal', 'unit normal')
       call contact_frame(3, [0.0_wp, 0.0_wp, 1.0_wp], frame, err, slip=[0.0_wp, 0.0_wp, -2.0_wp])
-      call expect_invalid('slip along the normal')
+      call expect_invalid(error, err, 'slip along the normal', 'slip direction')
       call contact_frame(3, [0.0_wp, 0.0_wp, 1.0_wp], frame, err, slip=[ieee_value(1.0_wp, ieee_quiet_nan), 1.0_wp, 0.0_wp])
-      call expect_invalid('slip not finite')
+      call expect_invalid(error, err, 'slip not finite', 'slip direction')
       call contact_frame(3, [0.0_wp, 0.0_wp, 1.0_wp], frame, err)
       if (allocated(err)) then
          call test_failed(error, 'valid frame refused: '//err%message)
@@ -276,20 +276,9 @@ contains
       end if
       call contact_operator(3, frame, h)
       call contact_law_operator(3, contact_law_slip, -0.1_wp, h, hp, err)
-      call expect_invalid('mu < 0')
+      call expect_invalid(error, err, 'mu < 0', 'mu =')
       call contact_law_operator(3, 7, 0.1_wp, h, hp, err)
-      call expect_invalid('unknown law')
-   contains
-      subroutine expect_invalid(what)
-         character(len=*), intent(in) :: what
-         if (allocated(error)) return
-         if (.not. allocated(err)) then
-            call test_failed(error, what//': accepted')
-         else if (err%stat /= stat_invalid_input) then
-            call test_failed(error, what//': wrong status')
-         end if
-         if (allocated(err)) deallocate (err)
-      end subroutine expect_invalid
+      call expect_invalid(error, err, 'unknown law', 'law = 7')
    end subroutine test_operator_errors
 
    ! ------------------------------------------------------------------ Omega_aux
@@ -397,30 +386,19 @@ contains
       n = reshape([0.0_wp, 1.0_wp, 0.0_wp, 1.0_wp], [2, 2])
       w = 1.0_wp
       call new_aux_domain(aux, 2, x, n, w, 0.0_wp, 0.0_wp, err)
-      call expect_invalid('depth = 0', 'depth')
+      call expect_invalid(error, err, 'depth = 0', 'depth')
       call new_aux_domain(aux, 2, x, n, w, 1.0_wp, -1.0_wp, err)
-      call expect_invalid('margin < 0', 'margin')
+      call expect_invalid(error, err, 'margin < 0', 'margin')
       call new_aux_domain(aux, 2, x, n, [1.0_wp, -1.0_wp], 1.0_wp, 0.0_wp, err)
-      call expect_invalid('negative weight', 'w(2)')
+      call expect_invalid(error, err, 'negative weight', 'w(2)')
       call new_aux_domain(aux, 2, x, n, [0.0_wp, 0.0_wp], 1.0_wp, 0.0_wp, err)
-      call expect_invalid('zero weights', 'sum to 0')
+      call expect_invalid(error, err, 'zero weights', 'sum to 0')
       call new_aux_domain(aux, 2, x, reshape([0.0_wp, 1.0_wp, 0.0_wp, -1.0_wp], [2, 2]), w, 1.0_wp, 0.0_wp, err)
-      call expect_invalid('opposite normals', 'cancel')
+      call expect_invalid(error, err, 'opposite normals', 'cancel')
       call new_aux_domain(aux, 2, x, 2*n, w, 1.0_wp, 0.0_wp, err)
-      call expect_invalid('non-unit normal', 'n(:, 1)')
+      call expect_invalid(error, err, 'non-unit normal', 'n(:, 1)')
       call new_aux_domain(aux, 2, x(:, 1:0), n(:, 1:0), w(1:0), 1.0_wp, 0.0_wp, err)
-      call expect_invalid('no points', 'no contact points')
-   contains
-      subroutine expect_invalid(what, word)
-         character(len=*), intent(in) :: what, word
-         if (allocated(error)) return
-         if (.not. allocated(err)) then
-            call test_failed(error, what//': accepted')
-         else if (err%stat /= stat_invalid_input .or. index(err%message, word) == 0) then
-            call test_failed(error, what//': wrong status or message: '//err%message)
-         end if
-         if (allocated(err)) deallocate (err)
-      end subroutine expect_invalid
+      call expect_invalid(error, err, 'no points', 'no contact points')
    end subroutine test_aux_errors
 
    ! ------------------------------------------------------------------ coupled solve
@@ -528,34 +506,23 @@ contains
       end do
       p3 = p1
       call recover_sprc_contact(p1, p2, 1, [contact_law_stick], 0.0_wp, sl, ws1, ws2, rec1, rec2, err)
-      call expect_invalid('no contact points', 'no contact points')
+      call expect_invalid(error, err, 'no contact points', 'no contact points')
       do i = 1, 2
          call patch_add_boundary_point(p1, [0.3_wp*i - 0.45_wp, 0.0_wp], 0.5_wp, [0.0_wp, 1.0_wp], boundary_contact)
       end do
       sl = 0.0_wp
       sl(2, :) = 1.0_wp
       call recover_sprc_contact(p1, p2, 1, [contact_law_stick], 0.0_wp, sl, ws1, ws2, rec1, rec2, err)
-      call expect_invalid('law too short', 'law and slip')
+      call expect_invalid(error, err, 'law too short', 'law and slip')
       call recover_sprc_contact(p1, p2, 1, [contact_law_slip, contact_law_slip], 0.3_wp, sl, ws1, ws2, rec1, rec2, err)
-      call expect_invalid('slip along the normal', 'boundary point 1 (law slip)')
+      call expect_invalid(error, err, 'slip along the normal', 'boundary point 1 (law slip)')
       call recover_sprc_contact(p1, p1, 1, [contact_law_stick, contact_law_stick], 0.0_wp, sl, ws1, ws2, rec1, &
          & rec2, err)
-      call expect_invalid('Omega_aux with contact points', 'patch2')
+      call expect_invalid(error, err, 'Omega_aux with contact points', 'patch2')
       call recover_sprc_contact(p1, p2, 1, [contact_law_stick, 9], 0.0_wp, sl, ws1, ws2, rec1, rec2, err)
-      call expect_invalid('unknown law', 'law = 9')
+      call expect_invalid(error, err, 'unknown law', 'law = 9')
       call recover_sprc_contact(p3, p2, 1, [contact_law_stick], 0.0_wp, sl, ws1, ws2, rec1, rec2, err)
-      call expect_invalid('patch without contact', 'no contact points')
-   contains
-      subroutine expect_invalid(what, word)
-         character(len=*), intent(in) :: what, word
-         if (allocated(error)) return
-         if (.not. allocated(err)) then
-            call test_failed(error, what//': accepted')
-         else if (err%stat /= stat_invalid_input .or. index(err%message, word) == 0) then
-            call test_failed(error, what//': wrong status or message: '//err%message)
-         end if
-         if (allocated(err)) deallocate (err)
-      end subroutine expect_invalid
+      call expect_invalid(error, err, 'patch without contact', 'no contact points')
    end subroutine test_coupled_errors
 
    !> Fields of the two bodies that satisfy `law` on z = 0 (body (1) below, its outward
@@ -814,5 +781,18 @@ contains
          end do
       end function eval
    end subroutine coupled_case
+
+   !> Fail `error` unless `err` holds stat_invalid_input with `word` in its message; clears err.
+   subroutine expect_invalid(error, err, what, word)
+      type(error_type), allocatable, intent(inout) :: error, err
+      character(len=*), intent(in) :: what, word
+      if (allocated(error)) return
+      if (.not. allocated(err)) then
+         call test_failed(error, what//': accepted')
+      else if (err%stat /= stat_invalid_input .or. index(err%message, word) == 0) then
+         call test_failed(error, what//': wrong status or message: '//err%message)
+      end if
+      if (allocated(err)) deallocate (err)
+   end subroutine expect_invalid
 
 end module sprc_test_contact_recovery
