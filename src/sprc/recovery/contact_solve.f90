@@ -38,7 +38,8 @@ module sprc_recovery_contact_solve
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, boundary_contact, patch_reset, patch_reserve
    use sprc_recovery_contact_aux, only: aux_domain_type, new_aux_domain, aux_contains
    use sprc_recovery_workspace, only: recovery_workspace_type
-   use sprc_recovery_solve, only: sprc_constraints, note_dropped, recovery_rank_tol, traction_rank_tol, flat_traction_rank
+   use sprc_recovery_solve, only: sprc_constraints, note_dropped, recovery_rank_tol, recovery_bite_ratio, traction_rank_tol, &
+      & flat_traction_rank
    use sprc_recovery_dense, only: qr_pivoted, apply_qt, apply_q, solve_upper
    use sprc_recovery_contact_operators, only: contact_frame, contact_operator, contact_law_operator, contact_rows, &
       & contact_law_slip, contact_law_name
@@ -191,7 +192,7 @@ contains
          e(m + 1:m + d, n1 + 1:n1 + n2) = z(1:d, 1:n2)
          m = m + d
       end do
-      call qr_pivoted(mz, n1 + n2, e, jpvt, tau, vn)
+      call qr_pivoted(mz, n1 + n2, e, jpvt, tau, vn, recovery_bite_ratio)
       cap = flat_traction_rank(d, merge(degree - 1, degree, curved))
       r = 0
       do k = 1, min(mz, n1 + n2, cap)
@@ -229,7 +230,7 @@ contains
       end do
       r = 0
       if (mc > 0) then
-         call qr_pivoted(nn, mc, wt, jpvt, tau, vn)
+         call qr_pivoted(nn, mc, wt, jpvt, tau, vn, recovery_bite_ratio)
          do k = 1, min(nn, mc)
             if (abs(wt(k, k)) > recovery_rank_tol*abs(wt(1, 1))) r = k
          end do
