@@ -19,8 +19,12 @@ module sprc_test_contact_recovery
    use sprc_recovery_workspace, only: recovery_workspace_type
    use sprc_core_material, only: plane_strain, solid
    use sprc_core_poly, only: poly_basis_type, new_poly_basis
-   use sprc_core_text, only: itoa
-   use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type
+   use sprc_core_text, only: itoa, rtoa
+   use sprc_io_namelist, only: read_text_file
+   use sprc_study_level, only: study_type, level_type
+   use sprc_test_study, only: run_text
+   use sprc_contact_result, only: contact_open
+   use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type, replaced
    implicit none
    private
 
@@ -67,7 +71,8 @@ contains
          new_unittest('coupled_exact_3d', test_coupled_exact_3d), &
          new_unittest('coupled_wrong_law', test_coupled_wrong_law), &
          new_unittest('coupled_errors', test_coupled_errors), &
-         new_unittest('contact_patch_depth', test_contact_patch_depth) &
+         new_unittest('contact_patch_depth', test_contact_patch_depth), &
+         new_unittest('study_patch_pressures', test_study_patch_pressures) &
          ]
    end subroutine collect_contact_recovery
 
@@ -485,6 +490,38 @@ contains
          end do
       end do
    end subroutine test_contact_patch_depth
+
+   !> The contact patch test (uniform sigma_yy = -1 across a flat interface of two materials on
+   !> non-matching cut grids, test/data/contact/patch_2d.nml, level 3, SPR and SPR-C): the
+   !> recovered pressures p_spr, p_sprc of the contact result are 1 and ts_sprc is 0 at every
+   !> closed point. Tolerance: the FE's 10 eps/rcond (test_contact_fe) plus the sqrt(eps) tier of
+   !> values that pass through a patch solve.
+   subroutine test_study_patch_pressures(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(level_type) :: result
+      type(study_type) :: study
+      character(len=:), allocatable :: text
+      real(wp) :: tol, worst
+      integer :: b
+
+      call read_text_file('test/data/contact/patch_2d.nml', text, error)
+      if (allocated(error)) return
+      text = replaced(text, "recovery = 'none'", "recovery = 'both'")
+      call run_text(text, 3, result, error, study)
+      if (allocated(error)) return
+      tol = tol_exact
+      do b = 1, size(result%bodies)
+         tol = tol + 10.0_wp*epsilon(1.0_wp)/result%bodies(b)%problem%rcond
+      end do
+      associate (c => result%contacts(1))
+         worst = max(maxval(abs(c%p_spr - 1.0_wp), c%state /= contact_open), &
+            & maxval(abs(c%p_sprc - 1.0_wp), c%state /= contact_open), maxval(c%ts_sprc, c%state /= contact_open))
+         ! all(...) rather than the max alone: a NaN (an unfilled, empty value) fails every comparison.
+         call check(error, count(c%state /= contact_open) > 0 .and. all(c%state == contact_open .or. &
+            & (abs(c%p_spr - 1.0_wp) <= tol .and. abs(c%p_sprc - 1.0_wp) <= tol .and. c%ts_sprc <= tol)), &
+            & 'p_spr, p_sprc = 1, ts_sprc = 0: max deviation '//rtoa(worst)//', tolerance '//rtoa(tol))
+      end associate
+   end subroutine test_study_patch_pressures
 
    !> Bad input of the coupled solve: clear errors, no crash.
    subroutine test_coupled_errors(error)

@@ -32,7 +32,8 @@ module sprc_study_level
    use sprc_grid_hanging, only: hanging_type
    use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature, default_points
    use sprc_grid_patches, only: recovery_input_type, recover_grid
-   use sprc_grid_recovered_field, only: recovered_field_type, method_spr, method_sprc
+   use sprc_grid_recovered_field, only: recovered_field_type, method_spr, method_sprc, field_eval
+   use sprc_recovery_contact_operators, only: contact_traction
    use sprc_grid_recovered_estimate, only: zz_estimate_type, estimate_error
    use sprc_fem_bc, only: fe_bc_type, bc_pressure, bc_traction, bc_displacement
    use sprc_fem_problem, only: elasticity_problem_type
@@ -418,6 +419,8 @@ contains
          end if
       end do
       call contact_result(surface, sol, spec, study%bodies(s)%units, result)
+      call recovered_tractions(surface, bodies(s), study%run, study%bodies(s)%units, result, error)
+      if (allocated(error)) return
       t_contact = t_contact + timer%elapsed + sol%t_contact
    end subroutine run_contact
 
@@ -514,6 +517,41 @@ contains
       result%ts_fe = (sol%tangential*units%modulus)*units%strain
       result%iterations = sol%iterations
    end subroutine contact_result
+
+   !> p_spr, p_sprc and ts_sprc of a contact result (scene units) from the slave body's
+   !> recovered fields (SPR, SPR-C where run) at its slave points: p = -n.sigma*.n,
+   !> ts = |sigma* n - (n.sigma* n) n| (sprc_recovery_contact_operators). The grid's SPR-C
+   !> patches at the contact surface are not yet the coupled contact patches
+   !> (sprc_recovery_contact_solve): they impose no boundary rows there.
+   subroutine recovered_tractions(surface, bl, run, units, result, error)
+      type(contact_surface_type), intent(in) :: surface
+      type(body_level_type), intent(in) :: bl
+      logical, intent(in) :: run(2)
+      type(analysis_units_type), intent(in) :: units
+      type(contact_result_type), intent(inout) :: result
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: sigma(6), p, ts, unit
+      integer :: i, m, d
+
+      d = surface%dim
+      unit = units%modulus*units%strain
+      if (size(surface%slave_cell) < surface%npoint) return
+      do m = 1, 2
+         if (.not. run(m)) cycle
+         do i = 1, surface%npoint
+            if (surface%slave_cell(i) < 1) cycle
+            call field_eval(bl%field(m), surface%slave_cell(i), surface%x(:, i), sigma, error)
+            if (allocated(error)) return
+            call contact_traction(d, surface%normal(:, i), sigma, p, ts)
+            if (m == 1) then
+               result%p_spr(i) = p*unit
+            else
+               result%p_sprc(i) = p*unit
+               result%ts_sprc(i) = ts*unit
+            end if
+         end do
+      end do
+   end subroutine recovered_tractions
 
    !> Recovery and estimate with one method (1 SPR, 2 SPR-C) at the patch degree `degree`.
    subroutine recover_and_estimate(sb, input, bl, m, degree, error)
