@@ -335,11 +335,20 @@ contains
       ! The relative L2 pressure error is no larger than the relative energy
       ! error of the stresses (measured: 0.5 and 0.4 times it at the finest level).
       call check(error, perr(n) <= err(n), 'pressure error '//real_text(perr(n))//' > err_fe '//real_text(err(n)))
+      if (allocated(error)) return
+      ! With a stable multiplier space (sprc_contact_solve: macro cells) the a
+      ! priori estimate h^(1/2) |lambda - lambda_h|_L2 <= C h^p gives a rate of
+      ! at least 1/2 for the L2 pressure error; a checkerboard mode stalls it.
+      rate = log(perr(n - 2)/perr(n))/log(real(2**(levels(n) - levels(n - 2)), wp))
+      write (buf, '(f6.3)') rate
+      call check(error, rate >= 0.95_wp*0.5_wp, 'err_p_fe rate '//trim(buf)//' < 0.95/2 (pressure errors '// &
+         & real_text(perr(n - 2))//', '//real_text(perr(n))//')')
    end subroutine shrink_case
 
    !> Hertz line contact (test/data/contact/hertz_2d.nml, a = 0.05, p0 =
    !> 2P/(pi a)): at h = a/25.6 on the contact the peak FE pressure is within
-   !> 3 % of p0 and the contact half-width within one cell of a (issue 11).
+   !> 3 % of p0 and the contact half-width within one contact cell (two slave
+   !> cells, sprc_contact_solve) of a.
    subroutine test_hertz_2d(error)
       type(error_type), allocatable, intent(out) :: error
       real(wp), parameter :: a = 0.05_wp, load = 1.0788436_wp, pi = acos(-1.0_wp), h = 2.0_wp/1024
@@ -358,7 +367,7 @@ contains
       end associate
       call check(error, abs(pmax/p0 - 1.0_wp) <= 0.03_wp, 'p_max/p0 = '//real_text(pmax/p0))
       if (allocated(error)) return
-      call check(error, abs(width - a) <= h, 'half-width '//real_text(width)//', a = 0.05, h = '//real_text(h))
+      call check(error, abs(width - a) <= 2*h, 'half-width '//real_text(width)//', a = 0.05, h = '//real_text(h))
    end subroutine test_hertz_2d
 
    !> Compound sphere (octant): the shrink fit's rings as spherical shells,

@@ -12,9 +12,17 @@
 !> method; the recovered traction is Tur's variant, not in this version).
 !>
 !> Discrete multiplier space: lambda constant on each contact cell c (P0): the
-!> slave points with a master point of one slave aggregate (cell aggregation's
-!> root), a sliver of surface joined to the nearest full cell (`group_cells`),
-!> measure W_c. It is
+!> slave points with a master point whose slave aggregates (cell
+!> aggregation's roots) share a parent cell (`macro_cells`: two cells along a
+!> 2D surface, up to four on a 3D one), a sliver of surface joined to the
+!> nearest full contact cell (`group_cells`), measure W_c. P0 on the slave
+!> cells themselves is not inf-sup stable against the continuous trace of
+!> the displacements: a pressure alternating from cell to cell is orthogonal
+!> to every interior trace function, and the multiplier showed it (a shrink
+!> fit's pressure oscillating around the ring at every level and kappa, a 3D
+!> Hertz peak far too high); P0 on the parent cells is the stable
+!> macro-element pair. The price: the open/closed boundary is resolved to a
+!> contact cell, two slave cells. The multiplier is
 !> eliminated cell by cell: stationarity in lambda_c gives
 !>   lambda_c = pbar + gamma gbar,
 !> with pbar, gbar the means over the cell's points of p_N and g, and the
@@ -23,7 +31,7 @@
 !> Its second variation is the cell's block of the system (symmetric); the
 !> first two terms are the symmetric Nitsche terms of sprc_fem_problem's
 !> Dirichlet conditions with the mean gap as the constraint, the last one
-!> the stabilization's variance term. One constraint per cell and direction
+!> the stabilization's variance term. One constraint per contact cell and direction
 !> matches the displacement space: enforcing g = 0 at every quadrature point
 !> instead (multipliers eliminated point by point) over-constrains the
 !> interface: the pressure oscillates between points and falsely opens
@@ -343,15 +351,15 @@ contains
       end do
    end subroutine point_operators
 
-   !> The contact cells: the aggregates (`root`, sprc_fem_aggregation) of the
-   !> slave leaves holding points with a master point, in root order, each
-   !> with its points in point order. A small cut cell's segment thus shares
-   !> its root's multiplier, as its displacement is the root's polynomial. A
-   !> group whose surface measure is below a quarter of its root's h^(dim-1)
-   !> (the surface clips a corner of a cell that aggregation keeps, as its
-   !> volume is not small) joins the group of at least that measure whose
-   !> centroid is nearest: a multiplier on a sliver is barely constrained by
-   !> the displacements, and its pressure is noise that can open it falsely.
+   !> The contact cells: the macro cells (`macro_cells`) of the slave
+   !> aggregates (`root`, sprc_fem_aggregation) holding points with a master
+   !> point, in leaf order, each with its points in point order. A small cut
+   !> cell's segment thus shares its root's multiplier, as its displacement is
+   !> the root's polynomial. A group whose surface measure is below half its
+   !> representative's h^(dim-1) (the surface clips a corner of a parent cell)
+   !> joins the group of at least that measure whose centroid is nearest: a
+   !> multiplier on a sliver is barely constrained by the displacements, and
+   !> its pressure is noise that can open it falsely.
    subroutine group_cells(surface, slave, ops)
       type(contact_surface_type), intent(in) :: surface
       type(elasticity_problem_type), intent(in) :: slave
@@ -360,15 +368,17 @@ contains
       integer :: fill(slave%grid%n_leaves), i, e, c, best, n_leaves, d
       real(wp) :: measure(slave%grid%n_leaves), centroid(surface%dim, slave%grid%n_leaves), dist, best_dist
       logical :: small(slave%grid%n_leaves)
+      integer :: macro(slave%grid%n_leaves)
 
       n_leaves = slave%grid%n_leaves
       d = surface%dim
       key = 0
       measure = 0.0_wp
       centroid = 0.0_wp
+      call macro_cells(surface, slave, macro)
       do i = 1, surface%npoint
          if (.not. surface%has_master(i)) cycle
-         key(i) = slave%root(surface%slave_cell(i))
+         key(i) = macro(slave%root(surface%slave_cell(i)))
          measure(key(i)) = measure(key(i)) + surface%weight(i)
          centroid(:, key(i)) = centroid(:, key(i)) + surface%weight(i)*surface%x(:, i)
       end do
@@ -377,7 +387,7 @@ contains
          group(e) = e
          if (.not. measure(e) > 0.0_wp) cycle
          centroid(:, e) = centroid(:, e)/measure(e)
-         small(e) = measure(e) < 0.25_wp*cell_size(slave, e)**(d - 1)
+         small(e) = measure(e) < 0.5_wp*cell_size(slave, e)**(d - 1)
       end do
       if (.not. all(small .or. .not. measure > 0.0_wp)) then
          do e = 1, n_leaves
@@ -421,6 +431,34 @@ contains
          fill(c) = fill(c) + 1
       end do
    end subroutine group_cells
+
+   !> macro(e): the representative of slave root e's contact macro cell, the
+   !> first root of the contact (in leaf order) with the same parent cell.
+   subroutine macro_cells(surface, slave, macro)
+      type(contact_surface_type), intent(in) :: surface
+      type(elasticity_problem_type), intent(in) :: slave
+      integer, intent(out) :: macro(:)
+      integer, allocatable :: roots(:)
+      logical :: used(size(macro))
+      integer :: i, j, e, d
+
+      d = surface%dim
+      used = .false.
+      do i = 1, surface%npoint
+         if (surface%has_master(i)) used(slave%root(surface%slave_cell(i))) = .true.
+      end do
+      roots = pack([(e, e=1, size(macro))], used)
+      macro = [(e, e=1, size(macro))]
+      do i = 1, size(roots)
+         do j = 1, i - 1
+            if (slave%grid%leaf_level(roots(j)) == slave%grid%leaf_level(roots(i)) .and. &
+               & all(slave%grid%leaf_coord(1:d, roots(j))/2 == slave%grid%leaf_coord(1:d, roots(i))/2)) then
+               macro(roots(i)) = macro(roots(j))
+               exit
+            end if
+         end do
+      end do
+   end subroutine macro_cells
 
    !> The means and deviations of cell c's operators on the union of its
    !> points' dofs (module notes): normal rows (frictionless) or all
