@@ -46,6 +46,7 @@ contains
          new_unittest('incline_stick_exact_frictionless_not', test_incline), &
          new_unittest('bodies_in_contact_share_units', test_units), &
          new_unittest('coulomb_proportional_steps', test_coulomb_steps), &
+         new_unittest('coulomb_stages_on_one_surface', test_coulomb_stages), &
          new_unittest('shrink_fit_sphere_q1', test_sphere) &
          ]
    end subroutine collect_contact_fe
@@ -205,6 +206,35 @@ contains
       if (allocated(error)) return
       call check(error, diff <= tol, 'pressures or tractions differ by '//real_text(diff)//' > '//real_text(tol))
    end subroutine test_coulomb_steps
+
+   !> Two &bc on one surface in stages 1 and 2 (SCENE.md `&bc stage`): their
+   !> loads add up, each applied in its own stage. The inclined interface
+   !> under Coulomb mu = 0.4 with the pressure 1 as 0.75 in stage 1 and 0.25
+   !> in stage 2 is a proportional path: the result of one &bc of pressure 1
+   !> to round-off (as `test_coulomb_steps`).
+   subroutine test_coulomb_stages(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(level_type) :: one, two
+      character(len=:), allocatable :: text
+      real(wp) :: tol, diff
+
+      call read_text_file(incline_2d, text, error)
+      if (allocated(error)) return
+      text = replaced(text, "friction='stick'", "friction='coulomb' mu=0.4")
+      call run_text(text, 3, one, error)
+      if (allocated(error)) return
+      call run_text(replaced(text, "type='pressure' value=1.0 /", "type='pressure' value=0.75 /"//nl// &
+         & "&bc on='upper_top' type='pressure' value=0.25 stage=2 /"), 3, two, error)
+      if (allocated(error)) return
+      call check(error, two%contacts(1)%iterations > one%contacts(1)%iterations, 'one increment only')
+      if (allocated(error)) return
+      tol = 10.0_wp*epsilon(1.0_wp)/min(one%bodies(1)%problem%rcond, two%bodies(1)%problem%rcond)
+      diff = max(maxval(abs(one%contacts(1)%p_fe - two%contacts(1)%p_fe)), &
+         & maxval(abs(one%contacts(1)%ts_fe - two%contacts(1)%ts_fe)))
+      call check(error, all(one%contacts(1)%state == two%contacts(1)%state), 'states differ')
+      if (allocated(error)) return
+      call check(error, diff <= tol, 'pressures or tractions differ by '//real_text(diff)//' > '//real_text(tol))
+   end subroutine test_coulomb_stages
 
    !> Bodies in contact share one unit system: the inclined-interface stick
    !> test with the modulus scaled by 1e200 and the pressure by 4e200 (alone,

@@ -456,7 +456,7 @@ contains
       logical :: found
 
       allocate (scene%bcs(count_groups(groups, 'bc')))
-      allocate (line_of(size(scene%shapes)), source=0)
+      allocate (line_of(size(scene%bcs)), source=0)
       n = 0
       do ig = 1, size(groups)
          if (groups(ig)%name /= 'bc') cycle
@@ -471,12 +471,7 @@ contains
                call nml_field_error(g, 'on', 'no &shape has this name; surfaces: '//shape_names(scene), error)
                return
             end if
-            if (line_of(bc%shape_index) > 0) then
-               call nml_field_error(g, 'on', 'this surface already has a &bc (on line '// &
-                  & itoa(line_of(bc%shape_index))//'): one &bc per surface', error)
-               return
-            end if
-            line_of(bc%shape_index) = g%line
+            line_of(n) = g%line
             call get_choice(g, 'type', bc_types, .true., bc%type, error)
             if (allocated(error)) return
             select case (bc%type)
@@ -503,11 +498,40 @@ contains
             end if
             call read_stage(g, bc, error)
             if (allocated(error)) return
+            call check_same_surface(g, scene%bcs(1:n), line_of, error)
+            if (allocated(error)) return
             call nml_check_consumed(g, error)
             if (allocated(error)) return
          end associate
       end do
    end subroutine read_bcs
+
+   !> The last of `bcs` against the earlier ones on its surface (their groups on
+   !> lines `line_of`): a surface takes several &bc only as loads of one type
+   !> (pressure, traction or displacement), each in its own stage; their loads
+   !> add up (SCENE.md `&bc stage`).
+   subroutine check_same_surface(g, bcs, line_of, error)
+      type(nml_group_type), intent(in) :: g
+      type(bc_spec_type), intent(in) :: bcs(:)
+      integer, intent(in) :: line_of(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: j, n
+
+      n = size(bcs)
+      do j = 1, n - 1
+         if (bcs(j)%shape_index /= bcs(n)%shape_index) cycle
+         if (bcs(j)%type /= bcs(n)%type .or. .not. any(bcs(n)%type == [character(len=12) :: 'pressure', &
+            & 'traction', 'displacement'])) then
+            call nml_field_error(g, 'on', "this surface already has a &bc of type = '"//bcs(j)%type// &
+               & "' (on line "//itoa(line_of(j))//'): several &bc on one surface must all be loads of one '// &
+               & 'type (pressure, traction or displacement), one per stage', error)
+         else if (bcs(j)%stage == bcs(n)%stage) then
+            call nml_field_error(g, 'stage', 'this surface already has a &bc in stage '//itoa(bcs(n)%stage)// &
+               & ' (on line '//itoa(line_of(j))//'): one &bc per surface and stage', error)
+         end if
+         if (allocated(error)) return
+      end do
+   end subroutine check_same_surface
 
    !> `stage` (integer >= 1, default 1) of a condition that carries a load.
    subroutine read_stage(g, bc, error)

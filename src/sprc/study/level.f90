@@ -35,7 +35,7 @@ module sprc_study_level
    use sprc_grid_recovered_field, only: recovered_field_type, method_spr, method_sprc, field_eval
    use sprc_recovery_contact_operators, only: contact_traction
    use sprc_grid_recovered_estimate, only: zz_estimate_type, estimate_error
-   use sprc_fem_bc, only: fe_bc_type, bc_pressure, bc_traction, bc_displacement
+   use sprc_fem_bc, only: fe_bc_type
    use sprc_fem_problem, only: elasticity_problem_type
    use sprc_fem_recovery_input, only: fe_recovery_input
    use sprc_fem_dilatation, only: dilatation_choice
@@ -461,41 +461,19 @@ contains
       end do
    end subroutine load_path
 
-   !> Assemble body b with the loads of the stages after `stage` set to zero
-   !> (its conditions restored afterwards).
+   !> Assemble body b with the loads of the stages up to `stage` only (its
+   !> conditions restored afterwards).
    subroutine stage_load(study, b, stage, problem, error)
       type(study_type), intent(in) :: study
       integer, intent(in) :: b, stage
       type(elasticity_problem_type), intent(inout) :: problem
       type(error_type), allocatable, intent(out) :: error
-      logical :: later(size(problem%bcs))
-      real(wp) :: value(size(problem%bcs)), vector(3, size(problem%bcs))
-      integer :: i, j
+      type(fe_bc_type), allocatable :: all_stages(:)
 
-      later = .false.
-      j = 0
-      do i = 1, size(study%scene%bcs)
-         if (study%scene%shapes(study%scene%bcs(i)%shape_index)%body_index /= b) cycle
-         j = j + 1
-         later(j) = study%scene%bcs(i)%stage > stage
-      end do
-      do j = 1, size(problem%bcs)
-         value(j) = problem%bcs(j)%value
-         vector(:, j) = 0.0_wp
-         if (allocated(problem%bcs(j)%vector)) vector(1:size(problem%bcs(j)%vector), j) = problem%bcs(j)%vector
-         if (.not. later(j)) cycle
-         select case (problem%bcs(j)%kind)
-         case (bc_pressure)
-            problem%bcs(j)%value = 0.0_wp
-         case (bc_traction, bc_displacement)
-            problem%bcs(j)%vector = 0.0_wp
-         end select
-      end do
+      all_stages = problem%bcs
+      call body_conditions(in_units(study%scene, study%bodies(b)%units), b, problem%bcs, stage)
       call problem%assemble(error)
-      do j = 1, size(problem%bcs)
-         problem%bcs(j)%value = value(j)
-         if (allocated(problem%bcs(j)%vector)) problem%bcs(j)%vector = vector(1:size(problem%bcs(j)%vector), j)
-      end do
+      problem%bcs = all_stages
    end subroutine stage_load
 
    !> The contact result of a pair in scene units (pressures times the stress

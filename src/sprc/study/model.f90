@@ -323,28 +323,47 @@ contains
    end subroutine build_shape
 
    !> The &bc groups on the surfaces of body `b` as FE conditions on the
-   !> body's own shape indices (its shapes in file order); surfaces without
-   !> &bc are free.
-   subroutine body_conditions(scene, b, bcs)
+   !> body's own shape indices (its shapes in file order of their first &bc);
+   !> surfaces without &bc are free. A surface with several &bc (one load type,
+   !> one per stage; SCENE.md `&bc stage`) gets one condition carrying the sum
+   !> of their loads; with `stage`, of those in stages <= stage only (the
+   !> cumulative load at the end of that stage; the condition stays, with a
+   !> zero load before its first stage).
+   subroutine body_conditions(scene, b, bcs, stage)
       type(scene_type), intent(in) :: scene
       !> Index of the body in `scene%bodies`.
       integer, intent(in) :: b
       type(fe_bc_type), allocatable, intent(out) :: bcs(:)
-      integer :: i, kind, n
+      integer, intent(in), optional :: stage
+      logical :: first(size(scene%bcs))
+      integer :: i, j, n, last
 
-      allocate (bcs(count(scene%shapes(scene%bcs%shape_index)%body_index == b)))
+      last = huge(1)
+      if (present(stage)) last = stage
+      do i = 1, size(scene%bcs)
+         first(i) = scene%shapes(scene%bcs(i)%shape_index)%body_index == b .and. &
+            & .not. any(scene%bcs(1:i - 1)%shape_index == scene%bcs(i)%shape_index)
+      end do
+      allocate (bcs(count(first)))
       n = 0
       do i = 1, size(scene%bcs)
-         associate (bc => scene%bcs(i), shape => scene%shapes(scene%bcs(i)%shape_index))
-            if (shape%body_index /= b) cycle
-            n = n + 1
-            kind = bc_kind_from_name(bc%type)
+         if (.not. first(i)) cycle
+         n = n + 1
+         associate (bc => scene%bcs(i))
             if (allocated(bc%vector)) then
-               bcs(n) = new_fe_bc(shape%body_shape, kind, bc%value, bc%vector)
+               bcs(n) = new_fe_bc(scene%shapes(bc%shape_index)%body_shape, bc_kind_from_name(bc%type), 0.0_wp, &
+                  & 0.0_wp*bc%vector)
             else
-               bcs(n) = new_fe_bc(shape%body_shape, kind, bc%value)
+               bcs(n) = new_fe_bc(scene%shapes(bc%shape_index)%body_shape, bc_kind_from_name(bc%type), 0.0_wp)
             end if
          end associate
+         do j = i, size(scene%bcs)
+            associate (bc => scene%bcs(j))
+               if (bc%shape_index /= scene%bcs(i)%shape_index .or. bc%stage > last) cycle
+               bcs(n)%value = bcs(n)%value + bc%value
+               if (allocated(bc%vector)) bcs(n)%vector = bcs(n)%vector + bc%vector
+            end associate
+         end do
       end do
    end subroutine body_conditions
 
