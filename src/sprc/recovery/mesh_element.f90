@@ -148,18 +148,16 @@ contains
       real(wp), intent(in) :: xi(:)
       real(wp), intent(out) :: n(:)
       real(wp), intent(out), optional :: dn(:, :)
-      real(wp) :: d(3, max_element_nodes)
 
+      ! dn absent: values only (the estimate and the checks of given coordinates, per point).
       select case (etype)
       case (elem_tri3, elem_tet4)
-         call simplex_shape(element_dim(etype), xi, n, d)
-      case (elem_quad4); call tensor_shape(quad4, 1, xi, n, d)
-      case (elem_quad9); call tensor_shape(quad9, 2, xi, n, d)
-      case (elem_hex8); call tensor_shape(hex8, 1, xi, n, d)
-      case (elem_hex27); call tensor_shape(hex27, 2, xi, n, d)
+         call simplex_shape(element_dim(etype), xi, n, dn)
+      case (elem_quad4); call tensor_shape(quad4, 1, xi, n, dn)
+      case (elem_quad9); call tensor_shape(quad9, 2, xi, n, dn)
+      case (elem_hex8); call tensor_shape(hex8, 1, xi, n, dn)
+      case (elem_hex27); call tensor_shape(hex27, 2, xi, n, dn)
       end select
-      if (present(dn)) dn(1:element_dim(etype), 1:element_nodes(etype)) = &
-         & d(1:element_dim(etype), 1:element_nodes(etype))
    end subroutine element_shape
 
    !> Vertex partition of unity nv(1:nvertex) at xi: the linear element on the vertices.
@@ -167,13 +165,12 @@ contains
       integer, intent(in) :: etype
       real(wp), intent(in) :: xi(:)
       real(wp), intent(out) :: nv(:)
-      real(wp) :: d(3, max_element_nodes)
 
       select case (etype)
       case (elem_tri3, elem_tet4)
-         call simplex_shape(element_dim(etype), xi, nv, d)
-      case (elem_quad4, elem_quad9); call tensor_shape(quad4, 1, xi, nv, d)
-      case (elem_hex8, elem_hex27); call tensor_shape(hex8, 1, xi, nv, d)
+         call simplex_shape(element_dim(etype), xi, nv)
+      case (elem_quad4, elem_quad9); call tensor_shape(quad4, 1, xi, nv)
+      case (elem_hex8, elem_hex27); call tensor_shape(hex8, 1, xi, nv)
       end select
    end subroutine element_vertex_shape
 
@@ -374,11 +371,13 @@ contains
    pure subroutine simplex_shape(rdim, xi, n, d)
       integer, intent(in) :: rdim
       real(wp), intent(in) :: xi(:)
-      real(wp), intent(out) :: n(:), d(:, :)
+      real(wp), intent(out) :: n(:)
+      real(wp), intent(out), optional :: d(:, :)
       integer :: k
 
       n(1) = 1.0_wp - sum(xi(1:rdim))
       n(2:rdim + 1) = xi(1:rdim)
+      if (.not. present(d)) return
       d(1:rdim, 1:rdim + 1) = 0.0_wp
       d(1:rdim, 1) = -1.0_wp
       do k = 1, rdim
@@ -386,12 +385,14 @@ contains
       end do
    end subroutine simplex_shape
 
-   !> Tensor Lagrange shape functions of degree deg on [0,1]^rdim, node j at idx(:, j)/deg.
-   !> Products written out per dimension (no temporaries: this runs per point).
+   !> Tensor Lagrange shape functions of degree deg on [0,1]^rdim, node j at idx(:, j)/deg,
+   !> and their derivatives d if wanted. Products written out per dimension (no temporaries:
+   !> this runs per point).
    pure subroutine tensor_shape(idx, deg, xi, n, d)
       integer, intent(in) :: idx(:, :), deg
       real(wp), intent(in) :: xi(:)
-      real(wp), intent(out) :: n(:), d(:, :)
+      real(wp), intent(out) :: n(:)
+      real(wp), intent(out), optional :: d(:, :)
       real(wp) :: l(0:2, 3), dl(0:2, 3)
       integer :: j, k, rdim
 
@@ -403,17 +404,29 @@ contains
       case (1)
          do j = 1, size(idx, 2)
             n(j) = l(idx(1, j), 1)
-            d(1, j) = dl(idx(1, j), 1)
          end do
       case (2)
          do j = 1, size(idx, 2)
             n(j) = l(idx(1, j), 1)*l(idx(2, j), 2)
+         end do
+      case default
+         do j = 1, size(idx, 2)
+            n(j) = l(idx(1, j), 1)*l(idx(2, j), 2)*l(idx(3, j), 3)
+         end do
+      end select
+      if (.not. present(d)) return
+      select case (rdim)
+      case (1)
+         do j = 1, size(idx, 2)
+            d(1, j) = dl(idx(1, j), 1)
+         end do
+      case (2)
+         do j = 1, size(idx, 2)
             d(1, j) = dl(idx(1, j), 1)*l(idx(2, j), 2)
             d(2, j) = l(idx(1, j), 1)*dl(idx(2, j), 2)
          end do
       case default
          do j = 1, size(idx, 2)
-            n(j) = l(idx(1, j), 1)*l(idx(2, j), 2)*l(idx(3, j), 3)
             d(1, j) = dl(idx(1, j), 1)*l(idx(2, j), 2)*l(idx(3, j), 3)
             d(2, j) = l(idx(1, j), 1)*dl(idx(2, j), 2)*l(idx(3, j), 3)
             d(3, j) = l(idx(1, j), 1)*l(idx(2, j), 2)*dl(idx(3, j), 3)
