@@ -35,12 +35,36 @@ contains
       type(recovered_patch_type), intent(in) :: rec
       real(wp), intent(in) :: x(:)
       real(wp), intent(out) :: sigma(:)
-      real(wp) :: s, pw(0:poly_max_degree, 3), p(poly_max_terms)
-      integer :: i, k, c, e(3)
+      real(wp) :: p(poly_max_terms)
+      integer :: i, k, c
 
-      ! Powers of each scaled coordinate once (s**e is a call per term); the terms as
-      ! s(1)**e(1) * s(2)**e(2) * s(3)**e(3), in that order; then each component as one
-      ! sum over the terms in term order (contiguous columns of coef).
+      if (rec%degree == 1) then
+         ! Terms 1, s_1, .., s_dim: the values term_values gives (products with ones).
+         p(1) = 1.0_wp
+         do k = 1, rec%dim
+            p(k + 1) = (x(k) - rec%x0(k))/rec%h
+         end do
+      else
+         call term_values(rec, x, p)
+      end if
+      ! Each component as one sum over the terms in term order (contiguous columns of coef).
+      do c = 1, rec%nstress
+         sigma(c) = 0.0_wp
+         do i = 1, rec%nterms
+            sigma(c) = sigma(c) + p(i)*rec%coef(i, c)
+         end do
+      end do
+   end subroutine eval_recovered_unchecked
+
+   !> The terms p(1:nterms) of rec's basis at x: powers of each scaled coordinate once (s**e
+   !> is a call per term), each term as s(1)**e(1) * s(2)**e(2) * s(3)**e(3) in that order.
+   pure subroutine term_values(rec, x, p)
+      type(recovered_patch_type), intent(in) :: rec
+      real(wp), intent(in) :: x(:)
+      real(wp), intent(out) :: p(:)
+      real(wp) :: s, pw(0:poly_max_degree, 3)
+      integer :: i, k, e(3)
+
       pw = 1.0_wp
       do k = 1, rec%dim
          s = (x(k) - rec%x0(k))/rec%h
@@ -56,13 +80,7 @@ contains
          end if
          p(i) = pw(e(1), 1)*pw(e(2), 2)*pw(e(3), 3)
       end do
-      do c = 1, rec%nstress
-         sigma(c) = 0.0_wp
-         do i = 1, rec%nterms
-            sigma(c) = sigma(c) + p(i)*rec%coef(i, c)
-         end do
-      end do
-   end subroutine eval_recovered_unchecked
+   end subroutine term_values
 
    pure subroutine check_rec(rec, nx, nsig, context, error)
       type(recovered_patch_type), intent(in) :: rec
