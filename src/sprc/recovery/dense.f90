@@ -167,31 +167,44 @@ contains
       end do
    end subroutine apply_q
 
-   !> b(i:m, 1:nrhs) := H_i b(i:m, 1:nrhs), H_i = I - tau v v^T, v = [1, a(i+1:m, i)]. Up to
-   !> `chunk` columns at a time: their sums are independent chains (one column's sum alone
-   !> waits on each addition); each column's sum is still c(i) + v(i+1) c(i+1) + ... in
-   !> that order, as in `reflect`.
+   !> b(i:m, 1:nrhs) := H_i b(i:m, 1:nrhs), H_i = I - tau v v^T, v = [1, a(i+1:m, i)]. Three
+   !> columns at a time (2D: the three stress components; 3D: two groups): their sums are
+   !> independent chains in scalars (one column's sum alone waits on each addition); each
+   !> column's sum is still c(i) + v(i+1) c(i+1) + ... in that order, as in `reflect`.
    pure subroutine reflect_columns(m, i, a, tau, nrhs, b)
       integer, intent(in) :: m, i, nrhs
       real(wp), intent(in), contiguous :: a(:, :)
       real(wp), intent(in) :: tau
       real(wp), intent(inout), contiguous :: b(:, :)
-      integer, parameter :: chunk = 8
-      real(wp) :: s(chunk)
-      integer :: j0, nc, r
+      real(wp) :: s1, s2, s3, v
+      integer :: j, r
 
       if (tau == 0.0_wp) return
-      do j0 = 1, nrhs, chunk
-         nc = min(chunk, nrhs - j0 + 1)
-         s(1:nc) = b(i, j0:j0 + nc - 1)
+      do j = 1, nrhs - 2, 3
+         s1 = b(i, j)
+         s2 = b(i, j + 1)
+         s3 = b(i, j + 2)
          do r = i + 1, m
-            s(1:nc) = s(1:nc) + a(r, i)*b(r, j0:j0 + nc - 1)
+            v = a(r, i)
+            s1 = s1 + v*b(r, j)
+            s2 = s2 + v*b(r, j + 1)
+            s3 = s3 + v*b(r, j + 2)
          end do
-         s(1:nc) = tau*s(1:nc)
-         b(i, j0:j0 + nc - 1) = b(i, j0:j0 + nc - 1) - s(1:nc)
+         s1 = tau*s1
+         s2 = tau*s2
+         s3 = tau*s3
+         b(i, j) = b(i, j) - s1
+         b(i, j + 1) = b(i, j + 1) - s2
+         b(i, j + 2) = b(i, j + 2) - s3
          do r = i + 1, m
-            b(r, j0:j0 + nc - 1) = b(r, j0:j0 + nc - 1) - s(1:nc)*a(r, i)
+            v = a(r, i)
+            b(r, j) = b(r, j) - s1*v
+            b(r, j + 1) = b(r, j + 1) - s2*v
+            b(r, j + 2) = b(r, j + 2) - s3*v
          end do
+      end do
+      do j = 3*(nrhs/3) + 1, nrhs
+         call reflect(m - i + 1, a(i + 1:m, i), tau, b(i:m, j))
       end do
    end subroutine reflect_columns
 
