@@ -3,9 +3,10 @@
 !> each, jittered; half of the patches carry a traction boundary with (p+1)^(dim-1)
 !> points per boundary face). Prints per-thread rates, the rate of an OpenMP loop over
 !> all threads, and, from a separate single-thread run with ws%timing on: the share of time
-!> spent inside LAPACK/BLAS (timed around each call), the mean nominal LAPACK/BLAS flops per
-!> patch (LAWN 41 leading terms, sprc_recovery_flops; hand-written loops not included), the
-!> rate achieved inside LAPACK/BLAS (those flops / the time inside), and the mean hand count
+!> spent inside the dense kernels (sprc_recovery_dense and the Gram / equilibrium products,
+!> timed around each call), their mean nominal flops per patch (counted as the LAPACK/BLAS
+!> calls of the same operations, LAWN 41 leading terms, sprc_recovery_flops), the rate
+!> achieved inside them (those flops / the time inside), and the mean hand count
 !> of forming the design matrix (the one counted hand-written loop, not in flops/patch).
 !> Patches that fail (rank deficient) are in the means: their calls up to the failure count.
 !>
@@ -32,8 +33,8 @@ program bench_recovery
    ! OpenBLAS in one thread throughout, as in the library's own patch loops
    ! (sprc_core_blas_threads: concurrent small calls with a pool of 2+ spin in the kernel).
    saved_blas = blas_serial_begin()
-   write (*, '(a)') ' dim  p  method  points  bpoints  patches/s/thread  patches/s (all threads)  LAPACK share'// &
-      & '  flops/patch  LAPACK GFLOP/s  design flops/patch'
+   write (*, '(a)') ' dim  p  method  points  bpoints  patches/s/thread  patches/s (all threads)  kernel share'// &
+      & '  flops/patch  kernel GFLOP/s  design flops/patch'
    do dim = 2, 3
       do p = 1, 2
          do method = 1, 2
