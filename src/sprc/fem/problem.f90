@@ -68,6 +68,7 @@ module sprc_fem_problem
       & material_matrix, compliance_matrix
    use sprc_core_timer, only: timer_type
    use sprc_core_text, only: itoa
+   use sprc_core_alloc, only: check_allocation
    use sprc_geometry_body, only: body_type
    use sprc_geometry_shape, only: shape_halfspace
    use sprc_geometry_region, only: cell_inside
@@ -328,8 +329,10 @@ contains
          call fatal_error(error, 'elasticity setup: gamma must be finite and > 0', stat_invalid_input)
          return
       end if
-      self%grid = grid
-      self%nodes = nodes
+      call grid%copy(self%grid, error)
+      if (allocated(error)) return
+      call nodes%copy(self%nodes, error)
+      if (allocated(error)) return
       self%bcs = bcs
       call classify_bcs(self, body, plane_axis, plane_coord)
 
@@ -477,13 +480,18 @@ contains
       type(cell_rule_type) :: rule
       type(error_type), allocatable :: cell_error
       logical, allocatable :: failed(:)
-      integer :: e, n, d, nv, ns, iv, is
+      integer, allocatable :: stats(:)
+      integer :: e, n, d, nv, ns, iv, is, stat
       real(wp) :: lo(3), hi(3)
+      character(len=*), parameter :: who = 'elasticity setup'
 
       n = self%grid%n_leaves
       d = self%dim
-      allocate (store(n), failed(n))
+      allocate (store(n), failed(n), stats(n), stat=stat)
+      call check_allocation(stat, who, 'the quadrature rule of each cell', n, storage_size(store)/8 + 8, error)
+      if (allocated(error)) return
       failed = .false.
+      stats = 0
       !$omp parallel do schedule(dynamic, 16) default(shared) private(e, rule, cell_error, lo, hi)
       do e = 1, n
          call self%grid%leaf_box(e, lo(1:d), hi(1:d))
@@ -492,14 +500,7 @@ contains
             failed(e) = .true.
             cycle
          end if
-         store(e)%nvol = rule%nvol
-         store(e)%nsurf = rule%nsurf
-         store(e)%x = rule%vol_x(1:d, 1:rule%nvol)
-         store(e)%w = rule%vol_w(1:rule%nvol)
-         store(e)%sx = rule%surf_x(1:d, 1:rule%nsurf)
-         store(e)%sw = rule%surf_w(1:rule%nsurf)
-         store(e)%sn = rule%surf_n(1:d, 1:rule%nsurf)
-         store(e)%ss = rule%surf_shape(1:rule%nsurf)
+         call keep_rule(rule, d, store(e), stats(e))
       end do
       !$omp end parallel do
       if (any(failed)) then
@@ -508,11 +509,24 @@ contains
          call cell_rule(quad, body, lo(1:d), hi(1:d), rule, error)
          return
       end if
+      if (any(stats /= 0)) then
+         e = findloc(stats /= 0, .true., 1)
+         call check_allocation(stats(e), who, 'the quadrature points of cell '//itoa(e - 1), &
+            & store(e)%nvol + store(e)%nsurf, 8*(2*d + 2) + 4, error)
+         return
+      end if
 
       nv = sum(store%nvol)
       ns = sum(store%nsurf)
-      allocate (self%vol_ptr(n + 1), self%surf_ptr(n + 1), self%vol_x(d, nv), self%vol_w(nv), &
-         & self%surf_x(d, ns), self%surf_w(ns), self%surf_n(d, ns), self%surf_shape(ns), self%fraction(n))
+      allocate (self%vol_ptr(n + 1), self%surf_ptr(n + 1), self%fraction(n), stat=stat)
+      call check_allocation(stat, who, 'the quadrature pointers and volume fractions', n + 1, 16, error)
+      if (allocated(error)) return
+      allocate (self%vol_x(d, nv), self%vol_w(nv), stat=stat)
+      call check_allocation(stat, who, 'the volume quadrature points', nv, 8*(d + 1), error)
+      if (allocated(error)) return
+      allocate (self%surf_x(d, ns), self%surf_w(ns), self%surf_n(d, ns), self%surf_shape(ns), stat=stat)
+      call check_allocation(stat, who, 'the surface quadrature points', ns, 8*(2*d + 1) + 4, error)
+      if (allocated(error)) return
       iv = 0
       is = 0
       do e = 1, n
@@ -533,6 +547,24 @@ contains
       self%surf_ptr(n + 1) = is + 1
       self%n_cut = count(self%grid%leaf_class /= cell_inside)
    end subroutine integrate
+
+   !> `store` = the points of `rule` (dimension d); `stat` nonzero when an array
+   !> could not be allocated (the points of all cells together grow with the grid).
+   pure subroutine keep_rule(rule, d, store, stat)
+      type(cell_rule_type), intent(in) :: rule
+      integer, intent(in) :: d
+      type(rule_store_type), intent(inout) :: store
+      integer, intent(out) :: stat
+
+      store%nvol = rule%nvol
+      store%nsurf = rule%nsurf
+      allocate (store%x, source=rule%vol_x(1:d, 1:rule%nvol), stat=stat)
+      if (stat == 0) allocate (store%w, source=rule%vol_w(1:rule%nvol), stat=stat)
+      if (stat == 0) allocate (store%sx, source=rule%surf_x(1:d, 1:rule%nsurf), stat=stat)
+      if (stat == 0) allocate (store%sw, source=rule%surf_w(1:rule%nsurf), stat=stat)
+      if (stat == 0) allocate (store%sn, source=rule%surf_n(1:d, 1:rule%nsurf), stat=stat)
+      if (stat == 0) allocate (store%ss, source=rule%surf_shape(1:rule%nsurf), stat=stat)
+   end subroutine keep_rule
 
    !> Number of reduced unknowns.
    pure integer function n_dofs(self)
@@ -559,7 +591,7 @@ contains
       if (allocated(error)) return
       call self%solve_reduced(error)
       if (allocated(error)) return
-      call expand_solution(self)
+      call expand_solution(self, error)
    end subroutine problem_solve
 
    !> The reduced stiffness `k` and load `f` (t_assembly). After setup.
@@ -614,14 +646,18 @@ contains
          return
       end if
       self%ubar = ubar
-      call expand_solution(self)
+      call expand_solution(self, error)
    end subroutine problem_set_solution
 
    !> u = T ubar; the problem counts as solved.
-   subroutine expand_solution(self)
+   subroutine expand_solution(self, error)
       class(elasticity_problem_type), intent(inout) :: self
+      type(error_type), allocatable, intent(out) :: error
+      integer :: stat
       if (allocated(self%u)) deallocate (self%u)
-      allocate (self%u(self%dim, self%nodes%n_nodes))
+      allocate (self%u(self%dim, self%nodes%n_nodes), stat=stat)
+      call check_allocation(stat, 'elasticity solve', 'the nodal displacements', self%nodes%n_nodes, 8*self%dim, error)
+      if (allocated(error)) return
       call self%constraints%expand(self%ubar, self%u)
       call dilatation_coefficients(self)
       self%solved = .true.
@@ -634,12 +670,15 @@ contains
       type(coo_type) :: coo
       integer, allocatable :: mdof(:), dofs(:, :), offset(:)
       real(wp), allocatable :: kbuf(:), fbuf(:, :)
-      integer :: nel, nd, maxm, c0, c1, e, m, k0, saved_blas
+      integer :: nel, nd, maxm, c0, c1, e, m, k0, saved_blas, stat
+      character(len=*), parameter :: who = 'elasticity assembly'
 
       nel = self%grid%n_leaves
       nd = self%dim*self%nen
       ! distinct reduced dofs of each element (bounds the buffers)
-      allocate (mdof(nel))
+      allocate (mdof(nel), stat=stat)
+      call check_allocation(stat, who, 'the reduced dof count of each element', nel, 4, error)
+      if (allocated(error)) return
       block
          integer, allocatable :: dtmp(:)
          real(wp), allocatable :: ttmp(:, :)
@@ -653,7 +692,9 @@ contains
          & capacity=sum(int(mdof, kind(coo%nnz))**2) + aggregate_capacity(self, mdof))
       if (allocated(error)) return
       if (allocated(self%f)) deallocate (self%f)
-      allocate (self%f(self%constraints%n_dofs))
+      allocate (self%f(self%constraints%n_dofs), stat=stat)
+      call check_allocation(stat, who, 'the load vector', self%constraints%n_dofs, 8, error)
+      if (allocated(error)) return
       self%f = 0.0_wp
       allocate (dofs(maxm, chunk_size), fbuf(maxm, chunk_size), offset(chunk_size + 1))
       ! Small dgemm calls from every thread: OpenBLAS in one thread (sprc_core_blas_threads).
@@ -910,7 +951,8 @@ contains
             & stat_invalid_input)
          return
       end if
-      call self%rigid_modes(r)
+      call self%rigid_modes(r, error)
+      if (allocated(error)) return
       call free_motions(self%k, r, vec, nfree, error)
       if (allocated(error) .or. nfree == 0) return
       ! Name every basic motion with a significant share in a free one, once.
@@ -950,18 +992,28 @@ contains
    !> The 3 (2D) / 6 (3D) rigid-body modes r(n_dofs, nm) in the reduced space:
    !> translations, rotations about the grid box centre scaled by 1/box size
    !> (all of unit magnitude), taken to the reduced space by restrict_field
-   !> (nodal values at the masters, zeroed components dropped).
-   pure subroutine rigid_modes(self, r)
+   !> (nodal values at the masters, zeroed components dropped). A failed
+   !> allocation is returned in `error`; without `error` the run time stops
+   !> the program, as before `error` was added (contact/solve.f90 still calls it so).
+   pure subroutine rigid_modes(self, r, error)
       class(elasticity_problem_type), intent(in) :: self
       real(wp), allocatable, intent(out) :: r(:, :)
+      type(error_type), allocatable, intent(out), optional :: error
       real(wp), allocatable :: field(:, :)
       real(wp) :: xc(3), y(3)
-      integer :: nm, i, j, d
+      integer :: nm, i, j, d, stat
 
       d = self%dim
       nm = merge(3, 6, d == 2)
       xc(1:d) = self%grid%box_min(1:d) + 0.5_wp*self%grid%box_size
-      allocate (field(d, self%nodes%n_nodes), r(self%constraints%n_dofs, nm))
+      if (present(error)) then
+         allocate (field(d, self%nodes%n_nodes), r(self%constraints%n_dofs, nm), stat=stat)
+         call check_allocation(stat, 'rigid_modes', 'the rigid-body motions (values)', &
+            & int(self%constraints%n_dofs, i8)*nm + int(self%nodes%n_nodes, i8)*d, 8, error)
+         if (allocated(error)) return
+      else
+         allocate (field(d, self%nodes%n_nodes), r(self%constraints%n_dofs, nm))
+      end if
       do i = 1, nm
          do j = 1, self%nodes%n_nodes
             y(1:d) = (self%nodes%x(:, j) - xc(1:d))/self%grid%box_size
@@ -996,13 +1048,16 @@ contains
       type(error_type), allocatable, intent(out) :: error
       real(wp), allocatable :: kr(:, :), diag(:), work(:), g(:, :), s(:), lam(:)
       real(wp) :: kmax
-      integer :: nm, nd, i, j, info
+      integer :: nm, nd, i, j, info, stat
       integer(kind(k%rowptr)) :: q
 
       nd = size(r, 1)
       nm = size(r, 2)
       nfree = 0
-      allocate (kr(nd, nm), diag(nd), g(nm, nm), s(nm), lam(nm), vec(nm, 0))
+      allocate (kr(nd, nm), diag(nd), stat=stat)
+      call check_allocation(stat, 'elasticity solve', 'the rigid-body check (K times each motion)', nd, 8*(nm + 1), error)
+      if (allocated(error)) return
+      allocate (g(nm, nm), s(nm), lam(nm), vec(nm, 0))
       do i = 1, nm
          call k%matvec(r(:, i), kr(:, i), error)
          if (allocated(error)) return
@@ -1041,9 +1096,12 @@ contains
    subroutine factor_and_solve(self, error)
       type(elasticity_problem_type), intent(inout) :: self
       type(error_type), allocatable, intent(out) :: error
+      integer :: stat
 
       if (allocated(self%ubar)) deallocate (self%ubar)
-      allocate (self%ubar(self%constraints%n_dofs))
+      allocate (self%ubar(self%constraints%n_dofs), stat=stat)
+      call check_allocation(stat, 'elasticity solve', 'the reduced solution', self%constraints%n_dofs, 8, error)
+      if (allocated(error)) return
       self%solver_iterations = 0
       if (use_iterative(self%solver, self%dim, self%constraints%n_dofs)) then
          call iterative_solve(self, error)
@@ -1245,7 +1303,7 @@ contains
       real(wp), intent(out), optional :: err_norm
       real(wp), allocatable :: parts(:, :)
       real(wp) :: sh(6), se(6), c(6, 6), de(6)
-      integer :: e, q, ns, nel
+      integer :: e, q, ns, nel, stat
 
       err_fe = 0.0_wp
       norm_fe = 0.0_wp
@@ -1262,7 +1320,9 @@ contains
       ns = self%nstress
       nel = self%grid%n_leaves
       c = self%compliance
-      allocate (parts(3, nel))
+      allocate (parts(3, nel), element_error(nel), stat=stat)
+      call check_allocation(stat, 'energy_error', 'the error of each element', nel, 32, error)
+      if (allocated(error)) return
       !$omp parallel do schedule(dynamic, 16) default(shared) private(e, q, sh, se, de)
       do e = 1, nel
          parts(:, e) = 0.0_wp
@@ -1276,7 +1336,7 @@ contains
          end do
       end do
       !$omp end parallel do
-      element_error = sqrt(parts(1, :))
+      element_error(:) = sqrt(parts(1, :))
       norm_fe = sqrt(sum(parts(2, :)))
       norm_exact = sqrt(sum(parts(3, :)))
       err_fe = sqrt(sum(parts(1, :)))/max(norm_exact, tiny(1.0_wp))
@@ -1293,7 +1353,7 @@ contains
       type(csr_type) :: a
       type(cholmod_solver_type) :: chol
       real(wp), allocatable :: scale(:)
-      integer :: i
+      integer :: i, stat
       integer(kind(self%k%rowptr)) :: q
 
       value = 0.0_wp
@@ -1301,8 +1361,11 @@ contains
          call fatal_error(error, 'scaled_rcond: the stiffness is not assembled', stat_invalid_input)
          return
       end if
-      a = self%k
-      allocate (scale(a%nrows))
+      call self%k%copy(a, error)
+      if (allocated(error)) return
+      allocate (scale(a%nrows), stat=stat)
+      call check_allocation(stat, 'scaled_rcond', 'the diagonal scaling', a%nrows, 8, error)
+      if (allocated(error)) return
       scale = 0.0_wp
       do i = 1, a%nrows
          do q = a%rowptr(i), a%rowptr(i + 1) - 1

@@ -50,6 +50,7 @@ module sprc_fem_sparse
       real(wp), allocatable :: val(:)
    contains
       procedure :: nnz => csr_nnz
+      procedure :: copy => csr_copy
       procedure :: matvec => csr_matvec
       procedure :: norm1 => csr_norm1
    end type csr_type
@@ -369,6 +370,24 @@ contains
       c = col(i); col(i) = col(j); col(j) = c
       v = val(i); val(i) = val(j); val(j) = v
    end subroutine swap
+
+   !> `copy` = the matrix, with a failed allocation returned as an error (the
+   !> intrinsic assignment copy = matrix stops the program when it cannot allocate).
+   subroutine csr_copy(self, copy, error)
+      class(csr_type), intent(in) :: self
+      type(csr_type), intent(out) :: copy
+      type(error_type), allocatable, intent(out) :: error
+      integer :: stat
+
+      stat = 0
+      if (allocated(self%rowptr)) allocate (copy%rowptr, source=self%rowptr, stat=stat)
+      if (stat == 0 .and. allocated(self%col)) allocate (copy%col, source=self%col, stat=stat)
+      if (stat == 0 .and. allocated(self%val)) allocate (copy%val, source=self%val, stat=stat)
+      call check_allocation(stat, 'csr_type%copy', 'the matrix', self%nnz(), 12, error)
+      if (allocated(error)) return
+      copy%nrows = self%nrows
+      copy%ncols = self%ncols
+   end subroutine csr_copy
 
    !> Number of stored entries.
    pure function csr_nnz(self) result(nnz)

@@ -654,9 +654,13 @@ contains
             end do
          end if
       else
+         ! A loop, not overlapping sections: gfortran copies those through a heap
+         ! temporary that it never checks, a crash when memory runs out (issue 15).
          nnew = rule%ns - s1
-         rule%sy(:, s0 + 1:s0 + nnew) = rule%sy(:, s1 + 1:s1 + nnew)
-         rule%sw(s0 + 1:s0 + nnew) = rule%sw(s1 + 1:s1 + nnew)
+         do i = 1, nnew
+            rule%sy(:, s0 + i) = rule%sy(:, s1 + i)
+            rule%sw(s0 + i) = rule%sw(s1 + i)
+         end do
          rule%ns = s0 + nnew
       end if
       rule%np = k0 - 1
