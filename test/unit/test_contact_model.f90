@@ -362,7 +362,8 @@ contains
       if (allocated(error)) return
       x = reshape([0.5_wp, 0.5_wp, 1.0_wp, 1.0_wp, 0.5_wp, 1.5_wp], [3, 2])
       normal = reshape([0.0_wp, 0.0_wp, -1.0_wp, 1.0_wp, 0.0_wp, 0.0_wp], [3, 2])
-      call new_contact_result(result, x, [0.5_wp, 0.5_wp], normal, 2, 1)
+      call new_contact_result(result, x, [0.5_wp, 0.5_wp], normal, 2, 1, error)
+      if (allocated(error)) return
       call fill_exact_pressure(pressure, result)
       call check(error, maxval(abs(result%p_exact - [5.0_wp, 2.0_wp])), 0.0_wp, roundoff, 'p_exact at both points')
    end subroutine test_fill_exact_pressure
@@ -380,14 +381,16 @@ contains
       if (allocated(error)) return
       normal = reshape([1.0_wp, 0.0_wp, sqrt(0.5_wp), sqrt(0.5_wp)], [2, 2])
       x = 20.0_wp*normal
-      call new_contact_result(contacts(1), x, [1.0_wp, 1.0_wp], normal, 1, 2)
+      call new_contact_result(contacts(1), x, [1.0_wp, 1.0_wp], normal, 1, 2, error)
+      if (allocated(error)) return
       call fill_contact_exact(scene, contacts, error)
       if (allocated(error)) return
       call check(error, maxval(abs(contacts(1)%p_exact - 3.923350_wp)) <= 0.5e-6_wp, 'p_c at both points')
       if (allocated(error)) return
       call read_scene('test/data/scenes/valid/contact_punch.nml', scene, error)
       if (allocated(error)) return
-      call new_contact_result(contacts(1), x, [1.0_wp, 1.0_wp], normal, 1, 2)
+      call new_contact_result(contacts(1), x, [1.0_wp, 1.0_wp], normal, 1, 2, error)
+      if (allocated(error)) return
       call fill_contact_exact(scene, contacts, error)
       if (allocated(error)) return
       call check(error, all(is_empty(contacts(1)%p_exact)), 'no &exact: p_exact empty')
@@ -400,11 +403,12 @@ contains
    function contact_sample() result(contacts)
       type(contact_result_type), allocatable :: contacts(:)
       real(wp) :: x(2, 3), normal(2, 3)
+      type(error_type), allocatable :: error
 
       allocate (contacts(2))
       x = reshape([0.0_wp, 1.0_wp, 0.5_wp, 1.0_wp, 1.0_wp, 1.0_wp], [2, 3])
       normal = reshape([0.0_wp, -1.0_wp, 0.0_wp, -1.0_wp, 0.0_wp, -1.0_wp], [2, 3])
-      call new_contact_result(contacts(1), x, [0.5_wp, 1.0_wp, 0.25_wp], normal, 2, 1)
+      call new_contact_result(contacts(1), x, [0.5_wp, 1.0_wp, 0.25_wp], normal, 2, 1, error)
       contacts(1)%state = [contact_slip, contact_stick, contact_open]
       contacts(1)%gap = [-1.0e-6_wp, 0.0_wp, 2.5e-3_wp]
       contacts(1)%p_fe = [2.0_wp, 1.0_wp, 0.0_wp]
@@ -413,7 +417,7 @@ contains
       contacts(1)%ts_fe = [0.6_wp, 0.1_wp, 0.0_wp]
       contacts(1)%iterations = 3
       call new_contact_result(contacts(2), reshape([2.0_wp, 1.0_wp], [2, 1]), [0.25_wp], &
-         & reshape([0.0_wp, -1.0_wp], [2, 1]), 2, 1)
+         & reshape([0.0_wp, -1.0_wp], [2, 1]), 2, 1, error)
       contacts(2)%state = [contact_slip]
       contacts(2)%gap = [-2.0e-6_wp]
       contacts(2)%p_fe = [4.0_wp]

@@ -273,7 +273,8 @@ contains
       allocate (x(2, n))
       x(1, :) = [(real(i, wp)/n, i=1, n)]
       x(2, :) = 0.0_wp
-      call new_contact_result(c(1), x, spread(1.0_wp/n, 1, n), spread([0.0_wp, -1.0_wp], 2, n), 1, 2)
+      call new_contact_result(c(1), x, spread(1.0_wp/n, 1, n), spread([0.0_wp, -1.0_wp], 2, n), 1, 2, error)
+      if (allocated(error)) return
       c(1)%p_fe = 1.0_wp - x(1, :)**2
       c(1)%p_exact = 1.0_wp - x(1, :)**2
       text = contact_svg(c, 'many')
@@ -298,7 +299,8 @@ contains
       phi = [(0.01_wp*(i - 1), i=1, 101)]
       x(1, :) = sin(phi)
       x(2, :) = 1.0_wp - cos(phi)
-      call new_contact_result(c(1), x, spread(0.01_wp, 1, 101), x, 1, 2)
+      call new_contact_result(c(1), x, spread(0.01_wp, 1, 101), x, 1, 2, error)
+      if (allocated(error)) return
       c(1)%p_fe = merge(1.0_wp - (phi/0.1_wp)**2, 0.0_wp, phi < 0.1_wp)
       text = contact_svg(c, 'window')
       call check(error, count_sub(text, 'class="point p_fe"'), 12, 'markers of the loaded stretch and margins')
@@ -326,10 +328,11 @@ contains
       type(contact_result_type) :: c
       real(wp) :: x(3, 3), normal(3, 3)
       integer :: i
+      type(error_type), allocatable :: error
 
       x = reshape([0.0_wp, 0.0_wp, 1.0_wp, 0.1_wp, 0.0_wp, 1.0_wp, 0.0_wp, 0.3_wp, 1.0_wp], [3, 3])
       normal = spread([0.0_wp, 0.0_wp, -1.0_wp], 2, 3)
-      call new_contact_result(c, x, [0.01_wp, 0.02_wp, 0.03_wp], normal, 1, 2)
+      call new_contact_result(c, x, [0.01_wp, 0.02_wp, 0.03_wp], normal, 1, 2, error)
       c%state = [2, contact_stick, 0]
       c%gap = [-1.0e-5_wp, 0.0_wp, 1.0e-3_wp]
       c%p_fe = [3.0_wp, 2.0_wp, 0.0_wp]

@@ -5,6 +5,8 @@
 !> p_exact. A real value that does not apply is empty (`report_empty`).
 module sprc_contact_result
    use sprc_core_kinds, only: wp
+   use sprc_core_error, only: error_type
+   use sprc_core_alloc, only: check_allocation
    use sprc_study_row, only: report_empty
    implicit none
    private
@@ -41,23 +43,26 @@ contains
 
    !> A result for `npoint` slave points: geometry copied, every value empty,
    !> every point open.
-   pure subroutine new_contact_result(self, x, weight, normal, slave, master)
+   pure subroutine new_contact_result(self, x, weight, normal, slave, master, error)
       type(contact_result_type), intent(out) :: self
       real(wp), intent(in) :: x(:, :), weight(:), normal(:, :)
       integer, intent(in) :: slave, master
-      integer :: n
+      type(error_type), allocatable, intent(out) :: error
+      integer :: n, stat
 
       n = size(weight)
       self%dim = size(x, 1)
       self%npoint = n
       self%slave = slave
       self%master = master
-      self%x = x
-      self%weight = weight
-      self%normal = normal
-      allocate (self%gap(n), self%p_fe(n), self%p_spr(n), self%p_sprc(n), self%p_exact(n), &
-         & self%ts_fe(n), self%ts_sprc(n), source=report_empty)
-      allocate (self%state(n), source=contact_open)
+      allocate (self%x, source=x, stat=stat)
+      if (stat == 0) allocate (self%weight, source=weight, stat=stat)
+      if (stat == 0) allocate (self%normal, source=normal, stat=stat)
+      if (stat == 0) allocate (self%gap(n), self%p_fe(n), self%p_spr(n), self%p_sprc(n), self%p_exact(n), &
+         & self%ts_fe(n), self%ts_sprc(n), source=report_empty, stat=stat)
+      if (stat == 0) allocate (self%state(n), source=contact_open, stat=stat)
+      call check_allocation(stat, 'contact result', 'the values of each slave point', n, &
+         & 8*(2*self%dim + 8) + 4, error)
    end subroutine new_contact_result
 
    !> The SCENE.md name of a state.

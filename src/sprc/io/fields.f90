@@ -9,6 +9,7 @@
 module sprc_io_fields
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type
+   use sprc_core_alloc, only: check_allocation
    use sprc_geometry_region, only: cell_cut
    use sprc_study_level, only: study_type, level_type, body_level_type, nodal_fe_stress
    use sprc_study_model, only: analysis_units_type
@@ -110,7 +111,7 @@ contains
       real(wp), allocatable :: sigma_fe(:, :), elem(:, :)
       real(wp) :: sunit, eunit
       integer, allocatable :: cls(:, :)
-      integer :: m
+      integer :: m, stat
 
       call h5%write_level(level, bl%nodes%x, bl%nodes%connectivity, cell_type, error, body=body)
       if (allocated(error)) return
@@ -119,7 +120,8 @@ contains
       eunit = sqrt(units%modulus)*units%strain
       call h5%write_node_field(level, 'displacement', units%strain*bl%problem%u, error, body=body)
       if (allocated(error)) return
-      call nodal_fe_stress(bl%problem, bl%nodes, sigma_fe)
+      call nodal_fe_stress(bl%problem, bl%nodes, sigma_fe, error)
+      if (allocated(error)) return
       call write_stress('sigma_fe', sunit*sigma_fe, error)
       if (allocated(error)) return
       do m = 1, 2
@@ -135,7 +137,9 @@ contains
          call h5%write_cell_field(level, 'exact_error_fe', elem, error, body=body)
          if (allocated(error)) return
       end if
-      allocate (cls(1, bl%grid%n_leaves))
+      allocate (cls(1, bl%grid%n_leaves), stat=stat)
+      call check_allocation(stat, 'HDF5 fields', 'the cut flag of each cell', bl%grid%n_leaves, 4, error)
+      if (allocated(error)) return
       cls(1, :) = merge(1, 0, bl%grid%leaf_class(1:bl%grid%n_leaves) == cell_cut)
       call h5%write_cell_field(level, 'cut', cls, error, body=body)
    contains

@@ -29,6 +29,7 @@ module sprc_io_hdf5
    use sprc_core_kinds, only: wp
    use sprc_core_text, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_io, stat_invalid_input
+   use sprc_core_alloc, only: check_allocation
    use sprc_io_xdmf, only: xdmf_grid_type, xdmf_field_type, write_xdmf_file => write_xdmf, &
       & cell_nodes, cell_dim, topology_name, center_node, center_cell, field_scalar, field_vector, &
       & field_components, level_group, grid_group, mesh_x_path, mesh_connectivity_path, field_path, n_attributes, &
@@ -143,6 +144,7 @@ contains
       type(h5_quiet_type) :: quiet
       character(len=:), allocatable :: where
       logical :: new_level
+      integer :: stat
 
       grid%level = level
       grid%body = ''
@@ -195,7 +197,10 @@ contains
          return
       end if
 
-      conn0 = connectivity - 1
+      allocate (conn0, source=connectivity - 1, stat=stat)
+      call check_allocation(stat, where//'write_level', 'the 0-based connectivity', size(connectivity, 2), &
+         & 4*size(connectivity, 1), error)
+      if (allocated(error)) return
       call quiet_begin(quiet)
       call write_level_data(self, grid, new_level, nodes_x, conn0, where, error)
       call quiet_end(quiet)
@@ -318,7 +323,7 @@ contains
       real(wp), allocatable, target :: rbuf(:, :)
       integer, allocatable, target :: ibuf(:, :)
       character(len=:), allocatable :: where
-      integer :: g, expected, stored, j
+      integer :: g, expected, stored, j, stat
       integer(hsize_t), allocatable :: dims(:)
 
       where = 'HDF5 output "'//file_name(self)//'" level '//itoa(level)//' '// &
@@ -386,14 +391,20 @@ contains
       else
          dims = int([stored, n], hsize_t)
       end if
+      if (present(real_values)) then
+         allocate (rbuf(stored, n), source=0.0_wp, stat=stat)
+         call check_allocation(stat, where//'write', 'the values', n, 8*stored, error)
+      else
+         allocate (ibuf(stored, n), source=0, stat=stat)
+         call check_allocation(stat, where//'write', 'the values', n, 4*stored, error)
+      end if
+      if (allocated(error)) return
       call quiet_begin(quiet)
       if (present(real_values)) then
-         allocate (rbuf(stored, n), source=0.0_wp)
          rbuf(:ncomp, :) = real_values
          call write_dataset(self%file, field_path(self%grids(g), center, name), dims, H5T_NATIVE_DOUBLE, c_loc(rbuf), &
             where, error)
       else
-         allocate (ibuf(stored, n), source=0)
          ibuf(:ncomp, :) = int_values
          call write_dataset(self%file, field_path(self%grids(g), center, name), dims, H5T_NATIVE_INTEGER, c_loc(ibuf), &
             where, error)

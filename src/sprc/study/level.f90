@@ -25,6 +25,7 @@ module sprc_study_level
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_unsupported, stat_internal, stat_invalid_input
    use sprc_core_timer, only: timer_type, wall_time
+   use sprc_core_alloc, only: check_allocation
    use sprc_geometry_body, only: body_type
    use sprc_exact_solution, only: exact_solution_type
    use sprc_grid_tree, only: grid_type
@@ -418,8 +419,9 @@ contains
             return
          end if
       end do
-      call contact_result(surface, sol, spec, study%bodies(s)%units, result)
-      call recovered_tractions(surface, bodies(s), study%run, study%bodies(s)%units, result, error)
+      call contact_result(surface, sol, spec, study%bodies(s)%units, result, error)
+      if (.not. allocated(error)) &
+         & call recovered_tractions(surface, bodies(s), study%run, study%bodies(s)%units, result, error)
       if (allocated(error)) return
       t_contact = t_contact + timer%elapsed + sol%t_contact
    end subroutine run_contact
@@ -478,15 +480,18 @@ contains
 
    !> The contact result of a pair in scene units (pressures times the stress
    !> unit, gaps times the displacement unit).
-   subroutine contact_result(surface, sol, spec, units, result)
+   subroutine contact_result(surface, sol, spec, units, result, error)
       type(contact_surface_type), intent(in) :: surface
       type(contact_solution_type), intent(in) :: sol
       type(contact_spec_type), intent(in) :: spec
       type(analysis_units_type), intent(in) :: units
       type(contact_result_type), intent(out) :: result
+      type(error_type), allocatable, intent(out) :: error
       integer :: closed_state
 
-      call new_contact_result(result, surface%x, surface%weight, surface%normal, spec%slave_index, spec%master_index)
+      call new_contact_result(result, surface%x, surface%weight, surface%normal, spec%slave_index, spec%master_index, &
+         & error)
+      if (allocated(error)) return
       closed_state = merge(contact_slip, contact_stick, friction_kind(spec%friction) == friction_frictionless)
       where (surface%has_master) result%gap = sol%gap*units%strain
       result%state = merge(closed_state, contact_open, sol%closed)
@@ -672,15 +677,18 @@ contains
 
    !> FE stress at each node: the average over the elements that hold it
    !> (the FE stress is discontinuous; this is only for viewing).
-   subroutine nodal_fe_stress(problem, nodes, sigma)
+   subroutine nodal_fe_stress(problem, nodes, sigma, error)
       type(elasticity_problem_type), intent(in) :: problem
       type(grid_nodes_type), intent(in) :: nodes
       real(wp), allocatable, intent(out) :: sigma(:, :)
+      type(error_type), allocatable, intent(out) :: error
       real(wp) :: s(6)
-      integer :: n, k, e, ns, count
+      integer :: n, k, e, ns, count, stat
 
       ns = problem%nstress
-      allocate (sigma(ns, nodes%n_nodes))
+      allocate (sigma(ns, nodes%n_nodes), stat=stat)
+      call check_allocation(stat, 'nodal FE stress', 'the stress at each node', nodes%n_nodes, 8*ns, error)
+      if (allocated(error)) return
       do n = 1, nodes%n_nodes
          sigma(:, n) = 0.0_wp
          count = 0
