@@ -12,7 +12,6 @@ program sprc_main
    use sprc_io_scene, only: scene_type, read_scene, read_scene_text, scene_summary, default_scene_text
    use sprc_study_model, only: build_bodies, scene_warnings
    use sprc_study_budget, only: level_memory
-   use sprc_core_blas_threads, only: blas_reserve_buffers
    use sprc_geometry_body, only: body_type
    use sprc_study_mesh, only: mesh_row_type, mesh_study, study_levels
    use sprc_study_level, only: study_type, prepare_study, run_level, level_type
@@ -115,10 +114,11 @@ contains
 
       call study_levels(scene, cli%levels, levels, error)
       if (allocated(error)) call fail(2, error%message)
+      ! The thread count first: prepare_study takes OpenBLAS's buffer for each thread.
+      if (cli%threads > 0) call omp_set_num_threads(cli%threads)
       call prepare_study(scene, cli%points, study, error)
       if (allocated(error)) call fail_with(error)
       call print_warnings(scene_warnings(scene, study%bodies%geometry))
-      if (cli%threads > 0) call omp_set_num_threads(cli%threads)
       prefix = scene%output
       if (len(cli%output) > 0) prefix = cli%output
       if (len(prefix) > 0) then
@@ -129,8 +129,6 @@ contains
       end if
       allocate (rows(size(levels)), contact_levels(0))
       threads = omp_get_max_threads()
-      call blas_reserve_buffers(error)
-      if (allocated(error)) call fail_with(error)
       do i = 1, size(levels)
          if (cli%threads == 0) then
             total_dofs = 0.0_wp

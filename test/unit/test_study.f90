@@ -12,6 +12,9 @@ module sprc_test_study
    use sprc_io_scene, only: read_scene_text
    use sprc_study_level, only: study_type, prepare_study, run_level, level_type, body_level_type
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, replaced
+   use sprc_core_blas_threads, only: blas_reserved_threads
+   use sprc_core_text, only: itoa
+   !$ use omp_lib, only: omp_get_max_threads
    implicit none
    private
 
@@ -27,7 +30,8 @@ contains
          new_unittest('two_bodies_far_apart', test_two_bodies), &
          new_unittest('body_own_box', test_body_box), &
          new_unittest('contact_lost_names_body', test_contact_lost), &
-         new_unittest('body_error_names_body', test_body_error) &
+         new_unittest('body_error_names_body', test_body_error), &
+         new_unittest('prepare_takes_blas_buffers', test_prepare_blas) &
          ]
    end subroutine collect_study
 
@@ -57,6 +61,26 @@ contains
          & "&bc on='sym_y' type='symmetry' /"//nl
       text = text//"&exact kind='lame_cylinder' center=0,0 r_in=5 r_out=20 p_in=1.0 /"//nl
    end function two_body_scene
+
+   !> prepare_study takes OpenBLAS's buffer of every thread (blas_reserve_buffers),
+   !> so that a library user who calls prepare_study and run_level gets an
+   !> error, not OpenBLAS's endless retry, when the buffers do not fit.
+   !> (Run alone: `fpm test unit -- study prepare_takes_blas_buffers`; nothing
+   !> else in this process has reserved them before.)
+   subroutine test_prepare_blas(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(study_type) :: study
+      integer :: threads
+      threads = 1
+      !$ threads = omp_get_max_threads()
+      call read_scene_text(two_body_scene(.true., .false., '1'), 'one body', scene, error)
+      if (allocated(error)) return
+      call prepare_study(scene, 0, study, error)
+      if (allocated(error)) return
+      call check(error, blas_reserved_threads() >= threads, &
+         & 'buffers of '//itoa(threads)//' threads reserved: '//itoa(blas_reserved_threads()))
+   end subroutine test_prepare_blas
 
    !> Read a scene from `text`, prepare the study (a copy in `study` if
    !> present) and run one level.

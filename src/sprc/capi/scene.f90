@@ -4,7 +4,6 @@
 module sprc_capi_scene
    use, intrinsic :: iso_c_binding, only: c_ptr, c_int, c_null_ptr, c_associated, c_f_pointer, c_loc
    use sprc_core_error, only: error_type, stat_invalid_input, stat_out_of_memory
-   use sprc_core_blas_threads, only: blas_reserve_buffers
    use sprc_io_scene, only: scene_type, read_scene
    use sprc_study_mesh, only: study_levels
    use sprc_study_level, only: study_type, prepare_study, run_level, level_type
@@ -88,8 +87,6 @@ contains
       end if
       if (allocated(error)) return
       call prepare_study(scene, 0, study, error)
-      if (allocated(error)) return
-      call blas_reserve_buffers(error)
       if (allocated(error)) return
       allocate (rows(size(levels)))
       do i = 1, size(levels)

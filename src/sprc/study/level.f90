@@ -26,6 +26,7 @@ module sprc_study_level
    use sprc_core_error, only: error_type, fatal_error, stat_unsupported, stat_internal, stat_invalid_input
    use sprc_core_timer, only: timer_type, wall_time
    use sprc_core_alloc, only: check_allocation
+   use sprc_core_blas_threads, only: blas_reserve_buffers
    use sprc_geometry_body, only: body_type
    use sprc_exact_solution, only: exact_solution_type
    use sprc_grid_tree, only: grid_type
@@ -128,7 +129,9 @@ module sprc_study_level
 contains
 
    !> Check that this version can run the scene and build what every level
-   !> shares. `points` = 0 takes the default for the scene's FE order.
+   !> shares. `points` = 0 takes the default for the scene's FE order. Takes
+   !> OpenBLAS's buffer for each thread of the current OpenMP team
+   !> (`blas_reserve_buffers`): set the thread count before.
    subroutine prepare_study(scene, points, study, error)
       type(scene_type), intent(in) :: scene
       integer, intent(in) :: points
@@ -183,6 +186,9 @@ contains
       do b = 1, size(study%bodies)
          study%have_exact = study%have_exact .or. allocated(study%bodies(b)%exact)
       end do
+      ! Every path to run_level passes here: OpenBLAS's buffers are taken
+      ! before the first level, while there is room (a failure is an error).
+      call blas_reserve_buffers(error)
    end subroutine prepare_study
 
    !> Bodies in contact share one unit system: the slave body's modulus unit
