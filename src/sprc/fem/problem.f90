@@ -511,8 +511,8 @@ contains
       end if
       if (any(stats /= 0)) then
          e = findloc(stats /= 0, .true., 1)
-         call check_allocation(stats(e), who, 'the quadrature points of cell '//itoa(e - 1), &
-            & store(e)%nvol + store(e)%nsurf, 8*(2*d + 2) + 4, error)
+         call check_allocation(stats(e), who, 'the quadrature points of cell '//itoa(e - 1)// &
+            & ' (coordinates, weights, normals)', store(e)%nvol*(d + 1) + store(e)%nsurf*(2*d + 1), 8, error)
          return
       end if
 
@@ -635,6 +635,7 @@ contains
       class(elasticity_problem_type), intent(inout) :: self
       real(wp), intent(in) :: ubar(:)
       type(error_type), allocatable, intent(out) :: error
+      integer :: stat
 
       if (.not. allocated(self%root)) then
          call fatal_error(error, 'elasticity set_solution: setup was not called or failed', stat_invalid_input)
@@ -645,7 +646,10 @@ contains
             & itoa(self%constraints%n_dofs)//' unknowns', stat_invalid_input)
          return
       end if
-      self%ubar = ubar
+      if (allocated(self%ubar)) deallocate (self%ubar)
+      allocate (self%ubar, source=ubar, stat=stat)
+      call check_allocation(stat, 'elasticity set_solution', 'the reduced solution', size(ubar), 8, error)
+      if (allocated(error)) return
       call expand_solution(self, error)
    end subroutine problem_set_solution
 
