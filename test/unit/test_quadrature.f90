@@ -39,7 +39,7 @@ module sprc_test_quadrature
    type :: grid_sums_type
       real(wp) :: m(4) = 0.0_wp
       real(wp) :: div = 0.0_wp, flux = 0.0_wp, wmin = huge(1.0_wp)
-      integer :: ncut = 0, nsplit = 0, nunresolved = 0
+      integer :: ncut = 0, nsplit = 0, nunresolved = 0, nsurf = 0
       logical :: finite = .true.
    end type grid_sums_type
 
@@ -60,6 +60,7 @@ contains
          new_unittest('divergence_theorem', test_divergence), &
          new_unittest('normals_and_shape_index', test_normals), &
          new_unittest('faces_on_grid_planes', test_grid_faces), &
+         new_unittest('planes_off_grid_through_centres', test_planes_off_grid), &
          new_unittest('degenerate_tiny_cut', test_tiny_cut), &
          new_unittest('degenerate_nodes_and_tangency', test_nodes_tangency), &
          new_unittest('degenerate_offcentre_tangent_hole', test_offcentre_tangent), &
@@ -492,6 +493,35 @@ contains
    !> a box [1/4, 3/4]^2 (every cell inside or outside: the whole boundary
    !> comes from boundary faces of inside cells, via cell_rule and
    !> boundary_face_rule) has perimeter 2 and area 1/4; a 3D box likewise; a
+   !> Shell octant whose symmetry planes pass through the sphere centres but
+   !> cut cells (level 3, q = 6): the measures to 1e-10, and a plane's surface
+   !> pass not subdivided where a sphere meets it at its equator (dp/dy_k = 0
+   !> there is a turning point of the sphere, not of the plane's surface).
+   !> Every cut cell then has at most 5 surfaces, each met by at most
+   !> 2 q^2 base points per pass (two resolved height directions), so a
+   !> cut cell has at most 5 * 2 * q^2 = 360 surface points.
+   subroutine test_planes_off_grid(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: body
+      type(grid_sums_type) :: sums
+      character(len=:), allocatable :: name
+      real(wp) :: exact(4)
+      integer :: i
+      integer, parameter :: q = 6
+
+      call make_case(10, body, name, exact, error)
+      if (allocated(error)) return
+      call integrate_grid(body, 3, q, sums, error)
+      if (allocated(error)) return
+      call check_sane(sums, name, error)
+      if (allocated(error)) return
+      do i = 1, 4
+         call check(error, sums%m(i), exact(i), tol3d, name//' quantity '//achar(48 + i), rel=.true.)
+         if (allocated(error)) return
+      end do
+      call check(error, sums%nsurf <= sums%ncut*5*2*q**2, name//': surface points beyond 360 per cut cell')
+   end subroutine test_planes_off_grid
+
    !> disk minus the halfspace x <= 1/2 (a subtracted plane on a grid plane)
    !> has the chord on the x > 1/2 side cells with normal -e_x.
    subroutine test_grid_faces(error)
@@ -977,6 +1007,7 @@ contains
             sums%wmin = min(sums%wmin, w)
             sums%finite = sums%finite .and. ieee_is_finite(w) .and. all(ieee_is_finite(rule%vol_x(:, i)))
          end do
+         sums%nsurf = sums%nsurf + rule%nsurf
          do i = 1, rule%nsurf
             w = rule%surf_w(i)
             sums%m(2) = sums%m(2) + w
@@ -1061,9 +1092,14 @@ contains
          call new_sphere(s(1), 'sphere', c, r1, error)
          v = 4.0_wp*pi*r1**3/3.0_wp
          exact = [v, 4.0_wp*pi*r1**2, v*c(1), v*c(1)**2 + 4.0_wp*pi*r1**5/15.0_wp]
-      case (6)
+      case (6, 10)
          name = 'shell octant'
          c = [0.25_wp, 0.25_wp, 0.25_wp]
+         if (icase == 10) then
+            ! symmetry planes through the sphere centres, cutting cells
+            name = 'shell octant off grid'
+            c = [0.2537_wp, 0.2419_wp, 0.2613_wp]
+         end if
          r1 = 0.7_wp
          r2 = 0.3_wp
          n = 5

@@ -551,7 +551,7 @@ contains
       logical, intent(in) :: top
       real(wp) :: pmin, pmax, p(0:ncoef - 1), c(0:ncoef - 1), clo(3), chi(3)
       integer :: k0, nk, i, j, k, m, s0, s1, b0, nnew, child, bit, d, status, owner, tag
-      logical :: resolved, base_free(3), require(np)
+      logical :: resolved, base_free(3), require(np), focus
 
       k0 = rule%np + 1
       do i = p0, p0 + np - 1
@@ -581,12 +581,13 @@ contains
       ! the surfaces wanted at the top must be crossed by the height lines
       require(1:nk) = top .and. want >= 0
       if (top .and. want > 0) require(1:nk) = rule%tag(k0:k0 + nk - 1) == want
-      call choose_direction(rule%poly(:, k0:k0 + nk - 1), require(1:nk), lo, hi, free, quad%min_ratio, k, resolved)
+      call choose_direction(rule%poly(:, k0:k0 + nk - 1), require(1:nk), top .and. want > 0, lo, hi, free, &
+         & quad%min_ratio, k, resolved)
       if (.not. resolved .and. top .and. want == 0) then
          ! walls parallel to some direction: volume now, their surfaces in own passes
          require(1:nk) = .false.
-         call choose_direction(rule%poly(:, k0:k0 + nk - 1), require(1:nk), lo, hi, free, quad%min_ratio, k, &
-            & resolved)
+         call choose_direction(rule%poly(:, k0:k0 + nk - 1), require(1:nk), .false., lo, hi, free, &
+            & quad%min_ratio, k, resolved)
       end if
       if (.not. resolved .and. depth < quad%max_depth) then
          rule%nsplit = rule%nsplit + 1
@@ -615,8 +616,12 @@ contains
          call push_point(rule, 0.5_wp*(lo + hi), 1.0_wp)
       else
          b0 = rule%np + 1
+         ! A pass for one surface needs in its base only where that surface's
+         ! root leaves the box or meets another surface (choose_direction).
+         focus = top .and. want > 0
          do i = k0, k0 + nk - 1
             p = rule%poly(:, i)
+            if (focus .and. rule%tag(i) /= want .and. depends_on(p, k)) cycle
             if (depends_on(p, k)) then
                call face_restriction(ctx, body, p, rule%owner(i), k, lo(k), c)
                call push_poly(rule, c, 0, 0)
@@ -630,6 +635,7 @@ contains
             if (.not. depends_on(rule%poly(:, i), k)) cycle
             do j = i + 1, k0 + nk - 1
                if (.not. depends_on(rule%poly(:, j), k)) cycle
+               if (focus .and. rule%tag(i) /= want .and. rule%tag(j) /= want) cycle
                p = rule%poly(:, i)
                call crossing(p, rule%poly(:, j), k, c, status)
                if (status == 1) call push_poly(rule, c, 0, 0)
@@ -700,13 +706,20 @@ contains
    !> over the box and |dp/dy_k| >= min_ratio * (its variation over the box),
    !> which keeps the turning points of the height function at least min_ratio
    !> box widths away; and every pair involving y_k with a crossing quadric.
+   !> With `focus` (a pass for the surface(s) marked in `require` only) the
+   !> other quadrics need neither a sign of dp/dy_k nor crossings among
+   !> themselves: the surface points are where a required root changes
+   !> membership, which changes only where that root leaves the box or meets
+   !> another surface (their crossing quadric), so a turning point of another
+   !> surface (a sphere at a symmetry plane through its centre) does not
+   !> matter; its roots are still found exactly in `lift`.
    !> Among valid ones the largest min |dp/dy_k|/|grad p| at the box center.
    !> A single free dimension is always resolved (all roots on a line are
    !> found). If none is valid: resolved = .false. and k is the direction with
    !> the best score.
-   pure subroutine choose_direction(polys, require, lo, hi, free, min_ratio, k, resolved)
+   pure subroutine choose_direction(polys, require, focus, lo, hi, free, min_ratio, k, resolved)
       real(wp), intent(in) :: polys(0:, :), lo(3), hi(3), min_ratio
-      logical, intent(in) :: require(:), free(3)
+      logical, intent(in) :: require(:), focus, free(3)
       integer, intent(out) :: k
       logical, intent(out) :: resolved
       real(wp) :: score, best_valid, best_any, dmin, dmax, g(3), mid(3), c(0:ncoef - 1)
@@ -735,6 +748,7 @@ contains
                end if
                cycle
             end if
+            if (focus .and. .not. require(i)) cycle
             g = quadric_gradient(polys(:, i), mid)
             if (norm2(g) > 0.0_wp) score = min(score, abs(g(d))/norm2(g))
             call derivative_range(polys(:, i), d, lo, hi, dmin, dmax)
@@ -755,6 +769,7 @@ contains
             if (.not. depends_on(polys(:, i), d)) cycle
             do j = i + 1, size(polys, 2)
                if (.not. depends_on(polys(:, j), d)) cycle
+               if (focus .and. .not. (require(i) .or. require(j))) cycle
                call crossing(polys(:, i), polys(:, j), d, c, status)
                if (status < 0) then
                   valid = .false.
