@@ -99,6 +99,7 @@ module sprc_contact_solve
    use sprc_fem_problem, only: elasticity_problem_type, free_motions, motion_names, solve_spd_or_lu
    use sprc_fem_umfpack, only: umfpack_solver_type
    use sprc_contact_surface, only: contact_surface_type
+   use sprc_contact_result, only: contact_open, contact_stick, contact_slip
    implicit none
    private
 
@@ -109,8 +110,6 @@ module sprc_contact_solve
    integer, parameter :: friction_frictionless = 0, friction_stick = 1, friction_coulomb = 2
    !> Active-set iterations before giving up.
    integer, parameter :: default_max_iterations = 50
-   !> States of a contact cell under Coulomb friction.
-   integer, parameter :: state_open = 0, state_stick = 1, state_slip = 2
    !> A slip direction counts as settled when it moves by less than this
    !> between iterations (unit vectors; in 2D it only flips).
    real(wp), parameter :: direction_tol = 1.0e-8_wp
@@ -649,7 +648,7 @@ contains
       allocate (slip(d, size(cells)), tau(d, size(cells)), tau_new(d, size(cells)))
       slip = 0.0_wp
       tau = 0.0_wp
-      state = merge(state_stick, state_open, closed)
+      state = merge(contact_stick, contact_open, closed)
       state_new = state
       do n = 1, size(loads, 2)
          do it = 1, maxit
@@ -659,9 +658,9 @@ contains
             ! The rigid-mode check on the symmetric part without the friction
             ! terms (which resist no rigid motion): the system with mu = 0.
             call coulomb_system(slave, master, ops, cells, state, tau, slip, 0.0_wp, loads(:, n), k, f, error)
-            if (.not. allocated(error)) call check_held(slave, master, k, names, count(state /= state_open), &
+            if (.not. allocated(error)) call check_held(slave, master, k, names, count(state /= contact_open), &
                & sol%iterations, error)
-            if (.not. allocated(error) .and. any(state == state_slip)) &
+            if (.not. allocated(error) .and. any(state == contact_slip)) &
                & call coulomb_system(slave, master, ops, cells, state, tau, slip, mu, loads(:, n), k, f, error)
             if (.not. allocated(error)) call solve_unsymmetric(k, f, x, sol, error)
             call timer%stop()
@@ -670,7 +669,7 @@ contains
             call coulomb_states(ops, cells, mu, slip, x, state_new, tau_new)
             changed = count(state_new /= state)
             do c = 1, size(cells)
-               if (state_new(c) == state_slip .and. state(c) == state_slip) then
+               if (state_new(c) == contact_slip .and. state(c) == contact_slip) then
                   if (norm2(tau_new(:, c) - tau(:, c)) > direction_tol) changed = changed + 1
                end if
             end do
@@ -709,7 +708,7 @@ contains
       ns = slave%n_dofs()
       capacity = slave%k%nnz() + master%k%nnz()
       do c = 1, size(cells)
-         if (state(c) /= state_open) capacity = capacity + int(cells(c)%nu, i8)**2
+         if (state(c) /= contact_open) capacity = capacity + int(cells(c)%nu, i8)**2
       end do
       call coo%init(ns + master%n_dofs(), ns + master%n_dofs(), error, capacity=capacity)
       if (allocated(error)) return
@@ -718,9 +717,9 @@ contains
       if (allocated(error)) return
       f = load
       do c = 1, size(cells)
-         if (state(c) == state_open) cycle
+         if (state(c) == contact_open) cycle
          associate (cell => cells(c), gamma => ops%gamma(c), nb => cells(c)%nbar)
-            if (state(c) == state_stick) then
+            if (state(c) == contact_stick) then
                call tied_block(cell, gamma, kc)
                f(cell%dofs) = f(cell%dofs) - cell%measure*matmul(cell%g0bar - slip(:, c), cell%tbar + gamma*cell%gbar)
             else
@@ -776,11 +775,11 @@ contains
       do c = 1, size(cells)
          call cell_multiplier(ops, cells, c, slip(:, c), x, lam_n, lam_t)
          if (lam_n >= 0.0_wp) then
-            state(c) = state_open
+            state(c) = contact_open
          else if (norm2(lam_t) <= -mu*lam_n) then
-            state(c) = state_stick
+            state(c) = contact_stick
          else
-            state(c) = state_slip
+            state(c) = contact_slip
             tau(:, c) = lam_t/norm2(lam_t)
          end if
       end do
@@ -799,9 +798,9 @@ contains
       real(wp) :: lam_n, lam_t(size(slip, 1))
       integer :: c
       do c = 1, size(cells)
-         if (state(c) == state_stick) cycle
+         if (state(c) == contact_stick) cycle
          call cell_multiplier(ops, cells, c, slip(:, c), x, lam_n, lam_t)
-         if (state(c) == state_slip) then
+         if (state(c) == contact_slip) then
             slip(:, c) = slip(:, c) + (lam_t + mu*lam_n*tau(:, c))/ops%gamma(c)
          else
             slip(:, c) = slip(:, c) + lam_t/ops%gamma(c)
@@ -824,13 +823,13 @@ contains
          sol%lambda_n(c) = lam_n
          do j = ops%cell_ptr(c), ops%cell_ptr(c + 1) - 1
             i = ops%cell_point(j)
-            sol%closed(i) = state(c) /= state_open
-            sol%slipping(i) = state(c) == state_slip
+            sol%closed(i) = state(c) /= contact_open
+            sol%slipping(i) = state(c) == contact_slip
             sol%pressure(i) = 0.0_wp
             sol%tangential(i) = 0.0_wp
-            if (state(c) == state_open) cycle
+            if (state(c) == contact_open) cycle
             sol%pressure(i) = -lam_n
-            sol%tangential(i) = merge(-mu*lam_n, norm2(lam_t), state(c) == state_slip)
+            sol%tangential(i) = merge(-mu*lam_n, norm2(lam_t), state(c) == contact_slip)
          end do
       end do
    end subroutine coulomb_output
