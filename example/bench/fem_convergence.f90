@@ -150,7 +150,7 @@ contains
          rate = 0.0_wp
          if (prev > 0.0_wp) rate = log(prev/err)/log(2.0_wp)
          write (output_unit, '(i5,es11.3,i9,es12.4,f7.3,i7,3f9.3)') level, box_size*2.0_wp**(-level), &
-            & problem%n_dofs(), err, rate, problem%n_aggregated, problem%t_quadrature, problem%t_assembly, &
+            & problem%n_dofs(), err, rate, problem%n_aggregated, problem%mesh%t_quadrature, problem%t_assembly, &
             & problem%t_solve
          prev = err
          errs(level) = err
@@ -181,7 +181,7 @@ contains
          call stop_on(error)
          call problem%scaled_rcond(rc, error)
          call stop_on(error)
-         write (output_unit, '(es11.2,es14.3,es14.3,es14.6,i8)') deltas(i), minval(problem%fraction), rc, err, &
+         write (output_unit, '(es11.2,es14.3,es14.3,es14.6,i8)') deltas(i), minval(problem%mesh%fraction), rc, err, &
             & problem%n_aggregated
       end do
    end subroutine sweep

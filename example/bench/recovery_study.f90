@@ -187,14 +187,14 @@ contains
          call solve_on_grid(problem, body, box_min, box_size, level, 0, degree, analysis, young, poisson, &
             & spread(0.0_wp, 1, size(box_min)), bcs, error, exact=exact)
          call stop_on(error)
-         call hanging%build(problem%grid, problem%nodes, error)
+         call hanging%build(problem%mesh%grid, problem%mesh%nodes, error)
          call stop_on(error)
          call fe_recovery_input(problem, input, error)
          call stop_on(error)
-         inside = [(body%phi(problem%nodes%x(:, n)) <= 0.0_wp, n=1, problem%nodes%n_nodes)]
+         inside = [(body%phi(problem%mesh%nodes%x(:, n)) <= 0.0_wp, n=1, problem%mesh%nodes%n_nodes)]
          bites = 0
          do m = method_spr, method_sprc
-            call recover_grid(input, problem%grid, problem%nodes, hanging, m, rdeg(m), field, error, exact=exact)
+            call recover_grid(input, problem%mesh%grid, problem%mesh%nodes, hanging, m, rdeg(m), field, error, exact=exact)
             call stop_on(error)
             call estimate_error(input, field, est(m), error, exact, inside)
             call stop_on(error)

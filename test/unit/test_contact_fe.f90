@@ -125,9 +125,9 @@ contains
             ! stresses in the body's units: sigma_scene = sigma*unit
             unit = (study%bodies(b)%units%modulus/s)*study%bodies(b)%units%strain
             tol = max(tol, 10.0_wp*epsilon(1.0_wp)/pb%rcond)
-            do e = 1, pb%grid%n_leaves
-               do q = pb%vol_ptr(e), pb%vol_ptr(e + 1) - 1
-                  call pb%stress_in_element(e, pb%vol_x(:, q), sigma(1:ns))
+            do e = 1, pb%mesh%grid%n_leaves
+               do q = pb%mesh%vol_ptr(e), pb%mesh%vol_ptr(e + 1) - 1
+                  call pb%stress_in_element(e, pb%mesh%vol_x(:, q), sigma(1:ns))
                   worst = max(worst, maxval(abs(sigma(1:ns)*unit - expected(1:ns))))
                end do
             end do
@@ -473,17 +473,17 @@ contains
             ns = p%nstress
             unit = u%modulus*u%strain
             call compliance_matrix(p%analysis, p%young*u%modulus, p%poisson, c(1:ns, 1:ns), error)
-            do e = 1, p%grid%n_leaves
-               do q = p%vol_ptr(e), p%vol_ptr(e + 1) - 1
-                  call p%stress_in_element(e, p%vol_x(:, q), sh(1:ns))
+            do e = 1, p%mesh%grid%n_leaves
+               do q = p%mesh%vol_ptr(e), p%mesh%vol_ptr(e + 1) - 1
+                  call p%stress_in_element(e, p%mesh%vol_x(:, q), sh(1:ns))
                   if (b == 1) then
-                     call exact%inner%stress(p%vol_x(:, q), se(1:ns))
+                     call exact%inner%stress(p%mesh%vol_x(:, q), se(1:ns))
                   else
-                     call exact%outer%stress(p%vol_x(:, q), se(1:ns))
+                     call exact%outer%stress(p%mesh%vol_x(:, q), se(1:ns))
                   end if
                   d(1:ns) = se(1:ns) - unit*sh(1:ns)
-                  e2 = e2 + p%vol_w(q)*dot_product(d(1:ns), matmul(c(1:ns, 1:ns), d(1:ns)))
-                  x2 = x2 + p%vol_w(q)*dot_product(se(1:ns), matmul(c(1:ns, 1:ns), se(1:ns)))
+                  e2 = e2 + p%mesh%vol_w(q)*dot_product(d(1:ns), matmul(c(1:ns, 1:ns), d(1:ns)))
+                  x2 = x2 + p%mesh%vol_w(q)*dot_product(se(1:ns), matmul(c(1:ns, 1:ns), se(1:ns)))
                end do
             end do
          end associate

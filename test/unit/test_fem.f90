@@ -17,6 +17,8 @@ module sprc_test_fem
    use sprc_geometry_shape, only: shape_type, new_disk, new_sphere, new_halfspace, new_box
    use sprc_geometry_body, only: body_type, new_body, csg_add, csg_subtract, csg_intersect
    use sprc_grid_nodes, only: element_node_index
+   use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature, default_points
+   use sprc_grid_cut_mesh, only: cut_mesh_type
    use sprc_exact_solution, only: exact_solution_type, init_exact_solution
    use sprc_exact_lame, only: lame_cylinder_type, new_lame_cylinder, lame_sphere_type, new_lame_sphere
    use sprc_exact_kirsch, only: kirsch_type, new_kirsch
@@ -92,7 +94,8 @@ contains
          new_unittest('threads', test_threads), &
          new_unittest('queries_and_api_errors', test_queries), &
          new_unittest('recovery_input_adapter', test_recovery_input), &
-         new_unittest('solve_in_steps', test_solve_in_steps) &
+         new_unittest('solve_in_steps', test_solve_in_steps), &
+         new_unittest('cut_mesh_handover', test_cut_mesh_handover) &
          ]
    end subroutine collect_fem
 
@@ -202,8 +205,8 @@ contains
       d = problem%dim
       unodal = 0.0_wp
       umax = 0.0_wp
-      do i = 1, problem%nodes%n_nodes
-         call field%displacement(problem%nodes%x(:, i), ue(1:d))
+      do i = 1, problem%mesh%nodes%n_nodes
+         call field%displacement(problem%mesh%nodes%x(:, i), ue(1:d))
          unodal = max(unodal, maxval(abs(problem%u(:, i) - ue(1:d))))
          umax = max(umax, maxval(abs(ue(1:d))))
       end do
@@ -431,9 +434,9 @@ contains
             if (allocated(error)) return
             call check(error, all(problem%strong_shape(4:3 + d)), 'symmetry planes imposed strongly')
             if (allocated(error)) return
-            do i = 1, problem%nodes%n_nodes
+            do i = 1, problem%mesh%nodes%n_nodes
                do k = 1, d
-                  if (problem%nodes%x(k, i) /= 0.0_wp) cycle
+                  if (problem%mesh%nodes%x(k, i) /= 0.0_wp) cycle
                   call check(error, problem%u(k, i) == 0.0_wp, 'u_k = 0 on the plane x_k = 0')
                   if (allocated(error)) return
                end do
@@ -572,11 +575,11 @@ contains
       call check(error, input%bc_pressure(2) == 1.5_wp .and. all(input%bc_traction(1:2, 4) == [0.5_wp, -0.25_wp]) &
          & .and. all(input%bc_traction(:, 1:3) == 0.0_wp), 'pressure and traction data')
       if (allocated(error)) return
-      call check(error, all(input%bshape == problem%surf_shape) .and. all(input%bw == problem%surf_w) .and. &
-         & all(input%w == problem%vol_w) .and. input%young == young .and. input%analysis == plane_strain, &
+      call check(error, all(input%bshape == problem%mesh%surf_shape) .and. all(input%bw == problem%mesh%surf_w) .and. &
+         & all(input%w == problem%mesh%vol_w) .and. input%young == young .and. input%analysis == plane_strain, &
          & 'points, weights and material are the problem''s')
       if (allocated(error)) return
-      do e = 1, problem%grid%n_leaves
+      do e = 1, problem%mesh%grid%n_leaves
          call problem%element_points(e, x, w, sigma)
          q0 = input%elem_ptr(e)
          q1 = input%elem_ptr(e + 1) - 1
@@ -595,6 +598,67 @@ contains
       call check(error, all(input%bc_kind == [rec_traction, rec_pressure, rec_symmetry, rec_symmetry]), &
          & 'a shape without a condition is a free (traction 0) surface')
    end subroutine test_recovery_input
+
+   !> setup takes the cut mesh over without a copy: the caller's mesh is gone,
+   !> the problem's has the same cells and rules, and the solution has the bits
+   !> of solve_on_grid. A missing mesh, a mesh without cell rules and rules of
+   !> another dimension are refused (a refused mesh stays with the caller).
+   subroutine test_cut_mesh_handover(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: body
+      type(fe_bc_type), allocatable :: bcs(:)
+      type(lame_cylinder_type) :: exact
+      type(elasticity_problem_type) :: problem, reference
+      type(cut_mesh_type), allocatable :: mesh
+      type(cut_quadrature_type) :: quad, quad3
+      type(error_type), allocatable :: refused
+      integer :: n_leaves, n_points
+
+      call lame_quarter(body, bcs, exact, plane_strain, error)
+      if (allocated(error)) return
+      call problem%setup(mesh, plane_strain, young, poisson, [0.0_wp, 0.0_wp], bcs, refused, exact=exact)
+      call check(error, allocated(refused), 'setup without a mesh is refused')
+      if (allocated(error)) return
+      call check(error, index(refused%message, 'no mesh') > 0 .and. refused%stat == stat_invalid_input, &
+         & 'the message says there is no mesh: '//refused%message)
+      if (allocated(error)) return
+      allocate (mesh)
+      call mesh%build(body, [0.0_wp, 0.0_wp], 25.0_wp, 3, 0, 1, error)
+      if (allocated(error)) return
+      deallocate (refused)
+      call problem%setup(mesh, plane_strain, young, poisson, [0.0_wp, 0.0_wp], bcs, refused, exact=exact)
+      call check(error, allocated(refused) .and. allocated(mesh), 'a mesh without cell rules is refused and kept')
+      if (allocated(error)) return
+      call check(error, index(refused%message, 'cut-cell rules') > 0, 'the message names the rules: '//refused%message)
+      if (allocated(error)) return
+      call new_cut_quadrature(quad3, 3, default_points(1), error)
+      if (allocated(error)) return
+      deallocate (refused)
+      call mesh%integrate(quad3, refused)
+      call check(error, allocated(refused), '3D rules on a 2D grid are refused')
+      if (allocated(error)) return
+      call check(error, refused%stat == stat_invalid_input .and. index(refused%message, 'dimension 3') > 0, &
+         & 'the message names the dimensions: '//refused%message)
+      if (allocated(error)) return
+      call new_cut_quadrature(quad, 2, default_points(1), error)
+      if (.not. allocated(error)) call mesh%integrate(quad, error)
+      if (allocated(error)) return
+      n_leaves = mesh%grid%n_leaves
+      n_points = size(mesh%vol_w)
+      call problem%setup(mesh, plane_strain, young, poisson, [0.0_wp, 0.0_wp], bcs, error, exact=exact)
+      if (allocated(error)) return
+      call check(error, .not. allocated(mesh) .and. allocated(problem%mesh), 'the problem holds the mesh')
+      if (allocated(error)) return
+      call check(error, problem%mesh%grid%n_leaves == n_leaves .and. size(problem%mesh%vol_w) == n_points, &
+         & 'the same cells and points')
+      if (allocated(error)) return
+      call problem%solve(error)
+      if (allocated(error)) return
+      call solve_on_grid(reference, body, [0.0_wp, 0.0_wp], 25.0_wp, 3, 0, 1, plane_strain, young, poisson, &
+         & [0.0_wp, 0.0_wp], bcs, error, exact=exact)
+      if (allocated(error)) return
+      call check(error, all(problem%u == reference%u), 'the bits of solve_on_grid')
+   end subroutine test_cut_mesh_handover
 
    !> solve = assemble + solve_reduced + set_solution: the steps repeated on a
    !> solved problem give the same bits; set_solution(2 ubar) gives 2 u
@@ -803,7 +867,7 @@ contains
       call solve_on_grid(problem, body, [0.0_wp, 0.0_wp], 10.0_wp, 3, 0, 1, plane_stress, young, poisson, &
          & [0.0_wp, 0.0_wp], bcs, error, exact=exact)
       if (allocated(error)) return
-      call check(error, sum(problem%surf_w, mask=problem%surf_shape == 1), 20.0_wp, 1.0e-12_wp, &
+      call check(error, sum(problem%mesh%surf_w, mask=problem%mesh%surf_shape == 1), 20.0_wp, 1.0e-12_wp, &
          & 'measure of the outer edges', rel=.true.)
       if (allocated(error)) return
       do p = 1, 2
@@ -883,7 +947,7 @@ contains
          call problem%scaled_rcond(rc(i), error)
          if (allocated(error)) return
          if (i > 1) then
-            call check(error, minval(problem%fraction) < 2.0_wp*deltas(i), 'a cut as small as delta exists')
+            call check(error, minval(problem%mesh%fraction) < 2.0_wp*deltas(i), 'a cut as small as delta exists')
             if (allocated(error)) return
             call check(error, rc(i) >= 0.1_wp*rc(1), 'scaled condition within 10x')
             if (allocated(error)) return
@@ -1046,7 +1110,7 @@ contains
       call check(error, maxval(abs(s - sx)), 0.0_wp, solve_tolerance(problem)*maxval(abs(sx)), 'stress_at')
       if (allocated(error)) return
       area = 0.0_wp
-      do i = 1, problem%grid%n_leaves
+      do i = 1, problem%mesh%grid%n_leaves
          call problem%element_points(i, x, w, sigma)
          area = area + sum(w)
          if (size(w) > 0) then

@@ -774,33 +774,33 @@ contains
       call solve_on_grid(fe, pb%body, [0.0_wp, 0.0_wp], 25.0_wp, 6, 0, 1, plane_strain, 1000.0_wp, 0.3_wp, &
          & [0.0_wp, 0.0_wp], bcs, error, exact=lame)
       if (allocated(error)) return
-      call pb%hanging%build(fe%grid, fe%nodes, error)
+      call pb%hanging%build(fe%mesh%grid, fe%mesh%nodes, error)
       if (allocated(error)) return
       associate (inp => pb%input)
          inp%analysis = plane_strain
          inp%young = 1000.0_wp
          inp%poisson = 0.3_wp
-         inp%elem_ptr = fe%vol_ptr
-         inp%x = fe%vol_x
-         inp%w = fe%vol_w
-         allocate (inp%stress(3, size(fe%vol_w)))
-         do e = 1, fe%grid%n_leaves
+         inp%elem_ptr = fe%mesh%vol_ptr
+         inp%x = fe%mesh%vol_x
+         inp%w = fe%mesh%vol_w
+         allocate (inp%stress(3, size(fe%mesh%vol_w)))
+         do e = 1, fe%mesh%grid%n_leaves
             call fe%element_points(e, x, w, sigma)
-            inp%stress(:, fe%vol_ptr(e):fe%vol_ptr(e + 1) - 1) = sigma
+            inp%stress(:, fe%mesh%vol_ptr(e):fe%mesh%vol_ptr(e + 1) - 1) = sigma
          end do
-         inp%belem_ptr = fe%surf_ptr
-         inp%bx = fe%surf_x
-         inp%bw = fe%surf_w
-         inp%bn = fe%surf_n
-         inp%bshape = fe%surf_shape
+         inp%belem_ptr = fe%mesh%surf_ptr
+         inp%bx = fe%mesh%surf_x
+         inp%bw = fe%mesh%surf_w
+         inp%bn = fe%mesh%surf_n
+         inp%bshape = fe%mesh%surf_shape
          inp%bc_kind = [bc_traction, bc_pressure, bc_symmetry, bc_symmetry]
          allocate (inp%bc_traction(3, 4), inp%bc_pressure(4))
          inp%bc_traction = 0.0_wp
          inp%bc_pressure = [0.0_wp, 1.0_wp, 0.0_wp, 0.0_wp]
       end associate
-      inside = [(pb%body%phi(fe%nodes%x(:, n)) <= 0.0_wp, n=1, fe%nodes%n_nodes)]
+      inside = [(pb%body%phi(fe%mesh%nodes%x(:, n)) <= 0.0_wp, n=1, fe%mesh%nodes%n_nodes)]
       do method = method_spr, method_sprc
-         call recover_grid(pb%input, fe%grid, fe%nodes, pb%hanging, method, 1, field, error)
+         call recover_grid(pb%input, fe%mesh%grid, fe%mesh%nodes, pb%hanging, method, 1, field, error)
          if (allocated(error)) return
          call estimate_error(pb%input, field, est(method), error, lame, inside)
          if (allocated(error)) return

@@ -166,7 +166,7 @@ contains
       call solve_on_grid(problem, body, [0.0_wp, 0.0_wp, 0.0_wp], 25.0_wp, 3, 0, 1, solid, young, poisson, &
          & [0.0_wp, 0.0_wp, 0.0_wp], bcs, error)
       if (allocated(error)) return
-      call krylov%set_blocks(problem%constraints%dof, problem%nodes%x(:, problem%constraints%master_node), error)
+      call krylov%set_blocks(problem%constraints%dof, problem%mesh%nodes%x(:, problem%constraints%master_node), error)
       if (allocated(error)) return
       tau = iteration_tolerance(0.5_wp**3, 1)
       krylov%tolerance = tau
@@ -206,7 +206,7 @@ contains
       call solve_on_grid(problem, body, [0.0_wp, 0.0_wp, 0.0_wp], 25.0_wp, 3, 0, 1, solid, young, poisson, &
          & [0.0_wp, 0.0_wp, 0.0_wp], bcs, error)
       if (allocated(error)) return
-      call krylov%set_blocks(problem%constraints%dof, problem%nodes%x(:, problem%constraints%master_node), error)
+      call krylov%set_blocks(problem%constraints%dof, problem%mesh%nodes%x(:, problem%constraints%master_node), error)
       if (allocated(error)) return
       krylov%max_iterations = 2
       krylov%tolerance = 1.0e-12_wp

@@ -186,7 +186,7 @@ contains
       if (allocated(error)) return
       call material_matrix(plane_strain, young, nu_inc, d, error)
       if (allocated(error)) return
-      nel = problem%grid%n_leaves
+      nel = problem%mesh%grid%n_leaves
       allocate (tr_bar(nel), tr_mean(maxval(problem%root)), vol(maxval(problem%root)))
       tr_mean = 0.0_wp
       vol = 0.0_wp

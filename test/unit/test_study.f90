@@ -136,10 +136,10 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer :: m
 
-      call check(error, x%grid%n_leaves == y%grid%n_leaves .and. x%problem%n_dofs() == y%problem%n_dofs(), &
-         & 'same cells and dofs')
+      call check(error, x%problem%mesh%grid%n_leaves == y%problem%mesh%grid%n_leaves .and. &
+         & x%problem%n_dofs() == y%problem%n_dofs(), 'same cells and dofs')
       if (allocated(error)) return
-      call check(error, all(x%nodes%x == y%nodes%x) .and. all(x%problem%u == y%problem%u), &
+      call check(error, all(x%problem%mesh%nodes%x == y%problem%mesh%nodes%x) .and. all(x%problem%u == y%problem%u), &
          & 'same nodes and displacements')
       if (allocated(error)) return
       call check(error, x%err_norm == y%err_norm .and. x%norm_exact == y%norm_exact .and. &

@@ -363,13 +363,13 @@ contains
       type(contact_surface_type), intent(in) :: surface
       type(elasticity_problem_type), intent(in) :: slave
       type(point_operators_type), intent(inout) :: ops
-      integer :: key(surface%npoint), group(slave%grid%n_leaves), cell_of_leaf(slave%grid%n_leaves)
-      integer :: fill(slave%grid%n_leaves), i, e, c, best, n_leaves, d
-      real(wp) :: measure(slave%grid%n_leaves), centroid(surface%dim, slave%grid%n_leaves), dist, best_dist
-      logical :: small(slave%grid%n_leaves)
-      integer :: macro(slave%grid%n_leaves)
+      integer :: key(surface%npoint), group(slave%mesh%grid%n_leaves), cell_of_leaf(slave%mesh%grid%n_leaves)
+      integer :: fill(slave%mesh%grid%n_leaves), i, e, c, best, n_leaves, d
+      real(wp) :: measure(slave%mesh%grid%n_leaves), centroid(surface%dim, slave%mesh%grid%n_leaves), dist, best_dist
+      logical :: small(slave%mesh%grid%n_leaves)
+      integer :: macro(slave%mesh%grid%n_leaves)
 
-      n_leaves = slave%grid%n_leaves
+      n_leaves = slave%mesh%grid%n_leaves
       d = surface%dim
       key = 0
       measure = 0.0_wp
@@ -450,8 +450,8 @@ contains
       macro = [(e, e=1, size(macro))]
       do i = 1, size(roots)
          do j = 1, i - 1
-            if (slave%grid%leaf_level(roots(j)) == slave%grid%leaf_level(roots(i)) .and. &
-               & all(slave%grid%leaf_coord(1:d, roots(j))/2 == slave%grid%leaf_coord(1:d, roots(i))/2)) then
+            if (slave%mesh%grid%leaf_level(roots(j)) == slave%mesh%grid%leaf_level(roots(i)) .and. &
+               & all(slave%mesh%grid%leaf_coord(1:d, roots(j))/2 == slave%mesh%grid%leaf_coord(1:d, roots(i))/2)) then
                macro(roots(i)) = macro(roots(j))
                exit
             end if
@@ -539,7 +539,7 @@ contains
       nd = d*problem%nen
       ns = problem%nstress
       allocate (dofs(nd*32), tmat(nd, nd*32))
-      call problem%constraints%element_map(problem%nodes%connectivity(:, e), dofs, tmat, m)
+      call problem%constraints%element_map(problem%mesh%nodes%connectivity(:, e), dofs, tmat, m)
       call problem%element_box(e, lo(1:d), hi(1:d))
       call shape_functions(d, problem%degree, lo(1:d), hi(1:d), x, sh, dndx)
       call strain_matrix(d, dndx, b)

@@ -4,18 +4,19 @@
 !>
 !> Use:
 !> ```
-!> call problem%setup(body, grid, nodes, hanging, quad, analysis, young, poisson, &
-!>                    body_force, bcs, error [, exact] [, eta] [, gamma])
+!> call mesh%build(body, box_min, box_size, level, refine_boundary, degree, error)
+!> call mesh%integrate(quad, error)
+!> call problem%setup(mesh, analysis, young, poisson, body_force, bcs, error [, exact] [, eta] [, gamma])
 !> call problem%solve(error)      ! = assemble, solve_reduced, set_solution(ubar)
 !> ! problem%u(dim, n_nodes), problem%stress_at(x, sigma, error),
 !> ! problem%element_points(e, x, w, sigma), problem%energy_error(...),
-!> ! problem%t_quadrature, t_assembly, t_solve
+!> ! problem%mesh (grid, nodes, cell rules), problem%t_assembly, t_solve
 !> ```
-!> The inputs are plain data: the body (geometry), its grid, Q`degree` nodes
-!> and hanging-node constraints built on that grid, the cut-cell quadrature
-!> settings, the material, a constant body force, boundary conditions by shape
-!> index (`sprc_fem_bc`) and optionally an exact solution (for exact_* kinds
-!> and for `energy_error`). The problem keeps copies of what it needs.
+!> The inputs are the body's cut mesh (`sprc_grid_cut_mesh`: body, grid,
+!> Q`degree` nodes, hanging-node constraints and cut-cell rules), which setup
+!> takes over without a copy (`move_alloc`), and plain data: the material, a
+!> constant body force, boundary conditions by shape index (`sprc_fem_bc`) and
+!> optionally an exact solution (for exact_* kinds and for `energy_error`).
 !>
 !> Formulation. Find u_h in V_h = {T ubar} with
 !>   a(u, v) + N(u, v) = l(v) for all v in V_h,
@@ -75,8 +76,8 @@ module sprc_fem_problem
    use sprc_grid_tree, only: grid_type
    use sprc_grid_nodes, only: grid_nodes_type
    use sprc_grid_hanging, only: hanging_type
-   use sprc_grid_quadrature, only: cut_quadrature_type, cell_rule_type, cell_rule, new_cut_quadrature, &
-      & default_points
+   use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature, default_points
+   use sprc_grid_cut_mesh, only: cut_mesh_type
    use sprc_exact_solution, only: exact_solution_type
    use sprc_fem_sparse, only: coo_type, csr_type
    use sprc_fem_cholmod, only: cholmod_solver_type
@@ -105,13 +106,6 @@ module sprc_fem_problem
    !> gives >= ~1e-7.
    real(wp), parameter :: rigid_tol = 1.0e-10_wp
 
-   !> Quadrature of one element while the rules are computed in parallel.
-   type :: rule_store_type
-      integer :: nvol = 0, nsurf = 0
-      real(wp), allocatable :: x(:, :), w(:), sx(:, :), sw(:), sn(:, :)
-      integer, allocatable :: ss(:)
-   end type rule_store_type
-
    !> The FE problem of one body (module notes).
    type :: elasticity_problem_type
       !> Dimension, element degree, analysis kind, Voigt size, nodes per element.
@@ -122,25 +116,17 @@ module sprc_fem_problem
       real(wp) :: body_force(3) = 0.0_wp
       !> Aggregation threshold and Nitsche penalty factor in use.
       real(wp) :: eta = 0.0_wp, gamma = 0.0_wp
-      type(grid_type) :: grid
-      type(grid_nodes_type) :: nodes
+      !> The cut mesh the problem is set up on (taken over from the caller by `setup`).
+      type(cut_mesh_type), allocatable :: mesh
       type(fe_bc_type), allocatable :: bcs(:)
       class(exact_solution_type), allocatable :: exact
       !> Condition index of each shape (0: free surface); shape symmetry imposed strongly.
       integer, allocatable :: bc_of_shape(:)
       logical, allocatable :: strong_shape(:)
-      !> Volume points of element e: vol_x(:, vol_ptr(e) : vol_ptr(e+1)-1), weights w|J| in vol_w.
-      integer, allocatable :: vol_ptr(:)
-      real(wp), allocatable :: vol_x(:, :), vol_w(:)
-      !> Surface points: coordinates, weights, unit outward normals, shape index.
-      integer, allocatable :: surf_ptr(:)
-      real(wp), allocatable :: surf_x(:, :), surf_w(:), surf_n(:, :)
-      integer, allocatable :: surf_shape(:)
-      !> Volume fraction of each element and its aggregation root (root(e) = e: well posed).
-      real(wp), allocatable :: fraction(:)
+      !> Aggregation root of each element (root(e) = e: well posed).
       integer, allocatable :: root(:)
-      !> Cut elements and aggregated (ill-posed) elements.
-      integer :: n_cut = 0, n_aggregated = 0
+      !> Aggregated (ill-posed) elements.
+      integer :: n_aggregated = 0
       !> u = T ubar.
       type(constraint_type) :: constraints
       !> Projected dilatation (B-bar) when active (`sprc_fem_dilatation`).
@@ -161,7 +147,7 @@ module sprc_fem_problem
       !> Reciprocal 1-norm condition estimate of the reduced stiffness (from the solver).
       real(wp) :: rcond = -1.0_wp
       !> Wall-clock seconds of the phases.
-      real(wp) :: t_quadrature = 0.0_wp, t_assembly = 0.0_wp, t_solve = 0.0_wp
+      real(wp) :: t_assembly = 0.0_wp, t_solve = 0.0_wp
    contains
       procedure :: setup => problem_setup
       procedure :: solve => problem_solve
@@ -223,11 +209,11 @@ contains
       end if
    end function gamma_note
 
-   !> Convenience: build the grid of `body` (uniform `level`, `refine_boundary`
-   !> extra levels on cut cells), its Q`degree` nodes and hanging constraints,
-   !> the cut quadrature (`points` per direction, default `default_points`),
-   !> then `setup` and `solve` the problem. `t_mesh` (optional) gets the grid,
-   !> node and constraint build time.
+   !> Convenience: build the cut mesh of `body` (uniform `level`,
+   !> `refine_boundary` extra levels on cut cells, Q`degree` nodes, hanging
+   !> constraints, cut quadrature with `points` per direction, default
+   !> `default_points`), then `setup` and `solve` the problem. `t_mesh`
+   !> (optional) gets the grid, node and constraint build time.
    subroutine solve_on_grid(problem, body, box_min, box_size, level, refine_boundary, degree, analysis, young, &
          & poisson, body_force, bcs, error, exact, points, eta, gamma, t_mesh, dilatation)
       type(elasticity_problem_type), intent(out) :: problem
@@ -242,43 +228,33 @@ contains
       real(wp), intent(in), optional :: eta, gamma
       real(wp), intent(out), optional :: t_mesh
       integer, intent(in), optional :: dilatation
-      type(grid_type) :: grid
-      type(grid_nodes_type) :: nodes
-      type(hanging_type) :: hanging
+      type(cut_mesh_type), allocatable :: mesh
       type(cut_quadrature_type) :: quad
-      type(timer_type) :: timer
       integer :: q
 
-      call timer%start()
-      call grid%build(body, body%dim, box_min, box_size, level, refine_boundary, error)
+      allocate (mesh)
+      call mesh%build(body, box_min, box_size, level, refine_boundary, degree, error)
       if (allocated(error)) return
-      call nodes%build(grid, degree, error)
-      if (allocated(error)) return
-      call hanging%build(grid, nodes, error)
-      if (allocated(error)) return
-      call timer%stop()
-      if (present(t_mesh)) t_mesh = timer%elapsed
+      if (present(t_mesh)) t_mesh = mesh%t_mesh
       q = default_points(degree)
       if (present(points)) q = points
       call new_cut_quadrature(quad, body%dim, q, error)
       if (allocated(error)) return
-      call problem%setup(body, grid, nodes, hanging, quad, analysis, young, poisson, body_force, bcs, error, &
-         & exact, eta, gamma, dilatation)
+      call mesh%integrate(quad, error)
+      if (allocated(error)) return
+      call problem%setup(mesh, analysis, young, poisson, body_force, bcs, error, exact, eta, gamma, dilatation)
       if (allocated(error)) return
       call problem%solve(error)
    end subroutine solve_on_grid
 
-   !> Prepare the problem: validate, integrate (t_quadrature), aggregate small
-   !> cells and build T (t_assembly). `body_force` has dim entries; `eta`
-   !> defaults to `default_eta`, `gamma` to `default_gamma(degree)`.
-   subroutine problem_setup(self, body, grid, nodes, hanging, quad, analysis, young, poisson, body_force, bcs, &
-         & error, exact, eta, gamma, dilatation)
+   !> Prepare the problem on `mesh` (built and integrated): validate, take the
+   !> mesh over (`mesh` is deallocated on return unless an input was refused),
+   !> aggregate small cells and build T (t_assembly). `body_force` has dim
+   !> entries; `eta` defaults to `default_eta`, `gamma` to `default_gamma(degree)`.
+   subroutine problem_setup(self, mesh, analysis, young, poisson, body_force, bcs, error, exact, eta, gamma, &
+         & dilatation)
       class(elasticity_problem_type), intent(out) :: self
-      type(body_type), intent(in) :: body
-      type(grid_type), intent(in) :: grid
-      type(grid_nodes_type), intent(in) :: nodes
-      type(hanging_type), intent(in) :: hanging
-      type(cut_quadrature_type), intent(in) :: quad
+      type(cut_mesh_type), allocatable, intent(inout) :: mesh
       integer, intent(in) :: analysis
       real(wp), intent(in) :: young, poisson, body_force(:)
       type(fe_bc_type), intent(in) :: bcs(:)
@@ -292,20 +268,25 @@ contains
       real(wp), allocatable :: plane_coord(:)
       integer :: i
 
-      call check_inputs(body, grid, nodes, hanging, quad, analysis, body_force, error)
+      if (.not. allocated(mesh)) then
+         call fatal_error(error, 'elasticity setup: no mesh was given', stat_invalid_input)
+         return
+      end if
+      call check_inputs(mesh%body, mesh%grid, mesh%nodes, mesh%hanging, mesh%quad, allocated(mesh%vol_ptr), analysis, &
+         & body_force, error)
       if (allocated(error)) return
-      call check_bcs(bcs, body%nshape, grid%dim, present(exact), error)
+      call check_bcs(bcs, mesh%body%nshape, mesh%grid%dim, present(exact), error)
       if (allocated(error)) return
       if (present(exact)) then
          call check_exact(exact, analysis, young, poisson, error)
          if (allocated(error)) return
          allocate (self%exact, source=exact)
       end if
-      self%dim = grid%dim
-      self%degree = nodes%degree
+      self%dim = mesh%grid%dim
+      self%degree = mesh%nodes%degree
       self%analysis = analysis
       self%nstress = voigt_size(analysis)
-      self%nen = nodes%nodes_per_element
+      self%nen = mesh%nodes%nodes_per_element
       self%young = young
       self%poisson = poisson
       call material_matrix(analysis, young, poisson, self%d(1:self%nstress, 1:self%nstress), error)
@@ -329,27 +310,19 @@ contains
          call fatal_error(error, 'elasticity setup: gamma must be finite and > 0', stat_invalid_input)
          return
       end if
-      call grid%copy(self%grid, error)
-      if (allocated(error)) return
-      call nodes%copy(self%nodes, error)
-      if (allocated(error)) return
+      call move_alloc(mesh, self%mesh)
       self%bcs = bcs
-      call classify_bcs(self, body, plane_axis, plane_coord)
+      call classify_bcs(self, plane_axis, plane_coord)
 
       call timer%start()
-      call integrate(self, body, quad, error)
-      call timer%stop()
-      self%t_quadrature = timer%elapsed
-      if (allocated(error)) return
-
-      call timer%reset()
-      call timer%start()
-      call aggregate_cells(grid, grid%leaf_class == cell_inside, self%fraction, self%eta, self%root, error)
-      if (.not. allocated(error)) then
-         self%n_aggregated = count(self%root /= [(i, i = 1, grid%n_leaves)])
-         call self%constraints%build(grid, nodes, hanging, self%root, plane_axis, plane_coord, &
-            & plane_tol(grid), error)
-      end if
+      associate (grid => self%mesh%grid)
+         call aggregate_cells(grid, grid%leaf_class == cell_inside, self%mesh%fraction, self%eta, self%root, error)
+         if (.not. allocated(error)) then
+            self%n_aggregated = count(self%root /= [(i, i = 1, grid%n_leaves)])
+            call self%constraints%build(grid, self%mesh%nodes, self%mesh%hanging, self%root, plane_axis, &
+               & plane_coord, plane_tol(grid), error)
+         end if
+      end associate
       if (.not. allocated(error)) call setup_dilatation(self, dilatation, error)
       call timer%stop()
       self%t_assembly = timer%elapsed
@@ -364,8 +337,8 @@ contains
       c = dilatation_auto
       if (present(choice)) c = choice
       if (.not. resolve_dilatation(c, self%analysis, self%poisson)) return
-      call self%dilatation%build(self%analysis, self%d(1:self%nstress, 1:self%nstress), self%degree, self%grid, &
-         & self%root, self%vol_ptr, self%vol_x, self%vol_w, error)
+      call self%dilatation%build(self%analysis, self%d(1:self%nstress, 1:self%nstress), self%degree, self%mesh%grid, &
+         & self%root, self%mesh%vol_ptr, self%mesh%vol_x, self%mesh%vol_w, error)
    end subroutine setup_dilatation
 
    pure real(wp) function plane_tol(grid)
@@ -373,12 +346,14 @@ contains
       plane_tol = 1.0e-12_wp*(grid%box_size + maxval(abs(grid%box_min)))
    end function plane_tol
 
-   subroutine check_inputs(body, grid, nodes, hanging, quad, analysis, body_force, error)
+   subroutine check_inputs(body, grid, nodes, hanging, quad, rules, analysis, body_force, error)
       type(body_type), intent(in) :: body
       type(grid_type), intent(in) :: grid
       type(grid_nodes_type), intent(in) :: nodes
       type(hanging_type), intent(in) :: hanging
       type(cut_quadrature_type), intent(in) :: quad
+      !> Whether the cut-cell rules were built.
+      logical, intent(in) :: rules
       integer, intent(in) :: analysis
       real(wp), intent(in) :: body_force(:)
       type(error_type), allocatable, intent(out) :: error
@@ -394,6 +369,9 @@ contains
          call fatal_error(error, 'elasticity setup: the nodes were not built on this grid', stat_invalid_input)
       else if (hanging%n_all /= nodes%n_nodes .or. .not. allocated(hanging%t_ptr)) then
          call fatal_error(error, 'elasticity setup: the hanging-node constraints were not built on these nodes', &
+            & stat_invalid_input)
+      else if (.not. rules) then
+         call fatal_error(error, 'elasticity setup: the cut-cell rules of the mesh were not built (mesh%integrate)', &
             & stat_invalid_input)
       else if (body%dim /= grid%dim .or. quad%dim /= grid%dim) then
          write (buf, '("elasticity setup: dimensions differ: grid ",i0,", body ",i0,", quadrature ",i0)') &
@@ -433,9 +411,8 @@ contains
 
    !> Condition of each shape, and the strong symmetry planes: a symmetry
    !> halfspace with an axis normal that no cell straddles.
-   subroutine classify_bcs(self, body, plane_axis, plane_coord)
+   subroutine classify_bcs(self, plane_axis, plane_coord)
       type(elasticity_problem_type), intent(inout) :: self
-      type(body_type), intent(in) :: body
       integer, allocatable, intent(out) :: plane_axis(:)
       real(wp), allocatable, intent(out) :: plane_coord(:)
       integer :: i, s, a, e, d
@@ -443,20 +420,21 @@ contains
       logical :: straddled
 
       d = self%dim
-      allocate (self%bc_of_shape(body%nshape), self%strong_shape(body%nshape), plane_axis(0), plane_coord(0))
+      allocate (self%bc_of_shape(self%mesh%body%nshape), self%strong_shape(self%mesh%body%nshape), plane_axis(0), &
+         & plane_coord(0))
       self%bc_of_shape = 0
       self%strong_shape = .false.
-      tol = plane_tol(self%grid)
+      tol = plane_tol(self%mesh%grid)
       do i = 1, size(self%bcs)
          s = self%bcs(i)%shape
          self%bc_of_shape(s) = i
-         if (self%bcs(i)%kind /= bc_symmetry .or. body%shapes(s)%kind /= shape_halfspace) cycle
-         a = maxloc(abs(body%shapes(s)%normal(1:d)), 1)
-         if (abs(abs(body%shapes(s)%normal(a)) - 1.0_wp) > 1.0e-12_wp) cycle
-         p = body%shapes(s)%point(a)
+         if (self%bcs(i)%kind /= bc_symmetry .or. self%mesh%body%shapes(s)%kind /= shape_halfspace) cycle
+         a = maxloc(abs(self%mesh%body%shapes(s)%normal(1:d)), 1)
+         if (abs(abs(self%mesh%body%shapes(s)%normal(a)) - 1.0_wp) > 1.0e-12_wp) cycle
+         p = self%mesh%body%shapes(s)%point(a)
          straddled = .false.
-         do e = 1, self%grid%n_leaves
-            call self%grid%leaf_box(e, lo(1:d), hi(1:d))
+         do e = 1, self%mesh%grid%n_leaves
+            call self%mesh%grid%leaf_box(e, lo(1:d), hi(1:d))
             if (lo(a) < p - tol .and. hi(a) > p + tol) then
                straddled = .true.
                exit
@@ -469,103 +447,6 @@ contains
       end do
    end subroutine classify_bcs
 
-   !> Cut-cell quadrature of every element (parallel, one rule object per
-   !> thread), concatenated in element order; volume fractions.
-   subroutine integrate(self, body, quad, error)
-      type(elasticity_problem_type), intent(inout) :: self
-      type(body_type), intent(in) :: body
-      type(cut_quadrature_type), intent(in) :: quad
-      type(error_type), allocatable, intent(out) :: error
-      type(rule_store_type), allocatable :: store(:)
-      type(cell_rule_type) :: rule
-      type(error_type), allocatable :: cell_error
-      logical, allocatable :: failed(:)
-      integer, allocatable :: stats(:)
-      integer :: e, n, d, nv, ns, iv, is, stat
-      real(wp) :: lo(3), hi(3)
-      character(len=*), parameter :: who = 'elasticity setup'
-
-      n = self%grid%n_leaves
-      d = self%dim
-      allocate (store(n), failed(n), stats(n), stat=stat)
-      call check_allocation(stat, who, 'the quadrature rule of each cell', n, storage_size(store)/8 + 8, error)
-      if (allocated(error)) return
-      failed = .false.
-      stats = 0
-      !$omp parallel do schedule(dynamic, 16) default(shared) private(e, rule, cell_error, lo, hi)
-      do e = 1, n
-         call self%grid%leaf_box(e, lo(1:d), hi(1:d))
-         call cell_rule(quad, body, lo(1:d), hi(1:d), rule, cell_error)
-         if (allocated(cell_error)) then
-            failed(e) = .true.
-            cycle
-         end if
-         call keep_rule(rule, d, store(e), stats(e))
-      end do
-      !$omp end parallel do
-      if (any(failed)) then
-         e = findloc(failed, .true., 1)
-         call self%grid%leaf_box(e, lo(1:d), hi(1:d))
-         call cell_rule(quad, body, lo(1:d), hi(1:d), rule, error)
-         return
-      end if
-      if (any(stats /= 0)) then
-         e = findloc(stats /= 0, .true., 1)
-         call check_allocation(stats(e), who, 'the quadrature points of cell '//itoa(e - 1)// &
-            & ' (coordinates, weights, normals)', store(e)%nvol*(d + 1) + store(e)%nsurf*(2*d + 1), 8, error)
-         return
-      end if
-
-      nv = sum(store%nvol)
-      ns = sum(store%nsurf)
-      allocate (self%vol_ptr(n + 1), self%surf_ptr(n + 1), self%fraction(n), stat=stat)
-      call check_allocation(stat, who, 'the quadrature pointers and volume fractions', n + 1, 16, error)
-      if (allocated(error)) return
-      allocate (self%vol_x(d, nv), self%vol_w(nv), stat=stat)
-      call check_allocation(stat, who, 'the volume quadrature points', nv, 8*(d + 1), error)
-      if (allocated(error)) return
-      allocate (self%surf_x(d, ns), self%surf_w(ns), self%surf_n(d, ns), self%surf_shape(ns), stat=stat)
-      call check_allocation(stat, who, 'the surface quadrature points', ns, 8*(2*d + 1) + 4, error)
-      if (allocated(error)) return
-      iv = 0
-      is = 0
-      do e = 1, n
-         self%vol_ptr(e) = iv + 1
-         self%surf_ptr(e) = is + 1
-         self%vol_x(:, iv + 1:iv + store(e)%nvol) = store(e)%x
-         self%vol_w(iv + 1:iv + store(e)%nvol) = store(e)%w
-         self%surf_x(:, is + 1:is + store(e)%nsurf) = store(e)%sx
-         self%surf_w(is + 1:is + store(e)%nsurf) = store(e)%sw
-         self%surf_n(:, is + 1:is + store(e)%nsurf) = store(e)%sn
-         self%surf_shape(is + 1:is + store(e)%nsurf) = store(e)%ss
-         iv = iv + store(e)%nvol
-         is = is + store(e)%nsurf
-         call self%grid%leaf_box(e, lo(1:d), hi(1:d))
-         self%fraction(e) = sum(store(e)%w)/product(hi(1:d) - lo(1:d))
-      end do
-      self%vol_ptr(n + 1) = iv + 1
-      self%surf_ptr(n + 1) = is + 1
-      self%n_cut = count(self%grid%leaf_class /= cell_inside)
-   end subroutine integrate
-
-   !> `store` = the points of `rule` (dimension d); `stat` nonzero when an array
-   !> could not be allocated (the points of all cells together grow with the grid).
-   pure subroutine keep_rule(rule, d, store, stat)
-      type(cell_rule_type), intent(in) :: rule
-      integer, intent(in) :: d
-      type(rule_store_type), intent(inout) :: store
-      integer, intent(out) :: stat
-
-      store%nvol = rule%nvol
-      store%nsurf = rule%nsurf
-      allocate (store%x, source=rule%vol_x(1:d, 1:rule%nvol), stat=stat)
-      if (stat == 0) allocate (store%w, source=rule%vol_w(1:rule%nvol), stat=stat)
-      if (stat == 0) allocate (store%sx, source=rule%surf_x(1:d, 1:rule%nsurf), stat=stat)
-      if (stat == 0) allocate (store%sw, source=rule%surf_w(1:rule%nsurf), stat=stat)
-      if (stat == 0) allocate (store%sn, source=rule%surf_n(1:d, 1:rule%nsurf), stat=stat)
-      if (stat == 0) allocate (store%ss, source=rule%surf_shape(1:rule%nsurf), stat=stat)
-   end subroutine keep_rule
-
    !> Number of reduced unknowns.
    pure integer function n_dofs(self)
       class(elasticity_problem_type), intent(in) :: self
@@ -577,7 +458,7 @@ contains
       class(elasticity_problem_type), intent(in) :: self
       integer, intent(in) :: e
       real(wp), intent(out) :: lo(:), hi(:)
-      call self%grid%leaf_box(e, lo, hi)
+      call self%mesh%grid%leaf_box(e, lo, hi)
    end subroutine element_box
 
    !> Assemble, solve and set the solution: `assemble`, `solve_reduced` and
@@ -659,8 +540,8 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer :: stat
       if (allocated(self%u)) deallocate (self%u)
-      allocate (self%u(self%dim, self%nodes%n_nodes), stat=stat)
-      call check_allocation(stat, 'elasticity solve', 'the nodal displacements', self%nodes%n_nodes, 8*self%dim, error)
+      allocate (self%u(self%dim, self%mesh%nodes%n_nodes), stat=stat)
+      call check_allocation(stat, 'elasticity solve', 'the nodal displacements', self%mesh%nodes%n_nodes, 8*self%dim, error)
       if (allocated(error)) return
       call self%constraints%expand(self%ubar, self%u)
       call dilatation_coefficients(self)
@@ -677,7 +558,7 @@ contains
       integer :: nel, nd, maxm, c0, c1, e, m, k0, saved_blas, stat
       character(len=*), parameter :: who = 'elasticity assembly'
 
-      nel = self%grid%n_leaves
+      nel = self%mesh%grid%n_leaves
       nd = self%dim*self%nen
       ! distinct reduced dofs of each element (bounds the buffers)
       allocate (mdof(nel), stat=stat)
@@ -688,7 +569,7 @@ contains
          real(wp), allocatable :: ttmp(:, :)
          allocate (dtmp(nd*32), ttmp(nd, nd*32))
          do e = 1, nel
-            call self%constraints%element_map(self%nodes%connectivity(:, e), dtmp, ttmp, mdof(e))
+            call self%constraints%element_map(self%mesh%nodes%connectivity(:, e), dtmp, ttmp, mdof(e))
          end do
       end block
       maxm = maxval(mdof)
@@ -783,7 +664,7 @@ contains
          do j = self%dilatation%ptr(a), self%dilatation%ptr(a + 1) - 1
             e = self%dilatation%member(j)
             call element_system(self, e, ke, fe, g, h, sv)
-            call self%constraints%element_map(self%nodes%connectivity(:, e), dofs, tmat, m)
+            call self%constraints%element_map(self%mesh%nodes%connectivity(:, e), dofs, tmat, m)
             svsum = svsum + sv
             do i = 1, m
                k = findloc(union(1:nu), dofs(i), 1)
@@ -831,7 +712,7 @@ contains
          if (self%dilatation%ptr(a + 1) - self%dilatation%ptr(a) == 1) &
             & call self%dilatation%add_aggregate_block(a, g, h, sv, ke, fe)
       end if
-      call self%constraints%element_map(self%nodes%connectivity(:, e), dofs, tmat, m)
+      call self%constraints%element_map(self%mesh%nodes%connectivity(:, e), dofs, tmat, m)
       if (m == 0) return
       call dgemm('N', 'N', nd, m, nd, 1.0_wp, ke, nd, tmat, nd, 0.0_wp, kt, nd)
       call dgemm('T', 'N', m, m, nd, 1.0_wp, tmat, nd, kt, nd, 0.0_wp, kr, m)
@@ -855,7 +736,7 @@ contains
       d = self%dim
       ns = self%nstress
       nd = d*self%nen
-      call self%grid%leaf_box(e, lo(1:d), hi(1:d))
+      call self%mesh%grid%leaf_box(e, lo(1:d), hi(1:d))
       h = minval(hi(1:d) - lo(1:d))
       pen = self%gamma*self%dmax/h
       ke = 0.0_wp
@@ -869,23 +750,23 @@ contains
          dmat = self%dilatation%d_dev
          a = self%dilatation%aggregate(e)
       end if
-      do q = self%vol_ptr(e), self%vol_ptr(e + 1) - 1
-         call shape_functions(d, self%degree, lo(1:d), hi(1:d), self%vol_x(:, q), n, dndx)
+      do q = self%mesh%vol_ptr(e), self%mesh%vol_ptr(e + 1) - 1
+         call shape_functions(d, self%degree, lo(1:d), hi(1:d), self%mesh%vol_x(:, q), n, dndx)
          call strain_matrix(d, dndx, b)
-         if (a > 0) call self%dilatation%add_moment(a, self%vol_x(:, q), self%vol_w(q), b, gm)
+         if (a > 0) call self%dilatation%add_moment(a, self%mesh%vol_x(:, q), self%mesh%vol_w(q), b, gm)
          db = matmul(dmat(1:ns, 1:ns), b)
-         call add_stiffness(b, db, self%vol_w(q), ke)
+         call add_stiffness(b, db, self%mesh%vol_w(q), ke)
          do c = 1, d
-            fe(c:nd:d) = fe(c:nd:d) + self%vol_w(q)*self%body_force(c)*n
+            fe(c:nd:d) = fe(c:nd:d) + self%mesh%vol_w(q)*self%body_force(c)*n
          end do
       end do
-      do q = self%surf_ptr(e), self%surf_ptr(e + 1) - 1
-         ib = self%bc_of_shape(self%surf_shape(q))
+      do q = self%mesh%surf_ptr(e), self%mesh%surf_ptr(e + 1) - 1
+         ib = self%bc_of_shape(self%mesh%surf_shape(q))
          kind = bc_free
          if (ib > 0) kind = self%bcs(ib)%kind
          if (kind == bc_free) cycle
-         if (kind == bc_symmetry .and. self%strong_shape(self%surf_shape(q))) cycle
-         associate (x => self%surf_x(:, q), nrm => self%surf_n(:, q), w => self%surf_w(q))
+         if (kind == bc_symmetry .and. self%strong_shape(self%mesh%surf_shape(q))) cycle
+         associate (x => self%mesh%surf_x(:, q), nrm => self%mesh%surf_n(:, q), w => self%mesh%surf_w(q))
             call shape_functions(d, self%degree, lo(1:d), hi(1:d), x, n, dndx)
             select case (kind)
             case (bc_pressure, bc_traction, bc_exact_traction)
@@ -1009,18 +890,18 @@ contains
 
       d = self%dim
       nm = merge(3, 6, d == 2)
-      xc(1:d) = self%grid%box_min(1:d) + 0.5_wp*self%grid%box_size
+      xc(1:d) = self%mesh%grid%box_min(1:d) + 0.5_wp*self%mesh%grid%box_size
       if (present(error)) then
-         allocate (field(d, self%nodes%n_nodes), r(self%constraints%n_dofs, nm), stat=stat)
+         allocate (field(d, self%mesh%nodes%n_nodes), r(self%constraints%n_dofs, nm), stat=stat)
          call check_allocation(stat, 'rigid_modes', 'the rigid-body motions (values)', &
-            & int(self%constraints%n_dofs, i8)*nm + int(self%nodes%n_nodes, i8)*d, 8, error)
+            & int(self%constraints%n_dofs, i8)*nm + int(self%mesh%nodes%n_nodes, i8)*d, 8, error)
          if (allocated(error)) return
       else
-         allocate (field(d, self%nodes%n_nodes), r(self%constraints%n_dofs, nm))
+         allocate (field(d, self%mesh%nodes%n_nodes), r(self%constraints%n_dofs, nm))
       end if
       do i = 1, nm
-         do j = 1, self%nodes%n_nodes
-            y(1:d) = (self%nodes%x(:, j) - xc(1:d))/self%grid%box_size
+         do j = 1, self%mesh%nodes%n_nodes
+            y(1:d) = (self%mesh%nodes%x(:, j) - xc(1:d))/self%mesh%grid%box_size
             field(:, j) = 0.0_wp
             if (i <= d) then
                field(i, j) = 1.0_wp
@@ -1154,9 +1035,9 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(petsc_solver_type) :: krylov
 
-      call krylov%set_blocks(self%constraints%dof, self%nodes%x(:, self%constraints%master_node), error)
+      call krylov%set_blocks(self%constraints%dof, self%mesh%nodes%x(:, self%constraints%master_node), error)
       if (allocated(error)) return
-      krylov%tolerance = iteration_tolerance(0.5_wp**self%grid%max_level, self%degree)
+      krylov%tolerance = iteration_tolerance(0.5_wp**self%mesh%grid%max_level, self%degree)
       self%solver_name = 'cg+gamg'
       self%solver_note = ''
       call solve_with(krylov, self%k, self%f, self%ubar, self%rcond, error)
@@ -1189,9 +1070,10 @@ contains
          gu = 0.0_wp
          do j = self%dilatation%ptr(a), self%dilatation%ptr(a + 1) - 1
             e = self%dilatation%member(j)
-            call self%grid%leaf_box(e, lo(1:d), hi(1:d))
+            call self%mesh%grid%leaf_box(e, lo(1:d), hi(1:d))
             call self%dilatation%element_moments(a, self%degree, lo(1:d), hi(1:d), &
-               & self%vol_x(:, self%vol_ptr(e):self%vol_ptr(e + 1) - 1), self%vol_w(self%vol_ptr(e):self%vol_ptr(e + 1) - 1), g)
+               & self%mesh%vol_x(:, self%mesh%vol_ptr(e):self%mesh%vol_ptr(e + 1) - 1), &
+               & self%mesh%vol_w(self%mesh%vol_ptr(e):self%mesh%vol_ptr(e + 1) - 1), g)
             call self%element_displacements(e, ue)
             gu = gu + matmul(ue, g)
          end do
@@ -1224,7 +1106,7 @@ contains
       real(wp), intent(out) :: ue(:)
       integer :: j
       do j = 1, self%nen
-         ue((j - 1)*self%dim + 1:j*self%dim) = self%u(:, self%nodes%connectivity(j, e))
+         ue((j - 1)*self%dim + 1:j*self%dim) = self%u(:, self%mesh%nodes%connectivity(j, e))
       end do
    end subroutine element_displacements
 
@@ -1237,7 +1119,7 @@ contains
       real(wp), intent(out) :: sigma(:)
       real(wp) :: ue(self%dim*self%nen), lo(3), hi(3), eps(6)
       call self%element_displacements(e, ue)
-      call self%grid%leaf_box(e, lo(1:self%dim), hi(1:self%dim))
+      call self%mesh%grid%leaf_box(e, lo(1:self%dim), hi(1:self%dim))
       if (self%dilatation%active) then
          call element_strain(self%dim, self%degree, lo(1:self%dim), hi(1:self%dim), x, ue, eps(1:self%nstress))
          call self%dilatation%projected_stress(e, x, eps(1:self%nstress), sigma)
@@ -1267,7 +1149,7 @@ contains
          call fatal_error(error, trim(buf), stat_invalid_input)
          return
       end if
-      e = self%grid%locate_point(x)
+      e = self%mesh%grid%locate_point(x)
       if (e == 0) then
          call fatal_error(error, 'stress_at: the point lies in no active element', stat_invalid_input)
          return
@@ -1283,13 +1165,13 @@ contains
       integer, intent(in) :: e
       real(wp), allocatable, intent(out) :: x(:, :), w(:), sigma(:, :)
       integer :: q, q0, q1
-      q0 = self%vol_ptr(e)
-      q1 = self%vol_ptr(e + 1) - 1
-      x = self%vol_x(:, q0:q1)
-      w = self%vol_w(q0:q1)
+      q0 = self%mesh%vol_ptr(e)
+      q1 = self%mesh%vol_ptr(e + 1) - 1
+      x = self%mesh%vol_x(:, q0:q1)
+      w = self%mesh%vol_w(q0:q1)
       allocate (sigma(self%nstress, q1 - q0 + 1))
       do q = q0, q1
-         call self%stress_in_element(e, self%vol_x(:, q), sigma(:, q - q0 + 1))
+         call self%stress_in_element(e, self%mesh%vol_x(:, q), sigma(:, q - q0 + 1))
       end do
    end subroutine element_points
 
@@ -1322,7 +1204,7 @@ contains
          return
       end if
       ns = self%nstress
-      nel = self%grid%n_leaves
+      nel = self%mesh%grid%n_leaves
       c = self%compliance
       allocate (parts(3, nel), element_error(nel), stat=stat)
       call check_allocation(stat, 'energy_error', 'the error of each element', nel, 32, error)
@@ -1330,13 +1212,13 @@ contains
       !$omp parallel do schedule(dynamic, 16) default(shared) private(e, q, sh, se, de)
       do e = 1, nel
          parts(:, e) = 0.0_wp
-         do q = self%vol_ptr(e), self%vol_ptr(e + 1) - 1
-            call self%stress_in_element(e, self%vol_x(:, q), sh(1:ns))
-            call self%exact%stress(self%vol_x(:, q), se(1:ns))
+         do q = self%mesh%vol_ptr(e), self%mesh%vol_ptr(e + 1) - 1
+            call self%stress_in_element(e, self%mesh%vol_x(:, q), sh(1:ns))
+            call self%exact%stress(self%mesh%vol_x(:, q), se(1:ns))
             de(1:ns) = se(1:ns) - sh(1:ns)
-            parts(1, e) = parts(1, e) + self%vol_w(q)*dot_product(de(1:ns), matmul(c(1:ns, 1:ns), de(1:ns)))
-            parts(2, e) = parts(2, e) + self%vol_w(q)*dot_product(sh(1:ns), matmul(c(1:ns, 1:ns), sh(1:ns)))
-            parts(3, e) = parts(3, e) + self%vol_w(q)*dot_product(se(1:ns), matmul(c(1:ns, 1:ns), se(1:ns)))
+            parts(1, e) = parts(1, e) + self%mesh%vol_w(q)*dot_product(de(1:ns), matmul(c(1:ns, 1:ns), de(1:ns)))
+            parts(2, e) = parts(2, e) + self%mesh%vol_w(q)*dot_product(sh(1:ns), matmul(c(1:ns, 1:ns), sh(1:ns)))
+            parts(3, e) = parts(3, e) + self%mesh%vol_w(q)*dot_product(se(1:ns), matmul(c(1:ns, 1:ns), se(1:ns)))
          end do
       end do
       !$omp end parallel do

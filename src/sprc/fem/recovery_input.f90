@@ -41,29 +41,29 @@ contains
       input%young = problem%young
       input%poisson = problem%poisson
       input%body_force(1:d) = problem%body_force(1:d)
-      nq = size(problem%vol_w)
-      nb = size(problem%surf_w)
+      nq = size(problem%mesh%vol_w)
+      nb = size(problem%mesh%surf_w)
       ns = problem%nstress
-      allocate (input%elem_ptr(size(problem%vol_ptr)), input%x(d, nq), input%w(nq), input%stress(ns, nq), stat=stat)
+      allocate (input%elem_ptr(size(problem%mesh%vol_ptr)), input%x(d, nq), input%w(nq), input%stress(ns, nq), stat=stat)
       call check_allocation(stat, who, 'the volume quadrature points and their stresses', nq, 8*(d + 1 + ns) + 4, error)
       if (allocated(error)) return
-      allocate (input%belem_ptr(size(problem%surf_ptr)), input%bx(d, nb), input%bw(nb), input%bn(d, nb), &
+      allocate (input%belem_ptr(size(problem%mesh%surf_ptr)), input%bx(d, nb), input%bw(nb), input%bn(d, nb), &
          & input%bshape(nb), stat=stat)
       call check_allocation(stat, who, 'the boundary quadrature points', nb, 8*(2*d + 1) + 8, error)
       if (allocated(error)) return
-      input%elem_ptr(:) = problem%vol_ptr
-      input%x(:, :) = problem%vol_x(1:d, :)
-      input%w(:) = problem%vol_w
-      do e = 1, problem%grid%n_leaves
-         do q = problem%vol_ptr(e), problem%vol_ptr(e + 1) - 1
-            call problem%stress_in_element(e, problem%vol_x(1:d, q), input%stress(:, q))
+      input%elem_ptr(:) = problem%mesh%vol_ptr
+      input%x(:, :) = problem%mesh%vol_x(1:d, :)
+      input%w(:) = problem%mesh%vol_w
+      do e = 1, problem%mesh%grid%n_leaves
+         do q = problem%mesh%vol_ptr(e), problem%mesh%vol_ptr(e + 1) - 1
+            call problem%stress_in_element(e, problem%mesh%vol_x(1:d, q), input%stress(:, q))
          end do
       end do
-      input%belem_ptr(:) = problem%surf_ptr
-      input%bx(:, :) = problem%surf_x(1:d, :)
-      input%bw(:) = problem%surf_w
-      input%bn(:, :) = problem%surf_n(1:d, :)
-      input%bshape(:) = problem%surf_shape
+      input%belem_ptr(:) = problem%mesh%surf_ptr
+      input%bx(:, :) = problem%mesh%surf_x(1:d, :)
+      input%bw(:) = problem%mesh%surf_w
+      input%bn(:, :) = problem%mesh%surf_n(1:d, :)
+      input%bshape(:) = problem%mesh%surf_shape
       call boundary_kinds(problem, input)
    end subroutine fe_recovery_input
 

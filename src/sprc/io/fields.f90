@@ -113,14 +113,14 @@ contains
       integer, allocatable :: cls(:, :)
       integer :: m, stat
 
-      call h5%write_level(level, bl%nodes%x, bl%nodes%connectivity, cell_type, error, body=body)
+      call h5%write_level(level, bl%problem%mesh%nodes%x, bl%problem%mesh%nodes%connectivity, cell_type, error, body=body)
       if (allocated(error)) return
       ! stress unit modulus*strain; energy norm sqrt(sigma D^-1 sigma): sqrt(modulus)*strain
       sunit = units%modulus*units%strain
       eunit = sqrt(units%modulus)*units%strain
       call h5%write_node_field(level, 'displacement', units%strain*bl%problem%u, error, body=body)
       if (allocated(error)) return
-      call nodal_fe_stress(bl%problem, bl%nodes, sigma_fe, error)
+      call nodal_fe_stress(bl%problem, bl%problem%mesh%nodes, sigma_fe, error)
       if (allocated(error)) return
       call write_stress('sigma_fe', sunit*sigma_fe, error)
       if (allocated(error)) return
@@ -137,10 +137,10 @@ contains
          call h5%write_cell_field(level, 'exact_error_fe', elem, error, body=body)
          if (allocated(error)) return
       end if
-      allocate (cls(1, bl%grid%n_leaves), stat=stat)
-      call check_allocation(stat, 'HDF5 fields', 'the cut flag of each cell', bl%grid%n_leaves, 4, error)
+      allocate (cls(1, bl%problem%mesh%grid%n_leaves), stat=stat)
+      call check_allocation(stat, 'HDF5 fields', 'the cut flag of each cell', bl%problem%mesh%grid%n_leaves, 4, error)
       if (allocated(error)) return
-      cls(1, :) = merge(1, 0, bl%grid%leaf_class(1:bl%grid%n_leaves) == cell_cut)
+      cls(1, :) = merge(1, 0, bl%problem%mesh%grid%leaf_class(1:bl%problem%mesh%grid%n_leaves) == cell_cut)
       call h5%write_cell_field(level, 'cut', cls, error, body=body)
    contains
       subroutine write_stress(name, values, error)

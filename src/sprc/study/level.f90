@@ -29,10 +29,9 @@ module sprc_study_level
    use sprc_core_blas_threads, only: blas_reserve_buffers
    use sprc_geometry_body, only: body_type
    use sprc_exact_solution, only: exact_solution_type
-   use sprc_grid_tree, only: grid_type
    use sprc_grid_nodes, only: grid_nodes_type
-   use sprc_grid_hanging, only: hanging_type
    use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature, default_points
+   use sprc_grid_cut_mesh, only: cut_mesh_type
    use sprc_grid_patches, only: recovery_input_type, recover_grid
    use sprc_grid_recovered_field, only: recovered_field_type, method_spr, method_sprc, field_eval
    use sprc_recovery_contact_operators, only: contact_traction
@@ -95,11 +94,9 @@ module sprc_study_level
       logical :: have_exact = .false.
    end type study_type
 
-   !> One body at one level.
+   !> One body at one level. Its cut mesh (grid, nodes, hanging-node
+   !> constraints, cell rules) is `problem%mesh`.
    type :: body_level_type
-      type(grid_type) :: grid
-      type(grid_nodes_type) :: nodes
-      type(hanging_type) :: hanging
       type(elasticity_problem_type) :: problem
       !> Recovered fields and estimates per method (1 SPR, 2 SPR-C), where run.
       type(recovered_field_type) :: field(2)
@@ -108,8 +105,6 @@ module sprc_study_level
       !> error per element (energy norm) of the FE stress.
       real(wp) :: err_norm = 0.0_wp, norm_exact = 0.0_wp
       real(wp), allocatable :: element_error(:)
-      !> Seconds to build the grid, nodes and constraints.
-      real(wp) :: t_mesh = 0.0_wp
       !> Factor taking this body's squared energy norms to those of the first
       !> body's units (a power of two; 1 for the first body), for the sums.
       real(wp) :: norm2_scale = 1.0_wp
@@ -239,7 +234,7 @@ contains
       t_contact = 0.0_wp
       if (size(study%scene%contacts) > 0) allocate (result%contacts(size(study%scene%contacts)))
       do k = 1, size(study%scene%contacts)
-         call run_contact(study, study%scene%contacts(k), quad, result%bodies, result%contacts(k), t_contact, error)
+         call run_contact(study, study%scene%contacts(k), result%bodies, result%contacts(k), t_contact, error)
          if (allocated(error)) return
       end do
       call sum_row(study, result, result%row)
@@ -266,30 +261,27 @@ contains
       type(body_level_type), intent(inout) :: bl
       logical, intent(in) :: in_contact
       type(error_type), allocatable, intent(out) :: error
-      type(timer_type) :: t_mesh
+      type(cut_mesh_type), allocatable :: mesh
 
       call check_level_memory(study%scene, sb%geometry, level, error)
       if (allocated(error)) return
-      call t_mesh%start()
-      call bl%grid%build(sb%geometry, study%dim, sb%box_min, sb%box_size, level, study%refine_boundary, error)
-      if (.not. allocated(error)) call bl%nodes%build(bl%grid, study%order, error)
-      if (.not. allocated(error)) call bl%hanging%build(bl%grid, bl%nodes, error)
-      call t_mesh%stop()
-      bl%t_mesh = t_mesh%elapsed
+      allocate (mesh)
+      call mesh%build(sb%geometry, sb%box_min, sb%box_size, level, study%refine_boundary, study%order, error)
       if (allocated(error)) return
-      if (any(study%run) .and. sum(bl%grid%n_inside) + sum(bl%grid%n_cut) < 2) then
+      if (any(study%run) .and. sum(mesh%grid%n_inside) + sum(mesh%grid%n_cut) < 2) then
          call fatal_error(error, 'one cell holds the whole body at this level, so every recovery patch is that '// &
             & 'one element: the recovered stress is the FE stress and the estimate (eta = 0) says nothing; '// &
             & 'use a higher level (or a smaller box_size)', stat_invalid_input)
          return
       end if
+      call mesh%integrate(quad, error)
+      if (allocated(error)) return
       if (allocated(sb%exact)) then
-         call bl%problem%setup(sb%geometry, bl%grid, bl%nodes, bl%hanging, quad, study%analysis, sb%young, &
-            & sb%poisson, sb%body_force, sb%bcs, error, exact=sb%exact, gamma=study%gamma, &
-            & dilatation=study%dilatation)
+         call bl%problem%setup(mesh, study%analysis, sb%young, sb%poisson, sb%body_force, sb%bcs, error, &
+            & exact=sb%exact, gamma=study%gamma, dilatation=study%dilatation)
       else
-         call bl%problem%setup(sb%geometry, bl%grid, bl%nodes, bl%hanging, quad, study%analysis, sb%young, &
-            & sb%poisson, sb%body_force, sb%bcs, error, gamma=study%gamma, dilatation=study%dilatation)
+         call bl%problem%setup(mesh, study%analysis, sb%young, sb%poisson, sb%body_force, sb%bcs, error, &
+            & gamma=study%gamma, dilatation=study%dilatation)
       end if
       if (allocated(error)) return
       if (in_contact) then
@@ -363,10 +355,9 @@ contains
    !> solve (sprc_contact_solve), then each body's errors and recoveries; the
    !> contact result in scene units. The block solves count in the slave
    !> body's t_solve; points, gaps and contact terms add to `t_contact`.
-   subroutine run_contact(study, spec, quad, bodies, result, t_contact, error)
+   subroutine run_contact(study, spec, bodies, result, t_contact, error)
       type(study_type), intent(in) :: study
       type(contact_spec_type), intent(in) :: spec
-      type(cut_quadrature_type), intent(in) :: quad
       type(body_level_type), intent(inout) :: bodies(:)
       type(contact_result_type), intent(out) :: result
       real(wp), intent(inout) :: t_contact
@@ -380,11 +371,13 @@ contains
       s = spec%slave_index
       m = spec%master_index
       call timer%start()
-      call slave_surface_points(surface, bodies(s)%grid, study%bodies(s)%geometry, quad, &
-         & study%scene%shapes(spec%slave_surface_index)%body_shape, error, split_grid=bodies(m)%grid)
-      if (.not. allocated(error)) call initial_gaps(surface, study%bodies(m)%geometry, &
-         & study%scene%shapes(spec%master_surface_index)%body_shape, bodies(m)%grid, &
-         & max(study%bodies(s)%box_size, study%bodies(m)%box_size), error)
+      associate (slave => bodies(s)%problem%mesh, master => bodies(m)%problem%mesh)
+         call slave_surface_points(surface, slave%grid, slave%body, slave%quad, &
+            & study%scene%shapes(spec%slave_surface_index)%body_shape, error, split_grid=master%grid)
+         if (.not. allocated(error)) call initial_gaps(surface, master%body, &
+            & study%scene%shapes(spec%master_surface_index)%body_shape, master%grid, &
+            & max(study%bodies(s)%box_size, study%bodies(m)%box_size), error)
+      end associate
       call timer%stop()
       if (allocated(error)) then
          error%message = "&contact '"//spec%slave//"' on '"//spec%master//"': "//error%message
@@ -553,11 +546,13 @@ contains
 
       method = merge(method_spr, method_sprc, m == 1)
       if (allocated(sb%exact)) then
-         call recover_grid(input, bl%grid, bl%nodes, bl%hanging, method, degree, bl%field(m), error, exact=sb%exact)
+         call recover_grid(input, bl%problem%mesh%grid, bl%problem%mesh%nodes, bl%problem%mesh%hanging, method, &
+            & degree, bl%field(m), error, exact=sb%exact)
          if (allocated(error)) return
          call estimate_error(input, bl%field(m), bl%est(m), error, exact=sb%exact)
       else
-         call recover_grid(input, bl%grid, bl%nodes, bl%hanging, method, degree, bl%field(m), error)
+         call recover_grid(input, bl%problem%mesh%grid, bl%problem%mesh%nodes, bl%problem%mesh%hanging, method, &
+            & degree, bl%field(m), error)
          if (allocated(error)) return
          call estimate_error(input, bl%field(m), bl%est(m), error)
       end if
@@ -583,11 +578,11 @@ contains
       row%t_solve = 0.0_wp
       do b = 1, size(result%bodies)
          associate (bl => result%bodies(b))
-            row%elements = row%elements + int(bl%grid%n_leaves, i8)
-            row%cut_elements = row%cut_elements + sum(bl%grid%n_cut)
+            row%elements = row%elements + int(bl%problem%mesh%grid%n_leaves, i8)
+            row%cut_elements = row%cut_elements + sum(bl%problem%mesh%grid%n_cut)
             row%dofs = row%dofs + int(bl%problem%n_dofs(), i8)
-            row%t_mesh = row%t_mesh + bl%t_mesh
-            row%t_quadrature = row%t_quadrature + bl%problem%t_quadrature
+            row%t_mesh = row%t_mesh + bl%problem%mesh%t_mesh
+            row%t_quadrature = row%t_quadrature + bl%problem%mesh%t_quadrature
             row%t_assembly = row%t_assembly + bl%problem%t_assembly
             row%t_solve = row%t_solve + bl%problem%t_solve
             row%solver_iterations = row%solver_iterations + bl%problem%solver_iterations
