@@ -160,6 +160,12 @@ contains
       if (allocated(error)) return
       ! The slave (shaft = inner) normal at (c, 0) is +x.
       call check(error, pressure%pressure(x, [1.0_wp, 0.0_wp]), p_c, roundoff, 'exact contact pressure', rel=.true.)
+      if (allocated(error)) return
+      ! The slave points of an interference fit lie at r = c + delta, off the
+      ! closed form's interface; the pressure there is still p_c.
+      x = scene%exact%center + (c + 10.0_wp*scene%exact%interference)*[0.6_wp, 0.8_wp]
+      call check(error, pressure%pressure(x, [0.6_wp, 0.8_wp]), p_c, roundoff, &
+         & 'exact contact pressure at a slave point off the interface', rel=.true.)
    end subroutine check_compound
 
    !> Issue 11's ring pair, one material (E, nu = 0.3), p_in = 0, in `analysis`.

@@ -38,26 +38,44 @@ module sprc_exact_pressure
    !> p = -n.sigma(x).n from the slave body's exact stress field.
    type, extends(exact_pressure_type) :: field_pressure_type
       class(exact_solution_type), allocatable :: field
+      !> When `radius` > 0, x is first moved radially onto the sphere (circle) of
+      !> that radius about `center`: a closed form with an interference models
+      !> both surfaces at one radius, while the slave points lie at r_contact +
+      !> delta; evaluating there would extrapolate the ring's field by
+      !> delta*dsigma_rr/dr (0.5 % of p_c for a stiff hub).
+      real(wp) :: center(3) = 0.0_wp, radius = 0.0_wp
    contains
       procedure :: pressure => field_pressure
    end type field_pressure_type
 
 contains
 
-   !> Wrap the slave body's exact solution (a copy is kept).
-   pure subroutine new_field_pressure(self, field)
+   !> Wrap the slave body's exact solution (a copy is kept); `center` and
+   !> `radius` name the interface the field is evaluated on (see the type).
+   pure subroutine new_field_pressure(self, field, center, radius)
       type(field_pressure_type), intent(out) :: self
       class(exact_solution_type), intent(in) :: field
+      real(wp), intent(in), optional :: center(:), radius
       self%dim = field%dim
       allocate (self%field, source=field)
+      if (present(center) .and. present(radius)) then
+         self%center(1:self%dim) = center(1:self%dim)
+         self%radius = radius
+      end if
    end subroutine new_field_pressure
 
    pure real(wp) function field_pressure(self, x, n)
       class(field_pressure_type), intent(in) :: self
       real(wp), intent(in) :: x(:), n(:)
-      real(wp) :: t(3)
+      real(wp) :: t(3), y(3), r
 
-      call self%field%traction(x, n, t(1:self%dim))
+      y(1:self%dim) = x(1:self%dim)
+      if (self%radius > 0.0_wp) then
+         y(1:self%dim) = x(1:self%dim) - self%center(1:self%dim)
+         r = norm2(y(1:self%dim))
+         if (r > 0.0_wp) y(1:self%dim) = self%center(1:self%dim) + (self%radius/r)*y(1:self%dim)
+      end if
+      call self%field%traction(y(1:self%dim), n, t(1:self%dim))
       field_pressure = -dot_product(n(1:self%dim), t(1:self%dim))
    end function field_pressure
 

@@ -467,7 +467,8 @@ contains
    !> The exact contact pressure on the slave surface of `&contact` pair `k`,
    !> in the units of `scene` (the scene's own for a contact result): hertz_*
    !> from the closed form with E* of the pair's two bodies; every other kind
-   !> from the slave body's exact field (p = -n.sigma.n). Not allocated
+   !> from the slave body's exact field (p = -n.sigma.n; compound_* on the
+   !> interface r = r_contact, where their closed form puts both surfaces). Not allocated
    !> without `&exact` or when the slave body has no exact field (a compound
    !> scene's third body).
    subroutine build_exact_pressure(scene, k, pressure, error)
@@ -495,7 +496,11 @@ contains
          case default
             call build_exact(scene, scene%contacts(k)%slave_index, field, error)
             if (allocated(error) .or. .not. allocated(field)) return
-            call new_field_pressure(from_field, field)
+            if (spec%kind == 'compound_cylinder' .or. spec%kind == 'compound_sphere') then
+               call new_field_pressure(from_field, field, spec%center, spec%r_contact)
+            else
+               call new_field_pressure(from_field, field)
+            end if
             allocate (pressure, source=from_field)
             return
          end select
