@@ -74,20 +74,39 @@
 !> naming the body (stat_singular).
 !>
 !> Friction: 'frictionless' and 'stick' (the closed zone tied: the vector
-!> gap) are symmetric. 'coulomb': the vector multiplier of a cell less its
-!> slip s_c (history), lambda_c = tbar + gamma (gbar - s_c), split along the
-!> cell's mean normal nbar into lambda_n and lambda_t; a closed cell sticks
-!> (the stick terms with the gap shifted by s_c) while |lambda_t| <= mu
-!> (-lambda_n), else it slips along tau = lambda_t/|lambda_t|: the normal
-!> terms plus the friction traction lambda_t = -mu lambda_n tau, whose
-!> linearization -mu W (gbar^T tau)(nbar^T (tbar + gamma gbar)) makes the
-!> system unsymmetric (UMFPACK). The load path comes in increments (`&bc
-!> stage` and `&contact steps`, the caller's `loads`); in each the states
-!> and slip directions are iterated until they repeat (directions within
-!> `direction_tol`), then the slips are updated: a slipping cell's so that
-!> its trial traction is the friction traction, an open cell's to its
-!> current tangential position. The rigid-mode check uses the system
-!> without the friction terms.
+!> gap) are symmetric. With stick and Coulomb the cell's normal nbar is the
+!> mean of the bisectors n_s - n_m of the two surfaces' normals (the contact
+!> plane, the same whichever body is the slave), and the initial vector gap
+!> of a point is g0 (n_s.n_m) n_m, its distance to the master's tangent plane
+!> along the master normal: the surfaces close along the common normal. Along
+!> the slave normal instead, a curved slave (a roller, n_s tilted by x/R from
+!> the flat master's normal) got a spurious tangential gap g0 x/R and a
+!> tangential traction p x/R from the normal load alone, O(a/R) but
+!> tangential tractions up to mu p at the contact edges, absent from the
+!> half-space theory (Cattaneo-Mindlin). 'coulomb': the vector multiplier of
+!> a cell less its slip s_c (history), lambda_c = tbar + gamma (gbar - s_c),
+!> split along nbar into lambda_n and lambda_t; a closed cell sticks (the
+!> stick terms with the gap shifted by s_c) while |lambda_t| <= mu
+!> (-lambda_n), else it slips along tau = lambda_t/|lambda_t| with the
+!> friction traction lambda_t = -mu lambda_n tau. A slipping cell's terms are
+!> the second variation of the cell energy with that lambda_t held:
+!>   W [lambda.gbar - 1/(2 gamma) |lambda - pbar|^2] - variance,
+!> the normal terms, the friction work and its stabilization (lambda_t -
+!> tt)/gamma . dtt (tt = tau.tbar u; without it the FE tangential traction
+!> of a slipping cell was free and the trial lambda_t jumped between the
+!> states), whose linearization -mu W (gt + tt/gamma)(nbar^T (tbar + gamma
+!> gbar)) makes the system unsymmetric (UMFPACK). The load path comes in
+!> increments (`&bc stage` and `&contact steps`, the caller's `loads`); in
+!> each the states and slip directions are iterated until they repeat
+!> (directions within `direction_tol`), then the slips are updated: a
+!> slipping cell's so that its trial traction is the friction traction, an
+!> open cell's to its current tangential position. A slipping cell whose
+!> trial turns against its slip direction sticks (`coulomb_states`): the
+!> trial is continuous in the friction traction, which cannot go from mu p
+!> tau to -mu p tau without crossing the stick range; sending it to the
+!> opposite slip instead made edge cells of small pressure flip between the
+!> two directions for ever (a roller under a normal then a tangential load).
+!> The rigid-mode check uses the system without the friction terms.
 module sprc_contact_solve
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_not_converged, stat_singular, &
@@ -158,6 +177,8 @@ module sprc_contact_solve
       real(wp), allocatable :: gap(:)
       !> Contact pressure p = -lambda_n (0 open) and |lambda_t| (module notes).
       real(wp), allocatable :: pressure(:), tangential(:)
+      !> The tangential traction lambda_t on the slave body itself (dim, npoint; 0 open or frictionless).
+      real(wp), allocatable :: traction_t(:, :)
       !> nbar.lambda_c of every contact cell: negative where the cell carries
       !> compression when closed.
       real(wp), allocatable :: lambda_n(:)
@@ -207,7 +228,7 @@ contains
       real(wp), allocatable :: f(:), x(:)
       logical, allocatable :: closed(:), next(:)
       integer, allocatable :: state(:)
-      real(wp), allocatable :: slip(:, :)
+      real(wp), allocatable :: slip(:, :), tau(:, :)
       integer :: it, maxit, n, c, switched
 
       call check_pair(slave, master, surface, friction, kappa, error)
@@ -232,14 +253,14 @@ contains
             return
          end if
          if (present(loads)) then
-            call solve_coulomb(slave, master, ops, cells, closed, mu, loads, names, maxit, x, sol, state, slip, error)
+            call solve_coulomb(slave, master, ops, cells, closed, mu, loads, names, maxit, x, sol, state, tau, slip, error)
          else
             call solve_coulomb(slave, master, ops, cells, closed, mu, reshape([slave%f, master%f], [n, 1]), names, &
-               & maxit, x, sol, state, slip, error)
+               & maxit, x, sol, state, tau, slip, error)
          end if
          if (allocated(error)) return
          call point_gaps(surface, ops, ops%ncell, x, sol)
-         call coulomb_output(ops, cells, mu, state, slip, x, sol)
+         call coulomb_output(ops, cells, mu, state, tau, slip, x, sol)
       end if
       do it = 1, merge(0, maxit, friction == friction_coulomb)
          sol%iterations = it
@@ -499,7 +520,8 @@ contains
          if (friction == friction_stick) then
             g(:, pos) = ops%gop(:, q0:q1)
             cell%tdev(:, pos, j) = ops%top(:, q0:q1)
-            cell%g0bar = cell%g0bar + surface%weight(i)*surface%g0(i)*nrm
+            cell%g0bar = cell%g0bar + surface%weight(i)*surface%g0(i)*dot_product(nrm, surface%master_normal(:, i))* &
+               & surface%master_normal(:, i)
          else
             g(1, pos) = matmul(nrm, ops%gop(:, q0:q1))
             cell%tdev(1, pos, j) = matmul(nrm, ops%top(:, q0:q1))
@@ -510,7 +532,13 @@ contains
          cell%tbar = cell%tbar + surface%weight(i)*cell%tdev(:, :, j)
       end do
       cell%measure = sum(cell%w)
-      cell%nbar = matmul(surface%normal(:, ops%cell_point(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1)), cell%w)
+      associate (pts => ops%cell_point(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1))
+         if (friction == friction_stick) then
+            cell%nbar = matmul(surface%normal(:, pts) - surface%master_normal(:, pts), cell%w)
+         else
+            cell%nbar = matmul(surface%normal(:, pts), cell%w)
+         end if
+      end associate
       cell%nbar = cell%nbar/norm2(cell%nbar)
       cell%gbar = cell%gbar/cell%measure
       cell%tbar = cell%tbar/cell%measure
@@ -595,13 +623,22 @@ contains
       type(cell_operators_type), intent(in) :: cell
       real(wp), intent(in) :: gamma
       real(wp), allocatable, intent(out) :: kc(:, :)
-      integer :: j
       kc = cell%measure*(matmul(transpose(cell%tbar), cell%gbar) + matmul(transpose(cell%gbar), cell%tbar) &
          & + gamma*matmul(transpose(cell%gbar), cell%gbar))
+      call add_variance(cell, gamma, kc)
+   end subroutine tied_block
+
+   !> The stabilization's variance term of a closed cell, -1/gamma sum_i w_i
+   !> dT_i^T dT_i over every row of the cell's operators (module notes).
+   pure subroutine add_variance(cell, gamma, kc)
+      type(cell_operators_type), intent(in) :: cell
+      real(wp), intent(in) :: gamma
+      real(wp), intent(inout) :: kc(:, :)
+      integer :: j
       do j = 1, size(cell%w)
          kc = kc - (cell%w(j)/gamma)*matmul(transpose(cell%tdev(:, :, j)), cell%tdev(:, :, j))
       end do
-   end subroutine tied_block
+   end subroutine add_variance
 
    !> Add the entries of a (rows and columns shifted by `shift`) to coo.
    subroutine add_csr(coo, a, shift, error)
@@ -624,7 +661,7 @@ contains
    !> an iteration on the cells' states (open, stick, slip) and slip
    !> directions, solved with UMFPACK (the slip terms are unsymmetric); the
    !> slip of each cell is history.
-   subroutine solve_coulomb(slave, master, ops, cells, closed, mu, loads, names, maxit, x, sol, state, slip, error)
+   subroutine solve_coulomb(slave, master, ops, cells, closed, mu, loads, names, maxit, x, sol, state, tau, slip, error)
       type(elasticity_problem_type), intent(in) :: slave, master
       type(point_operators_type), intent(in) :: ops
       type(cell_operators_type), intent(in) :: cells(:)
@@ -634,13 +671,13 @@ contains
       integer, intent(in) :: maxit
       real(wp), intent(inout) :: x(:)
       type(contact_solution_type), intent(inout) :: sol
-      !> Final state of each cell and its slip (history).
+      !> Final state of each cell, its slip direction (slipping cells) and its slip (history).
       integer, allocatable, intent(out) :: state(:)
-      real(wp), allocatable, intent(out) :: slip(:, :)
+      real(wp), allocatable, intent(out) :: tau(:, :), slip(:, :)
       type(error_type), allocatable, intent(out) :: error
       type(csr_type) :: k
       type(timer_type) :: timer
-      real(wp), allocatable :: tau(:, :), tau_new(:, :), f(:)
+      real(wp), allocatable :: tau_new(:, :), f(:)
       integer, allocatable :: state_new(:)
       integer :: n, it, c, d, changed
 
@@ -666,7 +703,7 @@ contains
             call timer%stop()
             sol%t_solve = sol%t_solve + timer%elapsed
             if (allocated(error)) return
-            call coulomb_states(ops, cells, mu, slip, x, state_new, tau_new)
+            call coulomb_states(ops, cells, mu, slip, x, state, tau, state_new, tau_new)
             changed = count(state_new /= state)
             do c = 1, size(cells)
                if (state_new(c) == contact_slip .and. state(c) == contact_slip) then
@@ -701,9 +738,9 @@ contains
       real(wp), allocatable, intent(out) :: f(:)
       type(error_type), allocatable, intent(out) :: error
       type(coo_type) :: coo
-      real(wp), allocatable :: kc(:, :), gn(:), tn(:), gt(:)
+      real(wp), allocatable :: kc(:, :), gn(:), tn(:), gt(:), tt(:)
       integer(i8) :: capacity
-      integer :: ns, c, j
+      integer :: ns, c
 
       ns = slave%n_dofs()
       capacity = slave%k%nnz() + master%k%nnz()
@@ -726,11 +763,11 @@ contains
                gn = matmul(nb, cell%gbar)
                tn = matmul(nb, cell%tbar)
                gt = matmul(tau(:, c), cell%gbar)
-               kc = cell%measure*(outer(tn, gn) + outer(gn, tn) + gamma*outer(gn, gn) - mu*outer(gt, tn + gamma*gn))
-               do j = 1, size(cell%w)
-                  kc = kc - (cell%w(j)/gamma)*outer(matmul(nb, cell%tdev(:, :, j)), matmul(nb, cell%tdev(:, :, j)))
-               end do
-               f(cell%dofs) = f(cell%dofs) - cell%measure*dot_product(nb, cell%g0bar)*(tn + gamma*gn - mu*gamma*gt)
+               tt = matmul(tau(:, c), cell%tbar)
+               kc = cell%measure*(outer(tn, gn) + outer(gn, tn) + gamma*outer(gn, gn) - outer(tt, tt)/gamma &
+                  & - mu*outer(gt + tt/gamma, tn + gamma*gn))
+               call add_variance(cell, gamma, kc)
+               f(cell%dofs) = f(cell%dofs) - cell%measure*dot_product(nb, cell%g0bar)*(tn + gamma*gn - mu*(gamma*gt + tt))
             end if
             call coo%add(cell%dofs, kc, error)
             if (allocated(error)) return
@@ -762,11 +799,16 @@ contains
    end subroutine cell_multiplier
 
    !> Trial states: open where lambda_n >= 0, stick where |lambda_t| <= mu
-   !> (-lambda_n), else slip along tau = lambda_t/|lambda_t|.
-   pure subroutine coulomb_states(ops, cells, mu, slip, x, state, tau)
+   !> (-lambda_n), else slip along tau = lambda_t/|lambda_t|; but a cell that
+   !> slipped along tau_old and whose trial now points against it (tau .
+   !> tau_old < 0) sticks: its friction traction cannot pass from mu p tau_old
+   !> to -mu p tau_old without crossing the stick range, where the trial,
+   !> continuous in the friction traction, changes sign (module notes).
+   pure subroutine coulomb_states(ops, cells, mu, slip, x, state_old, tau_old, state, tau)
       type(point_operators_type), intent(in) :: ops
       type(cell_operators_type), intent(in) :: cells(:)
-      real(wp), intent(in) :: mu, slip(:, :), x(:)
+      real(wp), intent(in) :: mu, slip(:, :), x(:), tau_old(:, :)
+      integer, intent(in) :: state_old(:)
       integer, intent(out) :: state(:)
       real(wp), intent(out) :: tau(:, :)
       real(wp) :: lam_n, lam_t(size(slip, 1))
@@ -777,6 +819,8 @@ contains
          if (lam_n >= 0.0_wp) then
             state(c) = contact_open
          else if (norm2(lam_t) <= -mu*lam_n) then
+            state(c) = contact_stick
+         else if (state_old(c) == contact_slip .and. dot_product(lam_t, tau_old(:, c)) < 0.0_wp) then
             state(c) = contact_stick
          else
             state(c) = contact_slip
@@ -809,10 +853,10 @@ contains
    end subroutine update_slip
 
    !> Per point: closed, slipping, pressure and tangential traction of its cell.
-   subroutine coulomb_output(ops, cells, mu, state, slip, x, sol)
+   subroutine coulomb_output(ops, cells, mu, state, tau, slip, x, sol)
       type(point_operators_type), intent(in) :: ops
       type(cell_operators_type), intent(in) :: cells(:)
-      real(wp), intent(in) :: mu, slip(:, :), x(:)
+      real(wp), intent(in) :: mu, tau(:, :), slip(:, :), x(:)
       integer, intent(in) :: state(:)
       type(contact_solution_type), intent(inout) :: sol
       real(wp) :: lam_n, lam_t(size(slip, 1))
@@ -829,7 +873,9 @@ contains
             sol%tangential(i) = 0.0_wp
             if (state(c) == contact_open) cycle
             sol%pressure(i) = -lam_n
-            sol%tangential(i) = merge(-mu*lam_n, norm2(lam_t), state(c) == contact_slip)
+            if (state(c) == contact_slip) lam_t = -mu*lam_n*tau(:, c)
+            sol%traction_t(:, i) = lam_t
+            sol%tangential(i) = norm2(lam_t)
          end do
       end do
    end subroutine coulomb_output
@@ -915,10 +961,11 @@ contains
 
       if (.not. allocated(sol%gap)) allocate (sol%gap(surface%npoint), sol%pressure(surface%npoint), &
          & sol%tangential(surface%npoint), sol%lambda_n(ncell), sol%closed(surface%npoint), &
-         & sol%slipping(surface%npoint))
+         & sol%slipping(surface%npoint), sol%traction_t(surface%dim, surface%npoint))
       sol%gap = huge(1.0_wp)
       sol%pressure = 0.0_wp
       sol%tangential = 0.0_wp
+      sol%traction_t = 0.0_wp
       sol%closed = .false.
       sol%slipping = .false.
       do i = 1, surface%npoint
@@ -960,7 +1007,8 @@ contains
                   sol%pressure(i) = -lam(1)
                else
                   sol%pressure(i) = -dot_product(lam, nrm)
-                  sol%tangential(i) = norm2(lam - dot_product(lam, nrm)*nrm)
+                  sol%traction_t(:, i) = lam - dot_product(lam, nrm)*nrm
+                  sol%tangential(i) = norm2(sol%traction_t(:, i))
                end if
             end do
          end associate
