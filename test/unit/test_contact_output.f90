@@ -43,7 +43,9 @@ contains
    subroutine test_csv_read_back(error)
       type(error_type), allocatable, intent(out) :: error
       character(len=*), parameter :: path = dir//'test_contact.csv'
-      character(len=*), parameter :: contract = 'level,x,y,z,weight,gap,state,p_fe,p_spr,p_sprc,p_exact,ts_fe,ts_sprc'
+      ! SCENE.md's columns, then the trailing signed tangential traction (an extension).
+      character(len=*), parameter :: contract = 'level,x,y,z,weight,gap,state,p_fe,p_spr,p_sprc,p_exact,ts_fe,ts_sprc,'// &
+         & 'tx_fe,ty_fe,tz_fe'
       type(contact_level_type) :: levels(2)
       character(len=:), allocatable :: text
       character(len=400) :: lines(10)
@@ -53,6 +55,7 @@ contains
       levels(2) = contact_level_type(4, contact_sample())
       levels(2)%contacts(1)%gap(1) = 1.0_wp/3.0_wp
       levels(2)%contacts(1)%ts_sprc = [0.1_wp, tiny(1.0_wp)/3.0_wp, -0.0_wp]
+      levels(2)%contacts(1)%t_fe(:, 1) = [0.25_wp, -1.0_wp/3.0_wp]
       call write_contact_csv(path, levels, error)
       if (allocated(error)) return
       call read_text_file(path, text, error)
@@ -88,7 +91,7 @@ contains
       integer :: j
 
       where = 'line of level '//itoa(level)//' point '//itoa(i)//': '
-      call check(error, count_sub(line, ','), 12, where//'13 cells')
+      call check(error, count_sub(line, ','), 15, where//'16 cells')
       if (allocated(error)) return
       call check(error, cell_of(line, 1), itoa(level), where//'level')
       if (allocated(error)) return
@@ -117,6 +120,12 @@ contains
       call check_cell(cell_of(line, 12), c%ts_fe(i), where//'ts_fe', error)
       if (allocated(error)) return
       call check_cell(cell_of(line, 13), c%ts_sprc(i), where//'ts_sprc', error)
+      do j = 1, c%dim
+         if (allocated(error)) return
+         call check_cell(cell_of(line, 13 + j), c%t_fe(j, i), where//'t_fe '//itoa(j), error)
+      end do
+      if (allocated(error) .or. c%dim == 3) return
+      call check(error, cell_of(line, 16), '', where//'tz_fe empty in 2D')
    end subroutine check_line
 
    !> A cell is empty for an empty value, else it reads back to the same bits.
@@ -340,6 +349,7 @@ contains
       c%p_sprc = [3.05_wp, 1.95_wp, 0.0_wp]
       c%p_exact = [3.0_wp, 2.0_wp, 0.0_wp]
       c%ts_fe = [(0.1_wp*i, i=1, 3)]
+      c%t_fe = reshape([(-0.01_wp*i, i=1, 9)], [3, 3])
       c%ts_sprc = [(0.11_wp*i, i=1, 3)]
    end function contact_sample_3d
 

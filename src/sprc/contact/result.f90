@@ -35,6 +35,9 @@ module sprc_contact_result
       real(wp), allocatable :: p_fe(:), p_spr(:), p_sprc(:), p_exact(:)
       !> Magnitude of the tangential traction: FE formulation and SPR-C.
       real(wp), allocatable :: ts_fe(:), ts_sprc(:)
+      !> The FE tangential traction on the slave body as a vector (dim, npoint):
+      !> its sign shows the direction of friction (Cattaneo-Mindlin).
+      real(wp), allocatable :: t_fe(:, :)
       !> Iterations of the contact nonlinearity summed over all increments.
       integer :: iterations = 0
    end type contact_result_type
@@ -60,9 +63,10 @@ contains
       if (stat == 0) allocate (self%normal, source=normal, stat=stat)
       if (stat == 0) allocate (self%gap(n), self%p_fe(n), self%p_spr(n), self%p_sprc(n), self%p_exact(n), &
          & self%ts_fe(n), self%ts_sprc(n), source=report_empty, stat=stat)
+      if (stat == 0) allocate (self%t_fe(self%dim, n), source=report_empty, stat=stat)
       if (stat == 0) allocate (self%state(n), source=contact_open, stat=stat)
       call check_allocation(stat, 'contact result', 'the values of each slave point', n, &
-         & 8*(2*self%dim + 8) + 4, error)
+         & 8*(3*self%dim + 8) + 4, error)
    end subroutine new_contact_result
 
    !> The SCENE.md name of a state.

@@ -1,6 +1,8 @@
 !> `PREFIX_contact.csv` (SCENE.md "Report"): one row per slave-surface
 !> quadrature point and level,
 !> `level,x,y,z,weight,gap,state,p_fe,p_spr,p_sprc,p_exact,ts_fe,ts_sprc`,
+!> then (an extension of SCENE.md, trailing) `tx_fe,ty_fe,tz_fe`, the FE
+!> tangential traction on the slave body as a vector (`tz_fe` empty in 2D),
 !> reals as in the report CSV (read back bit for bit), `z` empty in
 !> 2D, `state` open / stick / slip, an empty value (not computed) an empty
 !> cell. The pairs of a level follow each other in `&contact` order.
@@ -15,9 +17,9 @@ module sprc_io_contact
 
    public :: contact_level_type, contact_csv_header, write_contact_csv
 
-   !> The CSV header, exactly as SCENE.md states it.
+   !> The CSV header: SCENE.md's columns, then the signed tangential traction.
    character(len=*), parameter :: contact_csv_header = 'level,x,y,z,weight,gap,state,p_fe,p_spr,p_sprc,p_exact,'// &
-      & 'ts_fe,ts_sprc'
+      & 'ts_fe,ts_sprc,tx_fe,ty_fe,tz_fe'
 
    !> The contact results of one level of a study.
    type :: contact_level_type
@@ -65,14 +67,19 @@ contains
       integer, intent(in) :: level, i
       type(contact_result_type), intent(in) :: c
       character(len=:), allocatable :: line
-      character(len=:), allocatable :: z
+      character(len=:), allocatable :: z, tz
 
       z = ''
-      if (c%dim == 3) z = csv_real(c%x(3, i))
+      tz = ''
+      if (c%dim == 3) then
+         z = csv_real(c%x(3, i))
+         tz = csv_real(c%t_fe(3, i))
+      end if
       line = itoa(level)//','//csv_real(c%x(1, i))//','//csv_real(c%x(2, i))//','//z//','// &
          & csv_real(c%weight(i))//','//csv_real(c%gap(i))//','//state_name(c%state(i))//','// &
          & csv_real(c%p_fe(i))//','//csv_real(c%p_spr(i))//','//csv_real(c%p_sprc(i))//','// &
-         & csv_real(c%p_exact(i))//','//csv_real(c%ts_fe(i))//','//csv_real(c%ts_sprc(i))
+         & csv_real(c%p_exact(i))//','//csv_real(c%ts_fe(i))//','//csv_real(c%ts_sprc(i))//','// &
+         & csv_real(c%t_fe(1, i))//','//csv_real(c%t_fe(2, i))//','//tz
    end function point_line
 
 end module sprc_io_contact

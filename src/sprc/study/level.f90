@@ -497,6 +497,7 @@ contains
       where (sol%slipping) result%state = contact_slip
       result%p_fe = (sol%pressure*units%modulus)*units%strain
       result%ts_fe = (sol%tangential*units%modulus)*units%strain
+      result%t_fe = (sol%traction_t*units%modulus)*units%strain
       result%iterations = sol%iterations
    end subroutine contact_result
 
