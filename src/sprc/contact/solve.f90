@@ -112,6 +112,7 @@ module sprc_contact_solve
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_not_converged, stat_singular, &
       & stat_unsupported
    use sprc_core_text, only: itoa
+   use sprc_core_alloc, only: check_allocation
    use sprc_core_timer, only: timer_type
    use sprc_fem_sparse, only: coo_type, csr_type
    use sprc_fem_element, only: shape_functions, strain_matrix, traction_matrix, displacement_matrix
@@ -229,24 +230,31 @@ contains
       logical, allocatable :: closed(:), next(:)
       integer, allocatable :: state(:)
       real(wp), allocatable :: slip(:, :), tau(:, :)
-      integer :: it, maxit, n, c, switched
+      integer :: it, maxit, n, c, switched, stat
 
       call check_pair(slave, master, surface, friction, kappa, error)
       if (allocated(error)) return
       maxit = default_max_iterations
       if (present(max_iterations)) maxit = max_iterations
       call timer%start()
-      call point_operators(slave, master, surface, kappa, ops)
-      allocate (cells(ops%ncell), closed(ops%ncell), next(ops%ncell))
+      call point_operators(slave, master, surface, kappa, ops, error)
+      if (allocated(error)) return
+      allocate (cells(ops%ncell), closed(ops%ncell), next(ops%ncell), stat=stat)
+      call check_allocation(stat, 'contact solve', 'the contact cells', ops%ncell, 2, error)
+      if (allocated(error)) return
       do c = 1, ops%ncell
-         call cell_operators(surface, ops, c, merge(friction_stick, friction, friction == friction_coulomb), cells(c))
+         call cell_operators(surface, ops, c, merge(friction_stick, friction, friction == friction_coulomb), cells(c), &
+            & error)
+         if (allocated(error)) return
          closed(c) = any(surface%g0(ops%cell_point(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1)) <= &
             & cell_size(slave, slave%root(surface%slave_cell(ops%cell_point(ops%cell_ptr(c))))))
       end do
       call timer%stop()
       sol%t_contact = timer%elapsed
       n = slave%n_dofs() + master%n_dofs()
-      allocate (x(n))
+      allocate (x(n), stat=stat)
+      call check_allocation(stat, 'contact solve', 'the solution of both bodies', n, 8, error)
+      if (allocated(error)) return
       if (friction == friction_coulomb) then
          if (.not. present(mu)) then
             call fatal_error(error, 'contact solve: Coulomb friction needs mu', stat_invalid_input)
@@ -259,7 +267,8 @@ contains
                & maxit, x, sol, state, tau, slip, error)
          end if
          if (allocated(error)) return
-         call point_gaps(surface, ops, ops%ncell, x, sol)
+         call point_gaps(surface, ops, ops%ncell, x, sol, error)
+         if (allocated(error)) return
          call coulomb_output(ops, cells, mu, state, tau, slip, x, sol)
       end if
       do it = 1, merge(0, maxit, friction == friction_coulomb)
@@ -274,7 +283,8 @@ contains
          if (allocated(error)) return
          call timer%reset()
          call timer%start()
-         call evaluate(surface, ops, cells, closed, x, sol)
+         call evaluate(surface, ops, cells, closed, x, sol, error)
+         if (allocated(error)) return
          next = sol%lambda_n < 0.0_wp
          switched = 0
          do c = 1, ops%ncell
@@ -329,17 +339,21 @@ contains
    end subroutine check_pair
 
    !> Gap and traction operators of every point with a master point.
-   subroutine point_operators(slave, master, surface, kappa, ops)
+   subroutine point_operators(slave, master, surface, kappa, ops, error)
       type(elasticity_problem_type), intent(in) :: slave, master
       type(contact_surface_type), intent(in) :: surface
       real(wp), intent(in) :: kappa
       type(point_operators_type), intent(out) :: ops
+      type(error_type), allocatable, intent(out) :: error
       type(local_type), allocatable :: loc(:)
-      integer :: i, q0, q1, d, c
+      integer :: i, q0, q1, d, c, stat
 
       d = surface%dim
-      call group_cells(surface, slave, ops)
-      allocate (loc(surface%npoint), ops%ptr(surface%npoint + 1), ops%gamma(ops%ncell))
+      call group_cells(surface, slave, ops, error)
+      if (allocated(error)) return
+      allocate (loc(surface%npoint), ops%ptr(surface%npoint + 1), ops%gamma(ops%ncell), stat=stat)
+      call check_allocation(stat, 'contact operators', 'the points'' operators', surface%npoint, 128, error)
+      if (allocated(error)) return
       do c = 1, ops%ncell
          ops%gamma(c) = kappa*slave%young/cell_size(slave, slave%root(surface%slave_cell(ops%cell_point(ops%cell_ptr(c)))))
       end do
@@ -348,12 +362,17 @@ contains
          ops%ptr(i + 1) = ops%ptr(i)
          if (.not. surface%has_master(i)) cycle
          call body_operators(slave, surface%slave_cell(i), surface%x(:, i), surface%normal(:, i), loc(i)%ds, &
-            & loc(i)%ns, loc(i)%ts, loc(i)%ms)
-         call body_operators(master, surface%master_cell(i), surface%master_x(:, i), surface%normal(:, i), &
-            & loc(i)%dm, loc(i)%nm, loc(i)%tm, loc(i)%mm)
+            & loc(i)%ns, loc(i)%ts, loc(i)%ms, error)
+         if (.not. allocated(error)) call body_operators(master, surface%master_cell(i), surface%master_x(:, i), &
+            & surface%normal(:, i), loc(i)%dm, loc(i)%nm, loc(i)%tm, loc(i)%mm, error)
+         if (allocated(error)) return
          ops%ptr(i + 1) = ops%ptr(i) + loc(i)%ms + loc(i)%mm
       end do
-      allocate (ops%dofs(ops%ptr(surface%npoint + 1) - 1), ops%gop(d, size(ops%dofs)), ops%top(d, size(ops%dofs)))
+      allocate (ops%dofs(ops%ptr(surface%npoint + 1) - 1), ops%gop(d, ops%ptr(surface%npoint + 1) - 1), &
+         & ops%top(d, ops%ptr(surface%npoint + 1) - 1), stat=stat)
+      call check_allocation(stat, 'contact operators', 'the gap and traction operators', &
+         & ops%ptr(surface%npoint + 1) - 1, 4 + 16*d, error)
+      if (allocated(error)) return
       do i = 1, surface%npoint
          if (.not. surface%has_master(i)) cycle
          associate (p => loc(i))
@@ -380,12 +399,13 @@ contains
    !> joins the group of at least that measure whose centroid is nearest: a
    !> multiplier on a sliver is barely constrained by the displacements, and
    !> its pressure is noise that can open it falsely.
-   subroutine group_cells(surface, slave, ops)
+   subroutine group_cells(surface, slave, ops, error)
       type(contact_surface_type), intent(in) :: surface
       type(elasticity_problem_type), intent(in) :: slave
       type(point_operators_type), intent(inout) :: ops
+      type(error_type), allocatable, intent(out) :: error
       integer :: key(surface%npoint), group(slave%mesh%grid%n_leaves), cell_of_leaf(slave%mesh%grid%n_leaves)
-      integer :: fill(slave%mesh%grid%n_leaves), i, e, c, best, n_leaves, d
+      integer :: fill(slave%mesh%grid%n_leaves), i, e, c, best, n_leaves, d, stat
       real(wp) :: measure(slave%mesh%grid%n_leaves), centroid(surface%dim, slave%mesh%grid%n_leaves), dist, best_dist
       logical :: small(slave%mesh%grid%n_leaves)
       integer :: macro(slave%mesh%grid%n_leaves)
@@ -431,7 +451,9 @@ contains
       end do
       ops%ncell = count(fill > 0)
       allocate (ops%cell_ptr(ops%ncell + 1), ops%cell_point(count(surface%has_master)), &
-         & ops%cell_of_point(surface%npoint))
+         & ops%cell_of_point(surface%npoint), stat=stat)
+      call check_allocation(stat, 'contact cells', 'the cells'' points', surface%npoint + ops%ncell, 8, error)
+      if (allocated(error)) return
       ops%cell_ptr(1) = 1
       cell_of_leaf = 0
       c = 0
@@ -483,20 +505,23 @@ contains
    !> The means and deviations of cell c's operators on the union of its
    !> points' dofs (module notes): normal rows (frictionless) or all
    !> components (stick).
-   pure subroutine cell_operators(surface, ops, c, friction, cell)
+   pure subroutine cell_operators(surface, ops, c, friction, cell, error)
       type(contact_surface_type), intent(in) :: surface
       type(point_operators_type), intent(in) :: ops
       integer, intent(in) :: c, friction
       type(cell_operators_type), intent(out) :: cell
+      type(error_type), allocatable, intent(out) :: error
       integer, allocatable :: pos(:)
       real(wp), allocatable :: g(:, :)
-      integer :: j, i, q, q0, q1, np, d
+      integer :: j, i, q, q0, q1, np, d, stat
       real(wp) :: nrm(surface%dim)
 
       d = surface%dim
       np = ops%cell_ptr(c + 1) - ops%cell_ptr(c)
       cell%rows = merge(d, 1, friction == friction_stick)
-      allocate (cell%dofs(0))
+      allocate (cell%dofs(0), stat=stat)
+      call check_allocation(stat, 'contact cell '//itoa(c), 'its dofs', 0, 4, error)
+      if (allocated(error)) return
       do j = ops%cell_ptr(c), ops%cell_ptr(c + 1) - 1
          i = ops%cell_point(j)
          do q = ops%ptr(i), ops%ptr(i + 1) - 1
@@ -505,7 +530,9 @@ contains
       end do
       cell%nu = size(cell%dofs)
       allocate (cell%gbar(cell%rows, cell%nu), cell%tbar(cell%rows, cell%nu), cell%g0bar(cell%rows), &
-         & cell%tdev(cell%rows, cell%nu, np), cell%w(np), g(cell%rows, cell%nu))
+         & cell%tdev(cell%rows, cell%nu, np), cell%w(np), g(cell%rows, cell%nu), stat=stat)
+      call check_allocation(stat, 'contact cell '//itoa(c), 'its operators', cell%rows*cell%nu*(np + 3), 8, error)
+      if (allocated(error)) return
       cell%gbar = 0.0_wp
       cell%tbar = 0.0_wp
       cell%g0bar = 0.0_wp
@@ -550,23 +577,26 @@ contains
 
    !> Reduced operators of `problem` at x in element e: dofs(1:m), the
    !> displacement n(dim, m) and the traction sigma(u) nrm, t(dim, m).
-   subroutine body_operators(problem, e, x, nrm, dofs, n, t, m)
+   subroutine body_operators(problem, e, x, nrm, dofs, n, t, m, error)
       type(elasticity_problem_type), intent(in) :: problem
       integer, intent(in) :: e
       real(wp), intent(in) :: x(:), nrm(:)
       integer, allocatable, intent(out) :: dofs(:)
       real(wp), allocatable, intent(out) :: n(:, :), t(:, :)
       integer, intent(out) :: m
+      type(error_type), allocatable, intent(out) :: error
       real(wp) :: lo(3), hi(3)
       real(wp) :: sh(problem%nen), dndx(problem%dim, problem%nen), b(problem%nstress, problem%dim*problem%nen)
       real(wp) :: nmat(problem%dim, problem%dim*problem%nen), tn(problem%dim, problem%nstress)
       real(wp), allocatable :: tmat(:, :)
-      integer :: d, nd, ns
+      integer :: d, nd, ns, stat
 
       d = problem%dim
       nd = d*problem%nen
       ns = problem%nstress
-      allocate (dofs(nd*32), tmat(nd, nd*32))
+      allocate (dofs(nd*32), tmat(nd, nd*32), stat=stat)
+      call check_allocation(stat, 'contact operators', 'an element''s constraint map', nd*32, 4 + 8*nd, error)
+      if (allocated(error)) return
       call problem%constraints%element_map(problem%mesh%nodes%connectivity(:, e), dofs, tmat, m)
       call problem%element_box(e, lo(1:d), hi(1:d))
       call shape_functions(d, problem%degree, lo(1:d), hi(1:d), x, sh, dndx)
@@ -679,10 +709,12 @@ contains
       type(timer_type) :: timer
       real(wp), allocatable :: tau_new(:, :), f(:)
       integer, allocatable :: state_new(:)
-      integer :: n, it, c, d, changed
+      integer :: n, it, c, d, changed, stat
 
       d = slave%dim
-      allocate (slip(d, size(cells)), tau(d, size(cells)), tau_new(d, size(cells)))
+      allocate (slip(d, size(cells)), tau(d, size(cells)), tau_new(d, size(cells)), stat=stat)
+      call check_allocation(stat, 'contact solve (Coulomb)', 'the slips and slip directions', size(cells), 24*d, error)
+      if (allocated(error)) return
       slip = 0.0_wp
       tau = 0.0_wp
       state = merge(contact_stick, contact_open, closed)
@@ -909,14 +941,18 @@ contains
       type(error_type), allocatable, intent(out) :: error
       real(wp), allocatable :: rs(:, :), rm(:, :), r(:, :), vec(:, :)
       logical :: involved(12)
-      integer :: nfree, j, ns, ms, b
+      integer :: nfree, j, ns, ms, b, stat
       character(len=:), allocatable :: what
 
-      call slave%rigid_modes(rs)
-      call master%rigid_modes(rm)
+      call slave%rigid_modes(rs, error)
+      if (.not. allocated(error)) call master%rigid_modes(rm, error)
+      if (allocated(error)) return
       ns = size(rs, 2)
       ms = size(rm, 2)
-      allocate (r(size(rs, 1) + size(rm, 1), ns + ms), source=0.0_wp)
+      allocate (r(size(rs, 1) + size(rm, 1), ns + ms), source=0.0_wp, stat=stat)
+      call check_allocation(stat, 'contact rigid-mode check', 'the rigid-body motions of both bodies', &
+         & int(size(rs, 1) + size(rm, 1), i8)*(ns + ms), 8, error)
+      if (allocated(error)) return
       r(1:size(rs, 1), 1:ns) = rs
       r(size(rs, 1) + 1:, ns + 1:) = rm
       call free_motions(k, r, vec, nfree, error)
@@ -951,17 +987,23 @@ contains
 
    !> The outputs allocated and reset (every point open); the linearized
    !> normal gap of every point with a master point (huge elsewhere).
-   subroutine point_gaps(surface, ops, ncell, x, sol)
+   subroutine point_gaps(surface, ops, ncell, x, sol, error)
       type(contact_surface_type), intent(in) :: surface
       type(point_operators_type), intent(in) :: ops
       integer, intent(in) :: ncell
       real(wp), intent(in) :: x(:)
       type(contact_solution_type), intent(inout) :: sol
-      integer :: i, q0, q1
+      type(error_type), allocatable, intent(out) :: error
+      integer :: i, q0, q1, stat
 
-      if (.not. allocated(sol%gap)) allocate (sol%gap(surface%npoint), sol%pressure(surface%npoint), &
-         & sol%tangential(surface%npoint), sol%lambda_n(ncell), sol%closed(surface%npoint), &
-         & sol%slipping(surface%npoint), sol%traction_t(surface%dim, surface%npoint))
+      if (.not. allocated(sol%gap)) then
+         allocate (sol%gap(surface%npoint), sol%pressure(surface%npoint), sol%tangential(surface%npoint), &
+            & sol%lambda_n(ncell), sol%closed(surface%npoint), sol%slipping(surface%npoint), &
+            & sol%traction_t(surface%dim, surface%npoint), stat=stat)
+         call check_allocation(stat, 'contact solve', 'the values of each slave point', surface%npoint + ncell, &
+            & 8*(4 + surface%dim) + 8, error)
+         if (allocated(error)) return
+      end if
       sol%gap = huge(1.0_wp)
       sol%pressure = 0.0_wp
       sol%tangential = 0.0_wp
@@ -978,17 +1020,19 @@ contains
 
    !> Gaps, cell multipliers, pressures and tangential tractions of the
    !> solution x (module notes).
-   subroutine evaluate(surface, ops, cells, closed, x, sol)
+   subroutine evaluate(surface, ops, cells, closed, x, sol, error)
       type(contact_surface_type), intent(in) :: surface
       type(point_operators_type), intent(in) :: ops
       type(cell_operators_type), intent(in) :: cells(:)
       logical, intent(in) :: closed(:)
       real(wp), intent(in) :: x(:)
       type(contact_solution_type), intent(inout) :: sol
+      type(error_type), allocatable, intent(out) :: error
       real(wp) :: lam(surface%dim), nrm(surface%dim)
       integer :: i, c, j
 
-      call point_gaps(surface, ops, size(cells), x, sol)
+      call point_gaps(surface, ops, size(cells), x, sol, error)
+      if (allocated(error)) return
       do c = 1, size(cells)
          associate (cell => cells(c), pts => ops%cell_point(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1))
             lam = 0.0_wp

@@ -31,6 +31,7 @@ module sprc_contact_surface
    use sprc_core_kinds, only: wp
    use sprc_core_text, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_not_converged
+   use sprc_core_alloc, only: check_allocation
    use sprc_geometry_body, only: body_type, snap_tolerance, body_name, shape_name
    use sprc_grid_tree, only: grid_type
    use sprc_grid_quadrature, only: cut_quadrature_type, cell_rule_type, cell_rule, boundary_face_rule
@@ -73,7 +74,7 @@ contains
       real(wp), intent(in) :: x(:, :), weight(:), normal(:, :)
       integer, intent(in) :: slave_cell(:)
       type(error_type), allocatable, intent(out) :: error
-      integer :: d, n, i
+      integer :: d, n, i, stat
 
       d = size(x, 1)
       n = size(x, 2)
@@ -102,14 +103,15 @@ contains
       end do
       self%dim = d
       self%npoint = n
-      self%x = x
-      self%weight = weight
-      self%normal = normal
-      if (size(slave_cell) == n) then
-         self%slave_cell = slave_cell
-      else
-         allocate (self%slave_cell(n), source=0)
+      allocate (self%x, source=x, stat=stat)
+      if (stat == 0) allocate (self%weight, source=weight, stat=stat)
+      if (stat == 0) allocate (self%normal, source=normal, stat=stat)
+      if (stat == 0 .and. size(slave_cell) == n) then
+         allocate (self%slave_cell, source=slave_cell, stat=stat)
+      else if (stat == 0) then
+         allocate (self%slave_cell(n), source=0, stat=stat)
       end if
+      call check_allocation(stat, 'contact surface', 'its points', n, 8*(2*d + 1) + 4, error)
    end subroutine new_contact_surface
 
    !> The surface points of shape `shape` of `body` from the cut-cell rules of
@@ -134,7 +136,7 @@ contains
       integer, allocatable :: cell(:)
       real(wp) :: lo(3), hi(3), sub_lo(3), sub_hi(3)
       type(planes_type) :: planes(3)
-      integer :: leaf, n, d, j(3), k
+      integer :: leaf, n, d, j(3), k, stat
 
       if (shape < 1 .or. shape > body%nshape) then
          call fatal_error(error, "contact surface: shape "//itoa(shape)//" of body '"//body_name(body)// &
@@ -143,7 +145,9 @@ contains
       end if
       d = grid%dim
       n = 0
-      allocate (x(d, 64), w(64), nrm(d, 64), cell(64))
+      allocate (x(d, 64), w(64), nrm(d, 64), cell(64), stat=stat)
+      call check_allocation(stat, 'contact surface', 'its points', 64, 8*(2*d + 1) + 4, error)
+      if (allocated(error)) return
       do leaf = 1, grid%n_leaves
          call grid%leaf_box(leaf, lo(1:d), hi(1:d))
          call leaf_rule(grid%leaf_class(leaf) == cell_inside, lo(1:d), hi(1:d), rule, error)
@@ -204,7 +208,8 @@ contains
          integer :: q
          do q = 1, rule%nsurf
             if (rule%surf_shape(q) /= shape) cycle
-            if (n == size(w)) call grow(x, w, nrm, cell)
+            if (n == size(w)) call grow(x, w, nrm, cell, error)
+            if (allocated(error)) return
             n = n + 1
             x(:, n) = rule%surf_x(1:d, q)
             w(n) = rule%surf_w(q)
@@ -237,15 +242,18 @@ contains
       p = [p, hi]
    end subroutine lattice_planes
 
-   subroutine grow(x, w, nrm, cell)
+   subroutine grow(x, w, nrm, cell, error)
       real(wp), allocatable, intent(inout) :: x(:, :), w(:), nrm(:, :)
       integer, allocatable, intent(inout) :: cell(:)
+      type(error_type), allocatable, intent(out) :: error
       real(wp), allocatable :: x2(:, :), w2(:), n2(:, :)
       integer, allocatable :: c2(:)
-      integer :: m
+      integer :: m, stat
 
       m = size(w)
-      allocate (x2(size(x, 1), 2*m), w2(2*m), n2(size(x, 1), 2*m), c2(2*m))
+      allocate (x2(size(x, 1), 2*m), w2(2*m), n2(size(x, 1), 2*m), c2(2*m), stat=stat)
+      call check_allocation(stat, 'contact surface', 'its points', 2*m, 8*(2*size(x, 1) + 1) + 4, error)
+      if (allocated(error)) return
       x2(:, 1:m) = x
       w2(1:m) = w
       n2(:, 1:m) = nrm
@@ -267,18 +275,20 @@ contains
       real(wp), intent(in) :: search_distance
       type(error_type), allocatable, intent(out) :: error
       type(ray_hit_type) :: hit
-      integer :: i
+      integer :: i, stat
 
       call check_gap_input(self, master, shape, master_grid, search_distance, error)
       if (allocated(error)) return
       associate (d => self%dim, n => self%npoint)
          if (allocated(self%has_master)) deallocate (self%has_master, self%g0, self%g0_tolerance, self%master_x, &
             & self%master_normal, self%master_cell)
-         allocate (self%has_master(n), source=.false.)
-         allocate (self%g0(n), source=huge(1.0_wp))
-         allocate (self%g0_tolerance(n), source=0.0_wp)
-         allocate (self%master_x(d, n), self%master_normal(d, n), source=0.0_wp)
-         allocate (self%master_cell(n), source=0)
+         allocate (self%has_master(n), source=.false., stat=stat)
+         if (stat == 0) allocate (self%g0(n), source=huge(1.0_wp), stat=stat)
+         if (stat == 0) allocate (self%g0_tolerance(n), source=0.0_wp, stat=stat)
+         if (stat == 0) allocate (self%master_x(d, n), self%master_normal(d, n), source=0.0_wp, stat=stat)
+         if (stat == 0) allocate (self%master_cell(n), source=0, stat=stat)
+         call check_allocation(stat, 'contact gap', 'the master points', n, 8*(2*d + 2) + 8, error)
+         if (allocated(error)) return
          do i = 1, n
             call gap_of_point(master, shape, self%x(:, i), self%normal(:, i), search_distance, hit)
             if (hit%exhausted) then
