@@ -28,6 +28,7 @@ module sprc_test_contact_fe
    character(len=*), parameter :: patch_3d = 'test/data/contact/patch_3d.nml'
    character(len=*), parameter :: hertz_2d = 'test/data/contact/hertz_2d.nml'
    character(len=*), parameter :: incline_2d = 'test/data/contact/incline_2d.nml'
+   character(len=*), parameter :: cattaneo_2d = 'test/data/contact/cattaneo_2d.nml'
    character(len=*), parameter :: nl = new_line('a')
 
 contains
@@ -50,6 +51,7 @@ contains
          new_unittest('bodies_in_contact_share_units', test_units), &
          new_unittest('coulomb_proportional_steps', test_coulomb_steps), &
          new_unittest('coulomb_stages_on_one_surface', test_coulomb_stages), &
+         new_unittest('cattaneo_mindlin', test_cattaneo_mindlin), &
          new_unittest('shrink_fit_sphere_q1', test_sphere) &
          ]
    end subroutine collect_contact_fe
@@ -218,6 +220,65 @@ contains
       if (allocated(error)) return
       call check(error, two%contacts(1)%iterations > one%contacts(1)%iterations, 'one increment only')
    end subroutine test_coulomb_stages
+
+   !> Cattaneo-Mindlin (test/data/contact/cattaneo_2d.nml: a roller on a block
+   !> of the same material, mu = 0.3, stage 1 the normal load P, stage 2 the
+   !> tangential load Q = 0.5 mu P; Johnson 1985, sec. 7.1), level 3, h =
+   !> 2/512 = a/12.8 at the contact. The stick/slip iteration settles (it
+   !> cycled between the two slip directions of one cell before), and:
+   !> - the stick zone, from the outer edge of its leftmost contact cell to that
+   !>   of its rightmost (contact cells are 2h wide and aligned to 2h), ends
+   !>   within two cells (2h) of +-c, c = a sqrt(1 - Q/(mu P));
+   !> - the tangential traction on the block, q = -t_x of the roller's, is
+   !>   within the discretization error of q_ex(x) = mu p0 [sqrt(1 - x^2/a^2) -
+   !>   (c/a) sqrt(1 - x^2/c^2)] (the second term for |x| < c) in the slave
+   !>   surface's L2 norm: ||q - q_ex|| <= ||q_ex - P0 q_ex|| + mu ||p - p_ex||,
+   !>   the distance of q_ex from the piecewise constants on the contact cells
+   !>   (the multiplier space; computed here from q_ex alone) plus the error
+   !>   that the pressure carries into the slip zones' mu p (p_ex the Hertz
+   !>   pressure). Frictionless contact (q = 0) misses it by a factor 3.
+   subroutine test_cattaneo_mindlin(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), parameter :: pi = acos(-1.0_wp), load = 1.0788436_wp, q_load = 2*0.0809163_wp, mu = 0.3_wp
+      real(wp), parameter :: e_star = 1000.0_wp/(2*(1 - 0.3_wp**2)), h = 2.0_wp/512
+      type(level_type) :: result
+      character(len=:), allocatable :: text
+      real(wp) :: a, p0, c, lo, hi, err, bound
+      real(wp), allocatable :: q(:), q_ex(:), p_ex(:), q_mean(:)
+      integer, allocatable :: cell(:)
+      integer :: k
+
+      call read_text_file(cattaneo_2d, text, error)
+      if (allocated(error)) return
+      call run_text(text, 3, result, error)
+      if (allocated(error)) return
+      a = sqrt(4*load/(pi*e_star))
+      p0 = 2*load/(pi*a)
+      c = a*sqrt(1 - q_load/(mu*load))
+      associate (r => result%contacts(1), x => result%contacts(1)%x(1, :), w => result%contacts(1)%weight)
+         call check(error, any(r%state == contact_stick) .and. any(r%state == contact_slip), 'no stick or no slip')
+         if (allocated(error)) return
+         lo = floor(minval(x, r%state == contact_stick)/(2*h))*2*h
+         hi = ceiling(maxval(x, r%state == contact_stick)/(2*h))*2*h
+         call check(error, abs(-lo - c) <= 2*h .and. abs(hi - c) <= 2*h, 'stick zone '//real_text(lo)//' .. '// &
+            & real_text(hi)//', c = '//real_text(c)//', h = '//real_text(h))
+         if (allocated(error)) return
+         q = -r%t_fe(1, :)
+         p_ex = p0*sqrt(max(0.0_wp, 1 - (x/a)**2))
+         q_ex = mu*(p_ex - merge(p0*(c/a)*sqrt(max(0.0_wp, 1 - (x/c)**2)), 0.0_wp, abs(x) < c))
+         ! P0 q_ex: its mean over each contact cell (open points: q_ex = 0 there).
+         cell = floor(x/(2*h))
+         allocate (q_mean(size(x)))
+         do k = 1, size(x)
+            q_mean(k) = sum(w*q_ex, cell == cell(k))/sum(w, cell == cell(k))
+         end do
+         err = sqrt(sum(w*(q - q_ex)**2))
+         bound = sqrt(sum(w*(q_ex - q_mean)**2)) + mu*sqrt(sum(w*(r%p_fe - p_ex)**2))
+         call check(error, err <= bound .and. 3*err < sqrt(sum(w*q_ex**2)), '||q - q_ex|| = '//real_text(err)// &
+            & ' > '//real_text(bound)//' (best P0 plus mu times the pressure error), or not a third of ||q_ex|| = '// &
+            & real_text(sqrt(sum(w*q_ex**2))))
+      end associate
+   end subroutine test_cattaneo_mindlin
 
    !> Scenes `text` and `other` at level 3 give the same contact states, and
    !> pressures and tangential tractions to round-off (C eps/rcond times the
