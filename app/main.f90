@@ -21,6 +21,7 @@ program sprc_main
    use sprc_io_contact, only: contact_level_type, write_contact_csv
    use sprc_io_hdf5, only: h5_output_type
    use sprc_app_cli, only: cli_type, parse_cli, usage_text
+   use sprc_app_progress, only: progress_level, print_contact_progress
    implicit none
 
    type(cli_type) :: cli
@@ -141,7 +142,12 @@ contains
          end if
          if (.not. cli%quiet) write (error_unit, '(a,i0,a,i0,a,i0,a)') 'sprc: level ', levels(i), &
             ' (', i, ' of ', size(levels), ')'
-         call run_level(study, levels(i), result, error)
+         if (cli%quiet) then
+            call run_level(study, levels(i), result, error)
+         else
+            progress_level = levels(i)
+            call run_level(study, levels(i), result, error, progress=print_contact_progress)
+         end if
          if (.not. allocated(error)) then
             rows(i) = result%row
             if (allocated(result%contacts)) contact_levels = [contact_levels, contact_level_type(levels(i), result%contacts)]

@@ -123,8 +123,19 @@ module sprc_contact_solve
    implicit none
    private
 
-   public :: contact_solution_type, solve_contact_pair, friction_kind
+   public :: contact_solution_type, solve_contact_pair, friction_kind, contact_progress
    public :: friction_frictionless, friction_stick, friction_coulomb, default_max_iterations
+
+   abstract interface
+      !> Told after each iteration of the contact nonlinearity (the library
+      !> never prints; a driver may): load increment `increment` of
+      !> `increments` (1 of 1 without a load path), its iteration `iteration`,
+      !> and the slave points whose contact cells changed state (or slip
+      !> direction) in it; 0 ends the increment.
+      subroutine contact_progress(increment, increments, iteration, switched)
+         integer, intent(in) :: increment, increments, iteration, switched
+      end subroutine contact_progress
+   end interface
 
    !> Friction laws (SCENE.md `friction`).
    integer, parameter :: friction_frictionless = 0, friction_stick = 1, friction_coulomb = 2
@@ -209,7 +220,7 @@ contains
    !> both problems hold their solution (`set_solution`). `names` are the slave
    !> and master body names for messages.
    subroutine solve_contact_pair(slave, master, surface, friction, kappa, names, sol, error, max_iterations, mu, &
-         & loads)
+         & loads, progress)
       type(elasticity_problem_type), intent(inout) :: slave, master
       type(contact_surface_type), intent(in) :: surface
       integer, intent(in) :: friction
@@ -222,6 +233,8 @@ contains
       !> end of each increment, one column each; default one increment, the
       !> assembled loads).
       real(wp), intent(in), optional :: mu, loads(:, :)
+      !> Told after each iteration (`contact_progress`).
+      procedure(contact_progress), optional :: progress
       type(point_operators_type) :: ops
       type(cell_operators_type), allocatable :: cells(:)
       type(csr_type) :: k
@@ -261,10 +274,11 @@ contains
             return
          end if
          if (present(loads)) then
-            call solve_coulomb(slave, master, ops, cells, closed, mu, loads, names, maxit, x, sol, state, tau, slip, error)
+            call solve_coulomb(slave, master, ops, cells, closed, mu, loads, names, maxit, x, sol, state, tau, slip, &
+               & error, progress)
          else
             call solve_coulomb(slave, master, ops, cells, closed, mu, reshape([slave%f, master%f], [n, 1]), names, &
-               & maxit, x, sol, state, tau, slip, error)
+               & maxit, x, sol, state, tau, slip, error, progress)
          end if
          if (allocated(error)) return
          call point_gaps(surface, ops, ops%ncell, x, sol, error)
@@ -292,6 +306,7 @@ contains
          end do
          call timer%stop()
          sol%t_contact = sol%t_contact + timer%elapsed
+         if (present(progress)) call progress(1, 1, it, switched)
          if (switched == 0) exit
          closed = next
          if (it == maxit) then
@@ -691,7 +706,8 @@ contains
    !> an iteration on the cells' states (open, stick, slip) and slip
    !> directions, solved with UMFPACK (the slip terms are unsymmetric); the
    !> slip of each cell is history.
-   subroutine solve_coulomb(slave, master, ops, cells, closed, mu, loads, names, maxit, x, sol, state, tau, slip, error)
+   subroutine solve_coulomb(slave, master, ops, cells, closed, mu, loads, names, maxit, x, sol, state, tau, slip, error, &
+         & progress)
       type(elasticity_problem_type), intent(in) :: slave, master
       type(point_operators_type), intent(in) :: ops
       type(cell_operators_type), intent(in) :: cells(:)
@@ -705,11 +721,12 @@ contains
       integer, allocatable, intent(out) :: state(:)
       real(wp), allocatable, intent(out) :: tau(:, :), slip(:, :)
       type(error_type), allocatable, intent(out) :: error
+      procedure(contact_progress), optional :: progress
       type(csr_type) :: k
       type(timer_type) :: timer
       real(wp), allocatable :: tau_new(:, :), f(:)
       integer, allocatable :: state_new(:)
-      integer :: n, it, c, d, changed, stat
+      integer :: n, it, c, d, changed, switched, stat
 
       d = slave%dim
       allocate (slip(d, size(cells)), tau(d, size(cells)), tau_new(d, size(cells)), stat=stat)
@@ -736,12 +753,17 @@ contains
             sol%t_solve = sol%t_solve + timer%elapsed
             if (allocated(error)) return
             call coulomb_states(ops, cells, mu, slip, x, state, tau, state_new, tau_new)
-            changed = count(state_new /= state)
+            changed = 0
+            switched = 0
             do c = 1, size(cells)
-               if (state_new(c) == contact_slip .and. state(c) == contact_slip) then
-                  if (norm2(tau_new(:, c) - tau(:, c)) > direction_tol) changed = changed + 1
+               if (state_new(c) == state(c)) then
+                  if (state(c) /= contact_slip) cycle
+                  if (.not. norm2(tau_new(:, c) - tau(:, c)) > direction_tol) cycle
                end if
+               changed = changed + 1
+               switched = switched + ops%cell_ptr(c + 1) - ops%cell_ptr(c)
             end do
+            if (present(progress)) call progress(n, size(loads, 2), it, switched)
             state = state_new
             tau = tau_new
             if (changed == 0) exit

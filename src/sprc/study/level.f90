@@ -52,7 +52,7 @@ module sprc_study_level
       & contact_slip
    use sprc_contact_surface, only: contact_surface_type, slave_surface_points, initial_gaps
    use sprc_contact_solve, only: contact_solution_type, solve_contact_pair, friction_kind, friction_coulomb, &
-      & friction_frictionless
+      & friction_frictionless, contact_progress
    implicit none
    private
 
@@ -206,11 +206,13 @@ contains
    end subroutine shared_units
 
    !> One level of the study: every body analysed, the report row summed.
-   subroutine run_level(study, level, result, error)
+   subroutine run_level(study, level, result, error, progress)
       type(study_type), intent(in) :: study
       integer, intent(in) :: level
       type(level_type), intent(out) :: result
       type(error_type), allocatable, intent(out) :: error
+      !> Told after each contact iteration (sprc_contact_solve's `contact_progress`).
+      procedure(contact_progress), optional :: progress
       type(cut_quadrature_type) :: quad
       real(wp) :: t_start, t_contact
       integer :: b, k
@@ -234,7 +236,8 @@ contains
       t_contact = 0.0_wp
       if (size(study%scene%contacts) > 0) allocate (result%contacts(size(study%scene%contacts)))
       do k = 1, size(study%scene%contacts)
-         call run_contact(study, study%scene%contacts(k), result%bodies, result%contacts(k), t_contact, error)
+         call run_contact(study, study%scene%contacts(k), result%bodies, result%contacts(k), t_contact, error, &
+            & progress)
          if (allocated(error)) return
       end do
       call sum_row(study, result, result%row)
@@ -355,13 +358,14 @@ contains
    !> solve (sprc_contact_solve), then each body's errors and recoveries; the
    !> contact result in scene units. The block solves count in the slave
    !> body's t_solve; points, gaps and contact terms add to `t_contact`.
-   subroutine run_contact(study, spec, bodies, result, t_contact, error)
+   subroutine run_contact(study, spec, bodies, result, t_contact, error, progress)
       type(study_type), intent(in) :: study
       type(contact_spec_type), intent(in) :: spec
       type(body_level_type), intent(inout) :: bodies(:)
       type(contact_result_type), intent(out) :: result
       real(wp), intent(inout) :: t_contact
       type(error_type), allocatable, intent(out) :: error
+      procedure(contact_progress), optional :: progress
       type(contact_surface_type) :: surface
       type(contact_solution_type) :: sol
       type(timer_type) :: timer
@@ -395,10 +399,10 @@ contains
          names(2) = spec%master
          if (friction_kind(spec%friction) == friction_coulomb) then
             call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, friction_coulomb, spec%kappa, &
-               & names, sol, error, mu=spec%mu, loads=loads)
+               & names, sol, error, mu=spec%mu, loads=loads, progress=progress)
          else
             call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, friction_kind(spec%friction), &
-               & spec%kappa, names, sol, error)
+               & spec%kappa, names, sol, error, progress=progress)
          end if
       end block
       if (allocated(error)) return
