@@ -51,7 +51,7 @@ def summary(level, pts):
 
 def svg(levels):
     width, height, left, right, top, bottom = 760, 440, 70, 20, 40, 60
-    xmin, xmax, ymin, ymax = -1.2, 1.2, -0.05, 0.8
+    xmin, xmax, ymin, ymax = -1.2, 1.2, -0.05, 1.45
 
     def px(u):
         return left + (u - xmin) / (xmax - xmin) * (width - left - right)
@@ -70,7 +70,7 @@ def svg(levels):
         out.append(f'<line x1="{px(t):.1f}" y1="{py(ymin):.1f}" x2="{px(t):.1f}" y2="{py(ymax):.1f}" '
                    'stroke="#dddddd"/>')
         out.append(f'<text x="{px(t):.1f}" y="{py(ymin) + 16:.1f}" text-anchor="middle">{t:g}</text>')
-    for t in [0.0, 0.2, 0.4, 0.6, 0.8]:
+    for t in [0.0, 0.2, 0.4, 0.6, 0.8, 1.0, 1.2, 1.4]:
         out.append(f'<line x1="{px(xmin):.1f}" y1="{py(t):.1f}" x2="{px(xmax):.1f}" y2="{py(t):.1f}" '
                    'stroke="#dddddd"/>')
         out.append(f'<text x="{px(xmin) - 6:.1f}" y="{py(t) + 4:.1f}" text-anchor="end">{t:g}</text>')
