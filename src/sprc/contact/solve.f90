@@ -9,7 +9,9 @@
 !> and g the gap (frictionless: the normal gap g_n = g0 + (u_m - u_s).n, with
 !> lambda and p_N their normal parts; stick: the vector g = g0 n + u_m - u_s).
 !> Here p_N is the slave body's FE traction sigma(u_s) n (a Nitsche-type
-!> method; the recovered traction is Tur's variant, not in this version).
+!> method) or, with `recovered`, a known traction: the slave body's
+!> recovered traction sigma* n of the previous solution (Tur's variant,
+!> below).
 !>
 !> Discrete multiplier space: lambda constant on each contact cell c (P0): the
 !> slave points with a master point whose slave aggregates (cell
@@ -107,6 +109,20 @@
 !> opposite slip instead made edge cells of small pressure flip between the
 !> two directions for ever (a roller under a normal then a tangential load).
 !> The rigid-mode check uses the system without the friction terms.
+!>
+!> Recovered stabilization (Tur et al. 2015; SCENE.md `stabilization =
+!> 'recovered'`). p_N is a given traction p*_i per point (the caller's
+!> recovery of the previous solution), not a function of u. Then
+!> lambda_c = pbar* + gamma gbar and the cell's energy is
+!>   W_c [pbar*.gbar + gamma/2 |gbar|^2]   (+ a constant),
+!> so the cell's block is the penalty W gamma G^T G alone (the symmetric
+!> Nitsche terms T^T G + G^T T and the variance term drop out) and the known
+!> traction moves to the load: -W G^T (pbar* + gamma g0bar). The matrix
+!> depends on the active set only, not on p*: an update of p* with the same
+!> set changes the load alone. It is SPD for every gamma > 0 (no trace
+!> inverse bound to beat), and with p* the exact traction the exact solution
+!> satisfies it (gbar = 0, lambda = p*): the method is consistent when the
+!> recovery is exact. Frictionless and stick; Coulomb is refused.
 module sprc_contact_solve
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_not_converged, stat_singular, &
@@ -220,7 +236,7 @@ contains
    !> both problems hold their solution (`set_solution`). `names` are the slave
    !> and master body names for messages.
    subroutine solve_contact_pair(slave, master, surface, friction, kappa, names, sol, error, max_iterations, mu, &
-         & loads, progress)
+         & loads, progress, recovered)
       type(elasticity_problem_type), intent(inout) :: slave, master
       type(contact_surface_type), intent(in) :: surface
       integer, intent(in) :: friction
@@ -235,6 +251,10 @@ contains
       real(wp), intent(in), optional :: mu, loads(:, :)
       !> Told after each iteration (`contact_progress`).
       procedure(contact_progress), optional :: progress
+      !> The stabilization traction p*_i of each surface point (dim, npoint),
+      !> in the problems' units: Tur's variant (module notes); without it the
+      !> slave's FE traction.
+      real(wp), intent(in), optional :: recovered(:, :)
       type(point_operators_type) :: ops
       type(cell_operators_type), allocatable :: cells(:)
       type(csr_type) :: k
@@ -242,10 +262,11 @@ contains
       real(wp), allocatable :: f(:), x(:)
       logical, allocatable :: closed(:), next(:)
       integer, allocatable :: state(:)
-      real(wp), allocatable :: slip(:, :), tau(:, :)
+      real(wp), allocatable :: slip(:, :), tau(:, :), pstar(:, :)
       integer :: it, maxit, n, c, switched, stat
 
       call check_pair(slave, master, surface, friction, kappa, error)
+      if (.not. allocated(error) .and. present(recovered)) call check_recovered(surface, friction, recovered, error)
       if (allocated(error)) return
       maxit = default_max_iterations
       if (present(max_iterations)) maxit = max_iterations
@@ -262,6 +283,7 @@ contains
          closed(c) = any(surface%g0(ops%cell_point(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1)) <= &
             & cell_size(slave, slave%root(surface%slave_cell(ops%cell_point(ops%cell_ptr(c))))))
       end do
+      if (present(recovered)) call cell_tractions(surface, ops, cells, recovered, pstar)
       call timer%stop()
       sol%t_contact = timer%elapsed
       n = slave%n_dofs() + master%n_dofs()
@@ -289,7 +311,11 @@ contains
          sol%iterations = it
          call timer%reset()
          call timer%start()
-         call block_system(slave, master, ops, cells, closed, k, f, error)
+         if (present(recovered)) then
+            call block_system(slave, master, ops, cells, closed, k, f, error, pstar)
+         else
+            call block_system(slave, master, ops, cells, closed, k, f, error)
+         end if
          if (.not. allocated(error)) call check_held(slave, master, k, names, count(closed), it, error)
          if (.not. allocated(error)) call solve_block(k, f, x, sol, error)
          call timer%stop()
@@ -297,7 +323,11 @@ contains
          if (allocated(error)) return
          call timer%reset()
          call timer%start()
-         call evaluate(surface, ops, cells, closed, x, sol, error)
+         if (present(recovered)) then
+            call evaluate(surface, ops, cells, closed, x, sol, error, pstar)
+         else
+            call evaluate(surface, ops, cells, closed, x, sol, error)
+         end if
          if (allocated(error)) return
          next = sol%lambda_n < 0.0_wp
          switched = 0
@@ -623,8 +653,10 @@ contains
    end subroutine body_operators
 
    !> The block system [K_s 0; 0 K_m] + contact terms of the closed cells,
-   !> and its load (module notes).
-   subroutine block_system(slave, master, ops, cells, closed, k, f, error)
+   !> and its load (module notes); with `pstar` (each cell's mean
+   !> stabilization traction, `cell_tractions`) those of the recovered
+   !> stabilization.
+   subroutine block_system(slave, master, ops, cells, closed, k, f, error, pstar)
       type(elasticity_problem_type), intent(in) :: slave, master
       type(point_operators_type), intent(in) :: ops
       type(cell_operators_type), intent(in) :: cells(:)
@@ -632,6 +664,7 @@ contains
       type(csr_type), intent(out) :: k
       real(wp), allocatable, intent(out) :: f(:)
       type(error_type), allocatable, intent(out) :: error
+      real(wp), intent(in), optional :: pstar(:, :)
       type(coo_type) :: coo
       real(wp), allocatable :: kc(:, :)
       integer(i8) :: capacity
@@ -651,10 +684,15 @@ contains
       do c = 1, size(cells)
          if (.not. closed(c)) cycle
          associate (cell => cells(c), gamma => ops%gamma(c))
-            call tied_block(cell, gamma, kc)
+            if (present(pstar)) then
+               kc = (cell%measure*gamma)*matmul(transpose(cell%gbar), cell%gbar)
+               f(cell%dofs) = f(cell%dofs) - cell%measure*matmul(pstar(1:cell%rows, c) + gamma*cell%g0bar, cell%gbar)
+            else
+               call tied_block(cell, gamma, kc)
+               f(cell%dofs) = f(cell%dofs) - cell%measure*matmul(cell%g0bar, cell%tbar + gamma*cell%gbar)
+            end if
             call coo%add(cell%dofs, kc, error)
             if (allocated(error)) return
-            f(cell%dofs) = f(cell%dofs) - cell%measure*matmul(cell%g0bar, cell%tbar + gamma*cell%gbar)
          end associate
       end do
       call coo%to_csr(k, error)
@@ -1042,7 +1080,7 @@ contains
 
    !> Gaps, cell multipliers, pressures and tangential tractions of the
    !> solution x (module notes).
-   subroutine evaluate(surface, ops, cells, closed, x, sol, error)
+   subroutine evaluate(surface, ops, cells, closed, x, sol, error, pstar)
       type(contact_surface_type), intent(in) :: surface
       type(point_operators_type), intent(in) :: ops
       type(cell_operators_type), intent(in) :: cells(:)
@@ -1050,6 +1088,8 @@ contains
       real(wp), intent(in) :: x(:)
       type(contact_solution_type), intent(inout) :: sol
       type(error_type), allocatable, intent(out) :: error
+      !> The cells' mean stabilization tractions (recovered stabilization).
+      real(wp), intent(in), optional :: pstar(:, :)
       real(wp) :: lam(surface%dim), nrm(surface%dim)
       integer :: i, c, j
 
@@ -1058,7 +1098,11 @@ contains
       do c = 1, size(cells)
          associate (cell => cells(c), pts => ops%cell_point(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1))
             lam = 0.0_wp
-            lam(1:cell%rows) = matmul(cell%tbar + ops%gamma(c)*cell%gbar, x(cell%dofs)) + ops%gamma(c)*cell%g0bar
+            if (present(pstar)) then
+               lam(1:cell%rows) = pstar(1:cell%rows, c) + ops%gamma(c)*(matmul(cell%gbar, x(cell%dofs)) + cell%g0bar)
+            else
+               lam(1:cell%rows) = matmul(cell%tbar + ops%gamma(c)*cell%gbar, x(cell%dofs)) + ops%gamma(c)*cell%g0bar
+            end if
             if (cell%rows == 1) then
                sol%lambda_n(c) = lam(1)
             else
@@ -1080,5 +1124,57 @@ contains
          end associate
       end do
    end subroutine evaluate
+
+   !> The recovered stabilization traction must be finite, one vector per
+   !> surface point, and is not combined with Coulomb friction.
+   subroutine check_recovered(surface, friction, recovered, error)
+      type(contact_surface_type), intent(in) :: surface
+      integer, intent(in) :: friction
+      real(wp), intent(in) :: recovered(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: i
+
+      if (friction == friction_coulomb) then
+         call fatal_error(error, 'contact solve: the recovered stabilization is not combined with Coulomb friction '// &
+            & 'in this version', stat_unsupported)
+      else if (size(recovered, 1) /= surface%dim .or. size(recovered, 2) /= surface%npoint) then
+         call fatal_error(error, 'contact solve: recovered has shape ('//itoa(size(recovered, 1))//', '// &
+            & itoa(size(recovered, 2))//'), expected (dim, points) = ('//itoa(surface%dim)//', '// &
+            & itoa(surface%npoint)//')', stat_invalid_input)
+      else
+         do i = 1, surface%npoint
+            if (surface%has_master(i) .and. .not. all(abs(recovered(:, i)) <= huge(1.0_wp))) then
+               call fatal_error(error, 'contact solve: recovered(:, '//itoa(i - 1)//') (0-based point) is not finite', &
+                  & stat_invalid_input)
+               return
+            end if
+         end do
+      end if
+   end subroutine check_recovered
+
+   !> pstar(1:rows, c): the mean over contact cell c's points of the given
+   !> stabilization traction, its normal component n_i.p*_i (frictionless)
+   !> or the vector (stick), as the FE traction's mean tbar.
+   pure subroutine cell_tractions(surface, ops, cells, recovered, pstar)
+      type(contact_surface_type), intent(in) :: surface
+      type(point_operators_type), intent(in) :: ops
+      type(cell_operators_type), intent(in) :: cells(:)
+      real(wp), intent(in) :: recovered(:, :)
+      real(wp), allocatable, intent(out) :: pstar(:, :)
+      integer :: c, j, i
+
+      allocate (pstar(surface%dim, size(cells)), source=0.0_wp)
+      do c = 1, size(cells)
+         do j = ops%cell_ptr(c), ops%cell_ptr(c + 1) - 1
+            i = ops%cell_point(j)
+            if (cells(c)%rows == 1) then
+               pstar(1, c) = pstar(1, c) + surface%weight(i)*dot_product(surface%normal(:, i), recovered(:, i))
+            else
+               pstar(:, c) = pstar(:, c) + surface%weight(i)*recovered(:, i)
+            end if
+         end do
+         pstar(:, c) = pstar(:, c)/cells(c)%measure
+      end do
+   end subroutine cell_tractions
 
 end module sprc_contact_solve

@@ -13,8 +13,11 @@
 !> (sprc_contact_solve: one block system, active-set iteration) in one unit
 !> system (the slave body's modulus unit, the larger strain unit of the two),
 !> and their contact result (`contacts`) comes in scene units. This version
-!> runs one pair with the FE stabilization stress; more pairs and
-!> 'recovered' are refused (stat_unsupported) before any computation.
+!> runs one pair; more pairs (and the recovered stabilization with Coulomb
+!> friction) are refused (stat_unsupported) before any computation. With
+!> `stabilization = 'recovered'` the pair is solved with the FE
+!> stabilization first, then re-solved with the slave body's recovered
+!> traction of the previous solution until it settles (`stabilize_recovered`).
 !> Coulomb friction follows the load path of `&bc stage` and `&contact
 !> steps` (`load_path`); other friction laws take all stages as one load.
 !>
@@ -23,7 +26,8 @@
 module sprc_study_level
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use sprc_core_kinds, only: wp, i8
-   use sprc_core_error, only: error_type, fatal_error, stat_unsupported, stat_internal, stat_invalid_input
+   use sprc_core_error, only: error_type, fatal_error, stat_unsupported, stat_internal, stat_invalid_input, &
+      & stat_not_converged
    use sprc_core_timer, only: timer_type, wall_time
    use sprc_core_alloc, only: check_allocation
    use sprc_core_blas_threads, only: blas_reserve_buffers
@@ -52,7 +56,9 @@ module sprc_study_level
       & contact_slip
    use sprc_contact_surface, only: contact_surface_type, slave_surface_points, initial_gaps
    use sprc_contact_solve, only: contact_solution_type, solve_contact_pair, friction_kind, friction_coulomb, &
-      & friction_frictionless, contact_progress
+      & friction_frictionless, contact_progress, default_max_iterations
+   use sprc_fem_element, only: traction_matrix
+   use sprc_core_text, only: itoa, real_text
    implicit none
    private
 
@@ -404,6 +410,8 @@ contains
             call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, friction_kind(spec%friction), &
                & spec%kappa, names, sol, error, progress=progress)
          end if
+         if (.not. allocated(error) .and. spec%stabilization == 'recovered') &
+            & call stabilize_recovered(study, spec, surface, names, bodies, sol, error)
       end block
       if (allocated(error)) return
       bodies(s)%problem%t_solve = sol%t_solve
@@ -428,6 +436,101 @@ contains
       if (allocated(error)) return
       t_contact = t_contact + timer%elapsed + sol%t_contact
    end subroutine run_contact
+
+   !> Tur's recovered stabilization (sprc_contact_solve notes) from the FE-
+   !> stabilized solution `sol`: recover the slave body's stress, re-solve the
+   !> pair with its traction sigma* n at the slave points as the known
+   !> stabilization traction, until an update leaves the active set as it was
+   !> and moves the contact traction (pressure and tangential part, L2 over
+   !> the slave surface) by at most sqrt(eps) of its norm: the fixed point's
+   !> own round-off tier, as the update contracts by about C_I/kappa (the
+   !> traction operator's bound over the penalty). `sol%iterations` sums every
+   !> active-set iteration of every solve (SCENE.md contact_iterations), and
+   !> `sol%t_contact` the stabilization's recoveries (the stabilization
+   !> traction is a contact term; t_recovery stays the reported fields'); an
+   !> iteration that has not settled after default_max_iterations updates is
+   !> stat_not_converged.
+   subroutine stabilize_recovered(study, spec, surface, names, bodies, sol, error)
+      type(study_type), intent(in) :: study
+      type(contact_spec_type), intent(in) :: spec
+      type(contact_surface_type), intent(in) :: surface
+      character(len=*), intent(in) :: names(2)
+      type(body_level_type), intent(inout) :: bodies(:)
+      type(contact_solution_type), intent(inout) :: sol
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_solution_type) :: next
+      type(timer_type) :: timer
+      real(wp), allocatable :: pstar(:, :)
+      real(wp) :: change, size_, t_solve, t_contact
+      integer :: s, m, it, iterations
+
+      s = spec%slave_index
+      m = spec%master_index
+      iterations = sol%iterations
+      t_solve = sol%t_solve
+      t_contact = sol%t_contact
+      do it = 1, default_max_iterations
+         call timer%reset()
+         call timer%start()
+         call slave_recovered_traction(study, s, bodies(s), surface, pstar, error)
+         call timer%stop()
+         t_contact = t_contact + timer%elapsed
+         if (.not. allocated(error)) call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, &
+            & friction_kind(spec%friction), spec%kappa, names, next, error, recovered=pstar)
+         if (allocated(error)) return
+         iterations = iterations + next%iterations
+         t_solve = t_solve + next%t_solve
+         t_contact = t_contact + next%t_contact
+         change = sqrt(sum(surface%weight*((next%pressure - sol%pressure)**2 + (next%tangential - sol%tangential)**2)))
+         size_ = sqrt(sum(surface%weight*(next%pressure**2 + next%tangential**2)))
+         if (all(next%closed .eqv. sol%closed) .and. change <= sqrt(epsilon(1.0_wp))*size_) exit
+         if (it == default_max_iterations) then
+            call fatal_error(error, "contact '"//trim(names(1))//"' on '"//trim(names(2))//"': the recovered "// &
+               & 'stabilization did not settle in '//itoa(it)//' updates; the last moved the contact traction by '// &
+               & real_text(change/max(size_, tiny(1.0_wp)))//' of its norm and switched '// &
+               & itoa(count(next%closed .neqv. sol%closed))//' points (raise kappa)', stat_not_converged)
+            return
+         end if
+         sol = next
+      end do
+      sol = next
+      sol%iterations = iterations
+      sol%t_solve = t_solve
+      sol%t_contact = t_contact
+   end subroutine stabilize_recovered
+
+   !> The slave body's recovered traction sigma* n at every slave point
+   !> (dim, npoint; zero where the point has no slave cell), in the pair's
+   !> units: the study's SPR-C recovery of the current solution, with the
+   !> patch degree of the scene's SPR-C.
+   subroutine slave_recovered_traction(study, b, bl, surface, pstar, error)
+      type(study_type), intent(in) :: study
+      integer, intent(in) :: b
+      type(body_level_type), intent(inout) :: bl
+      type(contact_surface_type), intent(in) :: surface
+      real(wp), allocatable, intent(out) :: pstar(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      type(recovery_input_type) :: input
+      type(recovered_field_type) :: field
+      real(wp) :: sigma(6), tn(3, 6)
+      integer :: i, d
+
+      d = surface%dim
+      call fe_recovery_input(bl%problem, input, error)
+      if (allocated(error)) return
+      call free_contact_surfaces(study, b, input)
+      call recover_grid(input, bl%problem%mesh%grid, bl%problem%mesh%nodes, bl%problem%mesh%hanging, method_sprc, &
+         & study%degree(2), field, error)
+      if (allocated(error)) return
+      allocate (pstar(d, surface%npoint), source=0.0_wp)
+      do i = 1, surface%npoint
+         if (surface%slave_cell(i) < 1 .or. .not. surface%has_master(i)) cycle
+         call field_eval(field, surface%slave_cell(i), surface%x(:, i), sigma, error)
+         if (allocated(error)) return
+         call traction_matrix(d, surface%normal(:, i), tn(1:d, 1:bl%problem%nstress))
+         pstar(:, i) = matmul(tn(1:d, 1:bl%problem%nstress), sigma(1:bl%problem%nstress))
+      end do
+   end subroutine slave_recovered_traction
 
    !> The load path of a Coulomb pair (SCENE.md `&bc stage`, `&contact
    !> steps`): the block load at the end of each increment, stage k's loads

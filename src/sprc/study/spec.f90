@@ -188,8 +188,8 @@ contains
    end function recovery_degree
 
    !> What of the scene's `&contact` this version's contact FE does not run,
-   !> as a sentence ('' when it runs the scene): one pair with the FE
-   !> stabilization stress (sprc_contact_solve).
+   !> as a sentence ('' when it runs the scene): one pair; the recovered
+   !> stabilization with frictionless or stick contact (sprc_contact_solve).
    pure function contact_unsupported(scene) result(why)
       type(scene_type), intent(in) :: scene
       character(len=:), allocatable :: why
@@ -201,9 +201,8 @@ contains
       if (size(scene%contacts) > 1) then
          write (buf, '(i0)') size(scene%contacts)
          why = '&contact: '//trim(buf)//' contact pairs; this version runs one pair per scene'
-      else if (scene%contacts(1)%stabilization /= 'fe') then
-         why = "&contact: stabilization = '"//scene%contacts(1)%stabilization// &
-            & "' needs the SPR-C contact patches, not in this version (use 'fe')"
+      else if (scene%contacts(1)%stabilization == 'recovered' .and. scene%contacts(1)%friction == 'coulomb') then
+         why = "&contact: stabilization = 'recovered' with friction = 'coulomb' is not in this version (use 'fe')"
       end if
    end function contact_unsupported
 
