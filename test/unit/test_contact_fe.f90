@@ -10,7 +10,7 @@
 !> problem's units).
 module sprc_test_contact_fe
    use sprc_core_kinds, only: wp
-   use sprc_core_error, only: error_type, stat_singular
+   use sprc_core_error, only: error_type, stat_singular, stat_not_converged
    use sprc_io_namelist, only: read_text_file
    use sprc_study_level, only: study_type, level_type
    use sprc_test_study, only: run_text
@@ -52,7 +52,13 @@ contains
          new_unittest('coulomb_proportional_steps', test_coulomb_steps), &
          new_unittest('coulomb_stages_on_one_surface', test_coulomb_stages), &
          new_unittest('cattaneo_mindlin', test_cattaneo_mindlin), &
-         new_unittest('shrink_fit_sphere_q1', test_sphere) &
+         new_unittest('shrink_fit_sphere_q1', test_sphere), &
+         new_unittest('patch_2d_q1_recovered', test_patch_2d_q1_recovered), &
+         new_unittest('patch_2d_q2_recovered', test_patch_2d_q2_recovered), &
+         new_unittest('patch_2d_stick_recovered', test_patch_2d_stick_recovered), &
+         new_unittest('patch_3d_q1_recovered', test_patch_3d_q1_recovered), &
+         new_unittest('shrink_fit_q1_recovered', test_shrink_q1_recovered), &
+         new_unittest('recovered_not_converged', test_recovered_not_converged) &
          ]
    end subroutine collect_contact_fe
 
@@ -77,12 +83,14 @@ contains
    !> replaced), checked against the uniform state of normal stress -1 across
    !> the interface (2D sigma_yy, 3D sigma_zz; `ns` Voigt components) and the
    !> contact pressure `p_exact` (default 1) at every closed slave point.
-   subroutine patch_case(path, order, level, old, new, ns, error, stick, p_exact)
+   subroutine patch_case(path, order, level, old, new, ns, error, stick, p_exact, recovered)
       character(len=*), intent(in) :: path, old, new
       integer, intent(in) :: order, level, ns
       type(error_type), allocatable, intent(out) :: error
       logical, intent(in), optional :: stick
       real(wp), intent(in), optional :: p_exact
+      !> With the recovered stabilization (`test_patch_2d_q1_recovered`).
+      logical, intent(in), optional :: recovered
       type(level_type) :: result
       real(wp) :: worst, pworst, tol
       character(len=:), allocatable :: text
@@ -92,8 +100,10 @@ contains
       text = replaced(text, 'order    = 1', 'order    = '//achar(48 + order))
       if (len(old) > 0) text = replaced(text, old, new)
       if (present(stick)) text = replaced(text, "friction='frictionless'", "friction='stick'")
+      if (present(recovered)) text = replaced(text, '&contact ', "&contact stabilization='recovered' ")
       call uniform_errors(text, level, ns, result, worst, pworst, tol, error, p_exact)
       if (allocated(error)) return
+      if (present(recovered)) tol = tol + sqrt(epsilon(1.0_wp))
       call check(error, worst <= tol, 'uniform stress: max error '//real_text(worst)//' > '//real_text(tol))
       if (allocated(error)) return
       call check(error, all(result%contacts(1)%state /= contact_open), 'every slave point is closed')
@@ -392,13 +402,14 @@ contains
    !> closed measure (the report's contact_measure) the quarter circumference
    !> of the slave surface, pi/2 * 1.50001, within the cut-cell quadrature
    !> tolerance (`measure_tolerance`).
-   subroutine shrink_case(order, analysis, young_shaft, levels, error, kappa)
+   subroutine shrink_case(order, analysis, young_shaft, levels, error, kappa, stabilization)
       integer, intent(in) :: order
       character(len=*), intent(in) :: analysis
       real(wp), intent(in) :: young_shaft
       integer, intent(in) :: levels(:)
       type(error_type), allocatable, intent(out) :: error
       real(wp), intent(in), optional :: kappa
+      character(len=*), intent(in), optional :: stabilization
       real(wp), parameter :: delta = 1.0e-5_wp, p_in = 1.0e-3_wp
       type(compound_type) :: exact
       type(level_type) :: result
@@ -430,6 +441,7 @@ contains
          & "&bc on='hub_sx' type='symmetry' /"//nl//"&bc on='hub_sy' type='symmetry' /"//nl// &
          & "&contact slave='shaft' master='hub' slave_surface='shaft_out' master_surface='hub_in'"
       if (present(kappa)) text = text//" kappa="//real_text(kappa)
+      if (present(stabilization)) text = text//" stabilization='"//stabilization//"'"
       text = text//" /"//nl
       do i = 1, size(levels)
          call run_text(text, levels(i), result, error, study)
@@ -614,5 +626,63 @@ contains
       write (buf, '(es12.4)') x
       s = trim(adjustl(buf))
    end function real_text
+
+   !> The patch tests with the recovered stabilization (sprc_contact_solve
+   !> notes): the uniform state is its fixed point (the SPR-C traction of a
+   !> uniform FE field is exact, so gbar = 0 and lambda = p*), reached from
+   !> the penalty start. Tolerance: the solve's C eps/rcond plus the
+   !> iteration's stopping tier sqrt(eps) (relative change of the contact
+   !> traction, which bounds the distance to the fixed point while the update
+   !> contracts by at most 1/2).
+   subroutine test_patch_2d_q1_recovered(error)
+      type(error_type), allocatable, intent(out) :: error
+      call patch_case(patch_2d, 1, 3, '', '', 3, error, recovered=.true.)
+   end subroutine test_patch_2d_q1_recovered
+
+   subroutine test_patch_2d_q2_recovered(error)
+      type(error_type), allocatable, intent(out) :: error
+      call patch_case(patch_2d, 2, 2, '', '', 3, error, recovered=.true.)
+   end subroutine test_patch_2d_q2_recovered
+
+   subroutine test_patch_2d_stick_recovered(error)
+      type(error_type), allocatable, intent(out) :: error
+      call patch_case(patch_2d, 1, 3, "young=3.0 poisson=0.2", "young=1.0 poisson=0.3", 3, error, stick=.true., &
+         & recovered=.true.)
+   end subroutine test_patch_2d_stick_recovered
+
+   subroutine test_patch_3d_q1_recovered(error)
+      type(error_type), allocatable, intent(out) :: error
+      call patch_case(patch_3d, 1, 2, '', '', 6, error, recovered=.true.)
+   end subroutine test_patch_3d_q1_recovered
+
+   !> The shrink fit's checks (rates of err_fe and err_p_fe, pressure error
+   !> below err_fe) hold with the recovered stabilization.
+   subroutine test_shrink_q1_recovered(error)
+      type(error_type), allocatable, intent(out) :: error
+      call shrink_case(1, 'plane_strain', 2.0_wp, [4, 5, 6], error, stabilization='recovered')
+   end subroutine test_shrink_q1_recovered
+
+   !> A stabilization far too weak for the lagged traction (kappa = 1e-3: the
+   !> update contracts by about C_I/kappa > 1) does not settle: an error with
+   !> stat_not_converged saying so, not a wrong answer.
+   subroutine test_recovered_not_converged(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(level_type) :: result
+      type(error_type), allocatable :: failed
+      character(len=:), allocatable :: text
+
+      call read_text_file('example/scenes/shrink_fit.nml', text, error)
+      if (allocated(error)) return
+      text = replaced(text, "friction='frictionless' /", "friction='frictionless' stabilization='recovered' kappa=1e-3 /")
+      call run_text(text, 3, result, failed)
+      if (.not. allocated(failed)) then
+         call test_failed(error, 'the recovered stabilization settled at kappa = 1e-3')
+         return
+      end if
+      call check(error, failed%stat, stat_not_converged, 'status not converged: '//failed%message)
+      if (allocated(error)) return
+      call check(error, index(failed%message, "contact 'shaft' on 'hub': the recovered stabilization did not settle") &
+         & > 0, 'message: '//failed%message)
+   end subroutine test_recovered_not_converged
 
 end module sprc_test_contact_fe

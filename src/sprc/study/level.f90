@@ -406,12 +406,12 @@ contains
          if (friction_kind(spec%friction) == friction_coulomb) then
             call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, friction_coulomb, spec%kappa, &
                & names, sol, error, mu=spec%mu, loads=loads, progress=progress)
+         else if (spec%stabilization == 'recovered') then
+            call stabilize_recovered(study, spec, surface, names, bodies, sol, error)
          else
             call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, friction_kind(spec%friction), &
                & spec%kappa, names, sol, error, progress=progress)
          end if
-         if (.not. allocated(error) .and. spec%stabilization == 'recovered') &
-            & call stabilize_recovered(study, spec, surface, names, bodies, sol, error)
       end block
       if (allocated(error)) return
       bodies(s)%problem%t_solve = sol%t_solve
@@ -437,10 +437,11 @@ contains
       t_contact = t_contact + timer%elapsed + sol%t_contact
    end subroutine run_contact
 
-   !> Tur's recovered stabilization (sprc_contact_solve notes) from the FE-
-   !> stabilized solution `sol`: recover the slave body's stress, re-solve the
-   !> pair with its traction sigma* n at the slave points as the known
-   !> stabilization traction, until an update leaves the active set as it was
+   !> Tur's recovered stabilization (sprc_contact_solve notes): the pair
+   !> solved with a zero stabilization traction first (the penalty method,
+   !> SPD for every kappa), then again and again with the slave body's
+   !> recovered traction sigma* n of the previous solution at the slave
+   !> points as the known stabilization traction, until an update leaves the active set as it was
    !> and moves the contact traction (pressure and tangential part, L2 over
    !> the slave surface) by at most sqrt(eps) of its norm: the fixed point's
    !> own round-off tier, as the update contracts by about C_I/kappa (the
@@ -456,7 +457,7 @@ contains
       type(contact_surface_type), intent(in) :: surface
       character(len=*), intent(in) :: names(2)
       type(body_level_type), intent(inout) :: bodies(:)
-      type(contact_solution_type), intent(inout) :: sol
+      type(contact_solution_type), intent(out) :: sol
       type(error_type), allocatable, intent(out) :: error
       type(contact_solution_type) :: next
       type(timer_type) :: timer
@@ -466,6 +467,10 @@ contains
 
       s = spec%slave_index
       m = spec%master_index
+      allocate (pstar(surface%dim, surface%npoint), source=0.0_wp)
+      call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, friction_kind(spec%friction), &
+         & spec%kappa, names, sol, error, recovered=pstar)
+      if (allocated(error)) return
       iterations = sol%iterations
       t_solve = sol%t_solve
       t_contact = sol%t_contact
