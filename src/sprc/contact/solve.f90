@@ -122,7 +122,10 @@
 !> set changes the load alone. It is SPD for every gamma > 0 (no trace
 !> inverse bound to beat), and with p* the exact traction the exact solution
 !> satisfies it (gbar = 0, lambda = p*): the method is consistent when the
-!> recovery is exact. Frictionless and stick; Coulomb is refused.
+!> recovery is exact. Frictionless and stick; Coulomb is refused. A caller
+!> that updates p* passes a `contact_factor_type`: the solve starts from the
+!> active set of the previous one and, while the set repeats, reuses its
+!> CHOLMOD factor (one back substitution per update, no assembly).
 module sprc_contact_solve
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_not_converged, stat_singular, &
@@ -134,12 +137,13 @@ module sprc_contact_solve
    use sprc_fem_element, only: shape_functions, strain_matrix, traction_matrix, displacement_matrix
    use sprc_fem_problem, only: elasticity_problem_type, free_motions, motion_names, solve_spd_or_lu
    use sprc_fem_umfpack, only: umfpack_solver_type
+   use sprc_fem_cholmod, only: cholmod_solver_type
    use sprc_contact_surface, only: contact_surface_type
    use sprc_contact_result, only: contact_open, contact_stick, contact_slip
    implicit none
    private
 
-   public :: contact_solution_type, solve_contact_pair, friction_kind, contact_progress
+   public :: contact_solution_type, solve_contact_pair, friction_kind, contact_progress, contact_factor_type
    public :: friction_frictionless, friction_stick, friction_coulomb, default_max_iterations
 
    abstract interface
@@ -195,6 +199,18 @@ module sprc_contact_solve
       real(wp), allocatable :: ns(:, :), ts(:, :), nm(:, :), tm(:, :)
    end type local_type
 
+   !> The CHOLMOD factor of a recovered-stabilization block system and the
+   !> contact cells' active set it was built for (module notes), kept by the
+   !> caller between updates of the stabilization traction.
+   type :: contact_factor_type
+      private
+      type(cholmod_solver_type) :: chol
+      logical, allocatable :: closed(:)
+   contains
+      !> `destroy()`: release the factor (harmless when repeated).
+      procedure :: destroy => factor_destroy
+   end type contact_factor_type
+
    !> What the coupled solve gives per slave point (in the problems' units).
    type :: contact_solution_type
       !> Active-set iterations (factorizations).
@@ -236,7 +252,7 @@ contains
    !> both problems hold their solution (`set_solution`). `names` are the slave
    !> and master body names for messages.
    subroutine solve_contact_pair(slave, master, surface, friction, kappa, names, sol, error, max_iterations, mu, &
-         & loads, progress, recovered)
+         & loads, progress, recovered, factor)
       type(elasticity_problem_type), intent(inout) :: slave, master
       type(contact_surface_type), intent(in) :: surface
       integer, intent(in) :: friction
@@ -255,6 +271,9 @@ contains
       !> in the problems' units: Tur's variant (module notes); without it the
       !> slave's FE traction.
       real(wp), intent(in), optional :: recovered(:, :)
+      !> With `recovered`: the factor of the previous solve (module notes),
+      !> updated.
+      type(contact_factor_type), intent(inout), optional :: factor
       type(point_operators_type) :: ops
       type(cell_operators_type), allocatable :: cells(:)
       type(csr_type) :: k
@@ -264,6 +283,7 @@ contains
       integer, allocatable :: state(:)
       real(wp), allocatable :: slip(:, :), tau(:, :), pstar(:, :)
       integer :: it, maxit, n, c, switched, stat
+      logical :: kept
 
       call check_pair(slave, master, surface, friction, kappa, error)
       if (.not. allocated(error) .and. present(recovered)) call check_recovered(surface, friction, recovered, error)
@@ -284,6 +304,12 @@ contains
             & cell_size(slave, slave%root(surface%slave_cell(ops%cell_point(ops%cell_ptr(c))))))
       end do
       if (present(recovered)) call cell_tractions(surface, ops, cells, recovered, pstar)
+      kept = present(factor) .and. present(recovered)
+      if (kept) then
+         if (allocated(factor%closed)) then
+            if (size(factor%closed) == size(closed)) closed = factor%closed
+         end if
+      end if
       call timer%stop()
       sol%t_contact = timer%elapsed
       n = slave%n_dofs() + master%n_dofs()
@@ -311,13 +337,15 @@ contains
          sol%iterations = it
          call timer%reset()
          call timer%start()
-         if (present(recovered)) then
+         if (kept) then
+            call factored_solve(slave, master, ops, cells, closed, pstar, names, it, factor, x, sol, error)
+         else if (present(recovered)) then
             call block_system(slave, master, ops, cells, closed, k, f, error, pstar)
          else
             call block_system(slave, master, ops, cells, closed, k, f, error)
          end if
-         if (.not. allocated(error)) call check_held(slave, master, k, names, count(closed), it, error)
-         if (.not. allocated(error)) call solve_block(k, f, x, sol, error)
+         if (.not. (allocated(error) .or. kept)) call check_held(slave, master, k, names, count(closed), it, error)
+         if (.not. (allocated(error) .or. kept)) call solve_block(k, f, x, sol, error)
          call timer%stop()
          sol%t_solve = sol%t_solve + timer%elapsed
          if (allocated(error)) return
@@ -680,23 +708,91 @@ contains
       call add_csr(coo, slave%k, 0, error)
       if (.not. allocated(error)) call add_csr(coo, master%k, ns, error)
       if (allocated(error)) return
-      f = [slave%f, master%f]
       do c = 1, size(cells)
          if (.not. closed(c)) cycle
          associate (cell => cells(c), gamma => ops%gamma(c))
             if (present(pstar)) then
                kc = (cell%measure*gamma)*matmul(transpose(cell%gbar), cell%gbar)
-               f(cell%dofs) = f(cell%dofs) - cell%measure*matmul(pstar(1:cell%rows, c) + gamma*cell%g0bar, cell%gbar)
             else
                call tied_block(cell, gamma, kc)
-               f(cell%dofs) = f(cell%dofs) - cell%measure*matmul(cell%g0bar, cell%tbar + gamma*cell%gbar)
             end if
             call coo%add(cell%dofs, kc, error)
             if (allocated(error)) return
          end associate
       end do
       call coo%to_csr(k, error)
+      if (.not. allocated(error)) call block_load(slave, master, ops, cells, closed, f, pstar)
    end subroutine block_system
+
+   !> The load of `block_system`.
+   pure subroutine block_load(slave, master, ops, cells, closed, f, pstar)
+      type(elasticity_problem_type), intent(in) :: slave, master
+      type(point_operators_type), intent(in) :: ops
+      type(cell_operators_type), intent(in) :: cells(:)
+      logical, intent(in) :: closed(:)
+      real(wp), allocatable, intent(out) :: f(:)
+      real(wp), intent(in), optional :: pstar(:, :)
+      integer :: c
+
+      f = [slave%f, master%f]
+      do c = 1, size(cells)
+         if (.not. closed(c)) cycle
+         associate (cell => cells(c), gamma => ops%gamma(c))
+            if (present(pstar)) then
+               f(cell%dofs) = f(cell%dofs) - cell%measure*matmul(pstar(1:cell%rows, c) + gamma*cell%g0bar, cell%gbar)
+            else
+               f(cell%dofs) = f(cell%dofs) - cell%measure*matmul(cell%g0bar, cell%tbar + gamma*cell%gbar)
+            end if
+         end associate
+      end do
+   end subroutine block_load
+
+   !> One active-set iteration of the recovered stabilization with a kept
+   !> factor: while the active set is the factor's, only the load is built
+   !> and the factor solves it; else the block system is assembled, checked
+   !> for free rigid modes and factorized (CHOLMOD: SPD for every gamma),
+   !> replacing the factor.
+   subroutine factored_solve(slave, master, ops, cells, closed, pstar, names, it, factor, x, sol, error)
+      type(elasticity_problem_type), intent(in) :: slave, master
+      type(point_operators_type), intent(in) :: ops
+      type(cell_operators_type), intent(in) :: cells(:)
+      logical, intent(in) :: closed(:)
+      real(wp), intent(in) :: pstar(:, :)
+      character(len=*), intent(in) :: names(2)
+      integer, intent(in) :: it
+      type(contact_factor_type), intent(inout) :: factor
+      real(wp), intent(inout) :: x(:)
+      type(contact_solution_type), intent(inout) :: sol
+      type(error_type), allocatable, intent(out) :: error
+      type(csr_type) :: k
+      real(wp), allocatable :: f(:)
+      logical :: same
+
+      same = .false.
+      if (allocated(factor%closed)) same = size(factor%closed) == size(closed)
+      if (same) same = all(factor%closed .eqv. closed)
+      if (same) then
+         call block_load(slave, master, ops, cells, closed, f, pstar)
+      else
+         call factor%destroy()
+         call block_system(slave, master, ops, cells, closed, k, f, error, pstar)
+         if (.not. allocated(error)) call check_held(slave, master, k, names, count(closed), it, error)
+         if (.not. allocated(error)) call factor%chol%factorize(k, error)
+         if (allocated(error)) return
+         factor%closed = closed
+      end if
+      sol%solver_name = 'cholmod'
+      sol%rcond = factor%chol%rcond_estimate
+      call factor%chol%solve(f, x, error)
+      if (allocated(error)) error%message = 'contact solve (CHOLMOD): '//error%message
+   end subroutine factored_solve
+
+   !> Release a contact factor.
+   subroutine factor_destroy(self)
+      class(contact_factor_type), intent(inout) :: self
+      call self%chol%destroy()
+      if (allocated(self%closed)) deallocate (self%closed)
+   end subroutine factor_destroy
 
    !> The block of a closed cell whose rows are all tied (frictionless: the
    !> normal row; stick: every component): W [T^T G + G^T T + gamma G^T G] -

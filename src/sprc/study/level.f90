@@ -56,7 +56,7 @@ module sprc_study_level
       & contact_slip
    use sprc_contact_surface, only: contact_surface_type, slave_surface_points, initial_gaps
    use sprc_contact_solve, only: contact_solution_type, solve_contact_pair, friction_kind, friction_coulomb, &
-      & friction_frictionless, contact_progress, default_max_iterations
+      & friction_frictionless, contact_progress, default_max_iterations, contact_factor_type
    use sprc_fem_element, only: traction_matrix
    use sprc_core_text, only: itoa, real_text
    implicit none
@@ -459,6 +459,24 @@ contains
       type(body_level_type), intent(inout) :: bodies(:)
       type(contact_solution_type), intent(out) :: sol
       type(error_type), allocatable, intent(out) :: error
+      type(contact_factor_type) :: factor
+
+      call recovered_updates(study, spec, surface, names, bodies, factor, sol, error)
+      call factor%destroy()
+   end subroutine stabilize_recovered
+
+   !> The iteration of `stabilize_recovered` with the block factor kept
+   !> between updates (sprc_contact_solve: the matrix depends on the active
+   !> set only).
+   subroutine recovered_updates(study, spec, surface, names, bodies, factor, sol, error)
+      type(study_type), intent(in) :: study
+      type(contact_spec_type), intent(in) :: spec
+      type(contact_surface_type), intent(in) :: surface
+      character(len=*), intent(in) :: names(2)
+      type(body_level_type), intent(inout) :: bodies(:)
+      type(contact_factor_type), intent(inout) :: factor
+      type(contact_solution_type), intent(out) :: sol
+      type(error_type), allocatable, intent(out) :: error
       type(contact_solution_type) :: next
       type(timer_type) :: timer
       real(wp), allocatable :: pstar(:, :)
@@ -469,7 +487,7 @@ contains
       m = spec%master_index
       allocate (pstar(surface%dim, surface%npoint), source=0.0_wp)
       call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, friction_kind(spec%friction), &
-         & spec%kappa, names, sol, error, recovered=pstar)
+         & spec%kappa, names, sol, error, recovered=pstar, factor=factor)
       if (allocated(error)) return
       iterations = sol%iterations
       t_solve = sol%t_solve
@@ -481,7 +499,7 @@ contains
          call timer%stop()
          t_contact = t_contact + timer%elapsed
          if (.not. allocated(error)) call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, &
-            & friction_kind(spec%friction), spec%kappa, names, next, error, recovered=pstar)
+            & friction_kind(spec%friction), spec%kappa, names, next, error, recovered=pstar, factor=factor)
          if (allocated(error)) return
          iterations = iterations + next%iterations
          t_solve = t_solve + next%t_solve
@@ -502,7 +520,7 @@ contains
       sol%iterations = iterations
       sol%t_solve = t_solve
       sol%t_contact = t_contact
-   end subroutine stabilize_recovered
+   end subroutine recovered_updates
 
    !> The slave body's recovered traction sigma* n at every slave point
    !> (dim, npoint; zero where the point has no slave cell), in the pair's
