@@ -15,9 +15,10 @@
 !> and their contact result (`contacts`) comes in scene units. This version
 !> runs one pair; more pairs (and the recovered stabilization with Coulomb
 !> friction) are refused (stat_unsupported) before any computation. With
-!> `stabilization = 'recovered'` the pair is solved with the FE
-!> stabilization first, then re-solved with the slave body's recovered
-!> traction of the previous solution until it settles (`stabilize_recovered`).
+!> `stabilization = 'recovered'` the pair is solved with a zero
+!> stabilization traction first (penalty), then re-solved with the slave
+!> body's recovered traction of the previous solution until it settles
+!> (`stabilize_recovered`).
 !> Coulomb friction follows the load path of `&bc stage` and `&contact
 !> steps` (`load_path`); other friction laws take all stages as one load.
 !>
@@ -441,8 +442,8 @@ contains
    !> solved with a zero stabilization traction first (the penalty method,
    !> SPD for every kappa), then again and again with the slave body's
    !> recovered traction sigma* n of the previous solution at the slave
-   !> points as the known stabilization traction, until an update leaves the active set as it was
-   !> and moves the contact traction (pressure and tangential part, L2 over
+   !> points as the known stabilization traction, until an update leaves
+   !> the active set as it was and moves the contact traction (pressure and tangential part, L2 over
    !> the slave surface) by at most sqrt(eps) of its norm: the fixed point's
    !> own round-off tier, as the update contracts by about C_I/kappa (the
    !> traction operator's bound over the penalty). `sol%iterations` sums every
@@ -529,7 +530,7 @@ contains
    subroutine slave_recovered_traction(study, b, bl, surface, pstar, error)
       type(study_type), intent(in) :: study
       integer, intent(in) :: b
-      type(body_level_type), intent(inout) :: bl
+      type(body_level_type), intent(in) :: bl
       type(contact_surface_type), intent(in) :: surface
       real(wp), allocatable, intent(out) :: pstar(:, :)
       type(error_type), allocatable, intent(out) :: error
