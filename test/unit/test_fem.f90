@@ -1196,29 +1196,54 @@ contains
 
    end subroutine test_queries
 
-   !> Same displacement bits with 1 and 2 OpenMP threads (parallel quadrature
-   !> and element matrices, serial insertion).
+   !> Same bits with 1 and 2 OpenMP threads (parallel quadrature, element matrices
+   !> written to their places in the triplet list), 2D Q2 (Lame quarter, level 4) and
+   !> 3D Q1 (sphere octant, level 3): quadrature points and weights, matrix, load,
+   !> displacements.
    subroutine test_threads(error)
       type(error_type), allocatable, intent(out) :: error
       type(body_type) :: body
       type(fe_bc_type), allocatable :: bcs(:)
       type(lame_cylinder_type) :: exact
-      type(elasticity_problem_type) :: one, two
-      integer :: nthreads
+      type(lame_sphere_type) :: sphere
+      type(elasticity_problem_type) :: run(2)
+      integer :: nthreads, nt
 
       nthreads = 1
       !$ nthreads = omp_get_max_threads()
       call lame_quarter(body, bcs, exact, plane_strain, error)
       if (allocated(error)) return
-      !$ call omp_set_num_threads(1)
-      call solve_on_grid(one, body, [0.0_wp, 0.0_wp], 25.0_wp, 4, 1, 2, plane_strain, young, poisson, &
-         & [0.0_wp, 0.0_wp], bcs, error, exact=exact)
-      !$ call omp_set_num_threads(2)
-      if (.not. allocated(error)) call solve_on_grid(two, body, [0.0_wp, 0.0_wp], 25.0_wp, 4, 1, 2, plane_strain, &
-         & young, poisson, [0.0_wp, 0.0_wp], bcs, error, exact=exact)
+      do nt = 1, 2
+         !$ call omp_set_num_threads(nt)
+         call solve_on_grid(run(nt), body, [0.0_wp, 0.0_wp], 25.0_wp, 4, 1, 2, plane_strain, young, poisson, &
+            & [0.0_wp, 0.0_wp], bcs, error, exact=exact)
+         if (allocated(error)) exit
+      end do
       !$ call omp_set_num_threads(nthreads)
       if (allocated(error)) return
-      call check(error, all(one%u == two%u) .and. all(one%k%val == two%k%val), 'identical bits')
+      call check(error, same_bits(run(1), run(2)), '2D Q2: identical bits with 1 and 2 threads')
+      if (allocated(error)) return
+      call sphere_octant(body, bcs, sphere, error)
+      if (allocated(error)) return
+      do nt = 1, 2
+         !$ call omp_set_num_threads(nt)
+         call solve_on_grid(run(nt), body, [0.0_wp, 0.0_wp, 0.0_wp], 25.0_wp, 3, 0, 1, solid, young, poisson, &
+            & [0.0_wp, 0.0_wp, 0.0_wp], bcs, error, exact=sphere)
+         if (allocated(error)) exit
+      end do
+      !$ call omp_set_num_threads(nthreads)
+      if (allocated(error)) return
+      call check(error, same_bits(run(1), run(2)), '3D Q1: identical bits with 1 and 2 threads')
+   contains
+      logical function same_bits(a, b)
+         type(elasticity_problem_type), intent(in) :: a, b
+         same_bits = size(a%mesh%vol_w) == size(b%mesh%vol_w) .and. size(a%mesh%surf_w) == size(b%mesh%surf_w) &
+            & .and. size(a%k%val) == size(b%k%val)
+         if (.not. same_bits) return
+         same_bits = all(a%mesh%vol_x == b%mesh%vol_x) .and. all(a%mesh%vol_w == b%mesh%vol_w) .and. &
+            & all(a%mesh%surf_x == b%mesh%surf_x) .and. all(a%mesh%surf_w == b%mesh%surf_w) .and. &
+            & all(a%k%col == b%k%col) .and. all(a%k%val == b%k%val) .and. all(a%f == b%f) .and. all(a%u == b%u)
+      end function same_bits
    end subroutine test_threads
 
 end module sprc_test_fem

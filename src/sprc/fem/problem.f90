@@ -56,10 +56,12 @@
 !> every stress this type returns is then sigma_bar.
 !>
 !> Determinism: quadrature and element matrices are computed in parallel
-!> (OpenMP), in chunks of elements, and inserted into the COO list serially
-!> in element order; reductions (norms, errors) are summed serially in
-!> element order. The bits do not depend on the thread count.
+!> (OpenMP), each element's triplets written to the places its index fixes in
+!> the COO list (element order, as serial insertion would give); reductions
+!> (norms, errors) are summed serially in element order. The bits do not
+!> depend on the thread count.
 module sprc_fem_problem
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular, &
       & stat_not_positive_definite
@@ -96,9 +98,6 @@ module sprc_fem_problem
 
    public :: elasticity_problem_type, default_gamma, rigid_tol, solve_on_grid, gamma_range, gamma_note
    public :: free_motions, motion_names, solve_spd_or_lu
-
-   !> Elements per chunk of the parallel assembly (bounds the buffer of reduced matrices).
-   integer, parameter :: chunk_size = 256
 
    !> A rigid-body mode whose normalised energy (module notes of `check_rigid_modes`)
    !> is below this is free. Free modes give round-off, ~1e-15; the weakest
@@ -548,74 +547,121 @@ contains
       self%solved = .true.
    end subroutine expand_solution
 
-   !> K and f: element systems in parallel chunks, reduced by T_e, inserted in element order.
+   !> K and f: element systems in one parallel loop, reduced by T_e, triplets in element order.
    subroutine assemble(self, error)
       type(elasticity_problem_type), intent(inout) :: self
       type(error_type), allocatable, intent(out) :: error
       type(coo_type) :: coo
-      integer, allocatable :: mdof(:), dofs(:, :), offset(:)
-      real(wp), allocatable :: kbuf(:), fbuf(:, :)
-      integer :: nel, nd, maxm, c0, c1, e, m, k0, saved_blas, stat
+      integer, allocatable :: mdof(:), fdof(:), bad(:)
+      integer(i8), allocatable :: koff(:), foff(:)
+      real(wp), allocatable :: fval(:)
+      integer(i8) :: k
+      integer :: nel, maxm, e, saved_blas, stat
       character(len=*), parameter :: who = 'elasticity assembly'
 
       nel = self%mesh%grid%n_leaves
-      nd = self%dim*self%nen
-      ! distinct reduced dofs of each element (bounds the buffers)
-      allocate (mdof(nel), stat=stat)
-      call check_allocation(stat, who, 'the reduced dof count of each element', nel, 4, error)
+      ! distinct reduced dofs of each element (bounds the buffers and places its triplets)
+      allocate (mdof(nel), koff(nel + 1), foff(nel + 1), bad(nel), stat=stat)
+      call check_allocation(stat, who, 'the reduced dof count and offsets of each element', nel, 24, error)
       if (allocated(error)) return
-      block
-         integer, allocatable :: dtmp(:)
-         real(wp), allocatable :: ttmp(:, :)
-         allocate (dtmp(nd*32), ttmp(nd, nd*32))
-         do e = 1, nel
-            call self%constraints%element_map(self%mesh%nodes%connectivity(:, e), dtmp, ttmp, mdof(e))
-         end do
-      end block
+      call element_dof_counts(self, mdof)
       maxm = maxval(mdof)
+      koff(1) = 1
+      foff(1) = 1
+      do e = 1, nel
+         koff(e + 1) = koff(e) + int(mdof(e), i8)**2
+         foff(e + 1) = foff(e) + mdof(e)
+      end do
       call coo%init(self%constraints%n_dofs, self%constraints%n_dofs, error, &
-         & capacity=sum(int(mdof, kind(coo%nnz))**2) + aggregate_capacity(self, mdof))
+         & capacity=koff(nel + 1) - 1 + aggregate_capacity(self, mdof))
       if (allocated(error)) return
       if (allocated(self%f)) deallocate (self%f)
       allocate (self%f(self%constraints%n_dofs), stat=stat)
       call check_allocation(stat, who, 'the load vector', self%constraints%n_dofs, 8, error)
       if (allocated(error)) return
-      self%f = 0.0_wp
-      allocate (dofs(maxm, chunk_size), fbuf(maxm, chunk_size), offset(chunk_size + 1))
+      allocate (fdof(foff(nel + 1) - 1), fval(foff(nel + 1) - 1), stat=stat)
+      call check_allocation(stat, who, 'the reduced element loads', foff(nel + 1) - 1, 12, error)
+      if (allocated(error)) return
       ! Small dgemm calls from every thread: OpenBLAS in one thread (sprc_core_blas_threads).
       saved_blas = blas_serial_begin()
-      do c0 = 1, nel, chunk_size
-         c1 = min(nel, c0 + chunk_size - 1)
-         offset(1) = 1
-         do e = c0, c1
-            offset(e - c0 + 2) = offset(e - c0 + 1) + mdof(e)**2
-         end do
-         if (allocated(kbuf)) then
-            if (size(kbuf) < offset(c1 - c0 + 2)) deallocate (kbuf)
-         end if
-         if (.not. allocated(kbuf)) allocate (kbuf(offset(c1 - c0 + 2)))
-         !$omp parallel do schedule(dynamic, 4) default(shared) private(e, k0, m)
-         do e = c0, c1
-            k0 = offset(e - c0 + 1)
-            call reduced_element_system(self, e, maxm, dofs(:, e - c0 + 1), m, &
-               & kbuf(k0:k0 + mdof(e)**2 - 1), fbuf(:, e - c0 + 1))
-         end do
-         !$omp end parallel do
-         do e = c0, c1
-            m = mdof(e)
-            k0 = offset(e - c0 + 1)
-            call coo%add(dofs(1:m, e - c0 + 1), reshape(kbuf(k0:k0 + m*m - 1), [m, m]), error)
-            if (allocated(error)) exit
-            self%f(dofs(1:m, e - c0 + 1)) = self%f(dofs(1:m, e - c0 + 1)) + fbuf(1:m, e - c0 + 1)
-         end do
-         if (allocated(error)) exit
-      end do
+      call element_triplets(self, maxm, koff, foff, coo, fdof, fval, bad)
       call blas_serial_end(saved_blas)
-      if (allocated(error)) return
+      if (any(bad /= 0)) then
+         e = findloc(bad /= 0, .true., 1)
+         call fatal_error(error, who//': the stiffness of cell '//itoa(e - 1)//' is not finite (NaN or Inf)', &
+            & stat_invalid_input)
+         return
+      end if
+      coo%nnz = koff(nel + 1) - 1
+      ! the loads in element order, as the triplets: the same sums for any thread count
+      self%f = 0.0_wp
+      do k = 1, foff(nel + 1) - 1
+         self%f(fdof(k)) = self%f(fdof(k)) + fval(k)
+      end do
       call assemble_aggregates(self, maxm, coo, error)
       if (allocated(error)) return
       call coo%to_csr(self%k, error)
    end subroutine assemble
+
+   !> The number of distinct reduced dofs of every element (OpenMP over elements).
+   subroutine element_dof_counts(self, mdof)
+      type(elasticity_problem_type), intent(in) :: self
+      integer, intent(out) :: mdof(:)
+      integer, allocatable :: dtmp(:)
+      real(wp), allocatable :: ttmp(:, :)
+      integer :: nd, e
+
+      nd = self%dim*self%nen
+      !$omp parallel default(shared) private(dtmp, ttmp, e)
+      allocate (dtmp(nd*32), ttmp(nd, nd*32))
+      !$omp do schedule(static)
+      do e = 1, size(mdof)
+         call self%constraints%element_map(self%mesh%nodes%connectivity(:, e), dtmp, ttmp, mdof(e))
+      end do
+      !$omp end do
+      !$omp end parallel
+   end subroutine element_dof_counts
+
+   !> The reduced system of every element, in one parallel loop: element e's m x m block
+   !> goes to the triplets koff(e) .. koff(e + 1) - 1 of `coo` (column-major, as
+   !> coo%add would put it) and its load to fdof / fval(foff(e) .. foff(e + 1) - 1). The
+   !> places depend only on e, so the triplet list is the same for any thread count, and
+   !> a single parallel region has no serial step between chunks for a thread to wait at
+   !> (each such barrier costs a scheduling delay on a loaded machine). bad(e) /= 0: the
+   !> block of e is not finite.
+   subroutine element_triplets(self, maxm, koff, foff, coo, fdof, fval, bad)
+      type(elasticity_problem_type), intent(in) :: self
+      integer, intent(in) :: maxm
+      integer(i8), intent(in) :: koff(:), foff(:)
+      type(coo_type), intent(inout) :: coo
+      integer, intent(out) :: fdof(:), bad(:)
+      real(wp), intent(out) :: fval(:)
+      integer, allocatable :: dofs(:)
+      real(wp), allocatable :: kr(:), fr(:)
+      integer(i8) :: k
+      integer :: e, m, a, b
+
+      !$omp parallel default(shared) private(dofs, kr, fr, e, m, a, b, k)
+      allocate (dofs(maxm), kr(maxm*maxm), fr(maxm))
+      !$omp do schedule(dynamic, 16)
+      do e = 1, size(bad)
+         call reduced_element_system(self, e, maxm, dofs, m, kr, fr)
+         bad(e) = count(.not. ieee_is_finite(kr(1:m*m)))
+         k = koff(e) - 1
+         do b = 1, m
+            do a = 1, m
+               k = k + 1
+               coo%row(k) = dofs(a)
+               coo%col(k) = dofs(b)
+               coo%val(k) = kr(a + (b - 1)*m)
+            end do
+         end do
+         fdof(foff(e):foff(e) + m - 1) = dofs(1:m)
+         fval(foff(e):foff(e) + m - 1) = fr(1:m)
+      end do
+      !$omp end do
+      !$omp end parallel
+   end subroutine element_triplets
 
    !> COO entries the dilatation blocks of aggregates of several cells need at most.
    integer(i8) function aggregate_capacity(self, mdof) result(n)
