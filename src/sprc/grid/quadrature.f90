@@ -67,7 +67,7 @@
 module sprc_grid_quadrature
    use sprc_core_kinds, only: wp
    use sprc_core_text, only: itoa, rtoa
-   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_out_of_memory
    use sprc_core_gauss, only: max_gauss_points, gauss_legendre_nodes
    use sprc_geometry_region, only: cell_outside, cell_inside, cell_cut
    use sprc_geometry_shape, only: shape_halfspace, shape_box
@@ -121,6 +121,14 @@ module sprc_grid_quadrature
       real(wp), allocatable, private :: poly(:, :)
       integer, allocatable, private :: owner(:), tag(:)
       integer, private :: np = 0
+      !> Work of one level of the reduction (used before it recurses, or not recursive):
+      !> the roots on a height line and their quadrics, the shapes of a box, the
+      !> quadrics a surface pass requires.
+      real(wp), allocatable, private :: roots(:)
+      integer, allocatable, private :: root_owner(:), shapes(:)
+      logical, allocatable, private :: require(:)
+      !> An array could not grow (out of memory): the rule is incomplete.
+      logical, private :: failed = .false.
    end type cell_rule_type
 
    !> Default strength of a height direction (module notes, `min_ratio`).
@@ -217,6 +225,7 @@ contains
       if (allocated(error)) return
       call reset(rule, quad%dim)
       rule%cls = body%classify_box(lo, hi)
+      if (rule%failed) rule%cls = cell_outside
       select case (rule%cls)
       case (cell_inside)
          call tensor_volume(quad, lo, hi, rule)
@@ -224,6 +233,7 @@ contains
       case (cell_cut)
          call cut_rule(quad, body, lo, hi, rule)
       end select
+      call check_failed(rule, 'cell_rule', lo, hi, error)
    end subroutine cell_rule
 
    !> Volume and surface rule of a cell [lo, hi] treated as cut (whatever its
@@ -240,7 +250,8 @@ contains
       if (allocated(error)) return
       call reset(rule, quad%dim)
       rule%cls = cell_cut
-      call cut_rule(quad, body, lo, hi, rule)
+      if (.not. rule%failed) call cut_rule(quad, body, lo, hi, rule)
+      call check_failed(rule, 'cut_cell_rule', lo, hi, error)
    end subroutine cut_cell_rule
 
    !> Only the surface points of boundary parts lying on the faces of the cell
@@ -257,8 +268,30 @@ contains
       if (allocated(error)) return
       call reset(rule, quad%dim)
       rule%cls = body%classify_box(lo, hi)
-      call add_face_parts(quad, body, lo, hi, rule)
+      if (.not. rule%failed) call add_face_parts(quad, body, lo, hi, rule)
+      call check_failed(rule, 'boundary_face_rule', lo, hi, error)
    end subroutine boundary_face_rule
+
+   !> The error of a rule whose arrays could not grow (`failed`): out of memory, never
+   !> a crash (issue 15); the rule is then empty.
+   pure subroutine check_failed(rule, where, lo, hi, error)
+      type(cell_rule_type), intent(inout) :: rule
+      character(len=*), intent(in) :: where
+      real(wp), intent(in) :: lo(:), hi(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: i
+      character(len=:), allocatable :: box
+
+      if (.not. rule%failed) return
+      rule%nvol = 0
+      rule%nsurf = 0
+      box = ''
+      do i = 1, size(lo)
+         box = box//' ['//rtoa(lo(i))//', '//rtoa(hi(i))//']'
+      end do
+      call fatal_error(error, where//': out of memory for the quadrature points or work arrays of the cell'// &
+         & box, stat_out_of_memory)
+   end subroutine check_failed
 
    pure subroutine check_input(quad, body, lo, hi, where, error)
       type(cut_quadrature_type), intent(in) :: quad
@@ -294,6 +327,7 @@ contains
    pure subroutine reset(rule, dim)
       type(cell_rule_type), intent(inout) :: rule
       integer, intent(in) :: dim
+      integer :: st
       rule%dim = dim
       rule%cls = cell_outside
       rule%nvol = 0
@@ -302,12 +336,39 @@ contains
       rule%nunresolved = 0
       rule%ns = 0
       rule%np = 0
-      if (.not. allocated(rule%vol_x)) then
-         allocate (rule%vol_x(3, 64), rule%vol_w(64))
-         allocate (rule%surf_x(3, 32), rule%surf_w(32), rule%surf_n(3, 32), rule%surf_shape(32))
-         allocate (rule%sy(3, 64), rule%sw(64), rule%poly(0:ncoef - 1, 16), rule%owner(16), rule%tag(16))
-      end if
+      rule%failed = .false.
+      if (allocated(rule%roots)) return
+      ! all or nothing: a failure leaves every array unallocated for the next reset
+      if (allocated(rule%vol_x)) deallocate (rule%vol_x, rule%vol_w)
+      if (allocated(rule%surf_x)) deallocate (rule%surf_x, rule%surf_w, rule%surf_n, rule%surf_shape)
+      if (allocated(rule%sy)) deallocate (rule%sy, rule%sw, rule%poly, rule%owner, rule%tag)
+      allocate (rule%vol_x(3, 64), rule%vol_w(64), stat=st)
+      if (st == 0) allocate (rule%surf_x(3, 32), rule%surf_w(32), rule%surf_n(3, 32), rule%surf_shape(32), &
+         & stat=st)
+      if (st == 0) allocate (rule%sy(3, 64), rule%sw(64), rule%poly(0:ncoef - 1, 16), rule%owner(16), &
+         & rule%tag(16), stat=st)
+      if (st == 0) allocate (rule%roots(0:33), rule%root_owner(0:33), rule%shapes(16), rule%require(16), stat=st)
+      rule%failed = st /= 0
    end subroutine reset
+
+   !> Work arrays for n roots (indices 0 .. 2 n + 1), n quadrics to require and n shapes
+   !> (grown, never shrunk; `failed` if they cannot grow).
+   pure subroutine reserve_work(rule, n)
+      type(cell_rule_type), intent(inout) :: rule
+      integer, intent(in) :: n
+      integer :: st
+
+      if (size(rule%require) >= n) return
+      deallocate (rule%roots, rule%root_owner, rule%shapes, rule%require)
+      allocate (rule%roots(0:2*n + 1), rule%root_owner(0:2*n + 1), rule%shapes(n), rule%require(n), stat=st)
+      if (st == 0) return
+      ! back to the empty state: the next reset allocates afresh
+      rule%failed = .true.
+      if (allocated(rule%roots)) deallocate (rule%roots)
+      if (allocated(rule%root_owner)) deallocate (rule%root_owner)
+      if (allocated(rule%shapes)) deallocate (rule%shapes)
+      if (allocated(rule%require)) deallocate (rule%require)
+   end subroutine reserve_work
 
    !> Tensor rule of the whole cell.
    pure subroutine tensor_volume(quad, lo, hi, rule)
@@ -339,14 +400,16 @@ contains
       type(cell_rule_type), intent(inout) :: rule
       type(context_type) :: ctx
       real(wp) :: ylo(3), yhi(3)
-      integer :: list(body%nshape), n, i, dim
+      integer :: n, i, dim
       logical :: free(3)
 
       dim = quad%dim
       call new_context(ctx, dim, lo, hi)
-      call body%active_shapes(lo, hi, list, n)
+      call reserve_work(rule, body%nshape)
+      if (rule%failed) return
+      call body%active_shapes(lo, hi, rule%shapes(1:body%nshape), n)
       do i = 1, n
-         call add_shape_quadrics(body, list(i), ctx, lo, hi, rule)
+         call add_shape_quadrics(body, rule%shapes(i), ctx, lo, hi, rule)
       end do
       ylo = 0.0_wp
       yhi = 0.0_wp
@@ -399,34 +462,38 @@ contains
       real(wp), intent(in) :: lo(:), hi(:)
       type(cell_rule_type), intent(inout) :: rule
       type(context_type) :: ctx
-      real(wp) :: flo(quad%dim), fhi(quad%dim), ylo(3), yhi(3), xf, side
-      integer :: classes(body%nshape), m, iside, s, i, dim
+      real(wp) :: flo(3), fhi(3), ylo(3), yhi(3), xf, side
+      integer :: m, iside, s, i, dim
       logical :: free(3), on, inside_on_cell_side
 
       dim = quad%dim
+      ! the shapes' classes on a face in rule%shapes (the reduction below only grows it)
+      call reserve_work(rule, body%nshape)
+      if (rule%failed) return
       do m = 1, dim
          do iside = 1, 2
             side = merge(-1.0_wp, 1.0_wp, iside == 1)
             xf = merge(lo(m), hi(m), iside == 1)
-            flo = lo
-            fhi = hi
+            flo(1:dim) = lo(1:dim)
+            fhi(1:dim) = hi(1:dim)
             flo(m) = xf
             fhi(m) = xf
             do s = 1, body%nshape
-               call on_face_plane(body, s, m, side, xf, flo, fhi, on, inside_on_cell_side)
+               call on_face_plane(body, s, m, side, xf, flo(1:dim), fhi(1:dim), on, inside_on_cell_side)
                if (.not. on) cycle
                call new_context(ctx, dim, lo, hi)
                ctx%face_shape = s
                ctx%face_dim = m
                ctx%face_side = side
                ctx%cell_side_inside = inside_on_cell_side
-               call body%shape_classes(flo, fhi, classes)
+               call body%shape_classes(flo(1:dim), fhi(1:dim), rule%shapes(1:body%nshape))
                rule%np = 0
                do i = 1, body%nshape
                   if (i == s) then
-                     if (body%shapes(s)%kind == shape_box) call add_shape_quadrics(body, s, ctx, flo, fhi, rule)
-                  else if (classes(i) == cell_cut) then
-                     call add_shape_quadrics(body, i, ctx, flo, fhi, rule)
+                     if (body%shapes(s)%kind == shape_box) &
+                        & call add_shape_quadrics(body, s, ctx, flo(1:dim), fhi(1:dim), rule)
+                  else if (rule%shapes(i) == cell_cut) then
+                     call add_shape_quadrics(body, i, ctx, flo(1:dim), fhi(1:dim), rule)
                   end if
                end do
                ylo = 0.0_wp
@@ -440,6 +507,7 @@ contains
                free(m) = .false.
                call reduce(ctx, quad, body, rule, ylo, yhi, free, 1, rule%np, .true., -1, 0)
                rule%np = 0
+               if (rule%failed) return
             end do
          end do
       end do
@@ -486,8 +554,8 @@ contains
       class(body_type), intent(in) :: body
       real(wp), intent(in) :: x(:)
       logical, intent(in) :: cell_side
-      real(wp) :: v, xm(size(x))
-      integer :: s, m
+      real(wp) :: v, xm(3)
+      integer :: s, m, d
 
       s = ctx%face_shape
       m = ctx%face_dim
@@ -495,9 +563,10 @@ contains
          ! on the shape's inner side of the plane
          if (body%shapes(s)%kind == shape_box) then
             ! the other faces decide: phi with x_m moved to the box's mid-plane
-            xm = x
+            d = size(x)
+            xm(1:d) = x
             xm(m) = 0.5_wp*(body%shapes(s)%lower(m) + body%shapes(s)%upper(m))
-            v = body%shapes(s)%phi(xm)
+            v = body%shapes(s)%phi(xm(1:d))
          else
             v = -1.0_wp
          end if
@@ -551,8 +620,9 @@ contains
       logical, intent(in) :: top
       real(wp) :: pmin, pmax, p(0:ncoef - 1), c(0:ncoef - 1), clo(3), chi(3)
       integer :: k0, nk, i, j, k, m, s0, s1, b0, nnew, child, bit, d, status, owner, tag
-      logical :: resolved, base_free(3), require(np), focus
+      logical :: resolved, base_free(3), focus
 
+      if (rule%failed) return
       k0 = rule%np + 1
       do i = p0, p0 + np - 1
          p = rule%poly(:, i)
@@ -578,15 +648,18 @@ contains
          return
       end if
 
-      ! the surfaces wanted at the top must be crossed by the height lines
-      require(1:nk) = top .and. want >= 0
-      if (top .and. want > 0) require(1:nk) = rule%tag(k0:k0 + nk - 1) == want
-      call choose_direction(rule%poly(:, k0:k0 + nk - 1), require(1:nk), top .and. want > 0, lo, hi, free, &
+      ! the surfaces wanted at the top must be crossed by the height lines (rule%require:
+      ! used here only, before this level recurses)
+      call reserve_work(rule, nk)
+      if (rule%failed) return
+      rule%require(1:nk) = top .and. want >= 0
+      if (top .and. want > 0) rule%require(1:nk) = rule%tag(k0:k0 + nk - 1) == want
+      call choose_direction(rule%poly(:, k0:k0 + nk - 1), rule%require(1:nk), top .and. want > 0, lo, hi, free, &
          & quad%min_ratio, k, resolved)
       if (.not. resolved .and. top .and. want == 0) then
          ! walls parallel to some direction: volume now, their surfaces in own passes
-         require(1:nk) = .false.
-         call choose_direction(rule%poly(:, k0:k0 + nk - 1), require(1:nk), .false., lo, hi, free, &
+         rule%require(1:nk) = .false.
+         call choose_direction(rule%poly(:, k0:k0 + nk - 1), rule%require(1:nk), .false., lo, hi, free, &
             & quad%min_ratio, k, resolved)
       end if
       if (.not. resolved .and. depth < quad%max_depth) then
@@ -830,73 +903,78 @@ contains
       integer, intent(in) :: ip, k, k0, nk, want
       real(wp), intent(in) :: a, b
       logical, intent(in) :: free(3), top
-      real(wp) :: y(3), ym(3), wb, t(0:2*nk + 1), roots(2), ca, cb, cc, len, key
-      integer :: rown(0:2*nk + 1), nr, i, j, n, g, okey, owner
+      real(wp) :: y(3), ym(3), wb, roots(2), ca, cb, cc, len, key
+      integer :: nr, i, j, n, g, okey, owner
       logical :: inside, prev_in, have_prev
 
-      y = rule%sy(:, ip)
-      wb = rule%sw(ip)
-      nr = 0
-      do i = k0, k0 + nk - 1
-         if (.not. depends_on(rule%poly(:, i), k)) cycle
-         call line_coefficients(rule%poly(:, i), k, y, ca, cb, cc)
-         call quadratic_roots(ca, cb, cc, roots, n)
-         do j = 1, n
-            if (roots(j) > a .and. roots(j) < b) then
-               nr = nr + 1
-               t(nr) = roots(j)
-               rown(nr) = i
-            end if
-         end do
-      end do
-      ! insertion sort of the roots with their owners
-      do i = 2, nr
-         key = t(i)
-         okey = rown(i)
-         j = i - 1
-         do while (j >= 1)
-            if (t(j) <= key) exit
-            t(j + 1) = t(j)
-            rown(j + 1) = rown(j)
-            j = j - 1
-         end do
-         t(j + 1) = key
-         rown(j + 1) = okey
-      end do
-      t(0) = a
-      t(nr + 1) = b
-      rown(0) = 0
-
-      have_prev = .false.
-      prev_in = .false.
-      do j = 0, nr
-         len = t(j + 1) - t(j)
-         if (.not. len > 0.0_wp) cycle
-         if (top) then
-            ym = y
-            ym(k) = t(j) + 0.5_wp*len
-            inside = member(ctx, body, ym)
-            if (have_prev .and. (inside .neqv. prev_in) .and. want >= 0) then
-               if (want == 0 .or. rule%tag(rown(j)) == want) then
-                  ym(k) = t(j)
-                  owner = rule%owner(rown(j))
-                  call emit_surface(ctx, body, rule, ym, wb, k, free, owner)
+      ! the roots t and their quadrics rown in rule's work (lift does not recurse)
+      call reserve_work(rule, nk)
+      if (rule%failed) return
+      associate (t => rule%roots, rown => rule%root_owner)
+         y = rule%sy(:, ip)
+         wb = rule%sw(ip)
+         nr = 0
+         do i = k0, k0 + nk - 1
+            if (.not. depends_on(rule%poly(:, i), k)) cycle
+            call line_coefficients(rule%poly(:, i), k, y, ca, cb, cc)
+            call quadratic_roots(ca, cb, cc, roots, n)
+            do j = 1, n
+               if (roots(j) > a .and. roots(j) < b) then
+                  nr = nr + 1
+                  t(nr) = roots(j)
+                  rown(nr) = i
                end if
-            end if
-            have_prev = .true.
-            prev_in = inside
-            if (.not. inside .or. want > 0) cycle
-         end if
-         do g = 1, quad%q
-            ym = y
-            ym(k) = t(j) + len*quad%node(g)
-            if (top) then
-               call emit_volume(ctx, rule, ym, wb*len*quad%weight(g), free)
-            else
-               call push_point(rule, ym, wb*len*quad%weight(g))
-            end if
+            end do
          end do
-      end do
+         ! insertion sort of the roots with their owners
+         do i = 2, nr
+            key = t(i)
+            okey = rown(i)
+            j = i - 1
+            do while (j >= 1)
+               if (t(j) <= key) exit
+               t(j + 1) = t(j)
+               rown(j + 1) = rown(j)
+               j = j - 1
+            end do
+            t(j + 1) = key
+            rown(j + 1) = okey
+         end do
+         t(0) = a
+         t(nr + 1) = b
+         rown(0) = 0
+
+         have_prev = .false.
+         prev_in = .false.
+         do j = 0, nr
+            len = t(j + 1) - t(j)
+            if (.not. len > 0.0_wp) cycle
+            if (top) then
+               ym = y
+               ym(k) = t(j) + 0.5_wp*len
+               inside = member(ctx, body, ym)
+               if (have_prev .and. (inside .neqv. prev_in) .and. want >= 0) then
+                  if (want == 0 .or. rule%tag(rown(j)) == want) then
+                     ym(k) = t(j)
+                     owner = rule%owner(rown(j))
+                     call emit_surface(ctx, body, rule, ym, wb, k, free, owner)
+                  end if
+               end if
+               have_prev = .true.
+               prev_in = inside
+               if (.not. inside .or. want > 0) cycle
+            end if
+            do g = 1, quad%q
+               ym = y
+               ym(k) = t(j) + len*quad%node(g)
+               if (top) then
+                  call emit_volume(ctx, rule, ym, wb*len*quad%weight(g), free)
+               else
+                  call push_point(rule, ym, wb*len*quad%weight(g))
+               end if
+            end do
+         end do
+      end associate
    end subroutine lift
 
    !> Membership of the reference point y at the top level.
@@ -904,14 +982,16 @@ contains
       type(context_type), intent(in) :: ctx
       class(body_type), intent(in) :: body
       real(wp), intent(in) :: y(3)
-      real(wp) :: x(ctx%dim)
+      real(wp) :: x(3)
+      integer :: d
 
-      x = ctx%center(1:ctx%dim) + ctx%half(1:ctx%dim)*y(1:ctx%dim)
+      d = ctx%dim
+      x(1:d) = ctx%center(1:d) + ctx%half(1:d)*y(1:d)
       if (ctx%face_shape == 0) then
-         inside = body%phi(x) < 0.0_wp
+         inside = body%phi(x(1:d)) < 0.0_wp
       else
-         inside = face_member(ctx, body, x, .true.)
-         if (inside) inside = .not. face_member(ctx, body, x, .false.)
+         inside = face_member(ctx, body, x(1:d), .true.)
+         if (inside) inside = .not. face_member(ctx, body, x(1:d), .false.)
       end if
    end function member
 
@@ -968,11 +1048,16 @@ contains
       integer, intent(in) :: owner, tag
       real(wp), allocatable :: tp(:, :)
       integer, allocatable :: to(:), tt(:)
-      integer :: cap
+      integer :: cap, st
 
+      if (rule%failed) return
       cap = size(rule%poly, 2)
       if (rule%np == cap) then
-         allocate (tp(0:ncoef - 1, 2*cap), to(2*cap), tt(2*cap))
+         allocate (tp(0:ncoef - 1, 2*cap), to(2*cap), tt(2*cap), stat=st)
+         if (st /= 0) then
+            rule%failed = .true.
+            return
+         end if
          tp(:, 1:cap) = rule%poly
          to(1:cap) = rule%owner
          tt(1:cap) = rule%tag
@@ -989,26 +1074,32 @@ contains
    pure subroutine push_point(rule, y, w)
       type(cell_rule_type), intent(inout) :: rule
       real(wp), intent(in) :: y(3), w
-      call push_weighted(rule%sy, rule%sw, rule%ns, y, w)
+      if (.not. rule%failed) call push_weighted(rule%sy, rule%sw, rule%ns, y, w, rule%failed)
    end subroutine push_point
 
    pure subroutine push_volume(rule, x, w)
       type(cell_rule_type), intent(inout) :: rule
       real(wp), intent(in) :: x(3), w
-      call push_weighted(rule%vol_x, rule%vol_w, rule%nvol, x, w)
+      if (.not. rule%failed) call push_weighted(rule%vol_x, rule%vol_w, rule%nvol, x, w, rule%failed)
    end subroutine push_volume
 
-   !> Append (x, w) to a point list of n entries, doubling its capacity when full.
-   pure subroutine push_weighted(xs, ws, n, x, w)
+   !> Append (x, w) to a point list of n entries, doubling its capacity when full
+   !> (`failed` and nothing appended if it cannot grow).
+   pure subroutine push_weighted(xs, ws, n, x, w, failed)
       real(wp), allocatable, intent(inout) :: xs(:, :), ws(:)
       integer, intent(inout) :: n
       real(wp), intent(in) :: x(3), w
+      logical, intent(inout) :: failed
       real(wp), allocatable :: tx(:, :), tw(:)
-      integer :: cap
+      integer :: cap, st
 
       cap = size(ws)
       if (n == cap) then
-         allocate (tx(3, 2*cap), tw(2*cap))
+         allocate (tx(3, 2*cap), tw(2*cap), stat=st)
+         if (st /= 0) then
+            failed = .true.
+            return
+         end if
          tx(:, 1:cap) = xs
          tw(1:cap) = ws
          call move_alloc(tx, xs)
@@ -1025,11 +1116,16 @@ contains
       integer, intent(in) :: s
       real(wp), allocatable :: tx(:, :), tw(:), tn(:, :)
       integer, allocatable :: ts(:)
-      integer :: cap
+      integer :: cap, st
 
+      if (rule%failed) return
       cap = size(rule%surf_w)
       if (rule%nsurf == cap) then
-         allocate (tx(3, 2*cap), tw(2*cap), tn(3, 2*cap), ts(2*cap))
+         allocate (tx(3, 2*cap), tw(2*cap), tn(3, 2*cap), ts(2*cap), stat=st)
+         if (st /= 0) then
+            rule%failed = .true.
+            return
+         end if
          tx(:, 1:cap) = rule%surf_x
          tw(1:cap) = rule%surf_w
          tn(:, 1:cap) = rule%surf_n
