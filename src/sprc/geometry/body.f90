@@ -42,6 +42,10 @@ module sprc_geometry_body
    real(wp), parameter :: snap_ulps = 4.0_wp
    !> Halvings of a box searched for material outside the scene's box (check_body_in_box).
    integer, parameter :: depth_limit = 8
+   !> Bodies of up to this many shapes classify a box in fixed-size locals; larger ones
+   !> allocate with stat= (gfortran's automatic arrays are unchecked heap allocations:
+   !> out of memory, a segmentation fault).
+   integer, parameter :: few_shapes = 64
 
    !> A named body: its shapes and their CSG operations, in file order.
    type, extends(region_type) :: body_type
@@ -214,10 +218,20 @@ contains
    pure integer function classify_box(self, lo, hi) result(cls)
       class(body_type), intent(in) :: self
       real(wp), intent(in) :: lo(:), hi(:)
-      integer :: classes(self%nshape)
+      integer :: few(few_shapes), st
+      integer, allocatable :: many(:)
 
-      call self%shape_classes(lo, hi, classes)
-      cls = evaluate(self%ops, classes)
+      if (self%nshape <= few_shapes) then
+         call self%shape_classes(lo, hi, few(1:self%nshape))
+         cls = evaluate(self%ops, few(1:self%nshape))
+         return
+      end if
+      ! out of memory: cut, which never misses a cut
+      cls = cell_cut
+      allocate (many(self%nshape), stat=st)
+      if (st /= 0) return
+      call self%shape_classes(lo, hi, many)
+      cls = evaluate(self%ops, many)
    end function classify_box
 
    !> Shapes whose surface may pass through the box [lo, hi] and matters
@@ -229,10 +243,23 @@ contains
       real(wp), intent(in) :: lo(:), hi(:)
       integer, intent(out) :: list(:)
       integer, intent(out) :: n
-      integer :: classes(self%nshape)
+      integer :: few(few_shapes), st, k
+      integer, allocatable :: many(:)
 
-      call self%shape_classes(lo, hi, classes)
-      call unmasked_cuts(self%ops, classes, list, n)
+      if (self%nshape <= few_shapes) then
+         call self%shape_classes(lo, hi, few(1:self%nshape))
+         call unmasked_cuts(self%ops, few(1:self%nshape), list, n)
+         return
+      end if
+      allocate (many(self%nshape), stat=st)
+      if (st /= 0) then
+         ! out of memory: every shape (a superset; the quadrature drops the ones that do not matter)
+         n = self%nshape
+         list(1:n) = [(k, k=1, n)]
+         return
+      end if
+      call self%shape_classes(lo, hi, many)
+      call unmasked_cuts(self%ops, many, list, n)
    end subroutine active_shapes
 
    !> True if x lies on the part of shape i's surface that bounds the body:
@@ -278,19 +305,21 @@ contains
       real(wp), intent(in) :: x(:)
       integer, intent(in) :: i
       real(wp), intent(out) :: normal(:)
-      real(wp) :: g(size(x)), length
+      real(wp) :: g(3), length
+      integer :: d
 
-      g = self%shapes(i)%gradient(x)
-      length = norm2(g)
+      d = size(x)
+      g(1:d) = self%shapes(i)%gradient(x)
+      length = norm2(g(1:d))
       if (length > 0.0_wp) then
-         g = g/length
+         g(1:d) = g(1:d)/length
       else
          ! Only at an ellipsoid's center, which is never on its surface.
          g = 0.0_wp
          g(1) = 1.0_wp
       end if
-      if (self%ops(i) == csg_subtract) g = -g
-      normal(1:size(x)) = g
+      if (self%ops(i) == csg_subtract) g(1:d) = -g(1:d)
+      normal(1:d) = g(1:d)
    end subroutine outward_normal
 
    ! ------------------------------------------------------------ three-valued logic
@@ -328,14 +357,24 @@ contains
    !> Class of the body from the shapes' classes.
    pure integer function evaluate(ops, classes) result(cls)
       integer, intent(in) :: ops(:), classes(:)
-      integer :: k
-      cls = cell_outside
-      if (size(classes) == 0) return
-      cls = classes(1)
-      do k = 2, size(classes)
-         cls = combine(cls, ops(k), classes(k))
-      end do
+      cls = evaluate_with(ops, classes, 0, cell_outside)
    end function evaluate
+
+   !> `evaluate` with shape i's class replaced by ci (i = 0: none), without a copy.
+   pure integer function evaluate_with(ops, classes, i, ci) result(cls)
+      integer, intent(in) :: ops(:), classes(:), i, ci
+      integer :: k, c
+      cls = cell_outside
+      do k = 1, size(classes)
+         c = classes(k)
+         if (k == i) c = ci
+         if (k == 1) then
+            cls = c
+         else
+            cls = combine(cls, ops(k), c)
+         end if
+      end do
+   end function evaluate_with
 
    pure integer function combine(a, op, b) result(cls)
       integer, intent(in) :: a, op, b
@@ -381,12 +420,11 @@ contains
    !> for shape i give the same decided class.
    pure logical function masked(ops, classes, i)
       integer, intent(in) :: ops(:), classes(:), i
-      integer :: trial(size(classes)), as_inside
-      trial = classes
-      trial(i) = cell_inside
-      as_inside = evaluate(ops, trial)
-      trial(i) = cell_outside
-      masked = as_inside /= cell_cut .and. as_inside == evaluate(ops, trial)
+      integer :: as_inside, as_outside
+
+      as_inside = evaluate_with(ops, classes, i, cell_inside)
+      as_outside = evaluate_with(ops, classes, i, cell_outside)
+      masked = as_inside /= cell_cut .and. as_inside == as_outside
    end function masked
 
    pure subroutine unmasked_cuts(ops, classes, list, n)
