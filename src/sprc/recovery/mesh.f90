@@ -142,8 +142,10 @@ module sprc_recovery_mesh
       integer :: dim = 0, analysis = 0, nstress = 0, nen = 0
       logical :: sprc = .false.
       real(wp) :: young = 0.0_wp, poisson = 0.0_wp
-      real(wp), pointer :: x(:, :) => null(), gp(:, :, :) => null(), gw(:, :) => null(), gs(:, :, :) => null()
-      integer, pointer :: connectivity(:, :) => null()
+      ! contiguous: the gathering of a patch's points indexes them directly (no strides)
+      real(wp), pointer, contiguous :: x(:, :) => null(), gp(:, :, :) => null(), gw(:, :) => null(), &
+         & gs(:, :, :) => null()
+      integer, pointer, contiguous :: connectivity(:, :) => null()
       type(topology_type), pointer :: topo => null()
    contains
       procedure :: fill => mesh_fill
@@ -166,7 +168,7 @@ contains
       !> Element nodes (nen, nelem), 1-based, VTK order.
       integer, intent(in) :: connectivity(:, :)
       !> Integration points (dim, ngp, nelem), weight*|J| (ngp, nelem), FE stress (nstress, ngp, nelem).
-      real(wp), intent(in), target :: gp(:, :, :), gw(:, :), gs(:, :, :)
+      real(wp), intent(in), target, contiguous :: gp(:, :, :), gw(:, :), gs(:, :, :)
       real(wp), intent(in) :: young, poisson
       integer, intent(in) :: method
       type(mesh_recovery_type), intent(out), target :: result
@@ -217,8 +219,9 @@ contains
       call boundary_points(result, topo, error, facet_nodes, facet_kind, facet_traction)
       if (allocated(error)) return
       t(2) = wall_time()
+      ! The caller's reference coordinates are used in place (checked, not copied).
       if (present(gauss_xi)) then
-         call given_coordinates(result, gp, gauss_xi, xi, error)
+         call given_coordinates(result, gp, gauss_xi, error)
       else
          call point_coordinates(result, gp, xi, error)
       end if
@@ -229,7 +232,11 @@ contains
       t(4) = wall_time()
       call nodal_values(result, topo)
       t(5) = wall_time()
-      call estimate(result, gp, gw, gs, xi, error)
+      if (present(gauss_xi)) then
+         call estimate(result, gp, gw, gs, gauss_xi, error)
+      else
+         call estimate(result, gp, gw, gs, xi, error)
+      end if
       t(6) = wall_time()
       result%t_check = t(1) - t(0)
       result%t_topology = t(2) - t(1)
@@ -327,10 +334,14 @@ contains
       type(error_type), allocatable, intent(out) :: error
       real(wp), allocatable :: guess(:, :)
       integer, allocatable :: bad(:)
-      integer :: e, i, ngp
+      integer :: e, i, ngp, st
 
       ngp = size(gp, 2)
-      allocate (xi(r%dim, ngp, r%nelem), bad(r%nelem), guess(r%dim, ngp))
+      allocate (xi(r%dim, ngp, r%nelem), bad(r%nelem), guess(r%dim, ngp), stat=st)
+      if (st /= 0) then
+         call fatal_error(error, 'recover_on_mesh: out of memory for the reference coordinates', stat_out_of_memory)
+         return
+      end if
       bad(1) = map_element(1)
       guess = xi(:, :, 1)
       if (bad(1) /= 0) guess = 0.5_wp
@@ -394,10 +405,9 @@ contains
    !> stretches by about h_e) plus the round-off of evaluating the map (as in Newton's stopping
    !> test, sprc_recovery_mesh_element). OpenMP over elements; the first bad point (element
    !> order) is named.
-   subroutine given_coordinates(r, gp, gxi, xi, error)
+   subroutine given_coordinates(r, gp, gxi, error)
       type(mesh_recovery_type), intent(in) :: r
       real(wp), intent(in) :: gp(:, :, :), gxi(:, :, :)
-      real(wp), allocatable, intent(out) :: xi(:, :, :)
       type(error_type), allocatable, intent(out) :: error
       integer, allocatable :: bad(:)
       integer :: e, i, ngp, st
@@ -408,9 +418,10 @@ contains
             & shape_str(shape(gxi))//'; need '//shape_str([r%dim, ngp, r%nelem])//' as gp', stat_invalid_input)
          return
       end if
-      allocate (xi(r%dim, ngp, r%nelem), bad(r%nelem), stat=st)
+      allocate (bad(r%nelem), stat=st)
       if (st /= 0) then
-         call fatal_error(error, 'recover_on_mesh: out of memory for the reference coordinates', stat_out_of_memory)
+         call fatal_error(error, 'recover_on_mesh: out of memory for the check of the reference coordinates', &
+            & stat_out_of_memory)
          return
       end if
       !$omp parallel do schedule(static)
@@ -440,7 +451,6 @@ contains
          xmax = maxval(abs(xe(1:d, 1:r%nen)))
          status = 0
          do j = 1, ngp
-            xi(:, j, e) = gxi(:, j, e)
             status = j
             if (.not. all(abs(gxi(:, j, e)) <= huge(1.0_wp))) return
             if (.not. element_inside(r%element_type, gxi(:, j, e), inside_tol)) return
@@ -560,7 +570,7 @@ contains
    subroutine recover_patches(r, topo, gp, gw, gs, rounds, error)
       type(mesh_recovery_type), intent(inout), target :: r
       type(topology_type), intent(in), target :: topo
-      real(wp), intent(in), target :: gp(:, :, :), gw(:, :), gs(:, :, :)
+      real(wp), intent(in), target, contiguous :: gp(:, :, :), gw(:, :), gs(:, :, :)
       integer, intent(in) :: rounds
       type(error_type), allocatable, intent(out) :: error
       type(mesh_source_type) :: src
@@ -619,7 +629,7 @@ contains
       integer, intent(in) :: node, elements(:)
       type(patch_type), intent(inout) :: patch
       real(wp) :: h
-      integer :: d, i, e, k, a, np, nb, ngp, ns
+      integer :: d, i, e, k, a, np, nb, ngp, ns, q
 
       d = self%dim
       ns = self%nstress
@@ -642,12 +652,16 @@ contains
       patch%body_force(1:d) = self%topo%body_force(1:d)
       ! check_mesh_arrays validated the caller's points, weights and stresses.
       patch%points_checked = .true.
+      np = 0
       do i = 1, size(elements)
          e = elements(i)
-         patch%x(1:d, patch%npoints + 1:patch%npoints + ngp) = self%gp(:, :, e)
-         patch%w(patch%npoints + 1:patch%npoints + ngp) = self%gw(:, e)
-         patch%stress(1:ns, patch%npoints + 1:patch%npoints + ngp) = self%gs(:, :, e)
-         patch%npoints = patch%npoints + ngp
+         do q = 1, ngp
+            np = np + 1
+            patch%x(1:d, np) = self%gp(1:d, q, e)
+            patch%w(np) = self%gw(q, e)
+            patch%stress(1:ns, np) = self%gs(1:ns, q, e)
+         end do
+         patch%npoints = np
          if (.not. self%sprc) cycle
          do k = self%topo%bptr(e), self%topo%bptr(e + 1) - 1
             patch%nbpoints = patch%nbpoints + 1
