@@ -18,6 +18,7 @@ module sprc_fem_linear_solver
    use sprc_core_lapack, only: dlacn2
    use sprc_core_blas_threads, only: blas_threads, set_blas_threads
    use sprc_fem_sparse, only: csr_type, csr_validate
+   use sprc_core_alloc, only: check_allocation
    implicit none
    private
 
@@ -244,7 +245,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       real(wp), allocatable :: v(:), x(:), y(:)
       integer, allocatable :: isgn(:)
-      integer :: kase, isave(3)
+      integer :: kase, isave(3), stat
       real(wp) :: anorm, ainvnorm
 
       value = 0.0_wp
@@ -262,7 +263,9 @@ contains
       value = 0.0_wp
       if (.not. (anorm > 0.0_wp)) return
 
-      allocate (v(self%n), x(self%n), y(self%n), isgn(self%n))
+      allocate (v(self%n), x(self%n), y(self%n), isgn(self%n), stat=stat)
+      call check_allocation(stat, 'rcond', 'the estimator vectors', int(self%n, i8), 28, error)
+      if (allocated(error)) return
       ainvnorm = 0.0_wp
       kase = 0
       do

@@ -21,7 +21,8 @@
 !> sigma_h (`sigma_star`, kept for output). Per-element sums run in point order and the
 !> global sums in element order: the bits do not depend on the thread count.
 module sprc_grid_recovered_estimate
-   use sprc_core_kinds, only: wp
+   use sprc_core_kinds, only: wp, i8
+   use sprc_core_alloc, only: check_allocation
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_timer, only: wall_time
    use sprc_exact_solution, only: exact_solution_type
@@ -68,7 +69,7 @@ contains
       logical, intent(in), optional :: node_inside(:)
       real(wp), allocatable :: sex(:, :), zero(:, :)
       real(wp) :: t0
-      integer :: ne, ns, np, e, a, b, maxpts
+      integer :: ne, ns, np, e, a, b, maxpts, stat
 
       t0 = wall_time()
       call check_consistent(input, field, error, exact)
@@ -84,7 +85,10 @@ contains
       np = size(input%w)
       est%n_elements = ne
       est%has_exact = present(exact)
-      allocate (est%elem_err2(ne), est%elem_norm_h2(ne), est%sigma_star(ns, np))
+      allocate (est%elem_err2(ne), est%elem_norm_h2(ne), est%sigma_star(ns, np), stat=stat)
+      call check_allocation(stat, 'estimate_error', 'the element terms and sigma* at the points', &
+         & int(ne, i8) + int(ns, i8)*np, 8, error)
+      if (allocated(error)) return
       maxpts = 0
       do e = 1, ne
          maxpts = max(maxpts, input%elem_ptr(e + 1) - input%elem_ptr(e))
@@ -92,7 +96,10 @@ contains
       allocate (zero(ns, maxpts))
       zero = 0.0_wp
       if (est%has_exact) then
-         allocate (est%elem_err_ex2(ne), est%elem_err_star2(ne), sex(ns, np))
+         allocate (est%elem_err_ex2(ne), est%elem_err_star2(ne), sex(ns, np), stat=stat)
+         call check_allocation(stat, 'estimate_error', 'the exact errors and stresses at the points', &
+            & int(ne, i8) + int(ns, i8)*np, 8, error)
+         if (allocated(error)) return
       else
          allocate (sex(ns, 0))
       end if
@@ -110,7 +117,8 @@ contains
       est%eta = 0.0_wp
       if (est%norm_h**2 + est%err**2 > 0.0_wp) est%eta = est%err/sqrt(est%norm_h**2 + est%err**2)
       if (est%has_exact) then
-         call exact_norms(input, field, est, sex, zero, exact, node_inside)
+         call exact_norms(input, field, est, sex, zero, exact, error, node_inside)
+         if (allocated(error)) return
       end if
       est%t_estimate = field%t_field + (wall_time() - t0)
    end subroutine estimate_error
@@ -146,17 +154,18 @@ contains
          & est%sigma_star(:, a:b), est%elem_err_star2(e), err)
    end subroutine element_terms
 
-   subroutine exact_norms(input, field, est, sex, zero, exact, node_inside)
+   subroutine exact_norms(input, field, est, sex, zero, exact, error, node_inside)
       type(recovery_input_type), intent(in) :: input
       type(recovered_field_type), intent(in) :: field
       type(zz_estimate_type), intent(inout) :: est
       real(wp), intent(in) :: sex(:, :), zero(:, :)
       class(exact_solution_type), intent(in) :: exact
+      type(error_type), allocatable, intent(out) :: error
       logical, intent(in), optional :: node_inside(:)
       type(error_type), allocatable :: err
       logical, allocatable :: bnode(:)
       real(wp) :: s(6), sx(6), nex2
-      integer :: e, k, n, ns, a, b
+      integer :: e, k, n, ns, a, b, stat
 
       ns = field%nstress
       est%norm_ex = 0.0_wp
@@ -176,7 +185,9 @@ contains
       if (est%err_ex > 0.0_wp) est%theta = est%err/est%err_ex
 
       ! Boundary vertex nodes and boundary points.
-      allocate (bnode(field%n_nodes))
+      allocate (bnode(field%n_nodes), stat=stat)
+      call check_allocation(stat, 'estimate_error', 'the boundary node flags', field%n_nodes, 4, error)
+      if (allocated(error)) return
       bnode = .false.
       est%max_boundary_point_error = 0.0_wp
       do e = 1, field%n_elements

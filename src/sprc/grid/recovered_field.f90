@@ -31,7 +31,8 @@
 !> nodes). SPR: `nodal_interp`. SPR-C: the union at the node in the node's first
 !> element (at a vertex with a patch this is the patch value itself).
 module sprc_grid_recovered_field
-   use sprc_core_kinds, only: wp
+   use sprc_core_kinds, only: wp, i8
+   use sprc_core_alloc, only: check_allocation
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_internal
    use sprc_grid_tree, only: grid_type
    use sprc_grid_nodes, only: grid_nodes_type, element_shape
@@ -258,7 +259,7 @@ contains
       type(grid_nodes_type), intent(in) :: nodes
       type(hanging_type), intent(in) :: hanging
       type(error_type), allocatable, intent(out) :: error
-      integer :: e
+      integer :: e, stat
 
       field%n_elements = nodes%n_elements
       field%n_nodes = nodes%n_nodes
@@ -266,26 +267,38 @@ contains
       field%nvertex = 2**field%dim
       field%fe_degree = nodes%degree
       if (.not. allocated(field%elem_lo)) then
-         allocate (field%elem_lo(field%dim, field%n_elements), field%elem_hi(field%dim, field%n_elements))
+         allocate (field%elem_lo(field%dim, field%n_elements), field%elem_hi(field%dim, field%n_elements), stat=stat)
+         call check_allocation(stat, 'recovered field', 'the element boxes', field%n_elements, 16*field%dim, error)
+         if (allocated(error)) return
          do e = 1, field%n_elements
             call grid%leaf_box(e, field%elem_lo(:, e), field%elem_hi(:, e))
          end do
       end if
+      if (allocated(field%connectivity)) deallocate (field%connectivity)
+      if (allocated(field%node_x)) deallocate (field%node_x)
+      allocate (field%connectivity, mold=nodes%connectivity, stat=stat)
+      if (stat == 0) allocate (field%node_x, mold=nodes%x, stat=stat)
+      call check_allocation(stat, 'recovered field', 'the connectivity and node coordinates', &
+         & int(size(nodes%connectivity), i8) + int(size(nodes%x), i8), 8, error)
+      if (allocated(error)) return
       field%connectivity = nodes%connectivity
       field%node_x = nodes%x
       call corner_weights(field, hanging, error)
       if (allocated(error)) return
-      call nodal_values(field, nodes, hanging)
+      call nodal_values(field, nodes, hanging, error)
    end subroutine build_field
 
    subroutine corner_weights(field, hanging, error)
       type(recovered_field_type), intent(inout) :: field
       type(hanging_type), intent(in) :: hanging
       type(error_type), allocatable, intent(out) :: error
-      integer :: pass, e, j, n, k, s, pos, p
+      integer :: pass, e, j, n, k, s, pos, p, stat
       character(len=120) :: buf
 
-      allocate (field%corner_ptr(field%n_elements*field%nvertex + 1))
+      allocate (field%corner_ptr(field%n_elements*field%nvertex + 1), stat=stat)
+      call check_allocation(stat, 'recovered field', 'the corner pointers', &
+         & int(field%n_elements, i8)*field%nvertex + 1, 4, error)
+      if (allocated(error)) return
       ! Pass 1 counts the entries of each corner, pass 2 fills them.
       do pass = 1, 2
          pos = 1
@@ -323,22 +336,27 @@ contains
          end do
          if (pass == 1) then
             field%corner_ptr(field%n_elements*field%nvertex + 1) = pos
-            allocate (field%corner_patch(pos - 1), field%corner_coef(pos - 1))
+            allocate (field%corner_patch(pos - 1), field%corner_coef(pos - 1), stat=stat)
+            call check_allocation(stat, 'recovered field', 'the corner weights', pos - 1, 12, error)
+            if (allocated(error)) return
          end if
       end do
    end subroutine corner_weights
 
    !> nodal_interp: patch values, unions at free non-vertex nodes, then hanging constraints;
    !> nodal: the method's field at each node.
-   subroutine nodal_values(field, nodes, hanging)
+   subroutine nodal_values(field, nodes, hanging, error)
       type(recovered_field_type), intent(inout) :: field
       type(grid_nodes_type), intent(in) :: nodes
       type(hanging_type), intent(in) :: hanging
+      type(error_type), allocatable, intent(out) :: error
       type(error_type), allocatable :: err
-      integer :: n, k, e, ns
+      integer :: n, k, e, ns, stat
 
       ns = field%nstress
-      allocate (field%nodal_interp(ns, field%n_nodes), field%nodal(ns, field%n_nodes))
+      allocate (field%nodal_interp(ns, field%n_nodes), field%nodal(ns, field%n_nodes), stat=stat)
+      call check_allocation(stat, 'recovered field', 'the nodal stresses', int(ns, i8)*field%n_nodes, 16, error)
+      if (allocated(error)) return
       !$omp parallel do schedule(static) private(e, err)
       do n = 1, field%n_nodes
          e = nodes%node_element(nodes%node_element_ptr(n))

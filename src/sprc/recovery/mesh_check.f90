@@ -12,6 +12,7 @@
 module sprc_recovery_mesh_check
    use sprc_core_kinds, only: wp, i8
    use sprc_core_text, only: itoa, rtoa
+   use sprc_core_alloc, only: check_allocation
    use sprc_core_boundary, only: bc_traction, bc_symmetry, bc_free, bc_pressure
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_material, only: plane_stress, plane_strain, solid, voigt_size, check_material
@@ -243,14 +244,16 @@ contains
       logical, intent(in) :: c_indices
       type(error_type), allocatable, intent(out) :: error
       integer, allocatable :: table(:)
-      integer :: n, nslot, slot, m
+      integer :: n, nslot, slot, m, stat
 
       ! A power of two at least twice the used nodes: short probe chains.
       nslot = 4
       do while (nslot < 2*count(used))
          nslot = 2*nslot
       end do
-      allocate (table(nslot))
+      allocate (table(nslot), stat=stat)
+      call check_allocation(stat, 'mesh check', 'the duplicate-node hash table', nslot, 4, error)
+      if (allocated(error)) return
       table = 0
       do n = 1, size(nodes, 2)
          if (.not. used(n)) cycle

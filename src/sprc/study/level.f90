@@ -570,21 +570,26 @@ contains
       real(wp), allocatable, intent(out) :: loads(:, :)
       type(error_type), allocatable, intent(out) :: error
       real(wp), allocatable :: previous(:), current(:)
-      integer :: stages, k, j, n, ns
+      integer :: stages, k, j, n, ns, nd, stat
 
       stages = 1
       do k = 1, size(study%scene%bcs)
          stages = max(stages, study%scene%bcs(k)%stage)
       end do
       ns = slave%n_dofs()
-      allocate (loads(ns + master%n_dofs(), stages*spec%steps), previous(ns + master%n_dofs()))
+      nd = ns + master%n_dofs()
+      allocate (loads(nd, stages*spec%steps), previous(nd), current(nd), stat=stat)
+      call check_allocation(stat, 'contact load path', 'the loads of the increments', &
+         & int(nd, i8)*(stages*spec%steps + 2), 8, error)
+      if (allocated(error)) return
       previous = 0.0_wp
       n = 0
       do k = 1, stages
          call stage_load(study, spec%slave_index, k, slave, error)
          if (.not. allocated(error)) call stage_load(study, spec%master_index, k, master, error)
          if (allocated(error)) return
-         current = [slave%f, master%f]
+         current(1:ns) = slave%f
+         current(ns + 1:) = master%f
          do j = 1, spec%steps
             n = n + 1
             loads(:, n) = previous + (real(j, wp)/real(spec%steps, wp))*(current - previous)
