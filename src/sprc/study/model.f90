@@ -21,7 +21,7 @@ module sprc_study_model
    use sprc_exact_pressure, only: exact_pressure_type, field_pressure_type, new_field_pressure
    use sprc_exact_hertz, only: hertz_type, new_hertz_cylinder, new_hertz_sphere
    use sprc_core_text, only: itoa, real_text
-   use sprc_study_spec, only: scene_type, shape_spec_type
+   use sprc_study_spec, only: scene_type, shape_spec_type, kappa_note
    use sprc_fem_bc, only: fe_bc_type, new_fe_bc, bc_kind_from_name
    use sprc_fem_problem, only: gamma_note
    implicit none
@@ -190,6 +190,7 @@ contains
          & 'and the errors and estimates mean nothing'//new_line('a')
       if (len(gamma_note(scene%order, scene%nitsche_gamma)) > 0) &
          & text = text//'warning: '//gamma_note(scene%order, scene%nitsche_gamma)//new_line('a')
+      text = text//contact_warnings(scene)
       if (.not. scene%exact%present .or. size(bodies) == 0) return
       ! Only the one-body solutions have a domain to fit: uniform has no centre, the
       ! compound_* and hertz_* solutions span two bodies.
@@ -218,6 +219,21 @@ contains
             & real_text(scene%exact%radius)//'; check center and radius'//new_line('a')
       end select
    end function scene_warnings
+
+   !> The warnings of the contact pairs: a kappa outside `kappa_range`.
+   function contact_warnings(scene) result(text)
+      type(scene_type), intent(in) :: scene
+      character(len=:), allocatable :: text
+      integer :: k
+
+      text = ''
+      do k = 1, size(scene%contacts)
+         associate (c => scene%contacts(k))
+            if (len(kappa_note(c%kappa)) > 0) text = text//"warning: &contact slave='"//c%slave//"' master='"// &
+               & c%master//"': "//kappa_note(c%kappa)//new_line('a')
+         end associate
+      end do
+   end function contact_warnings
 
    !> Smallest and largest distance from `center` of the body's points among the centres
    !> of a lattice of 64^2 (2D) or 32^3 (3D) cells of the box; r(1) > r(2) if none is in

@@ -5,19 +5,31 @@
 !> reads and validates scene files into them; the study layer runs them.
 module sprc_study_spec
    use sprc_core_kinds, only: wp
+   use sprc_core_text, only: real_text
    use sprc_recovery_patch_loop, only: auto_degree
    implicit none
    private
 
    public :: scene_type, body_spec_type, shape_spec_type, bc_spec_type, exact_spec_type, contact_spec_type
    public :: recovery_degree, contact_unsupported
-   public :: default_kappa, default_stabilization
+   public :: default_kappa, default_stabilization, kappa_range, kappa_note
 
    !> Default of `&contact kappa`, the dimensionless factor of the contact
    !> stabilization (effective stiffness kappa*E/h, seed eq. 5), chosen by a
    !> sweep (sprc_contact_solve notes: results flat from 100 to 1e6); README
    !> documents it.
    real(wp), parameter :: default_kappa = 1000.0_wp
+   !> Safe range of `&contact kappa`, from a sweep 0.1 ... 1e12 (shrink fit
+   !> levels 5-7, Hertz roller levels 5-6; the stability study, README).
+   !> Inside, err_fe, err_p_fe and err_p_sprc move by at most 1.2 % from those
+   !> of the default at every level. Below, the stabilization no longer
+   !> dominates the slave's trace-inverse bound: the largest change of those
+   !> errors is 4.1 times themselves at 10 on the shrink fit (its recovered
+   !> pressure), 31 and 39 times at 1 and 0.1; 2.9 times at 1 on Hertz. Above, nothing
+   !> moved up to 1e8, but the block system's rcond falls in proportion to
+   !> kappa (1.7e-12 at 1e6 on the shrink fit's level 7): at 1e10 that
+   !> level's rigid-mode check and at 1e12 the Hertz factorization fail.
+   real(wp), parameter :: kappa_range(2) = [100.0_wp, 1.0e6_wp]
    !> Default of `&contact stabilization`: the FE stress. At the default kappa
    !> the recovered variant gives the same results to 4 digits at 1.0-1.15x
    !> the time (README "Contact", figures in the commit that chose it).
@@ -176,6 +188,25 @@ module sprc_study_spec
    end type scene_type
 
 contains
+
+   !> '' when `kappa` lies in `kappa_range`, else a sentence saying what to
+   !> expect (for a warning).
+   function kappa_note(kappa) result(note)
+      real(wp), intent(in) :: kappa
+      character(len=:), allocatable :: note
+
+      note = ''
+      if (kappa >= kappa_range(1) .and. kappa <= kappa_range(2)) return
+      note = 'kappa = '//real_text(kappa)//' lies outside the safe range ['//real_text(kappa_range(1))//', '// &
+         & real_text(kappa_range(2))//']: '
+      if (kappa < kappa_range(1)) then
+         note = note//'the contact stabilization may not hold the gap (the pressure error grows several times, '// &
+            & 'the active set may cycle); raise it'
+      else
+         note = note//'the condition number of the contact system grows in proportion to kappa (singular near '// &
+            & '1e10); lower it'
+      end if
+   end function kappa_note
 
    !> Patch polynomial degree of the scene's recovery `method` (1 SPR, 2 SPR-C): 'auto' (the
    !> default) by sprc_recovery_patch_loop's `auto_degree`, 'p' the FE order, 'p+1' one more.
