@@ -42,7 +42,8 @@ program stability_study
 
    !> One level of a contact run.
    type :: contact_type
-      real(wp) :: err_fe = 0.0_wp, err_p = 0.0_wp, err_p_sprc = 0.0_wp, p_ratio = 0.0_wp, rcond = 0.0_wp
+      real(wp) :: err_fe = 0.0_wp, err_sprc = 0.0_wp, theta = 0.0_wp, err_p = 0.0_wp, err_p_sprc = 0.0_wp
+      real(wp) :: p_ratio = 0.0_wp, rcond = 0.0_wp
       integer :: iterations = 0
       logical :: failed = .false.
       character(len=:), allocatable :: message
@@ -395,6 +396,8 @@ contains
             return
          end if
          r(k)%err_fe = result%row%err_fe
+         r(k)%err_sprc = result%row%err_sprc
+         r(k)%theta = result%row%theta_sprc
          r(k)%err_p = result%row%err_p_fe
          r(k)%err_p_sprc = result%row%err_p_sprc
          r(k)%p_ratio = result%row%p_max_fe/result%row%p_max_exact
@@ -408,34 +411,35 @@ contains
       character(len=*), intent(in) :: title, first, extra
       write (output_unit, '(/,a,/)') title
       if (len(extra) == 0) then
-         write (output_unit, '("| ",a," | err_fe | err_p_fe | err_p_sprc | p_max_fe/p_max_exact | iterations | rcond |")') &
-            & first
-         write (output_unit, '("|---|---|---|---|---|---|---|")')
+         write (output_unit, '("| ",a," | err_fe | err_sprc | theta_sprc | err_p_fe | err_p_sprc | p_max_fe/p_max_exact | ",'// &
+            & '"iterations | rcond |")') first
+         write (output_unit, '("|---|---|---|---|---|---|---|---|---|")')
       else
-         write (output_unit, '("| ",a," | err_fe | err_p_fe | err_p_sprc | p_max_fe/p_max_exact | iterations | rcond | ",'// &
-            & 'a," |")') first, extra
-         write (output_unit, '("|---|---|---|---|---|---|---|---|")')
+         write (output_unit, '("| ",a," | err_fe | err_sprc | theta_sprc | err_p_fe | err_p_sprc | p_max_fe/p_max_exact | ",'// &
+            & '"iterations | rcond | ",a," |")') first, extra
+         write (output_unit, '("|---|---|---|---|---|---|---|---|---|---|")')
       end if
    end subroutine contact_header
 
-   !> One contact row (err_fe '-' where the exact solution has no energy norm); `extra`, if
-   !> present, a last column.
+   !> One contact row (err_fe, err_sprc, theta_sprc '-' where the exact solution has no
+   !> energy norm); `extra`, if present, a last column.
    subroutine print_contact_row(label, r, extra)
       character(len=*), intent(in) :: label
       type(contact_type), intent(in) :: r
       character(len=*), intent(in), optional :: extra
-      character(len=12) :: fe
+      integer :: k
+      character(len=12) :: energy(3)
       character(len=:), allocatable :: tail
       tail = ''
       if (present(extra)) tail = ' '//extra//' |'
       if (r%failed) then
-         write (output_unit, '("| ",a," | failed: ",a," | | | | | |",a)') label, r%message, tail
+         write (output_unit, '("| ",a," | failed: ",a," | | | | | | | |",a)') label, r%message, tail
          return
       end if
-      fe = '-'
-      if (.not. is_empty(r%err_fe)) write (fe, '(es9.2)') r%err_fe
-      write (output_unit, '("| ",a," | ",a," | ",es9.2," | ",es9.2," | ",f7.4," | ",i0," | ",es8.1," |",a)') label, &
-         & trim(fe), r%err_p, r%err_p_sprc, r%p_ratio, r%iterations, r%rcond, tail
+      energy = '-'
+      if (.not. is_empty(r%err_fe)) write (energy, '(es9.2,:,/,es9.2,:,/,f6.3)') r%err_fe, r%err_sprc, r%theta
+      write (output_unit, '("| ",a,3(" | ",a)," | ",es9.2," | ",es9.2," | ",f7.4," | ",i0," | ",es8.1," |",a)') &
+         & label, (trim(adjustl(energy(k))), k=1, 3), r%err_p, r%err_p_sprc, r%p_ratio, r%iterations, r%rcond, tail
    end subroutine print_contact_row
 
    !> A row that ran, with finite pressures and pressure errors (and err_fe when `energy`).

@@ -160,7 +160,8 @@ contains
    !> (u = 0: err_fe 1, eta 0, theta 0 mean nothing), and an &exact whose domain does not fit
    !> the first body (its distances from the solution's centre, sampled on a lattice of
    !> 64^2 / 32^3 points of the box, do not reach the solution's radii within two lattice
-   !> steps; the errors would compare with the solution of another problem).
+   !> steps; the errors would compare with the solution of another problem); a contact
+   !> kappa outside its safe range (`kappa_note`).
    function scene_warnings(scene, bodies) result(text)
       type(scene_type), intent(in) :: scene
       type(body_type), intent(in) :: bodies(:)
