@@ -24,8 +24,8 @@ module sprc_study_spec
    !> Inside, err_fe, err_p_fe and err_p_sprc move by at most 1.2 % from those
    !> of the default at every level. Below, the stabilization no longer
    !> dominates the slave's trace-inverse bound: the largest change of those
-   !> errors is 4.1 times themselves at 10 on the shrink fit (its recovered
-   !> pressure), 31 and 39 times at 1 and 0.1; 2.9 times at 1 on Hertz. Above, nothing
+   !> errors is 4.2 times themselves at 10 on the shrink fit (its recovered
+   !> pressure), 32 and 40 times at 1 and 0.1; 2.9 times at 1 on Hertz. Above, nothing
    !> moved up to 1e8, but the block system's rcond falls in proportion to
    !> kappa (1.7e-12 at 1e6 on the shrink fit's level 7): at 1e10 that
    !> level's rigid-mode check and at 1e12 the Hertz factorization fail.
