@@ -502,7 +502,7 @@ contains
          ref = contact_case(c, default_kappa)
          do k = 1, size(kappas)
             r = contact_case(c, kappas(k))
-            inside = len(kappa_note(kappas(k))) == 0
+            inside = len(kappa_note(kappas(k), 'fe')) == 0
             label = trim(merge('shrink fit', 'Hertz     ', c == 1))//', '//etoa(kappas(k))
             if (.not. inside) label = label//' (outside)'
             change = 0.0_wp

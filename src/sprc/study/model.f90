@@ -230,8 +230,8 @@ contains
       text = ''
       do k = 1, size(scene%contacts)
          associate (c => scene%contacts(k))
-            if (len(kappa_note(c%kappa)) > 0) text = text//"warning: &contact slave='"//c%slave//"' master='"// &
-               & c%master//"': "//kappa_note(c%kappa)//new_line('a')
+            if (len(kappa_note(c%kappa, c%stabilization)) > 0) text = text//"warning: &contact slave='"// &
+               & c%slave//"' master='"//c%master//"': "//kappa_note(c%kappa, c%stabilization)//new_line('a')
          end associate
       end do
    end function contact_warnings
