@@ -24,6 +24,7 @@ module sprc_test_contact_recovery
    use sprc_study_level, only: study_type, level_type
    use sprc_test_study, only: run_text
    use sprc_contact_result, only: contact_open
+   use sprc_grid_recovered_field, only: recovered_field_type
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type, replaced
    implicit none
    private
@@ -72,7 +73,9 @@ contains
          new_unittest('coupled_wrong_law', test_coupled_wrong_law), &
          new_unittest('coupled_errors', test_coupled_errors), &
          new_unittest('contact_patch_depth', test_contact_patch_depth), &
-         new_unittest('study_patch_pressures', test_study_patch_pressures) &
+         new_unittest('study_patch_pressures', test_study_patch_pressures), &
+         new_unittest('grid_exact_2d', test_grid_exact_2d), &
+         new_unittest('grid_exact_3d', test_grid_exact_3d) &
          ]
    end subroutine collect_contact_recovery
 
@@ -522,6 +525,109 @@ contains
             & 'p_spr, p_sprc = 1, ts_sprc = 0: max deviation '//rtoa(worst)//', tolerance '//rtoa(tol))
       end associate
    end subroutine test_study_patch_pressures
+
+   !> The coupled contact patches through the grid path (sprc_grid_patches, sprc_study_level):
+   !> two blocks of different materials on non-matching offset grids whose flat interface
+   !> cuts cells of both, carrying the uniform stress sigma_yy = -1 (frictionless: the
+   !> materials may differ; stick: equal materials, or the lateral strains would differ).
+   !> Both bodies' SPR-C fields reproduce it (every patch, contact patches among them, in both
+   !> bodies) and p_sprc = 1, ts_sprc = 0 at the closed points: the contact residual is zero.
+   !> Q1 (patch degree 1) and Q2 (patch degree 3).
+   subroutine test_grid_exact_2d(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: text
+      integer :: order
+      character(len=*), parameter :: friction(2) = ['frictionless', 'stick       ']
+      integer :: k
+
+      call read_text_file('test/data/contact/patch_2d.nml', text, error)
+      if (allocated(error)) return
+      text = replaced(text, "recovery = 'none'", "recovery = 'both'")
+      do order = 1, 2
+         do k = 1, 2
+            call grid_exact_case(replaced(replaced(replaced(text, "order    = 1", "order    = "//itoa(order)), &
+               & "'frictionless'", "'"//trim(friction(k))//"'"), "young=3.0 poisson=0.2", &
+               & merge("young=1.0 poisson=0.3", "young=3.0 poisson=0.2", k == 2)), 3, [0.0_wp, -1.0_wp, 0.0_wp], &
+               & 'order '//itoa(order)//', '//trim(friction(k)), error)
+            if (allocated(error)) return
+         end do
+      end do
+   end subroutine test_grid_exact_2d
+
+   !> test_grid_exact_2d in 3D (Q1, frictionless and stick; Q2 frictionless), level 2 (level 1
+   !> for Q2).
+   subroutine test_grid_exact_3d(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: text
+      real(wp), parameter :: sigma(6) = [0.0_wp, 0.0_wp, -1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
+
+      call read_text_file('test/data/contact/patch_3d.nml', text, error)
+      if (allocated(error)) return
+      text = replaced(text, "recovery = 'none'", "recovery = 'both'")
+      call grid_exact_case(text, 2, sigma, 'Q1 frictionless', error)
+      if (allocated(error)) return
+      call grid_exact_case(replaced(replaced(text, "'frictionless'", "'stick'"), "young=3.0 poisson=0.2", &
+         & "young=1.0 poisson=0.3"), 2, sigma, 'Q1 stick', error)
+      if (allocated(error)) return
+      call grid_exact_case(replaced(text, "order    = 1", "order    = 2"), 1, sigma, 'Q2 frictionless', error)
+   end subroutine test_grid_exact_3d
+
+   !> One case of test_grid_exact_2d/3d: the scene `text` at `level` carries the uniform stress
+   !> `sigma` (Voigt).
+   subroutine grid_exact_case(text, level, sigma, name, error)
+      character(len=*), intent(in) :: text, name
+      integer, intent(in) :: level
+      real(wp), intent(in) :: sigma(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(level_type) :: result
+      real(wp) :: tol, worst
+      integer :: b, ncontact
+
+      call run_text(text, level, result, error)
+      if (allocated(error)) then
+         error%message = name//': '//error%message
+         return
+      end if
+      tol = tol_exact
+      do b = 1, size(result%bodies)
+         tol = tol + 10.0_wp*epsilon(1.0_wp)/result%bodies(b)%problem%rcond
+      end do
+      do b = 1, size(result%bodies)
+         call field_deviation(result%bodies(b)%field(2), sigma, worst, ncontact)
+         call check(error, ncontact > 0 .and. worst <= tol, name//', body '//itoa(b)//': '//itoa(ncontact)// &
+            & ' contact patches, SPR-C deviates by '//rtoa(worst)//' from the uniform stress, tolerance '//rtoa(tol))
+         if (allocated(error)) return
+      end do
+      associate (c => result%contacts(1))
+         worst = max(maxval(abs(c%p_sprc - 1.0_wp), c%state /= contact_open), maxval(c%ts_sprc, c%state /= contact_open))
+         call check(error, count(c%state /= contact_open) > 0 .and. all(c%state == contact_open .or. &
+            & (abs(c%p_sprc - 1.0_wp) <= tol .and. c%ts_sprc <= tol)), &
+            & name//': p_sprc = 1, ts_sprc = 0: max deviation '//rtoa(worst)//', tolerance '//rtoa(tol))
+      end associate
+   end subroutine grid_exact_case
+
+   !> Largest deviation of a recovered field's patch polynomials from the constant `sigma`
+   !> (the constant term against sigma, every other coefficient against 0: the scaled
+   !> coordinates are O(1) on a patch), and the number of its contact patches.
+   subroutine field_deviation(field, sigma, worst, ncontact)
+      type(recovered_field_type), intent(in) :: field
+      real(wp), intent(in) :: sigma(:)
+      real(wp), intent(out) :: worst
+      integer, intent(out) :: ncontact
+      integer :: ip, c
+
+      worst = 0.0_wp
+      ncontact = count(field%recs%boundary_kind == boundary_contact)
+      do ip = 1, size(field%recs)
+         associate (r => field%recs(ip))
+            if (.not. allocated(r%coef)) cycle
+            do c = 1, r%nstress
+               worst = max(worst, abs(r%coef(1, c) - sigma(c)))
+               if (r%nterms > 1) worst = max(worst, maxval(abs(r%coef(2:r%nterms, c))))
+            end do
+         end associate
+      end do
+   end subroutine field_deviation
 
    !> Bad input of the coupled solve: clear errors, no crash.
    subroutine test_coupled_errors(error)

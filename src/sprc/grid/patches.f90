@@ -39,8 +39,13 @@
 !>
 !> The loop itself (gathering, expansion, OpenMP, determinism) is the shared one of
 !> sprc_recovery_patch_loop; this module supplies the grid's patches (`grid_source_type`)
-!> and names a failing patch by its node. `skip_patch` leaves chosen patches to another
-!> module (contact recovers the patches it owns).
+!> and names a failing patch by its node.
+!>
+!> Contact (SPR-C with a `grid_contact_type`, sprc_grid_contact): the body's boundary points
+!> on the contact shape are contact points where their law is closed and free-surface
+!> (zero-traction) points where it is open; a patch holding a contact point is solved by
+!> the coupled contact solve (contact wins, seed), expanded like any other patch when it
+!> lacks rank.
 module sprc_grid_patches
    use sprc_core_kinds, only: wp
    use sprc_core_text, only: itoa, rtoa
@@ -53,8 +58,12 @@ module sprc_grid_patches
    use sprc_grid_tree, only: grid_type
    use sprc_grid_nodes, only: grid_nodes_type
    use sprc_grid_hanging, only: hanging_type
-   use sprc_recovery_patch, only: patch_type, patch_reset, patch_reserve, boundary_traction, boundary_symmetry
-   use sprc_recovery_patch_loop, only: patch_source_type, patch_loop_type, run_patch_loop, patch_capacity
+   use sprc_recovery_patch, only: patch_type, patch_reset, patch_reserve, boundary_traction, boundary_symmetry, &
+      & boundary_contact, recovered_patch_type
+   use sprc_recovery_workspace, only: recovery_workspace_type
+   use sprc_recovery_patch_loop, only: patch_source_type, patch_loop_type, run_patch_loop, patch_capacity, &
+      & recover_patch_default
+   use sprc_grid_contact, only: grid_contact_type, contact_patch_solve
    use sprc_grid_recovered_field, only: recovered_field_type, method_spr, method_sprc, build_field
    implicit none
    private
@@ -97,11 +106,13 @@ module sprc_grid_patches
       type(grid_nodes_type), pointer :: nodes => null()
       real(wp), pointer :: elem_lo(:, :) => null(), elem_hi(:, :) => null()
       class(exact_solution_type), pointer :: exact => null()
+      type(grid_contact_type), pointer :: contact => null()
       integer :: nstress = 0
       logical :: sprc = .false.
    contains
       procedure :: fill => grid_fill
       procedure :: points_of => grid_points_of
+      procedure :: recover => grid_recover
    end type grid_source_type
 
 contains
@@ -111,8 +122,9 @@ contains
    !> `method` is method_spr or method_sprc, `degree` the patch polynomial degree (1..3;
    !> the FE degree p or p+1). `exact` is needed for bc_exact_traction shapes. Errors:
    !> invalid input (stat_invalid_input, naming the field and index), a patch still rank
-   !> deficient after `max_rounds` expansions (stat_singular, naming the node).
-   subroutine recover_grid(input, grid, nodes, hanging, method, degree, field, error, exact, max_rounds)
+   !> deficient after `max_rounds` expansions (stat_singular, naming the node). With
+   !> `contact` (SPR-C only; ignored by SPR), the body's contact surface (module notes).
+   subroutine recover_grid(input, grid, nodes, hanging, method, degree, field, error, exact, max_rounds, contact)
       type(recovery_input_type), intent(in), target :: input
       type(grid_type), intent(in) :: grid
       type(grid_nodes_type), intent(in), target :: nodes
@@ -123,6 +135,7 @@ contains
       class(exact_solution_type), intent(in), optional, target :: exact
       !> Expansion rounds allowed per patch (>= 0; default `default_max_rounds`).
       integer, intent(in), optional :: max_rounds
+      type(grid_contact_type), intent(in), optional, target :: contact
       type(grid_source_type) :: src
       type(patch_loop_type) :: opt
       integer :: rounds_limit, ip, e, n
@@ -155,6 +168,14 @@ contains
       src%elem_lo => field%elem_lo
       src%elem_hi => field%elem_hi
       if (present(exact)) src%exact => exact
+      if (present(contact)) then
+         if (size(contact%law) /= size(input%bw) .or. size(contact%slip, 1) < grid%dim) then
+            call fatal_error(error, 'recover_grid: the contact description has '//itoa(size(contact%law))// &
+               & ' boundary points, the input '//itoa(size(input%bw)), stat_invalid_input)
+            return
+         end if
+         src%contact => contact
+      end if
       src%nstress = field%nstress
       src%sprc = method == method_sprc
       opt = patch_loop_type(dim=grid%dim, degree=degree, rounds_limit=rounds_limit, sprc=src%sprc)
@@ -278,11 +299,7 @@ contains
             end do
             if (.not. self%sprc) cycle
             do k = input%belem_ptr(e), input%belem_ptr(e + 1) - 1
-               if (associated(self%exact)) then
-                  call boundary_data(input, k, d, kind, t, self%exact)
-               else
-                  call boundary_data(input, k, d, kind, t)
-               end if
+               call point_kind(self, k, kind, t)
                if (kind == 0) cycle
                patch%nbpoints = patch%nbpoints + 1
                patch%bx(1:d, patch%nbpoints) = input%bx(:, k)
@@ -295,6 +312,69 @@ contains
          end do
       end associate
    end subroutine grid_fill
+
+   !> Recovery boundary kind (0: not constrained) and prescribed traction of input boundary
+   !> point k: contact or free on the contact shape (module notes), else `boundary_data`.
+   pure subroutine point_kind(self, k, kind, t)
+      class(grid_source_type), intent(in) :: self
+      integer, intent(in) :: k
+      integer, intent(out) :: kind
+      real(wp), intent(out) :: t(3)
+      integer :: d
+
+      d = self%nodes%dim
+      if (associated(self%contact)) then
+         if (self%input%bshape(k) == self%contact%shape) then
+            t = 0.0_wp
+            kind = merge(boundary_contact, boundary_traction, self%contact%law(k) /= 0)
+            return
+         end if
+      end if
+      if (associated(self%exact)) then
+         call boundary_data(self%input, k, d, kind, t, self%exact)
+      else
+         call boundary_data(self%input, k, d, kind, t)
+      end if
+   end subroutine point_kind
+
+   !> Solve a filled patch: the coupled contact solve if it holds contact points, else the
+   !> default (module notes). The law and slip of its boundary points follow `grid_fill`'s order.
+   subroutine grid_recover(self, node, elements, patch, degree, sprc, ws, rec, error)
+      class(grid_source_type), intent(in) :: self
+      integer, intent(in) :: node, elements(:), degree
+      type(patch_type), intent(in) :: patch
+      logical, intent(in) :: sprc
+      type(recovery_workspace_type), intent(inout) :: ws
+      type(recovered_patch_type), intent(out) :: rec
+      type(error_type), allocatable, intent(out) :: error
+      integer, allocatable :: law(:)
+      real(wp), allocatable :: slip(:, :)
+      real(wp) :: t(3)
+      integer :: i, j, k, kind, d
+
+      d = self%nodes%dim
+      if (sprc .and. associated(self%contact) .and. patch%nbpoints > 0) then
+         if (any(patch%bkind(1:patch%nbpoints) == boundary_contact)) then
+            allocate (law(patch%nbpoints), slip(d, patch%nbpoints))
+            j = 0
+            do i = 1, size(elements)
+               do k = self%input%belem_ptr(elements(i)), self%input%belem_ptr(elements(i) + 1) - 1
+                  call point_kind(self, k, kind, t)
+                  if (kind == 0) cycle
+                  j = j + 1
+                  law(j) = 0
+                  slip(:, j) = 0.0_wp
+                  if (kind /= boundary_contact) cycle
+                  law(j) = self%contact%law(k)
+                  slip(:, j) = self%contact%slip(1:d, k)
+               end do
+            end do
+            call contact_patch_solve(self%contact, patch, law, slip, degree, ws, rec, error)
+            return
+         end if
+      end if
+      call recover_patch_default(self, node, elements, patch, degree, sprc, ws, rec, error)
+   end subroutine grid_recover
 
    !> Recovery boundary kind (0: not constrained) and prescribed traction of boundary point k.
    pure subroutine boundary_data(input, k, d, kind, t, exact)

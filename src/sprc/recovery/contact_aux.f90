@@ -24,13 +24,11 @@
 !> perimeter; the difference is of the order of the displacement gradient).
 !>
 !> Size (the seed: too small an Omega_aux holds only boundary cells, whose FE stresses are
-!> the poorest; too large a one over-smooths). The caller chooses `depth`; the intended
-!> choice is depth = the patch size h of body (1)'s patch (sprc_recovery_patch), so that
-!> Omega_aux mirrors the patch: as many layers of body (2)'s cells as the patch has of body
-!> (1)'s, for comparable cell sizes. A fit on Omega_aux that is rank deficient (too few
-!> points of body (2), e.g. much coarser cells) is the caller's cue to double depth, like
-!> the expansion of a rank-deficient patch. This choice is not yet measured against
-!> alternatives (that needs the coupled contact recovery on FE solutions).
+!> the poorest; too large a one over-smooths). The caller chooses `depth`. The grid recovery
+!> takes 3 patch sizes (sprc_grid_contact, which gives the measurements: depth h, 2h, 3h, 4h
+!> on the shrink fit and the Hertz cylinder). A fit on Omega_aux that is rank deficient (too
+!> few points of body (2), e.g. much coarser cells) is the caller's cue to double depth, like
+!> the expansion of a rank-deficient patch (recover_contact_patch does).
 module sprc_recovery_contact_aux
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input

@@ -326,15 +326,18 @@ contains
    end subroutine body_coef
 
    !> One contact patch from the other body's sampling points (mesh-agnostic): Omega_aux of
-   !> patch1's contact points (sprc_recovery_contact_aux, margin 0) with depth `depth`, patch2
+   !> patch1's contact points (sprc_recovery_contact_aux, margin 0, widened as below) with depth `depth`, patch2
    !> filled with body (2)'s points y2(1:dim, j), weights w2(j), Voigt stresses stress2(:, j)
    !> inside it (x0 the Omega_aux centre, h the largest distance from it to a chosen point;
    !> material young2, poisson2, body force body_force2 if given; the analysis of patch1), then
    !> recover_sprc_contact. While the Omega_aux fit is rank deficient (too few or coplanar
-   !> points of body (2)) the depth is doubled, at most aux_max_doublings times; depth_used
+   !> points of body (2)) the depth is doubled, at most aux_max_doublings times, and the
+   !> cross-section widened by half the added depth on every side (a patch whose contact
+   !> points nearly coincide has a prism too thin to hold points); depth_used
    !> returns the depth of the solve. patch2 is storage reused between calls.
+   !> `max_doublings` (default aux_max_doublings) bounds the doublings.
    subroutine recover_contact_patch(patch1, degree, law, mu, slip, y2, w2, stress2, young2, poisson2, depth, &
-      & ws1, ws2, patch2, rec1, rec2, error, body_force2, depth_used)
+      & ws1, ws2, patch2, rec1, rec2, error, body_force2, depth_used, max_doublings)
       type(patch_type), intent(in) :: patch1
       integer, intent(in) :: degree, law(:)
       real(wp), intent(in) :: mu, slip(:, :), y2(:, :), w2(:), stress2(:, :), young2, poisson2, depth
@@ -344,10 +347,11 @@ contains
       type(error_type), allocatable, intent(out) :: error
       real(wp), intent(in), optional :: body_force2(:)
       real(wp), intent(out), optional :: depth_used
+      integer, intent(in), optional :: max_doublings
       type(aux_domain_type) :: aux
       real(wp), allocatable :: cx(:, :), cn(:, :), cw(:)
       real(wp) :: dep
-      integer :: d, k
+      integer :: d, k, kmax
 
       d = patch1%dim
       call check_contact_input(patch1, law, slip, error)
@@ -358,8 +362,10 @@ contains
       end if
       call contact_points(patch1, cx, cn, cw)
       dep = depth
-      do k = 0, aux_max_doublings
-         call new_aux_domain(aux, d, cx, cn, cw, dep, 0.0_wp, error)
+      kmax = aux_max_doublings
+      if (present(max_doublings)) kmax = max(0, min(max_doublings, aux_max_doublings))
+      do k = 0, kmax
+         call new_aux_domain(aux, d, cx, cn, cw, dep, 0.5_wp*(dep - depth), error)
          if (allocated(error)) then
             error%message = 'recover_contact_patch: '//error%message
             return
@@ -368,7 +374,7 @@ contains
          if (present(body_force2)) patch2%body_force(1:d) = body_force2(1:d)
          if (present(depth_used)) depth_used = dep
          dep = 2*dep
-         if (patch2%npoints == 0 .and. k < aux_max_doublings) cycle
+         if (patch2%npoints == 0 .and. k < kmax) cycle
          call recover_sprc_contact(patch1, patch2, degree, law, mu, slip, ws1, ws2, rec1, rec2, error)
          if (.not. allocated(error)) return
          if (error%stat /= stat_singular .or. index(error%message, 'Omega_aux fit') == 0) return

@@ -1,6 +1,7 @@
 !> The patch loop of SPR / SPR-C, shared by every producer of patches (the Cartesian grid,
-!> sprc_grid_patches; a caller's mesh, sprc_recovery_mesh; contact, which recovers some
-!> patches itself and skips them here). Seed eqs. 8-11, 19-24, 99-100; Figure 15.
+!> sprc_grid_patches; a caller's mesh, sprc_recovery_mesh). A producer may solve some patches
+!> its own way (`recover`: the grid's contact patches) or skip them (`skip`). Seed eqs. 8-11,
+!> 19-24, 99-100; Figure 15.
 !>
 !> A producer describes its mesh by plain arrays: the node -> element CSR (ne_ptr, ne_list;
 !> elements ascending per node), the element -> node table (connectivity, for expansion),
@@ -37,7 +38,7 @@ module sprc_recovery_patch_loop
    implicit none
    private
 
-   public :: patch_source_type, patch_loop_type, run_patch_loop, patch_capacity, auto_degree
+   public :: patch_source_type, patch_loop_type, run_patch_loop, patch_capacity, auto_degree, recover_patch_default
 
    !> What a producer gives the loop besides its mesh arrays: it must be safe to call from
    !> several threads at once (read-only).
@@ -48,6 +49,10 @@ module sprc_recovery_patch_loop
       !> [volume points, boundary points] element e adds to a patch (boundary points 0
       !> when the method takes none).
       procedure(points_interface), deferred :: points_of
+      !> Solve a filled patch: SPR or SPR-C (`recover_patch_default`). A producer overrides
+      !> it for patches it solves otherwise (the grid's contact patches); stat_singular
+      !> expands the patch as usual.
+      procedure :: recover => recover_patch_default
    end type patch_source_type
 
    abstract interface
@@ -237,13 +242,29 @@ contains
    contains
       subroutine solve(ws)
          type(recovery_workspace_type), intent(inout) :: ws
-         if (opt%sprc) then
-            call recover_sprc(sc%patch, opt%degree, ws, rec, error)
-         else
-            call recover_spr(sc%patch, opt%degree, ws, rec, error)
-         end if
+         call source%recover(n, sc%list(1:sc%nlist), sc%patch, opt%degree, opt%sprc, ws, rec, error)
       end subroutine solve
    end subroutine recover_patch
+
+   !> The default solve of a filled patch (`patch_source_type%recover`): SPR-C or SPR at
+   !> `degree` in `ws`. `node` and `elements` are the patch's, as given to `fill`.
+   subroutine recover_patch_default(self, node, elements, patch, degree, sprc, ws, rec, error)
+      class(patch_source_type), intent(in) :: self
+      integer, intent(in) :: node, elements(:), degree
+      type(patch_type), intent(in) :: patch
+      logical, intent(in) :: sprc
+      type(recovery_workspace_type), intent(inout) :: ws
+      type(recovered_patch_type), intent(out) :: rec
+      type(error_type), allocatable, intent(out) :: error
+
+      associate (unused => [node, elements]); end associate
+      associate (unused => self); end associate
+      if (sprc) then
+         call recover_sprc(patch, degree, ws, rec, error)
+      else
+         call recover_spr(patch, degree, ws, rec, error)
+      end if
+   end subroutine recover_patch_default
 
    subroutine list_add(sc, e, tag)
       type(scratch_type), intent(inout) :: sc

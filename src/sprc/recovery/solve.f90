@@ -477,8 +477,14 @@ contains
       rec%boundary_kind = kind
       if (kind == boundary_none) return
       if (kind == boundary_contact) then
-         if (.not. contact_by_caller) call fatal_error(error, 'recover_sprc: a patch with contact boundary points '// &
-            & 'needs the coupled contact solve (recover_sprc_contact)', stat_invalid_input)
+         if (.not. contact_by_caller) then
+            call fatal_error(error, 'recover_sprc: a patch with contact boundary points '// &
+               & 'needs the coupled contact solve (recover_sprc_contact)', stat_invalid_input)
+         else if (any(patch%bkind(1:patch%nbpoints) == boundary_symmetry)) then
+            ! Contact wins over tractions (seed); a symmetry plane agrees with any contact law
+            ! (zero shear on the plane), so a contact patch at one keeps it.
+            call symmetry_block(patch, ws, rec, mc, error)
+         end if
          return
       end if
       if ((kind == boundary_traction .or. patch%all_boundary_kinds) .and. traction_near_node(patch)) then

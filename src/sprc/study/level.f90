@@ -32,6 +32,7 @@ module sprc_study_level
    use sprc_core_timer, only: timer_type, wall_time
    use sprc_core_alloc, only: check_allocation
    use sprc_core_blas_threads, only: blas_reserve_buffers
+   use sprc_core_boundary, only: bc_none
    use sprc_geometry_body, only: body_type
    use sprc_exact_solution, only: exact_solution_type
    use sprc_grid_nodes, only: grid_nodes_type
@@ -39,7 +40,10 @@ module sprc_study_level
    use sprc_grid_cut_mesh, only: cut_mesh_type
    use sprc_grid_patches, only: recovery_input_type, recover_grid
    use sprc_grid_recovered_field, only: recovered_field_type, method_spr, method_sprc, field_eval
-   use sprc_recovery_contact_operators, only: contact_traction
+   use sprc_recovery_contact_operators, only: contact_traction, contact_law_frictionless, contact_law_slip, &
+      & contact_law_stick
+   use sprc_recovery_operators, only: traction_operator
+   use sprc_grid_contact, only: grid_contact_type, new_grid_contact
    use sprc_grid_recovered_estimate, only: zz_estimate_type, estimate_error
    use sprc_fem_bc, only: fe_bc_type
    use sprc_fem_problem, only: elasticity_problem_type
@@ -51,7 +55,6 @@ module sprc_study_level
       & analysis_units, in_units
    use sprc_study_budget, only: check_level_memory
    use sprc_study_row, only: report_row_type
-   use sprc_core_boundary, only: bc_none
    use sprc_study_contact_row, only: fill_contact_exact, fill_contact_row
    use sprc_contact_result, only: contact_result_type, new_contact_result, contact_open, contact_stick, &
       & contact_slip
@@ -301,53 +304,51 @@ contains
       if (allocated(study%scene%solver)) bl%problem%solver = solver_choice(study%scene%solver)
       call bl%problem%solve(error)
       if (allocated(error)) return
-      call finish_body(study, sb, bl, 0, error)
+      call finish_body(study, sb, bl, error)
    end subroutine run_body
 
-   !> After the FE solve: the exact error, the recoveries and estimates.
-   !> `b` is the body's scene index when it is in contact (else 0).
-   subroutine finish_body(study, sb, bl, b, error)
+   !> After the FE solve of a body not in contact: the exact error, the recoveries and estimates.
+   subroutine finish_body(study, sb, bl, error)
       type(study_type), intent(in) :: study
       type(study_body_type), intent(in) :: sb
       type(body_level_type), intent(inout) :: bl
-      integer, intent(in) :: b
       type(error_type), allocatable, intent(out) :: error
       type(recovery_input_type) :: input
-      real(wp) :: err_fe, norm_fe
-      integer :: m
 
-      if (allocated(sb%exact)) then
-         call bl%problem%energy_error(err_fe, bl%element_error, norm_fe, bl%norm_exact, error, bl%err_norm)
-         if (allocated(error)) return
-      end if
-      if (.not. any(study%run)) return
+      call exact_error(sb, bl, error)
+      if (allocated(error) .or. .not. any(study%run)) return
       call fe_recovery_input(bl%problem, input, error)
-      if (allocated(error)) return
-      if (b > 0) call free_contact_surfaces(study, b, input)
-      do m = 1, 2
-         if (.not. study%run(m)) cycle
-         call recover_and_estimate(sb, input, bl, m, study%degree(m), error)
-         if (allocated(error)) return
-      end do
+      if (.not. allocated(error)) call recover_body(study, sb, bl, input, error)
    end subroutine finish_body
 
-   !> SPR-C imposes nothing on body b's contact surfaces: they carry the
-   !> contact traction, not the zero traction of a free surface (the default
-   !> of a surface without `&bc`). Contact constraints in the patches (seed
-   !> eqs. 103-138) are not in this version.
-   subroutine free_contact_surfaces(study, b, input)
-      type(study_type), intent(in) :: study
-      integer, intent(in) :: b
-      type(recovery_input_type), intent(inout) :: input
-      integer :: k
+   !> The energy error of the FE stress where there is an exact solution.
+   subroutine exact_error(sb, bl, error)
+      type(study_body_type), intent(in) :: sb
+      type(body_level_type), intent(inout) :: bl
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: err_fe, norm_fe
 
-      do k = 1, size(study%scene%contacts)
-         associate (c => study%scene%contacts(k), shapes => study%scene%shapes)
-            if (c%slave_index == b) input%bc_kind(shapes(c%slave_surface_index)%body_shape) = bc_none
-            if (c%master_index == b) input%bc_kind(shapes(c%master_surface_index)%body_shape) = bc_none
-         end associate
+      if (.not. allocated(sb%exact)) return
+      call bl%problem%energy_error(err_fe, bl%element_error, norm_fe, bl%norm_exact, error, bl%err_norm)
+   end subroutine exact_error
+
+   !> The recoveries and estimates of a body from its recovery input; `contact` is its
+   !> contact surface (SPR-C's coupled contact patches, sprc_grid_contact).
+   subroutine recover_body(study, sb, bl, input, error, contact)
+      type(study_type), intent(in) :: study
+      type(study_body_type), intent(in) :: sb
+      type(body_level_type), intent(inout) :: bl
+      type(recovery_input_type), intent(in) :: input
+      type(error_type), allocatable, intent(out) :: error
+      type(grid_contact_type), intent(in), optional :: contact
+      integer :: m
+
+      do m = 1, 2
+         if (.not. study%run(m)) cycle
+         call recover_and_estimate(sb, input, bl, m, study%degree(m), error, contact)
+         if (allocated(error)) return
       end do
-   end subroutine free_contact_surfaces
+   end subroutine recover_body
 
    !> Whether body b belongs to a `&contact` pair.
    pure logical function in_contact(study, b)
@@ -423,15 +424,9 @@ contains
          bodies(k)%problem%rcond = sol%rcond
          bodies(k)%problem%solver_name = sol%solver_name
       end do
-      do b = 1, 2
-         k = merge(s, m, b == 1)
-         call finish_body(study, study%bodies(k), bodies(k), k, error)
-         if (allocated(error)) then
-            error%message = 'body '''//study%bodies(k)%name//''': '//error%message
-            return
-         end if
-      end do
       call contact_result(surface, sol, spec, study%bodies(s)%units, result, error)
+      if (allocated(error)) return
+      call finish_pair(study, spec, surface, result, bodies, error)
       if (.not. allocated(error)) &
          & call recovered_tractions(surface, bodies(s), study%run, study%bodies(s)%units, result, error)
       if (allocated(error)) return
@@ -556,6 +551,147 @@ contains
       end do
    end subroutine slave_recovered_traction
 
+   !> The stabilization's recovery of the slave alone (inside the contact
+   !> iteration, before the pair's coupled contact patches can be built)
+   !> imposes nothing on body b's contact surfaces: they carry the contact
+   !> traction, not the zero traction of a free surface (the default of a
+   !> surface without `&bc`).
+   subroutine free_contact_surfaces(study, b, input)
+      type(study_type), intent(in) :: study
+      integer, intent(in) :: b
+      type(recovery_input_type), intent(inout) :: input
+      integer :: k
+
+      do k = 1, size(study%scene%contacts)
+         associate (c => study%scene%contacts(k), shapes => study%scene%shapes)
+            if (c%slave_index == b) input%bc_kind(shapes(c%slave_surface_index)%body_shape) = bc_none
+            if (c%master_index == b) input%bc_kind(shapes(c%master_surface_index)%body_shape) = bc_none
+         end associate
+      end do
+   end subroutine free_contact_surfaces
+   !> After a pair's FE solve: both bodies' exact errors, recoveries and estimates, SPR-C
+   !> with each body's contact surface (`pair_contact`): the coupled contact patches of
+   !> both bodies, each with the other as body (2) (sprc_grid_contact).
+   subroutine finish_pair(study, spec, surface, result, bodies, error)
+      type(study_type), intent(in) :: study
+      type(contact_spec_type), intent(in) :: spec
+      type(contact_surface_type), intent(in) :: surface
+      type(contact_result_type), intent(in) :: result
+      type(body_level_type), intent(inout) :: bodies(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(recovery_input_type) :: inputs(2)
+      type(grid_contact_type) :: contacts(2)
+      integer :: b, k(2)
+
+      k = [spec%slave_index, spec%master_index]
+      do b = 1, 2
+         call exact_error(study%bodies(k(b)), bodies(k(b)), error)
+         if (.not. allocated(error) .and. any(study%run)) call fe_recovery_input(bodies(k(b))%problem, inputs(b), error)
+         if (allocated(error)) then
+            error%message = 'body '''//study%bodies(k(b))%name//''': '//error%message
+            return
+         end if
+      end do
+      if (.not. any(study%run)) return
+      do b = 1, 2
+         call pair_contact(study, spec, surface, result, bodies(spec%slave_index), b, inputs(b), &
+            & bodies(k(b))%problem%mesh%nodes, inputs(3 - b), contacts(b), error)
+         if (.not. allocated(error)) &
+            & call recover_body(study, study%bodies(k(b)), bodies(k(b)), inputs(b), error, contacts(b))
+         if (allocated(error)) then
+            error%message = 'body '''//study%bodies(k(b))%name//''': '//error%message
+            return
+         end if
+      end do
+   end subroutine finish_pair
+
+   !> The contact surface of side b (1 slave, 2 master) for its recovery (sprc_grid_contact):
+   !> each of the body's boundary points on its contact shape takes the state of the nearest
+   !> slave point (side 2: nearest master point of a slave point) within the size of its
+   !> element, else open; closed states give the law (frictionless; stick; Coulomb: stick
+   !> or slip) and, for slip, the slip direction of the body relative to the other: opposed
+   !> to the slave's FE tangential traction on the slave side, along it on the master side.
+   !> The other body's volume points and FE stresses are `other`.
+   subroutine pair_contact(study, spec, surface, result, slave, side, input, nodes, other, contact, error)
+      type(study_type), intent(in) :: study
+      type(contact_spec_type), intent(in) :: spec
+      type(contact_surface_type), intent(in) :: surface
+      type(contact_result_type), intent(in) :: result
+      type(body_level_type), intent(in) :: slave
+      integer, intent(in) :: side
+      type(recovery_input_type), intent(in) :: input, other
+      type(grid_nodes_type), intent(in) :: nodes
+      type(grid_contact_type), intent(out) :: contact
+      type(error_type), allocatable, intent(out) :: error
+      integer, allocatable :: law(:)
+      real(wp), allocatable :: slip(:, :)
+      real(wp) :: g(3, 6), sigma(6), t(3), size_e, dist, best
+      integer :: shape, nb, e, k, i, inear, d, ns
+
+      d = study%dim
+      ns = merge(3, 6, d == 2)
+      nb = size(input%bw)
+      shape = study%scene%shapes(merge(spec%slave_surface_index, spec%master_surface_index, side == 1))%body_shape
+      allocate (law(nb), slip(d, nb))
+      law = 0
+      slip = 0.0_wp
+      do e = 1, nodes%n_elements
+         if (input%belem_ptr(e + 1) == input%belem_ptr(e)) cycle
+         size_e = element_size(nodes, e)
+         do k = input%belem_ptr(e), input%belem_ptr(e + 1) - 1
+            if (input%bshape(k) /= shape) cycle
+            best = huge(1.0_wp)
+            inear = 0
+            do i = 1, surface%npoint
+               if (side == 1) then
+                  dist = norm2(surface%x(:, i) - input%bx(:, k))
+               else
+                  if (.not. surface%has_master(i)) cycle
+                  dist = norm2(surface%master_x(:, i) - input%bx(:, k))
+               end if
+               if (dist < best) then
+                  best = dist
+                  inear = i
+               end if
+            end do
+            if (inear == 0 .or. best > size_e) cycle
+            if (result%state(inear) == contact_open) cycle
+            select case (friction_kind(spec%friction))
+            case (friction_frictionless)
+               law(k) = contact_law_frictionless
+            case (friction_coulomb)
+               law(k) = merge(contact_law_slip, contact_law_stick, result%state(inear) == contact_slip)
+            case default
+               law(k) = contact_law_stick
+            end select
+            if (law(k) /= contact_law_slip) cycle
+            call slave%problem%stress_in_element(surface%slave_cell(inear), surface%x(:, inear), sigma(1:ns))
+            call traction_operator(d, surface%normal(:, inear), g)
+            t(1:d) = matmul(g(1:d, 1:ns), sigma(1:ns))
+            t(1:d) = t(1:d) - dot_product(t(1:d), surface%normal(:, inear))*surface%normal(:, inear)
+            ! No tangential traction to give a direction: then mu p ~ 0, and stick is safe.
+            if (norm2(t(1:d)) <= sqrt(epsilon(1.0_wp))*norm2(sigma(1:ns))) then
+               law(k) = contact_law_stick
+            else
+               slip(:, k) = merge(-1.0_wp, 1.0_wp, side == 1)*t(1:d)
+            end if
+         end do
+      end do
+      call new_grid_contact(contact, shape, law, slip, spec%mu, other%x, other%w, other%stress, other%young, &
+         & other%poisson, other%body_force(1:d), error)
+   end subroutine pair_contact
+
+   !> The largest edge of element e's box.
+   pure real(wp) function element_size(nodes, e)
+      type(grid_nodes_type), intent(in) :: nodes
+      integer, intent(in) :: e
+      integer :: nv
+
+      nv = 2**nodes%dim
+      element_size = maxval(maxval(nodes%x(:, nodes%connectivity(1:nv, e)), dim=2) - &
+         & minval(nodes%x(:, nodes%connectivity(1:nv, e)), dim=2))
+   end function element_size
+
    !> The load path of a Coulomb pair (SCENE.md `&bc stage`, `&contact
    !> steps`): the block load at the end of each increment, stage k's loads
    !> applied in `steps` equal increments once the stages before it are
@@ -639,9 +775,8 @@ contains
 
    !> p_spr, p_sprc and ts_sprc of a contact result (scene units) from the slave body's
    !> recovered fields (SPR, SPR-C where run) at its slave points: p = -n.sigma*.n,
-   !> ts = |sigma* n - (n.sigma* n) n| (sprc_recovery_contact_operators). The grid's SPR-C
-   !> patches at the contact surface are not yet the coupled contact patches
-   !> (sprc_recovery_contact_solve): they impose no boundary rows there.
+   !> ts = |sigma* n - (n.sigma* n) n| (sprc_recovery_contact_operators). SPR-C's field
+   !> there comes from the coupled contact patches (`finish_pair`).
    subroutine recovered_tractions(surface, bl, run, units, result, error)
       type(contact_surface_type), intent(in) :: surface
       type(body_level_type), intent(in) :: bl
@@ -673,23 +808,25 @@ contains
    end subroutine recovered_tractions
 
    !> Recovery and estimate with one method (1 SPR, 2 SPR-C) at the patch degree `degree`.
-   subroutine recover_and_estimate(sb, input, bl, m, degree, error)
+   !> With `contact`, SPR-C's contact patches (sprc_grid_contact).
+   subroutine recover_and_estimate(sb, input, bl, m, degree, error, contact)
       type(study_body_type), intent(in) :: sb
       type(recovery_input_type), intent(in) :: input
       type(body_level_type), intent(inout) :: bl
       integer, intent(in) :: m, degree
       type(error_type), allocatable, intent(out) :: error
+      type(grid_contact_type), intent(in), optional :: contact
       integer :: method
 
       method = merge(method_spr, method_sprc, m == 1)
       if (allocated(sb%exact)) then
          call recover_grid(input, bl%problem%mesh%grid, bl%problem%mesh%nodes, bl%problem%mesh%hanging, method, &
-            & degree, bl%field(m), error, exact=sb%exact)
+            & degree, bl%field(m), error, exact=sb%exact, contact=contact)
          if (allocated(error)) return
          call estimate_error(input, bl%field(m), bl%est(m), error, exact=sb%exact)
       else
          call recover_grid(input, bl%problem%mesh%grid, bl%problem%mesh%nodes, bl%problem%mesh%hanging, method, &
-            & degree, bl%field(m), error)
+            & degree, bl%field(m), error, contact=contact)
          if (allocated(error)) return
          call estimate_error(input, bl%field(m), bl%est(m), error)
       end if
