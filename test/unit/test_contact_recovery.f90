@@ -75,7 +75,8 @@ contains
          new_unittest('contact_patch_depth', test_contact_patch_depth), &
          new_unittest('study_patch_pressures', test_study_patch_pressures), &
          new_unittest('grid_exact_2d', test_grid_exact_2d), &
-         new_unittest('grid_exact_3d', test_grid_exact_3d) &
+         new_unittest('grid_exact_3d', test_grid_exact_3d), &
+         new_unittest('traction_jump_shrink_fit', test_traction_jump) &
          ]
    end subroutine collect_contact_recovery
 
@@ -571,6 +572,26 @@ contains
       if (allocated(error)) return
       call grid_exact_case(replaced(text, "order    = 1", "order    = 2"), 1, sigma, 'Q2 frictionless', error)
    end subroutine test_grid_exact_3d
+
+   !> Action-reaction of the recovered stresses on the compound cylinder (example shrink fit,
+   !> level 5): the jump of the normal traction between the two bodies at the contact points
+   !> (level_type%traction_jump) is zero in the exact solution; the FE and SPR stresses jump
+   !> by 8.6e-2 and 9.3e-2 of the traction there, SPR-C's contact patches by 2.0e-2. A
+   !> regression guard: SPR-C's jump below half of either.
+   subroutine test_traction_jump(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: text
+      type(level_type) :: result
+
+      call read_text_file('example/scenes/shrink_fit.nml', text, error)
+      if (allocated(error)) return
+      call run_text(text, 5, result, error)
+      if (allocated(error)) return
+      associate (j => result%traction_jump(:, 1))
+         call check(error, all(j >= 0.0_wp) .and. j(3) <= 0.5_wp*j(1) .and. j(3) <= 0.5_wp*j(2), &
+            & 'traction jump FE, SPR, SPR-C: '//rtoa(j(1))//', '//rtoa(j(2))//', '//rtoa(j(3)))
+      end associate
+   end subroutine test_traction_jump
 
    !> One case of test_grid_exact_2d/3d: the scene `text` at `level` carries the uniform stress
    !> `sigma` (Voigt).

@@ -19,8 +19,8 @@
 !> fit lacks rank.
 !>
 !> The other body's points are sorted into uniform cells once (a counting sort): a patch
-!> passes the solve only those in a box about its node that Omega_aux can reach with one
-!> doubling of its depth, and all it can reach with aux_max_doublings only if that fails.
+!> passes the solve only those in a box about its node that Omega_aux of the first depth can
+!> reach, and all it can reach with aux_max_doublings only if that fails.
 !>
 !> Small deformations: undeformed points and normals.
 module sprc_grid_contact
@@ -191,13 +191,13 @@ contains
       integer :: n
 
       call workspace_init(ws2)
-      ! First the points Omega_aux reaches with one doubling (depth 2 depth h, cross-section
-      ! widened by depth h / 2 beyond the patch): a box of half-width h (1 + 3 depth).
-      reach = patch%h*(1.0_wp + 3.0_wp*self%depth)
+      ! First the points Omega_aux of the first depth can hold (its contact points are within
+      ! h of the node): a box of half-width h (1 + depth).
+      reach = patch%h*(1.0_wp + self%depth)
       call gather_box(self, patch, reach, idx, n)
       call recover_contact_patch(patch, degree, law, self%mu, slip, self%y(:, idx(1:n)), self%w(idx(1:n)), &
          & self%stress(:, idx(1:n)), self%young, self%poisson, self%depth*patch%h, ws, ws2, patch2, rec, rec2, &
-         & error, body_force2=self%body_force, max_doublings=1)
+         & error, body_force2=self%body_force, max_doublings=0)
       if (.not. allocated(error)) return
       if (index(error%message, 'Omega_aux fit') == 0 .and. index(error%message, 'no integration points') == 0) return
       deallocate (error)

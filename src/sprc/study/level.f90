@@ -128,6 +128,10 @@ module sprc_study_level
       type(body_level_type), allocatable :: bodies(:)
       !> One result per `&contact` pair (not allocated without `&contact`).
       type(contact_result_type), allocatable :: contacts(:)
+      !> Per pair (columns) the jump of the normal traction between the two bodies over the
+      !> closed slave points with a master point, relative (`traction_jump`): rows FE, SPR,
+      !> SPR-C (negative where the recovery did not run).
+      real(wp), allocatable :: traction_jump(:, :)
       type(report_row_type) :: row
    end type level_type
 
@@ -244,10 +248,11 @@ contains
          end if
       end do
       t_contact = 0.0_wp
-      if (size(study%scene%contacts) > 0) allocate (result%contacts(size(study%scene%contacts)))
+      if (size(study%scene%contacts) > 0) allocate (result%contacts(size(study%scene%contacts)), &
+         & result%traction_jump(3, size(study%scene%contacts)))
       do k = 1, size(study%scene%contacts)
          call run_contact(study, study%scene%contacts(k), result%bodies, result%contacts(k), t_contact, error, &
-            & progress)
+            & result%traction_jump(:, k), progress)
          if (allocated(error)) return
       end do
       call sum_row(study, result, result%row)
@@ -366,13 +371,15 @@ contains
    !> solve (sprc_contact_solve), then each body's errors and recoveries; the
    !> contact result in scene units. The block solves count in the slave
    !> body's t_solve; points, gaps and contact terms add to `t_contact`.
-   subroutine run_contact(study, spec, bodies, result, t_contact, error, progress)
+   subroutine run_contact(study, spec, bodies, result, t_contact, error, jump, progress)
       type(study_type), intent(in) :: study
       type(contact_spec_type), intent(in) :: spec
       type(body_level_type), intent(inout) :: bodies(:)
       type(contact_result_type), intent(out) :: result
       real(wp), intent(inout) :: t_contact
       type(error_type), allocatable, intent(out) :: error
+      !> The pair's `traction_jump` (FE, SPR, SPR-C).
+      real(wp), intent(out) :: jump(3)
       procedure(contact_progress), optional :: progress
       type(contact_surface_type) :: surface
       type(contact_solution_type) :: sol
@@ -429,6 +436,7 @@ contains
       call finish_pair(study, spec, surface, result, bodies, error)
       if (.not. allocated(error)) &
          & call recovered_tractions(surface, bodies(s), study%run, study%bodies(s)%units, result, error)
+      if (.not. allocated(error)) call traction_jump(surface, result, bodies(s), bodies(m), study%run, jump, error)
       if (allocated(error)) return
       t_contact = t_contact + timer%elapsed + sol%t_contact
    end subroutine run_contact
@@ -806,6 +814,48 @@ contains
          end do
       end do
    end subroutine recovered_tractions
+
+   !> Action-reaction of a pair's stresses (seed eq. 107): over the closed slave points i with
+   !> a master point, jump = sqrt(sum w_i (t1_i - t2_i)^2) / sqrt(sum w_i t1_i^2), with t1 the
+   !> slave's normal traction n.sigma1.n at x_i and t2 the master's n.sigma2.n at its master
+   !> point (n the slave normal): for the FE stresses, SPR and SPR-C (jump(m + 1), -1 where
+   !> method m did not run or no point is closed).
+   subroutine traction_jump(surface, result, slave, master, run, jump, error)
+      type(contact_surface_type), intent(in) :: surface
+      type(contact_result_type), intent(in) :: result
+      type(body_level_type), intent(in) :: slave, master
+      logical, intent(in) :: run(2)
+      real(wp), intent(out) :: jump(3)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: s1(6), s2(6), t(2), num(3), den(3), ts
+      integer :: i, m, d, ns
+
+      d = surface%dim
+      ns = merge(3, 6, d == 2)
+      num = 0.0_wp
+      den = 0.0_wp
+      do i = 1, surface%npoint
+         if (result%state(i) == contact_open .or. .not. surface%has_master(i) .or. surface%slave_cell(i) < 1) cycle
+         do m = 0, 2
+            if (m == 0) then
+               call slave%problem%stress_in_element(surface%slave_cell(i), surface%x(:, i), s1(1:ns))
+               call master%problem%stress_in_element(surface%master_cell(i), surface%master_x(:, i), s2(1:ns))
+            else
+               if (.not. run(m)) cycle
+               call field_eval(slave%field(m), surface%slave_cell(i), surface%x(:, i), s1, error)
+               if (.not. allocated(error)) &
+                  & call field_eval(master%field(m), surface%master_cell(i), surface%master_x(:, i), s2, error)
+               if (allocated(error)) return
+            end if
+            call contact_traction(d, surface%normal(:, i), s1, t(1), ts)
+            call contact_traction(d, surface%normal(:, i), s2, t(2), ts)
+            num(m + 1) = num(m + 1) + surface%weight(i)*(t(1) - t(2))**2
+            den(m + 1) = den(m + 1) + surface%weight(i)*t(1)**2
+         end do
+      end do
+      jump = -1.0_wp
+      where (den > 0.0_wp) jump = sqrt(num/den)
+   end subroutine traction_jump
 
    !> Recovery and estimate with one method (1 SPR, 2 SPR-C) at the patch degree `degree`.
    !> With `contact`, SPR-C's contact patches (sprc_grid_contact).
