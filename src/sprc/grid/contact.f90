@@ -19,8 +19,8 @@
 !> fit lacks rank.
 !>
 !> The other body's points are sorted into uniform cells once (a counting sort): a patch
-!> passes the solve only those in a box about its node that Omega_aux of the first depth can
-!> reach, and all it can reach with aux_max_doublings only if that fails.
+!> passes the solve only those in a box about its node that Omega_aux can reach, the box
+!> growing with the depth doublings.
 !>
 !> Small deformations: undeformed points and normals.
 module sprc_grid_contact
@@ -188,24 +188,22 @@ contains
       type(recovered_patch_type) :: rec2
       integer, allocatable :: idx(:)
       real(wp) :: reach
-      integer :: n
+      integer :: n, k
 
       call workspace_init(ws2)
-      ! First the points Omega_aux of the first depth can hold (its contact points are within
-      ! h of the node): a box of half-width h (1 + depth).
-      reach = patch%h*(1.0_wp + self%depth)
-      call gather_box(self, patch, reach, idx, n)
-      call recover_contact_patch(patch, degree, law, self%mu, slip, self%y(:, idx(1:n)), self%w(idx(1:n)), &
-         & self%stress(:, idx(1:n)), self%young, self%poisson, self%depth*patch%h, ws, ws2, patch2, rec, rec2, &
-         & error, body_force2=self%body_force, max_doublings=0)
-      if (.not. allocated(error)) return
-      if (index(error%message, 'Omega_aux fit') == 0 .and. index(error%message, 'no integration points') == 0) return
-      deallocate (error)
-      reach = patch%h*(1.0_wp + self%depth*2.0_wp**(aux_max_doublings + 1))
-      call gather_box(self, patch, reach, idx, n)
-      call recover_contact_patch(patch, degree, law, self%mu, slip, self%y(:, idx(1:n)), self%w(idx(1:n)), &
-         & self%stress(:, idx(1:n)), self%young, self%poisson, self%depth*patch%h, ws, ws2, patch2, rec, rec2, &
-         & error, body_force2=self%body_force)
+      ! Omega_aux after k doublings reaches 2^k depth h beyond the contact points (within h of
+      ! the node) and widens by (2^k - 1) depth h / 2: the box of half-width
+      ! h (1 + depth (1.5 2^k - 0.5)) holds it. Each k gathers its own box, so that a patch
+      ! needing doublings does not scan the whole other body.
+      do k = 0, aux_max_doublings
+         reach = patch%h*(1.0_wp + self%depth*(1.5_wp*2.0_wp**k - 0.5_wp))
+         call gather_box(self, patch, reach, idx, n)
+         call recover_contact_patch(patch, degree, law, self%mu, slip, self%y(:, idx(1:n)), self%w(idx(1:n)), &
+            & self%stress(:, idx(1:n)), self%young, self%poisson, self%depth*patch%h, ws, ws2, patch2, rec, rec2, &
+            & error, body_force2=self%body_force, max_doublings=k)
+         if (.not. allocated(error)) return
+         if (index(error%message, 'Omega_aux fit') == 0) return
+      end do
    end subroutine contact_patch_solve
 
    !> The other body's points within `reach` of the patch node in every coordinate, in
