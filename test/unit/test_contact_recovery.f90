@@ -15,7 +15,7 @@ module sprc_test_contact_recovery
    use sprc_recovery_contact_aux, only: aux_domain_type, new_aux_domain, aux_contains, aux_select
    use sprc_recovery_contact_solve, only: recover_sprc_contact, recover_contact_patch
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reset, patch_add_point, &
-      & patch_add_boundary_point, boundary_contact
+      & patch_add_boundary_point, boundary_contact, boundary_symmetry, boundary_none
    use sprc_recovery_workspace, only: recovery_workspace_type
    use sprc_core_material, only: plane_strain, solid
    use sprc_core_poly, only: poly_basis_type, new_poly_basis
@@ -76,7 +76,8 @@ contains
          new_unittest('study_patch_pressures', test_study_patch_pressures), &
          new_unittest('grid_exact_2d', test_grid_exact_2d), &
          new_unittest('grid_exact_3d', test_grid_exact_3d), &
-         new_unittest('traction_jump_shrink_fit', test_traction_jump) &
+         new_unittest('traction_jump_shrink_fit', test_traction_jump), &
+         new_unittest('aux_boundary_points', test_aux_boundary) &
          ]
    end subroutine collect_contact_recovery
 
@@ -649,6 +650,61 @@ contains
          end associate
       end do
    end subroutine field_deviation
+
+   !> Body (2)'s own boundary points inside Omega_aux (recover_contact_patch's boundary2): a
+   !> symmetry plane x = 0 through the prism constrains the Omega_aux fit (its boundary kind is
+   !> symmetry; without boundary2 it has none) and, the uniform stress satisfying it and the
+   !> frictionless law, both fits stay exact; a symmetry point outside the prism is left out.
+   subroutine test_aux_boundary(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(patch_type) :: p1, p2, b2
+      type(recovery_workspace_type) :: ws1, ws2
+      type(recovered_patch_type) :: rec1, rec2
+      real(wp), parameter :: sigma(3) = [1.0_wp, -2.0_wp, 0.0_wp]
+      real(wp) :: y2(2, 16), w2(16), s2(3, 16), sl(2, 3), worst
+      integer :: i, j, n, pass
+
+      call patch_reset(p1, 2, plane_strain, 1.0_wp, 0.3_wp, [0.0_wp, 0.0_wp], 0.6_wp)
+      do i = 0, 3
+         do j = 0, 3
+            call patch_add_point(p1, [0.2_wp*i - 0.3_wp, -0.2_wp*j - 0.1_wp], 1.0_wp, sigma)
+         end do
+      end do
+      do i = 1, 3
+         call patch_add_boundary_point(p1, [0.2_wp*i - 0.4_wp, 0.0_wp], 0.2_wp, [0.0_wp, 1.0_wp], boundary_contact)
+      end do
+      n = 0
+      do i = 0, 3
+         do j = 0, 3
+            n = n + 1
+            y2(:, n) = [0.15_wp*i - 0.2_wp, 0.15_wp*j + 0.05_wp]
+            w2(n) = 1.0_wp
+            s2(:, n) = sigma
+         end do
+      end do
+      call patch_reset(b2, 2, plane_strain, 2.0_wp, 0.25_wp, [0.0_wp, 0.0_wp], 1.0_wp)
+      do j = 1, 3
+         call patch_add_boundary_point(b2, [0.0_wp, 0.1_wp*j], 0.1_wp, [-1.0_wp, 0.0_wp], boundary_symmetry)
+      end do
+      call patch_add_boundary_point(b2, [0.0_wp, 5.0_wp], 0.1_wp, [-1.0_wp, 0.0_wp], boundary_symmetry)
+      sl = 0.0_wp
+      do pass = 1, 2
+         if (pass == 1) then
+            call recover_contact_patch(p1, 1, [(contact_law_frictionless, i=1, 3)], 0.0_wp, sl, y2, w2, s2, 2.0_wp, &
+               & 0.25_wp, 0.5_wp, ws1, ws2, p2, rec1, rec2, error, boundary2=b2)
+         else
+            call recover_contact_patch(p1, 1, [(contact_law_frictionless, i=1, 3)], 0.0_wp, sl, y2, w2, s2, 2.0_wp, &
+               & 0.25_wp, 0.5_wp, ws1, ws2, p2, rec1, rec2, error)
+         end if
+         if (allocated(error)) return
+         worst = max(maxval(abs(rec1%coef(1, 1:3) - sigma)), maxval(abs(rec2%coef(1, 1:3) - sigma)), &
+            & maxval(abs(rec1%coef(2:, 1:3))), maxval(abs(rec2%coef(2:, 1:3))))
+         call check(error, worst <= tol_exact .and. rec2%boundary_kind == merge(boundary_symmetry, boundary_none, &
+            & pass == 1) .and. p2%nbpoints == merge(3, 0, pass == 1), 'pass '//itoa(pass)//': Omega_aux kind '// &
+            & itoa(rec2%boundary_kind)//', '//itoa(p2%nbpoints)//' boundary points, deviation '//rtoa(worst))
+         if (allocated(error)) return
+      end do
+   end subroutine test_aux_boundary
 
    !> Bad input of the coupled solve: clear errors, no crash.
    subroutine test_coupled_errors(error)

@@ -22,6 +22,9 @@
 !> passes the solve only those in a box about its node that Omega_aux can reach, the box
 !> growing with the depth doublings.
 !>
+!> The other body's boundary points where a prism meets its other boundaries (symmetry planes,
+!> loaded or free surfaces) constrain the Omega_aux fit as in any SPR-C patch.
+!>
 !> Small deformations: undeformed points and normals.
 module sprc_grid_contact
    use sprc_core_kinds, only: wp
@@ -56,6 +59,9 @@ module sprc_grid_contact
       real(wp) :: depth = default_aux_depth
       !> The other body: volume points sorted along the first axis, weight*|J|, FE stresses.
       real(wp), allocatable :: y(:, :), w(:), stress(:, :)
+      !> The other body's boundary points other than its contact surface (boundary arrays
+      !> only; nbpoints = 0 if not given): they constrain its Omega_aux fits.
+      type(patch_type) :: boundary
       !> The other body's material and body force.
       real(wp) :: young = 0.0_wp, poisson = 0.0_wp, body_force(3) = 0.0_wp
       !> Uniform cells over the box of the points, ncell(k) along axis k (1 beyond dim): the
@@ -71,12 +77,15 @@ contains
    !> point of its recovery input, mu, and the other body's volume points y(1:dim, j), weights
    !> w(j), FE stresses stress(:, j), material and body force. Errors (stat_invalid_input):
    !> sizes that disagree, an unknown law, a non-finite point.
-   subroutine new_grid_contact(self, shape, law, slip, mu, y, w, stress, young, poisson, body_force, error, depth)
+   subroutine new_grid_contact(self, shape, law, slip, mu, y, w, stress, young, poisson, body_force, error, depth, &
+      & boundary)
       type(grid_contact_type), intent(out) :: self
       integer, intent(in) :: shape, law(:)
       real(wp), intent(in) :: slip(:, :), mu, y(:, :), w(:), stress(:, :), young, poisson, body_force(:)
       type(error_type), allocatable, intent(out) :: error
       real(wp), intent(in), optional :: depth
+      !> The other body's boundary points (`boundary`).
+      type(patch_type), intent(in), optional :: boundary
       integer, allocatable :: bin(:)
       integer :: n, d, j, b, stat
       real(wp) :: ymax(3)
@@ -101,6 +110,7 @@ contains
       self%slip = slip
       self%mu = mu
       if (present(depth)) self%depth = depth
+      if (present(boundary)) self%boundary = boundary
       self%young = young
       self%poisson = poisson
       self%body_force = 0.0_wp
@@ -200,7 +210,7 @@ contains
          call gather_box(self, patch, reach, idx, n)
          call recover_contact_patch(patch, degree, law, self%mu, slip, self%y(:, idx(1:n)), self%w(idx(1:n)), &
             & self%stress(:, idx(1:n)), self%young, self%poisson, self%depth*patch%h, ws, ws2, patch2, rec, rec2, &
-            & error, body_force2=self%body_force, max_doublings=k)
+            & error, body_force2=self%body_force, max_doublings=k, boundary2=self%boundary)
          if (.not. allocated(error)) return
          if (index(error%message, 'Omega_aux fit') == 0) return
       end do

@@ -59,7 +59,7 @@ module sprc_grid_patches
    use sprc_grid_nodes, only: grid_nodes_type
    use sprc_grid_hanging, only: hanging_type
    use sprc_recovery_patch, only: patch_type, patch_reset, patch_reserve, boundary_traction, boundary_symmetry, &
-      & boundary_contact, recovered_patch_type
+      & boundary_contact, recovered_patch_type, patch_add_boundary_point
    use sprc_recovery_workspace, only: recovery_workspace_type
    use sprc_recovery_patch_loop, only: patch_source_type, patch_loop_type, run_patch_loop, patch_capacity, &
       & recover_patch_default
@@ -68,7 +68,7 @@ module sprc_grid_patches
    implicit none
    private
 
-   public :: recovery_input_type, check_recovery_input, recover_grid, default_max_rounds
+   public :: recovery_input_type, check_recovery_input, recover_grid, default_max_rounds, boundary_points
    public :: bc_none, bc_traction, bc_pressure, bc_exact_traction, bc_symmetry, bc_kind_name
 
    !> Default limit of expansion rounds per patch (module notes).
@@ -375,6 +375,27 @@ contains
       end if
       call recover_patch_default(self, node, elements, patch, degree, sprc, ws, rec, error)
    end subroutine grid_recover
+
+   !> The recovery boundary points of `input` (kinds and tractions as the patches take them,
+   !> bc_none left out) other than those on shape `skip_shape`, in the boundary arrays of
+   !> `points` (a contact's other body, sprc_grid_contact). `exact` as recover_grid's.
+   subroutine boundary_points(input, dim, skip_shape, points, exact)
+      type(recovery_input_type), intent(in) :: input
+      integer, intent(in) :: dim, skip_shape
+      type(patch_type), intent(out) :: points
+      class(exact_solution_type), intent(in), optional :: exact
+      real(wp) :: t(3)
+      integer :: k, kind
+
+      call patch_reset(points, dim, input%analysis, input%young, input%poisson, [(0.0_wp, k=1, dim)], 1.0_wp)
+      do k = 1, size(input%bw)
+         if (input%bshape(k) == skip_shape) cycle
+         call boundary_data(input, k, dim, kind, t, exact)
+         if (kind == 0) cycle
+         call patch_add_boundary_point(points, input%bx(:, k), input%bw(k), input%bn(:, k), kind, t(1:dim), &
+            & input%bshape(k))
+      end do
+   end subroutine boundary_points
 
    !> Recovery boundary kind (0: not constrained) and prescribed traction of boundary point k.
    pure subroutine boundary_data(input, k, d, kind, t, exact)

@@ -35,7 +35,8 @@ module sprc_recovery_contact_solve
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular
    use sprc_core_text, only: itoa
-   use sprc_recovery_patch, only: patch_type, recovered_patch_type, boundary_contact, patch_reset, patch_reserve
+   use sprc_recovery_patch, only: patch_type, recovered_patch_type, boundary_contact, patch_reset, patch_reserve, &
+      & patch_add_boundary_point
    use sprc_recovery_contact_aux, only: aux_domain_type, new_aux_domain, aux_contains
    use sprc_recovery_workspace, only: recovery_workspace_type
    use sprc_recovery_solve, only: sprc_constraints, note_dropped, recovery_rank_tol, recovery_bite_ratio, traction_rank_tol, &
@@ -337,7 +338,7 @@ contains
    !> returns the depth of the solve. patch2 is storage reused between calls.
    !> `max_doublings` (default aux_max_doublings) bounds the doublings.
    subroutine recover_contact_patch(patch1, degree, law, mu, slip, y2, w2, stress2, young2, poisson2, depth, &
-      & ws1, ws2, patch2, rec1, rec2, error, body_force2, depth_used, max_doublings)
+      & ws1, ws2, patch2, rec1, rec2, error, body_force2, depth_used, max_doublings, boundary2)
       type(patch_type), intent(in) :: patch1
       integer, intent(in) :: degree, law(:)
       real(wp), intent(in) :: mu, slip(:, :), y2(:, :), w2(:), stress2(:, :), young2, poisson2, depth
@@ -348,6 +349,9 @@ contains
       real(wp), intent(in), optional :: body_force2(:)
       real(wp), intent(out), optional :: depth_used
       integer, intent(in), optional :: max_doublings
+      !> Body (2)'s boundary points other than its contact surface (traction or symmetry kinds,
+      !> in the boundary arrays of a patch): those inside Omega_aux constrain its fit.
+      type(patch_type), intent(in), optional :: boundary2
       type(aux_domain_type) :: aux
       real(wp), allocatable :: cx(:, :), cn(:, :), cw(:)
       real(wp) :: dep
@@ -371,6 +375,7 @@ contains
             return
          end if
          call fill_aux_patch(patch1, aux, y2, w2, stress2, young2, poisson2, patch2)
+         if (present(boundary2)) call add_aux_boundary(aux, boundary2, patch2)
          if (present(body_force2)) patch2%body_force(1:d) = body_force2(1:d)
          if (present(depth_used)) depth_used = dep
          dep = 2*dep
@@ -399,6 +404,23 @@ contains
          cw(m) = patch1%bw(j)
       end do
    end subroutine contact_points
+
+   !> Body (2)'s boundary points inside Omega_aux into patch2 (where the prism meets another
+   !> boundary of body (2): its traction or symmetry, Figure 31).
+   pure subroutine add_aux_boundary(aux, boundary2, patch2)
+      type(aux_domain_type), intent(in) :: aux
+      type(patch_type), intent(in) :: boundary2
+      type(patch_type), intent(inout) :: patch2
+      integer :: j, d
+
+      d = aux%dim
+      do j = 1, boundary2%nbpoints
+         if (boundary2%bkind(j) == boundary_contact) cycle
+         if (.not. aux_contains(aux, boundary2%bx(:, j))) cycle
+         call patch_add_boundary_point(patch2, boundary2%bx(1:d, j), boundary2%bw(j), boundary2%bn(1:d, j), &
+            & boundary2%bkind(j), boundary2%btraction(1:d, j), boundary2%bpiece(j))
+      end do
+   end subroutine add_aux_boundary
 
    !> patch2 := body (2)'s points inside Omega_aux (recover_contact_patch).
    pure subroutine fill_aux_patch(patch1, aux, y2, w2, stress2, young2, poisson2, patch2)

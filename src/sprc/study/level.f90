@@ -38,7 +38,8 @@ module sprc_study_level
    use sprc_grid_nodes, only: grid_nodes_type
    use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature, default_points
    use sprc_grid_cut_mesh, only: cut_mesh_type
-   use sprc_grid_patches, only: recovery_input_type, recover_grid
+   use sprc_grid_patches, only: recovery_input_type, recover_grid, boundary_points
+   use sprc_recovery_patch, only: patch_type
    use sprc_grid_recovered_field, only: recovered_field_type, method_spr, method_sprc, field_eval
    use sprc_recovery_contact_operators, only: contact_traction, contact_law_frictionless, contact_law_slip, &
       & contact_law_stick
@@ -619,7 +620,8 @@ contains
    !> element, else open; closed states give the law (frictionless; stick; Coulomb: stick
    !> or slip) and, for slip, the slip direction of the body relative to the other: opposed
    !> to the slave's FE tangential traction on the slave side, along it on the master side.
-   !> The other body's volume points and FE stresses are `other`.
+   !> The other body's volume points, FE stresses and boundary points (its contact surface
+   !> left out) are `other`'s.
    subroutine pair_contact(study, spec, surface, result, slave, side, input, nodes, other, contact, error)
       type(study_type), intent(in) :: study
       type(contact_spec_type), intent(in) :: spec
@@ -634,7 +636,8 @@ contains
       integer, allocatable :: law(:)
       real(wp), allocatable :: slip(:, :)
       real(wp) :: g(3, 6), sigma(6), t(3), size_e, dist, best
-      integer :: shape, nb, e, k, i, inear, d, ns
+      type(patch_type) :: oboundary
+      integer :: shape, nb, e, k, i, inear, d, ns, o, oshape
 
       d = study%dim
       ns = merge(3, 6, d == 2)
@@ -685,8 +688,15 @@ contains
             end if
          end do
       end do
+      o = merge(spec%master_index, spec%slave_index, side == 1)
+      oshape = study%scene%shapes(merge(spec%master_surface_index, spec%slave_surface_index, side == 1))%body_shape
+      if (allocated(study%bodies(o)%exact)) then
+         call boundary_points(other, d, oshape, oboundary, study%bodies(o)%exact)
+      else
+         call boundary_points(other, d, oshape, oboundary)
+      end if
       call new_grid_contact(contact, shape, law, slip, spec%mu, other%x, other%w, other%stress, other%young, &
-         & other%poisson, other%body_force(1:d), error)
+         & other%poisson, other%body_force(1:d), error, boundary=oboundary)
    end subroutine pair_contact
 
    !> The largest edge of element e's box.
