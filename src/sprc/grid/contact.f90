@@ -18,9 +18,9 @@
 !> not over-smooth the Hertz peak at these levels). The solve doubles it while the Omega_aux
 !> fit lacks rank.
 !>
-!> The other body's points are sorted into uniform cells once (a counting sort): a patch
-!> passes the solve only those in a box about its node that Omega_aux can reach, the box
-!> growing with the depth doublings.
+!> The other body's volume and boundary points are sorted into uniform cells once (a
+!> counting sort, `point_cells_type`): a patch passes the solve only those in the bounding
+!> box of its Omega_aux, the box growing with the depth doublings.
 !>
 !> The other body's boundary points where a prism meets its other boundaries (symmetry planes,
 !> loaded or free surfaces) constrain the Omega_aux fit as in any SPR-C patch.
@@ -30,19 +30,31 @@ module sprc_grid_contact
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_alloc, only: check_allocation
-   use sprc_recovery_patch, only: patch_type, recovered_patch_type
+   use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reserve
    use sprc_recovery_workspace, only: recovery_workspace_type, workspace_init
    use sprc_recovery_contact_operators, only: contact_law_frictionless, contact_law_slip, contact_law_stick
-   use sprc_recovery_contact_solve, only: recover_contact_patch, aux_max_doublings
+   use sprc_recovery_contact_solve, only: recover_contact_patch, aux_max_doublings, contact_points, aux_margin
+   use sprc_recovery_contact_aux, only: aux_domain_type, new_aux_domain
    implicit none
    private
 
    public :: grid_contact_type, new_grid_contact, contact_patch_solve, default_aux_depth
+   public :: point_cells_type, new_point_cells, cells_box
 
    !> Omega_aux depth in patch sizes (module notes).
    real(wp), parameter :: default_aux_depth = 3.0_wp
    !> Mean points per cell of the other body's point cells.
    real(wp), parameter :: points_per_cell = 8.0_wp
+
+   !> Points sorted into uniform cells over their box (a counting sort, stable), ncell(k)
+   !> along axis k (1 beyond dim): the points of cell c (`cell_index`) are
+   !> perm(ptr(c) .. ptr(c+1)-1), ascending within a cell.
+   type :: point_cells_type
+      integer :: dim = 0
+      integer :: ncell(3) = 1
+      integer, allocatable :: ptr(:), perm(:)
+      real(wp) :: ymin(3) = 0.0_wp, width(3) = 1.0_wp
+   end type point_cells_type
 
    !> One body's contact surface for the grid recovery (module notes).
    type :: grid_contact_type
@@ -57,18 +69,15 @@ module sprc_grid_contact
       real(wp) :: mu = 0.0_wp
       !> Omega_aux depth in patch sizes.
       real(wp) :: depth = default_aux_depth
-      !> The other body: volume points sorted along the first axis, weight*|J|, FE stresses.
+      !> The other body: volume points, weight*|J|, FE stresses, and their cells.
       real(wp), allocatable :: y(:, :), w(:), stress(:, :)
+      type(point_cells_type) :: cells
       !> The other body's boundary points other than its contact surface (boundary arrays
       !> only; nbpoints = 0 if not given): they constrain its Omega_aux fits.
       type(patch_type) :: boundary
+      type(point_cells_type) :: boundary_cells
       !> The other body's material and body force.
       real(wp) :: young = 0.0_wp, poisson = 0.0_wp, body_force(3) = 0.0_wp
-      !> Uniform cells over the box of the points, ncell(k) along axis k (1 beyond dim): the
-      !> points of cell c (`cell_index`) are cell_ptr(c) .. cell_ptr(c+1)-1.
-      integer :: ncell(3) = 1
-      integer, allocatable :: cell_ptr(:)
-      real(wp) :: ymin(3) = 0.0_wp, cell_width(3) = 1.0_wp
    end type grid_contact_type
 
 contains
@@ -86,9 +95,7 @@ contains
       real(wp), intent(in), optional :: depth
       !> The other body's boundary points (`boundary`).
       type(patch_type), intent(in), optional :: boundary
-      integer, allocatable :: bin(:)
-      integer :: n, d, j, b, stat
-      real(wp) :: ymax(3)
+      integer :: n
 
       n = size(w)
       if (size(slip, 2) /= size(law) .or. size(y, 2) /= n .or. size(stress, 2) /= n) then
@@ -115,60 +122,69 @@ contains
       self%poisson = poisson
       self%body_force = 0.0_wp
       self%body_force(1:size(body_force)) = body_force
-      d = size(y, 1)
-      allocate (self%y(d, n), self%w(n), self%stress(size(stress, 1), n), bin(n), stat=stat)
-      call check_allocation(stat, 'grid contact', 'the other body''s points', n, 8*(d + size(stress, 1) + 2), error)
+      self%y = y
+      self%w = w
+      self%stress = stress
+      call new_point_cells(self%cells, y, error)
       if (allocated(error)) return
-      self%ymin = 0.0_wp
-      ymax = 0.0_wp
-      if (n > 0) then
-         self%ymin(1:d) = minval(y, dim=2)
-         ymax(1:d) = maxval(y, dim=2)
-      end if
-      ! About points_per_cell points a cell where they fill the box.
-      self%ncell = 1
-      self%ncell(1:d) = max(1, nint((real(n, wp)/points_per_cell)**(1.0_wp/d)))
-      self%cell_width = 1.0_wp
-      self%cell_width(1:d) = max((ymax(1:d) - self%ymin(1:d))/real(self%ncell(1:d), wp), tiny(1.0_wp))
-      allocate (self%cell_ptr(product(self%ncell) + 1), stat=stat)
-      call check_allocation(stat, 'grid contact', 'the cells of the other body''s points', product(self%ncell), 4, &
-         & error)
-      if (allocated(error)) return
-      self%cell_ptr = 0
-      do j = 1, n
-         bin(j) = cell_index(self, cell_of(self, y(:, j)))
-         self%cell_ptr(bin(j) + 1) = self%cell_ptr(bin(j) + 1) + 1
-      end do
-      self%cell_ptr(1) = 1
-      do b = 2, size(self%cell_ptr)
-         self%cell_ptr(b) = self%cell_ptr(b) + self%cell_ptr(b - 1)
-      end do
-      ! Stable counting sort: points keep their order within a cell.
-      do j = 1, n
-         b = bin(j)
-         self%y(:, self%cell_ptr(b)) = y(:, j)
-         self%w(self%cell_ptr(b)) = w(j)
-         self%stress(:, self%cell_ptr(b)) = stress(:, j)
-         self%cell_ptr(b) = self%cell_ptr(b) + 1
-      end do
-      do b = size(self%cell_ptr), 2, -1
-         self%cell_ptr(b) = self%cell_ptr(b - 1)
-      end do
-      self%cell_ptr(1) = 1
+      if (self%boundary%nbpoints > 0) &
+         & call new_point_cells(self%boundary_cells, self%boundary%bx(1:size(y, 1), 1:self%boundary%nbpoints), error)
    end subroutine new_grid_contact
 
+   !> Sort the points y(1:dim, j) into cells of about points_per_cell points (module notes).
+   subroutine new_point_cells(cells, y, error)
+      type(point_cells_type), intent(out) :: cells
+      real(wp), intent(in) :: y(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      integer, allocatable :: cell(:)
+      real(wp) :: ymax(3)
+      integer :: n, d, j, c, stat
+
+      d = size(y, 1)
+      n = size(y, 2)
+      cells%dim = d
+      cells%ymin = 0.0_wp
+      ymax = 0.0_wp
+      if (n > 0) then
+         cells%ymin(1:d) = minval(y, dim=2)
+         ymax(1:d) = maxval(y, dim=2)
+      end if
+      cells%ncell(1:d) = max(1, nint((real(n, wp)/points_per_cell)**(1.0_wp/d)))
+      cells%width(1:d) = max((ymax(1:d) - cells%ymin(1:d))/real(cells%ncell(1:d), wp), tiny(1.0_wp))
+      allocate (cells%ptr(product(cells%ncell) + 1), cells%perm(n), cell(n), stat=stat)
+      call check_allocation(stat, 'grid contact', 'the cells of the other body''s points', n, 12, error)
+      if (allocated(error)) return
+      cells%ptr = 0
+      do j = 1, n
+         cell(j) = cell_index(cells, cell_of(cells, y(:, j)))
+         cells%ptr(cell(j) + 1) = cells%ptr(cell(j) + 1) + 1
+      end do
+      cells%ptr(1) = 1
+      do c = 2, size(cells%ptr)
+         cells%ptr(c) = cells%ptr(c) + cells%ptr(c - 1)
+      end do
+      do j = 1, n
+         cells%perm(cells%ptr(cell(j))) = j
+         cells%ptr(cell(j)) = cells%ptr(cell(j)) + 1
+      end do
+      do c = size(cells%ptr), 2, -1
+         cells%ptr(c) = cells%ptr(c - 1)
+      end do
+      cells%ptr(1) = 1
+   end subroutine new_point_cells
+
    !> Cell coordinates (1-based, clamped to the box) of a point.
-   pure function cell_of(self, y) result(c)
-      type(grid_contact_type), intent(in) :: self
+   pure function cell_of(cells, y) result(c)
+      type(point_cells_type), intent(in) :: cells
       real(wp), intent(in) :: y(:)
       integer :: c(3), k
       real(wp) :: t
 
       c = 1
-      do k = 1, size(y)
-         t = (y(k) - self%ymin(k))/self%cell_width(k)
-         if (t >= real(self%ncell(k), wp)) then
-            c(k) = self%ncell(k)
+      do k = 1, cells%dim
+         t = (y(k) - cells%ymin(k))/cells%width(k)
+         if (t >= real(cells%ncell(k), wp)) then
+            c(k) = cells%ncell(k)
          else if (t >= 1.0_wp) then
             c(k) = int(t) + 1
          end if
@@ -176,11 +192,49 @@ contains
    end function cell_of
 
    !> Linear index of cell coordinates c (first axis fastest).
-   pure integer function cell_index(self, c)
-      type(grid_contact_type), intent(in) :: self
+   pure integer function cell_index(cells, c)
+      type(point_cells_type), intent(in) :: cells
       integer, intent(in) :: c(3)
-      cell_index = c(1) + self%ncell(1)*((c(2) - 1) + self%ncell(2)*(c(3) - 1))
+      cell_index = c(1) + cells%ncell(1)*((c(2) - 1) + cells%ncell(2)*(c(3) - 1))
    end function cell_index
+
+   !> The points y(:, j) in the box blo <= y <= bhi: idx(1:n), in cell order (fixed by the
+   !> points alone: the same for any thread count).
+   pure subroutine cells_box(cells, y, blo, bhi, idx, n)
+      type(point_cells_type), intent(in) :: cells
+      real(wp), intent(in) :: y(:, :), blo(:), bhi(:)
+      integer, allocatable, intent(out) :: idx(:)
+      integer, intent(out) :: n
+      integer :: lo(3), hi(3), i1, i2, i3, k, d, c
+
+      d = cells%dim
+      allocate (idx(0))
+      n = 0
+      if (.not. allocated(cells%ptr)) return
+      lo = cell_of(cells, blo(1:d))
+      hi = cell_of(cells, bhi(1:d))
+      do i3 = lo(3), hi(3)
+         do i2 = lo(2), hi(2)
+            c = cell_index(cells, [lo(1), i2, i3])
+            n = n + cells%ptr(c + hi(1) - lo(1) + 1) - cells%ptr(c)
+         end do
+      end do
+      deallocate (idx)
+      allocate (idx(n))
+      n = 0
+      do i3 = lo(3), hi(3)
+         do i2 = lo(2), hi(2)
+            do i1 = lo(1), hi(1)
+               c = cell_index(cells, [i1, i2, i3])
+               do k = cells%ptr(c), cells%ptr(c + 1) - 1
+                  if (any(y(1:d, cells%perm(k)) < blo(1:d)) .or. any(y(1:d, cells%perm(k)) > bhi(1:d))) cycle
+                  n = n + 1
+                  idx(n) = cells%perm(k)
+               end do
+            end do
+         end do
+      end do
+   end subroutine cells_box
 
    !> The coupled SPR-C solve of a patch holding contact points (sprc_recovery_contact_solve):
    !> law(j), slip(1:dim, j) per boundary point j of `patch`, body (2) the other body's points
@@ -196,60 +250,82 @@ contains
       type(recovery_workspace_type) :: ws2
       type(patch_type) :: patch2
       type(recovered_patch_type) :: rec2
+      type(patch_type) :: bbox
+      type(aux_domain_type) :: aux
       integer, allocatable :: idx(:)
-      real(wp) :: reach
+      real(wp), allocatable :: cx(:, :), cn(:, :), cw(:)
+      real(wp) :: dep, blo(3), bhi(3)
       integer :: n, k
 
       call workspace_init(ws2)
-      ! Omega_aux after k doublings reaches 2^k depth h beyond the contact points (within h of
-      ! the node) and widens by (2^k - 1) depth h / 2: the box of half-width
-      ! h (1 + depth (1.5 2^k - 0.5)) holds it. Each k gathers its own box, so that a patch
-      ! needing doublings does not scan the whole other body.
+      call contact_points(patch, cx, cn, cw)
+      ! Each k passes the points in the bounding box of Omega_aux after k doublings (which holds
+      ! the smaller ones), so that a patch scans no more of the other body than it can use.
       do k = 0, aux_max_doublings
-         reach = patch%h*(1.0_wp + self%depth*(1.5_wp*2.0_wp**k - 0.5_wp))
-         call gather_box(self, patch, reach, idx, n)
+         dep = self%depth*patch%h*2.0_wp**k
+         call new_aux_domain(aux, patch%dim, cx, cn, cw, dep, aux_margin(dep, self%depth*patch%h), error)
+         if (allocated(error)) return
+         call aux_bounds(aux, blo, bhi)
+         call cells_box(self%cells, self%y, blo, bhi, idx, n)
+         call box_boundary(self, blo, bhi, bbox)
          call recover_contact_patch(patch, degree, law, self%mu, slip, self%y(:, idx(1:n)), self%w(idx(1:n)), &
             & self%stress(:, idx(1:n)), self%young, self%poisson, self%depth*patch%h, ws, ws2, patch2, rec, rec2, &
-            & error, body_force2=self%body_force, max_doublings=k, boundary2=self%boundary)
+            & error, body_force2=self%body_force, max_doublings=k, boundary2=bbox)
          if (.not. allocated(error)) return
          if (index(error%message, 'Omega_aux fit') == 0) return
       end do
    end subroutine contact_patch_solve
 
-   !> The other body's points within `reach` of the patch node in every coordinate, in
-   !> their sorted order: idx(1:n).
-   pure subroutine gather_box(self, patch, reach, idx, n)
+   !> The other body's boundary points in the box blo..bhi (boundary arrays of `points`).
+   pure subroutine box_boundary(self, blo, bhi, points)
       type(grid_contact_type), intent(in) :: self
-      type(patch_type), intent(in) :: patch
-      real(wp), intent(in) :: reach
-      integer, allocatable, intent(out) :: idx(:)
-      integer, intent(out) :: n
-      integer :: lo(3), hi(3), i1, i2, i3, j, d, c
+      real(wp), intent(in) :: blo(:), bhi(:)
+      type(patch_type), intent(inout) :: points
+      integer, allocatable :: idx(:)
+      integer :: n, d
 
-      d = patch%dim
-      lo = cell_of(self, patch%x0(1:d) - reach)
-      hi = cell_of(self, patch%x0(1:d) + reach)
-      n = 0
-      do i3 = lo(3), hi(3)
-         do i2 = lo(2), hi(2)
-            c = cell_index(self, [lo(1), i2, i3])
-            n = n + self%cell_ptr(c + hi(1) - lo(1) + 1) - self%cell_ptr(c)
+      points%nbpoints = 0
+      if (self%boundary%nbpoints == 0) return
+      d = self%boundary_cells%dim
+      call cells_box(self%boundary_cells, self%boundary%bx(1:d, 1:self%boundary%nbpoints), blo, bhi, idx, n)
+      call patch_reserve(points, 0, n)
+      points%nbpoints = n
+      points%bx(:, 1:n) = self%boundary%bx(:, idx(1:n))
+      points%bw(1:n) = self%boundary%bw(idx(1:n))
+      points%bn(:, 1:n) = self%boundary%bn(:, idx(1:n))
+      points%bkind(1:n) = self%boundary%bkind(idx(1:n))
+      points%bpiece(1:n) = self%boundary%bpiece(idx(1:n))
+      points%btraction(:, 1:n) = self%boundary%btraction(:, idx(1:n))
+   end subroutine box_boundary
+
+   !> The axis-aligned bounding box blo..bhi of the prism Omega_aux (its 2^dim corners), widened
+   !> by a few ulps of its extent so that points on its faces stay inside.
+   pure subroutine aux_bounds(aux, blo, bhi)
+      type(aux_domain_type), intent(in) :: aux
+      real(wp), intent(out) :: blo(3), bhi(3)
+      real(wp) :: corner(3), a(3), b(3), pad
+      integer :: m, k, d
+
+      d = aux%dim
+      a = 0.0_wp
+      b = 0.0_wp
+      a(1) = aux%lo
+      b(1) = aux%hi
+      a(2:d) = aux%tmin(1:d - 1)
+      b(2:d) = aux%tmax(1:d - 1)
+      blo = huge(1.0_wp)
+      bhi = -huge(1.0_wp)
+      do m = 0, 2**d - 1
+         corner = aux%centre
+         do k = 1, d
+            corner(1:d) = corner(1:d) + merge(b(k), a(k), btest(m, k - 1))*aux%frame(1:d, k)
          end do
+         blo(1:d) = min(blo(1:d), corner(1:d))
+         bhi(1:d) = max(bhi(1:d), corner(1:d))
       end do
-      allocate (idx(n))
-      n = 0
-      do i3 = lo(3), hi(3)
-         do i2 = lo(2), hi(2)
-            do i1 = lo(1), hi(1)
-               c = cell_index(self, [i1, i2, i3])
-               do j = self%cell_ptr(c), self%cell_ptr(c + 1) - 1
-                  if (any(abs(self%y(1:d, j) - patch%x0(1:d)) > reach)) cycle
-                  n = n + 1
-                  idx(n) = j
-               end do
-            end do
-         end do
-      end do
-   end subroutine gather_box
+      pad = 16*epsilon(1.0_wp)*(maxval(bhi(1:d) - blo(1:d)) + maxval(abs(aux%centre(1:d))))
+      blo(1:d) = blo(1:d) - pad
+      bhi(1:d) = bhi(1:d) + pad
+   end subroutine aux_bounds
 
 end module sprc_grid_contact

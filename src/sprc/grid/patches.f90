@@ -59,7 +59,7 @@ module sprc_grid_patches
    use sprc_grid_nodes, only: grid_nodes_type
    use sprc_grid_hanging, only: hanging_type
    use sprc_recovery_patch, only: patch_type, patch_reset, patch_reserve, boundary_traction, boundary_symmetry, &
-      & boundary_contact, recovered_patch_type, patch_add_boundary_point
+      & boundary_contact, recovered_patch_type
    use sprc_recovery_workspace, only: recovery_workspace_type
    use sprc_recovery_patch_loop, only: patch_source_type, patch_loop_type, run_patch_loop, patch_capacity, &
       & recover_patch_default
@@ -388,12 +388,24 @@ contains
       integer :: k, kind
 
       call patch_reset(points, dim, input%analysis, input%young, input%poisson, [(0.0_wp, k=1, dim)], 1.0_wp)
+      ! One reservation (adding points one by one would grow the arrays at every point).
+      call patch_reserve(points, 0, size(input%bw))
       do k = 1, size(input%bw)
          if (input%bshape(k) == skip_shape) cycle
          call boundary_data(input, k, dim, kind, t, exact)
          if (kind == 0) cycle
-         call patch_add_boundary_point(points, input%bx(:, k), input%bw(k), input%bn(:, k), kind, t(1:dim), &
-            & input%bshape(k))
+         points%nbpoints = points%nbpoints + 1
+         associate (j => points%nbpoints)
+            points%bx(:, j) = 0.0_wp
+            points%bx(1:dim, j) = input%bx(:, k)
+            points%bw(j) = input%bw(k)
+            points%bn(:, j) = 0.0_wp
+            points%bn(1:dim, j) = input%bn(:, k)
+            points%bkind(j) = kind
+            points%bpiece(j) = input%bshape(k)
+            points%btraction(:, j) = 0.0_wp
+            points%btraction(1:dim, j) = t(1:dim)
+         end associate
       end do
    end subroutine boundary_points
 

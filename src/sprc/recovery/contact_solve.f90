@@ -35,8 +35,7 @@ module sprc_recovery_contact_solve
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular
    use sprc_core_text, only: itoa
-   use sprc_recovery_patch, only: patch_type, recovered_patch_type, boundary_contact, patch_reset, patch_reserve, &
-      & patch_add_boundary_point
+   use sprc_recovery_patch, only: patch_type, recovered_patch_type, boundary_contact, patch_reset, patch_reserve
    use sprc_recovery_contact_aux, only: aux_domain_type, new_aux_domain, aux_contains
    use sprc_recovery_workspace, only: recovery_workspace_type
    use sprc_recovery_solve, only: sprc_constraints, note_dropped, recovery_rank_tol, recovery_bite_ratio, traction_rank_tol, &
@@ -47,7 +46,8 @@ module sprc_recovery_contact_solve
    implicit none
    private
 
-   public :: recover_sprc_contact, recover_contact_patch, contact_curved_tol, aux_max_doublings
+   public :: recover_sprc_contact, recover_contact_patch, contact_curved_tol, aux_max_doublings, contact_points
+   public :: aux_margin
 
    !> A contact surface whose unit normals differ by more than this (1 - cos) is curved.
    real(wp), parameter :: contact_curved_tol = 1.0e-10_wp
@@ -369,7 +369,7 @@ contains
       kmax = aux_max_doublings
       if (present(max_doublings)) kmax = max(0, min(max_doublings, aux_max_doublings))
       do k = 0, kmax
-         call new_aux_domain(aux, d, cx, cn, cw, dep, 0.5_wp*(dep - depth), error)
+         call new_aux_domain(aux, d, cx, cn, cw, dep, aux_margin(dep, depth), error)
          if (allocated(error)) then
             error%message = 'recover_contact_patch: '//error%message
             return
@@ -385,6 +385,13 @@ contains
          if (error%stat /= stat_singular .or. index(error%message, 'Omega_aux fit') == 0) return
       end do
    end subroutine recover_contact_patch
+
+   !> The cross-section margin of Omega_aux at depth `dep` when the first depth is `depth`
+   !> (recover_contact_patch: half the added depth).
+   pure real(wp) function aux_margin(dep, depth)
+      real(wp), intent(in) :: dep, depth
+      aux_margin = 0.5_wp*(dep - depth)
+   end function aux_margin
 
    !> The contact points of patch1: coordinates, normals, weights.
    pure subroutine contact_points(patch1, cx, cn, cw)
@@ -411,14 +418,24 @@ contains
       type(aux_domain_type), intent(in) :: aux
       type(patch_type), intent(in) :: boundary2
       type(patch_type), intent(inout) :: patch2
-      integer :: j, d
+      integer :: j, n
 
-      d = aux%dim
+      n = 0
       do j = 1, boundary2%nbpoints
-         if (boundary2%bkind(j) == boundary_contact) cycle
-         if (.not. aux_contains(aux, boundary2%bx(:, j))) cycle
-         call patch_add_boundary_point(patch2, boundary2%bx(1:d, j), boundary2%bw(j), boundary2%bn(1:d, j), &
-            & boundary2%bkind(j), boundary2%btraction(1:d, j), boundary2%bpiece(j))
+         if (boundary2%bkind(j) /= boundary_contact .and. aux_contains(aux, boundary2%bx(:, j))) n = n + 1
+      end do
+      call patch_reserve(patch2, 0, patch2%nbpoints + n)
+      do j = 1, boundary2%nbpoints
+         if (boundary2%bkind(j) == boundary_contact .or. .not. aux_contains(aux, boundary2%bx(:, j))) cycle
+         patch2%nbpoints = patch2%nbpoints + 1
+         associate (k => patch2%nbpoints)
+            patch2%bx(:, k) = boundary2%bx(:, j)
+            patch2%bw(k) = boundary2%bw(j)
+            patch2%bn(:, k) = boundary2%bn(:, j)
+            patch2%bkind(k) = boundary2%bkind(j)
+            patch2%bpiece(k) = boundary2%bpiece(j)
+            patch2%btraction(:, k) = boundary2%btraction(:, j)
+         end associate
       end do
    end subroutine add_aux_boundary
 

@@ -44,7 +44,7 @@ module sprc_study_level
    use sprc_recovery_contact_operators, only: contact_traction, contact_law_frictionless, contact_law_slip, &
       & contact_law_stick
    use sprc_recovery_operators, only: traction_operator
-   use sprc_grid_contact, only: grid_contact_type, new_grid_contact
+   use sprc_grid_contact, only: grid_contact_type, new_grid_contact, point_cells_type, new_point_cells, cells_box
    use sprc_grid_recovered_estimate, only: zz_estimate_type, estimate_error
    use sprc_fem_bc, only: fe_bc_type
    use sprc_fem_problem, only: elasticity_problem_type
@@ -637,7 +637,10 @@ contains
       real(wp), allocatable :: slip(:, :)
       real(wp) :: g(3, 6), sigma(6), t(3), size_e, dist, best
       type(patch_type) :: oboundary
-      integer :: shape, nb, e, k, i, inear, d, ns, o, oshape
+      type(point_cells_type) :: cells
+      real(wp), allocatable :: sx(:, :)
+      integer, allocatable :: near(:), sel(:)
+      integer :: shape, nb, e, k, i, j, inear, d, ns, o, oshape, nnear
 
       d = study%dim
       ns = merge(3, 6, d == 2)
@@ -646,6 +649,16 @@ contains
       allocate (law(nb), slip(d, nb))
       law = 0
       slip = 0.0_wp
+      ! This side's points of the slave points (on the master side those with a master point), in cells.
+      if (side == 1) then
+         sel = [(i, i=1, surface%npoint)]
+         sx = surface%x
+      else
+         sel = pack([(i, i=1, surface%npoint)], surface%has_master)
+         sx = surface%master_x(:, sel)
+      end if
+      call new_point_cells(cells, sx, error)
+      if (allocated(error)) return
       do e = 1, nodes%n_elements
          if (input%belem_ptr(e + 1) == input%belem_ptr(e)) cycle
          size_e = element_size(nodes, e)
@@ -653,14 +666,11 @@ contains
             if (input%bshape(k) /= shape) cycle
             best = huge(1.0_wp)
             inear = 0
-            do i = 1, surface%npoint
-               if (side == 1) then
-                  dist = norm2(surface%x(:, i) - input%bx(:, k))
-               else
-                  if (.not. surface%has_master(i)) cycle
-                  dist = norm2(surface%master_x(:, i) - input%bx(:, k))
-               end if
-               if (dist < best) then
+            call cells_box(cells, sx, input%bx(:, k) - size_e, input%bx(:, k) + size_e, near, nnear)
+            do j = 1, nnear
+               i = sel(near(j))
+               dist = norm2(sx(:, near(j)) - input%bx(:, k))
+               if (dist < best .or. (dist == best .and. i < inear)) then
                   best = dist
                   inear = i
                end if
