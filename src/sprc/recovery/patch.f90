@@ -193,7 +193,10 @@ contains
       real(wp), intent(in) :: x(:), w, stress(:)
       integer :: i
 
-      call patch_reserve(patch, max(patch%npoints + 1, 2*patch%npoints), 0)
+      ! Grow only when full, by doubling: reserving 2*npoints at every call
+      ! reallocated at every point once the storage was half full (quadratic).
+      if (.not. allocated(patch%w)) call patch_reserve(patch, 0, 0)
+      if (patch%npoints >= size(patch%w)) call patch_reserve(patch, max(4, 2*patch%npoints), 0)
       i = patch%npoints + 1
       patch%x(:, i) = 0.0_wp
       patch%x(1:size(x), i) = x
@@ -213,7 +216,8 @@ contains
       integer, intent(in), optional :: piece
       integer :: j
 
-      call patch_reserve(patch, 0, max(patch%nbpoints + 1, 2*patch%nbpoints))
+      if (.not. allocated(patch%bw)) call patch_reserve(patch, 0, 0)
+      if (patch%nbpoints >= size(patch%bw)) call patch_reserve(patch, 0, max(4, 2*patch%nbpoints))
       j = patch%nbpoints + 1
       patch%bx(:, j) = 0.0_wp
       patch%bx(1:size(x), j) = x
