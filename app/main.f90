@@ -20,6 +20,7 @@ program sprc_main
    use sprc_io_svg, only: write_report_svg, write_contact_svg
    use sprc_io_contact, only: contact_level_type, write_contact_csv
    use sprc_io_hdf5, only: h5_output_type
+   use sprc_fem_petsc, only: start_ranks
    use sprc_app_cli, only: cli_type, parse_cli, usage_text
    use sprc_app_progress, only: progress_level, print_contact_progress
    implicit none
@@ -109,19 +110,26 @@ contains
       type(error_type), allocatable :: error
       character(len=:), allocatable :: prefix
       integer, allocatable :: levels(:)
-      integer :: i, b, threads, n_outputs
+      integer :: i, b, threads, n_outputs, rank, ranks
       character(len=16) :: buf
       real(wp) :: cells, dofs, bytes, total_dofs
+      logical :: quiet
 
       call study_levels(scene, cli%levels, levels, error)
       if (allocated(error)) call fail(2, error%message)
+      ! Under mpirun every rank runs the study (the solves are distributed);
+      ! rank 0 alone prints and writes the outputs.
+      call start_ranks(rank, ranks, error)
+      if (allocated(error)) call fail_with(error)
+      quiet = cli%quiet .or. rank > 0
       ! The thread count first: prepare_study takes OpenBLAS's buffer for each thread.
       if (cli%threads > 0) call omp_set_num_threads(cli%threads)
       call prepare_study(scene, cli%points, study, error)
       if (allocated(error)) call fail_with(error)
-      call print_warnings(scene_warnings(scene, study%bodies%geometry))
+      if (rank == 0) call print_warnings(scene_warnings(scene, study%bodies%geometry))
       prefix = scene%output
       if (len(cli%output) > 0) prefix = cli%output
+      if (rank > 0) prefix = ''
       if (len(prefix) > 0) then
          call make_parent_directory(prefix)
          partial_prefix = prefix
@@ -140,7 +148,7 @@ contains
             end do
             call omp_set_num_threads(merge(1, threads, total_dofs < serial_dofs))
          end if
-         if (.not. cli%quiet) write (error_unit, '(a,i0,a,i0,a,i0,a)') 'sprc: level ', levels(i), &
+         if (.not. quiet) write (error_unit, '(a,i0,a,i0,a,i0,a)') 'sprc: level ', levels(i), &
             ' (', i, ' of ', size(levels), ')'
          if (cli%quiet) then
             call run_level(study, levels(i), result, error)
@@ -158,9 +166,10 @@ contains
             error%message = trim(buf)//' '//error%message
             call fail_with(error)
          end if
-         if (.not. cli%quiet) write (error_unit, '(a,i0,a)') 'sprc: level ', levels(i), ' done in '// &
+         if (.not. quiet) write (error_unit, '(a,i0,a)') 'sprc: level ', levels(i), ' done in '// &
             fixed_text(rows(i)%t_total, 3)//' s'//peak_text()
       end do
+      if (rank > 0) return
       write (output_unit, '(a)') scene%title
       write (output_unit, '(a)', advance='no') report_table(rows)
       if (len(prefix) == 0) return
@@ -185,7 +194,7 @@ contains
             & prefix//trim(output_exts(i)))
       end do
       deallocate (partial_prefix)
-      if (cli%quiet) return
+      if (quiet) return
       if (n_outputs == 6) then
          write (error_unit, '(a)') 'sprc: wrote '//prefix//'.csv, .svg, .h5, .xdmf, _contact.csv, _contact.svg'
       else

@@ -47,6 +47,8 @@
     X(KSP_DIVERGED_NANORINF, -9)        \
     X(KSP_DIVERGED_INDEFINITE_PC, -8)   \
     X(KSP_DIVERGED_INDEFINITE_MAT, -10) \
+    X(INSERT_VALUES, 1)                 \
+    X(SCATTER_FORWARD, 0)               \
     X(PETSC_ERR_MEM, 55)
 
 #ifdef SPRC_PETSC_HEADERS
@@ -73,6 +75,9 @@ typedef struct _p_KSP *KSP;
 typedef struct _p_PC *PC;
 typedef struct _p_MatNullSpace *MatNullSpace;
 typedef struct _p_PetscOptions *PetscOptions;
+typedef struct _p_PetscSF *VecScatter;
+typedef int InsertMode;
+typedef int ScatterMode;
 typedef const char *MatType;
 typedef const char *KSPType;
 typedef const char *PCType;
@@ -80,8 +85,13 @@ typedef const char *PCType;
 SPRC_PETSC_CONSTANTS(SPRC_DEFINE_CONSTANT)
 #endif
 
-/* Open MPI's MPI_COMM_SELF (PETSc's PETSC_COMM_SELF) is this object. */
+/* Open MPI's MPI_COMM_SELF and MPI_COMM_WORLD (PETSc's PETSC_COMM_SELF and,
+ * by default, PETSC_COMM_WORLD) are these objects. */
 extern struct ompi_predefined_communicator_t ompi_mpi_comm_self;
+extern struct ompi_predefined_communicator_t ompi_mpi_comm_world;
+extern int MPI_Comm_rank(MPI_Comm, int *);
+extern int MPI_Comm_size(MPI_Comm, int *);
+extern PetscErrorCode PetscFinalize(void);
 extern PetscErrorCode PetscInitializeNoArguments(void);
 extern PetscErrorCode PetscInitialized(PetscBool *);
 extern PetscErrorCode PetscOptionsSetValue(PetscOptions, const char[], const char[]);
@@ -96,11 +106,17 @@ extern PetscErrorCode MatSetSizes(Mat, PetscInt, PetscInt, PetscInt, PetscInt);
 extern PetscErrorCode MatSetType(Mat, MatType);
 extern PetscErrorCode MatSetBlockSize(Mat, PetscInt);
 extern PetscErrorCode MatSeqAIJSetPreallocationCSR(Mat, const PetscInt[], const PetscInt[], const PetscScalar[]);
+extern PetscErrorCode MatMPIAIJSetPreallocationCSR(Mat, const PetscInt[], const PetscInt[], const PetscScalar[]);
 extern PetscErrorCode MatSetNearNullSpace(Mat, MatNullSpace);
 extern PetscErrorCode MatDestroy(Mat *);
 extern PetscErrorCode MatNullSpaceCreateRigidBody(Vec, MatNullSpace *);
 extern PetscErrorCode MatNullSpaceDestroy(MatNullSpace *);
 extern PetscErrorCode VecCreateSeq(MPI_Comm, PetscInt, Vec *);
+extern PetscErrorCode VecCreateMPI(MPI_Comm, PetscInt, PetscInt, Vec *);
+extern PetscErrorCode VecScatterCreateToAll(Vec, VecScatter *, Vec *);
+extern PetscErrorCode VecScatterBegin(VecScatter, Vec, Vec, InsertMode, ScatterMode);
+extern PetscErrorCode VecScatterEnd(VecScatter, Vec, Vec, InsertMode, ScatterMode);
+extern PetscErrorCode VecScatterDestroy(VecScatter *);
 extern PetscErrorCode VecSetBlockSize(Vec, PetscInt);
 extern PetscErrorCode VecGetArray(Vec, PetscScalar **);
 extern PetscErrorCode VecRestoreArray(Vec, PetscScalar **);
@@ -141,13 +157,14 @@ extern PetscErrorCode KSPGetConvergedReasonString(KSP, const char **);
     X(KSPSetType) X(KSPGetPC) X(KSPSetNormType) X(KSPSetComputeSingularValues) X(KSPSetFromOptions)          \
     X(KSPSetUp) X(KSPSetTolerances) X(KSPSetConvergenceTest) X(KSPSolve) X(KSPGetConvergedReason)           \
     X(KSPGetIterationNumber) X(KSPComputeExtremeSingularValues) X(KSPDestroy) X(PCSetType) X(PCApply)       \
-    X(KSPGetConvergedReasonString)
+    X(KSPGetConvergedReasonString) X(MatMPIAIJSetPreallocationCSR) X(VecCreateMPI) X(VecScatterCreateToAll)   \
+    X(VecScatterBegin) X(VecScatterEnd) X(VecScatterDestroy) X(MPI_Comm_rank) X(MPI_Comm_size) X(PetscFinalize)
 
 /* One pointer per function, set by load_petsc; from here on every call of
  * such a function goes through its pointer. */
 #define SPRC_DECLARE_POINTER(f) static __typeof__(f) *p_##f;
 SPRC_PETSC_FUNCTIONS(SPRC_DECLARE_POINTER)
-static struct ompi_predefined_communicator_t *p_comm_self;
+static struct ompi_predefined_communicator_t *p_comm_self, *p_comm_world;
 #define PetscInitializeNoArguments (*p_PetscInitializeNoArguments)
 #define PetscInitialized (*p_PetscInitialized)
 #define PetscOptionsSetValue (*p_PetscOptionsSetValue)
@@ -189,8 +206,18 @@ static struct ompi_predefined_communicator_t *p_comm_self;
 #define PCSetType (*p_PCSetType)
 #define PCApply (*p_PCApply)
 #define KSPGetConvergedReasonString (*p_KSPGetConvergedReasonString)
+#define MatMPIAIJSetPreallocationCSR (*p_MatMPIAIJSetPreallocationCSR)
+#define VecCreateMPI (*p_VecCreateMPI)
+#define VecScatterCreateToAll (*p_VecScatterCreateToAll)
+#define VecScatterBegin (*p_VecScatterBegin)
+#define VecScatterEnd (*p_VecScatterEnd)
+#define VecScatterDestroy (*p_VecScatterDestroy)
+#define MPI_Comm_rank (*p_MPI_Comm_rank)
+#define MPI_Comm_size (*p_MPI_Comm_size)
+#define PetscFinalize (*p_PetscFinalize)
 #undef PETSC_COMM_SELF
 #define PETSC_COMM_SELF ((MPI_Comm)(void *)p_comm_self)
+#define SPRC_COMM_WORLD ((MPI_Comm)(void *)p_comm_world)
 
 
 /* A PETSc error code as a status and a message naming the call that failed. */
@@ -224,13 +251,22 @@ static int load_petsc(char *msg, int64_t len)
     SPRC_PETSC_FUNCTIONS(SPRC_FIND)
 #undef SPRC_FIND
     p_comm_self = dlsym(h, "ompi_mpi_comm_self");
-    if (p_comm_self == NULL)
+    p_comm_world = dlsym(h, "ompi_mpi_comm_world");
+    if (p_comm_self == NULL || p_comm_world == NULL)
         return report(SPRC_INTERNAL, msg, len, "PETSc: %s is not built on Open MPI", SPRC_PETSC_LIBRARY);
     lib = h;
     return SPRC_OK;
 }
 
-/* PETSc (and MPI, as a singleton when not under mpirun) once per process. */
+/* The ranks of MPI_COMM_WORLD: 1 without mpirun (a singleton MPI). */
+static int world_rank = 0, world_size = 1;
+
+static void finalize_at_exit(void) { PetscFinalize(); }
+
+/* PETSc (and MPI, as a singleton when not under mpirun) once per process.
+ * Under mpirun with several ranks, MPI is finalized at exit (Open MPI's
+ * mpirun reports a rank that ends without MPI_Finalize as failed); a
+ * singleton run is left as it always was. */
 static int ensure_petsc(char *msg, int64_t len)
 {
     PetscBool up = PETSC_FALSE;
@@ -242,13 +278,31 @@ static int ensure_petsc(char *msg, int64_t len)
     TRY(PetscOptionsSetValue(NULL, "-no_signal_handler", NULL));
     TRY(PetscInitializeNoArguments());
     TRY(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+    if (MPI_Comm_rank(SPRC_COMM_WORLD, &world_rank) != 0 || MPI_Comm_size(SPRC_COMM_WORLD, &world_size) != 0)
+        return report(SPRC_INTERNAL, msg, len, "PETSc: MPI_Comm_rank or MPI_Comm_size failed");
+    if (world_size > 1) atexit(finalize_at_exit);
     return SPRC_OK;
+}
+
+/* Start PETSc and MPI and give this process's rank and the number of ranks
+ * (sprc runs under `mpirun -n R`: every rank runs the study, the solves are
+ * distributed over all of them). */
+int sprc_petsc_ranks(int *rank, int *size, char *msg, int64_t len)
+{
+    int status = ensure_petsc(msg, len);
+    *rank = world_rank;
+    *size = world_size;
+    return status;
 }
 
 typedef struct {
     Mat a;
     KSP ksp;
     Vec b, x, w;
+    Vec all;           /* the whole solution on every rank (distributed solves) */
+    VecScatter gather; /* x -> all */
+    MPI_Comm comm;     /* PETSC_COMM_SELF, or the world with several ranks */
+    PetscInt lo, n_local; /* this rank's rows: lo .. lo + n_local - 1 */
     int symmetric;
     double tau, bnorm; /* the solve's tolerance and size of b (energy_test) */
     double kappa;      /* condition estimate of B A (CG), 1 for GMRES */
@@ -264,8 +318,46 @@ void sprc_petsc_free(void **handle)
     VecDestroy(&s->b);
     VecDestroy(&s->x);
     VecDestroy(&s->w);
+    VecDestroy(&s->all);
+    VecScatterDestroy(&s->gather);
     free(s);
     *handle = NULL;
+}
+
+/* A vector of this rank's rows (block size dim). */
+static int create_vector(sprc_petsc *s, PetscInt n, PetscInt dim, Vec *v, char *msg, int64_t len)
+{
+    if (world_size > 1)
+        TRY(VecCreateMPI(s->comm, s->n_local, n, v));
+    else
+        TRY(VecCreateSeq(PETSC_COMM_SELF, n, v));
+    TRY(VecSetBlockSize(*v, dim));
+    return SPRC_OK;
+}
+
+/* This rank's rows of the CSR matrix (rowptr, col, val of all n rows, as
+ * every rank has them): a sequential matrix on one rank, MATMPIAIJ,
+ * preallocated from the rows' pattern, on several. */
+static int set_rows(sprc_petsc *s, PetscInt n, const PetscInt *rowptr, const PetscInt *col, const double *val,
+                    char *msg, int64_t len)
+{
+    PetscInt *local, i, first;
+    PetscErrorCode ierr;
+    if (world_size == 1) {
+        TRY(MatSetType(s->a, "seqaij"));
+        TRY(MatSeqAIJSetPreallocationCSR(s->a, rowptr, col, val));
+        return SPRC_OK;
+    }
+    (void)n;
+    TRY(MatSetType(s->a, "mpiaij"));
+    local = malloc(((size_t)s->n_local + 1) * sizeof(*local));
+    if (local == NULL) return report(SPRC_NO_MEMORY, msg, len, "PETSc setup: cannot allocate the local row starts");
+    first = rowptr[s->lo];
+    for (i = 0; i <= s->n_local; ++i) local[i] = rowptr[s->lo + i] - first;
+    ierr = MatMPIAIJSetPreallocationCSR(s->a, local, col + first, val + first);
+    free(local);
+    if (ierr != 0) return petsc_failure(ierr, "MatMPIAIJSetPreallocationCSR", msg, len);
+    return SPRC_OK;
 }
 
 /* Matrix with block size `dim` and its rigid-body near-null space from the
@@ -276,16 +368,17 @@ static int build_matrix(sprc_petsc *s, PetscInt n, PetscInt dim, const PetscInt 
     Vec xyz = NULL;
     MatNullSpace nearnull = NULL;
     PetscScalar *p;
+    int status;
 
-    TRY(MatCreate(PETSC_COMM_SELF, &s->a));
-    TRY(MatSetSizes(s->a, n, n, n, n));
-    TRY(MatSetType(s->a, "seqaij"));
+    TRY(MatCreate(s->comm, &s->a));
+    TRY(MatSetSizes(s->a, s->n_local, s->n_local, n, n));
     TRY(MatSetBlockSize(s->a, dim));
-    TRY(MatSeqAIJSetPreallocationCSR(s->a, rowptr, col, val));
-    TRY(VecCreateSeq(PETSC_COMM_SELF, n, &xyz));
-    TRY(VecSetBlockSize(xyz, dim));
+    status = set_rows(s, n, rowptr, col, val, msg, len);
+    if (status != SPRC_OK) return status;
+    status = create_vector(s, n, dim, &xyz, msg, len);
+    if (status != SPRC_OK) return status;
     TRY(VecGetArray(xyz, &p));
-    memcpy(p, coords, (size_t)n * sizeof(double));
+    memcpy(p, coords + s->lo, (size_t)s->n_local * sizeof(double));
     TRY(VecRestoreArray(xyz, &p));
     TRY(MatNullSpaceCreateRigidBody(xyz, &nearnull));
     TRY(MatSetNearNullSpace(s->a, nearnull));
@@ -300,7 +393,7 @@ static int build_matrix(sprc_petsc *s, PetscInt n, PetscInt dim, const PetscInt 
 static int build_solver(sprc_petsc *s, char *msg, int64_t len)
 {
     PC pc;
-    TRY(KSPCreate(PETSC_COMM_SELF, &s->ksp));
+    TRY(KSPCreate(s->comm, &s->ksp));
     TRY(KSPSetOperators(s->ksp, s->a, s->a));
     TRY(KSPSetType(s->ksp, s->symmetric ? "cg" : "gmres"));
     TRY(KSPGetPC(s->ksp, &pc));
@@ -314,11 +407,23 @@ static int build_solver(sprc_petsc *s, char *msg, int64_t len)
 
 static int create_vectors(sprc_petsc *s, PetscInt n, PetscInt dim, char *msg, int64_t len)
 {
-    TRY(VecCreateSeq(PETSC_COMM_SELF, n, &s->b));
-    TRY(VecSetBlockSize(s->b, dim));
+    int status = create_vector(s, n, dim, &s->b, msg, len);
+    if (status != SPRC_OK) return status;
     TRY(VecDuplicate(s->b, &s->x));
     TRY(VecDuplicate(s->b, &s->w));
+    if (world_size > 1) TRY(VecScatterCreateToAll(s->x, &s->gather, &s->all));
     return SPRC_OK;
+}
+
+/* This rank's rows: whole blocks, the blocks split into contiguous ranges
+ * of nearly equal length in rank order. */
+static void own_rows(sprc_petsc *s, PetscInt n, PetscInt dim)
+{
+    int64_t blocks = n / dim;
+    int64_t first = blocks * world_rank / world_size, last = blocks * (world_rank + 1) / world_size;
+    s->comm = world_size > 1 ? SPRC_COMM_WORLD : PETSC_COMM_SELF;
+    s->lo = (PetscInt)(first * dim);
+    s->n_local = (PetscInt)((last - first) * dim);
 }
 
 int sprc_petsc_setup(void **handle, int64_t n, int dim, const int32_t *rowptr, const int32_t *col,
@@ -336,6 +441,7 @@ int sprc_petsc_setup(void **handle, int64_t n, int dim, const int32_t *rowptr, c
     s = calloc(1, sizeof(*s));
     if (s == NULL) return report(SPRC_NO_MEMORY, msg, len, "PETSc setup: cannot allocate a handle");
     s->symmetric = symmetric;
+    own_rows(s, (PetscInt)n, dim);
     *handle = s;
     status = build_matrix(s, (PetscInt)n, dim, rowptr, col, val, coords, msg, len);
     if (status == SPRC_OK) status = build_solver(s, msg, len);
@@ -344,18 +450,26 @@ int sprc_petsc_setup(void **handle, int64_t n, int dim, const int32_t *rowptr, c
     return status;
 }
 
-static int copy_in(Vec v, const double *a, PetscInt n, char *msg, int64_t len)
+/* This rank's rows of the whole vector a into v. */
+static int copy_in(sprc_petsc *s, Vec v, const double *a, char *msg, int64_t len)
 {
     PetscScalar *p;
     TRY(VecGetArray(v, &p));
-    memcpy(p, a, (size_t)n * sizeof(double));
+    memcpy(p, a + s->lo, (size_t)s->n_local * sizeof(double));
     TRY(VecRestoreArray(v, &p));
     return SPRC_OK;
 }
 
-static int copy_out(Vec v, double *a, PetscInt n, char *msg, int64_t len)
+/* The whole solution into a (n values), on every rank. */
+static int copy_out(sprc_petsc *s, double *a, PetscInt n, char *msg, int64_t len)
 {
     PetscScalar *p;
+    Vec v = s->x;
+    if (world_size > 1) {
+        TRY(VecScatterBegin(s->gather, s->x, s->all, INSERT_VALUES, SCATTER_FORWARD));
+        TRY(VecScatterEnd(s->gather, s->x, s->all, INSERT_VALUES, SCATTER_FORWARD));
+        v = s->all;
+    }
     TRY(VecGetArray(v, &p));
     memcpy(a, p, (size_t)n * sizeof(double));
     TRY(VecRestoreArray(v, &p));
@@ -448,7 +562,7 @@ int sprc_petsc_solve(void *handle, int64_t n, const double *b, double *x, double
     *iterations = 0;
     *bound = 0.0;
     if (s == NULL) return report(SPRC_INVALID, msg, len, "PETSc solve: no solver was set up");
-    status = copy_in(s->b, b, (PetscInt)n, msg, len);
+    status = copy_in(s, s->b, b, msg, len);
     if (status == SPRC_OK) status = rhs_norm(s, &bnorm, msg, len);
     if (status != SPRC_OK) return status;
     if (!(bnorm > 0.0)) {
@@ -463,5 +577,5 @@ int sprc_petsc_solve(void *handle, int64_t n, const double *b, double *x, double
     if (status == SPRC_OK) status = ksp_outcome(s, iterations, msg, len);
     *bound = s->bound;
     if (status != SPRC_OK) return status;
-    return copy_out(s->x, x, (PetscInt)n, msg, len);
+    return copy_out(s, x, (PetscInt)n, msg, len);
 }

@@ -24,7 +24,7 @@ module sprc_fem_linear_solver
 
    public :: linear_solver_type, backend_error, message_length, blas_threads, set_blas_threads
    public :: solver_auto, solver_direct, solver_iterative, solver_names, solver_choice, use_iterative, &
-      & auto_iterative_min_dofs
+      & auto_iterative_min_dofs, solve_ranks, set_solve_ranks
 
    !> The scene's `solver`: 'auto', 'direct' (CHOLMOD, UMFPACK) or 'iterative'
    !> (Krylov + algebraic multigrid, `sprc_fem_petsc`); codes in `solver_names` order.
@@ -35,6 +35,12 @@ module sprc_fem_linear_solver
    !> crossover of the two solve times on a 2-core machine, README); 2D
    !> systems stay direct (CHOLMOD's fill is mild there).
    integer, parameter :: auto_iterative_min_dofs = 50000
+
+   !> MPI ranks the iterative solves are distributed over (`mpirun -n R`,
+   !> sprc_fem_petsc's `start_ranks`); 1 in a serial run. With several ranks
+   !> 'auto' solves every system iteratively: the direct solvers run on one
+   !> rank only, so they would be repeated on each.
+   integer, protected :: solve_ranks = 1
 
    !> Length of the message buffer the C shim fills.
    integer, parameter :: message_length = 512
@@ -325,11 +331,17 @@ contains
    end function solver_choice
 
    !> Whether the solver `choice` means the iterative solver for a system of
-   !> `n` unknowns in dimension `dim`.
+   !> `n` unknowns in dimension `dim` (on `solve_ranks` ranks).
    pure logical function use_iterative(choice, dim, n)
       integer, intent(in) :: choice, dim, n
-      use_iterative = choice == solver_iterative .or. &
-         & (choice == solver_auto .and. dim == 3 .and. n >= auto_iterative_min_dofs)
+      use_iterative = choice == solver_iterative .or. (choice == solver_auto .and. &
+         & (solve_ranks > 1 .or. (dim == 3 .and. n >= auto_iterative_min_dofs)))
    end function use_iterative
+
+   !> Set `solve_ranks` (by sprc_fem_petsc's `start_ranks` only).
+   subroutine set_solve_ranks(ranks)
+      integer, intent(in) :: ranks
+      solve_ranks = max(ranks, 1)
+   end subroutine set_solve_ranks
 
 end module sprc_fem_linear_solver

@@ -28,11 +28,11 @@ module sprc_fem_petsc
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_unsupported
    use sprc_core_blas_threads, only: blas_serial_begin, blas_serial_end
    use sprc_fem_sparse, only: csr_type
-   use sprc_fem_linear_solver, only: linear_solver_type, backend_error, message_length
+   use sprc_fem_linear_solver, only: linear_solver_type, backend_error, message_length, set_solve_ranks
    implicit none
    private
 
-   public :: petsc_solver_type, iteration_tolerance
+   public :: petsc_solver_type, iteration_tolerance, start_ranks
 
    !> Krylov solver with GAMG (module notes). Set the blocks (`set_blocks`)
    !> before `factorize`; `tolerance`, `max_iterations` and `symmetric` are
@@ -90,6 +90,13 @@ module sprc_fem_petsc
          integer(c_int64_t), value :: len
       end function sprc_petsc_solve
 
+      integer(c_int) function sprc_petsc_ranks(rank, size, msg, len) bind(c)
+         import :: c_int, c_int64_t, c_char
+         integer(c_int), intent(out) :: rank, size
+         character(kind=c_char), intent(inout) :: msg(*)
+         integer(c_int64_t), value :: len
+      end function sprc_petsc_ranks
+
       subroutine sprc_petsc_free(handle) bind(c)
          import :: c_ptr
          type(c_ptr), intent(inout) :: handle
@@ -97,6 +104,34 @@ module sprc_fem_petsc
    end interface
 
 contains
+
+   !> This process's `rank` (0-based) among `size` MPI ranks. Under Open MPI's
+   !> mpirun with several ranks (OMPI_COMM_WORLD_SIZE > 1) PETSc and MPI are
+   !> started here, before any solve, and every later iterative solve is
+   !> distributed over the ranks (`solve_ranks`); otherwise nothing is loaded
+   !> and the run is serial: rank 0 of 1.
+   subroutine start_ranks(rank, size, error)
+      integer, intent(out) :: rank, size
+      type(error_type), allocatable, intent(out) :: error
+      character(kind=c_char, len=message_length) :: msg
+      character(len=16) :: text
+      integer(c_int) :: status, r, s
+      integer :: length, env_status, ranks, io
+
+      rank = 0
+      size = 1
+      call get_environment_variable('OMPI_COMM_WORLD_SIZE', text, length, env_status)
+      if (env_status /= 0) return
+      read (text, *, iostat=io) ranks
+      if (io /= 0 .or. ranks <= 1) return
+      msg = ''
+      status = sprc_petsc_ranks(r, s, msg, int(len(msg), c_int64_t))
+      call backend_error(status, msg, error)
+      if (allocated(error)) return
+      rank = r
+      size = s
+      call set_solve_ranks(size)
+   end subroutine start_ranks
 
    !> Stopping tolerance tied to the discretization: the iteration error in the
    !> energy norm, relative to the solution's, at most 1e-7 (h/L)^p (h the
