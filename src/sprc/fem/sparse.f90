@@ -233,72 +233,146 @@ contains
 
    !> Convert to CSR, summing duplicates in insertion order; entries that sum
    !> to zero are kept (the pattern does not depend on values).
+   !>
+   !> Memory: beside the list and the result, only one band of rows is held
+   !> sorted at a time (12 bytes a triplet, about 1/`n_bands` of the list),
+   !> not the whole list a second time: the list of a large 3D assembly is
+   !> several GB. Each band is gathered twice from the list, first for the
+   !> pattern (the result is allocated at its exact size), then with values.
    subroutine coo_to_csr(self, a, error)
       class(coo_type), intent(in) :: self
       type(csr_type), intent(out) :: a
       type(error_type), allocatable, intent(out) :: error
-      integer(i8), allocatable :: next(:), marker(:)
-      integer, allocatable :: tcol(:)
+      integer, parameter :: n_bands = 4
+      integer(i8), allocatable :: start(:), next(:), marker(:)
+      integer, allocatable :: first_row(:), tcol(:)
       real(wp), allocatable :: tval(:)
-      integer(i8) :: k, p, q, rowstart, nnz
-      integer :: i, j, stat
+      integer(i8) :: k, band_max
+      integer :: i, b, stat
 
       a%nrows = self%nrows
       a%ncols = self%ncols
-      allocate (a%rowptr(self%nrows + 1), next(self%nrows + 1), marker(self%ncols), stat=stat)
-      call check_allocation(stat, 'coo_type%to_csr', 'the row pointers', max(self%nrows + 1, self%ncols), 24, error)
-      if (allocated(error)) return
-      allocate (tcol(self%nnz), tval(self%nnz), stat=stat)
-      call check_allocation(stat, 'coo_type%to_csr', 'the sorted triplets', self%nnz, 12, error)
+      allocate (a%rowptr(self%nrows + 1), start(self%nrows + 1), next(self%nrows), marker(self%ncols), stat=stat)
+      call check_allocation(stat, 'coo_type%to_csr', 'the row pointers', max(self%nrows + 1, self%ncols), 32, error)
       if (allocated(error)) return
 
-      ! Stable counting sort by row: within a row, triplets keep insertion order.
-      next = 0
+      ! start(i): where row i's triplets begin in the list sorted by row.
+      start = 0
       do k = 1, self%nnz
-         next(self%row(k) + 1) = next(self%row(k) + 1) + 1
+         start(self%row(k) + 1) = start(self%row(k) + 1) + 1
       end do
-      next(1) = 1
+      start(1) = 1
       do i = 1, self%nrows
-         next(i + 1) = next(i + 1) + next(i)
+         start(i + 1) = start(i + 1) + start(i)
       end do
-      a%rowptr(:) = next
+      call row_bands(start, (self%nnz + n_bands - 1)/n_bands, first_row, band_max)
+      allocate (tcol(band_max), tval(band_max), stat=stat)
+      call check_allocation(stat, 'coo_type%to_csr', 'a band of sorted triplets', band_max, 12, error)
+      if (allocated(error)) return
+
+      ! Pattern: distinct columns of each row (marker(j) = last row seen in column j).
+      marker = 0
+      do b = 1, size(first_row) - 1
+         call gather_band(self, first_row(b), first_row(b + 1) - 1, start, next, tcol)
+         do i = first_row(b), first_row(b + 1) - 1
+            a%rowptr(i + 1) = 0
+            do k = start(i) - start(first_row(b)) + 1, start(i + 1) - start(first_row(b))
+               if (marker(tcol(k)) /= i) then
+                  marker(tcol(k)) = i
+                  a%rowptr(i + 1) = a%rowptr(i + 1) + 1
+               end if
+            end do
+         end do
+      end do
+      a%rowptr(1) = 1
+      do i = 1, self%nrows
+         a%rowptr(i + 1) = a%rowptr(i + 1) + a%rowptr(i)
+      end do
+      allocate (a%col(a%rowptr(self%nrows + 1) - 1), a%val(a%rowptr(self%nrows + 1) - 1), stat=stat)
+      call check_allocation(stat, 'coo_type%to_csr', 'the CSR matrix', a%rowptr(self%nrows + 1) - 1, 12, error)
+      if (allocated(error)) return
+
+      ! Values: duplicates summed in list order (the gather is stable).
+      marker = 0
+      do b = 1, size(first_row) - 1
+         call gather_band(self, first_row(b), first_row(b + 1) - 1, start, next, tcol, tval)
+         call merge_band(a, first_row(b), first_row(b + 1) - 1, start, tcol, tval, marker)
+      end do
+   end subroutine coo_to_csr
+
+   !> Rows split into consecutive bands of at most `target` triplets each (or
+   !> one row, if longer): band b is rows first_row(b) .. first_row(b+1)-1;
+   !> `band_max` the most triplets of a band.
+   subroutine row_bands(start, target, first_row, band_max)
+      integer(i8), intent(in) :: start(:), target
+      integer, allocatable, intent(out) :: first_row(:)
+      integer(i8), intent(out) :: band_max
+      integer :: i, nrows
+
+      nrows = size(start) - 1
+      first_row = [1]
+      do i = 2, nrows
+         if (start(i + 1) - start(first_row(size(first_row))) > target) first_row = [first_row, i]
+      end do
+      first_row = [first_row, nrows + 1]
+      if (nrows == 0) first_row = [1, 1]
+      band_max = 1
+      do i = 1, size(first_row) - 1
+         band_max = max(band_max, start(first_row(i + 1)) - start(first_row(i)))
+      end do
+   end subroutine row_bands
+
+   !> The triplets of rows r0..r1 sorted by row, stable (list order within a
+   !> row): columns into `tcol`, and values into `tval` when present.
+   subroutine gather_band(self, r0, r1, start, next, tcol, tval)
+      class(coo_type), intent(in) :: self
+      integer, intent(in) :: r0, r1
+      integer(i8), intent(in) :: start(:)
+      integer(i8), intent(inout) :: next(:)
+      integer, intent(inout) :: tcol(:)
+      real(wp), intent(inout), optional :: tval(:)
+      integer(i8) :: k
+      integer :: i
+
+      next(r0:r1) = start(r0:r1) - start(r0) + 1
       do k = 1, self%nnz
          i = self%row(k)
+         if (i < r0 .or. i > r1) cycle
          tcol(next(i)) = self%col(k)
-         tval(next(i)) = self%val(k)
+         if (present(tval)) tval(next(i)) = self%val(k)
          next(i) = next(i) + 1
       end do
+   end subroutine gather_band
 
-      ! Merge duplicates in place: marker(j) is where column j of the current
-      ! row was written; positions grow across rows, so no reset is needed.
-      marker = 0
-      q = 0
-      do i = 1, self%nrows
-         rowstart = q + 1
-         do p = a%rowptr(i), a%rowptr(i + 1) - 1
+   !> Rows r0..r1 of `a` (pattern set) from a gathered band: duplicates
+   !> summed in order, columns sorted. marker(j) is where column j was last
+   !> written; positions grow across rows, so it needs no reset.
+   subroutine merge_band(a, r0, r1, start, tcol, tval, marker)
+      type(csr_type), intent(inout) :: a
+      integer, intent(in) :: r0, r1
+      integer(i8), intent(in) :: start(:)
+      integer, intent(in) :: tcol(:)
+      real(wp), intent(in) :: tval(:)
+      integer(i8), intent(inout) :: marker(:)
+      integer(i8) :: p, q
+      integer :: i, j
+
+      do i = r0, r1
+         q = a%rowptr(i) - 1
+         do p = start(i) - start(r0) + 1, start(i + 1) - start(r0)
             j = tcol(p)
-            if (marker(j) >= rowstart) then
-               tval(marker(j)) = tval(marker(j)) + tval(p)
+            if (marker(j) >= a%rowptr(i)) then
+               a%val(marker(j)) = a%val(marker(j)) + tval(p)
             else
                q = q + 1
                marker(j) = q
-               tcol(q) = j
-               tval(q) = tval(p)
+               a%col(q) = j
+               a%val(q) = tval(p)
             end if
          end do
-         a%rowptr(i) = rowstart
-         call sort_row(tcol(rowstart:q), tval(rowstart:q))
+         call sort_row(a%col(a%rowptr(i):q), a%val(a%rowptr(i):q))
       end do
-      a%rowptr(self%nrows + 1) = q + 1
-      nnz = q
-      deallocate (next, marker)
-
-      allocate (a%col(nnz), a%val(nnz), stat=stat)
-      call check_allocation(stat, 'coo_type%to_csr', 'the CSR matrix', nnz, 12, error)
-      if (allocated(error)) return
-      a%col(:) = tcol(1:nnz)
-      a%val(:) = tval(1:nnz)
-   end subroutine coo_to_csr
+   end subroutine merge_band
 
    !> Sort distinct columns ascending, carrying the values: insertion sort for
    !> the short rows of finite elements, heap sort beyond.
