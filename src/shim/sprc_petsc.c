@@ -258,15 +258,15 @@ static int load_petsc(char *msg, int64_t len)
     return SPRC_OK;
 }
 
-/* The ranks of MPI_COMM_WORLD: 1 without mpirun (a singleton MPI). */
-static int world_rank = 0, world_size = 1;
+/* The ranks of MPI_COMM_WORLD: 1 without mpirun (a singleton MPI).
+ * `distributed`: solves are spread over the world's ranks; set by
+ * sprc_petsc_ranks only, so a program that did not ask (a library caller
+ * under mpirun) keeps one solve per process on PETSC_COMM_SELF. */
+static int world_rank = 0, world_size = 1, distributed = 0;
 
 static void finalize_at_exit(void) { PetscFinalize(); }
 
-/* PETSc (and MPI, as a singleton when not under mpirun) once per process.
- * Under mpirun with several ranks, MPI is finalized at exit (Open MPI's
- * mpirun reports a rank that ends without MPI_Finalize as failed); a
- * singleton run is left as it always was. */
+/* PETSc (and MPI, as a singleton when not under mpirun) once per process. */
 static int ensure_petsc(char *msg, int64_t len)
 {
     PetscBool up = PETSC_FALSE;
@@ -280,18 +280,23 @@ static int ensure_petsc(char *msg, int64_t len)
     TRY(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
     if (MPI_Comm_rank(SPRC_COMM_WORLD, &world_rank) != 0 || MPI_Comm_size(SPRC_COMM_WORLD, &world_size) != 0)
         return report(SPRC_INTERNAL, msg, len, "PETSc: MPI_Comm_rank or MPI_Comm_size failed");
-    if (world_size > 1) atexit(finalize_at_exit);
     return SPRC_OK;
 }
 
-/* Start PETSc and MPI and give this process's rank and the number of ranks
- * (sprc runs under `mpirun -n R`: every rank runs the study, the solves are
- * distributed over all of them). */
+/* Start PETSc and MPI, give this process's rank and the number of ranks,
+ * and distribute every later solve over them (sprc runs under `mpirun -n R`:
+ * every rank runs the study and takes part in each solve). With several
+ * ranks MPI is finalized at exit: Open MPI's mpirun reports a rank that ends
+ * without MPI_Finalize as failed. */
 int sprc_petsc_ranks(int *rank, int *size, char *msg, int64_t len)
 {
     int status = ensure_petsc(msg, len);
     *rank = world_rank;
     *size = world_size;
+    if (status == SPRC_OK && world_size > 1 && !distributed) {
+        distributed = 1;
+        atexit(finalize_at_exit);
+    }
     return status;
 }
 
@@ -327,7 +332,7 @@ void sprc_petsc_free(void **handle)
 /* A vector of this rank's rows (block size dim). */
 static int create_vector(sprc_petsc *s, PetscInt n, PetscInt dim, Vec *v, char *msg, int64_t len)
 {
-    if (world_size > 1)
+    if (distributed)
         TRY(VecCreateMPI(s->comm, s->n_local, n, v));
     else
         TRY(VecCreateSeq(PETSC_COMM_SELF, n, v));
@@ -343,7 +348,7 @@ static int set_rows(sprc_petsc *s, PetscInt n, const PetscInt *rowptr, const Pet
 {
     PetscInt *local, i, first;
     PetscErrorCode ierr;
-    if (world_size == 1) {
+    if (!distributed) {
         TRY(MatSetType(s->a, "seqaij"));
         TRY(MatSeqAIJSetPreallocationCSR(s->a, rowptr, col, val));
         return SPRC_OK;
@@ -411,7 +416,7 @@ static int create_vectors(sprc_petsc *s, PetscInt n, PetscInt dim, char *msg, in
     if (status != SPRC_OK) return status;
     TRY(VecDuplicate(s->b, &s->x));
     TRY(VecDuplicate(s->b, &s->w));
-    if (world_size > 1) TRY(VecScatterCreateToAll(s->x, &s->gather, &s->all));
+    if (distributed) TRY(VecScatterCreateToAll(s->x, &s->gather, &s->all));
     return SPRC_OK;
 }
 
@@ -419,9 +424,9 @@ static int create_vectors(sprc_petsc *s, PetscInt n, PetscInt dim, char *msg, in
  * of nearly equal length in rank order. */
 static void own_rows(sprc_petsc *s, PetscInt n, PetscInt dim)
 {
-    int64_t blocks = n / dim;
-    int64_t first = blocks * world_rank / world_size, last = blocks * (world_rank + 1) / world_size;
-    s->comm = world_size > 1 ? SPRC_COMM_WORLD : PETSC_COMM_SELF;
+    int64_t blocks = n / dim, rank = distributed ? world_rank : 0, size = distributed ? world_size : 1;
+    int64_t first = blocks * rank / size, last = blocks * (rank + 1) / size;
+    s->comm = distributed ? SPRC_COMM_WORLD : PETSC_COMM_SELF;
     s->lo = (PetscInt)(first * dim);
     s->n_local = (PetscInt)((last - first) * dim);
 }
@@ -465,7 +470,7 @@ static int copy_out(sprc_petsc *s, double *a, PetscInt n, char *msg, int64_t len
 {
     PetscScalar *p;
     Vec v = s->x;
-    if (world_size > 1) {
+    if (distributed) {
         TRY(VecScatterBegin(s->gather, s->x, s->all, INSERT_VALUES, SCATTER_FORWARD));
         TRY(VecScatterEnd(s->gather, s->x, s->all, INSERT_VALUES, SCATTER_FORWARD));
         v = s->all;
