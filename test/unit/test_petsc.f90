@@ -17,7 +17,7 @@ module sprc_test_petsc
    use sprc_fem_bc, only: fe_bc_type
    use sprc_fem_problem, only: elasticity_problem_type, solve_on_grid
    use sprc_fem_linear_solver, only: solver_direct, solver_iterative, solver_auto, use_iterative, &
-      & auto_iterative_min_dofs, solver_choice
+      & auto_iterative_min_dofs, solver_choice, set_solve_ranks
    use sprc_fem_petsc, only: petsc_solver_type, iteration_tolerance
    use sprc_test_fem, only: sphere_octant, lame_quarter, young
    use sprc_testsuite, only: unittest_type, new_unittest, check, error_type
@@ -58,6 +58,12 @@ contains
       if (allocated(error)) return
       call check(error, use_iterative(solver_iterative, 2, 1) .and. .not. use_iterative(solver_direct, 3, 10**8), &
          & 'explicit choices')
+      if (allocated(error)) return
+      ! on several MPI ranks 'auto' distributes every solve; 'direct' stays direct
+      call set_solve_ranks(2)
+      call check(error, use_iterative(solver_auto, 2, 10) .and. .not. use_iterative(solver_direct, 3, 10**8), &
+         & 'auto on 2 ranks')
+      call set_solve_ranks(1)
    end subroutine test_choice
 
    !> Sphere octant, symmetry planes off the grid (Nitsche), one boundary
