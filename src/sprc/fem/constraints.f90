@@ -29,6 +29,7 @@ module sprc_fem_constraints
    use sprc_grid_tree, only: grid_type
    use sprc_grid_nodes, only: grid_nodes_type, element_shape
    use sprc_grid_hanging, only: hanging_type
+   use sprc_fem_sparse, only: sort_row
    implicit none
    private
 
@@ -216,21 +217,8 @@ contains
          integer, allocatable, intent(inout) :: cols(:)
          real(wp), allocatable, intent(inout) :: vals(:)
          integer, intent(inout) :: count
-         integer :: a, b, tc
-         real(wp) :: tv
-         do a = 2, nrow
-            tc = row_col(a)
-            tv = acc(a)
-            b = a - 1
-            do while (b >= 1)
-               if (row_col(b) <= tc) exit
-               row_col(b + 1) = row_col(b)
-               acc(b + 1) = acc(b)
-               b = b - 1
-            end do
-            row_col(b + 1) = tc
-            acc(b + 1) = tv
-         end do
+         integer :: a
+         call sort_row(row_col(1:nrow), acc(1:nrow))
          do a = 1, nrow
             marker(row_col(a)) = 0
          end do

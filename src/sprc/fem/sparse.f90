@@ -15,7 +15,7 @@ module sprc_fem_sparse
    implicit none
    private
 
-   public :: coo_type, csr_type, csr_validate
+   public :: coo_type, csr_type, csr_validate, sort_row
 
    !> Capacity of a `coo_type` whose first `add` finds no storage.
    integer(i8), parameter :: min_capacity = 64
