@@ -49,6 +49,7 @@
 module sprc_grid_patches
    use sprc_core_kinds, only: wp
    use sprc_core_text, only: itoa, rtoa
+   use sprc_core_alloc, only: check_allocation
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular
    use sprc_core_material, only: plane_stress, plane_strain, solid, voigt_size, check_material
    use sprc_core_poly, only: poly_max_degree
@@ -138,7 +139,7 @@ contains
       type(grid_contact_type), intent(in), optional, target :: contact
       type(grid_source_type) :: src
       type(patch_loop_type) :: opt
-      integer :: rounds_limit, ip, e, n
+      integer :: rounds_limit, ip, e, n, stat
       real(wp) :: t0
       character(len=160) :: buf
 
@@ -155,13 +156,19 @@ contains
       field%dim = grid%dim
       field%nstress = voigt_size(input%analysis)
       field%n_elements = nodes%n_elements
-      allocate (field%elem_lo(grid%dim, nodes%n_elements), field%elem_hi(grid%dim, nodes%n_elements))
+      allocate (field%elem_lo(grid%dim, nodes%n_elements), field%elem_hi(grid%dim, nodes%n_elements), stat=stat)
+      call check_allocation(stat, 'recover_grid', 'the element boxes', nodes%n_elements, 16*grid%dim, error)
+      if (allocated(error)) return
       do e = 1, nodes%n_elements
          call grid%leaf_box(e, field%elem_lo(:, e), field%elem_hi(:, e))
       end do
-      call number_patches(nodes, hanging, field)
+      call number_patches(nodes, hanging, field, error)
+      if (allocated(error)) return
       allocate (field%recs(field%n_patches), field%patch_rounds(field%n_patches), &
-         & field%patch_elements(field%n_patches))
+         & field%patch_elements(field%n_patches), stat=stat)
+      call check_allocation(stat, 'recover_grid', 'the patch records', field%n_patches, &
+         & storage_size(field%recs)/8 + 8, error)
+      if (allocated(error)) return
 
       src%input => input
       src%nodes => nodes
@@ -226,15 +233,18 @@ contains
    end subroutine check_options
 
    !> Free vertex nodes in node order get patches 1, 2, ...
-   subroutine number_patches(nodes, hanging, field)
+   subroutine number_patches(nodes, hanging, field, error)
       type(grid_nodes_type), intent(in) :: nodes
       type(hanging_type), intent(in) :: hanging
       type(recovered_field_type), intent(inout) :: field
+      type(error_type), allocatable, intent(out) :: error
       logical, allocatable :: vertex(:)
-      integer :: n, nv, e
+      integer :: n, nv, e, stat
 
       nv = 2**nodes%dim
-      allocate (vertex(nodes%n_nodes), field%patch_of_node(nodes%n_nodes))
+      allocate (vertex(nodes%n_nodes), field%patch_of_node(nodes%n_nodes), stat=stat)
+      call check_allocation(stat, 'recover_grid', 'the patch of each node', nodes%n_nodes, 8, error)
+      if (allocated(error)) return
       vertex = .false.
       ! VTK order puts the corners first.
       do e = 1, nodes%n_elements
@@ -242,7 +252,9 @@ contains
       end do
       vertex = vertex .and. hanging%free_index > 0
       field%n_patches = count(vertex)
-      allocate (field%patch_node(field%n_patches))
+      allocate (field%patch_node(field%n_patches), stat=stat)
+      call check_allocation(stat, 'recover_grid', 'the node of each patch', field%n_patches, 4, error)
+      if (allocated(error)) return
       field%n_patches = 0
       field%patch_of_node = 0
       do n = 1, nodes%n_nodes

@@ -29,6 +29,7 @@
 !> for its message.
 module sprc_recovery_patch_loop
    use sprc_core_kinds, only: wp
+   use sprc_core_alloc, only: check_allocation
    use sprc_core_error, only: error_type, fatal_error, stat_singular, stat_internal
    use sprc_core_poly, only: poly_nterms
    use sprc_core_blas_threads, only: blas_serial_begin, blas_serial_end
@@ -137,9 +138,11 @@ contains
       type(error_type), allocatable, intent(out) :: error
       logical, intent(in), optional :: skip(:)
       integer, allocatable :: status(:)
-      integer :: saved_blas
+      integer :: saved_blas, stat
 
-      allocate (status(size(patch_node)))
+      allocate (status(size(patch_node)), stat=stat)
+      call check_allocation(stat, 'patch loop', 'the status of each patch', size(patch_node), 4, error)
+      if (allocated(error)) return
       rounds = 0
       nel = 0
       failed = 0
@@ -152,7 +155,8 @@ contains
       failed = findloc(status /= 0, .true., dim=1)
       block
          type(scratch_type) :: sc
-         call init_scratch(sc, opt, size(connectivity, 2))
+         call init_scratch(sc, opt, size(connectivity, 2), error)
+         if (allocated(error)) return
          call recover_patch(opt, source, ne_ptr, ne_list, connectivity, patch_node(failed), sc, recs(failed), &
             & rounds(failed), nel(failed), error)
       end block
@@ -169,15 +173,21 @@ contains
       integer, intent(inout) :: rounds(:), nel(:), status(:)
       logical, intent(in), optional :: skip(:)
       type(scratch_type) :: sc
-      type(error_type), allocatable :: err
+      type(error_type), allocatable :: err, init_err
       integer :: ip
 
-      call init_scratch(sc, opt, size(connectivity, 2))
+      ! A thread whose scratch could not be allocated fails its patches; the serial
+      ! retry of the first of them reports the error.
+      call init_scratch(sc, opt, size(connectivity, 2), init_err)
       !$omp do schedule(dynamic, 16)
       do ip = 1, size(patch_node)
          status(ip) = 0
          if (present(skip)) then
             if (skip(ip)) cycle
+         end if
+         if (allocated(init_err)) then
+            status(ip) = init_err%stat
+            cycle
          end if
          call recover_patch(opt, source, ne_ptr, ne_list, connectivity, patch_node(ip), sc, recs(ip), rounds(ip), &
             & nel(ip), err)
@@ -187,18 +197,22 @@ contains
    end subroutine thread_loop
 
    !> Thread storage of the common capacity (module notes).
-   subroutine init_scratch(sc, opt, n_elements)
+   subroutine init_scratch(sc, opt, n_elements, error)
       type(scratch_type), intent(inout) :: sc
       type(patch_loop_type), intent(in) :: opt
       integer, intent(in) :: n_elements
-      type(error_type), allocatable :: err
+      type(error_type), allocatable, intent(out) :: error
+      integer :: stat
 
       call workspace_init(sc%ws)
       call workspace_init(sc%ws_big)
-      allocate (sc%list(64), sc%stamp(n_elements))
+      allocate (sc%list(64), sc%stamp(n_elements), stat=stat)
+      call check_allocation(stat, 'patch loop', 'the element stamps of a thread', n_elements, 4, error)
+      if (allocated(error)) return
       sc%stamp = 0
-      ! Cannot fail: dim and degree were validated by the producer.
-      call workspace_reserve(sc%ws, opt%dim, opt%degree, opt%cap(1), opt%cap(2), err)
+      ! dim and degree were validated by the producer: only an allocation can fail here.
+      call workspace_reserve(sc%ws, opt%dim, opt%degree, opt%cap(1), opt%cap(2), error)
+      if (allocated(error)) return
       call patch_reserve(sc%patch, opt%cap(1), opt%cap(2))
    end subroutine init_scratch
 
