@@ -76,6 +76,7 @@ module sprc_recovery_mesh
       & element_vertex_shape, element_node_xi, element_inside, element_inverse_map, element_name, &
       & facet_points, facet_npoints, max_facet_points, max_element_nodes
    use sprc_core_text, only: itoa
+   use sprc_core_alloc, only: check_allocation
    use sprc_recovery_mesh_bins, only: element_bins_type, build_element_bins, bin_of_point
    use sprc_recovery_mesh_check, only: check_mesh_options, check_mesh_arrays, check_mesh_facets, &
       & check_duplicate_nodes, check_duplicate_elements, vec_str, entry_name, index_name, &
@@ -208,9 +209,11 @@ contains
       if (allocated(error)) return
       t(1) = wall_time()
 
-      call init_result(result, dim, analysis, element_type, method, deg, young, poisson, nodes, connectivity)
+      call init_result(result, dim, analysis, element_type, method, deg, young, poisson, nodes, connectivity, error)
+      if (allocated(error)) return
       result%c_indices = ci
-      call node_elements(result, topo)
+      call node_elements(result, topo, error)
+      if (allocated(error)) return
       call check_duplicate_nodes(nodes, topo%ne_ptr(2:) > topo%ne_ptr(:size(nodes, 2)), ci, error)
       if (allocated(error)) return
       call check_duplicate_elements(connectivity, result%nvertex, topo%ne_ptr, topo%ne_list, ci, error)
@@ -230,7 +233,8 @@ contains
       call recover_patches(result, topo, gp, gw, gs, rounds, error)
       if (allocated(error)) return
       t(4) = wall_time()
-      call nodal_values(result, topo)
+      call nodal_values(result, topo, error)
+      if (allocated(error)) return
       t(5) = wall_time()
       if (present(gauss_xi)) then
          call estimate(result, gp, gw, gs, gauss_xi, error)
@@ -246,12 +250,13 @@ contains
       result%t_estimate = t(6) - t(5)
    end subroutine recover_on_mesh
 
-   subroutine init_result(r, dim, analysis, element_type, method, deg, young, poisson, nodes, connectivity)
+   subroutine init_result(r, dim, analysis, element_type, method, deg, young, poisson, nodes, connectivity, error)
       type(mesh_recovery_type), intent(inout) :: r
       integer, intent(in) :: dim, analysis, element_type, method, deg
       real(wp), intent(in) :: young, poisson, nodes(:, :)
       integer, intent(in) :: connectivity(:, :)
-      integer :: e, a
+      type(error_type), allocatable, intent(out) :: error
+      integer :: e, a, st
 
       r%dim = dim
       r%analysis = analysis
@@ -265,9 +270,17 @@ contains
       r%nvertex = element_vertices(element_type)
       r%young = young
       r%poisson = poisson
-      r%x = nodes
-      r%connectivity = connectivity
-      allocate (r%box_lo(dim, r%nelem), r%box_hi(dim, r%nelem))
+      if (allocated(r%x)) deallocate (r%x)
+      if (allocated(r%connectivity)) deallocate (r%connectivity)
+      allocate (r%x, source=nodes, stat=st)
+      call check_allocation(st, 'recover_on_mesh', 'the node coordinates', r%nnode, 8*dim, error)
+      if (allocated(error)) return
+      allocate (r%connectivity, source=connectivity, stat=st)
+      call check_allocation(st, 'recover_on_mesh', 'the connectivity', r%nelem, 4*size(connectivity, 1), error)
+      if (allocated(error)) return
+      allocate (r%box_lo(dim, r%nelem), r%box_hi(dim, r%nelem), stat=st)
+      call check_allocation(st, 'recover_on_mesh', 'the element boxes', r%nelem, 16*dim, error)
+      if (allocated(error)) return
       !$omp parallel do schedule(static) private(a)
       do e = 1, r%nelem
          r%box_lo(:, e) = nodes(:, connectivity(1, e))
@@ -281,14 +294,17 @@ contains
    end subroutine init_result
 
    !> Node -> element CSR (elements ascending per node); patches at the vertex nodes.
-   subroutine node_elements(r, topo)
+   subroutine node_elements(r, topo, error)
       type(mesh_recovery_type), intent(inout) :: r
       type(topology_type), intent(inout) :: topo
+      type(error_type), allocatable, intent(out) :: error
       integer, allocatable :: fill(:)
       logical, allocatable :: vertex(:)
-      integer :: e, a, n
+      integer :: e, a, n, st
 
-      allocate (topo%ne_ptr(r%nnode + 1), fill(r%nnode), vertex(r%nnode))
+      allocate (topo%ne_ptr(r%nnode + 1), fill(r%nnode), vertex(r%nnode), stat=st)
+      call check_allocation(st, 'recover_on_mesh', 'the node-element pointers', r%nnode + 1, 12, error)
+      if (allocated(error)) return
       fill = 0
       do e = 1, r%nelem
          fill(r%connectivity(:, e)) = fill(r%connectivity(:, e)) + 1
@@ -297,7 +313,9 @@ contains
       do n = 1, r%nnode
          topo%ne_ptr(n + 1) = topo%ne_ptr(n) + fill(n)
       end do
-      allocate (topo%ne_list(topo%ne_ptr(r%nnode + 1) - 1))
+      allocate (topo%ne_list(topo%ne_ptr(r%nnode + 1) - 1), stat=st)
+      call check_allocation(st, 'recover_on_mesh', 'the node-element list', topo%ne_ptr(r%nnode + 1) - 1, 4, error)
+      if (allocated(error)) return
       fill = 0
       do e = 1, r%nelem
          do a = 1, r%nen
@@ -311,7 +329,9 @@ contains
          vertex(r%connectivity(1:r%nvertex, e)) = .true.
       end do
       r%n_patches = count(vertex)
-      allocate (r%patch_node(r%n_patches), r%patch_of_node(r%nnode))
+      allocate (r%patch_node(r%n_patches), r%patch_of_node(r%nnode), stat=st)
+      call check_allocation(st, 'recover_on_mesh', 'the patch of each node', r%nnode, 8, error)
+      if (allocated(error)) return
       r%patch_of_node = 0
       r%n_patches = 0
       do n = 1, r%nnode
@@ -479,13 +499,15 @@ contains
       real(wp), intent(in), optional :: facet_traction_value(:, :)
       integer, allocatable :: owner(:), fill(:)
       real(wp) :: xq(3, max_facet_points), wq(max_facet_points), nq(3, max_facet_points), c(3)
-      integer :: nf, nfn, f, e, q, nq_f, k, d
+      integer :: nf, nfn, f, e, q, nq_f, k, d, st
 
       d = r%dim
       nf = 0
       if (present(facet_nodes)) nf = size(facet_nodes, 2)
       nfn = element_facet_nodes(r%element_type)
-      allocate (owner(nf), fill(r%nelem), topo%bptr(r%nelem + 1))
+      allocate (owner(nf), fill(r%nelem), topo%bptr(r%nelem + 1), stat=st)
+      call check_allocation(st, 'recover_on_mesh', 'the facet owners and boundary pointers', nf + 2*r%nelem + 1, 4, error)
+      if (allocated(error)) return
       fill = 0
       do f = 1, nf
          call facet_owner(r, topo, facet_nodes(:, f), f, owner(f), error)
@@ -500,7 +522,9 @@ contains
       k = topo%bptr(r%nelem + 1) - 1
       if (nf == 0) k = 0
       r%n_boundary_points = k
-      allocate (topo%bx(d, k), topo%bw(k), topo%bn(d, k), topo%bt(d, k), topo%bkind(k), topo%bpiece(k))
+      allocate (topo%bx(d, k), topo%bw(k), topo%bn(d, k), topo%bt(d, k), topo%bkind(k), topo%bpiece(k), stat=st)
+      call check_allocation(st, 'recover_on_mesh', 'the boundary points', k, 24*d + 16, error)
+      if (allocated(error)) return
       fill = 0
       do f = 1, nf
          e = owner(f)
@@ -575,7 +599,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(mesh_source_type) :: src
       type(patch_loop_type) :: opt
-      integer :: ip, n
+      integer :: ip, n, st
 
       src%dim = r%dim
       src%analysis = r%analysis
@@ -592,7 +616,9 @@ contains
       src%gs => gs
       opt = patch_loop_type(dim=r%dim, degree=r%degree, rounds_limit=rounds, sprc=src%sprc)
       opt%cap = patch_capacity(src, r%dim, r%degree, topo%ne_ptr, topo%ne_list, r%patch_node)
-      allocate (r%recs(r%n_patches), r%patch_rounds(r%n_patches), r%patch_elements(r%n_patches))
+      allocate (r%recs(r%n_patches), r%patch_rounds(r%n_patches), r%patch_elements(r%n_patches), stat=st)
+      call check_allocation(st, 'recover_on_mesh', 'the patch records', r%n_patches, storage_size(r%recs)/8 + 8, error)
+      if (allocated(error)) return
       call run_patch_loop(opt, src, topo%ne_ptr, topo%ne_list, r%connectivity, r%patch_node, r%recs, &
          & r%patch_rounds, r%patch_elements, ip, error)
       if (allocated(error)) then
@@ -676,13 +702,16 @@ contains
    end subroutine mesh_fill
 
    !> Nodal stresses: patch value at vertex nodes, the union elsewhere (module notes).
-   subroutine nodal_values(r, topo)
+   subroutine nodal_values(r, topo, error)
       type(mesh_recovery_type), intent(inout) :: r
       type(topology_type), intent(in) :: topo
+      type(error_type), allocatable, intent(out) :: error
       real(wp) :: xi(3)
-      integer :: n, e, a
+      integer :: n, e, a, st
 
-      allocate (r%nodal(r%nstress, r%nnode))
+      allocate (r%nodal(r%nstress, r%nnode), stat=st)
+      call check_allocation(st, 'recover_on_mesh', 'the nodal stresses', r%nnode, 8*r%nstress, error)
+      if (allocated(error)) return
       !$omp parallel do schedule(static) private(e, a, xi)
       do n = 1, r%nnode
          r%nodal(:, n) = 0.0_wp
@@ -751,11 +780,13 @@ contains
       real(wp), intent(in) :: gp(:, :, :), gw(:, :), gs(:, :, :), xi(:, :, :)
       type(error_type), allocatable, intent(out) :: error
       real(wp), allocatable :: sstar(:, :), cmat(:, :)
-      integer :: e, i, ngp, ns
+      integer :: e, i, ngp, ns, st
 
       ngp = size(gp, 2)
       ns = r%nstress
-      allocate (r%elem_err(r%nelem), r%elem_norm_h(r%nelem), cmat(ns, ns))
+      allocate (r%elem_err(r%nelem), r%elem_norm_h(r%nelem), cmat(ns, ns), stat=st)
+      call check_allocation(st, 'recover_on_mesh', 'the element errors', r%nelem, 16, error)
+      if (allocated(error)) return
       call compliance_matrix(r%analysis, r%young, r%poisson, cmat, error)
       if (allocated(error)) return
       !$omp parallel default(shared) private(sstar, i)
