@@ -227,7 +227,8 @@ contains
       ! listed out of order: the plot sorts them
       contacts(1)%x(1, :) = [1.0_wp, 0.0_wp, 0.5_wp]
       contacts(1)%p_fe = [0.0_wp, 2.0_wp, 1.0_wp]
-      text = contact_svg(contacts, 'order')
+      call contact_svg(contacts, 'order', text, error)
+      if (allocated(error)) return
       pos = 1
       do k = 1, 4
          i = index(text(pos:), 'class="point p_fe"')
@@ -254,7 +255,8 @@ contains
       type(contact_result_type) :: none(0)
       character(len=:), allocatable :: text, msg
 
-      text = contact_svg([contact_sample_3d()], '3D')
+      call contact_svg([contact_sample_3d()], '3D', text, error)
+      if (allocated(error)) return
       call check(error, xml_well_formed(text, 'svg', msg), '3D SVG well-formed: '//msg)
       if (allocated(error)) return
       call check(error, index(text, '<polyline') == 0, 'no lines through a surface')
@@ -263,7 +265,8 @@ contains
       if (allocated(error)) return
       call check(error, index(text, 'distance from the point of peak pressure') > 0, '3D abscissa')
       if (allocated(error)) return
-      text = contact_svg(none, 'empty')
+      call contact_svg(none, 'empty', text, error)
+      if (allocated(error)) return
       call check(error, xml_well_formed(text, 'svg', msg), 'empty SVG well-formed: '//msg)
       if (allocated(error)) return
       call check(error, index(text, 'no data') > 0, 'says no data')
@@ -286,7 +289,8 @@ contains
       if (allocated(error)) return
       c(1)%p_fe = 1.0_wp - x(1, :)**2
       c(1)%p_exact = 1.0_wp - x(1, :)**2
-      text = contact_svg(c, 'many')
+      call contact_svg(c, 'many', text, error)
+      if (allocated(error)) return
       call check(error, xml_well_formed(text, 'svg', msg), 'SVG well-formed: '//msg)
       if (allocated(error)) return
       call check(error, count_sub(text, 'class="point p_fe"'), 2000, 'every 10th FE point')
@@ -311,7 +315,8 @@ contains
       call new_contact_result(c(1), x, spread(0.01_wp, 1, 101), x, 1, 2, error)
       if (allocated(error)) return
       c(1)%p_fe = merge(1.0_wp - (phi/0.1_wp)**2, 0.0_wp, phi < 0.1_wp)
-      text = contact_svg(c, 'window')
+      call contact_svg(c, 'window', text, error)
+      if (allocated(error)) return
       call check(error, count_sub(text, 'class="point p_fe"'), 12, 'markers of the loaded stretch and margins')
       if (allocated(error)) return
       pos = 1

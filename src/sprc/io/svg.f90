@@ -24,6 +24,7 @@
 module sprc_io_svg
    use sprc_core_kinds, only: wp
    use sprc_core_text, only: fixed_text
+   use sprc_core_alloc, only: check_allocation
    use sprc_core_error, only: error_type, fatal_error, stat_io
    use sprc_io_report, only: report_row_type, report_column, is_empty
    use sprc_contact_result, only: contact_result_type
@@ -102,8 +103,11 @@ contains
       !> Title on top of the picture (plain text; escaped here).
       character(len=*), intent(in) :: title
       type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: svg
 
-      call write_text(path, 'contact SVG', contact_svg(contacts, title), error)
+      call contact_svg(contacts, title, svg, error)
+      if (allocated(error)) return
+      call write_text(path, 'contact SVG', svg, error)
    end subroutine write_contact_svg
 
    !> Write `text` to `path` (replacing it); `what` names the file in messages.
@@ -191,10 +195,11 @@ contains
    end function page_open
 
    !> The SVG text of the contact plot of `contacts` (one level's pairs).
-   function contact_svg(contacts, title) result(svg)
+   subroutine contact_svg(contacts, title, svg, error)
       type(contact_result_type), intent(in) :: contacts(:)
       character(len=*), intent(in) :: title
-      character(len=:), allocatable :: svg
+      character(len=:), allocatable, intent(out) :: svg
+      type(error_type), allocatable, intent(out) :: error
       type(series_style_type) :: styles(n_contact_series)
       real(wp), allocatable :: x(:, :), p(:, :), s(:)
       integer, allocatable :: order(:), shown(:)
@@ -202,7 +207,8 @@ contains
       integer :: dim, k
 
       styles = contact_styles()
-      call gather_points(contacts, x, p)
+      call gather_points(contacts, x, p, error)
+      if (allocated(error)) return
       dim = 2
       if (size(contacts) > 0) dim = contacts(1)%dim
       if (dim == 2) then
@@ -221,7 +227,7 @@ contains
          'quarter of it on either side.', '', title)
       svg = svg//contact_panel(s(shown), p(shown, :), styles, active, dim == 2)
       svg = svg//legend(styles, active)//'</g>'//nl//'</svg>'//nl
-   end function contact_svg
+   end subroutine contact_svg
 
    !> The contact plot's series: FE dots, SPR dashed squares, SPR-C dots, exact a black line.
    function contact_styles() result(styles)
@@ -234,14 +240,18 @@ contains
 
    !> Every slave point of every pair: coordinates x(dim, n) and pressures
    !> p(n, 4) in the order of `contact_styles`.
-   subroutine gather_points(contacts, x, p)
+   subroutine gather_points(contacts, x, p, error)
       type(contact_result_type), intent(in) :: contacts(:)
       real(wp), allocatable, intent(out) :: x(:, :), p(:, :)
-      integer :: k, n, m, dim
+      type(error_type), allocatable, intent(out) :: error
+      integer :: k, n, m, dim, stat
 
       dim = 2
       if (size(contacts) > 0) dim = contacts(1)%dim
-      allocate (x(dim, sum(contacts%npoint)), p(sum(contacts%npoint), n_contact_series))
+      allocate (x(dim, sum(contacts%npoint)), p(sum(contacts%npoint), n_contact_series), stat=stat)
+      call check_allocation(stat, 'contact SVG', 'the slave points', sum(contacts%npoint), 8*(dim + n_contact_series), &
+         & error)
+      if (allocated(error)) return
       n = 0
       do k = 1, size(contacts)
          m = contacts(k)%npoint
