@@ -486,11 +486,14 @@ contains
       type(timer_type) :: timer
       real(wp), allocatable :: pstar(:, :)
       real(wp) :: change, size_, t_solve, t_contact
-      integer :: s, m, it, iterations
+      integer :: s, m, it, iterations, stat
 
       s = spec%slave_index
       m = spec%master_index
-      allocate (pstar(surface%dim, surface%npoint), source=0.0_wp)
+      allocate (pstar(surface%dim, surface%npoint), source=0.0_wp, stat=stat)
+      call check_allocation(stat, 'contact pair', 'the recovered traction of each slave point', surface%npoint, &
+         & 8*surface%dim, error)
+      if (allocated(error)) return
       call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, friction_kind(spec%friction), &
          & spec%kappa, names, sol, error, recovered=pstar, factor=factor)
       if (allocated(error)) return
@@ -541,7 +544,7 @@ contains
       type(recovery_input_type) :: input
       type(recovered_field_type) :: field
       real(wp) :: sigma(6), tn(3, 6)
-      integer :: i, d
+      integer :: i, d, stat
 
       d = surface%dim
       call fe_recovery_input(bl%problem, input, error)
@@ -550,7 +553,9 @@ contains
       call recover_grid(input, bl%problem%mesh%grid, bl%problem%mesh%nodes, bl%problem%mesh%hanging, method_sprc, &
          & study%degree(2), field, error)
       if (allocated(error)) return
-      allocate (pstar(d, surface%npoint), source=0.0_wp)
+      allocate (pstar(d, surface%npoint), source=0.0_wp, stat=stat)
+      call check_allocation(stat, 'contact pair', 'the recovered traction of each slave point', surface%npoint, 8*d, error)
+      if (allocated(error)) return
       do i = 1, surface%npoint
          if (surface%slave_cell(i) < 1 .or. .not. surface%has_master(i)) cycle
          call field_eval(field, surface%slave_cell(i), surface%x(:, i), sigma, error)
@@ -640,13 +645,15 @@ contains
       type(point_cells_type) :: cells
       real(wp), allocatable :: sx(:, :)
       integer, allocatable :: near(:), sel(:)
-      integer :: shape, nb, e, k, i, j, inear, d, ns, o, oshape, nnear
+      integer :: shape, nb, e, k, i, j, inear, d, ns, o, oshape, nnear, stat
 
       d = study%dim
       ns = merge(3, 6, d == 2)
       nb = size(input%bw)
       shape = study%scene%shapes(merge(spec%slave_surface_index, spec%master_surface_index, side == 1))%body_shape
-      allocate (law(nb), slip(d, nb))
+      allocate (law(nb), slip(d, nb), stat=stat)
+      call check_allocation(stat, 'pair_contact', 'the contact law of each boundary point', nb, 4 + 8*d, error)
+      if (allocated(error)) return
       law = 0
       slip = 0.0_wp
       ! This side's points of the slave points (on the master side those with a master point), in cells.
