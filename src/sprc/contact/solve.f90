@@ -303,7 +303,10 @@ contains
          closed(c) = any(surface%g0(ops%cell_point(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1)) <= &
             & cell_size(slave, slave%root(surface%slave_cell(ops%cell_point(ops%cell_ptr(c))))))
       end do
-      if (present(recovered)) call cell_tractions(surface, ops, cells, recovered, pstar)
+      if (present(recovered)) then
+         call cell_tractions(surface, ops, cells, recovered, pstar, error)
+         if (allocated(error)) return
+      end if
       kept = present(factor) .and. present(recovered)
       if (kept) then
          if (allocated(factor%closed)) then
@@ -1251,15 +1254,19 @@ contains
    !> pstar(1:rows, c): the mean over contact cell c's points of the given
    !> stabilization traction, its normal component n_i.p*_i (frictionless)
    !> or the vector (stick), as the FE traction's mean tbar.
-   pure subroutine cell_tractions(surface, ops, cells, recovered, pstar)
+   pure subroutine cell_tractions(surface, ops, cells, recovered, pstar, error)
       type(contact_surface_type), intent(in) :: surface
       type(point_operators_type), intent(in) :: ops
       type(cell_operators_type), intent(in) :: cells(:)
       real(wp), intent(in) :: recovered(:, :)
       real(wp), allocatable, intent(out) :: pstar(:, :)
-      integer :: c, j, i
+      type(error_type), allocatable, intent(out) :: error
+      integer :: c, j, i, stat
 
-      allocate (pstar(surface%dim, size(cells)), source=0.0_wp)
+      allocate (pstar(surface%dim, size(cells)), source=0.0_wp, stat=stat)
+      call check_allocation(stat, 'contact solve', 'the recovered traction of each contact cell', size(cells), &
+         & 8*surface%dim, error)
+      if (allocated(error)) return
       do c = 1, size(cells)
          do j = ops%cell_ptr(c), ops%cell_ptr(c + 1) - 1
             i = ops%cell_point(j)
