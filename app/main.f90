@@ -114,6 +114,7 @@ contains
       character(len=16) :: buf
       real(wp) :: cells, dofs, bytes, total_dofs
       logical :: quiet
+      type(body_type), allocatable :: geometry(:)
 
       call study_levels(scene, cli%levels, levels, error)
       if (allocated(error)) call fail(2, error%message)
@@ -126,7 +127,11 @@ contains
       if (cli%threads > 0) call omp_set_num_threads(cli%threads)
       call prepare_study(scene, cli%points, study, error)
       if (allocated(error)) call fail_with(error)
-      if (rank == 0) call print_warnings(scene_warnings(scene, study%bodies%geometry))
+      ! A named copy: passing the strided component study%bodies%geometry made a hidden array temporary.
+      if (rank == 0) then
+         geometry = study%bodies%geometry
+         call print_warnings(scene_warnings(scene, geometry))
+      end if
       prefix = scene%output
       if (len(cli%output) > 0) prefix = cli%output
       if (rank > 0) prefix = ''
