@@ -92,12 +92,12 @@ contains
       type(c_ptr), value :: body_force, facet_nodes, facet_kind, facet_traction, gauss_xi
       type(c_ptr) :: rech
       character(len=*), parameter :: entry = 'sprc_recover'
-      real(c_double), pointer :: gxi(:, :, :)
+      real(c_double), pointer, contiguous :: gxi(:, :, :)
       type(capi_error_type), pointer :: err
       type(capi_recovery_type), pointer :: rec
       type(mesh_sizes_type) :: sz
       type(error_type), allocatable :: error
-      real(c_double), pointer :: x(:, :), gp(:, :, :), gw(:, :), gs(:, :, :), bf_ptr(:), ft_ptr(:, :)
+      real(c_double), pointer, contiguous :: x(:, :), gp(:, :, :), gw(:, :), gs(:, :, :), bf_ptr(:), ft_ptr(:, :)
       real(wp), allocatable :: bf(:), ft(:, :)
       integer(c_int), pointer :: conn_c(:, :), fn_c(:, :), fk_c(:)
       integer, allocatable :: conn(:, :), fn(:, :), fk(:)
