@@ -18,6 +18,7 @@ module sprc_test_contact_fe
    use sprc_core_material, only: plane_stress, plane_strain, compliance_matrix
    use sprc_exact_compound, only: compound_type, new_compound_cylinder, new_compound_sphere
    use sprc_grid_quadrature, only: default_points
+   use sprc_study_spec, only: default_kappa
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, replaced
    implicit none
    private
@@ -47,6 +48,7 @@ contains
          new_unittest('shrink_fit_q1_plane_stress_ratio_1000', test_shrink_q1_stress), &
          new_unittest('shrink_fit_q2_plane_strain', test_shrink_q2_strain), &
          new_unittest('hertz_2d', test_hertz_2d), &
+         new_unittest('kappa_decades', test_kappa_decades), &
          new_unittest('incline_stick_exact_frictionless_not', test_incline), &
          new_unittest('bodies_in_contact_share_units', test_units), &
          new_unittest('coulomb_proportional_steps', test_coulomb_steps), &
@@ -410,39 +412,17 @@ contains
       type(error_type), allocatable, intent(out) :: error
       real(wp), intent(in), optional :: kappa
       character(len=*), intent(in), optional :: stabilization
-      real(wp), parameter :: delta = 1.0e-5_wp, p_in = 1.0e-3_wp
       type(compound_type) :: exact
       type(level_type) :: result
       type(study_type) :: study
       character(len=:), allocatable :: text
       character(len=32) :: buf
       real(wp) :: err(size(levels)), perr(size(levels)), rate
-      integer :: i, kind, n
+      integer :: i, n
 
-      kind = merge(plane_stress, plane_strain, analysis == 'plane_stress')
-      call new_compound_cylinder(exact, [0.0_wp, 0.0_wp], 1.0_wp, 1.5_wp, 2.0_wp, p_in, delta, young_shaft, 0.3_wp, &
-         & 1.0_wp, 0.25_wp, kind, error)
+      call shrink_exact(analysis, young_shaft, exact, error)
       if (allocated(error)) return
-      write (buf, '(es23.16)') young_shaft
-      text = "&scene title='shrink fit' analysis='"//analysis//"' order="//achar(48 + order)// &
-         & " levels=3 box_min=0,0 box_size=2.5 recovery='none' output='' /"//nl// &
-         & "&body name='shaft' young="//trim(buf)//" poisson=0.3 /"//nl// &
-         & "&body name='hub' young=1.0 poisson=0.25 box_min=0.0,0.0 box_size=2.2 /"//nl// &
-         & "&shape body='shaft' op='add' kind='disk' name='shaft_out' center=0,0 radius=1.50001 /"//nl// &
-         & "&shape body='shaft' op='subtract' kind='disk' name='bore' center=0,0 radius=1 /"//nl// &
-         & "&shape body='shaft' op='intersect' kind='halfspace' name='shaft_sx' point=0,0 normal=-1,0 /"//nl// &
-         & "&shape body='shaft' op='intersect' kind='halfspace' name='shaft_sy' point=0,0 normal=0,-1 /"//nl// &
-         & "&shape body='hub' op='add' kind='disk' name='hub_out' center=0,0 radius=2 /"//nl// &
-         & "&shape body='hub' op='subtract' kind='disk' name='hub_in' center=0,0 radius=1.5 /"//nl// &
-         & "&shape body='hub' op='intersect' kind='halfspace' name='hub_sx' point=0,0 normal=-1,0 /"//nl// &
-         & "&shape body='hub' op='intersect' kind='halfspace' name='hub_sy' point=0,0 normal=0,-1 /"//nl// &
-         & "&bc on='bore' type='pressure' value=1.0e-3 /"//nl// &
-         & "&bc on='shaft_sx' type='symmetry' /"//nl//"&bc on='shaft_sy' type='symmetry' /"//nl// &
-         & "&bc on='hub_sx' type='symmetry' /"//nl//"&bc on='hub_sy' type='symmetry' /"//nl// &
-         & "&contact slave='shaft' master='hub' slave_surface='shaft_out' master_surface='hub_in'"
-      if (present(kappa)) text = text//" kappa="//real_text(kappa)
-      if (present(stabilization)) text = text//" stabilization='"//stabilization//"'"
-      text = text//" /"//nl
+      text = shrink_text(order, analysis, young_shaft, kappa, stabilization)
       do i = 1, size(levels)
          call run_text(text, levels(i), result, error, study)
          if (allocated(error)) return
@@ -471,6 +451,49 @@ contains
          & real_text(perr(n - 2))//', '//real_text(perr(n))//')')
    end subroutine shrink_case
 
+   !> The compound cylinder of `shrink_text`'s shrink fit.
+   subroutine shrink_exact(analysis, young_shaft, exact, error)
+      character(len=*), intent(in) :: analysis
+      real(wp), intent(in) :: young_shaft
+      type(compound_type), intent(out) :: exact
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), parameter :: delta = 1.0e-5_wp, p_in = 1.0e-3_wp
+      call new_compound_cylinder(exact, [0.0_wp, 0.0_wp], 1.0_wp, 1.5_wp, 2.0_wp, p_in, delta, young_shaft, 0.3_wp, &
+         & 1.0_wp, 0.25_wp, merge(plane_stress, plane_strain, analysis == 'plane_stress'), error)
+   end subroutine shrink_exact
+
+   !> The scene of `shrink_case` (quarter model, shaft slave, bore pressure
+   !> 1e-3, interference 1e-5), with `kappa` and `stabilization` when given.
+   function shrink_text(order, analysis, young_shaft, kappa, stabilization) result(text)
+      integer, intent(in) :: order
+      character(len=*), intent(in) :: analysis
+      real(wp), intent(in) :: young_shaft
+      real(wp), intent(in), optional :: kappa
+      character(len=*), intent(in), optional :: stabilization
+      character(len=:), allocatable :: text
+      character(len=32) :: buf
+      write (buf, '(es23.16)') young_shaft
+      text = "&scene title='shrink fit' analysis='"//analysis//"' order="//achar(48 + order)// &
+         & " levels=3 box_min=0,0 box_size=2.5 recovery='none' output='' /"//nl// &
+         & "&body name='shaft' young="//trim(buf)//" poisson=0.3 /"//nl// &
+         & "&body name='hub' young=1.0 poisson=0.25 box_min=0.0,0.0 box_size=2.2 /"//nl// &
+         & "&shape body='shaft' op='add' kind='disk' name='shaft_out' center=0,0 radius=1.50001 /"//nl// &
+         & "&shape body='shaft' op='subtract' kind='disk' name='bore' center=0,0 radius=1 /"//nl// &
+         & "&shape body='shaft' op='intersect' kind='halfspace' name='shaft_sx' point=0,0 normal=-1,0 /"//nl// &
+         & "&shape body='shaft' op='intersect' kind='halfspace' name='shaft_sy' point=0,0 normal=0,-1 /"//nl// &
+         & "&shape body='hub' op='add' kind='disk' name='hub_out' center=0,0 radius=2 /"//nl// &
+         & "&shape body='hub' op='subtract' kind='disk' name='hub_in' center=0,0 radius=1.5 /"//nl// &
+         & "&shape body='hub' op='intersect' kind='halfspace' name='hub_sx' point=0,0 normal=-1,0 /"//nl// &
+         & "&shape body='hub' op='intersect' kind='halfspace' name='hub_sy' point=0,0 normal=0,-1 /"//nl// &
+         & "&bc on='bore' type='pressure' value=1.0e-3 /"//nl// &
+         & "&bc on='shaft_sx' type='symmetry' /"//nl//"&bc on='shaft_sy' type='symmetry' /"//nl// &
+         & "&bc on='hub_sx' type='symmetry' /"//nl//"&bc on='hub_sy' type='symmetry' /"//nl// &
+         & "&contact slave='shaft' master='hub' slave_surface='shaft_out' master_surface='hub_in'"
+      if (present(kappa)) text = text//" kappa="//real_text(kappa)
+      if (present(stabilization)) text = text//" stabilization='"//stabilization//"'"
+      text = text//" /"//nl
+   end function shrink_text
+
    !> Hertz line contact (test/data/contact/hertz_2d.nml, a = 0.05, p0 =
    !> 2P/(pi a)): at h = a/25.6 on the contact the peak FE pressure is within
    !> 3 % of p0 and the contact half-width within one contact cell (two slave
@@ -495,6 +518,37 @@ contains
       if (allocated(error)) return
       call check(error, abs(width - a) <= 2*h, 'half-width '//real_text(width)//', a = 0.05, h = '//real_text(h))
    end subroutine test_hertz_2d
+
+   !> Issue 11's kappa sweep: err_fe and p_max_fe at a hundredth and a
+   !> hundred times `default_kappa` within 1 % (the issue's bound) of those
+   !> at the default, on the shrink fit with a Q2 shaft 1000 times stiffer
+   !> than the hub (plane stress, level 3), the case whose coercivity needs
+   !> the largest kappa. It fails with the former default 1000: at 10 err_fe
+   !> is 30 % higher.
+   subroutine test_kappa_decades(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), parameter :: factor(3) = [1.0_wp, 0.01_wp, 100.0_wp]
+      type(compound_type) :: exact
+      type(level_type) :: result
+      type(study_type) :: study
+      real(wp) :: err(3), pmax(3)
+      integer :: i
+
+      call shrink_exact('plane_stress', 1000.0_wp, exact, error)
+      if (allocated(error)) return
+      do i = 1, 3
+         call run_text(shrink_text(2, 'plane_stress', 1000.0_wp, factor(i)*default_kappa), 3, result, error, study)
+         if (allocated(error)) return
+         err(i) = energy_error_pair(study, result, exact)
+         pmax(i) = maxval(result%contacts(1)%p_fe)
+      end do
+      do i = 2, 3
+         call check(error, abs(err(i)/err(1) - 1.0_wp) < 0.01_wp .and. abs(pmax(i)/pmax(1) - 1.0_wp) < 0.01_wp, &
+            & 'kappa = '//real_text(factor(i)*default_kappa)//': err_fe '//real_text(err(i))//', p_max_fe '// &
+            & real_text(pmax(i))//' against '//real_text(err(1))//', '//real_text(pmax(1))//' at the default')
+         if (allocated(error)) return
+      end do
+   end subroutine test_kappa_decades
 
    !> Compound sphere (octant): the shrink fit's rings as spherical shells,
    !> Q1: err_fe over levels 2, 3, 4 at a rate of at least 0.95, the pressure

@@ -544,14 +544,14 @@ contains
          call check(error, c%friction == 'frictionless' .and. .not. c%has_kappa .and. c%steps == 1 .and. &
             & c%stabilization == 'fe', 'defaults: frictionless, kappa not given, steps 1, stabilization fe')
          if (allocated(error)) return
-         call check(error, c%kappa, 1000.0_wp, 0.0_wp, 'default kappa')
+         call check(error, c%kappa, 1.0e4_wp, 0.0_wp, 'default kappa')
          if (allocated(error)) return
       end associate
       call check(error, has_switch(scene_summary(s), 'contact', "on (slave 'punch' on master 'block', friction "// &
          & 'frictionless; coupled solve of both bodies, active-set iteration)'), &
          & 'summary names the pair and the friction law')
       if (allocated(error)) return
-      call check(error, index(scene_summary(s), 'kappa = 1000.0 (default), steps = 1, stabilization = fe') > 0, &
+      call check(error, index(scene_summary(s), 'kappa = 10000.0 (default), steps = 1, stabilization = fe') > 0, &
          & 'summary gives kappa, steps and stabilization with their defaults')
    end subroutine test_contact_defaults
 

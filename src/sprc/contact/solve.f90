@@ -49,10 +49,11 @@
 !> Dirichlet Nitsche terms, sprc_fem_problem: about (p+1)^2 times a geometric
 !> factor, cell aggregation keeping it independent of the cut; dmax = 1.35 E
 !> for nu = 0.3 in plane strain), with a margin for the variance term (at
-!> most C_I/kappa times the energy). A sweep (shrink fit, Hertz; figures in
-!> the commit that set the default) found err_fe and p_max flat from kappa =
-!> 100 to 1e6 and moving below it, where coercivity is lost; the default
-!> `default_kappa` = 1000 (sprc_study_spec) sits a decade inside that plateau.
+!> most C_I/kappa times the energy). Sweeps (shrink fit Q1 and Q2, Hertz;
+!> figures in the commits that set the default) found err_fe and p_max flat
+!> from kappa = 100 to 1e6 and moving below it, where coercivity is lost; the
+!> default `default_kappa` = 1e4 (sprc_study_spec) is the centre of that
+!> plateau in decades.
 !>
 !> Points. The slave surface's cut-cell quadrature points with their exact
 !> normals and initial gaps (sprc_contact_surface), cut at the master grid's

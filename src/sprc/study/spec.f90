@@ -15,20 +15,23 @@ module sprc_study_spec
    public :: default_kappa, default_stabilization, kappa_range, kappa_note
 
    !> Default of `&contact kappa`, the dimensionless factor of the contact
-   !> stabilization (effective stiffness kappa*E/h, seed eq. 5), chosen by a
-   !> sweep (sprc_contact_solve notes: results flat from 100 to 1e6); README
-   !> documents it.
-   real(wp), parameter :: default_kappa = 1000.0_wp
-   !> Safe range of `&contact kappa`, from a sweep 0.1 ... 1e12 (shrink fit
-   !> levels 5-7, Hertz roller levels 5-6; the stability study, README).
-   !> Inside, err_fe, err_p_fe and err_p_sprc move by at most 1.2 % from those
-   !> of the default at every level. Below, the stabilization no longer
-   !> dominates the slave's trace-inverse bound: the largest change of those
-   !> errors is 4.2 times themselves at 10 on the shrink fit (its recovered
-   !> pressure), 32 and 40 times at 1 and 0.1; 2.9 times at 1 on Hertz. Above, nothing
-   !> moved up to 1e8, but the block system's rcond falls in proportion to
-   !> kappa (1.7e-12 at 1e6 on the shrink fit's level 7): at 1e10 that
-   !> level's rigid-mode check and at 1e12 the Hertz factorization fail.
+   !> stabilization (effective stiffness kappa*E/h, seed eq. 5): the centre,
+   !> in decades, of the safe range `kappa_range`, so that every kappa from a
+   !> hundredth to a hundred times the default is safe (issue 11's four
+   !> decades; test kappa_decades). The previous default, 1000, had 10 in
+   !> them, where a stiff Q2 slave loses coercivity.
+   real(wp), parameter :: default_kappa = 1.0e4_wp
+   !> Safe range of `&contact kappa`, from sweeps 0.1 ... 1e12 (shrink fit
+   !> levels 5-7, Hertz roller levels 5-6; the stability study, README) and
+   !> 1 ... 1e8 at the finest levels (shrink fit Q1, and Q2 with a slave 1000
+   !> times stiffer; Hertz roller level 8; README "Contact"). Inside, err_fe
+   !> and p_max_fe do not move (0.02 %), err_p_fe moves by at most 1.6 %
+   !> except where it is itself near the round-off floor, which grows in
+   !> proportion to kappa. Below, the stabilization no longer dominates the
+   !> slave's trace-inverse bound (coercivity is lost: err_fe of the stiff Q2
+   !> slave grows by 30-160 % at 10). Above, the block system's rcond falls
+   !> in proportion to kappa until the rigid-mode check (1e10, shrink fit) or
+   !> the factorization (1e12, Hertz) fails.
    real(wp), parameter :: kappa_range(2) = [100.0_wp, 1.0e6_wp]
    !> Lower end of the safe range with `stabilization = 'recovered'`, whose
    !> cell blocks are a plain penalty (no trace-inverse bound to beat): on the
