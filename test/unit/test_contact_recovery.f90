@@ -26,6 +26,8 @@ module sprc_test_contact_recovery
    use sprc_contact_result, only: contact_open
    use sprc_grid_recovered_field, only: recovered_field_type
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type, replaced
+   use sprc_recovery_dense, only: qr_pivoted
+   use sprc_grid_contact, only: point_cells_type, new_point_cells, cells_box, cells_prism
    implicit none
    private
 
@@ -77,7 +79,9 @@ contains
          new_unittest('grid_exact_2d', test_grid_exact_2d), &
          new_unittest('grid_exact_3d', test_grid_exact_3d), &
          new_unittest('traction_jump_shrink_fit', test_traction_jump), &
-         new_unittest('aux_boundary_points', test_aux_boundary) &
+         new_unittest('aux_boundary_points', test_aux_boundary), &
+         new_unittest('qr_max_steps', test_qr_max_steps), &
+         new_unittest('cells_prism', test_cells_prism) &
          ]
    end subroutine collect_contact_recovery
 
@@ -1014,5 +1018,129 @@ contains
       end if
       if (allocated(err)) deallocate (err)
    end subroutine expect_invalid
+
+   !> qr_pivoted with max_steps = 3 on a full-rank 40 x 12 matrix (the contact rows' shape,
+   !> smaller): the first 3 rows of R (from the diagonal on, in the original column order:
+   !> later pivots swap whole columns), the first 3 pivots, reflectors and tau are those of
+   !> the full factorisation bit for bit (step k depends on the steps before it alone), and
+   !> tau = 0 after them. Exact equality is the claim, not a tolerance.
+   subroutine test_qr_max_steps(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: m = 40, n = 12, k = 3
+      real(wp) :: a(m, n), full(m, n), part(m, n), tauf(n), taup(n), vn(n, 2), rp(n), rf(n)
+      integer :: jf(n), jp(n), i, j
+
+      do j = 1, n
+         do i = 1, m
+            a(i, j) = sin(0.37_wp*i*j + 0.11_wp*i + 0.5_wp*j)
+         end do
+      end do
+      full = a
+      call qr_pivoted(m, n, full, jf, tauf, vn, 1.0e-12_wp)
+      part = a
+      call qr_pivoted(m, n, part, jp, taup, vn, 1.0e-12_wp, max_steps=k)
+      call check(error, all(jp(1:k) == jf(1:k)) .and. all(taup(1:k) == tauf(1:k)) .and. all(taup(k + 1:) == 0.0_wp), &
+         & 'the first pivots and tau equal, tau = 0 after max_steps')
+      if (allocated(error)) return
+      do i = 1, k
+         ! Later pivots swap whole columns: row i compares in the original column order.
+         rp(jp(i:n)) = part(i, i:n)
+         rf(jf(i:n)) = full(i, i:n)
+         call check(error, all(rp(jp(i:n)) == rf(jp(i:n))) .and. all(part(i + 1:m, i) == full(i + 1:m, i)), &
+            & 'row '//itoa(i)//' of R and reflector '//itoa(i)//' equal to the full factorisation''s')
+         if (allocated(error)) return
+      end do
+   end subroutine test_qr_max_steps
+
+   !> cells_prism (cell culling against Omega_aux) returns exactly the points of cells_box over
+   !> the prism's bounding box that aux_contains keeps, in the same order: 2D and 3D, scattered
+   !> points, prisms whose mean normal is oblique to the axes, with points placed on the prism's
+   !> faces too (the cells those cut are tested per point).
+   subroutine test_cells_prism(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: d, t
+
+      do d = 2, 3
+         do t = 1, 4
+            call one_case(d, t, error)
+            if (allocated(error)) return
+         end do
+      end do
+   contains
+      subroutine one_case(d, t, error)
+         integer, intent(in) :: d, t
+         type(error_type), allocatable, intent(out) :: error
+         integer, parameter :: npt = 4000, nc = 6
+         type(point_cells_type) :: cells
+         type(aux_domain_type) :: aux
+         real(wp) :: y(d, npt), x(d, nc), n(d, nc), w(nc), c(3), nn(3), blo(3), bhi(3), r
+         integer, allocatable :: box(:), got(:)
+         integer :: i, k, nbox, ngot, m
+
+         do i = 1, npt
+            y(:, i) = [(modulo(0.6180339887_wp*i*(k + 1) + 0.1_wp*k*t, 1.0_wp), k=1, d)]
+         end do
+         nn = 0.0_wp
+         nn(1:d) = [(cos(0.7_wp*t + 1.3_wp*k), k=1, d)]
+         nn = nn/norm2(nn)
+         c = 0.5_wp
+         do i = 1, nc
+            r = 0.1_wp*(i - 3.5_wp)
+            x(:, i) = c(1:d) + r*[(merge(nn(2), -nn(1), k == 1)*merge(1.0_wp, 0.0_wp, k <= 2), k=1, d)] &
+               & + 0.02_wp*i*[(merge(1.0_wp, 0.0_wp, k == d), k=1, d)]
+            n(:, i) = nn(1:d)
+            w(i) = 1.0_wp + 0.1_wp*i
+         end do
+         call new_aux_domain(aux, d, x, n, w, 0.15_wp*t, 0.05_wp*t, error)
+         if (allocated(error)) return
+         ! Points on the prism's faces: on the plane at its far end.
+         do i = 1, 200
+            y(:, i) = aux%centre(1:d) + aux%hi*aux%frame(1:d, 1) + &
+               & (aux%tmin(1) + (aux%tmax(1) - aux%tmin(1))*(i - 1)/199.0_wp)*aux%frame(1:d, 2)
+         end do
+         call new_point_cells(cells, y, error)
+         if (allocated(error)) return
+         call bounds(aux, d, blo, bhi)
+         call cells_box(cells, y, blo, bhi, box, nbox)
+         m = 0
+         do i = 1, nbox
+            if (.not. aux_contains(aux, y(:, box(i)))) cycle
+            m = m + 1
+            box(m) = box(i)
+         end do
+         call cells_prism(cells, y, aux, got, ngot)
+         call check(error, ngot == m .and. m > 0, 'dim '//itoa(d)//' case '//itoa(t)//': '//itoa(ngot)// &
+            & ' points, expected '//itoa(m))
+         if (allocated(error)) return
+         call check(error, all(got(1:ngot) == box(1:m)), 'dim '//itoa(d)//' case '//itoa(t)//': the same points in order')
+      end subroutine one_case
+
+      !> The prism's bounding box from its corners (as the grid recovery's), padded generously:
+      !> cells_box then holds every point of the prism.
+      pure subroutine bounds(aux, d, blo, bhi)
+         type(aux_domain_type), intent(in) :: aux
+         integer, intent(in) :: d
+         real(wp), intent(out) :: blo(3), bhi(3)
+         real(wp) :: p(3), a(3), b(3)
+         integer :: q, k
+
+         a = 0.0_wp
+         b = 0.0_wp
+         a(1) = aux%lo
+         b(1) = aux%hi
+         a(2:d) = aux%tmin(1:d - 1)
+         b(2:d) = aux%tmax(1:d - 1)
+         blo = huge(1.0_wp)
+         bhi = -huge(1.0_wp)
+         do q = 0, 2**d - 1
+            p = aux%centre
+            do k = 1, d
+               p(1:d) = p(1:d) + merge(b(k), a(k), btest(q, k - 1))*aux%frame(1:d, k)
+            end do
+            blo(1:d) = min(blo(1:d), p(1:d) - 1.0e-9_wp)
+            bhi(1:d) = max(bhi(1:d), p(1:d) + 1.0e-9_wp)
+         end do
+      end subroutine bounds
+   end subroutine test_cells_prism
 
 end module sprc_test_contact_recovery

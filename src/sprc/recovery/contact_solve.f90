@@ -193,8 +193,8 @@ contains
          e(m + 1:m + d, n1 + 1:n1 + n2) = z(1:d, 1:n2)
          m = m + d
       end do
-      call qr_pivoted(mz, n1 + n2, e, jpvt, tau, vn, recovery_bite_ratio)
       cap = flat_traction_rank(d, merge(degree - 1, degree, curved))
+      call qr_pivoted(mz, n1 + n2, e, jpvt, tau, vn, recovery_bite_ratio, max_steps=cap)
       r = 0
       do k = 1, min(mz, n1 + n2, cap)
          if (abs(e(k, k)) > traction_rank_tol*abs(e(1, 1))) r = k

@@ -35,7 +35,11 @@ contains
    !> most its column's norm: a rank decision |R_kk| > tol |R_11| with tol >= stop_ratio
    !> comes out as for the full factorisation. (Equilibrium rows of SPR-C have rank 2 of 9
    !> in 2D p = 1, 3 of 24 in 3D: the rest of the factorisation was round-off.)
-   pure subroutine qr_pivoted(m, n, a, jpvt, tau, vn, stop_ratio)
+   !> With max_steps: only the first max_steps steps (tau = 0 from there). Step k depends on
+   !> the steps before it alone, so rows 1..max_steps of R, their pivots and reflectors are
+   !> those of the full factorisation, bit for bit: a caller that keeps at most max_steps
+   !> rows need not reduce the rest (the contact rows keep at most 9 of a 48-column block).
+   pure subroutine qr_pivoted(m, n, a, jpvt, tau, vn, stop_ratio, max_steps)
       integer, intent(in) :: m, n
       real(wp), intent(inout), contiguous :: a(:, :)
       integer, intent(out) :: jpvt(:)
@@ -44,16 +48,20 @@ contains
       !> array here would be a malloc per call in gfortran).
       real(wp), intent(out) :: vn(:, :)
       real(wp), intent(in), optional :: stop_ratio
+      integer, intent(in), optional :: max_steps
       real(wp), parameter :: tol3z = sqrt(epsilon(1.0_wp))
       real(wp) :: t, t2
-      integer :: i, j, k, p, it
+      integer :: i, j, k, p, it, steps
 
       do j = 1, n
          jpvt(j) = j
          vn(j, 1) = vnorm(a(1:m, j))
          vn(j, 2) = vn(j, 1)
       end do
-      do k = 1, min(m, n)
+      steps = min(m, n)
+      if (present(max_steps)) steps = max(0, min(steps, max_steps))
+      tau(steps + 1:min(m, n)) = 0.0_wp
+      do k = 1, steps
          p = k - 1 + maxloc(vn(k:n, 1), dim=1)
          if (present(stop_ratio) .and. k > 1) then
             if (vn(p, 1) <= stop_ratio*abs(a(1, 1))) then
