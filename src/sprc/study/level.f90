@@ -608,7 +608,7 @@ contains
       end do
       if (.not. any(study%run)) return
       do b = 1, 2
-         call pair_contact(study, spec, surface, result, bodies(spec%slave_index), b, inputs(b), &
+         call pair_contact(study, spec, surface, result, b, inputs(b), &
             & bodies(k(b))%problem%mesh%nodes, inputs(3 - b), contacts(b), error)
          if (.not. allocated(error)) &
             & call recover_body(study, study%bodies(k(b)), bodies(k(b)), inputs(b), error, contacts(b))
@@ -624,15 +624,15 @@ contains
    !> slave point (side 2: nearest master point of a slave point) within the size of its
    !> element, else open; closed states give the law (frictionless; stick; Coulomb: stick
    !> or slip) and, for slip, the slip direction of the body relative to the other: opposed
-   !> to the slave's FE tangential traction on the slave side, along it on the master side.
+   !> to the contact's FE tangential traction on the slave (`result%t_fe`) on the slave side,
+   !> along it on the master side.
    !> The other body's volume points, FE stresses and boundary points (its contact surface
    !> left out) are `other`'s.
-   subroutine pair_contact(study, spec, surface, result, slave, side, input, nodes, other, contact, error)
+   subroutine pair_contact(study, spec, surface, result, side, input, nodes, other, contact, error)
       type(study_type), intent(in) :: study
       type(contact_spec_type), intent(in) :: spec
       type(contact_surface_type), intent(in) :: surface
       type(contact_result_type), intent(in) :: result
-      type(body_level_type), intent(in) :: slave
       integer, intent(in) :: side
       type(recovery_input_type), intent(in) :: input, other
       type(grid_nodes_type), intent(in) :: nodes
@@ -640,15 +640,14 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer, allocatable :: law(:)
       real(wp), allocatable :: slip(:, :)
-      real(wp) :: g(3, 6), sigma(6), t(3), size_e, dist, best
+      real(wp) :: t(3), size_e, dist, best
       type(patch_type) :: oboundary
       type(point_cells_type) :: cells
       real(wp), allocatable :: sx(:, :)
       integer, allocatable :: near(:), sel(:)
-      integer :: shape, nb, e, k, i, j, inear, d, ns, o, oshape, nnear, stat
+      integer :: shape, nb, e, k, i, j, inear, d, o, oshape, nnear, stat
 
       d = study%dim
-      ns = merge(3, 6, d == 2)
       nb = size(input%bw)
       shape = study%scene%shapes(merge(spec%slave_surface_index, spec%master_surface_index, side == 1))%body_shape
       allocate (law(nb), slip(d, nb), stat=stat)
@@ -693,12 +692,13 @@ contains
                law(k) = contact_law_stick
             end select
             if (law(k) /= contact_law_slip) cycle
-            call slave%problem%stress_in_element(surface%slave_cell(inear), surface%x(:, inear), sigma(1:ns))
-            call traction_operator(d, surface%normal(:, inear), g)
-            t(1:d) = matmul(g(1:d, 1:ns), sigma(1:ns))
-            t(1:d) = t(1:d) - dot_product(t(1:d), surface%normal(:, inear))*surface%normal(:, inear)
+            ! The direction of the contact's own tangential traction at the slave point (the
+            ! multiplier, of magnitude mu p_fe on a slipping point), not that of the slave's FE
+            ! stress there: near the edge of the contact zone the stress of a cut cell gave a
+            ! tangential traction of the wrong sign (Cattaneo-Mindlin level 3, x > 0.043).
+            t(1:d) = result%t_fe(:, inear)
             ! No tangential traction to give a direction: then mu p ~ 0, and stick is safe.
-            if (norm2(t(1:d)) <= sqrt(epsilon(1.0_wp))*norm2(sigma(1:ns))) then
+            if (.not. (norm2(t(1:d)) > sqrt(epsilon(1.0_wp))*abs(result%p_fe(inear)))) then
                law(k) = contact_law_stick
             else
                slip(:, k) = merge(-1.0_wp, 1.0_wp, side == 1)*t(1:d)
