@@ -355,20 +355,19 @@ contains
       type(aux_domain_type) :: aux
       integer, allocatable :: idx(:)
       real(wp), allocatable :: cx(:, :), cn(:, :), cw(:)
-      real(wp) :: dep, blo(3), bhi(3)
+      real(wp) :: dep
       integer :: n, k
 
       call workspace_init(ws2)
       call contact_points(patch, cx, cn, cw)
-      ! Each k passes the points in the bounding box of Omega_aux after k doublings (which holds
-      ! the smaller ones), so that a patch scans no more of the other body than it can use.
+      ! Each k passes the points in Omega_aux after k doublings (which holds the smaller ones),
+      ! so that a patch copies no more of the other body than it can use.
       do k = 0, aux_max_doublings
          dep = self%depth*patch%h*2.0_wp**k
          call new_aux_domain(aux, patch%dim, cx, cn, cw, dep, aux_margin(dep, self%depth*patch%h), error)
          if (allocated(error)) return
          call cells_prism(self%cells, self%y, aux, idx, n)
-         call aux_bounds(aux, blo, bhi)
-         call box_boundary(self, blo, bhi, bbox)
+         call prism_boundary(self, aux, bbox)
          call recover_contact_patch(patch, degree, law, self%mu, slip, self%y(:, idx(1:n)), self%w(idx(1:n)), &
             & self%stress(:, idx(1:n)), self%young, self%poisson, self%depth*patch%h, ws, ws2, patch2, rec, rec2, &
             & error, body_force2=self%body_force, max_doublings=k, boundary2=bbox)
@@ -377,10 +376,10 @@ contains
       end do
    end subroutine contact_patch_solve
 
-   !> The other body's boundary points in the box blo..bhi (boundary arrays of `points`).
-   pure subroutine box_boundary(self, blo, bhi, points)
+   !> The other body's boundary points in Omega_aux (boundary arrays of `points`).
+   pure subroutine prism_boundary(self, aux, points)
       type(grid_contact_type), intent(in) :: self
-      real(wp), intent(in) :: blo(:), bhi(:)
+      type(aux_domain_type), intent(in) :: aux
       type(patch_type), intent(inout) :: points
       integer, allocatable :: idx(:)
       integer :: n, d
@@ -388,7 +387,7 @@ contains
       points%nbpoints = 0
       if (self%boundary%nbpoints == 0) return
       d = self%boundary_cells%dim
-      call cells_box(self%boundary_cells, self%boundary%bx(1:d, 1:self%boundary%nbpoints), blo, bhi, idx, n)
+      call cells_prism(self%boundary_cells, self%boundary%bx(1:d, 1:self%boundary%nbpoints), aux, idx, n)
       call patch_reserve(points, 0, n)
       points%nbpoints = n
       points%bx(:, 1:n) = self%boundary%bx(:, idx(1:n))
@@ -397,7 +396,7 @@ contains
       points%bkind(1:n) = self%boundary%bkind(idx(1:n))
       points%bpiece(1:n) = self%boundary%bpiece(idx(1:n))
       points%btraction(:, 1:n) = self%boundary%btraction(:, idx(1:n))
-   end subroutine box_boundary
+   end subroutine prism_boundary
 
    !> The axis-aligned bounding box blo..bhi of the prism Omega_aux (its 2^dim corners), widened
    !> by a few ulps of its extent so that points on its faces stay inside.

@@ -445,29 +445,30 @@ contains
       type(aux_domain_type), intent(in) :: aux
       real(wp), intent(in) :: y2(:, :), w2(:), stress2(:, :), young2, poisson2
       type(patch_type), intent(inout) :: patch2
-      integer :: j, n, d, ns
+      integer, allocatable :: inside(:)
+      integer :: j, k, n, d, ns
       real(wp) :: h
 
       d = patch1%dim
       ns = merge(3, 6, d == 2)
+      allocate (inside(size(w2)))
       h = 0.0_wp
       n = 0
       do j = 1, size(w2)
          if (.not. aux_contains(aux, y2(:, j))) cycle
          n = n + 1
+         inside(n) = j
          h = max(h, norm2(y2(1:d, j) - aux%centre(1:d)))
       end do
       call patch_reset(patch2, d, patch1%analysis, young2, poisson2, aux%centre(1:d), max(h, tiny(1.0_wp)))
       call patch_reserve(patch2, n, 0)
-      n = 0
-      do j = 1, size(w2)
-         if (.not. aux_contains(aux, y2(:, j))) cycle
-         n = n + 1
-         patch2%x(:, n) = 0.0_wp
-         patch2%x(1:d, n) = y2(1:d, j)
-         patch2%w(n) = w2(j)
-         patch2%stress(:, n) = 0.0_wp
-         patch2%stress(1:ns, n) = stress2(1:ns, j)
+      do k = 1, n
+         j = inside(k)
+         patch2%x(:, k) = 0.0_wp
+         patch2%x(1:d, k) = y2(1:d, j)
+         patch2%w(k) = w2(j)
+         patch2%stress(:, k) = 0.0_wp
+         patch2%stress(1:ns, k) = stress2(1:ns, j)
       end do
       patch2%npoints = n
    end subroutine fill_aux_patch
