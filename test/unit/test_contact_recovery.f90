@@ -27,7 +27,7 @@ module sprc_test_contact_recovery
    use sprc_grid_recovered_field, only: recovered_field_type
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type, replaced
    use sprc_recovery_dense, only: qr_pivoted
-   use sprc_grid_contact, only: point_cells_type, new_point_cells, cells_box, cells_prism
+   use sprc_grid_contact, only: point_cells_type, new_point_cells, cells_box, cells_prism, aux_bounds
    implicit none
    private
 
@@ -1101,7 +1101,7 @@ contains
          end do
          call new_point_cells(cells, y, error)
          if (allocated(error)) return
-         call bounds(aux, d, blo, bhi)
+         call aux_bounds(aux, blo, bhi)
          call cells_box(cells, y, blo, bhi, box, nbox)
          m = 0
          do i = 1, nbox
@@ -1115,33 +1115,6 @@ contains
          if (allocated(error)) return
          call check(error, all(got(1:ngot) == box(1:m)), 'dim '//itoa(d)//' case '//itoa(t)//': the same points in order')
       end subroutine one_case
-
-      !> The prism's bounding box from its corners (as the grid recovery's), padded generously:
-      !> cells_box then holds every point of the prism.
-      pure subroutine bounds(aux, d, blo, bhi)
-         type(aux_domain_type), intent(in) :: aux
-         integer, intent(in) :: d
-         real(wp), intent(out) :: blo(3), bhi(3)
-         real(wp) :: p(3), a(3), b(3)
-         integer :: q, k
-
-         a = 0.0_wp
-         b = 0.0_wp
-         a(1) = aux%lo
-         b(1) = aux%hi
-         a(2:d) = aux%tmin(1:d - 1)
-         b(2:d) = aux%tmax(1:d - 1)
-         blo = huge(1.0_wp)
-         bhi = -huge(1.0_wp)
-         do q = 0, 2**d - 1
-            p = aux%centre
-            do k = 1, d
-               p(1:d) = p(1:d) + merge(b(k), a(k), btest(q, k - 1))*aux%frame(1:d, k)
-            end do
-            blo(1:d) = min(blo(1:d), p(1:d) - 1.0e-9_wp)
-            bhi(1:d) = max(bhi(1:d), p(1:d) + 1.0e-9_wp)
-         end do
-      end subroutine bounds
    end subroutine test_cells_prism
 
    !> Cattaneo-Mindlin (test/data/contact/cattaneo_2d.nml, level 3, a/h = 12.8; the closed

@@ -39,7 +39,7 @@ module sprc_grid_contact
    private
 
    public :: grid_contact_type, new_grid_contact, contact_patch_solve, default_aux_depth
-   public :: point_cells_type, new_point_cells, cells_box, cells_prism
+   public :: point_cells_type, new_point_cells, cells_box, cells_prism, aux_bounds
 
    !> Omega_aux depth in patch sizes (module notes).
    real(wp), parameter :: default_aux_depth = 3.0_wp
@@ -205,26 +205,81 @@ contains
       real(wp), intent(in) :: y(:, :), blo(:), bhi(:)
       integer, allocatable, intent(out) :: idx(:)
       integer, intent(out) :: n
-      integer :: lo(3), hi(3), i1, i2, i3, k, d, c
+      real(wp) :: lo(3), hi(3)
+
+      lo = 0.0_wp
+      hi = 0.0_wp
+      lo(1:cells%dim) = blo(1:cells%dim)
+      hi(1:cells%dim) = bhi(1:cells%dim)
+      call cells_select(cells, y, lo, hi, idx, n)
+   end subroutine cells_box
+
+   !> The points y(:, j) inside Omega_aux: idx(1:n), the points of `cells_box` over the
+   !> prism's bounding box (`aux_bounds`) for which aux_contains holds, in the same order.
+   !> A cell whose box lies inside the prism (the prism is convex: the box's projections on
+   !> the prism's axes within its bounds, by a margin far above the round-off of
+   !> aux_contains) is taken without a test per point, and one outside it is skipped; only
+   !> the points of cells that straddle a face are tested. (The prism of an oblique normal
+   !> fills a fraction of its bounding box: 3D compound sphere level 4, 2975 points in the
+   !> box and 784 in the prism per patch on average, and the test per point was most of the
+   !> contact patches' time.)
+   pure subroutine cells_prism(cells, y, aux, idx, n)
+      type(point_cells_type), intent(in) :: cells
+      real(wp), intent(in) :: y(:, :)
+      type(aux_domain_type), intent(in) :: aux
+      integer, allocatable, intent(out) :: idx(:)
+      integer, intent(out) :: n
+      real(wp) :: blo(3), bhi(3)
+
+      call aux_bounds(aux, blo, bhi)
+      call cells_select(cells, y, blo, bhi, idx, n, aux)
+   end subroutine cells_prism
+
+   !> The points in the box blo..bhi (and, with aux, in Omega_aux: `cells_prism`), in cell order.
+   pure subroutine cells_select(cells, y, blo, bhi, idx, n, aux)
+      type(point_cells_type), intent(in) :: cells
+      real(wp), intent(in) :: y(:, :), blo(3), bhi(3)
+      integer, allocatable, intent(out) :: idx(:)
+      integer, intent(out) :: n
+      type(aux_domain_type), intent(in), optional :: aux
+      real(wp) :: clo(3), chi(3), pad(3)
+      integer :: lo(3), hi(3), ic(3), i1, i2, i3, k, d, c, state
 
       d = cells%dim
       call box_cells(cells, blo, bhi, lo, hi, n)
       allocate (idx(n))
       n = 0
       if (.not. allocated(cells%ptr)) return
+      ! A point sorted into a cell lies in the cell's box up to the round-off of cell_of.
+      pad(1:d) = 1.0e-12_wp*cells%width(1:d) + &
+         & 8*epsilon(1.0_wp)*(abs(cells%ymin(1:d)) + cells%ncell(1:d)*cells%width(1:d))
+      state = 0
       do i3 = lo(3), hi(3)
          do i2 = lo(2), hi(2)
             do i1 = lo(1), hi(1)
-               c = cell_index(cells, [i1, i2, i3])
+               ic = [i1, i2, i3]
+               c = cell_index(cells, ic)
+               if (cells%ptr(c + 1) == cells%ptr(c)) cycle
+               if (present(aux)) then
+                  clo(1:d) = cells%ymin(1:d) + (ic(1:d) - 1)*cells%width(1:d) - pad(1:d)
+                  chi(1:d) = cells%ymin(1:d) + ic(1:d)*cells%width(1:d) + pad(1:d)
+                  state = box_in_prism(aux, clo, chi)
+                  if (state < 0) cycle
+               end if
                do k = cells%ptr(c), cells%ptr(c + 1) - 1
-                  if (outside_box(y(1:d, cells%perm(k)), blo(1:d), bhi(1:d))) cycle
+                  if (state == 0) then
+                     if (any(y(1:d, cells%perm(k)) < blo(1:d)) .or. any(y(1:d, cells%perm(k)) > bhi(1:d))) cycle
+                     if (present(aux)) then
+                        if (.not. aux_contains(aux, y(:, cells%perm(k)))) cycle
+                     end if
+                  end if
                   n = n + 1
                   idx(n) = cells%perm(k)
                end do
             end do
          end do
       end do
-   end subroutine cells_box
+   end subroutine cells_select
 
    !> The range lo..hi of cell coordinates over the box blo..bhi and the number of points in
    !> those cells (0 without cells).
@@ -248,62 +303,6 @@ contains
          end do
       end do
    end subroutine box_cells
-
-   !> True if y lies outside the box blo..bhi.
-   pure logical function outside_box(y, blo, bhi)
-      real(wp), intent(in) :: y(:), blo(:), bhi(:)
-      outside_box = any(y < blo) .or. any(y > bhi)
-   end function outside_box
-
-   !> The points y(:, j) inside Omega_aux: idx(1:n), the points of `cells_box` over the
-   !> prism's bounding box (`aux_bounds`) for which aux_contains holds, in the same order.
-   !> A cell whose box lies inside the prism (the prism is convex: the box's projections on
-   !> the prism's axes within its bounds, by a margin far above the round-off of
-   !> aux_contains) is taken without a test per point, and one outside it is skipped; only
-   !> the points of cells that straddle a face are tested. (The prism of an oblique normal
-   !> fills a fraction of its bounding box: 3D compound sphere level 4, 2975 points in the
-   !> box and 784 in the prism per patch on average, and the test per point was most of the
-   !> contact patches' time.)
-   pure subroutine cells_prism(cells, y, aux, idx, n)
-      type(point_cells_type), intent(in) :: cells
-      real(wp), intent(in) :: y(:, :)
-      type(aux_domain_type), intent(in) :: aux
-      integer, allocatable, intent(out) :: idx(:)
-      integer, intent(out) :: n
-      real(wp) :: blo(3), bhi(3), clo(3), chi(3), pad(3)
-      integer :: lo(3), hi(3), ic(3), i1, i2, i3, k, d, c, state
-
-      d = cells%dim
-      call aux_bounds(aux, blo, bhi)
-      call box_cells(cells, blo, bhi, lo, hi, n)
-      allocate (idx(n))
-      n = 0
-      if (.not. allocated(cells%ptr)) return
-      ! A point sorted into a cell lies in the cell's box up to the round-off of cell_of.
-      pad(1:d) = 1.0e-12_wp*cells%width(1:d) + &
-         & 8*epsilon(1.0_wp)*(abs(cells%ymin(1:d)) + cells%ncell(1:d)*cells%width(1:d))
-      do i3 = lo(3), hi(3)
-         do i2 = lo(2), hi(2)
-            do i1 = lo(1), hi(1)
-               ic = [i1, i2, i3]
-               c = cell_index(cells, ic)
-               if (cells%ptr(c + 1) == cells%ptr(c)) cycle
-               clo(1:d) = cells%ymin(1:d) + (ic(1:d) - 1)*cells%width(1:d) - pad(1:d)
-               chi(1:d) = cells%ymin(1:d) + ic(1:d)*cells%width(1:d) + pad(1:d)
-               state = box_in_prism(aux, clo, chi)
-               if (state < 0) cycle
-               do k = cells%ptr(c), cells%ptr(c + 1) - 1
-                  if (state == 0) then
-                     if (outside_box(y(1:d, cells%perm(k)), blo(1:d), bhi(1:d))) cycle
-                     if (.not. aux_contains(aux, y(:, cells%perm(k)))) cycle
-                  end if
-                  n = n + 1
-                  idx(n) = cells%perm(k)
-               end do
-            end do
-         end do
-      end do
-   end subroutine cells_prism
 
    !> Where the box clo..chi lies relative to Omega_aux: 1 inside, -1 outside, 0 across a
    !> face (or too close to one to tell), from its projections on the prism's axes.
