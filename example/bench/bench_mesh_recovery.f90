@@ -11,13 +11,18 @@
 !> 1- and 2-thread runs alternate, and the speedup is the median of the paired ratios, so
 !> that a load that comes and goes on a shared machine hits both alike.
 !>
+!> Each run's nodal stresses, element errors and global error are reduced to a fingerprint of
+!> their bits (`fingerprint`, printed in hexadecimal): every run of one mesh and method, at any
+!> thread count, must give the same one (the library's determinism; 'bits' says whether they
+!> did), and a change meant to keep the bits keeps it.
+!>
 !> The caller's reference coordinates of the points are passed (gauss_xi), as an FE code has
 !> them; the word `newton` derives them instead (Newton's method per point, the 'points' phase).
 !>
 !> Run: fpm run --profile release --example bench_mesh_recovery [-- NREP [quad4|hex8|all [spr|sprc|all
 !> [newton]]]] (the optional words restrict the runs to one mesh and one method).
 program bench_mesh_recovery
-   use sprc_core_kinds, only: wp
+   use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type
    use sprc_core_material, only: plane_strain, solid
    use sprc_recovery_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_method_spr, mesh_method_sprc, &
@@ -77,6 +82,8 @@ contains
       real(wp), allocatable :: t(:, :, :)
       real(wp) :: med(8), c0, c1
       integer :: nt, k, i, ntmax
+      integer(i8) :: bits, bits1
+      logical :: same
 
       if (len_trim(only_mesh) > 0 .and. trim(only_mesh) /= 'all' .and. index(label, trim(only_mesh)) == 0) return
       if (len_trim(only_method) > 0 .and. trim(only_method) /= 'all' .and. trim(only_method) /= trim(merge('spr ', &
@@ -98,6 +105,12 @@ contains
                & res%t_estimate, 0.0_wp]
             t(7, k, nt) = sum(t(1:6, k, nt))
             t(8, k, nt) = 1.0e3_wp*(c1 - c0)
+            bits = fingerprint(res)
+            if (k == 1 .and. nt == 1) then
+               bits1 = bits
+               same = .true.
+            end if
+            same = same .and. bits == bits1
          end do
       end do
       !$ call omp_set_num_threads(nmax)
@@ -110,8 +123,28 @@ contains
       end do
       if (ntmax == 2) write (*, '(a,f6.2,a,f6.2)') '   speedup on 2 threads (median of the paired runs): total', &
          & median(t(7, :, 1)/t(7, :, 2)), ', patches', median(t(4, :, 1)/t(4, :, 2))
-      write (*, '(a,es10.3,a,es10.3)') '   global error ', res%err, ', eta ', res%eta
+      write (*, '(a,es10.3,a,es10.3,a,z16.16,a,a)') '   global error ', res%err, ', eta ', res%eta, &
+         & ', fingerprint ', bits1, ', bits ', trim(merge('identical in every run', 'DIFFER between runs   ', same))
    end subroutine run
+
+   !> The bits of the nodal stresses, element errors and global error, folded (xor-shift).
+   integer(i8) function fingerprint(res) result(h)
+      type(mesh_recovery_type), intent(in) :: res
+      h = fold(fold(fold(88172645463325252_i8, reshape(res%nodal, [size(res%nodal)])), res%elem_err), [res%err])
+   end function fingerprint
+
+   pure integer(i8) function fold(h0, v) result(h)
+      integer(i8), intent(in) :: h0
+      real(wp), intent(in) :: v(:)
+      integer :: i
+      h = h0
+      do i = 1, size(v)
+         h = ieor(h, transfer(v(i), h))
+         h = ieor(h, shiftl(h, 13))
+         h = ieor(h, shiftr(h, 7))
+         h = ieor(h, shiftl(h, 17))
+      end do
+   end function fold
 
    !> One recovery: facets for SPR-C only, the reference coordinates unless `newton`.
    subroutine recover(m, method, res, error)
