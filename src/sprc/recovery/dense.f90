@@ -227,7 +227,11 @@ contains
       logical, intent(in), optional :: transposed
       integer :: i, j
 
-      ok = all([(a(i, i) /= 0.0_wp, i=1, k)])
+      ! A loop, not all([(...)]): the constructor of run-time size was a heap temporary.
+      ok = .true.
+      do i = 1, k
+         if (a(i, i) == 0.0_wp) ok = .false.
+      end do
       if (.not. ok) return
       do j = 1, nrhs
          if (present(transposed)) then

@@ -271,7 +271,9 @@ contains
       type(recovered_patch_type), intent(out) :: rec
       type(error_type), allocatable, intent(out) :: error
 
-      associate (unused => [node, elements]); end associate
+      ! Unused here (an overriding producer's): scalars only, no array constructor (a
+      ! heap temporary per patch).
+      associate (unused => node + size(elements)); end associate
       associate (unused => self); end associate
       if (sprc) then
          call recover_sprc(patch, degree, ws, rec, error)

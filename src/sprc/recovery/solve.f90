@@ -302,7 +302,7 @@ contains
       integer, intent(in) :: mc
       character(len=*), intent(in) :: context
       type(error_type), allocatable, intent(out) :: error
-      integer :: np, nt, ns, c
+      integer :: np, nt, ns, c, i
       logical :: ok
 
       np = patch%npoints
@@ -332,7 +332,12 @@ contains
          return
       end if
       call coef_storage(rec, nt, ns)
-      rec%coef(ws%jpvt_p(1:nt), 1:ns) = ws%rhs(1:nt, 1:ns)
+      ! Loops, not vector-subscript assignments: those made array temporaries per patch.
+      do c = 1, ns
+         do i = 1, nt
+            rec%coef(ws%jpvt_p(i), c) = ws%rhs(i, c)
+         end do
+      end do
    end subroutine least_squares
 
    !> The constrained minimum (module notes): with z_c = R Pi^T A_c the objective is
@@ -344,7 +349,7 @@ contains
       type(recovery_workspace_type), intent(inout) :: ws
       integer, intent(in) :: mc
       logical, intent(out) :: ok
-      integer :: nt, ns, n, c, i, b
+      integer :: nt, ns, n, c, i, b, k
 
       nt = ws%nt
       ns = ws%ns
@@ -352,7 +357,9 @@ contains
       do i = 1, mc
          do c = 1, ns
             b = (c - 1)*nt
-            ws%cq(b + 1:b + nt, i) = ws%c(i, b + ws%jpvt_p(1:nt))
+            do k = 1, nt
+               ws%cq(b + k, i) = ws%c(i, b + ws%jpvt_p(k))
+            end do
          end do
       end do
       call workspace_tic(ws)
@@ -366,7 +373,9 @@ contains
          ws%z((c - 1)*nt + 1:c*nt, 1) = ws%rhs(1:nt, c)
       end do
       call apply_qt(n, mc, ws%cq, ws%tau, 1, ws%z)
-      ws%z(1:mc, 1) = ws%lam(ws%jpvt(1:mc))
+      do i = 1, mc
+         ws%z(i, 1) = ws%lam(ws%jpvt(i))
+      end do
       call solve_upper(mc, ws%cq, 1, ws%z, ok, transposed=.true.)
       if (ok) call apply_q(n, mc, ws%cq, ws%tau, 1, ws%z)
       call workspace_toc(ws, ns*flops_trtrs(nt, mc) + flops_geqrf(n, mc) + 2*flops_ormqr_left(n, 1, mc) + &
@@ -557,7 +566,9 @@ contains
          r = min(r, cap)
          do k = 1, r
             ws%c(mc + k, 1:n) = 0.0_wp
-            ws%c(mc + k, ws%jpvt(k:n)) = ws%estack(k, k:n)
+            do i = k, n
+               ws%c(mc + k, ws%jpvt(i)) = ws%estack(k, i)
+            end do
             ws%lam(mc + k) = ws%trhs(k, 1)
          end do
          mc = mc + r
@@ -748,7 +759,9 @@ contains
       rec%rows(kind) = rec%rows(kind) + m
       if (m == 0) return
       n = ws%n
-      ws%cq(1:n, 1:m) = transpose(ws%blk(1:m, 1:n))
+      do k = 1, m
+         ws%cq(1:n, k) = ws%blk(k, 1:n)
+      end do
       call pivoted_rank(ws, n, m, rec, r, error)
       if (allocated(error)) return
       call sort_int(ws%jpvt(1:r))
