@@ -11,7 +11,8 @@ module sprc_recovery_estimate
    implicit none
    private
 
-   public :: eval_recovered, eval_recovered_unchecked, eval_union, zz_error_integral, zz_error_norm, energy_norms
+   public :: eval_recovered, eval_recovered_unchecked, eval_recovered_points, eval_union, zz_error_integral, zz_error_norm, &
+      & energy_norms
    public :: scaled_norm, relative_error
 
 contains
@@ -35,26 +36,52 @@ contains
       type(recovered_patch_type), intent(in) :: rec
       real(wp), intent(in) :: x(:)
       real(wp), intent(out) :: sigma(:)
-      real(wp) :: p(poly_max_terms)
-      integer :: i, k, c
+      real(wp) :: xp(3, 1), s(6, 1)
 
-      if (rec%degree == 1) then
-         ! Terms 1, s_1, .., s_dim: the values term_values gives (products with ones).
-         p(1) = 1.0_wp
-         do k = 1, rec%dim
-            p(k + 1) = (x(k) - rec%x0(k))/rec%h
-         end do
-      else
-         call term_values(rec, x, p)
-      end if
-      ! Each component as one sum over the terms in term order (contiguous columns of coef).
-      do c = 1, rec%nstress
-         sigma(c) = 0.0_wp
-         do i = 1, rec%nterms
-            sigma(c) = sigma(c) + p(i)*rec%coef(i, c)
+      xp(1:rec%dim, 1) = x(1:rec%dim)
+      call eval_recovered_points(rec, xp(1:rec%dim, :), s)
+      sigma(1:rec%nstress) = s(1:rec%nstress, 1)
+   end subroutine eval_recovered_unchecked
+
+   !> `eval_recovered_unchecked` at the points x(1:dim, i) into sigma(1:nstress, i): one call
+   !> per element instead of per point.
+   pure subroutine eval_recovered_points(rec, x, sigma)
+      type(recovered_patch_type), intent(in) :: rec
+      real(wp), intent(in) :: x(:, :)
+      real(wp), intent(inout) :: sigma(:, :)
+
+      call eval_points(rec, rec%nterms, rec%nstress, rec%coef, x, sigma)
+   end subroutine eval_recovered_points
+
+   !> The kernel of `eval_recovered_points`, with the coefficients coef(nt, ns) of explicit
+   !> shape. Each component one sum over the terms in term order, from zero.
+   pure subroutine eval_points(rec, nt, ns, coef, x, sigma)
+      type(recovered_patch_type), intent(in) :: rec
+      integer, intent(in) :: nt, ns
+      real(wp), intent(in) :: coef(nt, ns), x(:, :)
+      real(wp), intent(inout) :: sigma(:, :)
+      real(wp) :: p(poly_max_terms), acc
+      integer :: i, k, c, t
+
+      do i = 1, size(x, 2)
+         if (rec%degree == 1) then
+            ! Terms 1, s_1, .., s_dim: the values term_values gives (products with ones).
+            p(1) = 1.0_wp
+            do k = 1, rec%dim
+               p(k + 1) = (x(k, i) - rec%x0(k))/rec%h
+            end do
+         else
+            call term_values(rec, x(:, i), p)
+         end if
+         do c = 1, ns
+            acc = 0.0_wp
+            do t = 1, nt
+               acc = acc + p(t)*coef(t, c)
+            end do
+            sigma(c, i) = acc
          end do
       end do
-   end subroutine eval_recovered_unchecked
+   end subroutine eval_points
 
    !> The terms p(1:nterms) of rec's basis at x: powers of each scaled coordinate once (s**e
    !> is a call per term), each term as s(1)**e(1) * s(2)**e(2) * s(3)**e(3) in that order.

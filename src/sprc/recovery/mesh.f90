@@ -62,7 +62,7 @@
 !> Parallelism and determinism: the patch loop is sprc_recovery_patch_loop's (shared with
 !> the grid); the bits do not depend on the thread count.
 module sprc_recovery_mesh
-   use sprc_core_kinds, only: wp
+   use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular, &
       & stat_not_converged, stat_out_of_memory
    use sprc_core_material, only: voigt_size, compliance_matrix
@@ -70,7 +70,7 @@ module sprc_recovery_mesh
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reset, patch_reserve, &
       & boundary_traction, boundary_symmetry
    use sprc_recovery_patch_loop, only: patch_source_type, patch_loop_type, run_patch_loop, patch_capacity, auto_degree
-   use sprc_recovery_estimate, only: eval_recovered_unchecked, energy_norms, scaled_norm, relative_error
+   use sprc_recovery_estimate, only: eval_recovered_points, energy_norms, scaled_norm, relative_error
    use sprc_recovery_mesh_element, only: elem_tri3, elem_quad4, elem_tet4, elem_hex8, elem_quad9, elem_hex27, &
       & element_dim, element_nodes, element_vertices, element_degree, element_facet_nodes, element_shape, &
       & element_vertex_shape, element_node_xi, element_inside, element_inverse_map, element_name, &
@@ -137,6 +137,17 @@ module sprc_recovery_mesh
       real(wp) :: body_force(3) = 0.0_wp
    end type topology_type
 
+   !> The integration rule of the caller's points when every element has the same reference
+   !> points, bit for bit (as an FE code's Gauss rule): their shape values, evaluated once
+   !> instead of at every point of every element (the same values, so the same bits).
+   type :: rule_type
+      !> True if every element's reference points are those of element 1.
+      logical :: shared = .false.
+      !> Shape values at the points: the element's map(1:nen, i); the method's field
+      !> n(:, i) (`method_shape`).
+      real(wp), allocatable :: map(:, :), n(:, :)
+   end type rule_type
+
    !> The caller's mesh as a source of patches (sprc_recovery_patch_loop): read-only views
    !> of the result's copy of the mesh, the topology and the caller's point arrays.
    type, extends(patch_source_type) :: mesh_source_type
@@ -189,6 +200,7 @@ contains
       !> checked (`given_coordinates`) instead of derived by Newton's method.
       real(wp), intent(in), optional :: gauss_xi(:, :, :)
       type(topology_type), target :: topo
+      type(rule_type) :: rule
       real(wp), allocatable :: xi(:, :, :)
       integer :: deg, rounds
       logical :: ci
@@ -224,7 +236,7 @@ contains
       t(2) = wall_time()
       ! The caller's reference coordinates are used in place (checked, not copied).
       if (present(gauss_xi)) then
-         call given_coordinates(result, gp, gauss_xi, error)
+         call given_coordinates(result, gp, gauss_xi, rule, error)
       else
          call point_coordinates(result, gp, xi, error)
       end if
@@ -237,9 +249,9 @@ contains
       if (allocated(error)) return
       t(5) = wall_time()
       if (present(gauss_xi)) then
-         call estimate(result, gp, gw, gs, gauss_xi, error)
+         call estimate(result, gp, gw, gs, gauss_xi, rule, error)
       else
-         call estimate(result, gp, gw, gs, xi, error)
+         call estimate(result, gp, gw, gs, xi, rule, error)
       end if
       t(6) = wall_time()
       result%t_check = t(1) - t(0)
@@ -423,13 +435,16 @@ contains
    !> |x(gxi) - gp|_inf <= inside_tol h_e + (nen + 2) eps (|gp| + sum_a |N_a| |x_a|), with h_e
    !> the largest extent of the element's box (inside_tol in reference units, which the map
    !> stretches by about h_e) plus the round-off of evaluating the map (as in Newton's stopping
-   !> test, sprc_recovery_mesh_element). OpenMP over elements; the first bad point (element
-   !> order) is named.
-   subroutine given_coordinates(r, gp, gxi, error)
+   !> test, sprc_recovery_mesh_element). `rule`: the shape values of element 1's points, and
+   !> whether every element has the same points (then its shape values serve every element).
+   !> OpenMP over elements; the first bad point (element order) is named.
+   subroutine given_coordinates(r, gp, gxi, rule, error)
       type(mesh_recovery_type), intent(in) :: r
       real(wp), intent(in) :: gp(:, :, :), gxi(:, :, :)
+      type(rule_type), intent(out) :: rule
       type(error_type), allocatable, intent(out) :: error
       integer, allocatable :: bad(:)
+      logical :: shared
       integer :: e, i, ngp, st
 
       ngp = size(gp, 2)
@@ -438,17 +453,23 @@ contains
             & shape_str(shape(gxi))//'; need '//shape_str([r%dim, ngp, r%nelem])//' as gp', stat_invalid_input)
          return
       end if
-      allocate (bad(r%nelem), stat=st)
+      allocate (bad(r%nelem), rule%map(max_element_nodes, ngp), rule%n(max_element_nodes, ngp), stat=st)
       if (st /= 0) then
          call fatal_error(error, 'recover_on_mesh: out of memory for the check of the reference coordinates', &
             & stat_out_of_memory)
          return
       end if
-      !$omp parallel do schedule(static)
+      do i = 1, ngp
+         call element_shape(r%element_type, gxi(:, i, 1), rule%map(:, i))
+         call method_shape(r, gxi(:, i, 1), rule%n(:, i))
+      end do
+      shared = .true.
+      !$omp parallel do schedule(static) reduction(.and.:shared)
       do e = 1, r%nelem
-         bad(e) = check_element(e)
+         bad(e) = check_element(e, shared)
       end do
       !$omp end parallel do
+      rule%shared = shared
       if (all(bad == 0)) return
       e = findloc(bad /= 0, .true., dim=1)
       i = bad(e)
@@ -457,27 +478,44 @@ contains
          & ' or does not map onto '//entry_name(r%c_indices, 'gp', 'gauss_points', [0, i, e])//' = '// &
          & vec_str(gp(:, i, e)), stat_invalid_input)
    contains
-      !> 0, or the first point of e whose coordinates fail.
-      integer function check_element(e) result(status)
+      !> 0, or the first point of e whose coordinates fail; shared = .false. if e's points
+      !> differ from element 1's.
+      integer function check_element(e, shared) result(status)
          integer, intent(in) :: e
+         logical, intent(inout) :: shared
          real(wp) :: xe(3, max_element_nodes), n(max_element_nodes), x(3), he, xmax, tol
-         integer :: a, j, d
+         integer :: a, j, d, nen
+         logical :: same
 
          d = r%dim
-         do a = 1, r%nen
+         nen = r%nen
+         xe(3, 1:nen) = 0.0_wp
+         do a = 1, nen
             xe(1:d, a) = r%x(:, r%connectivity(a, e))
          end do
          he = maxval(r%box_hi(:, e) - r%box_lo(:, e))
-         xmax = maxval(abs(xe(1:d, 1:r%nen)))
+         xmax = maxval(abs(xe(1:d, 1:nen)))
+         same = same_bits(gxi(:, :, e), gxi(:, :, 1))
+         shared = shared .and. same
          status = 0
          do j = 1, ngp
             status = j
             if (.not. all(abs(gxi(:, j, e)) <= huge(1.0_wp))) return
             if (.not. element_inside(r%element_type, gxi(:, j, e), inside_tol)) return
-            call element_shape(r%element_type, gxi(:, j, e), n)
-            x(1:d) = matmul(xe(1:d, 1:r%nen), n(1:r%nen))
-            tol = inside_tol*he + real(r%nen + 2, wp)*epsilon(1.0_wp)*(maxval(abs(gp(:, j, e))) + &
-               & sum(abs(n(1:r%nen)))*xmax)
+            if (same) then
+               n(1:nen) = rule%map(1:nen, j)
+            else
+               call element_shape(r%element_type, gxi(:, j, e), n)
+            end if
+            ! Three scalar sums (x(1:d) in memory stalled on store forwarding).
+            x = 0.0_wp
+            do a = 1, nen
+               x(1) = x(1) + xe(1, a)*n(a)
+               x(2) = x(2) + xe(2, a)*n(a)
+               x(3) = x(3) + xe(3, a)*n(a)
+            end do
+            tol = inside_tol*he + real(nen + 2, wp)*epsilon(1.0_wp)*(maxval(abs(gp(:, j, e))) + &
+               & sum(abs(n(1:nen)))*xmax)
             if (.not. (maxval(abs(x(1:d) - gp(:, j, e))) <= tol)) return
             status = 0
          end do
@@ -489,6 +527,20 @@ contains
          if (r%c_indices) s = '['//itoa(v(3))//']['//itoa(v(2))//']['//itoa(v(1))//']'
       end function shape_str
    end subroutine given_coordinates
+
+   !> True if a and b (same shape) hold the same bits (+0 and -0 differ: so do their shape
+   !> values' signs of zero).
+   pure logical function same_bits(a, b)
+      real(wp), intent(in) :: a(:, :), b(:, :)
+      integer :: i, j
+      same_bits = .false.
+      do j = 1, size(a, 2)
+         do i = 1, size(a, 1)
+            if (transfer(a(i, j), 1_i8) /= transfer(b(i, j), 1_i8)) return
+         end do
+      end do
+      same_bits = .true.
+   end function same_bits
 
    !> Quadrature points of the facets, gathered per owning element (CSR), normals outward.
    subroutine boundary_points(r, topo, error, facet_nodes, facet_kind, facet_traction_value)
@@ -654,26 +706,32 @@ contains
       class(mesh_source_type), intent(in) :: self
       integer, intent(in) :: node, elements(:)
       type(patch_type), intent(inout) :: patch
-      real(wp) :: h
-      integer :: d, i, e, k, a, np, nb, ngp, ns, q
+      real(wp) :: h, x0(3), dx(3)
+      integer :: d, i, e, k, a, m, np, nb, ngp, ns
 
       d = self%dim
       ns = self%nstress
       ngp = size(self%gp, 2)
       ! h = the largest distance: the largest square, one root (sqrt is monotonic and
-      ! correctly rounded: the same value as the largest root).
+      ! correctly rounded: the same value as the largest root). Squares summed in coordinate
+      ! order from zero, as sum() does, in scalars.
+      x0 = 0.0_wp
+      x0(1:d) = self%x(:, node)
       h = 0.0_wp
       nb = 0
       do i = 1, size(elements)
          e = elements(i)
          do a = 1, self%nen
-            h = max(h, sum((self%x(:, self%connectivity(a, e)) - self%x(:, node))**2))
+            m = self%connectivity(a, e)
+            dx = 0.0_wp
+            dx(1:d) = self%x(1:d, m) - x0(1:d)
+            h = max(h, ((0.0_wp + dx(1)**2) + dx(2)**2) + dx(3)**2)
          end do
          if (self%sprc) nb = nb + self%topo%bptr(e + 1) - self%topo%bptr(e)
       end do
       h = sqrt(h)
       np = ngp*size(elements)
-      call patch_reset(patch, d, self%analysis, self%young, self%poisson, self%x(:, node), h)
+      call patch_reset(patch, d, self%analysis, self%young, self%poisson, x0(1:d), h)
       call patch_reserve(patch, np, nb)
       patch%body_force(1:d) = self%topo%body_force(1:d)
       ! check_mesh_arrays validated the caller's points, weights and stresses.
@@ -681,12 +739,11 @@ contains
       np = 0
       do i = 1, size(elements)
          e = elements(i)
-         do q = 1, ngp
-            np = np + 1
-            patch%x(1:d, np) = self%gp(1:d, q, e)
-            patch%w(np) = self%gw(q, e)
-            patch%stress(1:ns, np) = self%gs(1:ns, q, e)
-         end do
+         ! Whole blocks of the element's points (fixed leading dimensions: no descriptors).
+         call copy_block(d, ngp, self%gp(:, :, e), 3, patch%x(:, np + 1:np + ngp))
+         patch%w(np + 1:np + ngp) = self%gw(:, e)
+         call copy_block(ns, ngp, self%gs(:, :, e), 6, patch%stress(:, np + 1:np + ngp))
+         np = np + ngp
          patch%npoints = np
          if (.not. self%sprc) cycle
          do k = self%topo%bptr(e), self%topo%bptr(e + 1) - 1
@@ -700,6 +757,17 @@ contains
          end do
       end do
    end subroutine mesh_fill
+
+   !> b(1:m, 1:n) = a(1:m, 1:n) for b of leading dimension ldb.
+   pure subroutine copy_block(m, n, a, ldb, b)
+      integer, intent(in) :: m, n, ldb
+      real(wp), intent(in) :: a(m, n)
+      real(wp), intent(inout) :: b(ldb, n)
+      integer :: j
+      do j = 1, n
+         b(1:m, j) = a(1:m, j)
+      end do
+   end subroutine copy_block
 
    !> Nodal stresses: patch value at vertex nodes, the union elsewhere (module notes).
    subroutine nodal_values(r, topo, error)
@@ -716,42 +784,87 @@ contains
       do n = 1, r%nnode
          r%nodal(:, n) = 0.0_wp
          if (r%patch_of_node(n) > 0) then
-            call eval_patch(r, r%patch_of_node(n), r%x(:, n), r%nodal(:, n))
+            call eval_recovered_points(r%recs(r%patch_of_node(n)), r%x(:, n:n), r%nodal(:, n:n))
          else if (topo%ne_ptr(n + 1) > topo%ne_ptr(n)) then
             e = topo%ne_list(topo%ne_ptr(n))
             a = findloc(r%connectivity(:, e), n, dim=1)
             call element_node_xi(r%element_type, a, xi)
-            call union_at(r, e, xi, r%x(:, n), r%nodal(:, n))
+            call union_at_node(r, e, xi, n)
          end if
       end do
       !$omp end parallel do
    end subroutine nodal_values
 
-   !> Patch ip's polynomial at x (recovered by a successful solve: no checks needed).
-   pure subroutine eval_patch(r, ip, x, sigma)
-      type(mesh_recovery_type), intent(in) :: r
-      integer, intent(in) :: ip
-      real(wp), intent(in) :: x(:)
-      real(wp), intent(out) :: sigma(:)
-      call eval_recovered_unchecked(r%recs(ip), x, sigma)
-   end subroutine eval_patch
+   !> The union (eq. 102) at node n of element e, reference point xi, into nodal(:, n).
+   pure subroutine union_at_node(r, e, xi, n)
+      type(mesh_recovery_type), intent(inout) :: r
+      integer, intent(in) :: e, n
+      real(wp), intent(in) :: xi(:)
+      real(wp) :: nv(max_element_nodes, 1), s(6, 1), sj(6, 1, 8)
 
-   !> Union (eq. 102) at reference point xi / physical point x of element e.
-   subroutine union_at(r, e, xi, x, sigma)
-      type(mesh_recovery_type), intent(in) :: r
-      integer, intent(in) :: e
-      real(wp), intent(in) :: xi(:), x(:)
-      real(wp), intent(out) :: sigma(:)
-      real(wp) :: nv(8), sj(6)
-      integer :: j
+      sj = 0.0_wp
+      call element_vertex_shape(r%element_type, xi, nv(:, 1))
+      call element_field(r, e, .true., 1, nv, r%x(:, n:n), s, sj)
+      r%nodal(:, n) = s(1:r%nstress, 1)
+   end subroutine union_at_node
 
-      call element_vertex_shape(r%element_type, xi, nv)
-      sigma(1:r%nstress) = 0.0_wp
-      do j = 1, r%nvertex
-         call eval_patch(r, r%patch_of_node(r%connectivity(j, e)), x, sj)
-         sigma(1:r%nstress) = sigma(1:r%nstress) + nv(j)*sj(1:r%nstress)
-      end do
-   end subroutine union_at
+   !> The shape values the method's field uses at reference point xi: the element's own
+   !> (SPR, nodal interpolation, n(1:nen)) or the vertex partition of unity (SPR-C, the
+   !> union, n(1:nvertex)).
+   pure subroutine method_shape(r, xi, n)
+      type(mesh_recovery_type), intent(in) :: r
+      real(wp), intent(in) :: xi(:)
+      real(wp), intent(out) :: n(:)
+      if (r%method == mesh_method_sprc) then
+         call element_vertex_shape(r%element_type, xi, n)
+      else
+         call element_shape(r%element_type, xi, n)
+      end if
+   end subroutine method_shape
+
+   !> A field of element e at np points x(1:dim, i), sigma(1:nstress, i), from the shape
+   !> values n(:, i) there: the nodal interpolation sum_a n_a nodal(:, a) (eq. 101; SPR's
+   !> field), or if `union` the union sum_J n_J sigma*_J(x) over the vertices (eq. 102; SPR-C's
+   !> field), each patch evaluated at all np points at once into sj(:, 1:np, J) (work space
+   !> sj(6, np, nvertex); its rows beyond nstress must be finite: they are summed, unused).
+   !> Sums in node / vertex order, in six scalar lanes.
+   pure subroutine element_field(r, e, union, np, n, x, sigma, sj)
+      type(mesh_recovery_type), intent(in) :: r
+      integer, intent(in) :: e, np
+      logical, intent(in) :: union
+      real(wp), intent(in) :: n(:, :), x(:, :)
+      real(wp), intent(out) :: sigma(:, :)
+      real(wp), intent(inout) :: sj(:, :, :)
+      real(wp) :: v(6, max_element_nodes), acc(6)
+      integer :: a, i, ns, nv
+
+      ns = r%nstress
+      if (union) then
+         nv = r%nvertex
+         do a = 1, nv
+            call eval_recovered_points(r%recs(r%patch_of_node(r%connectivity(a, e))), x(:, 1:np), sj(:, :, a))
+         end do
+         do i = 1, np
+            acc = 0.0_wp
+            do a = 1, nv
+               acc = acc + n(a, i)*sj(:, i, a)
+            end do
+            sigma(1:ns, i) = acc(1:ns)
+         end do
+      else
+         v(ns + 1:6, 1:r%nen) = 0.0_wp
+         do a = 1, r%nen
+            v(1:ns, a) = r%nodal(1:ns, r%connectivity(a, e))
+         end do
+         do i = 1, np
+            acc = 0.0_wp
+            do a = 1, r%nen
+               acc = acc + v(:, a)*n(a, i)
+            end do
+            sigma(1:ns, i) = acc(1:ns)
+         end do
+      end if
+   end subroutine element_field
 
    !> The method's field at reference point xi / physical point x of element e.
    subroutine field_at(r, e, xi, x, sigma)
@@ -759,27 +872,25 @@ contains
       integer, intent(in) :: e
       real(wp), intent(in) :: xi(:), x(:)
       real(wp), intent(out) :: sigma(:)
-      real(wp) :: n(max_element_nodes)
-      integer :: a
+      real(wp) :: n(max_element_nodes, 1), xp(3, 1), s(6, 1), sj(6, 1, 8)
 
-      if (r%method == mesh_method_sprc) then
-         call union_at(r, e, xi, x, sigma)
-      else
-         call element_shape(r%element_type, xi, n)
-         sigma(1:r%nstress) = 0.0_wp
-         do a = 1, r%nen
-            sigma(1:r%nstress) = sigma(1:r%nstress) + r%nodal(:, r%connectivity(a, e))*n(a)
-         end do
-      end if
+      sj = 0.0_wp
+      call method_shape(r, xi, n(:, 1))
+      xp(1:r%dim, 1) = x(1:r%dim)
+      call element_field(r, e, r%method == mesh_method_sprc, 1, n, xp(1:r%dim, :), s, sj)
+      sigma(1:r%nstress) = s(1:r%nstress, 1)
    end subroutine field_at
 
    !> ZZ estimate at the caller's points (module notes); OpenMP over elements, the sums in
-   !> element order (the bits do not depend on the thread count).
-   subroutine estimate(r, gp, gw, gs, xi, error)
+   !> element order (the bits do not depend on the thread count). The shape values of the
+   !> points are those of `rule` when all elements share one rule (`shared_rule`), else
+   !> evaluated per point.
+   subroutine estimate(r, gp, gw, gs, xi, rule, error)
       type(mesh_recovery_type), intent(inout) :: r
       real(wp), intent(in) :: gp(:, :, :), gw(:, :), gs(:, :, :), xi(:, :, :)
+      type(rule_type), intent(in) :: rule
       type(error_type), allocatable, intent(out) :: error
-      real(wp), allocatable :: sstar(:, :), cmat(:, :)
+      real(wp), allocatable :: sstar(:, :), sj(:, :, :), n(:, :), cmat(:, :)
       integer :: e, i, ngp, ns, st
 
       ngp = size(gp, 2)
@@ -789,13 +900,18 @@ contains
       if (allocated(error)) return
       call compliance_matrix(r%analysis, r%young, r%poisson, cmat, error)
       if (allocated(error)) return
-      !$omp parallel default(shared) private(sstar, i)
-      allocate (sstar(ns, ngp))
+      !$omp parallel default(shared) private(sstar, sj, n, i)
+      allocate (sstar(ns, ngp), sj(6, ngp, 8), n(max_element_nodes, ngp))
+      sj = 0.0_wp
+      if (rule%shared) n = rule%n
       !$omp do schedule(static)
       do e = 1, r%nelem
-         do i = 1, ngp
-            call field_at(r, e, xi(:, i, e), gp(:, i, e), sstar(:, i))
-         end do
+         if (.not. rule%shared) then
+            do i = 1, ngp
+               call method_shape(r, xi(:, i, e), n(:, i))
+            end do
+         end if
+         call element_field(r, e, r%method == mesh_method_sprc, ngp, n, gp(:, :, e), sstar, sj)
          call energy_norms(cmat, gw(:, e), sstar, gs(:, :, e), r%elem_err(e), r%elem_norm_h(e))
       end do
       !$omp end do
