@@ -60,19 +60,27 @@ contains
       integer, intent(in) :: nt, ns
       real(wp), intent(in) :: coef(nt, ns), x(:, :)
       real(wp), intent(inout) :: sigma(:, :)
-      real(wp) :: p(poly_max_terms), acc
-      integer :: i, k, c, t
+      real(wp) :: p(poly_max_terms), acc, s1, s2, s3
+      integer :: i, c, t
 
       do i = 1, size(x, 2)
          if (rec%degree == 1) then
-            ! Terms 1, s_1, .., s_dim: the values term_values gives (products with ones).
-            p(1) = 1.0_wp
-            do k = 1, rec%dim
-               p(k + 1) = (x(k, i) - rec%x0(k))/rec%h
+            ! Terms 1, s_1, .., s_dim (the values term_values gives: products with ones), in
+            ! scalars: stored to p(:) and loaded in pairs they stalled on store forwarding (perf).
+            s1 = (x(1, i) - rec%x0(1))/rec%h
+            s2 = (x(2, i) - rec%x0(2))/rec%h
+            s3 = 0.0_wp
+            if (rec%dim == 3) s3 = (x(3, i) - rec%x0(3))/rec%h
+            do c = 1, ns
+               acc = 0.0_wp + 1.0_wp*coef(1, c)
+               acc = acc + s1*coef(2, c)
+               acc = acc + s2*coef(3, c)
+               if (nt == 4) acc = acc + s3*coef(4, c)
+               sigma(c, i) = acc
             end do
-         else
-            call term_values(rec, x(:, i), p)
+            cycle
          end if
+         call term_values(rec, x(:, i), p)
          do c = 1, ns
             acc = 0.0_wp
             do t = 1, nt

@@ -317,9 +317,14 @@ contains
       allocate (topo%ne_ptr(r%nnode + 1), fill(r%nnode), vertex(r%nnode), stat=st)
       call check_allocation(st, 'recover_on_mesh', 'the node-element pointers', r%nnode + 1, 12, error)
       if (allocated(error)) return
+      ! Loops, not fill(connectivity(:, e)): that vector subscript made a heap temporary per
+      ! element.
       fill = 0
       do e = 1, r%nelem
-         fill(r%connectivity(:, e)) = fill(r%connectivity(:, e)) + 1
+         do a = 1, r%nen
+            n = r%connectivity(a, e)
+            fill(n) = fill(n) + 1
+         end do
       end do
       topo%ne_ptr(1) = 1
       do n = 1, r%nnode
@@ -338,7 +343,9 @@ contains
       end do
       vertex = .false.
       do e = 1, r%nelem
-         vertex(r%connectivity(1:r%nvertex, e)) = .true.
+         do a = 1, r%nvertex
+            vertex(r%connectivity(a, e)) = .true.
+         end do
       end do
       r%n_patches = count(vertex)
       allocate (r%patch_node(r%n_patches), r%patch_of_node(r%nnode), stat=st)
@@ -739,7 +746,8 @@ contains
       np = 0
       do i = 1, size(elements)
          e = elements(i)
-         ! Whole blocks of the element's points (fixed leading dimensions: no descriptors).
+         ! Whole blocks of the element's points (fixed leading dimensions: no descriptors;
+         ! contiguous sections, so the run-time pack check passes them in place).
          call copy_block(d, ngp, self%gp(:, :, e), 3, patch%x(:, np + 1:np + ngp))
          patch%w(np + 1:np + ngp) = self%gw(:, e)
          call copy_block(ns, ngp, self%gs(:, :, e), 6, patch%stress(:, np + 1:np + ngp))
