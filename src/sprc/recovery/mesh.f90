@@ -451,6 +451,8 @@ contains
       type(rule_type), intent(out) :: rule
       type(error_type), allocatable, intent(out) :: error
       integer, allocatable :: bad(:)
+      logical, allocatable :: ok1(:)
+      real(wp), allocatable :: nsum1(:)
       logical :: shared
       integer :: e, i, ngp, st
 
@@ -460,15 +462,20 @@ contains
             & shape_str(shape(gxi))//'; need '//shape_str([r%dim, ngp, r%nelem])//' as gp', stat_invalid_input)
          return
       end if
-      allocate (bad(r%nelem), rule%map(max_element_nodes, ngp), rule%n(max_element_nodes, ngp), stat=st)
+      allocate (bad(r%nelem), rule%map(max_element_nodes, ngp), rule%n(max_element_nodes, ngp), ok1(ngp), &
+         & nsum1(ngp), stat=st)
       if (st /= 0) then
          call fatal_error(error, 'recover_on_mesh: out of memory for the check of the reference coordinates', &
             & stat_out_of_memory)
          return
       end if
+      ! Element 1's points: what an element with the same bits shares (the outcome of the
+      ! point checks, the shape values and their sum of magnitudes).
       do i = 1, ngp
+         ok1(i) = point_ok(gxi(:, i, 1))
          call element_shape(r%element_type, gxi(:, i, 1), rule%map(:, i))
          call method_shape(r, gxi(:, i, 1), rule%n(:, i))
+         nsum1(i) = sum(abs(rule%map(1:r%nen, i)))
       end do
       shared = .true.
       !$omp parallel do schedule(static) reduction(.and.:shared)
@@ -490,7 +497,7 @@ contains
       integer function check_element(e, shared) result(status)
          integer, intent(in) :: e
          logical, intent(inout) :: shared
-         real(wp) :: xe(3, max_element_nodes), n(max_element_nodes), x(3), he, xmax, tol
+         real(wp) :: xe(3, max_element_nodes), n(max_element_nodes), x(3), he, xmax, tol, nsum, gmax, dev
          integer :: a, j, d, nen
          logical :: same
 
@@ -507,12 +514,14 @@ contains
          status = 0
          do j = 1, ngp
             status = j
-            if (.not. all(abs(gxi(:, j, e)) <= huge(1.0_wp))) return
-            if (.not. element_inside(r%element_type, gxi(:, j, e), inside_tol)) return
             if (same) then
+               if (.not. ok1(j)) return
                n(1:nen) = rule%map(1:nen, j)
+               nsum = nsum1(j)
             else
+               if (.not. point_ok(gxi(:, j, e))) return
                call element_shape(r%element_type, gxi(:, j, e), n)
+               nsum = sum(abs(n(1:nen)))
             end if
             ! Three scalar sums (x(1:d) in memory stalled on store forwarding).
             x = 0.0_wp
@@ -521,12 +530,23 @@ contains
                x(2) = x(2) + xe(2, a)*n(a)
                x(3) = x(3) + xe(3, a)*n(a)
             end do
-            tol = inside_tol*he + real(nen + 2, wp)*epsilon(1.0_wp)*(maxval(abs(gp(:, j, e))) + &
-               & sum(abs(n(1:nen)))*xmax)
-            if (.not. (maxval(abs(x(1:d) - gp(:, j, e))) <= tol)) return
+            gmax = max(abs(gp(1, j, e)), abs(gp(2, j, e)))
+            dev = max(abs(x(1) - gp(1, j, e)), abs(x(2) - gp(2, j, e)))
+            if (d == 3) then
+               gmax = max(gmax, abs(gp(3, j, e)))
+               dev = max(dev, abs(x(3) - gp(3, j, e)))
+            end if
+            tol = inside_tol*he + real(nen + 2, wp)*epsilon(1.0_wp)*(gmax + nsum*xmax)
+            if (.not. (dev <= tol)) return
             status = 0
          end do
       end function check_element
+      !> Finite and inside the reference element (inside_tol).
+      pure logical function point_ok(xi)
+         real(wp), intent(in) :: xi(:)
+         point_ok = all(abs(xi) <= huge(1.0_wp))
+         if (point_ok) point_ok = element_inside(r%element_type, xi, inside_tol)
+      end function point_ok
       pure function shape_str(v) result(s)
          integer, intent(in) :: v(:)
          character(len=:), allocatable :: s

@@ -222,7 +222,9 @@ contains
       class(patch_source_type), intent(in) :: source
       integer, intent(in) :: ne_ptr(:), ne_list(:), connectivity(:, :), n
       type(scratch_type), intent(inout) :: sc
-      type(recovered_patch_type), intent(out) :: rec
+      ! inout: every solve resets rec (its intent(out)); an intent(out) here re-initialised
+      ! the record once more per patch (a copy of the default, perf: memmove).
+      type(recovered_patch_type), intent(inout) :: rec
       integer, intent(out) :: rounds, nel
       type(error_type), allocatable, intent(out) :: error
       integer :: k, round, nprev

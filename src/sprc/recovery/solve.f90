@@ -431,10 +431,19 @@ contains
       do i = 1, d
          ws%erhs((i - 1)*nt + 1:i*nt) = -patch%h*patch%body_force(i)*ws%mp(1:nt, 1)
       end do
-      do j = 1, n
-         do k = 1, n
-            ws%blk(k, j) = sparse_dot(k, ws%tmp(1:d*nt, j))
+      ! blk(k, :) = B(:, k)^T tmp, a row at a time over the nonzeros of B(:, k) (each entry
+      ! the sum sparse_dot forms, in the same order; one loop of n per nonzero instead of a
+      ! loop of one or two per entry).
+      do k = 1, n
+         ws%blk(k, 1:n) = 0.0_wp
+         do l = ws%bnz_ptr(k), ws%bnz_ptr(k + 1) - 1
+            r = ws%bnz_row(l)
+            do j = 1, n
+               ws%blk(k, j) = ws%blk(k, j) + ws%bnz_val(l)*ws%tmp(r, j)
+            end do
          end do
+      end do
+      do j = 1, n
          ws%brhs(j) = sparse_dot(j, ws%erhs(1:d*nt))
       end do
       call workspace_toc(ws, d*flops_gemm(nt, n, nt) + flops_gemm(n, n, d*nt) + flops_gemv(d*nt, n))
