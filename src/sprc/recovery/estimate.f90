@@ -266,16 +266,71 @@ contains
    !> Both energy norms of one element for a validated caller (finite stresses, weights
    !> >= 0) and its compliance cmat(nstress, nstress): err = ||s* - s_h||, norm_h = ||s_h||,
    !> the bits of `zz_error_norm` (of s* and of a zero s*) without its checks and set-up.
+   !> When neither needs scaling (`scaled_sum`'s test) both sums are formed in one pass
+   !> with scale 1, as scaled_sum forms them then.
    pure subroutine energy_norms(cmat, w, sigma_star, sigma_h, err, norm_h)
-      real(wp), intent(in) :: cmat(:, :), w(:), sigma_star(:, :), sigma_h(:, :)
+      real(wp), intent(in), contiguous :: cmat(:, :), w(:), sigma_star(:, :), sigma_h(:, :)
       real(wp), intent(out) :: err, norm_h
-      real(wp) :: s, ssq
+      real(wp) :: s, ssq, ssq_h
 
+      if (size(cmat, 1) == 3 .and. unscaled(size(w), sigma_star, sigma_h)) then
+         call accumulate3_both(size(w), cmat, w, sigma_star, sigma_h, ssq, ssq_h)
+         err = sqrt(ssq)
+         norm_h = sqrt(ssq_h)
+         return
+      end if
       call scaled_sum(size(cmat, 1), size(w), cmat, size(cmat, 1), w, sigma_star, sigma_h, .true., s, ssq)
       err = s*sqrt(ssq)
       call scaled_sum(size(cmat, 1), size(w), cmat, size(cmat, 1), w, sigma_h, sigma_h, .false., s, ssq)
       norm_h = s*sqrt(ssq)
    end subroutine energy_norms
+
+   !> True if scaled_sum would take s = 1 for both the differences a - b and b (2D stresses).
+   pure logical function unscaled(n, a, b)
+      integer, intent(in) :: n
+      real(wp), intent(in) :: a(3, n), b(3, n)
+      real(wp), parameter :: safe_hi = 2.0_wp**200, safe_lo = 2.0_wp**(-200)
+      real(wp) :: d, h
+      integer :: i, j
+
+      unscaled = .false.
+      do i = 1, n
+         do j = 1, 3
+            d = abs(a(j, i) - b(j, i))
+            h = abs(b(j, i))
+            if (.not. (d <= safe_hi .and. h <= safe_hi)) return
+            if ((d > 0.0_wp .and. d < safe_lo) .or. (h > 0.0_wp .and. h < safe_lo)) return
+         end do
+      end do
+      unscaled = .true.
+   end function unscaled
+
+   !> `accumulate3` of the differences a - b and of b (with a = 0) at once, scale 1: the same
+   !> products and sums per quantity, in the same order.
+   pure subroutine accumulate3_both(n, c, w, a, b, ssq, ssq_h)
+      integer, intent(in) :: n
+      real(wp), intent(in) :: c(3, 3), w(n), a(3, n), b(3, n)
+      real(wp), intent(out) :: ssq, ssq_h
+      real(wp) :: d1, d2, d3, q
+      integer :: i
+
+      ssq = 0.0_wp
+      ssq_h = 0.0_wp
+      do i = 1, n
+         d1 = (a(1, i) - b(1, i))*1.0_wp
+         d2 = (a(2, i) - b(2, i))*1.0_wp
+         d3 = (a(3, i) - b(3, i))*1.0_wp
+         q = ((d1*((c(1, 1)*d1 + c(1, 2)*d2) + c(1, 3)*d3) + d2*((c(2, 1)*d1 + c(2, 2)*d2) + c(2, 3)*d3)) + &
+            & d3*((c(3, 1)*d1 + c(3, 2)*d2) + c(3, 3)*d3))
+         ssq = ssq + w(i)*q
+         d1 = (0.0_wp - b(1, i))*1.0_wp
+         d2 = (0.0_wp - b(2, i))*1.0_wp
+         d3 = (0.0_wp - b(3, i))*1.0_wp
+         q = ((d1*((c(1, 1)*d1 + c(1, 2)*d2) + c(1, 3)*d3) + d2*((c(2, 1)*d1 + c(2, 2)*d2) + c(2, 3)*d3)) + &
+            & d3*((c(3, 1)*d1 + c(3, 2)*d2) + c(3, 3)*d3))
+         ssq_h = ssq_h + w(i)*q
+      end do
+   end subroutine accumulate3_both
 
    !> ssq = sum_i w_i d_i^T cmat d_i / s**2, d_i = a_i - b_i (a = 0 if not use_a), s the power
    !> of two of the largest |d| (`power_of_two`), or s = 1 where every nonzero |d| lies
