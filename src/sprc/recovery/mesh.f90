@@ -503,9 +503,11 @@ contains
 
          d = r%dim
          nen = r%nen
-         xe(3, 1:nen) = 0.0_wp
+         ! Fixed-length copies (run-time length d became a memcpy call per node).
          do a = 1, nen
-            xe(1:d, a) = r%x(:, r%connectivity(a, e))
+            xe(1:2, a) = r%x(1:2, r%connectivity(a, e))
+            xe(3, a) = 0.0_wp
+            if (d == 3) xe(3, a) = r%x(3, r%connectivity(a, e))
          end do
          he = maxval(r%box_hi(:, e) - r%box_lo(:, e))
          xmax = maxval(abs(xe(1:d, 1:nen)))
@@ -516,20 +518,14 @@ contains
             status = j
             if (same) then
                if (.not. ok1(j)) return
-               n(1:nen) = rule%map(1:nen, j)
+               call map_point(xe, rule%map(:, j), x)
                nsum = nsum1(j)
             else
                if (.not. point_ok(gxi(:, j, e))) return
                call element_shape(r%element_type, gxi(:, j, e), n)
+               call map_point(xe, n, x)
                nsum = sum(abs(n(1:nen)))
             end if
-            ! Three scalar sums (x(1:d) in memory stalled on store forwarding).
-            x = 0.0_wp
-            do a = 1, nen
-               x(1) = x(1) + xe(1, a)*n(a)
-               x(2) = x(2) + xe(2, a)*n(a)
-               x(3) = x(3) + xe(3, a)*n(a)
-            end do
             gmax = max(abs(gp(1, j, e)), abs(gp(2, j, e)))
             dev = max(abs(x(1) - gp(1, j, e)), abs(x(2) - gp(2, j, e)))
             if (d == 3) then
@@ -541,6 +537,19 @@ contains
             status = 0
          end do
       end function check_element
+      !> x = sum_a xe(:, a) n(a) in three scalar sums (x(1:d) in memory stalled on store
+      !> forwarding); n is used in place (a copy of run-time length is a memcpy call).
+      pure subroutine map_point(xe, n, x)
+         real(wp), intent(in) :: xe(:, :), n(:)
+         real(wp), intent(out) :: x(3)
+         integer :: a
+         x = 0.0_wp
+         do a = 1, r%nen
+            x(1) = x(1) + xe(1, a)*n(a)
+            x(2) = x(2) + xe(2, a)*n(a)
+            x(3) = x(3) + xe(3, a)*n(a)
+         end do
+      end subroutine map_point
       !> Finite and inside the reference element (inside_tol).
       pure logical function point_ok(xi)
          real(wp), intent(in) :: xi(:)
@@ -742,16 +751,19 @@ contains
       ! h = the largest distance: the largest square, one root (sqrt is monotonic and
       ! correctly rounded: the same value as the largest root). Squares summed in coordinate
       ! order from zero, as sum() does, in scalars.
+      ! Fixed-length copies and differences (run-time length d became memcpy calls).
       x0 = 0.0_wp
-      x0(1:d) = self%x(:, node)
+      x0(1:2) = self%x(1:2, node)
+      if (d == 3) x0(3) = self%x(3, node)
       h = 0.0_wp
       nb = 0
       do i = 1, size(elements)
          e = elements(i)
          do a = 1, self%nen
             m = self%connectivity(a, e)
-            dx = 0.0_wp
-            dx(1:d) = self%x(1:d, m) - x0(1:d)
+            dx(1:2) = self%x(1:2, m) - x0(1:2)
+            dx(3) = 0.0_wp
+            if (d == 3) dx(3) = self%x(3, m) - x0(3)
             h = max(h, ((0.0_wp + dx(1)**2) + dx(2)**2) + dx(3)**2)
          end do
          if (self%sprc) nb = nb + self%topo%bptr(e + 1) - self%topo%bptr(e)
@@ -760,7 +772,7 @@ contains
       np = ngp*size(elements)
       call patch_reset(patch, d, self%analysis, self%young, self%poisson, x0(1:d), h)
       call patch_reserve(patch, np, nb)
-      patch%body_force(1:d) = self%topo%body_force(1:d)
+      patch%body_force = self%topo%body_force
       ! check_mesh_arrays validated the caller's points, weights and stresses.
       patch%points_checked = .true.
       np = 0
@@ -786,15 +798,31 @@ contains
       end do
    end subroutine mesh_fill
 
-   !> b(1:m, 1:n) = a(1:m, 1:n) for b of leading dimension ldb.
+   !> b(1:m, 1:n) = a(1:m, 1:n) for b of leading dimension ldb. Columns of 2, 3 or 6 as
+   !> fixed-length copies (a column copy of run-time length became a memcpy call).
    pure subroutine copy_block(m, n, a, ldb, b)
       integer, intent(in) :: m, n, ldb
       real(wp), intent(in) :: a(m, n)
       real(wp), intent(inout) :: b(ldb, n)
       integer :: j
-      do j = 1, n
-         b(1:m, j) = a(1:m, j)
-      end do
+      select case (m)
+      case (2)
+         do j = 1, n
+            b(1:2, j) = a(1:2, j)
+         end do
+      case (3)
+         do j = 1, n
+            b(1:3, j) = a(1:3, j)
+         end do
+      case (6)
+         do j = 1, n
+            b(1:6, j) = a(1:6, j)
+         end do
+      case default
+         do j = 1, n
+            b(1:m, j) = a(1:m, j)
+         end do
+      end select
    end subroutine copy_block
 
    !> Nodal stresses: patch value at vertex nodes, the union elsewhere (module notes).
@@ -877,21 +905,30 @@ contains
             do a = 1, nv
                acc = acc + n(a, i)*sj(:, i, a)
             end do
-            sigma(1:ns, i) = acc(1:ns)
+            call store(acc, sigma(:, i))
          end do
       else
-         v(ns + 1:6, 1:r%nen) = 0.0_wp
+         ! Copies of fixed length (3 or 6): a copy of run-time length ns became a memcpy call.
          do a = 1, r%nen
-            v(1:ns, a) = r%nodal(1:ns, r%connectivity(a, e))
+            v(1:3, a) = r%nodal(1:3, r%connectivity(a, e))
+            v(4:6, a) = 0.0_wp
+            if (ns == 6) v(4:6, a) = r%nodal(4:6, r%connectivity(a, e))
          end do
          do i = 1, np
             acc = 0.0_wp
             do a = 1, r%nen
                acc = acc + v(:, a)*n(a, i)
             end do
-            sigma(1:ns, i) = acc(1:ns)
+            call store(acc, sigma(:, i))
          end do
       end if
+   contains
+      pure subroutine store(acc, sig)
+         real(wp), intent(in) :: acc(6)
+         real(wp), intent(inout) :: sig(:)
+         sig(1:3) = acc(1:3)
+         if (ns == 6) sig(4:6) = acc(4:6)
+      end subroutine store
    end subroutine element_field
 
    !> The method's field at reference point xi / physical point x of element e.

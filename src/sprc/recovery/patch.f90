@@ -147,8 +147,11 @@ contains
       patch%analysis = analysis
       patch%young = young
       patch%poisson = poisson
+      ! Entry by entry: a copy of run-time length is a memcpy call (per patch).
       patch%x0 = 0.0_wp
-      patch%x0(1:min(3, size(x0))) = x0(1:min(3, size(x0)))
+      if (size(x0) >= 1) patch%x0(1) = x0(1)
+      if (size(x0) >= 2) patch%x0(2) = x0(2)
+      if (size(x0) >= 3) patch%x0(3) = x0(3)
       patch%h = h
       patch%npoints = 0
       patch%nbpoints = 0
