@@ -269,6 +269,7 @@ contains
       integer, intent(in) :: connectivity(:, :)
       type(error_type), allocatable, intent(out) :: error
       integer :: e, a, st
+      real(wp) :: lo(3), hi(3)
 
       r%dim = dim
       r%analysis = analysis
@@ -293,14 +294,25 @@ contains
       allocate (r%box_lo(dim, r%nelem), r%box_hi(dim, r%nelem), stat=st)
       call check_allocation(st, 'recover_on_mesh', 'the element boxes', r%nelem, 16*dim, error)
       if (allocated(error)) return
-      !$omp parallel do schedule(static) private(a)
+      !$omp parallel do schedule(static) private(a, lo, hi)
       do e = 1, r%nelem
-         r%box_lo(:, e) = nodes(:, connectivity(1, e))
-         r%box_hi(:, e) = nodes(:, connectivity(1, e))
-         do a = 2, r%nen
-            r%box_lo(:, e) = min(r%box_lo(:, e), nodes(:, connectivity(a, e)))
-            r%box_hi(:, e) = max(r%box_hi(:, e), nodes(:, connectivity(a, e)))
+         ! In fixed-length scalars (run-time length dim made memcpy calls and short loops).
+         lo = huge(1.0_wp)
+         hi = -huge(1.0_wp)
+         do a = 1, r%nen
+            lo(1:2) = min(lo(1:2), nodes(1:2, connectivity(a, e)))
+            hi(1:2) = max(hi(1:2), nodes(1:2, connectivity(a, e)))
+            if (dim == 3) then
+               lo(3) = min(lo(3), nodes(3, connectivity(a, e)))
+               hi(3) = max(hi(3), nodes(3, connectivity(a, e)))
+            end if
          end do
+         r%box_lo(1:2, e) = lo(1:2)
+         r%box_hi(1:2, e) = hi(1:2)
+         if (dim == 3) then
+            r%box_lo(3, e) = lo(3)
+            r%box_hi(3, e) = hi(3)
+         end if
       end do
       !$omp end parallel do
    end subroutine init_result
@@ -320,10 +332,12 @@ contains
       ! Loops, not fill(connectivity(:, e)): that vector subscript made a heap temporary per
       ! element.
       fill = 0
+      vertex = .false.
       do e = 1, r%nelem
          do a = 1, r%nen
             n = r%connectivity(a, e)
             fill(n) = fill(n) + 1
+            if (a <= r%nvertex) vertex(n) = .true.
          end do
       end do
       topo%ne_ptr(1) = 1
@@ -339,12 +353,6 @@ contains
             n = r%connectivity(a, e)
             topo%ne_list(topo%ne_ptr(n) + fill(n)) = e
             fill(n) = fill(n) + 1
-         end do
-      end do
-      vertex = .false.
-      do e = 1, r%nelem
-         do a = 1, r%nvertex
-            vertex(r%connectivity(a, e)) = .true.
          end do
       end do
       r%n_patches = count(vertex)

@@ -234,9 +234,16 @@ contains
       rec%x0 = patch%x0
       rec%h = patch%h
 
+      ! Per coordinate with fixed bounds (a loop of run-time length dim per point cost more
+      ! than its two or three divisions).
       do i = 1, np
-         ws%s(1:patch%dim, i) = (patch%x(1:patch%dim, i) - patch%x0(1:patch%dim))/patch%h
+         ws%s(1:2, i) = (patch%x(1:2, i) - patch%x0(1:2))/patch%h
       end do
+      if (patch%dim == 3) then
+         do i = 1, np
+            ws%s(3, i) = (patch%x(3, i) - patch%x0(3))/patch%h
+         end do
+      end if
       call ws%basis%eval_points(ws%s(1:patch%dim, 1:np), ws%pw)
       if (weighted) then
          wsum = sum(patch%w(1:np))
