@@ -751,7 +751,7 @@ contains
       integer, intent(in) :: node, elements(:)
       type(patch_type), intent(inout) :: patch
       real(wp) :: h, x0(3), dx(3)
-      integer :: d, i, e, k, a, m, np, nb, ngp, ns
+      integer :: d, i, e, k, a, m, np, nb, ngp, ns, q
 
       d = self%dim
       ns = self%nstress
@@ -786,11 +786,15 @@ contains
       np = 0
       do i = 1, size(elements)
          e = elements(i)
-         ! Whole blocks of the element's points (fixed leading dimensions: no descriptors;
-         ! contiguous sections, so the run-time pack check passes them in place).
-         call copy_block(d, ngp, self%gp(:, :, e), 3, patch%x(:, np + 1:np + ngp))
-         patch%w(np + 1:np + ngp) = self%gw(:, e)
-         call copy_block(ns, ngp, self%gs(:, :, e), 6, patch%stress(:, np + 1:np + ngp))
+         ! Point by point with fixed-length copies (a copy of run-time length d or ns is a
+         ! memcpy call).
+         do q = 1, ngp
+            patch%x(1:2, np + q) = self%gp(1:2, q, e)
+            if (d == 3) patch%x(3, np + q) = self%gp(3, q, e)
+            patch%w(np + q) = self%gw(q, e)
+            patch%stress(1:3, np + q) = self%gs(1:3, q, e)
+            if (ns == 6) patch%stress(4:6, np + q) = self%gs(4:6, q, e)
+         end do
          np = np + ngp
          patch%npoints = np
          if (.not. self%sprc) cycle
@@ -805,33 +809,6 @@ contains
          end do
       end do
    end subroutine mesh_fill
-
-   !> b(1:m, 1:n) = a(1:m, 1:n) for b of leading dimension ldb. Columns of 2, 3 or 6 as
-   !> fixed-length copies (a column copy of run-time length became a memcpy call).
-   pure subroutine copy_block(m, n, a, ldb, b)
-      integer, intent(in) :: m, n, ldb
-      real(wp), intent(in) :: a(m, n)
-      real(wp), intent(inout) :: b(ldb, n)
-      integer :: j
-      select case (m)
-      case (2)
-         do j = 1, n
-            b(1:2, j) = a(1:2, j)
-         end do
-      case (3)
-         do j = 1, n
-            b(1:3, j) = a(1:3, j)
-         end do
-      case (6)
-         do j = 1, n
-            b(1:6, j) = a(1:6, j)
-         end do
-      case default
-         do j = 1, n
-            b(1:m, j) = a(1:m, j)
-         end do
-      end select
-   end subroutine copy_block
 
    !> Nodal stresses: patch value at vertex nodes, the union elsewhere (module notes).
    subroutine nodal_values(r, topo, error)
