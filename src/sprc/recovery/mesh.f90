@@ -823,7 +823,7 @@ contains
       if (allocated(error)) return
       !$omp parallel do schedule(static) private(e, a, xi)
       do n = 1, r%nnode
-         r%nodal(:, n) = 0.0_wp
+         ! Each branch writes the whole column (a zero fill first was a memset call per node).
          if (r%patch_of_node(n) > 0) then
             call eval_recovered_points(r%recs(r%patch_of_node(n)), r%x(:, n:n), r%nodal(:, n:n))
          else if (topo%ne_ptr(n + 1) > topo%ne_ptr(n)) then
@@ -831,6 +831,8 @@ contains
             a = findloc(r%connectivity(:, e), n, dim=1)
             call element_node_xi(r%element_type, a, xi)
             call union_at_node(r, e, xi, n)
+         else
+            r%nodal(:, n) = 0.0_wp
          end if
       end do
       !$omp end parallel do
