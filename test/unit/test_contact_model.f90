@@ -302,7 +302,8 @@ contains
       type(report_row_type) :: row
 
       contacts = contact_sample()
-      call fill_contact_row(contacts, row)
+      call fill_contact_row(contacts, row, error)
+      if (allocated(error)) return
       call check(error, row%has_contact, 'has_contact')
       if (allocated(error)) return
       call check(error, row%contact_measure, 1.75_wp, 0.0_wp, 'contact_measure: closed points only')
@@ -332,7 +333,8 @@ contains
       do k = 1, size(contacts)
          contacts(k)%p_exact = report_empty
       end do
-      call fill_contact_row(contacts, row)
+      call fill_contact_row(contacts, row, error)
+      if (allocated(error)) return
       call check(error, is_empty(row%p_max_exact) .and. is_empty(row%err_p_fe) .and. is_empty(row%err_p_sprc), &
          & 'no exact: p_max_exact and err_p_* empty')
       if (allocated(error)) return
@@ -341,7 +343,8 @@ contains
       do k = 1, size(contacts)
          contacts(k)%p_exact = 0.0_wp
       end do
-      call fill_contact_row(contacts, row)
+      call fill_contact_row(contacts, row, error)
+      if (allocated(error)) return
       call check(error, row%p_max_exact, 0.0_wp, 0.0_wp, 'zero exact pressure: p_max_exact 0')
       if (allocated(error)) return
       call check(error, is_empty(row%err_p_fe), 'zero exact pressure: no relative error')

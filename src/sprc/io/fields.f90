@@ -7,7 +7,7 @@
 !> the contact pressures, gap, state, tangential tractions, weights and
 !> normals (scene units; an empty value, not computed, is NaN).
 module sprc_io_fields
-   use sprc_core_kinds, only: wp
+   use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type
    use sprc_core_alloc, only: check_allocation
    use sprc_geometry_region, only: cell_cut
@@ -19,6 +19,9 @@ module sprc_io_fields
    use sprc_contact_result, only: contact_result_type
    implicit none
    private
+
+   !> The writer, as allocation errors name it.
+   character(len=*), parameter :: who = 'HDF5 fields'
 
    public :: write_level_fields
 
@@ -74,10 +77,18 @@ contains
       character(len=*), intent(in) :: name
       type(contact_result_type), intent(in) :: c
       type(error_type), allocatable, intent(out) :: error
-      integer :: i
+      integer, allocatable :: ints(:, :)
+      real(wp), allocatable :: work(:, :)
+      integer :: i, stat
 
       if (c%npoint == 0) return
-      call h5%write_level(level, c%x, reshape([(i, i=1, c%npoint)], [1, c%npoint]), cell_vertex, error, body=name)
+      allocate (ints(1, c%npoint), stat=stat)
+      call check_allocation(stat, who, 'the vertex of each slave point', c%npoint, 4, error)
+      if (allocated(error)) return
+      do i = 1, c%npoint
+         ints(1, i) = i
+      end do
+      call h5%write_level(level, c%x, ints, cell_vertex, error, body=name)
       if (.not. allocated(error)) call scalar('p_fe', c%p_fe)
       if (.not. allocated(error)) call scalar('p_spr', c%p_spr)
       if (.not. allocated(error)) call scalar('p_sprc', c%p_sprc)
@@ -88,13 +99,15 @@ contains
       if (.not. allocated(error)) call scalar('weight', c%weight)
       if (.not. allocated(error)) call h5%write_node_field(level, 'normal', c%normal, error, body=name)
       ! 0 open, 1 stick, 2 slip (sprc_contact_result)
-      if (.not. allocated(error)) call h5%write_node_field(level, 'state', reshape(c%state, [1, c%npoint]), error, &
-         & body=name)
+      if (allocated(error)) return
+      ints(1, :) = c%state
+      call h5%write_node_field(level, 'state', ints, error, body=name)
    contains
       subroutine scalar(field, values)
          character(len=*), intent(in) :: field
          real(wp), intent(in) :: values(:)
-         call h5%write_node_field(level, field, reshape(values, [1, size(values)]), error, body=name)
+         call scaled_row(1.0_wp, values, .false., work, error)
+         if (.not. allocated(error)) call h5%write_node_field(level, field, work, error, body=name)
       end subroutine scalar
    end subroutine write_contact
 
@@ -108,7 +121,7 @@ contains
       logical, intent(in) :: done(2)
       type(error_type), allocatable, intent(out) :: error
       character(len=4), parameter :: method_name(2) = ['spr ', 'sprc']
-      real(wp), allocatable :: sigma_fe(:, :), elem(:, :)
+      real(wp), allocatable :: sigma_fe(:, :), work(:, :)
       real(wp) :: sunit, eunit
       integer, allocatable :: cls(:, :)
       integer :: m, stat
@@ -118,27 +131,34 @@ contains
       ! stress unit modulus*strain; energy norm sqrt(sigma D^-1 sigma): sqrt(modulus)*strain
       sunit = units%modulus*units%strain
       eunit = sqrt(units%modulus)*units%strain
-      call h5%write_node_field(level, 'displacement', units%strain*bl%problem%u, error, body=body)
+      call scaled(units%strain, bl%problem%u, work, error)
+      if (allocated(error)) return
+      call h5%write_node_field(level, 'displacement', work, error, body=body)
       if (allocated(error)) return
       call nodal_fe_stress(bl%problem, bl%problem%mesh%nodes, sigma_fe, error)
       if (allocated(error)) return
-      call write_stress('sigma_fe', sunit*sigma_fe, error)
+      sigma_fe = sunit*sigma_fe
+      call write_stress('sigma_fe', sigma_fe, error)
       if (allocated(error)) return
       do m = 1, 2
          if (.not. done(m)) cycle
-         call write_stress('sigma_'//trim(method_name(m)), sunit*bl%field(m)%nodal, error)
+         call scaled(sunit, bl%field(m)%nodal, work, error)
          if (allocated(error)) return
-         elem = reshape(eunit*sqrt(bl%est(m)%elem_err2), [1, size(bl%est(m)%elem_err2)])
-         call h5%write_cell_field(level, 'zz_error_'//trim(method_name(m)), elem, error, body=body)
+         call write_stress('sigma_'//trim(method_name(m)), work, error)
+         if (allocated(error)) return
+         call scaled_row(eunit, bl%est(m)%elem_err2, .true., work, error)
+         if (allocated(error)) return
+         call h5%write_cell_field(level, 'zz_error_'//trim(method_name(m)), work, error, body=body)
          if (allocated(error)) return
       end do
       if (allocated(bl%element_error)) then
-         elem = reshape(eunit*bl%element_error, [1, size(bl%element_error)])
-         call h5%write_cell_field(level, 'exact_error_fe', elem, error, body=body)
+         call scaled_row(eunit, bl%element_error, .false., work, error)
+         if (allocated(error)) return
+         call h5%write_cell_field(level, 'exact_error_fe', work, error, body=body)
          if (allocated(error)) return
       end if
       allocate (cls(1, bl%problem%mesh%grid%n_leaves), stat=stat)
-      call check_allocation(stat, 'HDF5 fields', 'the cut flag of each cell', bl%problem%mesh%grid%n_leaves, 4, error)
+      call check_allocation(stat, who, 'the cut flag of each cell', bl%problem%mesh%grid%n_leaves, 4, error)
       if (allocated(error)) return
       cls(1, :) = merge(1, 0, bl%problem%mesh%grid%leaf_class(1:bl%problem%mesh%grid%n_leaves) == cell_cut)
       call h5%write_cell_field(level, 'cut', cls, error, body=body)
@@ -155,5 +175,40 @@ contains
          end if
       end subroutine write_stress
    end subroutine write_body
+
+   !> out = unit*values, `out` (re)allocated here with stat= (a field of one
+   !> value per node or cell: sprc_core_alloc).
+   subroutine scaled(unit, values, out, error)
+      real(wp), intent(in) :: unit, values(:, :)
+      real(wp), allocatable, intent(inout) :: out(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: stat
+
+      if (allocated(out)) deallocate (out)
+      allocate (out(size(values, 1), size(values, 2)), stat=stat)
+      call check_allocation(stat, who, 'a field in the scene''s units', size(values, kind=i8), 8, error)
+      if (allocated(error)) return
+      out(:, :) = unit*values
+   end subroutine scaled
+
+   !> out(1, :) = unit*values, or unit*sqrt(values) when `root`: one value per
+   !> cell or point as a field of one component, allocated as in `scaled`.
+   subroutine scaled_row(unit, values, root, out, error)
+      real(wp), intent(in) :: unit, values(:)
+      logical, intent(in) :: root
+      real(wp), allocatable, intent(inout) :: out(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: stat
+
+      if (allocated(out)) deallocate (out)
+      allocate (out(1, size(values)), stat=stat)
+      call check_allocation(stat, who, 'a field in the scene''s units', size(values), 8, error)
+      if (allocated(error)) return
+      if (root) then
+         out(1, :) = unit*sqrt(values)
+      else
+         out(1, :) = unit*values
+      end if
+   end subroutine scaled_row
 
 end module sprc_io_fields

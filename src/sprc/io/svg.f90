@@ -22,7 +22,7 @@
 !> surface with a margin. Same page layout, markers and legend as the report
 !> plot.
 module sprc_io_svg
-   use sprc_core_kinds, only: wp
+   use sprc_core_kinds, only: wp, i8
    use sprc_core_text, only: fixed_text
    use sprc_core_alloc, only: check_allocation
    use sprc_core_error, only: error_type, fatal_error, stat_io
@@ -75,9 +75,16 @@ module sprc_io_svg
    !> Text built piece by piece in amortized linear time (a plot of many
    !> points made by repeated concatenation took quadratic time: 23 s for
    !> the 22k slave points of a 3D level).
+   !> Its growth is an allocation sized by the input (the slave points):
+   !> one that fails marks the buffer (`stat`), which then takes no more
+   !> pieces, and `buffer_error` turns the mark into an error.
    type :: text_buffer_type
       character(len=:), allocatable :: text
       integer :: n = 0
+      !> The stat= of a growth that failed (-1: longer than the longest string); 0 while all fitted.
+      integer :: stat = 0
+      !> The length that growth asked for.
+      integer(i8) :: wanted = 0
    end type text_buffer_type
    !> Extent of the contact plot's panel (one panel across the page).
    real(wp), parameter :: contact_right = page_width - 25.0_wp
@@ -103,11 +110,11 @@ contains
       !> Title on top of the picture (plain text; escaped here).
       character(len=*), intent(in) :: title
       type(error_type), allocatable, intent(out) :: error
-      character(len=:), allocatable :: svg
+      type(text_buffer_type) :: buf
 
-      call contact_svg(contacts, title, svg, error)
+      call contact_picture(contacts, title, buf, error)
       if (allocated(error)) return
-      call write_text(path, 'contact SVG', svg, error)
+      call write_text(path, 'contact SVG', buf%text(:buf%n), error)
    end subroutine write_contact_svg
 
    !> Write `text` to `path` (replacing it); `what` names the file in messages.
@@ -200,34 +207,59 @@ contains
       character(len=*), intent(in) :: title
       character(len=:), allocatable, intent(out) :: svg
       type(error_type), allocatable, intent(out) :: error
+      type(text_buffer_type) :: buf
+      integer :: stat
+
+      call contact_picture(contacts, title, buf, error)
+      if (allocated(error)) return
+      allocate (character(len=buf%n) :: svg, stat=stat)
+      call check_allocation(stat, 'contact SVG', 'the text of the picture', buf%n, 1, error)
+      if (allocated(error)) return
+      svg(1:buf%n) = buf%text(:buf%n)
+   end subroutine contact_svg
+
+   !> The contact plot of `contacts` in `buf`. Every array sized by the
+   !> slave points is allocated here, with stat= (sprc_core_alloc): the
+   !> points in abscissa order, then those shown, are prefixes of `order`.
+   subroutine contact_picture(contacts, title, buf, error)
+      type(contact_result_type), intent(in) :: contacts(:)
+      character(len=*), intent(in) :: title
+      type(text_buffer_type), intent(out) :: buf
+      type(error_type), allocatable, intent(out) :: error
       type(series_style_type) :: styles(n_contact_series)
       real(wp), allocatable :: x(:, :), p(:, :), s(:)
-      integer, allocatable :: order(:), shown(:)
+      integer, allocatable :: order(:), work(:)
       logical :: active(n_contact_series)
-      integer :: dim, k
+      integer :: dim, k, n, stat
 
       styles = contact_styles()
       call gather_points(contacts, x, p, error)
       if (allocated(error)) return
       dim = 2
       if (size(contacts) > 0) dim = contacts(1)%dim
+      n = size(x, 2)
+      allocate (s(n), order(n), work(n), stat=stat)
+      call check_allocation(stat, 'contact SVG', 'the abscissae of the slave points', n, 16, error)
+      if (allocated(error)) return
       if (dim == 2) then
-         s = along_surface(x)
+         call along_surface(x, s)
       else
-         s = from_peak(x, p)
+         call from_peak(x, p, s)
       end if
-      order = sorted(s)
-      if (dim == 2) s(order) = arc_length(x(:, order))
-      shown = pack(order, loaded_window(s(order), p(order, :)))
+      call sort_order(s, order, work)
+      if (dim == 2) call arc_length(x, order, s)
+      call loaded_window(s, p, order, n)
       do k = 1, n_contact_series
          active(k) = any(.not. is_empty(p(:, k)))
       end do
-      svg = page_open('sprc contact pressure along the slave surface (p = -n.sigma.n, positive in compression). '// &
-         'Empty values (not computed) are left out; the abscissa spans the loaded part of the surface and a '// &
-         'quarter of it on either side.', '', title)
-      svg = svg//contact_panel(s(shown), p(shown, :), styles, active, dim == 2)
-      svg = svg//legend(styles, active)//'</g>'//nl//'</svg>'//nl
-   end subroutine contact_svg
+      call append(buf, page_open('sprc contact pressure along the slave surface (p = -n.sigma.n, positive in '// &
+         'compression). Empty values (not computed) are left out; the abscissa spans the loaded part of the '// &
+         'surface and a quarter of it on either side.', '', title))
+      call contact_panel(buf, s, p, order(:n), styles, active, dim == 2, error)
+      if (allocated(error)) return
+      call append(buf, legend(styles, active)//'</g>'//nl//'</svg>'//nl)
+      call buffer_error(buf, 'contact SVG', error)
+   end subroutine contact_picture
 
    !> The contact plot's series: FE dots, SPR dashed squares, SPR-C dots, exact a black line.
    function contact_styles() result(styles)
@@ -264,89 +296,118 @@ contains
       end do
    end subroutine gather_points
 
-   !> 2D: the coordinate of each point along the principal direction of the
-   !> points (largest spread), from their centroid, the direction's first
+   !> 2D: s, the coordinate of each point x(:, i) along the principal direction
+   !> of the points (largest spread), from their centroid, the direction's first
    !> nonzero component positive.
-   pure function along_surface(x) result(s)
+   pure subroutine along_surface(x, s)
       real(wp), intent(in) :: x(:, :)
-      real(wp) :: s(size(x, 2))
-      real(wp) :: c(2), d(2, size(x, 2)), t(2), theta
+      real(wp), intent(out) :: s(:)
+      real(wp) :: c(2), d(2), t(2), sxy, sxx, syy, theta
+      integer :: i
 
       if (size(x, 2) == 0) return
       c = sum(x, dim=2)/size(x, 2)
-      d = x - spread(c, 2, size(x, 2))
-      theta = 0.5_wp*atan2(2.0_wp*sum(d(1, :)*d(2, :)), sum(d(1, :)**2) - sum(d(2, :)**2))
+      sxy = 0.0_wp
+      sxx = 0.0_wp
+      syy = 0.0_wp
+      do i = 1, size(x, 2)
+         d = x(:, i) - c
+         sxy = sxy + d(1)*d(2)
+         sxx = sxx + d(1)**2
+         syy = syy + d(2)**2
+      end do
+      theta = 0.5_wp*atan2(2.0_wp*sxy, sxx - syy)
       t = [cos(theta), sin(theta)]
       if (t(1) < 0.0_wp .or. (.not. (abs(t(1)) > 0.0_wp) .and. t(2) < 0.0_wp)) t = -t
-      s = matmul(t, d)
-   end function along_surface
-
-   !> Arc length at each of the points `x(dim, n)` (in order along a curve):
-   !> the sum of the distances between consecutive points, 0 at the first.
-   pure function arc_length(x) result(s)
-      real(wp), intent(in) :: x(:, :)
-      real(wp) :: s(size(x, 2))
-      integer :: i
-
-      if (size(x, 2) == 0) return
-      s(1) = 0.0_wp
-      do i = 2, size(x, 2)
-         s(i) = s(i - 1) + norm2(x(:, i) - x(:, i - 1))
+      do i = 1, size(x, 2)
+         s(i) = dot_product(t, x(:, i) - c)
       end do
-   end function arc_length
+   end subroutine along_surface
 
-   !> The points to plot, `s` ascending: those within a quarter of the loaded
-   !> stretch (where some pressure exceeds 1e-3 of the largest) on either side
-   !> of it, so that a Hertz contact a few per cent of the surface long fills
-   !> the picture; every point when nothing is loaded.
-   pure function loaded_window(s, p) result(keep)
-      real(wp), intent(in) :: s(:), p(:, :)
-      logical :: keep(size(s))
-      logical :: loaded(size(s))
-      real(wp) :: p_max, lo, hi, margin
+   !> s(order(i)) = the arc length at the points x(:, order(:)), in that order
+   !> along a curve: the sum of the distances between consecutive points, 0 at the first.
+   pure subroutine arc_length(x, order, s)
+      real(wp), intent(in) :: x(:, :)
+      integer, intent(in) :: order(:)
+      real(wp), intent(inout) :: s(:)
       integer :: i
 
-      keep = .true.
+      if (size(order) == 0) return
+      s(order(1)) = 0.0_wp
+      do i = 2, size(order)
+         s(order(i)) = s(order(i - 1)) + norm2(x(:, order(i)) - x(:, order(i - 1)))
+      end do
+   end subroutine arc_length
+
+   !> The points to plot: of `order` (s ascending), the first `m` on return are
+   !> those within a quarter of the loaded stretch (where some pressure exceeds
+   !> 1e-3 of the largest) on either side of it, in the same order, so that a
+   !> Hertz contact a few per cent of the surface long fills the picture; every
+   !> point when nothing is loaded.
+   pure subroutine loaded_window(s, p, order, m)
+      real(wp), intent(in) :: s(:), p(:, :)
+      integer, intent(inout) :: order(:)
+      integer, intent(out) :: m
+      real(wp) :: p_max, lo, hi, margin
+      integer :: i, j
+
+      m = size(order)
       p_max = 0.0_wp
       do i = 1, size(s)
          p_max = max(p_max, maxval(abs(p(i, :)), mask=.not. is_empty(p(i, :))))
       end do
       if (.not. (p_max > 0.0_wp)) return
+      lo = huge(1.0_wp)
+      hi = -huge(1.0_wp)
       do i = 1, size(s)
-         loaded(i) = any(abs(p(i, :)) > 1.0e-3_wp*p_max .and. .not. is_empty(p(i, :)))
+         if (.not. any(abs(p(i, :)) > 1.0e-3_wp*p_max .and. .not. is_empty(p(i, :)))) cycle
+         lo = min(lo, s(i))
+         hi = max(hi, s(i))
       end do
-      lo = minval(s, mask=loaded)
-      hi = maxval(s, mask=loaded)
       margin = 0.25_wp*(hi - lo)
-      if (.not. (margin > 0.0_wp)) margin = 0.05_wp*(s(size(s)) - s(1))
-      keep = s >= lo - margin .and. s <= hi + margin
-   end function loaded_window
+      if (.not. (margin > 0.0_wp)) margin = 0.05_wp*(s(order(size(order))) - s(order(1)))
+      m = 0
+      do i = 1, size(order)
+         j = order(i)
+         if (s(j) < lo - margin .or. s(j) > hi + margin) cycle
+         m = m + 1
+         order(m) = j
+      end do
+   end subroutine loaded_window
 
-   !> 3D: the distance of each point from the point of largest exact pressure
+   !> 3D: s, the distance of each point from the point of largest exact pressure
    !> (largest FE pressure without an exact one; the first point without either).
-   pure function from_peak(x, p) result(s)
+   pure subroutine from_peak(x, p, s)
       real(wp), intent(in) :: x(:, :), p(:, :)
-      real(wp) :: s(size(x, 2))
+      real(wp), intent(out) :: s(:)
       integer :: i, peak, k
 
       if (size(x, 2) == 0) return
-      peak = 1
+      peak = 0
       do k = 4, 1, -3
-         if (all(is_empty(p(:, k)))) cycle
-         peak = maxloc(p(:, k), dim=1, mask=.not. is_empty(p(:, k)))
-         exit
+         do i = 1, size(x, 2)
+            if (is_empty(p(i, k))) cycle
+            if (peak == 0) then
+               peak = i
+            else if (p(i, k) > p(peak, k)) then
+               peak = i
+            end if
+         end do
+         if (peak > 0) exit
       end do
+      peak = max(peak, 1)
       do i = 1, size(x, 2)
          s(i) = norm2(x(:, i) - x(:, peak))
       end do
-   end function from_peak
+   end subroutine from_peak
 
-   !> The permutation sorting `v` ascending: a stable bottom-up merge sort
-   !> (a 3D slave surface has tens of thousands of points in no order).
-   pure function sorted(v) result(order)
+   !> `order`, the permutation sorting `v` ascending: a stable bottom-up merge
+   !> sort (a 3D slave surface has tens of thousands of points in no order);
+   !> `work` is scratch of the same size.
+   pure subroutine sort_order(v, order, work)
       real(wp), intent(in) :: v(:)
-      integer :: order(size(v))
-      integer :: work(size(v)), width, lo, mid, hi, i, j, k, n
+      integer, intent(out) :: order(:), work(:)
+      integer :: width, lo, mid, hi, i, j, k, n
 
       n = size(v)
       order = [(i, i=1, n)]
@@ -376,68 +437,103 @@ contains
          order = work
          width = 2*width
       end do
-   end function sorted
+   end subroutine sort_order
 
-   !> The one panel of the contact plot: frame, grid, ticks, axis titles, one
-   !> series per active column of p (joined by lines when `lines`).
-   function contact_panel(s, p, styles, active, lines) result(text)
+   !> The one panel of the contact plot, appended to `buf`: frame, grid, ticks,
+   !> axis titles, one series per active column of p over the points `shown`
+   !> (joined by lines when `lines`).
+   subroutine contact_panel(buf, s, p, shown, styles, active, lines, error)
+      type(text_buffer_type), intent(inout) :: buf
       real(wp), intent(in) :: s(:), p(:, :)
+      integer, intent(in) :: shown(:)
       type(series_style_type), intent(in) :: styles(:)
       logical, intent(in) :: active(:), lines
-      character(len=:), allocatable :: text
+      type(error_type), allocatable, intent(out) :: error
       type(linear_axis_type) :: ax, ay
-      logical :: valid(size(s), size(styles))
-      real(wp) :: xs(size(s)), ys(size(s))
-      type(text_buffer_type) :: buf
-      integer :: k, i, m
+      real(wp), allocatable :: xs(:), ys(:)
+      real(wp) :: s_range(2), p_range(2)
+      integer :: k, i, m, stat
 
+      s_range = [huge(1.0_wp), -huge(1.0_wp)]
+      p_range = [0.0_wp, 0.0_wp]
       do k = 1, size(styles)
-         valid(:, k) = active(k) .and. .not. is_empty(p(:, k))
+         if (.not. active(k)) cycle
+         do i = 1, size(shown)
+            if (is_empty(p(shown(i), k))) cycle
+            s_range = [min(s_range(1), s(shown(i))), max(s_range(2), s(shown(i)))]
+            p_range = [min(p_range(1), p(shown(i), k)), max(p_range(2), p(shown(i), k))]
+         end do
       end do
-      text = '<g>'//nl//'<text x="'//num((plot_left + contact_right)/2)//'" y="'//num(plot_bottom + 42)// &
-         '" text-anchor="middle">'//pick(lines, 'arc length along the slave surface', &
+      call append(buf, '<g>'//nl//'<text x="'//num((plot_left + contact_right)/2)//'" y="'// &
+         num(plot_bottom + 42)//'" text-anchor="middle">'//pick(lines, 'arc length along the slave surface', &
          'distance from the point of peak pressure')//'</text>'//nl// &
          '<text x="22" y="'//num((plot_top + plot_bottom)/2)//'" text-anchor="middle" '// &
-         'transform="rotate(-90 22 '//num((plot_top + plot_bottom)/2)//')">contact pressure p</text>'//nl
-      if (.not. any(valid)) then
-         text = text//frame(plot_left, contact_right)//'<text x="'//num((plot_left + contact_right)/2)//'" y="'// &
-            num((plot_top + plot_bottom)/2)//'" text-anchor="middle" fill="#888888">no data</text>'//nl//'</g>'//nl
+         'transform="rotate(-90 22 '//num((plot_top + plot_bottom)/2)//')">contact pressure p</text>'//nl)
+      if (s_range(1) > s_range(2)) then
+         call append(buf, frame(plot_left, contact_right)//'<text x="'//num((plot_left + contact_right)/2)// &
+            '" y="'//num((plot_top + plot_bottom)/2)//'" text-anchor="middle" fill="#888888">no data</text>'// &
+            nl//'</g>'//nl)
          return
       end if
-      ax = linear_axis(pack(spread(s, 2, size(styles)), valid))
-      ay = linear_axis([pack(p, valid), 0.0_wp])
-      call append(buf, text//linear_ticks(ax, .true.)//linear_ticks(ay, .false.)//frame(plot_left, contact_right))
+      allocate (xs(size(shown)), ys(size(shown)), stat=stat)
+      call check_allocation(stat, 'contact SVG', 'the positions of the points shown', size(shown), 16, error)
+      if (allocated(error)) return
+      ax = linear_axis(s_range)
+      ay = linear_axis(p_range)
+      call append(buf, linear_ticks(ax, .true.)//linear_ticks(ay, .false.)//frame(plot_left, contact_right))
       do k = 1, size(styles)
+         if (.not. active(k)) cycle
          m = 0
-         do i = 1, size(s)
-            if (.not. valid(i, k)) cycle
+         do i = 1, size(shown)
+            if (is_empty(p(shown(i), k))) cycle
             m = m + 1
-            xs(m) = linear_map(ax, s(i), plot_left, contact_right)
-            ys(m) = linear_map(ay, p(i, k), plot_bottom, plot_top)
+            xs(m) = linear_map(ax, s(shown(i)), plot_left, contact_right)
+            ys(m) = linear_map(ay, p(shown(i), k), plot_bottom, plot_top)
          end do
-         if (lines .and. m >= 2) call append(buf, polyline(styles(k), xs(:m), ys(:m)))
+         if (lines .and. m >= 2) call append_polyline(buf, styles(k), xs(:m), ys(:m))
          do i = 1, m, max(1, (m + max_markers - 1)/max_markers)
             call append(buf, marker(styles(k), xs(i), ys(i), 'point '//styles(k)%name))
          end do
       end do
-      text = buf%text(:buf%n)//'</g>'//nl
-   end function contact_panel
+      call append(buf, '</g>'//nl)
+   end subroutine contact_panel
 
-   !> Add `piece` to the end of `buf`, doubling its room when full.
+   !> Add `piece` to the end of `buf`, doubling its room when full. A growth
+   !> that cannot be allocated marks `buf` failed (`stat`, `wanted`); a failed
+   !> buffer takes no more pieces.
    pure subroutine append(buf, piece)
       type(text_buffer_type), intent(inout) :: buf
       character(len=*), intent(in) :: piece
       character(len=:), allocatable :: larger
+      integer(i8) :: needed, room
 
-      if (.not. allocated(buf%text)) allocate (character(len=max(4096, 2*len(piece))) :: buf%text)
-      if (buf%n + len(piece) > len(buf%text)) then
-         allocate (character(len=max(2*len(buf%text), buf%n + len(piece))) :: larger)
-         larger(:buf%n) = buf%text(:buf%n)
+      if (buf%stat /= 0) return
+      needed = int(buf%n, i8) + len(piece)
+      room = 0
+      if (allocated(buf%text)) room = len(buf%text)
+      if (needed > room) then
+         room = min(max(4096_i8, 2*room, needed), int(huge(0), i8))
+         buf%wanted = room
+         if (needed > room) then
+            buf%stat = -1
+            return
+         end if
+         allocate (character(len=room) :: larger, stat=buf%stat)
+         if (buf%stat /= 0) return
+         if (buf%n > 0) larger(:buf%n) = buf%text(:buf%n)
          call move_alloc(larger, buf%text)
       end if
       buf%text(buf%n + 1:buf%n + len(piece)) = piece
       buf%n = buf%n + len(piece)
    end subroutine append
+
+   !> `error` (stat_out_of_memory) when a growth of `buf` failed; `who` names the picture.
+   pure subroutine buffer_error(buf, who, error)
+      type(text_buffer_type), intent(in) :: buf
+      character(len=*), intent(in) :: who
+      type(error_type), allocatable, intent(out) :: error
+      call check_allocation(buf%stat, who, 'the text of the picture', buf%wanted, 1, error)
+   end subroutine buffer_error
 
    !> An axis from a multiple of a round step (1, 2 or 5 times a power of ten,
    !> about five steps) below the values to one above them; a single value
@@ -667,20 +763,29 @@ contains
          '" stroke="'//colour//'" stroke-width="1"/>'//nl
    end function line
 
-   !> The line of a series through the points (xs, ys).
+   !> The line of a series through the few points (xs, ys) of the report plot.
    function polyline(style, xs, ys) result(text)
       type(series_style_type), intent(in) :: style
       real(wp), intent(in) :: xs(:), ys(:)
       character(len=:), allocatable :: text
-      type(text_buffer_type) :: pts
-      integer :: i
-      call append(pts, '')
-      do i = 1, size(xs)
-         call append(pts, ' '//num(xs(i))//','//num(ys(i)))
-      end do
-      text = '<polyline class="line '//style%name//'" points="'//pts%text(2:pts%n)// &
-         '" fill="none" stroke="'//style%colour//'"'//style%stroke//'/>'//nl
+      type(text_buffer_type) :: buf
+      call append_polyline(buf, style, xs, ys)
+      text = ''
+      if (buf%stat == 0) text = buf%text(:buf%n)
    end function polyline
+
+   !> Append the line of a series through the points (xs, ys) to `buf`.
+   subroutine append_polyline(buf, style, xs, ys)
+      type(text_buffer_type), intent(inout) :: buf
+      type(series_style_type), intent(in) :: style
+      real(wp), intent(in) :: xs(:), ys(:)
+      integer :: i
+      call append(buf, '<polyline class="line '//style%name//'" points="')
+      do i = 1, size(xs)
+         call append(buf, pick(i > 1, ' ', '')//num(xs(i))//','//num(ys(i)))
+      end do
+      call append(buf, '" fill="none" stroke="'//style%colour//'"'//style%stroke//'/>'//nl)
+   end subroutine append_polyline
 
    !> The marker of a series centred at (x, y): a pale wide disc, a filled
    !> circle, an open square, or nothing.

@@ -15,11 +15,12 @@
 !> After a level's contact solve and recoveries:
 !> ```fortran
 !> call fill_contact_exact(study%scene, result%contacts, error)   ! p_exact where &exact gives it
-!> call fill_contact_row(result%contacts, result%row)
+!> call fill_contact_row(result%contacts, result%row, error)
 !> ```
 module sprc_study_contact_row
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type
+   use sprc_core_alloc, only: check_allocation
    use sprc_exact_pressure, only: exact_pressure_type
    use sprc_contact_result, only: contact_result_type, contact_open
    use sprc_study_row, only: report_row_type, report_empty, is_empty
@@ -62,22 +63,31 @@ contains
    end subroutine fill_exact_pressure
 
    !> The contact columns of `row` from the level's contact results; `has_contact` set.
-   subroutine fill_contact_row(contacts, row)
+   !> The slave points of all pairs are gathered in arrays allocated with stat=
+   !> (sprc_core_alloc): an allocation that fails is `error`.
+   subroutine fill_contact_row(contacts, row, error)
       type(contact_result_type), intent(in) :: contacts(:)
       type(report_row_type), intent(inout) :: row
+      type(error_type), allocatable, intent(out) :: error
       real(wp), allocatable :: w(:), p_fe(:), p_spr(:), p_sprc(:), p_ex(:)
       logical, allocatable :: closed(:)
-      integer :: k
+      integer :: k, n, m, stat
 
-      allocate (w(0), p_fe(0), p_spr(0), p_sprc(0), p_ex(0), closed(0))
+      n = sum(contacts%npoint)
+      allocate (w(n), p_fe(n), p_spr(n), p_sprc(n), p_ex(n), closed(n), stat=stat)
+      call check_allocation(stat, 'contact report row', 'the slave points of the pairs', n, 44, error)
+      if (allocated(error)) return
+      n = 0
       do k = 1, size(contacts)
          associate (c => contacts(k))
-            w = [w, c%weight]
-            p_fe = [p_fe, c%p_fe]
-            p_spr = [p_spr, c%p_spr]
-            p_sprc = [p_sprc, c%p_sprc]
-            p_ex = [p_ex, c%p_exact]
-            closed = [closed, c%state /= contact_open]
+            m = c%npoint
+            w(n + 1:n + m) = c%weight
+            p_fe(n + 1:n + m) = c%p_fe
+            p_spr(n + 1:n + m) = c%p_spr
+            p_sprc(n + 1:n + m) = c%p_sprc
+            p_ex(n + 1:n + m) = c%p_exact
+            closed(n + 1:n + m) = c%state /= contact_open
+            n = n + m
          end associate
       end do
       row%has_contact = .true.

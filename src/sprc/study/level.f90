@@ -263,7 +263,8 @@ contains
          result%row%t_contact = t_contact
          call fill_contact_exact(study%scene, result%contacts, error)
          if (allocated(error)) return
-         call fill_contact_row(result%contacts, result%row)
+         call fill_contact_row(result%contacts, result%row, error)
+         if (allocated(error)) return
       end if
       result%row%t_total = wall_time() - t_start
       call check_row(result%row, study%have_exact, result%done, error)
