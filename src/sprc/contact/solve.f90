@@ -23,8 +23,13 @@
 !> to every interior trace function, and the multiplier showed it (a shrink
 !> fit's pressure oscillating around the ring at every level and kappa, a 3D
 !> Hertz peak far too high); P0 on the parent cells is the stable
-!> macro-element pair. The price: the open/closed boundary is resolved to a
-!> contact cell, two slave cells. The multiplier is
+!> macro-element pair. The same holds against the master's trace, which the
+!> constraint moves alone when the slave is much the stiffer: where the
+!> master's cells are larger than the slave's, a contact cell is the ancestor
+!> spanning at least two master cells (a shaft slave on a grid half the size
+!> of a soft hub's pressure alternated by 5 % from cell to cell). The price:
+!> the open/closed boundary is resolved to a contact cell, two slave cells
+!> (or two master cells). The multiplier is
 !> eliminated cell by cell: stationarity in lambda_c gives
 !>   lambda_c = pbar + gamma gbar,
 !> with pbar, gbar the means over the cell's points of p_N and g, and the
@@ -426,7 +431,7 @@ contains
       integer :: i, q0, q1, d, c, stat
 
       d = surface%dim
-      call group_cells(surface, slave, ops, error)
+      call group_cells(surface, slave, master, ops, error)
       if (allocated(error)) return
       allocate (loc(surface%npoint), ops%ptr(surface%npoint + 1), ops%gamma(ops%ncell), stat=stat)
       call check_allocation(stat, 'contact operators', 'the points'' operators', surface%npoint, 128, error)
@@ -476,9 +481,9 @@ contains
    !> joins the group of at least that measure whose centroid is nearest: a
    !> multiplier on a sliver is barely constrained by the displacements, and
    !> its pressure is noise that can open it falsely.
-   subroutine group_cells(surface, slave, ops, error)
+   subroutine group_cells(surface, slave, master, ops, error)
       type(contact_surface_type), intent(in) :: surface
-      type(elasticity_problem_type), intent(in) :: slave
+      type(elasticity_problem_type), intent(in) :: slave, master
       type(point_operators_type), intent(inout) :: ops
       type(error_type), allocatable, intent(out) :: error
       integer :: key(surface%npoint), group(slave%mesh%grid%n_leaves), cell_of_leaf(slave%mesh%grid%n_leaves)
@@ -492,7 +497,7 @@ contains
       key = 0
       measure = 0.0_wp
       centroid = 0.0_wp
-      call macro_cells(surface, slave, macro)
+      call macro_cells(surface, slave, master, macro)
       do i = 1, surface%npoint
          if (.not. surface%has_master(i)) cycle
          key(i) = macro(slave%root(surface%slave_cell(i)))
@@ -552,26 +557,36 @@ contains
    end subroutine group_cells
 
    !> macro(e): the representative of slave root e's contact macro cell, the
-   !> first root of the contact (in leaf order) with the same parent cell.
-   subroutine macro_cells(surface, slave, macro)
+   !> first root of the contact (in leaf order) with the same ancestor `shift`
+   !> levels up: the parent (shift 1), or the ancestor at least twice as large
+   !> as the master cells of the root's points (module notes).
+   subroutine macro_cells(surface, slave, master, macro)
       type(contact_surface_type), intent(in) :: surface
-      type(elasticity_problem_type), intent(in) :: slave
+      type(elasticity_problem_type), intent(in) :: slave, master
       integer, intent(out) :: macro(:)
       integer, allocatable :: roots(:)
       logical :: used(size(macro))
-      integer :: i, j, e, d
+      integer :: shift(size(macro))
+      integer :: i, j, e, d, r
 
       d = surface%dim
       used = .false.
+      shift = 1
       do i = 1, surface%npoint
-         if (surface%has_master(i)) used(slave%root(surface%slave_cell(i))) = .true.
+         if (.not. surface%has_master(i)) cycle
+         r = slave%root(surface%slave_cell(i))
+         used(r) = .true.
+         shift(r) = max(shift(r), 1 + max(0, ceiling(log(cell_size(master, surface%master_cell(i))/ &
+            & cell_size(slave, r))/log(2.0_wp) - 1.0e-6_wp)))
       end do
       roots = pack([(e, e=1, size(macro))], used)
       macro = [(e, e=1, size(macro))]
       do i = 1, size(roots)
          do j = 1, i - 1
             if (slave%mesh%grid%leaf_level(roots(j)) == slave%mesh%grid%leaf_level(roots(i)) .and. &
-               & all(slave%mesh%grid%leaf_coord(1:d, roots(j))/2 == slave%mesh%grid%leaf_coord(1:d, roots(i))/2)) then
+               & shift(roots(j)) == shift(roots(i)) .and. &
+               & all(slave%mesh%grid%leaf_coord(1:d, roots(j))/2**shift(roots(j)) == &
+               & slave%mesh%grid%leaf_coord(1:d, roots(i))/2**shift(roots(i)))) then
                macro(roots(i)) = macro(roots(j))
                exit
             end if
