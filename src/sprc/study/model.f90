@@ -221,10 +221,15 @@ contains
       end select
    end function scene_warnings
 
-   !> The warnings of the contact pairs: a kappa outside `kappa_range`.
+   !> The warnings of the contact pairs: a kappa outside `kappa_range`; a
+   !> slave at least `stiff_slave` times as stiff as its master.
    function contact_warnings(scene) result(text)
       type(scene_type), intent(in) :: scene
       character(len=:), allocatable :: text
+      !> The stability study (README): with the shaft as the slave, E_hub/E_shaft
+      !> = 1e-1 already doubled err_p_fe; the softer body as the slave never cost.
+      real(wp), parameter :: stiff_slave = 10.0_wp
+      real(wp) :: e(2), decades
       integer :: k
 
       text = ''
@@ -232,6 +237,15 @@ contains
          associate (c => scene%contacts(k))
             if (len(kappa_note(c%kappa, c%stabilization)) > 0) text = text//"warning: &contact slave='"// &
                & c%slave//"' master='"//c%master//"': "//kappa_note(c%kappa, c%stabilization)//new_line('a')
+            if (c%slave_index < 1 .or. c%master_index < 1) cycle
+            e = [scene%bodies(c%slave_index)%young, scene%bodies(c%master_index)%young]
+            if (.not. (e(1) > 0.0_wp .and. e(2) > 0.0_wp .and. e(1) < huge(1.0_wp) .and. e(2) < huge(1.0_wp))) cycle
+            ! logarithms: the moduli may lie anywhere in the representable range
+            decades = log10(e(1)) - log10(e(2))
+            if (decades >= log10(stiff_slave)) text = text//"warning: &contact slave='"//c%slave//"' master='"// &
+               & c%master//"': the slave is about 1e"//itoa(nint(decades))//' times as stiff as the master; the '// &
+               & 'contact pressure is more accurate with the softer body as the slave (swap slave and master, '// &
+               & 'and slave_surface and master_surface)'//new_line('a')
          end associate
       end do
    end function contact_warnings
