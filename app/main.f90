@@ -39,6 +39,8 @@ program sprc_main
    !> which made small levels slower on two threads than on one and the error-against-time
    !> curve run backwards (figures in the commit that set it). Same bits either way.
    real(wp), parameter :: serial_dofs = 5000.0_wp
+   !> The level of the warm-up run (`warm_up`): cheap, but through every library the study calls.
+   integer, parameter :: warm_level = 2
 
    interface
       !> C's rename(3) (stdio.h): replaces `new` atomically within a file system.
@@ -110,7 +112,7 @@ contains
       type(error_type), allocatable :: error
       character(len=:), allocatable :: prefix
       integer, allocatable :: levels(:)
-      integer :: i, threads, n_outputs, rank, ranks
+      integer :: i, threads, n_outputs, rank, ranks, n_contact
       character(len=16) :: buf
       real(wp) :: total_dofs
       logical :: quiet
@@ -141,12 +143,14 @@ contains
          call h5%create(prefix//'.h5'//partial, error)
          if (allocated(error)) call fail_with(error)
       end if
-      allocate (rows(size(levels)), contact_levels(0))
+      ! One slot per level: the levels' contact results move in, not copied (they are sized by the slave points).
+      allocate (rows(size(levels)), contact_levels(size(levels)))
+      n_contact = 0
       threads = omp_get_max_threads()
       do i = 1, size(levels)
          total_dofs = study_dofs(study, levels(i))
          if (cli%threads == 0) call omp_set_num_threads(merge(1, threads, total_dofs < serial_dofs))
-         if (i == 1 .and. total_dofs < serial_dofs) call warm_up(study, levels(i))
+         if (i == 1 .and. total_dofs < serial_dofs) call warm_up(study, min(levels(i), warm_level))
          if (.not. quiet) write (error_unit, '(a,i0,a,i0,a,i0,a)') 'sprc: level ', levels(i), &
             ' (', i, ' of ', size(levels), ')'
          if (cli%quiet) then
@@ -157,8 +161,12 @@ contains
          end if
          if (.not. allocated(error)) then
             rows(i) = result%row
-            if (allocated(result%contacts)) contact_levels = [contact_levels, contact_level_type(levels(i), result%contacts)]
             if (h5%opened()) call write_level_fields(h5, study, result, error)
+         end if
+         if (.not. allocated(error) .and. allocated(result%contacts)) then
+            n_contact = n_contact + 1
+            contact_levels(n_contact)%level = levels(i)
+            call move_alloc(result%contacts, contact_levels(n_contact)%contacts)
          end if
          if (allocated(error)) then
             write (buf, '("level ",i0,":")') levels(i)
@@ -177,10 +185,10 @@ contains
       if (.not. allocated(error)) call h5%close(error)
       if (.not. allocated(error)) call h5%write_xdmf(prefix//'.xdmf'//partial, error, data_path=prefix//'.h5')
       n_outputs = 4
-      if (size(contact_levels) > 0 .and. .not. allocated(error)) then
+      if (n_contact > 0 .and. .not. allocated(error)) then
          n_outputs = 6
-         call write_contact_csv(prefix//'_contact.csv'//partial, contact_levels, error)
-         associate (finest => contact_levels(size(contact_levels)))
+         call write_contact_csv(prefix//'_contact.csv'//partial, contact_levels(:n_contact), error)
+         associate (finest => contact_levels(n_contact))
             if (.not. allocated(error)) call write_contact_svg(prefix//'_contact.svg'//partial, finest%contacts, &
                & scene%title//', contact pressure at level '//itoa(finest%level), error)
          end associate
@@ -216,10 +224,12 @@ contains
       end do
    end function study_dofs
 
-   !> Runs `level` once, untimed, and drops the result, so that the run's one-off costs (first
-   !> calls into the shared libraries, cold caches, the heap's first pages) stay out of the
-   !> first level's times; only a small first level, where they are a material share of its time
-   !> (figures in the commit that added it). An error is left for the timed run to report.
+   !> Runs `level` (a coarse one) once, untimed, and drops the result, so that the run's one-off
+   !> costs (first calls into the shared libraries, cold caches) stay out of the first level's
+   !> times; only before a small first level, where they are a material share of its time
+   !> (figures in the commits that added it). Not the first level itself: a small level can still
+   !> be expensive (Coulomb stages), and running it twice doubled a fuzzed run to 26 s. An error
+   !> (a body smaller than a cell at that level) only ends the warm-up.
    subroutine warm_up(study, level)
       type(study_type), intent(in) :: study
       integer, intent(in) :: level
