@@ -47,6 +47,7 @@ contains
          new_unittest('hertz_examples', test_hertz_examples), &
          new_unittest('contact_row_hand_values', test_contact_row), &
          new_unittest('contact_row_without_exact', test_contact_row_no_exact), &
+         new_unittest('contact_row_huge_pressure', test_contact_row_huge), &
          new_unittest('fill_exact_pressure', test_fill_exact_pressure), &
          new_unittest('fill_contact_exact_scene', test_fill_contact_exact) &
          ]
@@ -349,6 +350,25 @@ contains
       if (allocated(error)) return
       call check(error, is_empty(row%err_p_fe), 'zero exact pressure: no relative error')
    end subroutine test_contact_row_no_exact
+
+   !> The relative pressure error does not overflow when the FE pressure is far
+   !> larger than the exact one (a fuzzed load of 1e308): p_fe = 1e300 p_exact
+   !> gives err_p_fe = 1e300 - 1 by hand (it was Infinity: the squares of
+   !> (p_fe - p_exact)/max|p_exact| overflowed).
+   subroutine test_contact_row_huge(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_result_type), allocatable :: contacts(:)
+      type(report_row_type) :: row
+      integer :: k
+
+      contacts = contact_sample()
+      do k = 1, size(contacts)
+         contacts(k)%p_fe = 1.0e300_wp*contacts(k)%p_exact
+      end do
+      call fill_contact_row(contacts, row, error)
+      if (allocated(error)) return
+      call check(error, row%err_p_fe, 1.0e300_wp - 1.0_wp, roundoff, 'err_p_fe of p_fe = 1e300 p_exact', rel=.true.)
+   end subroutine test_contact_row_huge
 
    !> fill_exact_pressure evaluates at each point with its normal: the uniform
    !> patch test's p = -n.sigma.n = -sigma_zz for n = -e_z, -sigma_xx for n = e_x.

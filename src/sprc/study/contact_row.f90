@@ -111,11 +111,12 @@ contains
    end function maximum
 
    !> ||p - p_ex|| / ||p_ex|| in the weighted L2 norm; empty if either has an
-   !> empty value or ||p_ex|| = 0. Pressures are divided by the largest |p_ex|
-   !> first, so squares neither overflow nor underflow whatever the units.
+   !> empty value or ||p_ex|| = 0. Each norm's values are divided by their
+   !> largest magnitude first, so squares neither overflow nor underflow
+   !> whatever the units and however far p is from p_ex.
    pure real(wp) function relative_l2(p, p_ex, w)
       real(wp), intent(in) :: p(:), p_ex(:), w(:)
-      real(wp) :: norm_ex, unit
+      real(wp) :: norm_ex, unit, unit_d
 
       relative_l2 = report_empty
       if (size(p) == 0) return
@@ -124,7 +125,10 @@ contains
       if (.not. (unit > 0.0_wp)) return
       norm_ex = sqrt(sum(w*(p_ex/unit)**2))
       if (.not. (norm_ex > 0.0_wp)) return
-      relative_l2 = sqrt(sum(w*((p - p_ex)/unit)**2))/norm_ex
+      ! The difference in its own unit: p may be far larger than p_ex.
+      unit_d = maxval(abs(p - p_ex))
+      relative_l2 = 0.0_wp
+      if (unit_d > 0.0_wp) relative_l2 = (unit_d/unit)*(sqrt(sum(w*((p - p_ex)/unit_d)**2))/norm_ex)
    end function relative_l2
 
 end module sprc_study_contact_row
