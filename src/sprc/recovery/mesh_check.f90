@@ -259,9 +259,11 @@ contains
       integer, allocatable :: table(:)
       integer :: n, nslot, slot, m, stat
 
-      ! A power of two at least twice the used nodes: short probe chains.
+      ! A power of two at least 1.5 times the used nodes: load at most 2/3, short probe chains
+      ! in adjacent slots, and a table half the size of one at load 1/2 (262,144 nodes: 2 MB,
+      ! which stays in a core's L2 cache; its accesses are random).
       nslot = 4
-      do while (nslot < 2*count(used))
+      do while (2*nslot < 3*count(used))
          nslot = 2*nslot
       end do
       allocate (table(nslot), stat=stat)
