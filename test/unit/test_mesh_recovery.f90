@@ -1213,11 +1213,11 @@ contains
       end do
    end subroutine case_fill
 
-   pure function case_points_of(self, e) result(counts)
+   pure function case_points_of(self, elements) result(counts)
       class(case_source_type), intent(in) :: self
-      integer, intent(in) :: e
+      integer, intent(in) :: elements(:)
       integer :: counts(2)
-      counts = [size(self%c%gp, 2) + 0*e, 0]
+      counts = [size(self%c%gp, 2)*size(elements), 0]
    end function case_points_of
 
    !> The shared patch loop (sprc_recovery_patch_loop) with patches left to another module

@@ -265,15 +265,20 @@ contains
       end do
    end subroutine number_patches
 
-   !> [volume points, boundary points] leaf e adds to a patch (boundary points of every
+   !> [volume points, boundary points] the leaves add to a patch (boundary points of every
    !> kind: the capacity of before).
-   pure function grid_points_of(self, e) result(counts)
+   pure function grid_points_of(self, elements) result(counts)
       class(grid_source_type), intent(in) :: self
-      integer, intent(in) :: e
+      integer, intent(in) :: elements(:)
       integer :: counts(2)
+      integer :: i, e
 
-      counts = [self%input%elem_ptr(e + 1) - self%input%elem_ptr(e), 0]
-      if (self%sprc) counts(2) = self%input%belem_ptr(e + 1) - self%input%belem_ptr(e)
+      counts = 0
+      do i = 1, size(elements)
+         e = elements(i)
+         counts(1) = counts(1) + self%input%elem_ptr(e + 1) - self%input%elem_ptr(e)
+         if (self%sprc) counts(2) = counts(2) + self%input%belem_ptr(e + 1) - self%input%belem_ptr(e)
+      end do
    end function grid_points_of
 
    !> The patch of node n over the listed leaves (storage reused).

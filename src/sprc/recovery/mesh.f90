@@ -735,14 +735,18 @@ contains
       r%n_tolerance_bites = count(r%recs%tolerance_bites)
    end subroutine recover_patches
 
-   !> [volume points, boundary points] element e adds to a patch.
-   pure function mesh_points_of(self, e) result(counts)
+   !> [volume points, boundary points] the elements add to a patch.
+   pure function mesh_points_of(self, elements) result(counts)
       class(mesh_source_type), intent(in) :: self
-      integer, intent(in) :: e
+      integer, intent(in) :: elements(:)
       integer :: counts(2)
+      integer :: i
 
-      counts = [size(self%gp, 2), 0]
-      if (self%sprc) counts(2) = self%topo%bptr(e + 1) - self%topo%bptr(e)
+      counts = [size(self%gp, 2)*size(elements), 0]
+      if (.not. self%sprc) return
+      do i = 1, size(elements)
+         counts(2) = counts(2) + self%topo%bptr(elements(i) + 1) - self%topo%bptr(elements(i))
+      end do
    end function mesh_points_of
 
    !> The patch of node n over the listed elements (storage reused).

@@ -6,8 +6,8 @@
 !> A producer describes its mesh by plain arrays: the node -> element CSR (ne_ptr, ne_list;
 !> elements ascending per node), the element -> node table (connectivity, for expansion),
 !> the node of each patch; and by a `patch_source_type` extension that gathers the points
-!> of a list of elements into a `patch_type` (`fill`) and counts the points an element
-!> contributes (`points_of`, for the workspace capacity).
+!> of a list of elements into a `patch_type` (`fill`) and counts the points a list of
+!> elements contributes (`points_of`, for the workspace capacity).
 !>
 !> Patch of node n: the elements of n, in list order. A patch whose basis matrix lacks
 !> rank (the core returns stat_singular) gets one more ring, every element sharing a node
@@ -47,8 +47,9 @@ module sprc_recovery_patch_loop
    contains
       !> Reset `patch` and gather the points of `elements` for the patch of `node`.
       procedure(fill_interface), deferred :: fill
-      !> [volume points, boundary points] element e adds to a patch (boundary points 0
-      !> when the method takes none).
+      !> [volume points, boundary points] the elements of a list add to a patch (boundary
+      !> points 0 when the method takes none). A list, not one element: one dynamic
+      !> dispatch per patch, not per element.
       procedure(points_interface), deferred :: points_of
       !> Solve a filled patch: SPR or SPR-C (`recover_patch_default`). A producer overrides
       !> it for patches it solves otherwise (the grid's contact patches); stat_singular
@@ -64,10 +65,10 @@ module sprc_recovery_patch_loop
          type(patch_type), intent(inout) :: patch
       end subroutine fill_interface
 
-      pure function points_interface(self, e) result(counts)
+      pure function points_interface(self, elements) result(counts)
          import :: patch_source_type
          class(patch_source_type), intent(in) :: self
-         integer, intent(in) :: e
+         integer, intent(in) :: elements(:)
          integer :: counts(2)
       end function points_interface
    end interface
@@ -109,16 +110,12 @@ contains
       class(patch_source_type), intent(in) :: source
       integer, intent(in) :: dim, degree, ne_ptr(:), ne_list(:), nodes(:)
       integer :: cap(2)
-      integer :: i, k, n, c(2)
+      integer :: i, n
 
       cap = [4*poly_nterms(dim, degree), 0]
       do i = 1, size(nodes)
          n = nodes(i)
-         c = 0
-         do k = ne_ptr(n), ne_ptr(n + 1) - 1
-            c = c + source%points_of(ne_list(k))
-         end do
-         cap = max(cap, c)
+         cap = max(cap, source%points_of(ne_list(ne_ptr(n):ne_ptr(n + 1) - 1)))
       end do
    end function patch_capacity
 
