@@ -846,8 +846,9 @@ contains
       end do
    end subroutine sort_int
 
-   !> rec%coef allocated (nterms, nstress) and zero: storage of the patch's own size, so
-   !> that a mesh of many patches holds only what its degree needs.
+   !> rec%coef allocated (nterms, nstress), its entries left to the caller (least_squares
+   !> sets every one): storage of the patch's own size, so that a mesh of many patches
+   !> holds only what its degree needs.
    pure subroutine coef_storage(rec, nt, ns)
       type(recovered_patch_type), intent(inout) :: rec
       integer, intent(in) :: nt, ns
@@ -855,7 +856,6 @@ contains
          if (any(shape(rec%coef) /= [nt, ns])) deallocate (rec%coef)
       end if
       if (.not. allocated(rec%coef)) allocate (rec%coef(nt, ns))
-      rec%coef = 0.0_wp
    end subroutine coef_storage
 
 end module sprc_recovery_solve
