@@ -225,7 +225,8 @@ contains
       real(wp), intent(inout) :: b(:, :)
       logical, intent(out) :: ok
       logical, intent(in), optional :: transposed
-      integer :: i, j
+      real(wp) :: s
+      integer :: i, j, l
 
       ! A loop, not all([(...)]): the constructor of run-time size was a heap temporary.
       ok = .true.
@@ -237,7 +238,14 @@ contains
          if (present(transposed)) then
             if (transposed) then
                do i = 1, k
-                  b(i, j) = (b(i, j) - dot_product(a(1:i - 1, i), b(1:i - 1, j)))/a(i, i)
+                  ! dot_product's sum, in scalar loads: a paired load of b(i-2:i-1) just
+                  ! after the scalar store of b(i-1) stalled on store forwarding (perf).
+                  s = 0.0_wp
+                  !GCC$ novector
+                  do l = 1, i - 1
+                     s = s + a(l, i)*b(l, j)
+                  end do
+                  b(i, j) = (b(i, j) - s)/a(i, i)
                end do
                cycle
             end if
