@@ -265,7 +265,8 @@ contains
       end if
       value = 1.0_wp
       if (self%n == 0) return
-      anorm = a%norm1()
+      anorm = a%norm1(error)
+      if (allocated(error)) return
       value = 0.0_wp
       if (.not. (anorm > 0.0_wp)) return
 

@@ -27,6 +27,7 @@ module sprc_fem_petsc
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_unsupported
    use sprc_core_blas_threads, only: blas_serial_begin, blas_serial_end
+   use sprc_core_alloc, only: check_allocation
    use sprc_fem_sparse, only: csr_type
    use sprc_fem_linear_solver, only: linear_solver_type, backend_error, message_length, set_solve_ranks
    implicit none
@@ -158,7 +159,7 @@ contains
       integer, intent(in) :: dof(:, :)
       real(wp), intent(in) :: x(:, :)
       type(error_type), allocatable, intent(out) :: error
-      integer :: m, c, n
+      integer :: m, c, n, stat
 
       self%dim = size(dof, 1)
       self%rcond_tol = 0.0_wp
@@ -168,7 +169,9 @@ contains
       end if
       n = count(dof > 0)
       if (allocated(self%slot)) deallocate (self%slot)
-      allocate (self%slot(n))
+      allocate (self%slot(n), stat=stat)
+      call check_allocation(stat, 'iterative solver', 'the place of each unknown', n, 4, error)
+      if (allocated(error)) return
       self%slot = 0
       do m = 1, size(dof, 2)
          do c = 1, self%dim
@@ -183,6 +186,13 @@ contains
          return
       end if
       self%n_padded = self%dim*size(dof, 2)
+      if (allocated(self%coords)) deallocate (self%coords)
+      allocate (self%coords(self%n_padded), stat=stat)
+      call check_allocation(stat, 'iterative solver', 'the block coordinates', self%n_padded, 8, error)
+      if (allocated(error)) then
+         deallocate (self%slot)
+         return
+      end if
       self%coords = reshape(x, [self%n_padded])
    end subroutine set_blocks
 
@@ -227,7 +237,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer, allocatable :: row_of(:)
       integer(i8) :: nnz, q, k
-      integer :: p, i
+      integer :: p, i, stat
       real(wp) :: mean_diag
       character(len=200) :: buf
 
@@ -238,9 +248,13 @@ contains
          call fatal_error(error, trim(buf), stat_unsupported)
          return
       end if
-      allocate (row_of(self%n_padded), rowptr(self%n_padded + 1), col(nnz), val(nnz))
+      allocate (row_of(self%n_padded), rowptr(self%n_padded + 1), col(nnz), val(nnz), stat=stat)
+      call check_allocation(stat, 'iterative solver', 'the blocked matrix', nnz, 12, error)
+      if (allocated(error)) return
       row_of = 0
-      row_of(self%slot) = [(i, i = 1, a%nrows)]
+      do i = 1, a%nrows
+         row_of(self%slot(i)) = i
+      end do
       mean_diag = 0.0_wp
       do i = 1, a%nrows
          do q = a%rowptr(i), a%rowptr(i + 1) - 1
@@ -277,14 +291,17 @@ contains
       character(kind=c_char, len=message_length) :: msg
       real(wp), allocatable :: bp(:), xp(:)
       integer(c_int) :: status, its
-      integer :: j, saved
+      integer :: j, saved, stat
 
       if (transposed .and. .not. self%symmetric) then
          call fatal_error(error, 'iterative solver: transposed solves of an unsymmetric system are not supported', &
             & stat_unsupported)
          return
       end if
-      allocate (bp(self%n_padded), xp(self%n_padded))
+      allocate (bp(self%n_padded), xp(self%n_padded), stat=stat)
+      call check_allocation(stat, 'iterative solver', 'the blocked right-hand side and solution', self%n_padded, &
+         & 16, error)
+      if (allocated(error)) return
       do j = 1, nrhs
          bp = 0.0_wp
          bp(self%slot) = b(:, j)

@@ -498,29 +498,23 @@ contains
    end subroutine csr_matvec
 
    !> Matrix 1-norm: the largest column sum of magnitudes (0 for an empty matrix).
-   !> With `error`, a failed allocation of the column sums returns it (norm 0);
-   !> without, it stops the program as before.
+   !> A failed allocation of the column sums returns `error` (norm 0).
    function csr_norm1(self, error) result(norm)
       class(csr_type), intent(in) :: self
-      type(error_type), allocatable, intent(out), optional :: error
+      type(error_type), allocatable, intent(out) :: error
       real(wp) :: norm
       real(wp), allocatable :: colsum(:)
       integer(i8) :: k
       integer :: stat
 
       norm = 0.0_wp
-      if (present(error)) then
-         allocate (colsum(self%ncols), stat=stat)
-         call check_allocation(stat, 'csr_type%norm1', 'the column sums', self%ncols, 8, error)
-         if (allocated(error)) return
-      else
-         allocate (colsum(self%ncols))
-      end if
+      allocate (colsum(self%ncols), stat=stat)
+      call check_allocation(stat, 'csr_type%norm1', 'the column sums', self%ncols, 8, error)
+      if (allocated(error)) return
       colsum = 0.0_wp
       do k = 1, self%nnz()
          colsum(self%col(k)) = colsum(self%col(k)) + abs(self%val(k))
       end do
-      norm = 0.0_wp
       if (self%ncols > 0) norm = maxval(colsum)
    end function csr_norm1
 
