@@ -13,7 +13,7 @@ module sprc_test_sparse
    use sprc_core_error, only: stat_invalid_input, stat_singular, stat_not_positive_definite, stat_out_of_memory
    use sprc_core_lapack, only: dgesv, dgetrf, dgecon, dlange
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type
-   use sprc_fem_sparse, only: coo_type, csr_type
+   use sprc_fem_sparse, only: coo_type, csr_type, block_list_type
    use sprc_fem_linear_solver, only: linear_solver_type
    use sprc_fem_cholmod, only: cholmod_solver_type
    use sprc_fem_umfpack, only: umfpack_solver_type
@@ -33,6 +33,7 @@ contains
          new_unittest('coo_duplicates_sorted', test_coo_duplicates_sorted), &
          new_unittest('coo_insertion_order', test_coo_insertion_order), &
          new_unittest('coo_blocks', test_coo_blocks), &
+         new_unittest('block_list_as_coo', test_block_list_as_coo), &
          new_unittest('coo_rejects', test_coo_rejects), &
          new_unittest('coo_zero_size', test_coo_zero_size), &
          new_unittest('coo_out_of_memory', test_coo_out_of_memory), &
@@ -146,6 +147,74 @@ contains
       if (allocated(error)) return
       call check(error, same(a%val, b%val) .and. all(a%col == b%col), 'repeatable')
    end subroutine test_coo_insertion_order
+
+   !> A block list (pseudo-random blocks with values of mixed magnitudes, so that the
+   !> order of each sum shows in its bits; an empty block; a vector per block) gives
+   !> the matrix of adding the same blocks to a COO list in block order, bit for bit,
+   !> with 1 and 2 threads; the summed vector equals sums in block order.
+   subroutine test_block_list_as_coo(error)
+      !$ use omp_lib, only: omp_get_max_threads, omp_set_num_threads
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: n = 40, nb = 60
+      type(block_list_type) :: blocks
+      type(coo_type) :: coo
+      type(csr_type) :: a, ref
+      real(wp), allocatable :: f(:)
+      real(wp) :: fref(n), r
+      integer :: m(nb), b, i, j, nt, saved, k
+      integer(i8) :: p, v
+      logical :: seen(n)
+
+      do b = 1, nb
+         m(b) = mod(7*b, 9)
+      end do
+      call blocks%init(n, m, error)
+      if (allocated(error)) return
+      call coo%init(n, n, error)
+      if (allocated(error)) return
+      fref = 0.0_wp
+      k = 0
+      do b = 1, nb
+         p = blocks%dof_ptr(b)
+         v = blocks%val_ptr(b)
+         seen = .false.
+         do i = 1, m(b)
+            ! distinct dofs, not sorted
+            do
+               k = mod(17*k + 11, n)
+               if (.not. seen(k + 1)) exit
+            end do
+            seen(k + 1) = .true.
+            blocks%dofs(p + i - 1) = k + 1
+            blocks%rhs(p + i - 1) = 10.0_wp**mod(3*b + i, 17) - 1.0_wp/real(i, wp)
+            fref(k + 1) = fref(k + 1) + blocks%rhs(p + i - 1)
+         end do
+         do j = 1, m(b)
+            do i = 1, m(b)
+               r = 10.0_wp**mod(5*b + 3*i + j, 19)*(1.0_wp + 1.0_wp/real(i + 2*j, wp))
+               blocks%val(v + i - 1 + (j - 1)*m(b)) = r
+            end do
+         end do
+         call coo%add(blocks%dofs(p:p + m(b) - 1), &
+            & reshape(blocks%val(v:v + m(b)**2 - 1), [m(b), m(b)]), error)
+         if (allocated(error)) return
+      end do
+      call coo%to_csr(ref, error)
+      if (allocated(error)) return
+      saved = 1
+      !$ saved = omp_get_max_threads()
+      do nt = 1, 2
+         !$ call omp_set_num_threads(nt)
+         call blocks%to_csr(a, error, f)
+         if (allocated(error)) exit
+         call check(error, all(a%rowptr == ref%rowptr) .and. all(a%col == ref%col) .and. same(a%val, ref%val), &
+            & 'the matrix of the COO list, bit for bit, with '//merge('1', '2', nt == 1)//' thread(s)')
+         if (allocated(error)) exit
+         call check(error, same(f, fref), 'the vector summed in block order')
+         if (allocated(error)) exit
+      end do
+      !$ call omp_set_num_threads(saved)
+   end subroutine test_block_list_as_coo
 
    !> Element blocks (general and square) against a dense sum, including a
    !> repeated index inside one block; a misshapen block is rejected.

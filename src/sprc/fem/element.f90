@@ -16,13 +16,12 @@
 !> sized by the element, so it may be called from OpenMP threads.
 module sprc_fem_element
    use sprc_core_kinds, only: wp
-   use sprc_core_lapack, only: dgemm
    use sprc_grid_nodes, only: element_node_index
    implicit none
    private
 
    public :: shape_functions, strain_matrix, traction_matrix, displacement_matrix
-   public :: add_stiffness, element_stress, element_strain
+   public :: add_stiffness, mirror_upper, element_stress, element_strain
 
 contains
 
@@ -124,16 +123,36 @@ contains
       end do
    end subroutine displacement_matrix
 
-   !> ke += w b^T d b, with db = d b (nstress, ndof) supplied by the caller
-   !> (it is also what a Nitsche term or a stress needs).
-   subroutine add_stiffness(b, db, w, ke)
+   !> ke += w b^T d b on and above the diagonal (i <= j), with db = d b (nstress, ndof)
+   !> supplied by the caller (it is also what a Nitsche term or a stress needs); the
+   !> caller mirrors the upper triangle when its sums are complete (`mirror_upper`).
+   !> Plain loops, not BLAS: OpenBLAS takes a lock on every call, which serializes the
+   !> threads of an element loop on these tiny products.
+   pure subroutine add_stiffness(b, db, w, ke)
       real(wp), intent(in) :: b(:, :), db(:, :), w
       real(wp), intent(inout) :: ke(:, :)
-      integer :: ns, ndof
-      ns = size(b, 1)
-      ndof = size(b, 2)
-      call dgemm('T', 'N', ndof, ndof, ns, w, b, ns, db, ns, 1.0_wp, ke, size(ke, 1))
+      real(wp) :: bt(size(b, 2), size(b, 1)), c
+      integer :: s, j
+
+      bt = transpose(b)
+      do j = 1, size(b, 2)
+         do s = 1, size(b, 1)
+            c = w*db(s, j)
+            ke(1:j, j) = ke(1:j, j) + c*bt(1:j, s)
+         end do
+      end do
    end subroutine add_stiffness
+
+   !> k(j, i) = k(i, j) for i < j: the lower triangle from the upper one.
+   pure subroutine mirror_upper(k)
+      real(wp), intent(inout) :: k(:, :)
+      integer :: i, j
+      do j = 2, size(k, 2)
+         do i = 1, j - 1
+            k(j, i) = k(i, j)
+         end do
+      end do
+   end subroutine mirror_upper
 
    !> Stress sigma(nstress) = d b u_e at a point of the box [lo, hi] from the
    !> element's nodal displacements ue(dim*nen), node-major.

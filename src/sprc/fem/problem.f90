@@ -65,7 +65,7 @@ module sprc_fem_problem
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular, &
       & stat_not_positive_definite
-   use sprc_core_lapack, only: dgemm, dsyev
+   use sprc_core_lapack, only: dsyev
    use sprc_core_blas_threads, only: blas_serial_begin, blas_serial_end
    use sprc_core_material, only: plane_stress, plane_strain, solid, voigt_size, analysis_name, &
       & material_matrix, compliance_matrix
@@ -81,13 +81,13 @@ module sprc_fem_problem
    use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature, default_points
    use sprc_grid_cut_mesh, only: cut_mesh_type
    use sprc_exact_solution, only: exact_solution_type
-   use sprc_fem_sparse, only: coo_type, csr_type
+   use sprc_fem_sparse, only: block_list_type, csr_type
    use sprc_fem_cholmod, only: cholmod_solver_type
    use sprc_fem_umfpack, only: umfpack_solver_type
    use sprc_fem_linear_solver, only: linear_solver_type, solver_auto, use_iterative
    use sprc_fem_petsc, only: petsc_solver_type, iteration_tolerance
    use sprc_fem_element, only: shape_functions, strain_matrix, traction_matrix, displacement_matrix, &
-      & add_stiffness, element_stress, element_strain
+      & add_stiffness, mirror_upper, element_stress, element_strain
    use sprc_fem_bc, only: fe_bc_type, check_bcs, bc_free, bc_pressure, bc_traction, bc_displacement, &
       & bc_symmetry, bc_exact_traction, bc_exact_displacement
    use sprc_fem_aggregation, only: aggregate_cells, default_eta
@@ -130,6 +130,9 @@ module sprc_fem_problem
       type(constraint_type) :: constraints
       !> Projected dilatation (B-bar) when active (`sprc_fem_dilatation`).
       type(dilatation_type) :: dilatation
+      !> Volume stiffness of the whole unit cell [0, 1]^dim under the inside cells' tensor
+      !> rule, and the integrals of its shape functions (`whole_cell_terms`).
+      real(wp), allocatable :: k_whole(:, :), n_whole(:)
       !> Reduced stiffness and load.
       type(csr_type) :: k
       real(wp), allocatable :: f(:)
@@ -547,44 +550,35 @@ contains
       self%solved = .true.
    end subroutine expand_solution
 
-   !> K and f: element systems in one parallel loop, reduced by T_e, triplets in element order.
+   !> K and f: the reduced element systems in one parallel loop, each into its own block of
+   !> a block list (the aggregates' dilatation blocks after them), summed row by row in
+   !> parallel (`block_list_type`): the same sums, in element order, for any thread count.
    subroutine assemble(self, error)
       type(elasticity_problem_type), intent(inout) :: self
       type(error_type), allocatable, intent(out) :: error
-      type(coo_type) :: coo
-      integer, allocatable :: mdof(:), fdof(:), bad(:)
-      integer(i8), allocatable :: koff(:), foff(:)
-      real(wp), allocatable :: fval(:)
-      integer(i8) :: k
+      type(block_list_type) :: blocks
+      integer, allocatable :: mdof(:), bad(:), multi(:)
       integer :: nel, maxm, e, saved_blas, stat
       character(len=*), parameter :: who = 'elasticity assembly'
 
       nel = self%mesh%grid%n_leaves
-      ! distinct reduced dofs of each element (bounds the buffers and places its triplets)
-      allocate (mdof(nel), koff(nel + 1), foff(nel + 1), bad(nel), stat=stat)
-      call check_allocation(stat, who, 'the reduced dof count and offsets of each element', nel, 24, error)
+      call whole_cell_terms(self)
+      call multi_cell_aggregates(self, multi, error)
       if (allocated(error)) return
-      call element_dof_counts(self, mdof)
-      maxm = maxval(mdof)
-      koff(1) = 1
-      foff(1) = 1
-      do e = 1, nel
-         koff(e + 1) = koff(e) + int(mdof(e), i8)**2
-         foff(e + 1) = foff(e) + mdof(e)
-      end do
-      call coo%init(self%constraints%n_dofs, self%constraints%n_dofs, error, &
-         & capacity=koff(nel + 1) - 1 + aggregate_capacity(self, mdof))
+      ! distinct reduced dofs of each element and aggregate: the block sizes
+      allocate (mdof(nel + size(multi)), bad(nel), stat=stat)
+      call check_allocation(stat, who, 'the reduced dof count of each element', nel, 8, error)
       if (allocated(error)) return
-      if (allocated(self%f)) deallocate (self%f)
-      allocate (self%f(self%constraints%n_dofs), stat=stat)
-      call check_allocation(stat, who, 'the load vector', self%constraints%n_dofs, 8, error)
+      call element_dof_counts(self, mdof(1:nel))
+      maxm = 0
+      if (nel > 0) maxm = maxval(mdof(1:nel))
+      call aggregate_dof_counts(self, maxm, multi, mdof(nel + 1:))
+      call blocks%init(self%constraints%n_dofs, mdof, error)
       if (allocated(error)) return
-      allocate (fdof(foff(nel + 1) - 1), fval(foff(nel + 1) - 1), stat=stat)
-      call check_allocation(stat, who, 'the reduced element loads', foff(nel + 1) - 1, 12, error)
-      if (allocated(error)) return
-      ! Small dgemm calls from every thread: OpenBLAS in one thread (sprc_core_blas_threads).
+      ! The element kernels call no BLAS; the dilatation blocks do (small dgemm and
+      ! dpotrs from every thread): OpenBLAS in one thread (sprc_core_blas_threads).
       saved_blas = blas_serial_begin()
-      call element_triplets(self, maxm, koff, foff, coo, fdof, fval, bad)
+      call element_blocks(self, maxm, blocks, bad)
       call blas_serial_end(saved_blas)
       if (any(bad /= 0)) then
          e = findloc(bad /= 0, .true., 1)
@@ -592,16 +586,87 @@ contains
             & stat_invalid_input)
          return
       end if
-      coo%nnz = koff(nel + 1) - 1
-      ! the loads in element order, as the triplets: the same sums for any thread count
-      self%f = 0.0_wp
-      do k = 1, foff(nel + 1) - 1
-         self%f(fdof(k)) = self%f(fdof(k)) + fval(k)
-      end do
-      call assemble_aggregates(self, maxm, coo, error)
-      if (allocated(error)) return
-      call coo%to_csr(self%k, error)
+      call aggregate_blocks(self, maxm, multi, nel, blocks)
+      deallocate (mdof, bad)
+      call blocks%to_csr(self%k, error, self%f)
    end subroutine assemble
+
+   !> `k_whole`, `n_whole`: the volume terms of the unit cell. Every inside cell (a cube of
+   !> edge h, integrated by the same tensor rule) has h^(dim-2) k_whole and h^dim n_whole:
+   !> an affine map of the rule, so only the rounding differs from integrating the cell
+   !> itself, and most of the cells of a level cost a copy. Not with the projected
+   !> dilatation, whose moments need the points.
+   subroutine whole_cell_terms(self)
+      type(elasticity_problem_type), intent(inout) :: self
+      real(wp) :: x(3), w, lo(3), hi(3), n(self%nen), dndx(self%dim, self%nen)
+      real(wp) :: b(self%nstress, self%dim*self%nen), db(self%nstress, self%dim*self%nen)
+      integer :: ipt, i, k, idx, d, ns, nq
+
+      if (allocated(self%k_whole)) deallocate (self%k_whole, self%n_whole)
+      if (self%dilatation%active) return
+      d = self%dim
+      ns = self%nstress
+      nq = self%mesh%quad%q
+      allocate (self%k_whole(d*self%nen, d*self%nen), self%n_whole(self%nen))
+      self%k_whole = 0.0_wp
+      self%n_whole = 0.0_wp
+      lo = 0.0_wp
+      hi = 1.0_wp
+      ! the points in the order of the quadrature's tensor rule
+      do ipt = 1, nq**d
+         i = ipt - 1
+         w = 1.0_wp
+         do k = 1, d
+            idx = mod(i, nq) + 1
+            i = i/nq
+            x(k) = self%mesh%quad%node(idx)
+            w = w*self%mesh%quad%weight(idx)
+         end do
+         call shape_functions(d, self%degree, lo(1:d), hi(1:d), x(1:d), n, dndx)
+         call strain_matrix(d, dndx, b)
+         db = matmul(self%d(1:ns, 1:ns), b)
+         call add_stiffness(b, db, w, self%k_whole)
+         self%n_whole = self%n_whole + w*n
+      end do
+      call mirror_upper(self%k_whole)
+   end subroutine whole_cell_terms
+
+   !> Whether element e takes its volume terms from `k_whole` (module notes of
+   !> `whole_cell_terms`): an inside cell with the tensor rule's points, a cube.
+   pure logical function whole_cell(self, e, lo, hi) result(yes)
+      type(elasticity_problem_type), intent(in) :: self
+      integer, intent(in) :: e
+      real(wp), intent(in) :: lo(:), hi(:)
+      real(wp) :: width(size(lo))
+
+      yes = .false.
+      if (.not. allocated(self%k_whole)) return
+      if (self%mesh%grid%leaf_class(e) /= cell_inside) return
+      if (self%mesh%vol_ptr(e + 1) - self%mesh%vol_ptr(e) /= self%mesh%quad%q**self%dim) return
+      width = hi - lo
+      yes = maxval(width) - minval(width) <= 8*epsilon(1.0_wp)*maxval(width)
+   end function whole_cell
+
+   !> The aggregates of several cells (their dilatation blocks couple the members'
+   !> dofs); none without the projected dilatation.
+   subroutine multi_cell_aggregates(self, multi, error)
+      type(elasticity_problem_type), intent(in) :: self
+      integer, allocatable, intent(out) :: multi(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: a, n, stat
+
+      n = 0
+      if (self%dilatation%active) n = count(self%dilatation%ptr(2:) - self%dilatation%ptr(:self%dilatation%n_aggregates) > 1)
+      allocate (multi(n), stat=stat)
+      call check_allocation(stat, 'elasticity assembly', 'the aggregates of several cells', n, 4, error)
+      if (allocated(error) .or. n == 0) return
+      n = 0
+      do a = 1, self%dilatation%n_aggregates
+         if (self%dilatation%ptr(a + 1) - self%dilatation%ptr(a) == 1) cycle
+         n = n + 1
+         multi(n) = a
+      end do
+   end subroutine multi_cell_aggregates
 
    !> The number of distinct reduced dofs of every element (OpenMP over elements).
    subroutine element_dof_counts(self, mdof)
@@ -622,88 +687,88 @@ contains
       !$omp end parallel
    end subroutine element_dof_counts
 
-   !> The reduced system of every element, in one parallel loop: element e's m x m block
-   !> goes to the triplets koff(e) .. koff(e + 1) - 1 of `coo` (column-major, as
-   !> coo%add would put it) and its load to fdof / fval(foff(e) .. foff(e + 1) - 1). The
-   !> places depend only on e, so the triplet list is the same for any thread count, and
-   !> a single parallel region has no serial step between chunks for a thread to wait at
-   !> (each such barrier costs a scheduling delay on a loaded machine). bad(e) /= 0: the
-   !> block of e is not finite.
-   subroutine element_triplets(self, maxm, koff, foff, coo, fdof, fval, bad)
+   !> The reduced system of every element, in one parallel loop, into block e of
+   !> `blocks` (its dofs, its m x m matrix column-major, its load). The places depend
+   !> only on e, and a single parallel region has no serial step between chunks for a
+   !> thread to wait at (each such barrier costs a scheduling delay on a loaded
+   !> machine). bad(e) /= 0: the block of e is not finite.
+   subroutine element_blocks(self, maxm, blocks, bad)
       type(elasticity_problem_type), intent(in) :: self
       integer, intent(in) :: maxm
-      integer(i8), intent(in) :: koff(:), foff(:)
-      type(coo_type), intent(inout) :: coo
-      integer, intent(out) :: fdof(:), bad(:)
-      real(wp), intent(out) :: fval(:)
-      integer, allocatable :: dofs(:)
-      real(wp), allocatable :: kr(:), fr(:)
-      integer(i8) :: k
-      integer :: e, m, a, b
+      type(block_list_type), intent(inout) :: blocks
+      integer, intent(out) :: bad(:)
+      integer(i8) :: p, v
+      integer :: e, m
 
-      !$omp parallel default(shared) private(dofs, kr, fr, e, m, a, b, k)
-      allocate (dofs(maxm), kr(maxm*maxm), fr(maxm))
-      !$omp do schedule(dynamic, 16)
+      !$omp parallel do schedule(dynamic, 16) default(shared) private(e, m, p, v)
       do e = 1, size(bad)
-         call reduced_element_system(self, e, maxm, dofs, m, kr, fr)
-         bad(e) = count(.not. ieee_is_finite(kr(1:m*m)))
-         k = koff(e) - 1
-         do b = 1, m
-            do a = 1, m
-               k = k + 1
-               coo%row(k) = dofs(a)
-               coo%col(k) = dofs(b)
-               coo%val(k) = kr(a + (b - 1)*m)
-            end do
-         end do
-         fdof(foff(e):foff(e) + m - 1) = dofs(1:m)
-         fval(foff(e):foff(e) + m - 1) = fr(1:m)
+         p = blocks%dof_ptr(e)
+         v = blocks%val_ptr(e)
+         m = int(blocks%dof_ptr(e + 1) - p)
+         call reduced_element_system(self, e, maxm, blocks%dofs(p:p + m - 1), blocks%val(v:v + int(m, i8)**2 - 1), &
+            & blocks%rhs(p:p + m - 1))
+         bad(e) = count(.not. ieee_is_finite(blocks%val(v:v + int(m, i8)**2 - 1)))
       end do
-      !$omp end do
-      !$omp end parallel
-   end subroutine element_triplets
+      !$omp end parallel do
+   end subroutine element_blocks
 
-   !> COO entries the dilatation blocks of aggregates of several cells need at most.
-   integer(i8) function aggregate_capacity(self, mdof) result(n)
+   !> The sizes of the dilatation blocks of the aggregates `multi`: the distinct reduced
+   !> dofs of their members together.
+   subroutine aggregate_dof_counts(self, maxm, multi, mdof)
       type(elasticity_problem_type), intent(in) :: self
-      integer, intent(in) :: mdof(:)
-      integer :: a, j
-      integer(i8) :: m
-      n = 0
-      if (.not. self%dilatation%active) return
-      do a = 1, self%dilatation%n_aggregates
-         if (self%dilatation%ptr(a + 1) - self%dilatation%ptr(a) == 1) cycle
-         m = 0
-         do j = self%dilatation%ptr(a), self%dilatation%ptr(a + 1) - 1
-            m = m + mdof(self%dilatation%member(j))
-         end do
-         n = n + m*m
-      end do
-   end function aggregate_capacity
+      integer, intent(in) :: maxm, multi(:)
+      integer, intent(out) :: mdof(:)
+      integer, allocatable :: union(:)
+      integer :: i
 
-   !> Dilatation blocks of the aggregates of several cells (serially, in
-   !> aggregate order): the members' moments reduced by T_e and summed on the
-   !> union of their reduced dofs.
-   subroutine assemble_aggregates(self, maxm, coo, error)
-      type(elasticity_problem_type), intent(inout) :: self
-      integer, intent(in) :: maxm
-      type(coo_type), intent(inout) :: coo
-      type(error_type), allocatable, intent(out) :: error
+      do i = 1, size(multi)
+         call aggregate_union(self, maxm, multi(i), union, mdof(i))
+      end do
+   end subroutine aggregate_dof_counts
+
+   !> union(1:nu): the distinct reduced dofs of the members of aggregate a, in order of
+   !> first appearance (members in order, each element's dofs ascending).
+   subroutine aggregate_union(self, maxm, a, union, nu)
+      type(elasticity_problem_type), intent(in) :: self
+      integer, intent(in) :: maxm, a
+      integer, allocatable, intent(out) :: union(:)
+      integer, intent(out) :: nu
+      real(wp) :: tmat(self%dim*self%nen, maxm)
+      integer :: dofs(maxm), j, i, m
+
+      allocate (union(maxm*(self%dilatation%ptr(a + 1) - self%dilatation%ptr(a))))
+      nu = 0
+      do j = self%dilatation%ptr(a), self%dilatation%ptr(a + 1) - 1
+         call self%constraints%element_map(self%mesh%nodes%connectivity(:, self%dilatation%member(j)), dofs, tmat, m)
+         do i = 1, m
+            if (any(union(1:nu) == dofs(i))) cycle
+            nu = nu + 1
+            union(nu) = dofs(i)
+         end do
+      end do
+   end subroutine aggregate_union
+
+   !> Dilatation blocks of the aggregates of several cells (serially, in aggregate
+   !> order; blocks nel + 1 ..): the members' moments reduced by T_e and summed on
+   !> the union of their reduced dofs.
+   subroutine aggregate_blocks(self, maxm, multi, nel, blocks)
+      type(elasticity_problem_type), intent(in) :: self
+      integer, intent(in) :: maxm, multi(:), nel
+      type(block_list_type), intent(inout) :: blocks
       real(wp) :: ke(self%dim*self%nen, self%dim*self%nen), fe(self%dim*self%nen)
       real(wp) :: tmat(self%dim*self%nen, maxm)
       real(wp) :: g(self%dim*self%nen, self%dilatation%np), h(self%dim*self%nen, self%dilatation%np)
       real(wp) :: sv(self%dilatation%np), svsum(self%dilatation%np)
       real(wp), allocatable :: gu(:, :), hu(:, :), ku(:, :), fu(:)
       integer, allocatable :: union(:)
-      integer :: dofs(maxm), a, j, e, m, nu, i, k, np
+      integer(i8) :: p, v
+      integer :: dofs(maxm), a, j, e, m, nu, i, k, np, ia
 
-      if (.not. self%dilatation%active) return
       np = self%dilatation%np
-      do a = 1, self%dilatation%n_aggregates
-         if (self%dilatation%ptr(a + 1) - self%dilatation%ptr(a) == 1) cycle
-         nu = 0
-         allocate (union(maxm*(self%dilatation%ptr(a + 1) - self%dilatation%ptr(a))))
-         allocate (gu(size(union), np), hu(size(union), np))
+      do ia = 1, size(multi)
+         a = multi(ia)
+         call aggregate_union(self, maxm, a, union, nu)
+         allocate (gu(nu, np), hu(nu, np), ku(nu, nu), fu(nu))
          gu = 0.0_wp
          hu = 0.0_wp
          svsum = 0.0_wp
@@ -714,41 +779,38 @@ contains
             svsum = svsum + sv
             do i = 1, m
                k = findloc(union(1:nu), dofs(i), 1)
-               if (k == 0) then
-                  nu = nu + 1
-                  union(nu) = dofs(i)
-                  k = nu
-               end if
                gu(k, :) = gu(k, :) + matmul(tmat(:, i), g)
                hu(k, :) = hu(k, :) + matmul(tmat(:, i), h)
             end do
          end do
-         allocate (ku(nu, nu), fu(nu))
          ku = 0.0_wp
          fu = 0.0_wp
-         ! contiguous copies for the BLAS calls
-         gu = gu(1:nu, :)
-         hu = hu(1:nu, :)
          call self%dilatation%add_aggregate_block(a, gu, hu, svsum, ku, fu)
-         call coo%add(union(1:nu), ku, error)
-         if (allocated(error)) return
-         self%f(union(1:nu)) = self%f(union(1:nu)) + fu
-         deallocate (union, gu, hu, ku, fu)
+         p = blocks%dof_ptr(nel + ia)
+         v = blocks%val_ptr(nel + ia)
+         blocks%dofs(p:p + nu - 1) = union(1:nu)
+         blocks%val(v:v + int(nu, i8)**2 - 1) = reshape(ku, [int(nu, i8)**2])
+         blocks%rhs(p:p + nu - 1) = fu
+         deallocate (gu, hu, ku, fu)
       end do
-   end subroutine assemble_aggregates
+   end subroutine aggregate_blocks
 
    !> Reduced system of element e: kr = T_e^T k_e T_e (m x m, column-major in
-   !> kr), fr = T_e^T f_e, on the reduced dofs dofs(1:m).
-   subroutine reduced_element_system(self, e, maxm, dofs, m, kr, fr)
+   !> kr), fr = T_e^T f_e, on the reduced dofs dofs(1:m) (the sizes of dofs, kr and fr
+   !> are the element's count m, from `element_dof_counts`). T_e has a few nonzeros per row (one, 1, where no
+   !> constraint acts): the products run over them only, in a fixed order, and
+   !> where T_e is a selection they copy k_e's entries exactly.
+   subroutine reduced_element_system(self, e, maxm, dofs, kr, fr)
       type(elasticity_problem_type), intent(in) :: self
       integer, intent(in) :: e, maxm
-      integer, intent(out) :: dofs(:), m
+      integer, intent(out) :: dofs(:)
       real(wp), intent(out) :: kr(:), fr(:)
       real(wp) :: ke(self%dim*self%nen, self%dim*self%nen), fe(self%dim*self%nen)
       real(wp) :: tmat(self%dim*self%nen, maxm), kt(self%dim*self%nen, maxm)
       real(wp) :: g(self%dim*self%nen, self%dilatation%np), h(self%dim*self%nen, self%dilatation%np)
       real(wp) :: sv(self%dilatation%np)
-      integer :: nd, a
+      integer :: tpos(self%dim*self%nen, maxm), tcount(self%dim*self%nen)
+      integer :: nd, a, i, j, k, c, m
 
       nd = self%dim*self%nen
       call element_system(self, e, ke, fe, g, h, sv)
@@ -760,9 +822,40 @@ contains
       end if
       call self%constraints%element_map(self%mesh%nodes%connectivity(:, e), dofs, tmat, m)
       if (m == 0) return
-      call dgemm('N', 'N', nd, m, nd, 1.0_wp, ke, nd, tmat, nd, 0.0_wp, kt, nd)
-      call dgemm('T', 'N', m, m, nd, 1.0_wp, tmat, nd, kt, nd, 0.0_wp, kr, m)
-      fr(1:m) = matmul(fe, tmat(:, 1:m))
+      ! the nonzeros of each row of T_e
+      do i = 1, nd
+         tcount(i) = 0
+         do c = 1, m
+            if (tmat(i, c) == 0.0_wp) cycle
+            tcount(i) = tcount(i) + 1
+            tpos(i, tcount(i)) = c
+         end do
+      end do
+      ! kt = k_e T_e
+      kt(:, 1:m) = 0.0_wp
+      do j = 1, nd
+         do k = 1, tcount(j)
+            c = tpos(j, k)
+            kt(:, c) = kt(:, c) + ke(:, j)*tmat(j, c)
+         end do
+      end do
+      ! kr = T_e^T kt, fr = T_e^T f_e
+      kr(1:m*m) = 0.0_wp
+      fr(1:m) = 0.0_wp
+      do c = 1, m
+         do i = 1, nd
+            do k = 1, tcount(i)
+               a = tpos(i, k)
+               kr(a + (c - 1)*m) = kr(a + (c - 1)*m) + tmat(i, a)*kt(i, c)
+            end do
+         end do
+      end do
+      do i = 1, nd
+         do k = 1, tcount(i)
+            a = tpos(i, k)
+            fr(a) = fr(a) + tmat(i, a)*fe(i)
+         end do
+      end do
    end subroutine reduced_element_system
 
    !> Unreduced stiffness ke and load fe of element e: volume terms, Neumann
@@ -796,16 +889,24 @@ contains
          dmat = self%dilatation%d_dev
          a = self%dilatation%aggregate(e)
       end if
-      do q = self%mesh%vol_ptr(e), self%mesh%vol_ptr(e + 1) - 1
-         call shape_functions(d, self%degree, lo(1:d), hi(1:d), self%mesh%vol_x(:, q), n, dndx)
-         call strain_matrix(d, dndx, b)
-         if (a > 0) call self%dilatation%add_moment(a, self%mesh%vol_x(:, q), self%mesh%vol_w(q), b, gm)
-         db = matmul(dmat(1:ns, 1:ns), b)
-         call add_stiffness(b, db, self%mesh%vol_w(q), ke)
+      if (whole_cell(self, e, lo(1:d), hi(1:d))) then
+         ke = h**(d - 2)*self%k_whole
          do c = 1, d
-            fe(c:nd:d) = fe(c:nd:d) + self%mesh%vol_w(q)*self%body_force(c)*n
+            fe(c:nd:d) = (h**d*self%body_force(c))*self%n_whole
          end do
-      end do
+      else
+         do q = self%mesh%vol_ptr(e), self%mesh%vol_ptr(e + 1) - 1
+            call shape_functions(d, self%degree, lo(1:d), hi(1:d), self%mesh%vol_x(:, q), n, dndx)
+            call strain_matrix(d, dndx, b)
+            if (a > 0) call self%dilatation%add_moment(a, self%mesh%vol_x(:, q), self%mesh%vol_w(q), b, gm)
+            db = matmul(dmat(1:ns, 1:ns), b)
+            call add_stiffness(b, db, self%mesh%vol_w(q), ke)
+            do c = 1, d
+               fe(c:nd:d) = fe(c:nd:d) + self%mesh%vol_w(q)*self%body_force(c)*n
+            end do
+         end do
+         call mirror_upper(ke)
+      end if
       do q = self%mesh%surf_ptr(e), self%mesh%surf_ptr(e + 1) - 1
          ib = self%bc_of_shape(self%mesh%surf_shape(q))
          kind = bc_free

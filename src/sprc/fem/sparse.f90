@@ -1,12 +1,20 @@
 !> Sparse matrices for assembly and direct solves: a growable triplet list
 !> (`coo_type`) that finite elements add to, and compressed sparse rows
-!> (`csr_type`) that the solvers read.
+!> (`csr_type`) that the solvers read, and a list of dense element blocks
+!> (`block_list_type`) that a finite-element assembly fills in parallel and
+!> turns into CSR row by row in parallel.
 !>
 !> The COO -> CSR conversion sums duplicates in insertion order, so the same
 !> sequence of `add` calls gives a bit-identical matrix on every run and with
 !> any thread count. It is O(nnz + nrows + ncols): a stable counting sort by
 !> row, duplicates merged through a column marker, then a sort of each row's
 !> distinct columns (rows are short: at most 81 entries for Q1 elasticity).
+!>
+!> The block list gives the same matrix as adding its blocks to a COO list in
+!> block order (each entry summed over the blocks in block order), but needs
+!> no row and column index per value and builds each row on its own: rows are
+!> shared out among the OpenMP threads, and a row's sums do not depend on which
+!> thread forms them, so the bits do not depend on the thread count.
 module sprc_fem_sparse
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use sprc_core_kinds, only: wp, i8
@@ -15,7 +23,7 @@ module sprc_fem_sparse
    implicit none
    private
 
-   public :: coo_type, csr_type, csr_validate, sort_row
+   public :: coo_type, csr_type, block_list_type, csr_validate, sort_row
 
    !> Capacity of a `coo_type` whose first `add` finds no storage.
    integer(i8), parameter :: min_capacity = 64
@@ -39,6 +47,22 @@ module sprc_fem_sparse
       procedure :: clear => coo_clear
       procedure :: to_csr => coo_to_csr
    end type coo_type
+
+   !> Square dense blocks on lists of distinct indices of an `n` x `n` matrix, with
+   !> a vector per block: block b adds val(val_ptr(b) + (i - 1) + (j - 1) m) to
+   !> A(dofs(p + i), dofs(p + j)) and rhs(p + i) to f(dofs(p + i)), p = dof_ptr(b) - 1,
+   !> m = dof_ptr(b + 1) - dof_ptr(b) (column-major blocks). `init` sizes the arrays;
+   !> the caller fills dofs, val and rhs (block by block, in any order or in parallel);
+   !> `to_csr` sums them.
+   type :: block_list_type
+      integer :: n = 0, nblocks = 0
+      integer(i8), allocatable :: dof_ptr(:), val_ptr(:)
+      integer, allocatable :: dofs(:)
+      real(wp), allocatable :: val(:), rhs(:)
+   contains
+      procedure :: init => blocks_init
+      procedure :: to_csr => blocks_to_csr
+   end type block_list_type
 
    !> Compressed sparse rows, 1-based: row `i` holds `col(k), val(k)` for
    !> `k = rowptr(i) .. rowptr(i+1)-1`, columns strictly increasing.
@@ -444,6 +468,201 @@ contains
       c = col(i); col(i) = col(j); col(j) = c
       v = val(i); val(i) = val(j); val(j) = v
    end subroutine swap
+
+   !> Room for blocks of sizes m(1..nblocks) on an n x n matrix (their dofs,
+   !> values and vectors uninitialised).
+   subroutine blocks_init(self, n, m, error)
+      class(block_list_type), intent(inout) :: self
+      integer, intent(in) :: n, m(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: b, stat
+
+      self%n = n
+      self%nblocks = size(m)
+      if (allocated(self%dof_ptr)) deallocate (self%dof_ptr, self%val_ptr)
+      if (allocated(self%dofs)) deallocate (self%dofs, self%val, self%rhs)
+      allocate (self%dof_ptr(size(m) + 1), self%val_ptr(size(m) + 1), stat=stat)
+      call check_allocation(stat, 'block list', 'the block offsets', size(m) + 1, 16, error)
+      if (allocated(error)) return
+      self%dof_ptr(1) = 1
+      self%val_ptr(1) = 1
+      do b = 1, size(m)
+         self%dof_ptr(b + 1) = self%dof_ptr(b) + m(b)
+         self%val_ptr(b + 1) = self%val_ptr(b) + int(m(b), i8)**2
+      end do
+      allocate (self%dofs(self%dof_ptr(size(m) + 1) - 1), self%rhs(self%dof_ptr(size(m) + 1) - 1), stat=stat)
+      call check_allocation(stat, 'block list', 'the block dofs and vectors', self%dof_ptr(size(m) + 1) - 1, 12, error)
+      if (allocated(error)) return
+      allocate (self%val(self%val_ptr(size(m) + 1) - 1), stat=stat)
+      call check_allocation(stat, 'block list', 'the block values', self%val_ptr(size(m) + 1) - 1, 8, error)
+   end subroutine blocks_init
+
+   !> The sum of the blocks as CSR `a` (columns sorted; entries that sum to zero
+   !> kept) and, with `f`, the sum of their vectors. Rows are built in parallel,
+   !> each entry summed over the blocks in block order (module notes).
+   subroutine blocks_to_csr(self, a, error, f)
+      class(block_list_type), intent(in) :: self
+      type(csr_type), intent(out) :: a
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable, intent(out), optional :: f(:)
+      integer(i8), allocatable :: inc_ptr(:), next(:)
+      integer, allocatable :: inc_blk(:), inc_loc(:)
+      integer(i8) :: p, total
+      integer :: i, b, stat, failed
+      character(len=*), parameter :: who = 'block list to CSR'
+
+      a%nrows = self%n
+      a%ncols = self%n
+      total = self%dof_ptr(self%nblocks + 1) - 1
+      allocate (a%rowptr(self%n + 1), inc_ptr(self%n + 1), next(self%n), inc_blk(total), inc_loc(total), stat=stat)
+      call check_allocation(stat, who, 'the blocks of each row', max(int(self%n, i8), total), 32, error)
+      if (allocated(error)) return
+      if (present(f)) then
+         allocate (f(self%n), stat=stat)
+         call check_allocation(stat, who, 'the summed vector', self%n, 8, error)
+         if (allocated(error)) return
+      end if
+      ! Row i meets block inc_blk(k) at its local index inc_loc(k), k = inc_ptr(i) ..
+      ! inc_ptr(i + 1) - 1, in block order (a counting sort by row).
+      inc_ptr = 0
+      do p = 1, total
+         inc_ptr(self%dofs(p) + 1) = inc_ptr(self%dofs(p) + 1) + 1
+      end do
+      inc_ptr(1) = 1
+      do i = 1, self%n
+         inc_ptr(i + 1) = inc_ptr(i + 1) + inc_ptr(i)
+      end do
+      next = inc_ptr(1:self%n)
+      do b = 1, self%nblocks
+         do p = self%dof_ptr(b), self%dof_ptr(b + 1) - 1
+            i = self%dofs(p)
+            inc_blk(next(i)) = b
+            inc_loc(next(i)) = int(p - self%dof_ptr(b)) + 1
+            next(i) = next(i) + 1
+         end do
+      end do
+      deallocate (next)
+      call row_counts(self, inc_ptr, inc_blk, a%rowptr, failed)
+      if (failed /= 0) then
+         call check_allocation(failed, who, 'the column marks of a thread', self%n, 4, error)
+         return
+      end if
+      a%rowptr(1) = 1
+      do i = 1, self%n
+         a%rowptr(i + 1) = a%rowptr(i + 1) + a%rowptr(i)
+      end do
+      allocate (a%col(a%rowptr(self%n + 1) - 1), a%val(a%rowptr(self%n + 1) - 1), stat=stat)
+      call check_allocation(stat, who, 'the CSR matrix', a%rowptr(self%n + 1) - 1, 12, error)
+      if (allocated(error)) return
+      call row_sums(self, inc_ptr, inc_blk, inc_loc, a, failed)
+      if (failed /= 0) then
+         call check_allocation(failed, who, 'the column places of a thread', self%n, 8, error)
+         return
+      end if
+      if (present(f)) call vector_sums(self, inc_ptr, inc_blk, inc_loc, f)
+   end subroutine blocks_to_csr
+
+   !> rowptr(i + 1) = the number of distinct columns of row i (OpenMP over rows;
+   !> each thread marks columns in its own array). `failed` /= 0: a thread could not
+   !> allocate its marks (the stat= value).
+   subroutine row_counts(self, inc_ptr, inc_blk, rowptr, failed)
+      type(block_list_type), intent(in) :: self
+      integer(i8), intent(in) :: inc_ptr(:)
+      integer, intent(in) :: inc_blk(:)
+      integer(i8), intent(inout) :: rowptr(:)
+      integer, intent(out) :: failed
+      integer, allocatable :: mark(:)
+      integer(i8) :: k, p, cnt
+      integer :: i, j, stat
+
+      failed = 0
+      !$omp parallel default(shared) private(mark, k, p, cnt, i, j, stat) reduction(max: failed)
+      allocate (mark(self%n), stat=stat)
+      if (stat == 0) mark = 0
+      failed = stat
+      !$omp do schedule(dynamic, 256)
+      do i = 1, self%n
+         if (stat /= 0) cycle
+         cnt = 0
+         do k = inc_ptr(i), inc_ptr(i + 1) - 1
+            do p = self%dof_ptr(inc_blk(k)), self%dof_ptr(inc_blk(k) + 1) - 1
+               j = self%dofs(p)
+               if (mark(j) == i) cycle
+               mark(j) = i
+               cnt = cnt + 1
+            end do
+         end do
+         rowptr(i + 1) = cnt
+      end do
+      !$omp end do
+      !$omp end parallel
+   end subroutine row_counts
+
+   !> The values of every row (rowptr set): entries summed over the row's blocks in
+   !> block order, then the row's columns sorted (OpenMP over rows). place(j) is where
+   !> this thread last wrote column j; its rows come in increasing order, so places
+   !> before rowptr(i) belong to earlier rows and need no reset.
+   subroutine row_sums(self, inc_ptr, inc_blk, inc_loc, a, failed)
+      type(block_list_type), intent(in) :: self
+      integer(i8), intent(in) :: inc_ptr(:)
+      integer, intent(in) :: inc_blk(:), inc_loc(:)
+      type(csr_type), intent(inout) :: a
+      integer, intent(out) :: failed
+      integer(i8), allocatable :: place(:)
+      integer(i8) :: k, p, q, v0
+      integer :: i, j, m, b, stat
+
+      failed = 0
+      !$omp parallel default(shared) private(place, k, p, q, v0, i, j, m, b, stat) reduction(max: failed)
+      allocate (place(self%n), stat=stat)
+      if (stat == 0) place = 0
+      failed = stat
+      !$omp do schedule(dynamic, 256)
+      do i = 1, self%n
+         if (stat /= 0) cycle
+         q = a%rowptr(i) - 1
+         do k = inc_ptr(i), inc_ptr(i + 1) - 1
+            b = inc_blk(k)
+            m = int(self%dof_ptr(b + 1) - self%dof_ptr(b))
+            ! row inc_loc(k) of block b: its entries m apart (column-major)
+            v0 = self%val_ptr(b) + inc_loc(k) - 1
+            do p = self%dof_ptr(b), self%dof_ptr(b + 1) - 1
+               j = self%dofs(p)
+               if (place(j) >= a%rowptr(i)) then
+                  a%val(place(j)) = a%val(place(j)) + self%val(v0)
+               else
+                  q = q + 1
+                  place(j) = q
+                  a%col(q) = j
+                  a%val(q) = self%val(v0)
+               end if
+               v0 = v0 + m
+            end do
+         end do
+         call sort_row(a%col(a%rowptr(i):q), a%val(a%rowptr(i):q))
+      end do
+      !$omp end do
+      !$omp end parallel
+   end subroutine row_sums
+
+   !> f(i) = the sum of the blocks' vector entries on row i, in block order.
+   subroutine vector_sums(self, inc_ptr, inc_blk, inc_loc, f)
+      type(block_list_type), intent(in) :: self
+      integer(i8), intent(in) :: inc_ptr(:)
+      integer, intent(in) :: inc_blk(:), inc_loc(:)
+      real(wp), intent(out) :: f(:)
+      integer(i8) :: k
+      integer :: i
+
+      !$omp parallel do schedule(static) default(shared) private(k)
+      do i = 1, self%n
+         f(i) = 0.0_wp
+         do k = inc_ptr(i), inc_ptr(i + 1) - 1
+            f(i) = f(i) + self%rhs(self%dof_ptr(inc_blk(k)) + inc_loc(k) - 1)
+         end do
+      end do
+      !$omp end parallel do
+   end subroutine vector_sums
 
    !> `copy` = the matrix, with a failed allocation returned as an error (the
    !> intrinsic assignment copy = matrix stops the program when it cannot allocate).
