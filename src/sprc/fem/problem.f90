@@ -78,7 +78,7 @@ module sprc_fem_problem
    use sprc_grid_tree, only: grid_type
    use sprc_grid_nodes, only: grid_nodes_type
    use sprc_grid_hanging, only: hanging_type
-   use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature, default_points
+   use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature, default_points, tensor_point
    use sprc_grid_cut_mesh, only: cut_mesh_type
    use sprc_exact_solution, only: exact_solution_type
    use sprc_fem_sparse, only: block_list_type, csr_type
@@ -600,7 +600,7 @@ contains
       type(elasticity_problem_type), intent(inout) :: self
       real(wp) :: x(3), w, lo(3), hi(3), n(self%nen), dndx(self%dim, self%nen)
       real(wp) :: b(self%nstress, self%dim*self%nen), db(self%nstress, self%dim*self%nen)
-      integer :: ipt, i, k, idx, d, ns, nq
+      integer :: ipt, d, ns, nq
 
       if (allocated(self%k_whole)) deallocate (self%k_whole, self%n_whole)
       if (self%dilatation%active) return
@@ -612,16 +612,8 @@ contains
       self%n_whole = 0.0_wp
       lo = 0.0_wp
       hi = 1.0_wp
-      ! the points in the order of the quadrature's tensor rule
       do ipt = 1, nq**d
-         i = ipt - 1
-         w = 1.0_wp
-         do k = 1, d
-            idx = mod(i, nq) + 1
-            i = i/nq
-            x(k) = self%mesh%quad%node(idx)
-            w = w*self%mesh%quad%weight(idx)
-         end do
+         call tensor_point(self%mesh%quad, lo(1:d), hi(1:d), ipt, x, w)
          call shape_functions(d, self%degree, lo(1:d), hi(1:d), x(1:d), n, dndx)
          call strain_matrix(d, dndx, b)
          db = matmul(self%d(1:ns, 1:ns), b)

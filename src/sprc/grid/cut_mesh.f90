@@ -22,7 +22,7 @@ module sprc_grid_cut_mesh
    use sprc_grid_tree, only: grid_type
    use sprc_grid_nodes, only: grid_nodes_type
    use sprc_grid_hanging, only: hanging_type
-   use sprc_grid_quadrature, only: cut_quadrature_type, cell_rule_type, cell_rule
+   use sprc_grid_quadrature, only: cut_quadrature_type, cell_rule_type, cell_rule, tensor_point
    implicit none
    private
 
@@ -100,6 +100,11 @@ contains
       self%t_quadrature = timer%elapsed
    end subroutine mesh_integrate
 
+   !> The rules of all cells in parallel (a cut cell's kept in `store`, an inside cell
+   !> without boundary points only counted), then the points of every cell copied (or,
+   !> for such an inside cell, generated: the tensor rule, as `cell_rule` gives it) to
+   !> the places its index fixes, again in parallel: no serial pass over the points,
+   !> and no allocation for most cells.
    subroutine integrate(self, error)
       type(cut_mesh_type), intent(inout) :: self
       type(error_type), allocatable, intent(out) :: error
@@ -108,7 +113,7 @@ contains
       type(error_type), allocatable :: cell_error
       logical, allocatable :: failed(:)
       integer, allocatable :: stats(:)
-      integer :: e, n, d, nv, ns, iv, is, stat
+      integer :: e, n, d, stat
       real(wp) :: lo(3), hi(3)
       character(len=*), parameter :: who = 'cut mesh quadrature'
 
@@ -127,7 +132,7 @@ contains
             failed(e) = .true.
             cycle
          end if
-         call keep_rule(rule, d, store(e), stats(e))
+         call keep_rule(rule, d, tensor_only(rule, self%quad), store(e), stats(e))
       end do
       !$omp end parallel do
       if (any(failed)) then
@@ -142,49 +147,85 @@ contains
             & ' (coordinates, weights, normals)', store(e)%nvol*(d + 1) + store(e)%nsurf*(2*d + 1), 8, error)
          return
       end if
+      call gather_points(self, store, error)
+      if (allocated(error)) return
+      self%n_cut = count(self%grid%leaf_class /= cell_inside)
+   end subroutine integrate
 
-      nv = sum(store%nvol)
-      ns = sum(store%nsurf)
+   !> Whether `rule` is the plain tensor rule of its cell: an inside cell without
+   !> boundary points on its faces.
+   pure logical function tensor_only(rule, quad)
+      type(cell_rule_type), intent(in) :: rule
+      type(cut_quadrature_type), intent(in) :: quad
+      tensor_only = rule%cls == cell_inside .and. rule%nsurf == 0 .and. rule%nvol == quad%q**quad%dim
+   end function tensor_only
+
+   !> The points of all cells, concatenated in cell order (pointers from the counts, then
+   !> each cell's points to its places in parallel), and the volume fractions.
+   subroutine gather_points(self, store, error)
+      type(cut_mesh_type), intent(inout) :: self
+      type(rule_store_type), intent(inout) :: store(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: e, n, d, nv, ns, iv, is, k, stat
+      real(wp) :: lo(3), hi(3)
+      character(len=*), parameter :: who = 'cut mesh quadrature'
+
+      n = size(store)
+      d = self%grid%dim
       allocate (self%vol_ptr(n + 1), self%surf_ptr(n + 1), self%fraction(n), stat=stat)
       call check_allocation(stat, who, 'the quadrature pointers and volume fractions', n + 1, 16, error)
       if (allocated(error)) return
+      self%vol_ptr(1) = 1
+      self%surf_ptr(1) = 1
+      do e = 1, n
+         self%vol_ptr(e + 1) = self%vol_ptr(e) + store(e)%nvol
+         self%surf_ptr(e + 1) = self%surf_ptr(e) + store(e)%nsurf
+      end do
+      nv = self%vol_ptr(n + 1) - 1
+      ns = self%surf_ptr(n + 1) - 1
       allocate (self%vol_x(d, nv), self%vol_w(nv), stat=stat)
       call check_allocation(stat, who, 'the volume quadrature points', nv, 8*(d + 1), error)
       if (allocated(error)) return
       allocate (self%surf_x(d, ns), self%surf_w(ns), self%surf_n(d, ns), self%surf_shape(ns), stat=stat)
       call check_allocation(stat, who, 'the surface quadrature points', ns, 8*(2*d + 1) + 4, error)
       if (allocated(error)) return
-      iv = 0
-      is = 0
+      !$omp parallel do schedule(dynamic, 64) default(shared) private(e, iv, is, k, lo, hi)
       do e = 1, n
-         self%vol_ptr(e) = iv + 1
-         self%surf_ptr(e) = is + 1
-         self%vol_x(:, iv + 1:iv + store(e)%nvol) = store(e)%x
-         self%vol_w(iv + 1:iv + store(e)%nvol) = store(e)%w
-         self%surf_x(:, is + 1:is + store(e)%nsurf) = store(e)%sx
-         self%surf_w(is + 1:is + store(e)%nsurf) = store(e)%sw
-         self%surf_n(:, is + 1:is + store(e)%nsurf) = store(e)%sn
-         self%surf_shape(is + 1:is + store(e)%nsurf) = store(e)%ss
-         iv = iv + store(e)%nvol
-         is = is + store(e)%nsurf
+         iv = self%vol_ptr(e) - 1
+         is = self%surf_ptr(e) - 1
          call self%grid%leaf_box(e, lo(1:d), hi(1:d))
-         self%fraction(e) = sum(store(e)%w)/product(hi(1:d) - lo(1:d))
+         if (allocated(store(e)%w)) then
+            self%vol_x(:, iv + 1:iv + store(e)%nvol) = store(e)%x
+            self%vol_w(iv + 1:iv + store(e)%nvol) = store(e)%w
+            self%surf_x(:, is + 1:is + store(e)%nsurf) = store(e)%sx
+            self%surf_w(is + 1:is + store(e)%nsurf) = store(e)%sw
+            self%surf_n(:, is + 1:is + store(e)%nsurf) = store(e)%sn
+            self%surf_shape(is + 1:is + store(e)%nsurf) = store(e)%ss
+            deallocate (store(e)%x, store(e)%w, store(e)%sx, store(e)%sw, store(e)%sn, store(e)%ss)
+         else
+            do k = 1, store(e)%nvol
+               call tensor_point(self%quad, lo(1:d), hi(1:d), k, self%vol_x(:, iv + k), self%vol_w(iv + k))
+            end do
+         end if
+         self%fraction(e) = sum(self%vol_w(iv + 1:iv + store(e)%nvol))/product(hi(1:d) - lo(1:d))
       end do
-      self%vol_ptr(n + 1) = iv + 1
-      self%surf_ptr(n + 1) = is + 1
-      self%n_cut = count(self%grid%leaf_class /= cell_inside)
-   end subroutine integrate
+      !$omp end parallel do
+   end subroutine gather_points
 
-   !> `store` = the points of `rule` (dimension d); `stat` nonzero when an array
+   !> `store` = the points of `rule` (dimension d), or only their counts when `counts_only`
+   !> (the tensor rule, generated again by `gather_points`); `stat` nonzero when an array
    !> could not be allocated (the points of all cells together grow with the grid).
-   pure subroutine keep_rule(rule, d, store, stat)
+   pure subroutine keep_rule(rule, d, counts_only, store, stat)
       type(cell_rule_type), intent(in) :: rule
       integer, intent(in) :: d
+      logical, intent(in) :: counts_only
       type(rule_store_type), intent(inout) :: store
       integer, intent(out) :: stat
 
       store%nvol = rule%nvol
       store%nsurf = rule%nsurf
+      stat = 0
+      if (counts_only) return
       allocate (store%x, source=rule%vol_x(1:d, 1:rule%nvol), stat=stat)
       if (stat == 0) allocate (store%w, source=rule%vol_w(1:rule%nvol), stat=stat)
       if (stat == 0) allocate (store%sx, source=rule%surf_x(1:d, 1:rule%nsurf), stat=stat)

@@ -78,7 +78,7 @@ module sprc_grid_quadrature
    private
 
    public :: cut_quadrature_type, new_cut_quadrature, default_points, default_max_depth, default_min_ratio
-   public :: cell_rule_type, cell_rule, cut_cell_rule, boundary_face_rule
+   public :: cell_rule_type, cell_rule, cut_cell_rule, boundary_face_rule, tensor_point
 
    !> Settings of the cut-cell quadrature: immutable once built, share it between threads.
    type :: cut_quadrature_type
@@ -376,21 +376,33 @@ contains
       real(wp), intent(in) :: lo(:), hi(:)
       type(cell_rule_type), intent(inout) :: rule
       real(wp) :: x(3), w
-      integer :: ipt, i, d, idx
+      integer :: ipt
 
       do ipt = 1, quad%q**quad%dim
-         i = ipt - 1
-         w = 1.0_wp
-         x = 0.0_wp
-         do d = 1, quad%dim
-            idx = mod(i, quad%q) + 1
-            i = i/quad%q
-            x(d) = lo(d) + (hi(d) - lo(d))*quad%node(idx)
-            w = w*(hi(d) - lo(d))*quad%weight(idx)
-         end do
+         call tensor_point(quad, lo, hi, ipt, x, w)
          call push_volume(rule, x, w)
       end do
    end subroutine tensor_volume
+
+   !> Point `ipt` (1 .. q**dim, first direction fastest) of the tensor Gauss rule of the
+   !> box [lo, hi]: coordinates x(1:dim) (x(dim+1:) = 0) and weight w (|J| included).
+   pure subroutine tensor_point(quad, lo, hi, ipt, x, w)
+      type(cut_quadrature_type), intent(in) :: quad
+      real(wp), intent(in) :: lo(:), hi(:)
+      integer, intent(in) :: ipt
+      real(wp), intent(out) :: x(:), w
+      integer :: i, d, idx
+
+      i = ipt - 1
+      w = 1.0_wp
+      x = 0.0_wp
+      do d = 1, quad%dim
+         idx = mod(i, quad%q) + 1
+         i = i/quad%q
+         x(d) = lo(d) + (hi(d) - lo(d))*quad%node(idx)
+         w = w*(hi(d) - lo(d))*quad%weight(idx)
+      end do
+   end subroutine tensor_point
 
    !> Cut rule proper: the active shapes' quadrics on the cell, then the faces.
    pure subroutine cut_rule(quad, body, lo, hi, rule)
