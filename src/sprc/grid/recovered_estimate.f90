@@ -45,8 +45,8 @@ module sprc_grid_recovered_estimate
       real(wp) :: err = 0.0_wp, norm_h = 0.0_wp, eta = 0.0_wp
       !> True if the exact-solution quantities below were computed.
       logical :: has_exact = .false.
-      !> Per element: ||sigma_ex - sigma_h||^2 and ||sigma_ex - sigma*||^2.
-      real(wp), allocatable :: elem_err_ex2(:), elem_err_star2(:)
+      !> Per element: ||sigma_ex - sigma_h||^2, ||sigma_ex - sigma*||^2 and ||sigma_ex||^2.
+      real(wp), allocatable :: elem_err_ex2(:), elem_err_star2(:), elem_norm_ex2(:)
       real(wp) :: norm_ex = 0.0_wp, err_star = 0.0_wp, rel_err_star = 0.0_wp, err_ex = 0.0_wp, theta = 0.0_wp
       real(wp) :: max_boundary_node_error = 0.0_wp, max_boundary_point_error = 0.0_wp
       integer :: n_boundary_nodes = 0
@@ -96,9 +96,9 @@ contains
       allocate (zero(ns, maxpts))
       zero = 0.0_wp
       if (est%has_exact) then
-         allocate (est%elem_err_ex2(ne), est%elem_err_star2(ne), sex(ns, np), stat=stat)
+         allocate (est%elem_err_ex2(ne), est%elem_err_star2(ne), est%elem_norm_ex2(ne), sex(ns, np), stat=stat)
          call check_allocation(stat, 'estimate_error', 'the exact errors and stresses at the points', &
-            & int(ne, i8) + int(ns, i8)*np, 8, error)
+            & 3*int(ne, i8) + int(ns, i8)*np, 8, error)
          if (allocated(error)) return
       else
          allocate (sex(ns, 0))
@@ -117,7 +117,7 @@ contains
       est%eta = 0.0_wp
       if (est%norm_h**2 + est%err**2 > 0.0_wp) est%eta = est%err/sqrt(est%norm_h**2 + est%err**2)
       if (est%has_exact) then
-         call exact_norms(input, field, est, sex, zero, exact, error, node_inside)
+         call exact_norms(input, field, est, exact, error, node_inside)
          if (allocated(error)) return
       end if
       est%t_estimate = field%t_field + (wall_time() - t0)
@@ -152,29 +152,26 @@ contains
          & input%stress(:, a:b), est%elem_err_ex2(e), err)
       call zz_error_integral(input%analysis, input%young, input%poisson, input%w(a:b), sex(:, a:b), &
          & est%sigma_star(:, a:b), est%elem_err_star2(e), err)
+      call zz_error_integral(input%analysis, input%young, input%poisson, input%w(a:b), sex(:, a:b), &
+         & zero(:, 1:m), est%elem_norm_ex2(e), err)
    end subroutine element_terms
 
-   subroutine exact_norms(input, field, est, sex, zero, exact, error, node_inside)
+   subroutine exact_norms(input, field, est, exact, error, node_inside)
       type(recovery_input_type), intent(in) :: input
       type(recovered_field_type), intent(in) :: field
       type(zz_estimate_type), intent(inout) :: est
-      real(wp), intent(in) :: sex(:, :), zero(:, :)
       class(exact_solution_type), intent(in) :: exact
       type(error_type), allocatable, intent(out) :: error
       logical, intent(in), optional :: node_inside(:)
-      type(error_type), allocatable :: err
       logical, allocatable :: bnode(:)
-      real(wp) :: s(6), sx(6), nex2
-      integer :: e, k, n, ns, a, b, stat
+      real(wp) :: s(6), sx(6)
+      integer :: e, k, n, ns, stat
 
       ns = field%nstress
+      ! the element terms (from the parallel loop) summed in element order
       est%norm_ex = 0.0_wp
       do e = 1, field%n_elements
-         a = input%elem_ptr(e)
-         b = input%elem_ptr(e + 1) - 1
-         call zz_error_integral(input%analysis, input%young, input%poisson, input%w(a:b), sex(:, a:b), &
-            & zero(:, 1:b - a + 1), nex2, err)
-         est%norm_ex = est%norm_ex + nex2
+         est%norm_ex = est%norm_ex + est%elem_norm_ex2(e)
       end do
       est%norm_ex = sqrt(est%norm_ex)
       est%err_ex = sqrt(sum(est%elem_err_ex2))
