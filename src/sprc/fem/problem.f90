@@ -56,10 +56,10 @@
 !> every stress this type returns is then sigma_bar.
 !>
 !> Determinism: quadrature and element matrices are computed in parallel
-!> (OpenMP), each element's triplets written to the places its index fixes in
-!> the COO list (element order, as serial insertion would give); reductions
-!> (norms, errors) are summed serially in element order. The bits do not
-!> depend on the thread count.
+!> (OpenMP), each element's block written to the places its index fixes in a
+!> block list, whose rows are then summed in parallel, each entry over the
+!> blocks in element order (`sprc_fem_sparse`); reductions (norms, errors) are
+!> summed serially in element order. The bits do not depend on the thread count.
 module sprc_fem_problem
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use sprc_core_kinds, only: wp, i8

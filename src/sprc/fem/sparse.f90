@@ -281,14 +281,7 @@ contains
       if (allocated(error)) return
 
       ! start(i): where row i's triplets begin in the list sorted by row.
-      start = 0
-      do k = 1, self%nnz
-         start(self%row(k) + 1) = start(self%row(k) + 1) + 1
-      end do
-      start(1) = 1
-      do i = 1, self%nrows
-         start(i + 1) = start(i + 1) + start(i)
-      end do
+      call row_starts(self%row(1:self%nnz), start)
       call row_bands(start, (self%nnz + n_bands - 1)/n_bands, first_row, band_max)
       allocate (tcol(band_max), tval(band_max), stat=stat)
       call check_allocation(stat, 'coo_type%to_csr', 'a band of sorted triplets', band_max, 12, error)
@@ -308,12 +301,7 @@ contains
             end do
          end do
       end do
-      a%rowptr(1) = 1
-      do i = 1, self%nrows
-         a%rowptr(i + 1) = a%rowptr(i + 1) + a%rowptr(i)
-      end do
-      allocate (a%col(a%rowptr(self%nrows + 1) - 1), a%val(a%rowptr(self%nrows + 1) - 1), stat=stat)
-      call check_allocation(stat, 'coo_type%to_csr', 'the CSR matrix', a%rowptr(self%nrows + 1) - 1, 12, error)
+      call allocate_rows(a, 'coo_type%to_csr', error)
       if (allocated(error)) return
 
       ! Values: duplicates summed in list order (the gather is stable).
@@ -323,6 +311,40 @@ contains
          call merge_band(a, first_row(b), first_row(b + 1) - 1, start, tcol, tval, marker)
       end do
    end subroutine coo_to_csr
+
+   !> rowptr(i + 1) holds the entry count of row i: make the row pointers of `a` from
+   !> the counts and allocate its columns and values.
+   subroutine allocate_rows(a, who, error)
+      type(csr_type), intent(inout) :: a
+      character(len=*), intent(in) :: who
+      type(error_type), allocatable, intent(out) :: error
+      integer :: i, stat
+
+      a%rowptr(1) = 1
+      do i = 1, a%nrows
+         a%rowptr(i + 1) = a%rowptr(i + 1) + a%rowptr(i)
+      end do
+      allocate (a%col(a%rowptr(a%nrows + 1) - 1), a%val(a%rowptr(a%nrows + 1) - 1), stat=stat)
+      call check_allocation(stat, who, 'the CSR matrix', a%rowptr(a%nrows + 1) - 1, 12, error)
+   end subroutine allocate_rows
+
+   !> start(i): where row i begins (1-based) in a list of entries in rows `rows` once
+   !> sorted by row (the pointers of a counting sort); size(start) = rows + 1.
+   pure subroutine row_starts(rows, start)
+      integer, intent(in) :: rows(:)
+      integer(i8), intent(out) :: start(:)
+      integer(i8) :: k
+      integer :: i
+
+      start = 0
+      do k = 1, size(rows, kind=i8)
+         start(rows(k) + 1) = start(rows(k) + 1) + 1
+      end do
+      start(1) = 1
+      do i = 1, size(start) - 1
+         start(i + 1) = start(i + 1) + start(i)
+      end do
+   end subroutine row_starts
 
    !> Rows split into consecutive bands of at most `target` triplets each (or
    !> one row, if longer): band b is rows first_row(b) .. first_row(b+1)-1;
@@ -524,14 +546,7 @@ contains
       end if
       ! Row i meets block inc_blk(k) at its local index inc_loc(k), k = inc_ptr(i) ..
       ! inc_ptr(i + 1) - 1, in block order (a counting sort by row).
-      inc_ptr = 0
-      do p = 1, total
-         inc_ptr(self%dofs(p) + 1) = inc_ptr(self%dofs(p) + 1) + 1
-      end do
-      inc_ptr(1) = 1
-      do i = 1, self%n
-         inc_ptr(i + 1) = inc_ptr(i + 1) + inc_ptr(i)
-      end do
+      call row_starts(self%dofs(1:total), inc_ptr)
       next = inc_ptr(1:self%n)
       do b = 1, self%nblocks
          do p = self%dof_ptr(b), self%dof_ptr(b + 1) - 1
@@ -547,12 +562,7 @@ contains
          call check_allocation(failed, who, 'the column marks of a thread', self%n, 4, error)
          return
       end if
-      a%rowptr(1) = 1
-      do i = 1, self%n
-         a%rowptr(i + 1) = a%rowptr(i + 1) + a%rowptr(i)
-      end do
-      allocate (a%col(a%rowptr(self%n + 1) - 1), a%val(a%rowptr(self%n + 1) - 1), stat=stat)
-      call check_allocation(stat, who, 'the CSR matrix', a%rowptr(self%n + 1) - 1, 12, error)
+      call allocate_rows(a, who, error)
       if (allocated(error)) return
       call row_sums(self, inc_ptr, inc_blk, inc_loc, a, failed)
       if (failed /= 0) then
