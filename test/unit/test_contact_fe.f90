@@ -17,6 +17,7 @@ module sprc_test_contact_fe
    use sprc_contact_result, only: contact_open, contact_stick, contact_slip, contact_result_type
    use sprc_core_material, only: plane_stress, plane_strain, compliance_matrix
    use sprc_exact_compound, only: compound_type, new_compound_cylinder, new_compound_sphere
+   use sprc_exact_hertz, only: cattaneo_mindlin_traction
    use sprc_grid_quadrature, only: default_points
    use sprc_study_spec, only: default_kappa
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, replaced
@@ -277,7 +278,7 @@ contains
          if (allocated(error)) return
          q = -r%t_fe(1, :)
          p_ex = p0*sqrt(max(0.0_wp, 1 - (x/a)**2))
-         q_ex = mu*(p_ex - merge(p0*(c/a)*sqrt(max(0.0_wp, 1 - (x/c)**2)), 0.0_wp, abs(x) < c))
+         q_ex = cattaneo_mindlin_traction(x, a, c, mu, p0)
          ! P0 q_ex: its mean over each contact cell (open points: q_ex = 0 there).
          cell = floor(x/(2*h))
          allocate (q_mean(size(x)))

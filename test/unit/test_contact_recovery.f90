@@ -28,6 +28,7 @@ module sprc_test_contact_recovery
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type, replaced
    use sprc_recovery_dense, only: qr_pivoted
    use sprc_grid_contact, only: point_cells_type, new_point_cells, cells_box, cells_prism, aux_bounds
+   use sprc_exact_hertz, only: cattaneo_mindlin_traction
    implicit none
    private
 
@@ -1118,8 +1119,7 @@ contains
    end subroutine test_cells_prism
 
    !> Cattaneo-Mindlin (test/data/contact/cattaneo_2d.nml, level 3, a/h = 12.8; the closed
-   !> form as test_contact_fe's cattaneo_mindlin: q_ex(x) = mu p0 [sqrt(1 - x^2/a^2) - (c/a)
-   !> sqrt(1 - x^2/c^2)], the second term for |x| < c, 0 outside the contact zone): SPR-C's
+   !> form q_ex of exact/hertz's cattaneo_mindlin_traction, as test_contact_fe's): SPR-C's
    !> tangential traction ts_sprc is closer to q_ex than the FE's |t_fe| in the slave
    !> surface's L2 norm (issue 12's acceptance; no tolerance: the comparison is the claim).
    !> With the slip direction of the Coulomb patches taken from the slave's FE stress, whose
@@ -1144,8 +1144,7 @@ contains
       p0 = 2*load/(pi*a)
       c = a*sqrt(1 - q_load/(mu*load))
       associate (r => result%contacts(1), x => result%contacts(1)%x(1, :), w => result%contacts(1)%weight)
-         q_ex = mu*p0*(sqrt(max(0.0_wp, 1 - (x/a)**2)) - merge((c/a)*sqrt(max(0.0_wp, 1 - (x/c)**2)), 0.0_wp, &
-            & abs(x) < c))
+         q_ex = cattaneo_mindlin_traction(x, a, c, mu, p0)
          ! Points without a slave cell carry no value (NaN, never equal to itself): none may be closed.
          filled = r%ts_sprc == r%ts_sprc .and. norm2(r%t_fe, dim=1) == norm2(r%t_fe, dim=1)
          call check(error, all(filled .or. r%state == contact_open), 'a closed point without a traction')

@@ -15,7 +15,7 @@ module sprc_test_exact_contact
    use sprc_core_material, only: plane_stress, plane_strain, solid, analysis_name
    use sprc_exact_uniform, only: uniform_type, new_uniform
    use sprc_exact_compound, only: compound_type, new_compound_cylinder, new_compound_sphere
-   use sprc_exact_hertz, only: hertz_type, new_hertz_cylinder, new_hertz_sphere
+   use sprc_exact_hertz, only: hertz_type, new_hertz_cylinder, new_hertz_sphere, cattaneo_mindlin_traction
    use sprc_exact_pressure, only: field_pressure_type, new_field_pressure
    use sprc_test_exact, only: check_equilibrium_fd, check_compatibility_fd, shell_points, expect_error, npoint
    use sprc_testsuite, only: unittest_type, new_unittest, check, error_type
@@ -49,6 +49,7 @@ contains
          new_unittest('compound_errors', test_compound_errors), &
          new_unittest('hertz_hand_values', test_hertz_hand_values), &
          new_unittest('hertz_total_force', test_hertz_total_force), &
+         new_unittest('cattaneo_mindlin_total_force', test_cattaneo_mindlin_force), &
          new_unittest('hertz_errors', test_hertz_errors), &
          new_unittest('field_pressure', test_field_pressure) &
          ]
@@ -526,6 +527,30 @@ contains
       end do
       call check(error, total, 2.0_wp, 1.0e-13_wp, 'point contact: int p dA = F', rel=.true.)
    end subroutine test_hertz_total_force
+
+   !> The Cattaneo-Mindlin traction integrates to the tangential load: int q ds over the
+   !> contact = mu P (1 - c^2/a^2) = Q with P = pi a p0/2 (Johnson 1985, sec. 7.1), by
+   !> Gauss on each smooth piece (s = c sin t on the stick zone, s = a sin t beyond it).
+   subroutine test_cattaneo_mindlin_force(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), parameter :: a = 0.05_wp, c = 0.035_wp, mu = 0.3_wp, p0 = 13.7_wp
+      real(wp) :: x(20), w(20), t, tc, total
+      integer :: i
+
+      call gauss_legendre(20, x, w, error)
+      if (allocated(error)) return
+      tc = asin(c/a)
+      total = 0.0_wp
+      do i = 1, 20
+         t = 0.25_wp*pi*(x(i) + 1.0_wp)
+         total = total + 0.25_wp*pi*w(i)*cattaneo_mindlin_traction(c*sin(t), a, c, mu, p0)*c*cos(t)
+         t = tc + 0.5_wp*(0.5_wp*pi - tc)*(x(i) + 1.0_wp)
+         total = total + 0.5_wp*(0.5_wp*pi - tc)*w(i)*cattaneo_mindlin_traction(a*sin(t), a, c, mu, p0)*a*cos(t)
+      end do
+      call check(error, 2*total, mu*(0.5_wp*pi*a*p0)*(1 - (c/a)**2), 1.0e-13_wp, 'int q ds = Q', rel=.true.)
+      if (allocated(error)) return
+      call check(error, cattaneo_mindlin_traction(2*a, a, c, mu, p0), 0.0_wp, 0.0_wp, 'q = 0 outside the contact')
+   end subroutine test_cattaneo_mindlin_force
 
    subroutine test_hertz_errors(error)
       type(error_type), allocatable, intent(out) :: error

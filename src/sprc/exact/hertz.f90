@@ -25,7 +25,7 @@ module sprc_exact_hertz
    implicit none
    private
 
-   public :: hertz_type, new_hertz_cylinder, new_hertz_sphere
+   public :: hertz_type, new_hertz_cylinder, new_hertz_sphere, cattaneo_mindlin_traction
 
    real(wp), parameter :: pi = acos(-1.0_wp)
 
@@ -143,5 +143,17 @@ contains
       end associate
       hertz_pressure = self%p0*sqrt(max(0.0_wp, 1.0_wp - ratio))
    end function hertz_pressure
+
+   !> Cattaneo-Mindlin (Johnson 1985, sec. 7.1): the tangential traction of a Hertz
+   !> line contact (half-width a, peak pressure p0) under a tangential load Q < mu P
+   !> at distance s from the contact axis: mu p0 [sqrt(1 - s^2/a^2) - (c/a) sqrt(1 -
+   !> s^2/c^2)], the second term only in the stick zone |s| < c, c = a sqrt(1 - Q/(mu P));
+   !> 0 outside the contact zone.
+   elemental real(wp) function cattaneo_mindlin_traction(s, a, c, mu, p0) result(q)
+      real(wp), intent(in) :: s, a, c, mu, p0
+
+      q = mu*p0*sqrt(max(0.0_wp, 1.0_wp - (s/a)**2))
+      if (abs(s) < c) q = q - mu*p0*(c/a)*sqrt(max(0.0_wp, 1.0_wp - (s/c)**2))
+   end function cattaneo_mindlin_traction
 
 end module sprc_exact_hertz
