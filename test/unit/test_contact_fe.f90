@@ -61,7 +61,8 @@ contains
          new_unittest('patch_2d_stick_recovered', test_patch_2d_stick_recovered), &
          new_unittest('patch_3d_q1_recovered', test_patch_3d_q1_recovered), &
          new_unittest('shrink_fit_q1_recovered', test_shrink_q1_recovered), &
-         new_unittest('recovered_not_converged', test_recovered_not_converged) &
+         new_unittest('recovered_not_converged', test_recovered_not_converged), &
+         new_unittest('recovered_fixed_point', test_recovered_fixed_point) &
          ]
    end subroutine collect_contact_fe
 
@@ -739,5 +740,35 @@ contains
       call check(error, index(failed%message, "contact 'shaft' on 'hub': the recovered stabilization did not settle") &
          & > 0, 'message: '//failed%message)
    end subroutine test_recovered_not_converged
+
+   !> A settled recovered stabilization is stabilized by the recovered stress
+   !> it reports: the stabilization pressure p* of the last solve (the slave's
+   !> coupled SPR-C traction of the solution before it) equals the report's
+   !> p_sprc of the final solution over the closed points, to the settling
+   !> tier (the last update moved the contact traction by at most sqrt(eps) of
+   !> its norm; the recovered traction, a bounded linear map of the same
+   !> displacement change, is allowed two orders of magnitude more). A
+   !> stabilization by another recovery (the slave alone, its contact surface
+   !> free) misses by the difference of the two recoveries.
+   subroutine test_recovered_fixed_point(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(level_type) :: result
+      character(len=:), allocatable :: text
+      real(wp) :: diff, norm
+
+      call read_text_file('example/scenes/shrink_fit.nml', text, error)
+      if (allocated(error)) return
+      text = replaced(text, "friction='frictionless' /", "friction='frictionless' stabilization='recovered' kappa=1 /")
+      call run_text(text, 4, result, error)
+      if (allocated(error)) return
+      associate (c => result%contacts(1))
+         call check(error, allocated(c%p_star), 'p_star is set with the recovered stabilization')
+         if (allocated(error)) return
+         diff = sqrt(sum(c%weight*(c%p_star - c%p_sprc)**2, mask=c%state /= contact_open))
+         norm = sqrt(sum(c%weight*c%p_sprc**2, mask=c%state /= contact_open))
+         call check(error, count(c%state /= contact_open) > 0 .and. diff <= 100.0_wp*sqrt(epsilon(1.0_wp))*norm, &
+            & 'p_star against p_sprc: relative L2 difference '//real_text(diff/norm))
+      end associate
+   end subroutine test_recovered_fixed_point
 
 end module sprc_test_contact_fe

@@ -38,6 +38,11 @@ module sprc_contact_result
       !> The FE tangential traction on the slave body as a vector (dim, npoint):
       !> its sign shows the direction of friction (Cattaneo-Mindlin).
       real(wp), allocatable :: t_fe(:, :)
+      !> With `stabilization = 'recovered'` only: the stabilization pressure
+      !> -n.t* of the last solve, t* the slave's recovered traction (SPR-C with
+      !> the coupled contact patches) of the solution before it; once the
+      !> iteration has settled it agrees with p_sprc to the settling tolerance.
+      real(wp), allocatable :: p_star(:)
       !> Iterations of the contact nonlinearity summed over all increments.
       integer :: iterations = 0
    end type contact_result_type

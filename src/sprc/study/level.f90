@@ -17,7 +17,7 @@
 !> friction) are refused (stat_unsupported) before any computation. With
 !> `stabilization = 'recovered'` the pair is solved with a zero
 !> stabilization traction first (penalty), then re-solved with the slave
-!> body's recovered traction of the previous solution until it settles
+!> body's coupled SPR-C traction of the previous solution until it settles
 !> (`stabilize_recovered`).
 !> Coulomb friction follows the load path of `&bc stage` and `&contact
 !> steps` (`load_path`); other friction laws take all stages as one load.
@@ -32,7 +32,6 @@ module sprc_study_level
    use sprc_core_timer, only: timer_type, wall_time
    use sprc_core_alloc, only: check_allocation
    use sprc_core_blas_threads, only: blas_reserve_buffers
-   use sprc_core_boundary, only: bc_none
    use sprc_geometry_body, only: body_type
    use sprc_exact_solution, only: exact_solution_type
    use sprc_grid_nodes, only: grid_nodes_type
@@ -386,7 +385,7 @@ contains
       type(contact_surface_type) :: surface
       type(contact_solution_type) :: sol
       type(timer_type) :: timer
-      real(wp), allocatable :: loads(:, :)
+      real(wp), allocatable :: loads(:, :), tstar(:, :)
       integer :: s, m, b, k
 
       s = spec%slave_index
@@ -418,7 +417,7 @@ contains
             call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, friction_coulomb, spec%kappa, &
                & names, sol, error, mu=spec%mu, loads=loads, progress=progress)
          else if (spec%stabilization == 'recovered') then
-            call stabilize_recovered(study, spec, surface, names, bodies, sol, error)
+            call stabilize_recovered(study, spec, surface, names, bodies, sol, tstar, error)
          else
             call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, friction_kind(spec%friction), &
                & spec%kappa, names, sol, error, progress=progress)
@@ -435,6 +434,9 @@ contains
       end do
       call contact_result(surface, sol, spec, study%bodies(s)%units, result, error)
       if (allocated(error)) return
+      ! p* = -n.t* (t* = 0 at a point without slave cell), in scene units as p_fe.
+      if (allocated(tstar)) result%p_star = -sum(surface%normal*tstar, dim=1)* &
+         & (study%bodies(s)%units%modulus*study%bodies(s)%units%strain)
       call finish_pair(study, spec, surface, result, bodies, error)
       if (.not. allocated(error)) &
          & call recovered_tractions(surface, bodies(s), study%run, study%bodies(s)%units, result, error)
@@ -457,24 +459,26 @@ contains
    !> traction is a contact term; t_recovery stays the reported fields'); an
    !> iteration that has not settled after default_max_iterations updates is
    !> stat_not_converged.
-   subroutine stabilize_recovered(study, spec, surface, names, bodies, sol, error)
+   subroutine stabilize_recovered(study, spec, surface, names, bodies, sol, pstar, error)
       type(study_type), intent(in) :: study
       type(contact_spec_type), intent(in) :: spec
       type(contact_surface_type), intent(in) :: surface
       character(len=*), intent(in) :: names(2)
       type(body_level_type), intent(inout) :: bodies(:)
       type(contact_solution_type), intent(out) :: sol
+      !> The stabilization traction of the last solve (dim, npoint; pair units).
+      real(wp), allocatable, intent(out) :: pstar(:, :)
       type(error_type), allocatable, intent(out) :: error
       type(contact_factor_type) :: factor
 
-      call recovered_updates(study, spec, surface, names, bodies, factor, sol, error)
+      call recovered_updates(study, spec, surface, names, bodies, factor, sol, pstar, error)
       call factor%destroy()
    end subroutine stabilize_recovered
 
    !> The iteration of `stabilize_recovered` with the block factor kept
    !> between updates (sprc_contact_solve: the matrix depends on the active
    !> set only).
-   subroutine recovered_updates(study, spec, surface, names, bodies, factor, sol, error)
+   subroutine recovered_updates(study, spec, surface, names, bodies, factor, sol, pstar, error)
       type(study_type), intent(in) :: study
       type(contact_spec_type), intent(in) :: spec
       type(contact_surface_type), intent(in) :: surface
@@ -482,10 +486,10 @@ contains
       type(body_level_type), intent(inout) :: bodies(:)
       type(contact_factor_type), intent(inout) :: factor
       type(contact_solution_type), intent(out) :: sol
+      real(wp), allocatable, intent(out) :: pstar(:, :)
       type(error_type), allocatable, intent(out) :: error
       type(contact_solution_type) :: next
       type(timer_type) :: timer
-      real(wp), allocatable :: pstar(:, :)
       real(wp) :: change, size_, t_solve, t_contact
       integer :: s, m, it, iterations, stat
 
@@ -504,7 +508,7 @@ contains
       do it = 1, default_max_iterations
          call timer%reset()
          call timer%start()
-         call slave_recovered_traction(study, s, bodies(s), surface, pstar, error)
+         call slave_recovered_traction(study, spec, surface, sol, bodies, pstar, error)
          call timer%stop()
          t_contact = t_contact + timer%elapsed
          if (.not. allocated(error)) call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, &
@@ -533,26 +537,39 @@ contains
 
    !> The slave body's recovered traction sigma* n at every slave point
    !> (dim, npoint; zero where the point has no slave cell), in the pair's
-   !> units: the study's SPR-C recovery of the current solution, with the
-   !> patch degree of the scene's SPR-C.
-   subroutine slave_recovered_traction(study, b, bl, surface, pstar, error)
+   !> units: the slave's SPR-C recovery of the current solution `sol`, with
+   !> the patch degree of the scene's SPR-C and the pair's coupled contact
+   !> patches (`pair_contact` of sol's contact states, the master's FE
+   !> stresses as body (2)): the field the report's p_sprc comes from, so
+   !> that a settled iteration is stabilized by the recovered stress it
+   !> reports. Open parts of the contact surface are free surfaces.
+   subroutine slave_recovered_traction(study, spec, surface, sol, bodies, pstar, error)
       type(study_type), intent(in) :: study
-      integer, intent(in) :: b
-      type(body_level_type), intent(in) :: bl
+      type(contact_spec_type), intent(in) :: spec
       type(contact_surface_type), intent(in) :: surface
+      type(contact_solution_type), intent(in) :: sol
+      type(body_level_type), intent(in) :: bodies(:)
       real(wp), allocatable, intent(out) :: pstar(:, :)
       type(error_type), allocatable, intent(out) :: error
-      type(recovery_input_type) :: input
+      type(recovery_input_type) :: inputs(2)
+      type(contact_result_type) :: result
+      type(grid_contact_type) :: contact
       type(recovered_field_type) :: field
       real(wp) :: sigma(6), tn(3, 6)
-      integer :: i, d, stat
+      integer :: i, d, s, stat
 
       d = surface%dim
-      call fe_recovery_input(bl%problem, input, error)
+      s = spec%slave_index
+      call contact_result(surface, sol, spec, study%bodies(s)%units, result, error)
+      if (.not. allocated(error)) call fe_recovery_input(bodies(s)%problem, inputs(1), error)
+      if (.not. allocated(error)) call fe_recovery_input(bodies(spec%master_index)%problem, inputs(2), error)
+      if (.not. allocated(error)) call pair_contact(study, spec, surface, result, 1, inputs(1), &
+         & bodies(s)%problem%mesh%nodes, inputs(2), contact, error)
       if (allocated(error)) return
-      call free_contact_surfaces(study, b, input)
-      call recover_grid(input, bl%problem%mesh%grid, bl%problem%mesh%nodes, bl%problem%mesh%hanging, method_sprc, &
-         & study%degree(2), field, error)
+      associate (mesh => bodies(s)%problem%mesh)
+         call recover_grid(inputs(1), mesh%grid, mesh%nodes, mesh%hanging, method_sprc, study%degree(2), field, &
+            & error, contact=contact)
+      end associate
       if (allocated(error)) return
       allocate (pstar(d, surface%npoint), source=0.0_wp, stat=stat)
       call check_allocation(stat, 'contact pair', 'the recovered traction of each slave point', surface%npoint, 8*d, error)
@@ -561,29 +578,11 @@ contains
          if (surface%slave_cell(i) < 1 .or. .not. surface%has_master(i)) cycle
          call field_eval(field, surface%slave_cell(i), surface%x(:, i), sigma, error)
          if (allocated(error)) return
-         call traction_matrix(d, surface%normal(:, i), tn(1:d, 1:bl%problem%nstress))
-         pstar(:, i) = matmul(tn(1:d, 1:bl%problem%nstress), sigma(1:bl%problem%nstress))
+         call traction_matrix(d, surface%normal(:, i), tn(1:d, 1:bodies(s)%problem%nstress))
+         pstar(:, i) = matmul(tn(1:d, 1:bodies(s)%problem%nstress), sigma(1:bodies(s)%problem%nstress))
       end do
    end subroutine slave_recovered_traction
 
-   !> The stabilization's recovery of the slave alone (inside the contact
-   !> iteration, before the pair's coupled contact patches can be built)
-   !> imposes nothing on body b's contact surfaces: they carry the contact
-   !> traction, not the zero traction of a free surface (the default of a
-   !> surface without `&bc`).
-   subroutine free_contact_surfaces(study, b, input)
-      type(study_type), intent(in) :: study
-      integer, intent(in) :: b
-      type(recovery_input_type), intent(inout) :: input
-      integer :: k
-
-      do k = 1, size(study%scene%contacts)
-         associate (c => study%scene%contacts(k), shapes => study%scene%shapes)
-            if (c%slave_index == b) input%bc_kind(shapes(c%slave_surface_index)%body_shape) = bc_none
-            if (c%master_index == b) input%bc_kind(shapes(c%master_surface_index)%body_shape) = bc_none
-         end associate
-      end do
-   end subroutine free_contact_surfaces
    !> After a pair's FE solve: both bodies' exact errors, recoveries and estimates, SPR-C
    !> with each body's contact surface (`pair_contact`): the coupled contact patches of
    !> both bodies, each with the other as body (2) (sprc_grid_contact).
