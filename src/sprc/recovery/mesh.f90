@@ -943,7 +943,9 @@ contains
    !> evaluated per point.
    subroutine estimate(r, gp, gw, gs, xi, rule, error)
       type(mesh_recovery_type), intent(inout) :: r
-      real(wp), intent(in) :: gp(:, :, :), gw(:, :), gs(:, :, :), xi(:, :, :)
+      real(wp), intent(in) :: gp(:, :, :), xi(:, :, :)
+      ! Contiguous as recover_on_mesh's: energy_norms takes each element's slice without a copy.
+      real(wp), intent(in), contiguous :: gw(:, :), gs(:, :, :)
       type(rule_type), intent(in) :: rule
       type(error_type), allocatable, intent(out) :: error
       real(wp), allocatable :: sstar(:, :), sj(:, :, :), n(:, :), cmat(:, :)
