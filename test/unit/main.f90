@@ -29,6 +29,7 @@ program sprc_unit_tests
    use sprc_test_contact_fe, only: collect_contact_fe
    use sprc_test_petsc, only: collect_petsc
    use sprc_test_contact_recovery, only: collect_contact_recovery
+   use sprc_test_partition, only: collect_partition
    implicit none
 
    type(testsuite_type), allocatable :: suites(:)
@@ -60,7 +61,8 @@ program sprc_unit_tests
       new_testsuite('contact_output', collect_contact_output), &
       new_testsuite('contact_fe', collect_contact_fe), &
       new_testsuite('petsc', collect_petsc), &
-      new_testsuite('contact_recovery', collect_contact_recovery) &
+      new_testsuite('contact_recovery', collect_contact_recovery), &
+      new_testsuite('partition', collect_partition) &
       ]
 
    call get_arg(1, suite_name)

@@ -477,10 +477,16 @@ contains
       call expand_solution(self, error)
    end subroutine problem_solve
 
-   !> The reduced stiffness `k` and load `f` (t_assembly). After setup.
-   subroutine problem_assemble(self, error)
+   !> The reduced stiffness `k` and load `f` (t_assembly). After setup. With
+   !> `rows` = [lo, hi] (a rank's rows of a partitioned level,
+   !> `sprc_study_partition`) only the element and aggregate blocks that touch
+   !> reduced rows lo..hi are computed, so only those rows of k and f are
+   !> complete: each is summed over the same blocks in the same order as
+   !> without `rows`, so it has the same bits.
+   subroutine problem_assemble(self, error, rows)
       class(elasticity_problem_type), intent(inout) :: self
       type(error_type), allocatable, intent(out) :: error
+      integer, intent(in), optional :: rows(2)
       type(timer_type) :: timer
 
       if (.not. allocated(self%root)) then
@@ -489,7 +495,11 @@ contains
       end if
       self%solved = .false.
       call timer%start()
-      call assemble(self, error)
+      if (present(rows)) then
+         call assemble(self, rows, error)
+      else
+         call assemble(self, [1, self%constraints%n_dofs], error)
+      end if
       call timer%stop()
       self%t_assembly = self%t_assembly + timer%elapsed
    end subroutine problem_assemble
@@ -553,8 +563,10 @@ contains
    !> K and f: the reduced element systems in one parallel loop, each into its own block of
    !> a block list (the aggregates' dilatation blocks after them), summed row by row in
    !> parallel (`block_list_type`): the same sums, in element order, for any thread count.
-   subroutine assemble(self, error)
+   !> A block that touches no row of `rows` is left empty.
+   subroutine assemble(self, rows, error)
       type(elasticity_problem_type), intent(inout) :: self
+      integer, intent(in) :: rows(2)
       type(error_type), allocatable, intent(out) :: error
       type(block_list_type) :: blocks
       integer, allocatable :: mdof(:), bad(:), multi(:)
@@ -569,10 +581,8 @@ contains
       allocate (mdof(nel + size(multi)), bad(nel), stat=stat)
       call check_allocation(stat, who, 'the reduced dof count of each element', nel, 8, error)
       if (allocated(error)) return
-      call element_dof_counts(self, mdof(1:nel))
-      maxm = 0
-      if (nel > 0) maxm = maxval(mdof(1:nel))
-      call aggregate_dof_counts(self, maxm, multi, mdof(nel + 1:))
+      call element_dof_counts(self, rows, mdof(1:nel), maxm)
+      call aggregate_dof_counts(self, maxm, rows, multi, mdof(nel + 1:))
       call blocks%init(self%constraints%n_dofs, mdof, error)
       if (allocated(error)) return
       ! The element kernels call no BLAS; the dilatation blocks do (small dgemm and
@@ -660,20 +670,25 @@ contains
       end do
    end subroutine multi_cell_aggregates
 
-   !> The number of distinct reduced dofs of every element (OpenMP over elements).
-   subroutine element_dof_counts(self, mdof)
+   !> The number of distinct reduced dofs of every element (OpenMP over elements),
+   !> 0 for an element with no dof in `rows`; `maxm` the largest count of all.
+   subroutine element_dof_counts(self, rows, mdof, maxm)
       type(elasticity_problem_type), intent(in) :: self
-      integer, intent(out) :: mdof(:)
+      integer, intent(in) :: rows(2)
+      integer, intent(out) :: mdof(:), maxm
       integer, allocatable :: dtmp(:)
       real(wp), allocatable :: ttmp(:, :)
       integer :: nd, e
 
       nd = self%dim*self%nen
-      !$omp parallel default(shared) private(dtmp, ttmp, e)
+      maxm = 0
+      !$omp parallel default(shared) private(dtmp, ttmp, e) reduction(max:maxm)
       allocate (dtmp(nd*32), ttmp(nd, nd*32))
       !$omp do schedule(static)
       do e = 1, size(mdof)
          call self%constraints%element_map(self%mesh%nodes%connectivity(:, e), dtmp, ttmp, mdof(e))
+         maxm = max(maxm, mdof(e))
+         if (.not. any(dtmp(1:mdof(e)) >= rows(1) .and. dtmp(1:mdof(e)) <= rows(2))) mdof(e) = 0
       end do
       !$omp end do
       !$omp end parallel
@@ -697,6 +712,9 @@ contains
          p = blocks%dof_ptr(e)
          v = blocks%val_ptr(e)
          m = int(blocks%dof_ptr(e + 1) - p)
+         bad(e) = 0
+         ! an empty block adds nothing: none of the element's dofs, or none of the rows assembled
+         if (m == 0) cycle
          call reduced_element_system(self, e, maxm, blocks%dofs(p:p + m - 1), blocks%val(v:v + int(m, i8)**2 - 1), &
             & blocks%rhs(p:p + m - 1))
          bad(e) = count(.not. ieee_is_finite(blocks%val(v:v + int(m, i8)**2 - 1)))
@@ -705,16 +723,17 @@ contains
    end subroutine element_blocks
 
    !> The sizes of the dilatation blocks of the aggregates `multi`: the distinct reduced
-   !> dofs of their members together.
-   subroutine aggregate_dof_counts(self, maxm, multi, mdof)
+   !> dofs of their members together (0 when none is in `rows`).
+   subroutine aggregate_dof_counts(self, maxm, rows, multi, mdof)
       type(elasticity_problem_type), intent(in) :: self
-      integer, intent(in) :: maxm, multi(:)
+      integer, intent(in) :: maxm, rows(2), multi(:)
       integer, intent(out) :: mdof(:)
       integer, allocatable :: union(:)
       integer :: i
 
       do i = 1, size(multi)
          call aggregate_union(self, maxm, multi(i), union, mdof(i))
+         if (.not. any(union(1:mdof(i)) >= rows(1) .and. union(1:mdof(i)) <= rows(2))) mdof(i) = 0
       end do
    end subroutine aggregate_dof_counts
 
@@ -759,6 +778,7 @@ contains
       np = self%dilatation%np
       do ia = 1, size(multi)
          a = multi(ia)
+         if (blocks%dof_ptr(nel + ia + 1) == blocks%dof_ptr(nel + ia)) cycle
          call aggregate_union(self, maxm, a, union, nu)
          allocate (gu(nu, np), hu(nu, np), ku(nu, nu), fu(nu))
          gu = 0.0_wp

@@ -86,16 +86,23 @@ contains
 
    !> Cut-cell quadrature of every element with the settings `quad` (parallel,
    !> one rule object per thread), concatenated in element order; volume
-   !> fractions (t_quadrature). After `build`.
-   subroutine mesh_integrate(self, quad, error)
+   !> fractions (t_quadrature). After `build`. With `cells` = [first, last],
+   !> only the elements first..last get their rules (a rank's share of a
+   !> partitioned level, `sprc_study_partition`); the others get no points
+   !> and fraction 0 until the shares are gathered.
+   subroutine mesh_integrate(self, quad, error, cells)
       class(cut_mesh_type), intent(inout) :: self
       type(cut_quadrature_type), intent(in) :: quad
       type(error_type), allocatable, intent(out) :: error
+      integer, intent(in), optional :: cells(2)
       type(timer_type) :: timer
+      integer :: range(2)
 
       self%quad = quad
+      range = [1, self%grid%n_leaves]
+      if (present(cells)) range = [max(cells(1), 1), min(cells(2), self%grid%n_leaves)]
       call timer%start()
-      call integrate(self, error)
+      call integrate(self, range, error)
       call timer%stop()
       self%t_quadrature = timer%elapsed
    end subroutine mesh_integrate
@@ -105,8 +112,9 @@ contains
    !> for such an inside cell, generated: the tensor rule, as `cell_rule` gives it) to
    !> the places its index fixes, again in parallel: no serial pass over the points,
    !> and no allocation for most cells.
-   subroutine integrate(self, error)
+   subroutine integrate(self, range, error)
       type(cut_mesh_type), intent(inout) :: self
+      integer, intent(in) :: range(2)
       type(error_type), allocatable, intent(out) :: error
       type(rule_store_type), allocatable :: store(:)
       type(cell_rule_type) :: rule
@@ -125,7 +133,7 @@ contains
       failed = .false.
       stats = 0
       !$omp parallel do schedule(dynamic, 16) default(shared) private(e, rule, cell_error, lo, hi)
-      do e = 1, n
+      do e = range(1), range(2)
          call self%grid%leaf_box(e, lo(1:d), hi(1:d))
          call cell_rule(self%quad, self%body, lo(1:d), hi(1:d), rule, cell_error)
          if (allocated(cell_error)) then

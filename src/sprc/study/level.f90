@@ -54,6 +54,7 @@ module sprc_study_level
    use sprc_study_model, only: build_bodies, build_exact, body_conditions, analysis_kind, analysis_units_type, &
       & analysis_units, in_units
    use sprc_study_budget, only: check_level_memory
+   use sprc_study_partition, only: partition_type, start_partition, integrate_level, solve_level
    use sprc_study_row, only: report_row_type
    use sprc_study_contact_row, only: fill_contact_exact, fill_contact_row
    use sprc_contact_result, only: contact_result_type, new_contact_result, contact_open, contact_stick, &
@@ -102,6 +103,8 @@ module sprc_study_level
       !> Recoveries to run (1 SPR, 2 SPR-C) and whether the scene has an exact solution.
       logical :: run(2) = .false.
       logical :: have_exact = .false.
+      !> The MPI ranks a level is shared out among (`sprc_study_partition`; one in a serial run).
+      type(partition_type) :: partition
    end type study_type
 
    !> One body at one level. Its cut mesh (grid, nodes, hanging-node
@@ -195,6 +198,8 @@ contains
       do b = 1, size(study%bodies)
          study%have_exact = study%have_exact .or. allocated(study%bodies(b)%exact)
       end do
+      call start_partition(study%partition, error)
+      if (allocated(error)) return
       ! Every path to run_level passes here: OpenBLAS's buffers are taken
       ! before the first level, while there is room (a failure is an error).
       call blas_reserve_buffers(error)
@@ -293,7 +298,7 @@ contains
             & 'use a higher level (or a smaller box_size)', stat_invalid_input)
          return
       end if
-      call mesh%integrate(quad, error)
+      call integrate_level(study%partition, mesh, quad, error)
       if (allocated(error)) return
       if (allocated(sb%exact)) then
          call bl%problem%setup(mesh, study%analysis, sb%young, sb%poisson, sb%body_force, sb%bcs, error, &
@@ -308,7 +313,7 @@ contains
          return
       end if
       if (allocated(study%scene%solver)) bl%problem%solver = solver_choice(study%scene%solver)
-      call bl%problem%solve(error)
+      call solve_level(study%partition, bl%problem, error)
       if (allocated(error)) return
       call finish_body(study, sb, bl, error)
    end subroutine run_body
