@@ -9,7 +9,8 @@ module sprc_test_partition
    use sprc_study_spec, only: scene_type
    use sprc_io_scene, only: read_scene_text
    use sprc_study_level, only: study_type, prepare_study
-   use sprc_study_partition, only: split_by_work, owned_rows, cut_cell_work
+   use sprc_study_partition, only: owned_rows, cut_cell_work
+   use sprc_grid_share, only: split_by_work
    use sprc_geometry_region, only: cell_inside
    use sprc_grid_cut_mesh, only: cut_mesh_type
    use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature

@@ -80,6 +80,7 @@ module sprc_fem_problem
    use sprc_grid_hanging, only: hanging_type
    use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature, default_points, tensor_point
    use sprc_grid_cut_mesh, only: cut_mesh_type
+   use sprc_grid_share, only: share_type, share_range
    use sprc_exact_solution, only: exact_solution_type
    use sprc_fem_sparse, only: block_list_type, csr_type
    use sprc_fem_cholmod, only: cholmod_solver_type
@@ -1339,16 +1340,20 @@ contains
    !> element_error(e) = ||sigma_ex - sigma_h||_E on element e, norm_fe = ||sigma_h||_E,
    !> norm_exact = ||sigma_ex||_E and optionally err_norm = ||sigma_ex - sigma_h||_E
    !> (sums over several bodies add its square). Needs the exact solution given to setup.
-   subroutine energy_error(self, err_fe, element_error, norm_fe, norm_exact, error, err_norm)
+   !> With `share` (a level shared out among ranks, `sprc_grid_share`) each rank
+   !> integrates its range of elements and the terms are gathered before the sums.
+   subroutine energy_error(self, err_fe, element_error, norm_fe, norm_exact, error, err_norm, share)
       class(elasticity_problem_type), intent(in) :: self
       real(wp), intent(out) :: err_fe
       real(wp), allocatable, intent(out) :: element_error(:)
       real(wp), intent(out) :: norm_fe, norm_exact
       type(error_type), allocatable, intent(out) :: error
       real(wp), intent(out), optional :: err_norm
+      class(share_type), intent(in), optional :: share
       real(wp), allocatable :: parts(:, :)
       real(wp) :: sh(6), se(6), c(6, 6), de(6)
-      integer :: e, q, ns, nel, stat
+      integer, allocatable :: first(:)
+      integer :: e, q, ns, nel, stat, lo, hi
 
       err_fe = 0.0_wp
       norm_fe = 0.0_wp
@@ -1368,8 +1373,9 @@ contains
       allocate (parts(3, nel), element_error(nel), stat=stat)
       call check_allocation(stat, 'energy_error', 'the error of each element', nel, 32, error)
       if (allocated(error)) return
+      call share_range(share, self%mesh%vol_ptr(2:) - self%mesh%vol_ptr(:nel) + 1, first, lo, hi)
       !$omp parallel do schedule(dynamic, 16) default(shared) private(e, q, sh, se, de)
-      do e = 1, nel
+      do e = lo, hi
          parts(:, e) = 0.0_wp
          do q = self%mesh%vol_ptr(e), self%mesh%vol_ptr(e + 1) - 1
             call self%stress_in_element(e, self%mesh%vol_x(:, q), sh(1:ns))
@@ -1381,6 +1387,10 @@ contains
          end do
       end do
       !$omp end parallel do
+      if (present(share)) then
+         call share%gather_slices(3*(int(first, i8) - 1) + 1, parts, error)
+         if (allocated(error)) return
+      end if
       element_error(:) = sqrt(parts(1, :))
       norm_fe = sqrt(sum(parts(2, :)))
       norm_exact = sqrt(sum(parts(3, :)))

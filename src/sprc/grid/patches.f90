@@ -66,6 +66,7 @@ module sprc_grid_patches
       & recover_patch_default
    use sprc_grid_contact, only: grid_contact_type, contact_patch_solve
    use sprc_grid_recovered_field, only: recovered_field_type, method_spr, method_sprc, build_field
+   use sprc_grid_share, only: share_type, share_range, gather_patches
    implicit none
    private
 
@@ -125,7 +126,11 @@ contains
    !> invalid input (stat_invalid_input, naming the field and index), a patch still rank
    !> deficient after `max_rounds` expansions (stat_singular, naming the node). With
    !> `contact` (SPR-C only; ignored by SPR), the body's contact surface (module notes).
-   subroutine recover_grid(input, grid, nodes, hanging, method, degree, field, error, exact, max_rounds, contact)
+   !> With `share` (a level shared out among ranks, `sprc_grid_share`) each rank
+   !> recovers its range of patches and the records are gathered: the same field
+   !> on every rank as one process recovers.
+   subroutine recover_grid(input, grid, nodes, hanging, method, degree, field, error, exact, max_rounds, contact, &
+         & share)
       type(recovery_input_type), intent(in), target :: input
       type(grid_type), intent(in) :: grid
       type(grid_nodes_type), intent(in), target :: nodes
@@ -137,9 +142,12 @@ contains
       !> Expansion rounds allowed per patch (>= 0; default `default_max_rounds`).
       integer, intent(in), optional :: max_rounds
       type(grid_contact_type), intent(in), optional, target :: contact
+      class(share_type), intent(in), optional :: share
       type(grid_source_type) :: src
       type(patch_loop_type) :: opt
-      integer :: rounds_limit, ip, e, n, stat
+      logical, allocatable :: skip(:)
+      integer, allocatable :: first(:)
+      integer :: rounds_limit, ip, e, n, stat, lo, hi
       real(wp) :: t0
       character(len=160) :: buf
 
@@ -189,8 +197,15 @@ contains
       ! Over all nodes, hanging ones included: the capacity (and with it the bits) of before.
       opt%cap = patch_capacity(src, grid%dim, degree, nodes%node_element_ptr, nodes%node_element, &
          & [(n, n=1, nodes%n_nodes)])
+      call share_range(share, patch_work(input, nodes, field%patch_node), first, lo, hi)
+      skip = [(ip < lo .or. ip > hi, ip=1, field%n_patches)]
       call run_patch_loop(opt, src, nodes%node_element_ptr, nodes%node_element, nodes%connectivity, &
-         & field%patch_node, field%recs, field%patch_rounds, field%patch_elements, ip, error)
+         & field%patch_node, field%recs, field%patch_rounds, field%patch_elements, ip, error, skip)
+      if (present(share)) then
+         call share%agree('the recovery', error)
+         if (.not. allocated(error)) &
+            & call gather_patches(share, first, field%recs, field%patch_rounds, field%patch_elements, error)
+      end if
       if (allocated(error)) then
          if (ip == 0) return
          n = field%patch_node(ip)
@@ -214,6 +229,24 @@ contains
       call build_field(field, grid, nodes, hanging, error)
       field%t_field = wall_time() - t0
    end subroutine recover_grid
+
+   !> The work of each patch for sharing them out: its elements, those with
+   !> boundary points counted four times (their constraints and expansions).
+   pure function patch_work(input, nodes, patch_node) result(work)
+      type(recovery_input_type), intent(in) :: input
+      type(grid_nodes_type), intent(in) :: nodes
+      integer, intent(in) :: patch_node(:)
+      integer :: work(size(patch_node))
+      integer :: ip, k, e
+
+      do ip = 1, size(patch_node)
+         work(ip) = 0
+         do k = nodes%node_element_ptr(patch_node(ip)), nodes%node_element_ptr(patch_node(ip) + 1) - 1
+            e = nodes%node_element(k)
+            work(ip) = work(ip) + merge(4, 1, input%belem_ptr(e + 1) > input%belem_ptr(e))
+         end do
+      end do
+   end function patch_work
 
    subroutine check_options(method, degree, rounds_limit, error)
       integer, intent(in) :: method, degree, rounds_limit

@@ -29,6 +29,7 @@ module sprc_grid_recovered_estimate
    use sprc_recovery_estimate, only: zz_error_integral
    use sprc_grid_recovered_field, only: recovered_field_type, field_eval_unchecked, interp_default
    use sprc_grid_patches, only: recovery_input_type
+   use sprc_grid_share, only: share_type, share_range
    implicit none
    private
 
@@ -59,7 +60,10 @@ contains
    !> ZZ estimate of `field` against the FE stresses of `input` (the same input the field was
    !> recovered from), and with `exact` the error norms. Errors: input and field disagree
    !> (stat_invalid_input), exact solution of another dimension.
-   subroutine estimate_error(input, field, est, error, exact, node_inside)
+   !> With `share` (a level shared out among ranks, `sprc_grid_share`) each rank
+   !> computes the terms of its range of elements and the terms (and sigma*) are
+   !> gathered before the sums: the same bits on every rank as in one process.
+   subroutine estimate_error(input, field, est, error, exact, node_inside, share)
       type(recovery_input_type), intent(in) :: input
       type(recovered_field_type), intent(in) :: field
       type(zz_estimate_type), intent(out) :: est
@@ -67,9 +71,11 @@ contains
       class(exact_solution_type), intent(in), optional :: exact
       !> Nodes inside or on the body (n_nodes), for max_boundary_node_error.
       logical, intent(in), optional :: node_inside(:)
+      class(share_type), intent(in), optional :: share
       real(wp), allocatable :: sex(:, :), zero(:, :)
       real(wp) :: t0
-      integer :: ne, ns, np, e, a, b, maxpts, stat
+      integer, allocatable :: first(:)
+      integer :: ne, ns, np, e, a, b, maxpts, stat, lo, hi
 
       t0 = wall_time()
       call check_consistent(input, field, error, exact)
@@ -104,13 +110,18 @@ contains
          allocate (sex(ns, 0))
       end if
 
+      call share_range(share, input%elem_ptr(2:) - input%elem_ptr(:ne) + 1, first, lo, hi)
       !$omp parallel do schedule(dynamic, 64) private(a, b)
-      do e = 1, ne
+      do e = lo, hi
          a = input%elem_ptr(e)
          b = input%elem_ptr(e + 1) - 1
          call element_terms(input, field, e, a, b, est, zero, sex, exact)
       end do
       !$omp end parallel do
+      if (present(share)) then
+         call gather_terms(share, first, input%elem_ptr, est, error)
+         if (allocated(error)) return
+      end if
 
       est%err = sqrt(sum(est%elem_err2))
       est%norm_h = sqrt(sum(est%elem_norm_h2))
@@ -122,6 +133,26 @@ contains
       end if
       est%t_estimate = field%t_field + (wall_time() - t0)
    end subroutine estimate_error
+
+   !> The element terms and sigma* of every rank's elements (`first`, as
+   !> `split_by_work`) gathered in element order.
+   subroutine gather_terms(share, first, elem_ptr, est, error)
+      class(share_type), intent(in) :: share
+      integer, intent(in) :: first(:), elem_ptr(:)
+      type(zz_estimate_type), intent(inout) :: est
+      type(error_type), allocatable, intent(out) :: error
+      integer(i8) :: cells(size(first))
+
+      cells = int(first, i8)
+      call share%gather_slices(cells, est%elem_err2, error)
+      if (.not. allocated(error)) call share%gather_slices(cells, est%elem_norm_h2, error)
+      if (.not. allocated(error)) call share%gather_slices(size(est%sigma_star, 1, i8)*(elem_ptr(first) - 1) + 1, &
+         & est%sigma_star, error)
+      if (allocated(error) .or. .not. est%has_exact) return
+      call share%gather_slices(cells, est%elem_err_ex2, error)
+      if (.not. allocated(error)) call share%gather_slices(cells, est%elem_err_star2, error)
+      if (.not. allocated(error)) call share%gather_slices(cells, est%elem_norm_ex2, error)
+   end subroutine gather_terms
 
    !> sigma* at the element's points and its energy-norm terms. Cannot fail: the input was
    !> validated and the weights are positive and finite.

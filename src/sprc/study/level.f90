@@ -55,6 +55,7 @@ module sprc_study_level
       & analysis_units, in_units
    use sprc_study_budget, only: check_level_memory
    use sprc_study_partition, only: partition_type, start_partition, integrate_level, solve_level
+   use sprc_grid_share, only: share_type
    use sprc_study_row, only: report_row_type
    use sprc_study_contact_row, only: fill_contact_exact, fill_contact_row
    use sprc_contact_result, only: contact_result_type, new_contact_result, contact_open, contact_stick, &
@@ -326,22 +327,37 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(recovery_input_type) :: input
 
-      call exact_error(sb, bl, error)
+      call exact_error(study, sb, bl, error)
       if (allocated(error) .or. .not. any(study%run)) return
       call fe_recovery_input(bl%problem, input, error)
       if (.not. allocated(error)) call recover_body(study, sb, bl, input, error)
    end subroutine finish_body
 
    !> The energy error of the FE stress where there is an exact solution.
-   subroutine exact_error(sb, bl, error)
+   subroutine exact_error(study, sb, bl, error)
+      type(study_type), intent(in) :: study
       type(study_body_type), intent(in) :: sb
       type(body_level_type), intent(inout) :: bl
       type(error_type), allocatable, intent(out) :: error
+      type(partition_type), target :: part
       real(wp) :: err_fe, norm_fe
 
       if (.not. allocated(sb%exact)) return
-      call bl%problem%energy_error(err_fe, bl%element_error, norm_fe, bl%norm_exact, error, bl%err_norm)
+      part = study%partition
+      call bl%problem%energy_error(err_fe, bl%element_error, norm_fe, bl%norm_exact, error, bl%err_norm, &
+         & share=level_share(study, part))
    end subroutine exact_error
+
+   !> `part` (the study's partition) when the level's element work is shared
+   !> out among ranks, else null: an absent `share` (a body in contact keeps
+   !> the whole-level recovery on every rank, doc/distributed.md).
+   function level_share(study, part) result(share)
+      type(study_type), intent(in) :: study
+      type(partition_type), intent(in), target :: part
+      class(share_type), pointer :: share
+      share => null()
+      if (part%ranks > 1 .and. size(study%scene%contacts) == 0) share => part
+   end function level_share
 
    !> The recoveries and estimates of a body from its recovery input; `contact` is its
    !> contact surface (SPR-C's coupled contact patches, sprc_grid_contact).
@@ -356,7 +372,7 @@ contains
 
       do m = 1, 2
          if (.not. study%run(m)) cycle
-         call recover_and_estimate(sb, input, bl, m, study%degree(m), error, contact)
+         call recover_and_estimate(study, sb, input, bl, m, study%degree(m), error, contact)
          if (allocated(error)) return
       end do
    end subroutine recover_body
@@ -604,7 +620,7 @@ contains
 
       k = [spec%slave_index, spec%master_index]
       do b = 1, 2
-         call exact_error(study%bodies(k(b)), bodies(k(b)), error)
+         call exact_error(study, study%bodies(k(b)), bodies(k(b)), error)
          if (.not. allocated(error) .and. any(study%run)) call fe_recovery_input(bodies(k(b))%problem, inputs(b), error)
          if (allocated(error)) then
             error%message = 'body '''//study%bodies(k(b))%name//''': '//error%message
@@ -891,26 +907,29 @@ contains
 
    !> Recovery and estimate with one method (1 SPR, 2 SPR-C) at the patch degree `degree`.
    !> With `contact`, SPR-C's contact patches (sprc_grid_contact).
-   subroutine recover_and_estimate(sb, input, bl, m, degree, error, contact)
+   subroutine recover_and_estimate(study, sb, input, bl, m, degree, error, contact)
+      type(study_type), intent(in) :: study
       type(study_body_type), intent(in) :: sb
       type(recovery_input_type), intent(in) :: input
       type(body_level_type), intent(inout) :: bl
       integer, intent(in) :: m, degree
       type(error_type), allocatable, intent(out) :: error
       type(grid_contact_type), intent(in), optional :: contact
+      type(partition_type), target :: part
       integer :: method
 
       method = merge(method_spr, method_sprc, m == 1)
+      part = study%partition
       if (allocated(sb%exact)) then
          call recover_grid(input, bl%problem%mesh%grid, bl%problem%mesh%nodes, bl%problem%mesh%hanging, method, &
-            & degree, bl%field(m), error, exact=sb%exact, contact=contact)
+            & degree, bl%field(m), error, exact=sb%exact, contact=contact, share=level_share(study, part))
          if (allocated(error)) return
-         call estimate_error(input, bl%field(m), bl%est(m), error, exact=sb%exact)
+         call estimate_error(input, bl%field(m), bl%est(m), error, exact=sb%exact, share=level_share(study, part))
       else
          call recover_grid(input, bl%problem%mesh%grid, bl%problem%mesh%nodes, bl%problem%mesh%hanging, method, &
-            & degree, bl%field(m), error, contact=contact)
+            & degree, bl%field(m), error, contact=contact, share=level_share(study, part))
          if (allocated(error)) return
-         call estimate_error(input, bl%field(m), bl%est(m), error)
+         call estimate_error(input, bl%field(m), bl%est(m), error, share=level_share(study, part))
       end if
    end subroutine recover_and_estimate
 

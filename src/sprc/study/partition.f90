@@ -28,12 +28,12 @@
 module sprc_study_partition
    use, intrinsic :: iso_c_binding, only: c_int, c_int32_t, c_int64_t, c_double, c_char
    use sprc_core_kinds, only: wp, i8
-   use sprc_core_error, only: error_type, fatal_error, stat_internal
+   use sprc_core_error, only: error_type
    use sprc_core_alloc, only: check_allocation
    use sprc_core_timer, only: timer_type
-   use sprc_core_text, only: itoa
    use sprc_geometry_region, only: cell_inside
    use sprc_grid_cut_mesh, only: cut_mesh_type
+   use sprc_grid_share, only: share_type, split_by_work
    use sprc_grid_quadrature, only: cut_quadrature_type
    use sprc_fem_sparse, only: csr_type
    use sprc_fem_problem, only: elasticity_problem_type
@@ -41,13 +41,14 @@ module sprc_study_partition
    implicit none
    private
 
-   public :: partition_type, start_partition, split_by_work, owned_rows, cut_cell_work
+   public :: partition_type, start_partition, owned_rows, cut_cell_work
    public :: integrate_level, solve_level
 
    !> This process's place among the ranks of a partitioned level (rank 0 of
    !> 1: serial).
-   type :: partition_type
-      integer :: rank = 0, ranks = 1
+   type, extends(share_type) :: partition_type
+   contains
+      procedure :: gather => gather_real
    end type partition_type
 
    !> Quadrature work of a cut cell in units of an inside cell's (whose tensor
@@ -104,31 +105,6 @@ contains
       part%ranks = s
    end subroutine start_partition
 
-   !> Contiguous ranges of nearly equal total `work`: rank r (0-based) gets
-   !> items first(r + 1) .. first(r + 2) - 1. An item goes to the rank whose
-   !> share of the total holds the middle of its work (integer arithmetic:
-   !> the same ranges on every rank).
-   pure function split_by_work(work, ranks) result(first)
-      integer, intent(in) :: work(:), ranks
-      integer :: first(ranks + 1)
-      integer(i8) :: total, acc
-      integer :: e, owner, r
-
-      total = max(sum(int(work, i8)), 1_i8)
-      acc = 0
-      first = size(work) + 1
-      first(1) = 1
-      r = 0
-      do e = 1, size(work)
-         owner = int(min((int(ranks, i8)*(2*acc + work(e)))/(2*total), int(ranks - 1, i8)))
-         do while (r < owner)
-            r = r + 1
-            first(r + 1) = e
-         end do
-         acc = acc + work(e)
-      end do
-   end function split_by_work
-
    !> The reduced rows [lo, hi] of rank `rank` of `ranks`: those of a
    !> contiguous range of whole master blocks (`dof(c, m)`, numbered master by
    !> master), the blocks split evenly. Empty (hi < lo) for a rank without blocks.
@@ -161,7 +137,7 @@ contains
       call timer%start()
       first = split_by_work(merge(1, cut_cell_work, mesh%grid%leaf_class == cell_inside), part%ranks)
       call mesh%integrate(quad, error, [first(part%rank + 1), first(part%rank + 2) - 1])
-      call agree(part, 'the cut-cell quadrature', error)
+      call part%agree('the cut-cell quadrature', error)
       if (.not. allocated(error)) call gather_points(part, first, mesh, error)
       call timer%stop()
       mesh%t_quadrature = timer%elapsed
@@ -188,7 +164,7 @@ contains
          rows(:, r) = owned_rows(problem%constraints%dof, r, part%ranks)
       end do
       call problem%assemble(error, rows(:, part%rank))
-      call agree(part, 'the assembly', error)
+      call part%agree('the assembly', error)
       if (allocated(error)) return
       call timer%start()
       call gather_rows(part, rows, problem%k, problem%f, error)
@@ -201,28 +177,6 @@ contains
       ubar = problem%ubar
       call problem%set_solution(ubar, error)
    end subroutine solve_level
-
-   !> Every rank learns whether any failed (before a collective step, so that
-   !> none waits for a rank that has returned): a rank without an error of its
-   !> own gets one naming the failed rank.
-   subroutine agree(part, what, error)
-      type(partition_type), intent(in) :: part
-      character(len=*), intent(in) :: what
-      type(error_type), allocatable, intent(inout) :: error
-      type(error_type), allocatable :: comm_error
-      integer :: failed(part%ranks), mine(1), r
-
-      mine = merge(1, 0, allocated(error))
-      call gather_int(part, mine, spread(1_i8, 1, part%ranks), failed, comm_error)
-      if (allocated(comm_error)) then
-         if (.not. allocated(error)) call move_alloc(comm_error, error)
-         return
-      end if
-      if (allocated(error) .or. all(failed == 0)) return
-      r = findloc(failed, 1, 1) - 1
-      call fatal_error(error, 'rank '//itoa(r)//' failed in '//what//' (its message is on its standard error)', &
-         & stat_internal)
-   end subroutine agree
 
    !> The points and fractions of every rank's leaves (`first`, as `split_by_work`
    !> gave them) gathered in leaf order into `mesh`.
@@ -248,7 +202,7 @@ contains
       call gather_int(part, mesh%vol_ptr(lo + 1:hi + 1) - mesh%vol_ptr(lo:hi), cells, nvol, error)
       if (.not. allocated(error)) &
          & call gather_int(part, mesh%surf_ptr(lo + 1:hi + 1) - mesh%surf_ptr(lo:hi), cells, nsurf, error)
-      if (.not. allocated(error)) call gather_real(part, mesh%fraction(lo:hi), cells, fraction, error)
+      if (.not. allocated(error)) call part%gather(mesh%fraction(lo:hi), cells, fraction, error)
       if (allocated(error)) return
       vol_ptr(1) = 1
       surf_ptr(1) = 1
@@ -269,11 +223,11 @@ contains
       if (allocated(error)) return
       associate (v0 => mesh%vol_ptr(lo), v1 => mesh%vol_ptr(hi + 1) - 1, s0 => mesh%surf_ptr(lo), &
          & s1 => mesh%surf_ptr(hi + 1) - 1)
-         call gather_real(part, mesh%vol_x(:, v0:v1), d*nv, vol_x, error)
-         if (.not. allocated(error)) call gather_real(part, mesh%vol_w(v0:v1), nv, vol_w, error)
-         if (.not. allocated(error)) call gather_real(part, mesh%surf_x(:, s0:s1), d*ns, surf_x, error)
-         if (.not. allocated(error)) call gather_real(part, mesh%surf_w(s0:s1), ns, surf_w, error)
-         if (.not. allocated(error)) call gather_real(part, mesh%surf_n(:, s0:s1), d*ns, surf_n, error)
+         call part%gather(mesh%vol_x(:, v0:v1), d*nv, vol_x, error)
+         if (.not. allocated(error)) call part%gather(mesh%vol_w(v0:v1), nv, vol_w, error)
+         if (.not. allocated(error)) call part%gather(mesh%surf_x(:, s0:s1), d*ns, surf_x, error)
+         if (.not. allocated(error)) call part%gather(mesh%surf_w(s0:s1), ns, surf_w, error)
+         if (.not. allocated(error)) call part%gather(mesh%surf_n(:, s0:s1), d*ns, surf_n, error)
          if (.not. allocated(error)) call gather_int(part, mesh%surf_shape(s0:s1), ns, surf_shape, error)
       end associate
       if (allocated(error)) return
@@ -310,7 +264,7 @@ contains
       if (allocated(error)) return
       associate (lo => rows(1, part%rank), hi => rows(2, part%rank))
          call gather_int(part, int(k%rowptr(lo + 1:hi + 1) - k%rowptr(lo:hi)), counts, lens, error)
-         if (.not. allocated(error)) call gather_real(part, f(lo:hi), counts, f_all, error)
+         if (.not. allocated(error)) call part%gather(f(lo:hi), counts, f_all, error)
          if (allocated(error)) return
          all%rowptr(1) = 1
          do i = 1, n
@@ -324,7 +278,7 @@ contains
          call check_allocation(stat, who, 'the entries of K', all%rowptr(n + 1) - 1, 12, error)
          if (allocated(error)) return
          call gather_int(part, k%col(k%rowptr(lo):k%rowptr(hi + 1) - 1), nnz, all%col, error)
-         if (.not. allocated(error)) call gather_real(part, k%val(k%rowptr(lo):k%rowptr(hi + 1) - 1), nnz, &
+         if (.not. allocated(error)) call part%gather(k%val(k%rowptr(lo):k%rowptr(hi + 1) - 1), nnz, &
             & all%val, error)
       end associate
       if (allocated(error)) return
@@ -336,8 +290,8 @@ contains
 
    !> all = the `local` arrays of the ranks concatenated in rank order (counts(r)
    !> values from rank r - 1; `local` has this rank's count).
-   subroutine gather_real(part, local, counts, all, error)
-      type(partition_type), intent(in) :: part
+   subroutine gather_real(self, local, counts, all, error)
+      class(partition_type), intent(in) :: self
       real(wp), intent(in) :: local(*)
       integer(i8), intent(in) :: counts(:)
       real(wp), intent(inout) :: all(*)
@@ -346,7 +300,7 @@ contains
       integer(c_int) :: status
 
       msg = ''
-      status = sprc_mpi_gather_double(local, counts(part%rank + 1), all, counts, int(part%ranks, c_int), msg, &
+      status = sprc_mpi_gather_double(local, counts(self%rank + 1), all, counts, int(self%ranks, c_int), msg, &
          & int(len(msg), c_int64_t))
       call backend_error(status, msg, error)
    end subroutine gather_real
