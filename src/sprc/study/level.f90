@@ -356,7 +356,7 @@ contains
       type(partition_type), intent(in), target :: part
       class(share_type), pointer :: share
       share => null()
-      if (part%ranks > 1 .and. size(study%scene%contacts) == 0) share => part
+      if (part%shared() .and. size(study%scene%contacts) == 0) share => part
    end function level_share
 
    !> The recoveries and estimates of a body from its recovery input; `contact` is its

@@ -47,8 +47,13 @@ module sprc_study_partition
    !> This process's place among the ranks of a partitioned level (rank 0 of
    !> 1: serial).
    type, extends(share_type) :: partition_type
+      !> False: every rank does the whole level's per-cell work (only the solve
+      !> is distributed), as chosen by SPRC_PARTITION=0 in the environment; the
+      !> test that the shared-out level gives the same bits compares the two.
+      logical :: split = .true.
    contains
       procedure :: gather => gather_real
+      procedure :: shared
    end type partition_type
 
    !> Quadrature work of a cut cell in units of an inside cell's (whose tensor
@@ -94,9 +99,13 @@ contains
       type(partition_type), intent(out) :: part
       type(error_type), allocatable, intent(out) :: error
       character(kind=c_char, len=message_length) :: msg
+      character(len=8) :: choice
       integer(c_int) :: status, r, s
+      integer :: length, env_status
 
       if (solve_ranks <= 1) return
+      call get_environment_variable('SPRC_PARTITION', choice, length, env_status)
+      part%split = .not. (env_status == 0 .and. choice == '0')
       msg = ''
       status = sprc_mpi_ranks(r, s, msg, int(len(msg), c_int64_t))
       call backend_error(status, msg, error)
@@ -104,6 +113,12 @@ contains
       part%rank = r
       part%ranks = s
    end subroutine start_partition
+
+   !> Whether the level's per-cell work is shared out (several ranks, `split`).
+   pure logical function shared(self)
+      class(partition_type), intent(in) :: self
+      shared = self%ranks > 1 .and. self%split
+   end function shared
 
    !> The reduced rows [lo, hi] of rank `rank` of `ranks`: those of a
    !> contiguous range of whole master blocks (`dof(c, m)`, numbered master by
@@ -130,7 +145,7 @@ contains
       type(timer_type) :: timer
       integer, allocatable :: first(:)
 
-      if (part%ranks == 1) then
+      if (.not. part%shared()) then
          call mesh%integrate(quad, error)
          return
       end if
@@ -155,7 +170,7 @@ contains
       integer, allocatable :: rows(:, :)
       integer :: r
 
-      if (part%ranks == 1) then
+      if (.not. part%shared()) then
          call problem%solve(error)
          return
       end if
