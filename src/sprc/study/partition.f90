@@ -19,12 +19,16 @@
 !>   are gathered in rank order: the reduced system of every rank is the
 !>   serial one, bit for bit (PETSc's stash would add a row's off-rank parts
 !>   in an order that is not fixed).
+!> - Recovery, estimate and exact error: `sprc_grid_share` (patches and
+!>   elements in contiguous ranges, the records and element terms gathered;
+!>   partition_type is the share whose gather is MPI's). A scene with
+!>   `&contact` keeps them (and its assembly) on the whole level on every rank.
 !>
-!> What is not partitioned yet: every rank holds the whole level (grid,
-!> points, K, the gathered solution), so the memory per rank is the serial
-!> run's; recovery and estimates run on every rank over the whole level.
-!> A serial run (one rank) takes none of these paths: nothing of MPI is
-!> loaded.
+!> What is not partitioned: every rank holds the whole level (grid, points,
+!> K, the gathered solution), so the memory per rank is the serial run's
+!> plus its share of PETSc's. A serial run (one rank) takes none of these
+!> paths: nothing of MPI is loaded. SPRC_PARTITION=0 in the environment keeps
+!> every rank on the whole level (`split`).
 module sprc_study_partition
    use, intrinsic :: iso_c_binding, only: c_int, c_int32_t, c_int64_t, c_double, c_char
    use sprc_core_kinds, only: wp, i8
