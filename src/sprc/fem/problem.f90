@@ -1372,6 +1372,8 @@ contains
       c = self%compliance
       allocate (parts(3, nel), element_error(nel), stat=stat)
       call check_allocation(stat, 'energy_error', 'the error of each element', nel, 32, error)
+      ! A rank that failed alone must not leave the others waiting in the gather.
+      if (present(share)) call share%agree('energy_error', error)
       if (allocated(error)) return
       call share_range(share, self%mesh%vol_ptr(2:) - self%mesh%vol_ptr(:nel) + 1, first, lo, hi)
       !$omp parallel do schedule(dynamic, 16) default(shared) private(e, q, sh, se, de)

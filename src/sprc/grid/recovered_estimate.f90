@@ -94,21 +94,22 @@ contains
       allocate (est%elem_err2(ne), est%elem_norm_h2(ne), est%sigma_star(ns, np), stat=stat)
       call check_allocation(stat, 'estimate_error', 'the element terms and sigma* at the points', &
          & int(ne, i8) + int(ns, i8)*np, 8, error)
-      if (allocated(error)) return
       maxpts = 0
       do e = 1, ne
          maxpts = max(maxpts, input%elem_ptr(e + 1) - input%elem_ptr(e))
       end do
       allocate (zero(ns, maxpts))
       zero = 0.0_wp
-      if (est%has_exact) then
+      if (est%has_exact .and. .not. allocated(error)) then
          allocate (est%elem_err_ex2(ne), est%elem_err_star2(ne), est%elem_norm_ex2(ne), sex(ns, np), stat=stat)
          call check_allocation(stat, 'estimate_error', 'the exact errors and stresses at the points', &
             & 3*int(ne, i8) + int(ns, i8)*np, 8, error)
-         if (allocated(error)) return
       else
          allocate (sex(ns, 0))
       end if
+      ! A rank that failed alone must not leave the others waiting in the gather.
+      if (present(share)) call share%agree('estimate_error', error)
+      if (allocated(error)) return
 
       call share_range(share, input%elem_ptr(2:) - input%elem_ptr(:ne) + 1, first, lo, hi)
       !$omp parallel do schedule(dynamic, 64) private(a, b)
