@@ -25,13 +25,16 @@
 !> The other body's boundary points where a prism meets its other boundaries (symmetry planes,
 !> loaded or free surfaces) constrain the Omega_aux fit as in any SPR-C patch.
 !>
+!> Each thread keeps the Omega_aux fit's workspace and patch in its recovery workspace
+!> (`contact_scratch_type`), allocated on its first contact patch.
+!>
 !> Small deformations: undeformed points and normals.
 module sprc_grid_contact
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_alloc, only: check_allocation
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reserve
-   use sprc_recovery_workspace, only: recovery_workspace_type, workspace_init
+   use sprc_recovery_workspace, only: recovery_workspace_type
    use sprc_recovery_contact_operators, only: contact_law_frictionless, contact_law_slip, contact_law_stick
    use sprc_recovery_contact_solve, only: recover_contact_patch, aux_max_doublings, contact_points, aux_margin
    use sprc_recovery_contact_aux, only: aux_domain_type, new_aux_domain, aux_contains
@@ -55,6 +58,13 @@ module sprc_grid_contact
       integer, allocatable :: ptr(:), perm(:)
       real(wp) :: ymin(3) = 0.0_wp, width(3) = 1.0_wp
    end type point_cells_type
+
+   !> A thread's storage of contact patches, kept in its recovery workspace (module notes): the
+   !> Omega_aux fit's workspace and patch, and the other body's boundary points in Omega_aux.
+   type :: contact_scratch_type
+      type(recovery_workspace_type) :: ws2
+      type(patch_type) :: patch2, bbox
+   end type contact_scratch_type
 
    !> One body's contact surface for the grid recovery (module notes).
    type :: grid_contact_type
@@ -338,7 +348,8 @@ contains
 
    !> The coupled SPR-C solve of a patch holding contact points (sprc_recovery_contact_solve):
    !> law(j), slip(1:dim, j) per boundary point j of `patch`, body (2) the other body's points
-   !> (module notes). rec is the patch's recovered stress.
+   !> (module notes). rec is the patch's recovered stress. The Omega_aux storage is the
+   !> thread's (in `ws`, module notes).
    subroutine contact_patch_solve(self, patch, law, slip, degree, ws, rec, error)
       type(grid_contact_type), intent(in) :: self
       type(patch_type), intent(in) :: patch
@@ -347,32 +358,44 @@ contains
       type(recovery_workspace_type), intent(inout) :: ws
       type(recovered_patch_type), intent(out) :: rec
       type(error_type), allocatable, intent(out) :: error
-      type(recovery_workspace_type) :: ws2
-      type(patch_type) :: patch2
-      type(recovered_patch_type) :: rec2
-      type(patch_type) :: bbox
-      type(aux_domain_type) :: aux
-      integer, allocatable :: idx(:)
-      real(wp), allocatable :: cx(:, :), cn(:, :), cw(:)
-      real(wp) :: dep
-      integer :: n, k
+      class(*), allocatable :: scratch
 
-      call workspace_init(ws2)
-      call contact_points(patch, cx, cn, cw)
-      ! Each k passes the points in Omega_aux after k doublings (which holds the smaller ones),
-      ! so that a patch copies no more of the other body than it can use.
-      do k = 0, aux_max_doublings
-         dep = self%depth*patch%h*2.0_wp**k
-         call new_aux_domain(aux, patch%dim, cx, cn, cw, dep, aux_margin(dep, self%depth*patch%h), error)
-         if (allocated(error)) return
-         call cells_prism(self%cells, self%y, aux, idx, n)
-         call prism_boundary(self, aux, bbox)
-         call recover_contact_patch(patch, degree, law, self%mu, slip, self%y(:, idx(1:n)), self%w(idx(1:n)), &
-            & self%stress(:, idx(1:n)), self%young, self%poisson, self%depth*patch%h, ws, ws2, patch2, rec, rec2, &
-            & error, body_force2=self%body_force, max_doublings=k, boundary2=bbox)
-         if (.not. allocated(error)) return
-         if (index(error%message, 'Omega_aux fit') == 0) return
-      end do
+      ! Out of ws for the call (ws and the scratch are distinct arguments below).
+      call move_alloc(ws%contact, scratch)
+      if (.not. allocated(scratch)) then
+         allocate (contact_scratch_type :: scratch)
+      end if
+      select type (scratch)
+      type is (contact_scratch_type)
+         call solve(scratch)
+      end select
+      call move_alloc(scratch, ws%contact)
+   contains
+      subroutine solve(sc)
+         type(contact_scratch_type), intent(inout) :: sc
+         type(recovered_patch_type) :: rec2
+         type(aux_domain_type) :: aux
+         integer, allocatable :: idx(:)
+         real(wp), allocatable :: cx(:, :), cn(:, :), cw(:)
+         real(wp) :: dep
+         integer :: n, k
+
+         call contact_points(patch, cx, cn, cw)
+         ! Each k passes the points in Omega_aux after k doublings (which holds the smaller ones),
+         ! so that a patch copies no more of the other body than it can use.
+         do k = 0, aux_max_doublings
+            dep = self%depth*patch%h*2.0_wp**k
+            call new_aux_domain(aux, patch%dim, cx, cn, cw, dep, aux_margin(dep, self%depth*patch%h), error)
+            if (allocated(error)) return
+            call cells_prism(self%cells, self%y, aux, idx, n)
+            call prism_boundary(self, aux, sc%bbox)
+            call recover_contact_patch(patch, degree, law, self%mu, slip, self%y(:, idx(1:n)), self%w(idx(1:n)), &
+               & self%stress(:, idx(1:n)), self%young, self%poisson, self%depth*patch%h, ws, sc%ws2, sc%patch2, rec, &
+               & rec2, error, body_force2=self%body_force, max_doublings=k, boundary2=sc%bbox)
+            if (.not. allocated(error)) return
+            if (index(error%message, 'Omega_aux fit') == 0) return
+         end do
+      end subroutine solve
    end subroutine contact_patch_solve
 
    !> The other body's boundary points in Omega_aux (boundary arrays of `points`).

@@ -13,6 +13,10 @@
 !> local variable of a procedure called there), or call `workspace_init` on a
 !> `private` copy first: gfortran does not apply default initialisation to
 !> OpenMP private copies, and a garbage capacity would be trusted.
+!>
+!> Contact patches (sprc_grid_contact) keep in the thread's workspace what they need
+!> besides it (`contact`): the workspace and patch of the Omega_aux fit, allocated on the
+!> thread's first contact patch and kept.
 module sprc_recovery_workspace
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_out_of_memory
@@ -84,6 +88,8 @@ module sprc_recovery_workspace
       !> hand-written loop (only if `timing`; `design_matrix_flops`), kept apart from `flops`.
       integer(i8) :: design_flops = 0
       real(wp) :: t0 = 0.0_wp
+      !> Contact patches' storage (module notes; its type is sprc_grid_contact's: a producer's).
+      class(*), allocatable :: contact
    end type recovery_workspace_type
 
 contains
