@@ -81,6 +81,7 @@ contains
          new_unittest('grid_exact_3d', test_grid_exact_3d), &
          new_unittest('traction_jump_shrink_fit', test_traction_jump), &
          new_unittest('aux_boundary_points', test_aux_boundary), &
+         new_unittest('aux_candidates', test_aux_candidates), &
          new_unittest('qr_max_steps', test_qr_max_steps), &
          new_unittest('cells_prism', test_cells_prism), &
          new_unittest('cattaneo_mindlin_sprc', test_cattaneo_sprc) &
@@ -711,6 +712,55 @@ contains
          if (allocated(error)) return
       end do
    end subroutine test_aux_boundary
+
+   !> recover_contact_patch's `candidates`: body (2)'s points given by index (every other
+   !> point, and those far outside Omega_aux) give the same bits as the same points passed as
+   !> arrays of their own; an index outside body (2) is a clear error.
+   subroutine test_aux_candidates(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(error_type), allocatable :: err
+      type(patch_type) :: p1, p2
+      type(recovery_workspace_type) :: ws1, ws2
+      type(recovered_patch_type) :: rec1, rec2, ref1, ref2
+      real(wp) :: y2(2, 40), w2(40), s2(3, 40), sl(2, 3)
+      integer :: i, j, n
+      integer, allocatable :: pick(:)
+
+      call patch_reset(p1, 2, plane_strain, 1.0_wp, 0.3_wp, [0.0_wp, 0.0_wp], 0.6_wp)
+      do i = 0, 3
+         do j = 0, 3
+            call patch_add_point(p1, [0.2_wp*i - 0.3_wp, -0.2_wp*j - 0.1_wp], 1.0_wp, &
+               & [1.0_wp + 0.1_wp*i, -2.0_wp + 0.05_wp*j, 0.3_wp*i*j])
+         end do
+      end do
+      do i = 1, 3
+         call patch_add_boundary_point(p1, [0.2_wp*i - 0.4_wp, 0.0_wp], 0.2_wp, [0.0_wp, 1.0_wp], boundary_contact)
+      end do
+      n = 0
+      do i = 0, 4
+         do j = 0, 7
+            n = n + 1
+            ! Columns 3 and 4 lie far to the right of the prism.
+            y2(:, n) = [0.15_wp*i - 0.2_wp + merge(5.0_wp, 0.0_wp, i >= 3), 0.1_wp*j + 0.05_wp]
+            w2(n) = 1.0_wp + 0.01_wp*n
+            s2(:, n) = [1.0_wp + 0.2_wp*y2(1, n), -2.0_wp + 0.3_wp*y2(2, n)**2, 0.1_wp*n]
+         end do
+      end do
+      pick = [(n, n=1, 40, 2)]
+      sl = 0.0_wp
+      call recover_contact_patch(p1, 1, [(contact_law_frictionless, i=1, 3)], 0.0_wp, sl, y2(:, pick), w2(pick), &
+         & s2(:, pick), 2.0_wp, 0.25_wp, 0.5_wp, ws1, ws2, p2, ref1, ref2, error)
+      if (allocated(error)) return
+      call recover_contact_patch(p1, 1, [(contact_law_frictionless, i=1, 3)], 0.0_wp, sl, y2, w2, s2, 2.0_wp, &
+         & 0.25_wp, 0.5_wp, ws1, ws2, p2, rec1, rec2, error, candidates=pick)
+      if (allocated(error)) return
+      call check(error, all(rec1%coef == ref1%coef) .and. all(rec2%coef == ref2%coef) .and. p2%npoints > 0, &
+         & 'candidates: the fits differ from those of the same points as arrays')
+      if (allocated(error)) return
+      call recover_contact_patch(p1, 1, [(contact_law_frictionless, i=1, 3)], 0.0_wp, sl, y2, w2, s2, 2.0_wp, &
+         & 0.25_wp, 0.5_wp, ws1, ws2, p2, rec1, rec2, err, candidates=[1, 41])
+      call expect_invalid(error, err, 'candidate 41 of 40 points', 'candidates(2) = 41')
+   end subroutine test_aux_candidates
 
    !> Bad input of the coupled solve: clear errors, no crash.
    subroutine test_coupled_errors(error)

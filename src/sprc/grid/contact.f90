@@ -389,9 +389,9 @@ contains
             if (allocated(error)) return
             call cells_prism(self%cells, self%y, aux, idx, n)
             call prism_boundary(self, aux, sc%bbox)
-            call recover_contact_patch(patch, degree, law, self%mu, slip, self%y(:, idx(1:n)), self%w(idx(1:n)), &
-               & self%stress(:, idx(1:n)), self%young, self%poisson, self%depth*patch%h, ws, sc%ws2, sc%patch2, rec, &
-               & rec2, error, body_force2=self%body_force, max_doublings=k, boundary2=sc%bbox)
+            call recover_contact_patch(patch, degree, law, self%mu, slip, self%y, self%w, self%stress, self%young, &
+               & self%poisson, self%depth*patch%h, ws, sc%ws2, sc%patch2, rec, rec2, error, &
+               & body_force2=self%body_force, max_doublings=k, boundary2=sc%bbox, candidates=idx(1:n))
             if (.not. allocated(error)) return
             if (index(error%message, 'Omega_aux fit') == 0) return
          end do

@@ -336,9 +336,11 @@ contains
    !> cross-section widened by half the added depth on every side (a patch whose contact
    !> points nearly coincide has a prism too thin to hold points); depth_used
    !> returns the depth of the solve. patch2 is storage reused between calls.
-   !> `max_doublings` (default aux_max_doublings) bounds the doublings.
+   !> `max_doublings` (default aux_max_doublings) bounds the doublings. With `candidates`, only
+   !> body (2)'s points j = candidates(i) are considered, in that order (a caller that has
+   !> culled them, sprc_grid_contact: no copy of the points).
    subroutine recover_contact_patch(patch1, degree, law, mu, slip, y2, w2, stress2, young2, poisson2, depth, &
-      & ws1, ws2, patch2, rec1, rec2, error, body_force2, depth_used, max_doublings, boundary2)
+      & ws1, ws2, patch2, rec1, rec2, error, body_force2, depth_used, max_doublings, boundary2, candidates)
       type(patch_type), intent(in) :: patch1
       integer, intent(in) :: degree, law(:)
       real(wp), intent(in) :: mu, slip(:, :), y2(:, :), w2(:), stress2(:, :), young2, poisson2, depth
@@ -352,10 +354,11 @@ contains
       !> Body (2)'s boundary points other than its contact surface (traction or symmetry kinds,
       !> in the boundary arrays of a patch): those inside Omega_aux constrain its fit.
       type(patch_type), intent(in), optional :: boundary2
+      integer, intent(in), optional :: candidates(:)
       type(aux_domain_type) :: aux
       real(wp), allocatable :: cx(:, :), cn(:, :), cw(:)
       real(wp) :: dep
-      integer :: d, k, kmax
+      integer :: d, k, kmax, j
 
       d = patch1%dim
       call check_contact_input(patch1, law, slip, error)
@@ -363,6 +366,14 @@ contains
       if (size(y2, 1) < d .or. size(w2) > size(y2, 2) .or. size(stress2, 2) < size(w2)) then
          call fatal_error(error, 'recover_contact_patch: y2, w2 and stress2 disagree in size', stat_invalid_input)
          return
+      end if
+      if (present(candidates)) then
+         if (any(candidates < 1 .or. candidates > size(w2))) then
+            j = findloc(candidates < 1 .or. candidates > size(w2), .true., dim=1)
+            call fatal_error(error, 'recover_contact_patch: candidates('//itoa(j)//') = '//itoa(candidates(j))// &
+               & ' is not a point of body (2) (1..'//itoa(size(w2))//')', stat_invalid_input)
+            return
+         end if
       end if
       call contact_points(patch1, cx, cn, cw)
       dep = depth
@@ -374,7 +385,11 @@ contains
             error%message = 'recover_contact_patch: '//error%message
             return
          end if
-         call fill_aux_patch(patch1, aux, y2, w2, stress2, young2, poisson2, patch2)
+         if (present(candidates)) then
+            call fill_aux_patch(patch1, aux, y2, w2, stress2, young2, poisson2, patch2, candidates)
+         else
+            call fill_aux_patch(patch1, aux, y2, w2, stress2, young2, poisson2, patch2)
+         end if
          if (present(boundary2)) call add_aux_boundary(aux, boundary2, patch2)
          if (present(body_force2)) patch2%body_force(1:d) = body_force2(1:d)
          if (present(depth_used)) depth_used = dep
@@ -439,22 +454,27 @@ contains
       end do
    end subroutine add_aux_boundary
 
-   !> patch2 := body (2)'s points inside Omega_aux (recover_contact_patch).
-   pure subroutine fill_aux_patch(patch1, aux, y2, w2, stress2, young2, poisson2, patch2)
+   !> patch2 := body (2)'s points inside Omega_aux (recover_contact_patch), of `candidates` if given.
+   pure subroutine fill_aux_patch(patch1, aux, y2, w2, stress2, young2, poisson2, patch2, candidates)
       type(patch_type), intent(in) :: patch1
       type(aux_domain_type), intent(in) :: aux
       real(wp), intent(in) :: y2(:, :), w2(:), stress2(:, :), young2, poisson2
       type(patch_type), intent(inout) :: patch2
+      integer, intent(in), optional :: candidates(:)
       integer, allocatable :: inside(:)
-      integer :: j, k, n, d, ns
+      integer :: i, j, k, n, d, ns, nc
       real(wp) :: h
 
       d = patch1%dim
       ns = merge(3, 6, d == 2)
-      allocate (inside(size(w2)))
+      nc = size(w2)
+      if (present(candidates)) nc = size(candidates)
+      allocate (inside(nc))
       h = 0.0_wp
       n = 0
-      do j = 1, size(w2)
+      do i = 1, nc
+         j = i
+         if (present(candidates)) j = candidates(i)
          if (.not. aux_contains(aux, y2(:, j))) cycle
          n = n + 1
          inside(n) = j
