@@ -671,15 +671,7 @@ contains
       real(wp) :: y2(2, 16), w2(16), s2(3, 16), sl(2, 3), worst
       integer :: i, j, n, pass
 
-      call patch_reset(p1, 2, plane_strain, 1.0_wp, 0.3_wp, [0.0_wp, 0.0_wp], 0.6_wp)
-      do i = 0, 3
-         do j = 0, 3
-            call patch_add_point(p1, [0.2_wp*i - 0.3_wp, -0.2_wp*j - 0.1_wp], 1.0_wp, sigma)
-         end do
-      end do
-      do i = 1, 3
-         call patch_add_boundary_point(p1, [0.2_wp*i - 0.4_wp, 0.0_wp], 0.2_wp, [0.0_wp, 1.0_wp], boundary_contact)
-      end do
+      call strip_patch(p1, sigma)
       n = 0
       do i = 0, 3
          do j = 0, 3
@@ -713,6 +705,24 @@ contains
       end do
    end subroutine test_aux_boundary
 
+   !> Patch (1) of the Omega_aux tests: 4 x 4 points below y = 0 carrying sigma, three
+   !> contact points on y = 0 (normal +y, into body (2)).
+   subroutine strip_patch(p1, sigma)
+      type(patch_type), intent(out) :: p1
+      real(wp), intent(in) :: sigma(3)
+      integer :: i, j
+
+      call patch_reset(p1, 2, plane_strain, 1.0_wp, 0.3_wp, [0.0_wp, 0.0_wp], 0.6_wp)
+      do i = 0, 3
+         do j = 0, 3
+            call patch_add_point(p1, [0.2_wp*i - 0.3_wp, -0.2_wp*j - 0.1_wp], 1.0_wp, sigma)
+         end do
+      end do
+      do i = 1, 3
+         call patch_add_boundary_point(p1, [0.2_wp*i - 0.4_wp, 0.0_wp], 0.2_wp, [0.0_wp, 1.0_wp], boundary_contact)
+      end do
+   end subroutine strip_patch
+
    !> recover_contact_patch's `candidates`: body (2)'s points given by index (every other
    !> point, and those far outside Omega_aux) give the same bits as the same points passed as
    !> arrays of their own; an index outside body (2) is a clear error.
@@ -726,16 +736,7 @@ contains
       integer :: i, j, n
       integer, allocatable :: pick(:)
 
-      call patch_reset(p1, 2, plane_strain, 1.0_wp, 0.3_wp, [0.0_wp, 0.0_wp], 0.6_wp)
-      do i = 0, 3
-         do j = 0, 3
-            call patch_add_point(p1, [0.2_wp*i - 0.3_wp, -0.2_wp*j - 0.1_wp], 1.0_wp, &
-               & [1.0_wp + 0.1_wp*i, -2.0_wp + 0.05_wp*j, 0.3_wp*i*j])
-         end do
-      end do
-      do i = 1, 3
-         call patch_add_boundary_point(p1, [0.2_wp*i - 0.4_wp, 0.0_wp], 0.2_wp, [0.0_wp, 1.0_wp], boundary_contact)
-      end do
+      call strip_patch(p1, [1.0_wp, -2.0_wp, 0.3_wp])
       n = 0
       do i = 0, 4
          do j = 0, 7
