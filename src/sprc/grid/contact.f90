@@ -359,11 +359,15 @@ contains
       type(recovered_patch_type), intent(out) :: rec
       type(error_type), allocatable, intent(out) :: error
       class(*), allocatable :: scratch
+      integer :: stat
 
       ! Out of ws for the call (ws and the scratch are distinct arguments below).
       call move_alloc(ws%contact, scratch)
       if (.not. allocated(scratch)) then
-         allocate (contact_scratch_type :: scratch)
+         allocate (contact_scratch_type :: scratch, stat=stat)
+         call check_allocation(stat, 'contact patch', 'the thread''s Omega_aux storage', 1, &
+            & storage_size(ws)/8, error)
+         if (allocated(error)) return
       end if
       select type (scratch)
       type is (contact_scratch_type)
