@@ -14,7 +14,8 @@ program sprc_main
    use sprc_study_budget, only: level_memory
    use sprc_geometry_body, only: body_type
    use sprc_study_mesh, only: mesh_row_type, mesh_study, study_levels
-   use sprc_study_level, only: study_type, prepare_study, run_level, level_type
+   use sprc_study_level, only: study_type, prepare_study, run_level, level_type, hold_starts
+   use sprc_fem_nested, only: fe_displacement_type
    use sprc_io_report, only: report_row_type, report_table, write_report_csv, format_mesh_row
    use sprc_io_fields, only: write_level_fields
    use sprc_io_svg, only: write_report_svg, write_contact_svg
@@ -106,6 +107,8 @@ contains
       type(cli_type), intent(in) :: cli
       type(study_type) :: study
       type(level_type) :: result
+      !> The previous level's displacements, where the iterative solves start.
+      type(fe_displacement_type), allocatable :: starts(:)
       type(report_row_type), allocatable :: rows(:)
       type(contact_level_type), allocatable :: contact_levels(:)
       type(h5_output_type) :: h5
@@ -154,11 +157,12 @@ contains
          if (.not. quiet) write (error_unit, '(a,i0,a,i0,a,i0,a)') 'sprc: level ', levels(i), &
             ' (', i, ' of ', size(levels), ')'
          if (cli%quiet) then
-            call run_level(study, levels(i), result, error)
+            call run_level(study, levels(i), result, error, start=starts)
          else
             progress_level = levels(i)
-            call run_level(study, levels(i), result, error, progress=print_contact_progress)
+            call run_level(study, levels(i), result, error, progress=print_contact_progress, start=starts)
          end if
+         if (.not. allocated(error)) call hold_starts(result, starts, error)
          if (.not. allocated(error)) then
             rows(i) = result%row
             if (h5%opened()) call write_level_fields(h5, study, result, error)

@@ -132,6 +132,7 @@ extern PetscErrorCode KSPSetNormType(KSP, KSPNormType);
 extern PetscErrorCode KSPSetComputeSingularValues(KSP, PetscBool);
 extern PetscErrorCode KSPSetFromOptions(KSP);
 extern PetscErrorCode KSPSetUp(KSP);
+extern PetscErrorCode KSPSetInitialGuessNonzero(KSP, PetscBool);
 extern PetscErrorCode KSPSetTolerances(KSP, PetscReal, PetscReal, PetscReal, PetscInt);
 extern PetscErrorCode KSPSetConvergenceTest(KSP, PetscErrorCode (*)(KSP, PetscInt, PetscReal, KSPConvergedReason *,
                                                                     void *),
@@ -155,7 +156,7 @@ extern PetscErrorCode KSPGetConvergedReasonString(KSP, const char **);
     X(MatNullSpaceCreateRigidBody) X(MatNullSpaceDestroy) X(VecCreateSeq) X(VecSetBlockSize) X(VecGetArray)  \
     X(VecRestoreArray) X(VecDot) X(VecNorm) X(VecDuplicate) X(VecDestroy) X(KSPCreate) X(KSPSetOperators)    \
     X(KSPSetType) X(KSPGetPC) X(KSPSetNormType) X(KSPSetComputeSingularValues) X(KSPSetFromOptions)          \
-    X(KSPSetUp) X(KSPSetTolerances) X(KSPSetConvergenceTest) X(KSPSolve) X(KSPGetConvergedReason)           \
+    X(KSPSetUp) X(KSPSetInitialGuessNonzero) X(KSPSetTolerances) X(KSPSetConvergenceTest) X(KSPSolve) X(KSPGetConvergedReason)           \
     X(KSPGetIterationNumber) X(KSPComputeExtremeSingularValues) X(KSPDestroy) X(PCSetType) X(PCApply)       \
     X(KSPGetConvergedReasonString) X(MatMPIAIJSetPreallocationCSR) X(VecCreateMPI) X(VecScatterCreateToAll)   \
     X(VecScatterBegin) X(VecScatterEnd) X(VecScatterDestroy) X(MPI_Comm_rank) X(MPI_Comm_size) X(PetscFinalize)
@@ -196,6 +197,7 @@ static struct ompi_predefined_communicator_t *p_comm_self, *p_comm_world;
 #define KSPSetComputeSingularValues (*p_KSPSetComputeSingularValues)
 #define KSPSetFromOptions (*p_KSPSetFromOptions)
 #define KSPSetUp (*p_KSPSetUp)
+#define KSPSetInitialGuessNonzero (*p_KSPSetInitialGuessNonzero)
 #define KSPSetTolerances (*p_KSPSetTolerances)
 #define KSPSetConvergenceTest (*p_KSPSetConvergenceTest)
 #define KSPSolve (*p_KSPSolve)
@@ -482,21 +484,34 @@ static int copy_out(sprc_petsc *s, double *a, PetscInt n, char *msg, int64_t len
 }
 
 /* The size of b the stopping test measures against: the natural norm
- * sqrt(b^T B b) for CG (B the GAMG preconditioner), ||B b||_2 for GMRES. */
+ * sqrt(b^T B b) for CG (B the GAMG preconditioner), ||B b||_2 for GMRES;
+ * 0 when b = 0. A b != 0 of no positive size means the preconditioner is
+ * not positive definite (CG; the caller may take GMRES) or gave NaN or Inf:
+ * an error, never a zero solution. */
 static int rhs_norm(sprc_petsc *s, double *bnorm, char *msg, int64_t len)
 {
     PC pc;
     PetscScalar bb;
-    PetscReal nrm;
+    PetscReal nrm, b2;
+    *bnorm = 0.0;
+    TRY(VecNorm(s->b, NORM_2, &b2));
+    if (b2 == 0.0) return SPRC_OK;
     TRY(KSPGetPC(s->ksp, &pc));
     TRY(PCApply(pc, s->b, s->w));
     if (s->symmetric) {
         TRY(VecDot(s->b, s->w, &bb));
-        *bnorm = bb > 0.0 ? sqrt(bb) : 0.0;
+        nrm = bb > 0.0 ? sqrt(bb) : bb;
     } else {
         TRY(VecNorm(s->w, NORM_2, &nrm));
-        *bnorm = nrm;
     }
+    if (isnan(nrm) || isinf(nrm) || isinf(b2))
+        return report(SPRC_INTERNAL, msg, len, "PETSc solve: the preconditioned right-hand side is NaN or Inf "
+                      "(||b||_2 = %.3e)", b2);
+    if (!(nrm > 0.0))
+        return report(s->symmetric ? SPRC_NOT_POSDEF : SPRC_INTERNAL, msg, len,
+                      "PETSc solve: the preconditioner B is not positive definite (%s = %.3e for ||b||_2 = %.3e)",
+                      s->symmetric ? "b^T B b" : "||B b||_2", nrm, b2);
+    *bnorm = nrm;
     return SPRC_OK;
 }
 
@@ -528,8 +543,9 @@ static PetscErrorCode energy_test(KSP ksp, PetscInt it, PetscReal rnorm, KSPConv
     return 0;
 }
 
-static int run_ksp(sprc_petsc *s, int max_it, char *msg, int64_t len)
+static int run_ksp(sprc_petsc *s, int max_it, int guess, char *msg, int64_t len)
 {
+    TRY(KSPSetInitialGuessNonzero(s->ksp, guess ? PETSC_TRUE : PETSC_FALSE));
     TRY(KSPSetTolerances(s->ksp, 0.0, 0.0, PETSC_DEFAULT, max_it));
     TRY(KSPSetConvergenceTest(s->ksp, energy_test, s, NULL));
     TRY(KSPSolve(s->ksp, s->b, s->x));
@@ -553,11 +569,13 @@ static int ksp_outcome(sprc_petsc *s, int *iterations, char *msg, int64_t len)
 }
 
 /* Solve A x = b (b, x of order n) to the tolerance `tau` of energy_test in
- * at most `max_it` iterations. `iterations` gets the Krylov iterations and
+ * at most `max_it` iterations, from x = 0, or from the x given when `guess`
+ * is nonzero (the test's bound holds for any start: it measures the
+ * residual reached against b). `iterations` gets the Krylov iterations and
  * `bound` the stopping quantity reached; a solve that ends otherwise is
  * SPRC_NOT_CONVERGED (SPRC_NOT_POSDEF when CG meets an indefinite system)
  * with the count and the bound in the message. */
-int sprc_petsc_solve(void *handle, int64_t n, const double *b, double *x, double tau, int max_it,
+int sprc_petsc_solve(void *handle, int64_t n, const double *b, double *x, int guess, double tau, int max_it,
                      int *iterations, double *bound, char *msg, int64_t len)
 {
     sprc_petsc *s = handle;
@@ -569,8 +587,9 @@ int sprc_petsc_solve(void *handle, int64_t n, const double *b, double *x, double
     if (s == NULL) return report(SPRC_INVALID, msg, len, "PETSc solve: no solver was set up");
     status = copy_in(s, s->b, b, msg, len);
     if (status == SPRC_OK) status = rhs_norm(s, &bnorm, msg, len);
+    if (status == SPRC_OK && guess) status = copy_in(s, s->x, x, msg, len);
     if (status != SPRC_OK) return status;
-    if (!(bnorm > 0.0)) {
+    if (bnorm == 0.0) {
         memset(x, 0, (size_t)n * sizeof(double));
         return SPRC_OK;
     }
@@ -578,7 +597,7 @@ int sprc_petsc_solve(void *handle, int64_t n, const double *b, double *x, double
     s->bnorm = bnorm;
     s->kappa = 1.0;
     s->bound = 1.0;
-    status = run_ksp(s, max_it, msg, len);
+    status = run_ksp(s, max_it, guess, msg, len);
     if (status == SPRC_OK) status = ksp_outcome(s, iterations, msg, len);
     *bound = s->bound;
     if (status != SPRC_OK) return status;

@@ -10,6 +10,7 @@
 !> ||e||_K / ||u||_K <= c eps kappa(K)).
 module sprc_test_petsc
    use sprc_core_kinds, only: wp
+   use sprc_core_text, only: itoa
    use sprc_core_error, only: stat_invalid_input, stat_not_converged
    use sprc_core_material, only: plane_strain, solid
    use sprc_geometry_body, only: body_type
@@ -19,6 +20,7 @@ module sprc_test_petsc
    use sprc_fem_linear_solver, only: solver_direct, solver_iterative, solver_auto, use_iterative, &
       & auto_iterative_min_dofs, solver_choice, set_solve_ranks
    use sprc_fem_petsc, only: petsc_solver_type, iteration_tolerance
+   use sprc_fem_nested, only: fe_displacement_type
    use sprc_test_fem, only: sphere_octant, lame_quarter, young
    use sprc_testsuite, only: unittest_type, new_unittest, check, error_type
    implicit none
@@ -41,7 +43,9 @@ contains
          new_unittest('lame_2d', test_lame_2d), &
          new_unittest('gmres', test_gmres), &
          new_unittest('not_converged', test_not_converged), &
-         new_unittest('bad_layout', test_bad_layout) &
+         new_unittest('bad_layout', test_bad_layout), &
+         new_unittest('nested_linear_field', test_nested_linear), &
+         new_unittest('nested_start', test_nested_start) &
          ]
    end subroutine collect_petsc
 
@@ -246,5 +250,107 @@ contains
       call krylov%set_blocks(reshape([1, 2, 3, 4, 5, 7], [3, 2]), x, refused)
       call check(error, allocated(refused), 'a gap in the numbering is refused')
    end subroutine test_bad_layout
+
+   !> The held displacement of a grid reproduces a linear field exactly (Q1
+   !> interpolates it) at the master nodes of the next level's grid, the
+   !> nodes on faces next to external cells included: within 100 eps of the
+   !> field's size.
+   subroutine test_nested_linear(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: body
+      type(fe_bc_type), allocatable :: bcs(:)
+      type(lame_sphere_type) :: exact
+      type(elasticity_problem_type) :: coarse, fine
+      type(fe_displacement_type) :: held
+      real(wp), allocatable :: x(:, :), v(:, :)
+      real(wp), parameter :: a(3, 3) = reshape([1.0_wp, -2.0_wp, 0.5_wp, 3.0_wp, 0.25_wp, -1.0_wp, 2.0_wp, &
+         & 1.5_wp, -0.75_wp], [3, 3]), c(3) = [0.3_wp, -0.2_wp, 0.1_wp]
+      real(wp) :: scale
+      integer :: n
+
+      call nested_pair(body, bcs, exact, coarse, fine, error)
+      if (allocated(error)) return
+      do n = 1, size(coarse%u, 2)
+         coarse%u(:, n) = matmul(a, coarse%mesh%nodes%x(:, n)) + c
+      end do
+      call coarse%hold_displacement(held, error)
+      if (allocated(error)) return
+      x = fine%mesh%nodes%x(:, fine%constraints%master_node)
+      allocate (v(3, size(x, 2)))
+      call held%values_at(x, v)
+      scale = maxval(abs(coarse%u))
+      do n = 1, size(x, 2)
+         v(:, n) = v(:, n) - (matmul(a, x(:, n)) + c)
+      end do
+      call check(error, maxval(abs(v))/scale, 0.0_wp, 100.0_wp*epsilon(1.0_wp), &
+         & 'the coarse grid''s linear field at the fine masters')
+   end subroutine test_nested_linear
+
+   !> Nested iteration: the fine solve started from the coarse solution
+   !> (`start`) reaches CHOLMOD's solution within the same bound as from
+   !> zero (compare_solvers), in fewer iterations, with the same bits when
+   !> repeated.
+   subroutine test_nested_start(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: body
+      type(fe_bc_type), allocatable :: bcs(:)
+      type(lame_sphere_type) :: exact
+      type(elasticity_problem_type) :: coarse, fine
+      real(wp), allocatable :: u_direct(:), u_start(:), e(:), ke(:), ku(:)
+      real(wp) :: tau, rel
+      integer :: its_zero, its_start
+
+      call nested_pair(body, bcs, exact, coarse, fine, error)
+      if (allocated(error)) return
+      u_direct = fine%ubar
+      fine%solver = solver_iterative
+      call fine%solve_reduced(error)
+      if (allocated(error)) return
+      its_zero = fine%solver_iterations
+      allocate (fine%start)
+      call coarse%hold_displacement(fine%start, error)
+      if (allocated(error)) return
+      call fine%solve_reduced(error)
+      if (allocated(error)) return
+      its_start = fine%solver_iterations
+      u_start = fine%ubar
+      call check(error, its_start < its_zero, 'fewer iterations from the coarse solution: '// &
+         & itoa(its_start)//' against '//itoa(its_zero))
+      if (allocated(error)) return
+      tau = iteration_tolerance(0.5_wp**fine%mesh%grid%max_level, 1)
+      e = u_start - u_direct
+      allocate (ke(size(e)), ku(size(e)))
+      call fine%k%matvec(e, ke, error)
+      if (allocated(error)) return
+      call fine%k%matvec(u_direct, ku, error)
+      if (allocated(error)) return
+      rel = sqrt(dot_product(e, ke)/dot_product(u_direct, ku))
+      call check(error, rel, 0.0_wp, 2.0_wp*tau + c_backward*epsilon(1.0_wp)/fine%rcond, &
+         & 'energy-norm difference to CHOLMOD from the coarse start')
+      if (allocated(error)) return
+      call fine%solve_reduced(error)
+      if (allocated(error)) return
+      call check(error, all(fine%ubar == u_start) .and. fine%solver_iterations == its_start, &
+         & 'the same bits and iterations when repeated')
+   end subroutine test_nested_start
+
+   !> The sphere octant with its planes off the grid, solved (directly) at
+   !> levels 2 and 3.
+   subroutine nested_pair(body, bcs, exact, coarse, fine, error)
+      type(body_type), intent(out) :: body
+      type(fe_bc_type), allocatable, intent(out) :: bcs(:)
+      type(lame_sphere_type), intent(out) :: exact
+      type(elasticity_problem_type), intent(out) :: coarse, fine
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), parameter :: box_min(3) = [-0.37_wp, -0.53_wp, -0.29_wp], box_size = 27.5_wp
+
+      call sphere_octant(body, bcs, exact, error)
+      if (allocated(error)) return
+      call solve_on_grid(coarse, body, box_min, box_size, 2, 0, 1, solid, young, poisson, [0.0_wp, 0.0_wp, 0.0_wp], &
+         & bcs, error)
+      if (allocated(error)) return
+      call solve_on_grid(fine, body, box_min, box_size, 3, 0, 1, solid, young, poisson, [0.0_wp, 0.0_wp, 0.0_wp], &
+         & bcs, error)
+   end subroutine nested_pair
 
 end module sprc_test_petsc

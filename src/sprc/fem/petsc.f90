@@ -56,6 +56,11 @@ module sprc_fem_petsc
       integer, public :: iterations = 0
       !> The stopping quantity reached by the last solve (<= tolerance).
       real(wp), public :: residual_bound = 0.0_wp
+      !> Where the Krylov iteration starts (reduced unknowns, order n; nested
+      !> iteration: another grid's solution), for every one-column solve while
+      !> allocated with that order; otherwise x = 0. The stopping test does
+      !> not depend on the start.
+      real(wp), allocatable, public :: guess(:)
    contains
       procedure :: set_blocks
       procedure :: factorize_backend => petsc_factorize
@@ -77,12 +82,14 @@ module sprc_fem_petsc
          integer(c_int64_t), value :: len
       end function sprc_petsc_setup
 
-      integer(c_int) function sprc_petsc_solve(handle, n, b, x, tau, max_it, iterations, bound, msg, len) bind(c)
+      integer(c_int) function sprc_petsc_solve(handle, n, b, x, guess, tau, max_it, iterations, bound, msg, len) &
+            & bind(c)
          import :: c_ptr, c_int, c_int64_t, c_double, c_char
          type(c_ptr), value :: handle
          integer(c_int64_t), value :: n
          real(c_double), intent(in) :: b(*)
-         real(c_double), intent(out) :: x(*)
+         real(c_double), intent(inout) :: x(*)
+         integer(c_int), value :: guess
          real(c_double), value :: tau
          integer(c_int), value :: max_it
          integer(c_int), intent(out) :: iterations
@@ -290,7 +297,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       character(kind=c_char, len=message_length) :: msg
       real(wp), allocatable :: bp(:), xp(:)
-      integer(c_int) :: status, its
+      integer(c_int) :: status, its, start
       integer :: j, saved, stat
 
       if (transposed .and. .not. self%symmetric) then
@@ -305,9 +312,17 @@ contains
       do j = 1, nrhs
          bp = 0.0_wp
          bp(self%slot) = b(:, j)
+         xp = 0.0_wp
+         start = 0_c_int
+         if (allocated(self%guess) .and. nrhs == 1) then
+            if (size(self%guess) == n) then
+               xp(self%slot) = self%guess
+               start = 1_c_int
+            end if
+         end if
          msg = ''
          saved = blas_serial_begin()
-         status = sprc_petsc_solve(self%handle, int(self%n_padded, c_int64_t), bp, xp, &
+         status = sprc_petsc_solve(self%handle, int(self%n_padded, c_int64_t), bp, xp, start, &
             & real(self%tolerance, c_double), int(self%max_iterations, c_int), its, self%residual_bound, msg, &
             & int(len(msg), c_int64_t))
          call blas_serial_end(saved)

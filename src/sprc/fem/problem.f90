@@ -87,6 +87,7 @@ module sprc_fem_problem
    use sprc_fem_umfpack, only: umfpack_solver_type
    use sprc_fem_linear_solver, only: linear_solver_type, solver_auto, use_iterative
    use sprc_fem_petsc, only: petsc_solver_type, iteration_tolerance
+   use sprc_fem_nested, only: fe_displacement_type
    use sprc_fem_element, only: shape_functions, strain_matrix, traction_matrix, displacement_matrix, &
       & add_stiffness, mirror_upper, element_stress, element_strain
    use sprc_fem_bc, only: fe_bc_type, check_bcs, bc_free, bc_pressure, bc_traction, bc_displacement, &
@@ -147,6 +148,10 @@ module sprc_fem_problem
       character(len=:), allocatable :: solver_name, solver_note
       !> Krylov iterations of the last solve (0 for a direct solve).
       integer :: solver_iterations = 0
+      !> This body's displacement on another grid of its study, where an
+      !> iterative solve starts (nested iteration, `sprc_fem_nested`); the
+      !> direct solvers ignore it. A setting, read by `solve_reduced`.
+      type(fe_displacement_type), allocatable :: start
       !> Reciprocal 1-norm condition estimate of the reduced stiffness (from the solver).
       real(wp) :: rcond = -1.0_wp
       !> Wall-clock seconds of the phases.
@@ -166,6 +171,7 @@ module sprc_fem_problem
       procedure :: energy_error
       procedure :: scaled_rcond
       procedure :: rigid_modes
+      procedure :: hold_displacement
    end type elasticity_problem_type
 
 contains
@@ -1197,6 +1203,10 @@ contains
 
       call krylov%set_blocks(self%constraints%dof, self%mesh%nodes%x(:, self%constraints%master_node), error)
       if (allocated(error)) return
+      if (allocated(self%start)) then
+         call start_guess(self, krylov%guess, error)
+         if (allocated(error)) return
+      end if
       krylov%tolerance = iteration_tolerance(0.5_wp**self%mesh%grid%max_level, self%degree)
       self%solver_name = 'cg+gamg'
       self%solver_note = ''
@@ -1216,6 +1226,41 @@ contains
       self%solver_iterations = self%solver_iterations + krylov%iterations
       if (allocated(error)) error%message = 'elasticity solve (GMRES fallback): '//error%message
    end subroutine iterative_solve
+
+   !> `start` at the masters: the reduced unknowns' initial guess.
+   subroutine start_guess(self, guess, error)
+      type(elasticity_problem_type), intent(in) :: self
+      real(wp), allocatable, intent(out) :: guess(:)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: v(:, :)
+      integer :: m, c, stat
+
+      associate (con => self%constraints)
+         allocate (v(self%dim, con%n_masters), guess(con%n_dofs), stat=stat)
+         call check_allocation(stat, 'elasticity solve', 'the nested start', con%n_dofs, 16, error)
+         if (allocated(error)) return
+         call self%start%values_at(self%mesh%nodes%x(:, con%master_node), v)
+         do m = 1, con%n_masters
+            do c = 1, self%dim
+               if (con%dof(c, m) > 0) guess(con%dof(c, m)) = v(c, m)
+            end do
+         end do
+      end associate
+   end subroutine start_guess
+
+   !> The solved displacement, kept apart from the problem (`held`), to start
+   !> an iterative solve of the same body on another grid (`start`).
+   subroutine hold_displacement(self, held, error)
+      class(elasticity_problem_type), intent(in) :: self
+      type(fe_displacement_type), intent(inout) :: held
+      type(error_type), allocatable, intent(out) :: error
+
+      if (.not. self%solved) then
+         call fatal_error(error, 'hold_displacement: the problem is not solved', stat_invalid_input)
+         return
+      end if
+      call held%hold(self%mesh%grid, self%degree, self%mesh%nodes%connectivity, self%u, error)
+   end subroutine hold_displacement
 
    !> theta_bar on every aggregate from the nodal displacements (projected dilatation only).
    subroutine dilatation_coefficients(self)

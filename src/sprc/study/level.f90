@@ -47,6 +47,7 @@ module sprc_study_level
    use sprc_grid_recovered_estimate, only: zz_estimate_type, estimate_error
    use sprc_fem_bc, only: fe_bc_type
    use sprc_fem_problem, only: elasticity_problem_type
+   use sprc_fem_nested, only: fe_displacement_type
    use sprc_fem_recovery_input, only: fe_recovery_input
    use sprc_fem_dilatation, only: dilatation_choice
    use sprc_fem_linear_solver, only: solver_choice
@@ -68,7 +69,7 @@ module sprc_study_level
    implicit none
    private
 
-   public :: study_type, study_body_type, prepare_study, run_level, level_type, body_level_type
+   public :: study_type, study_body_type, prepare_study, run_level, level_type, body_level_type, hold_starts
    public :: nodal_fe_stress
 
    !> What every level needs of one body, built once from the scene.
@@ -226,13 +227,16 @@ contains
    end subroutine shared_units
 
    !> One level of the study: every body analysed, the report row summed.
-   subroutine run_level(study, level, result, error, progress)
+   subroutine run_level(study, level, result, error, progress, start)
       type(study_type), intent(in) :: study
       integer, intent(in) :: level
       type(level_type), intent(out) :: result
       type(error_type), allocatable, intent(out) :: error
       !> Told after each contact iteration (sprc_contact_solve's `contact_progress`).
       procedure(contact_progress), optional :: progress
+      !> Per body, its displacement at another level (`hold_displacement`),
+      !> where an iterative solve of the body starts (`sprc_fem_nested`).
+      type(fe_displacement_type), intent(in), optional :: start(:)
       type(cut_quadrature_type) :: quad
       real(wp) :: t_start, t_contact
       integer :: b, k
@@ -247,7 +251,12 @@ contains
          associate (u => study%bodies(b)%units, u1 => study%bodies(1)%units)
             result%bodies(b)%norm2_scale = (u%modulus/u1%modulus)*(u%strain/u1%strain)**2
          end associate
-         call run_body(study, study%bodies(b), level, quad, result%bodies(b), in_contact(study, b), error)
+         if (starts_given(start, size(study%bodies))) then
+            call run_body(study, study%bodies(b), level, quad, result%bodies(b), in_contact(study, b), error, &
+               & start(b))
+         else
+            call run_body(study, study%bodies(b), level, quad, result%bodies(b), in_contact(study, b), error)
+         end if
          if (allocated(error)) then
             if (size(study%bodies) > 1) error%message = 'body '''//study%bodies(b)%name//''': '//error%message
             return
@@ -275,10 +284,35 @@ contains
       call check_row(result%row, study%have_exact, result%done, error)
    end subroutine run_level
 
+   !> Every body's solved displacement of `result`, for `run_level`'s `start`
+   !> at the next level (a body that was not solved holds nothing: its
+   !> solve there starts from zero).
+   subroutine hold_starts(result, start, error)
+      type(level_type), intent(in) :: result
+      type(fe_displacement_type), allocatable, intent(inout) :: start(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: b
+
+      if (allocated(start)) deallocate (start)
+      allocate (start(size(result%bodies)))
+      do b = 1, size(result%bodies)
+         if (result%bodies(b)%problem%solved) call result%bodies(b)%problem%hold_displacement(start(b), error)
+         if (allocated(error)) return
+      end do
+   end subroutine hold_starts
+
+   !> Whether `start` holds one displacement per body (run_level).
+   pure logical function starts_given(start, n_bodies)
+      type(fe_displacement_type), intent(in), optional :: start(:)
+      integer, intent(in) :: n_bodies
+      starts_given = .false.
+      if (present(start)) starts_given = size(start) == n_bodies
+   end function starts_given
+
    !> Mesh, FE solve, recoveries and estimates of one body at `level`; a
    !> body `in_contact` is only meshed and assembled (its pair solves it,
    !> `run_contact`).
-   subroutine run_body(study, sb, level, quad, bl, in_contact, error)
+   subroutine run_body(study, sb, level, quad, bl, in_contact, error, start)
       type(study_type), intent(in) :: study
       type(study_body_type), intent(in) :: sb
       integer, intent(in) :: level
@@ -286,6 +320,7 @@ contains
       type(body_level_type), intent(inout) :: bl
       logical, intent(in) :: in_contact
       type(error_type), allocatable, intent(out) :: error
+      type(fe_displacement_type), intent(in), optional :: start
       type(cut_mesh_type), allocatable :: mesh
 
       call check_level_memory(study%scene, sb%geometry, level, error)
@@ -314,6 +349,7 @@ contains
          return
       end if
       if (allocated(study%scene%solver)) bl%problem%solver = solver_choice(study%scene%solver)
+      if (present(start)) allocate (bl%problem%start, source=start)
       call solve_level(study%partition, bl%problem, error)
       if (allocated(error)) return
       call finish_body(study, sb, bl, error)
