@@ -105,7 +105,8 @@ extern PetscErrorCode MatCreate(MPI_Comm, Mat *);
 extern PetscErrorCode MatSetSizes(Mat, PetscInt, PetscInt, PetscInt, PetscInt);
 extern PetscErrorCode MatSetType(Mat, MatType);
 extern PetscErrorCode MatSetBlockSize(Mat, PetscInt);
-extern PetscErrorCode MatSeqAIJSetPreallocationCSR(Mat, const PetscInt[], const PetscInt[], const PetscScalar[]);
+extern PetscErrorCode MatCreateSeqAIJWithArrays(MPI_Comm, PetscInt, PetscInt, PetscInt[], PetscInt[], PetscScalar[],
+                                                Mat *);
 extern PetscErrorCode MatMPIAIJSetPreallocationCSR(Mat, const PetscInt[], const PetscInt[], const PetscScalar[]);
 extern PetscErrorCode MatSetNearNullSpace(Mat, MatNullSpace);
 extern PetscErrorCode MatDestroy(Mat *);
@@ -152,7 +153,7 @@ extern PetscErrorCode KSPGetConvergedReasonString(KSP, const char **);
 #define SPRC_PETSC_FUNCTIONS(X)                                                                              \
     X(PetscInitializeNoArguments) X(PetscInitialized) X(PetscOptionsSetValue) X(PetscReturnErrorHandler)    \
     X(PetscPushErrorHandler) X(PetscErrorMessage) X(MatCreate) X(MatSetSizes) X(MatSetType)                 \
-    X(MatSetBlockSize) X(MatSeqAIJSetPreallocationCSR) X(MatSetNearNullSpace) X(MatDestroy)                  \
+    X(MatSetBlockSize) X(MatCreateSeqAIJWithArrays) X(MatSetNearNullSpace) X(MatDestroy)                  \
     X(MatNullSpaceCreateRigidBody) X(MatNullSpaceDestroy) X(VecCreateSeq) X(VecSetBlockSize) X(VecGetArray)  \
     X(VecRestoreArray) X(VecDot) X(VecNorm) X(VecDuplicate) X(VecDestroy) X(KSPCreate) X(KSPSetOperators)    \
     X(KSPSetType) X(KSPGetPC) X(KSPSetNormType) X(KSPSetComputeSingularValues) X(KSPSetFromOptions)          \
@@ -176,7 +177,7 @@ static struct ompi_predefined_communicator_t *p_comm_self, *p_comm_world;
 #define MatSetSizes (*p_MatSetSizes)
 #define MatSetType (*p_MatSetType)
 #define MatSetBlockSize (*p_MatSetBlockSize)
-#define MatSeqAIJSetPreallocationCSR (*p_MatSeqAIJSetPreallocationCSR)
+#define MatCreateSeqAIJWithArrays (*p_MatCreateSeqAIJWithArrays)
 #define MatSetNearNullSpace (*p_MatSetNearNullSpace)
 #define MatDestroy (*p_MatDestroy)
 #define MatNullSpaceCreateRigidBody (*p_MatNullSpaceCreateRigidBody)
@@ -343,19 +344,13 @@ static int create_vector(sprc_petsc *s, PetscInt n, PetscInt dim, Vec *v, char *
 }
 
 /* This rank's rows of the CSR matrix (rowptr, col, val of all n rows, as
- * every rank has them): a sequential matrix on one rank, MATMPIAIJ,
- * preallocated from the rows' pattern, on several. */
-static int set_rows(sprc_petsc *s, PetscInt n, const PetscInt *rowptr, const PetscInt *col, const double *val,
-                    char *msg, int64_t len)
+ * every rank has them) as MATMPIAIJ, preallocated from the rows' pattern
+ * (PETSc copies them). */
+static int set_rows(sprc_petsc *s, const PetscInt *rowptr, const PetscInt *col, const double *val, char *msg,
+                    int64_t len)
 {
     PetscInt *local, i, first;
     PetscErrorCode ierr;
-    if (!distributed) {
-        TRY(MatSetType(s->a, "seqaij"));
-        TRY(MatSeqAIJSetPreallocationCSR(s->a, rowptr, col, val));
-        return SPRC_OK;
-    }
-    (void)n;
     TRY(MatSetType(s->a, "mpiaij"));
     local = malloc(((size_t)s->n_local + 1) * sizeof(*local));
     if (local == NULL) return report(SPRC_NO_MEMORY, msg, len, "PETSc setup: cannot allocate the local row starts");
@@ -368,7 +363,8 @@ static int set_rows(sprc_petsc *s, PetscInt n, const PetscInt *rowptr, const Pet
 }
 
 /* Matrix with block size `dim` and its rigid-body near-null space from the
- * node coordinates coords(dim, n/dim). */
+ * node coordinates coords(dim, n/dim). On one rank the matrix is the
+ * caller's CSR arrays themselves (columns ascending in each row). */
 static int build_matrix(sprc_petsc *s, PetscInt n, PetscInt dim, const PetscInt *rowptr, const PetscInt *col,
                         const double *val, const double *coords, char *msg, int64_t len)
 {
@@ -377,11 +373,18 @@ static int build_matrix(sprc_petsc *s, PetscInt n, PetscInt dim, const PetscInt 
     PetscScalar *p;
     int status;
 
-    TRY(MatCreate(s->comm, &s->a));
-    TRY(MatSetSizes(s->a, s->n_local, s->n_local, n, n));
-    TRY(MatSetBlockSize(s->a, dim));
-    status = set_rows(s, n, rowptr, col, val, msg, len);
-    if (status != SPRC_OK) return status;
+    if (distributed) {
+        TRY(MatCreate(s->comm, &s->a));
+        TRY(MatSetSizes(s->a, s->n_local, s->n_local, n, n));
+        TRY(MatSetBlockSize(s->a, dim));
+        status = set_rows(s, rowptr, col, val, msg, len);
+        if (status != SPRC_OK) return status;
+    } else {
+        /* the caller's arrays, not a copy (they live until sprc_petsc_free) */
+        TRY(MatCreateSeqAIJWithArrays(PETSC_COMM_SELF, n, n, (PetscInt *)rowptr, (PetscInt *)col, (double *)val,
+                                      &s->a));
+        TRY(MatSetBlockSize(s->a, dim));
+    }
     status = create_vector(s, n, dim, &xyz, msg, len);
     if (status != SPRC_OK) return status;
     TRY(VecGetArray(xyz, &p));
@@ -433,13 +436,19 @@ static void own_rows(sprc_petsc *s, PetscInt n, PetscInt dim)
     s->n_local = (PetscInt)((last - first) * dim);
 }
 
+/* Set up the solver of the order-n matrix given in 0-based CSR (rowptr,
+ * col, val), blocks of `dim` unknowns at the node coordinates `coords`.
+ * `borrowed` is set to 1 when PETSc uses the arrays in place (one rank):
+ * they must then stay as they are until sprc_petsc_free; 0 when it copied
+ * them (several ranks). */
 int sprc_petsc_setup(void **handle, int64_t n, int dim, const int32_t *rowptr, const int32_t *col,
-                     const double *val, const double *coords, int symmetric, char *msg, int64_t len)
+                     const double *val, const double *coords, int symmetric, int *borrowed, char *msg, int64_t len)
 {
     sprc_petsc *s;
     int status;
 
     *handle = NULL;
+    *borrowed = !distributed;
     if (n < 1 || n > INT32_MAX || rowptr[n] < 0 || (dim != 2 && dim != 3) || n % dim != 0)
         return report(SPRC_INVALID, msg, len, "PETSc setup: order %lld with block size %d does not fit", (long long)n,
                       dim);

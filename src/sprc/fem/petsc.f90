@@ -28,7 +28,7 @@ module sprc_fem_petsc
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_unsupported
    use sprc_core_blas_threads, only: blas_serial_begin, blas_serial_end
    use sprc_core_alloc, only: check_allocation
-   use sprc_fem_sparse, only: csr_type
+   use sprc_fem_sparse, only: csr_type, sort_row
    use sprc_fem_linear_solver, only: linear_solver_type, backend_error, message_length, set_solve_ranks
    implicit none
    private
@@ -46,6 +46,10 @@ module sprc_fem_petsc
       integer, allocatable :: slot(:)
       !> Coordinates of each block's node, dim values per block.
       real(wp), allocatable :: coords(:)
+      !> The blocked matrix in 0-based CSR (`padded_csr`). On one rank it is
+      !> PETSc's matrix itself, so it lives until `destroy`.
+      integer(c_int32_t), allocatable :: rowptr(:), col(:)
+      real(wp), allocatable :: val(:)
       !> Bound of the relative energy norm of the iteration error (CG; see
       !> energy_test in the shim) at which a solve stops.
       real(wp), public :: tolerance = 1.0e-8_wp
@@ -69,8 +73,8 @@ module sprc_fem_petsc
    end type petsc_solver_type
 
    interface
-      integer(c_int) function sprc_petsc_setup(handle, n, dim, rowptr, col, val, coords, symmetric, msg, len) &
-            & bind(c)
+      integer(c_int) function sprc_petsc_setup(handle, n, dim, rowptr, col, val, coords, symmetric, borrowed, msg, &
+            & len) bind(c)
          import :: c_ptr, c_int, c_int32_t, c_int64_t, c_double, c_char
          type(c_ptr), intent(out) :: handle
          integer(c_int64_t), value :: n
@@ -78,6 +82,7 @@ module sprc_fem_petsc
          integer(c_int32_t), intent(in) :: rowptr(*), col(*)
          real(c_double), intent(in) :: val(*), coords(*)
          integer(c_int), value :: symmetric
+         integer(c_int), intent(out) :: borrowed
          character(kind=c_char), intent(inout) :: msg(*)
          integer(c_int64_t), value :: len
       end function sprc_petsc_setup
@@ -208,9 +213,7 @@ contains
       type(csr_type), intent(in) :: a
       type(error_type), allocatable, intent(out) :: error
       character(kind=c_char, len=message_length) :: msg
-      integer(c_int32_t), allocatable :: rowptr(:), col(:)
-      real(wp), allocatable :: val(:)
-      integer(c_int) :: status
+      integer(c_int) :: status, borrowed
       integer :: saved
 
       call petsc_destroy(self)
@@ -222,20 +225,23 @@ contains
             & stat_invalid_input)
          return
       end if
-      call padded_csr(self, a, rowptr, col, val, error)
+      call padded_csr(self, a, self%rowptr, self%col, self%val, error)
       if (allocated(error)) return
       msg = ''
       saved = blas_serial_begin()
-      status = sprc_petsc_setup(self%handle, int(self%n_padded, c_int64_t), int(self%dim, c_int), rowptr, col, &
-         & val, self%coords, merge(1_c_int, 0_c_int, self%symmetric), msg, int(len(msg), c_int64_t))
+      status = sprc_petsc_setup(self%handle, int(self%n_padded, c_int64_t), int(self%dim, c_int), self%rowptr, &
+         & self%col, self%val, self%coords, merge(1_c_int, 0_c_int, self%symmetric), borrowed, msg, &
+         & int(len(msg), c_int64_t))
       call blas_serial_end(saved)
+      if (borrowed == 0 .or. status /= 0) deallocate (self%rowptr, self%col, self%val)
       call backend_error(status, msg, error)
       self%iterations = 0
    end subroutine petsc_factorize
 
    !> `a` in blocked order with identity rows (the mean diagonal) at the
-   !> fixed components; 0-based 32-bit CSR, refused if PETSc's 32-bit
-   !> indices cannot hold it.
+   !> fixed components; 0-based 32-bit CSR with the columns of each row
+   !> ascending (as PETSc's matrix on the arrays needs), refused if PETSc's
+   !> 32-bit indices cannot hold it.
    subroutine padded_csr(self, a, rowptr, col, val, error)
       class(petsc_solver_type), intent(in) :: self
       type(csr_type), intent(in) :: a
@@ -284,6 +290,8 @@ contains
             col(k) = int(self%slot(a%col(q)) - 1, c_int32_t)
             val(k) = a%val(q)
          end do
+         if (any(col(rowptr(p) + 2:k) <= col(rowptr(p) + 1:k - 1))) call sort_row(col(rowptr(p) + 1:k), &
+            & val(rowptr(p) + 1:k))
       end do
       rowptr(self%n_padded + 1) = int(k, c_int32_t)
    end subroutine padded_csr
@@ -336,6 +344,9 @@ contains
    subroutine petsc_destroy(self)
       class(petsc_solver_type), intent(inout) :: self
       if (c_associated(self%handle)) call sprc_petsc_free(self%handle)
+      if (allocated(self%rowptr)) deallocate (self%rowptr)
+      if (allocated(self%col)) deallocate (self%col)
+      if (allocated(self%val)) deallocate (self%val)
    end subroutine petsc_destroy
 
 end module sprc_fem_petsc
