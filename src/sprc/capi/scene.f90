@@ -6,7 +6,8 @@ module sprc_capi_scene
    use sprc_core_error, only: error_type, stat_invalid_input, stat_out_of_memory
    use sprc_io_scene, only: scene_type, read_scene
    use sprc_study_mesh, only: study_levels
-   use sprc_study_level, only: study_type, prepare_study, run_level, level_type
+   use sprc_study_level, only: study_type, prepare_study, run_level, level_type, hold_starts
+   use sprc_fem_nested, only: fe_displacement_type
    use sprc_study_row, only: report_row_type
    use sprc_capi_error, only: capi_error_type, get_capi_error, set_capi_error
    use sprc_capi_report, only: capi_report_type
@@ -75,6 +76,8 @@ contains
       type(scene_type) :: scene
       type(study_type) :: study
       type(level_type) :: result
+      !> The previous level's displacements, where the iterative solves start.
+      type(fe_displacement_type), allocatable :: starts(:)
       integer, allocatable :: levels(:)
       integer :: i
 
@@ -90,9 +93,11 @@ contains
       if (allocated(error)) return
       allocate (rows(size(levels)))
       do i = 1, size(levels)
-         call run_level(study, levels(i), result, error)
+         call run_level(study, levels(i), result, error, start=starts)
          if (allocated(error)) return
          rows(i) = result%row
+         call hold_starts(result, starts, error)
+         if (allocated(error)) return
       end do
    end subroutine run_study
 
