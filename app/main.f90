@@ -4,7 +4,7 @@ program sprc_main
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
    use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
    use omp_lib, only: omp_set_num_threads, omp_get_max_threads
-   use sprc_core_kinds, only: wp, i8
+   use sprc_core_kinds, only: wp
    use sprc_core_text, only: fixed_text, itoa, byte_text
    use sprc_core_memory, only: peak_memory
    use sprc_core_error, only: error_type, stat_invalid_input, stat_io
@@ -22,6 +22,7 @@ program sprc_main
    use sprc_io_contact, only: contact_level_type, write_contact_csv
    use sprc_io_hdf5, only: h5_output_type
    use sprc_fem_petsc, only: start_ranks
+   use sprc_study_partition, only: largest_over_ranks, fail_together
    use sprc_app_cli, only: cli_type, parse_cli, usage_text
    use sprc_app_progress, only: progress_level, print_contact_progress
    implicit none
@@ -42,6 +43,11 @@ program sprc_main
    real(wp), parameter :: serial_dofs = 5000.0_wp
    !> The level of the warm-up run (`warm_up`): cheap, but through every library the study calls.
    integer, parameter :: warm_level = 2
+   !> The MPI ranks of this run (`mpirun -n R`; 1 without).
+   integer :: world_ranks = 1
+   !> How long a failed rank waits for the others to fail too (`fail`): a
+   !> failure that all ranks know of brings them there within milliseconds.
+   real(wp), parameter :: fail_wait = 10.0_wp
 
    interface
       !> C's rename(3) (stdio.h): replaces `new` atomically within a file system.
@@ -49,6 +55,12 @@ program sprc_main
          import :: c_int, c_char
          character(kind=c_char), intent(in) :: old(*), new(*)
       end function c_rename
+
+      !> MPI_Abort of every rank (src/shim/sprc_mpi.c).
+      subroutine sprc_mpi_abort(code) bind(C)
+         import :: c_int
+         integer(c_int), value :: code
+      end subroutine sprc_mpi_abort
    end interface
 
    call parse_cli(cli, message)
@@ -113,7 +125,7 @@ contains
       type(contact_level_type), allocatable :: contact_levels(:)
       type(h5_output_type) :: h5
       type(error_type), allocatable :: error
-      character(len=:), allocatable :: prefix
+      character(len=:), allocatable :: prefix, text
       integer, allocatable :: levels(:)
       integer :: i, threads, n_outputs, rank, ranks, n_contact
       character(len=16) :: buf
@@ -127,6 +139,7 @@ contains
       ! rank 0 alone prints and writes the outputs.
       call start_ranks(rank, ranks, error)
       if (allocated(error)) call fail_with(error)
+      world_ranks = ranks
       quiet = cli%quiet .or. rank > 0
       ! The thread count first: prepare_study takes OpenBLAS's buffer for each thread.
       if (cli%threads > 0) call omp_set_num_threads(cli%threads)
@@ -177,8 +190,10 @@ contains
             error%message = trim(buf)//' '//error%message
             call fail_with(error)
          end if
+         text = peak_text(study, ranks, error)
+         if (allocated(error)) call fail_with(error)
          if (.not. quiet) write (error_unit, '(a,i0,a)') 'sprc: level ', levels(i), ' done in '// &
-            fixed_text(rows(i)%t_total, 3)//' s'//peak_text()
+            fixed_text(rows(i)%t_total, 3)//' s'//text
       end do
       if (rank > 0) return
       write (output_unit, '(a)') scene%title
@@ -243,13 +258,19 @@ contains
    end subroutine warm_up
 
    !> ', peak memory 171 MB': the peak resident memory of the run so far (with levels
-   !> in increasing order, that of the level just done); '' where unknown.
-   function peak_text() result(text)
+   !> in increasing order, that of the level just done); '' where unknown. Under
+   !> mpirun the largest of the ranks' (each rank's own peak; every rank calls this).
+   function peak_text(study, ranks, error) result(text)
+      type(study_type), intent(in) :: study
+      integer, intent(in) :: ranks
+      type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: text
-      integer(i8) :: bytes
+      real(wp) :: bytes
       text = ''
-      bytes = peak_memory()
-      if (bytes >= 0) text = ', peak memory '//byte_text(real(bytes, wp))
+      call largest_over_ranks(study%partition, real(peak_memory(), wp), bytes, error)
+      if (bytes < 0.0_wp .or. allocated(error)) return
+      text = ', peak memory '//byte_text(bytes)
+      if (ranks > 1) text = text//' (largest rank of '//itoa(ranks)//')'
    end function peak_text
 
    !> mkdir -p of the directory part of an output prefix (the library does no
@@ -332,6 +353,11 @@ contains
             open (newunit=unit, file=partial_prefix//trim(output_exts(i))//partial, status='old', iostat=stat)
             if (stat == 0) close (unit, status='delete', iostat=stat)
          end do
+      end if
+      ! Under mpirun: a rank that failed alone ends the run on every rank
+      ! (the others may wait in a collective it will not enter).
+      if (world_ranks > 1) then
+         if (.not. fail_together(fail_wait)) call sprc_mpi_abort(int(status, c_int))
       end if
       ! `stop`, not `error stop`: gfortran prints a backtrace on error stop.
       select case (status)

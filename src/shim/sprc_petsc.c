@@ -53,6 +53,7 @@
 
 #ifdef SPRC_PETSC_HEADERS
 #include <petscksp.h>
+#undef MPI_Allreduce /* PETSc's logging wraps it in a macro; the prototype below is MPI's */
 #define SPRC_CHECK_CONSTANT(name, value) _Static_assert((name) == (value), #name " differs in this PETSc");
 SPRC_PETSC_CONSTANTS(SPRC_CHECK_CONSTANT)
 _Static_assert(sizeof(PetscInt) == 4 && sizeof(PetscScalar) == 8 && sizeof(PetscReal) == 8,
@@ -69,6 +70,8 @@ typedef enum { NORM_1 = 0, NORM_2 = 1 } NormType;
 typedef int KSPNormType;
 typedef int KSPConvergedReason;
 typedef struct ompi_communicator_t *MPI_Comm;
+typedef struct ompi_datatype_t *MPI_Datatype;
+typedef struct ompi_op_t *MPI_Op;
 typedef struct _p_Mat *Mat;
 typedef struct _p_Vec *Vec;
 typedef struct _p_KSP *KSP;
@@ -91,6 +94,7 @@ extern struct ompi_predefined_communicator_t ompi_mpi_comm_self;
 extern struct ompi_predefined_communicator_t ompi_mpi_comm_world;
 extern int MPI_Comm_rank(MPI_Comm, int *);
 extern int MPI_Comm_size(MPI_Comm, int *);
+extern int MPI_Allreduce(const void *, void *, int, MPI_Datatype, MPI_Op, MPI_Comm);
 extern PetscErrorCode PetscFinalize(void);
 extern PetscErrorCode PetscInitializeNoArguments(void);
 extern PetscErrorCode PetscInitialized(PetscBool *);
@@ -160,13 +164,15 @@ extern PetscErrorCode KSPGetConvergedReasonString(KSP, const char **);
     X(KSPSetUp) X(KSPSetInitialGuessNonzero) X(KSPSetTolerances) X(KSPSetConvergenceTest) X(KSPSolve) X(KSPGetConvergedReason)           \
     X(KSPGetIterationNumber) X(KSPComputeExtremeSingularValues) X(KSPDestroy) X(PCSetType) X(PCApply)       \
     X(KSPGetConvergedReasonString) X(MatMPIAIJSetPreallocationCSR) X(VecCreateMPI) X(VecScatterCreateToAll)   \
-    X(VecScatterBegin) X(VecScatterEnd) X(VecScatterDestroy) X(MPI_Comm_rank) X(MPI_Comm_size) X(PetscFinalize)
+    X(VecScatterBegin) X(VecScatterEnd) X(VecScatterDestroy) X(MPI_Comm_rank) X(MPI_Comm_size) X(PetscFinalize)   \
+    X(MPI_Allreduce)
 
 /* One pointer per function, set by load_petsc; from here on every call of
  * such a function goes through its pointer. */
 #define SPRC_DECLARE_POINTER(f) static __typeof__(f) *p_##f;
 SPRC_PETSC_FUNCTIONS(SPRC_DECLARE_POINTER)
 static struct ompi_predefined_communicator_t *p_comm_self, *p_comm_world;
+static void *p_mpi_int, *p_op_min; /* Open MPI's MPI_INT and MPI_MIN */
 #define PetscInitializeNoArguments (*p_PetscInitializeNoArguments)
 #define PetscInitialized (*p_PetscInitialized)
 #define PetscOptionsSetValue (*p_PetscOptionsSetValue)
@@ -218,6 +224,7 @@ static struct ompi_predefined_communicator_t *p_comm_self, *p_comm_world;
 #define MPI_Comm_rank (*p_MPI_Comm_rank)
 #define MPI_Comm_size (*p_MPI_Comm_size)
 #define PetscFinalize (*p_PetscFinalize)
+#define MPI_Allreduce (*p_MPI_Allreduce)
 #undef PETSC_COMM_SELF
 #define PETSC_COMM_SELF ((MPI_Comm)(void *)p_comm_self)
 #define SPRC_COMM_WORLD ((MPI_Comm)(void *)p_comm_world)
@@ -255,7 +262,9 @@ static int load_petsc(char *msg, int64_t len)
 #undef SPRC_FIND
     p_comm_self = dlsym(h, "ompi_mpi_comm_self");
     p_comm_world = dlsym(h, "ompi_mpi_comm_world");
-    if (p_comm_self == NULL || p_comm_world == NULL)
+    p_mpi_int = dlsym(h, "ompi_mpi_int");
+    p_op_min = dlsym(h, "ompi_mpi_op_min");
+    if (p_comm_self == NULL || p_comm_world == NULL || p_mpi_int == NULL || p_op_min == NULL)
         return report(SPRC_INTERNAL, msg, len, "PETSc: %s is not built on Open MPI", SPRC_PETSC_LIBRARY);
     lib = h;
     return SPRC_OK;
@@ -269,6 +278,15 @@ static int world_rank = 0, world_size = 1, distributed = 0;
 
 static void finalize_at_exit(void) { PetscFinalize(); }
 
+/* PetscFinalize (and so MPI_Finalize) at exit, once: Open MPI's mpirun
+ * reports a rank that ends without MPI_Finalize as failed, also with one rank. */
+static void finalize_when_done(void)
+{
+    static int registered = 0;
+    if (!registered) atexit(finalize_at_exit);
+    registered = 1;
+}
+
 /* PETSc (and MPI, as a singleton when not under mpirun) once per process. */
 static int ensure_petsc(char *msg, int64_t len)
 {
@@ -281,6 +299,7 @@ static int ensure_petsc(char *msg, int64_t len)
     TRY(PetscOptionsSetValue(NULL, "-no_signal_handler", NULL));
     TRY(PetscInitializeNoArguments());
     TRY(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+    if (getenv("OMPI_COMM_WORLD_SIZE") != NULL) finalize_when_done();
     if (MPI_Comm_rank(SPRC_COMM_WORLD, &world_rank) != 0 || MPI_Comm_size(SPRC_COMM_WORLD, &world_size) != 0)
         return report(SPRC_INTERNAL, msg, len, "PETSc: MPI_Comm_rank or MPI_Comm_size failed");
     return SPRC_OK;
@@ -298,9 +317,38 @@ int sprc_petsc_ranks(int *rank, int *size, char *msg, int64_t len)
     *size = world_size;
     if (status == SPRC_OK && world_size > 1 && !distributed) {
         distributed = 1;
-        atexit(finalize_at_exit);
+        finalize_when_done();
     }
     return status;
+}
+
+/* Every rank learns whether any failed, before a collective step (distributed
+ * solves; a serial one returns `status`): a rank that did not fail gets
+ * SPRC_INTERNAL naming the lowest failed rank and `what` it was doing, so no
+ * rank enters a collective that a failed one will not. */
+static int agree_status(int status, const char *what, char *msg, int64_t len)
+{
+    int mine, first = 0;
+    if (!distributed) return status;
+    mine = status != SPRC_OK ? world_rank : world_size;
+    if (MPI_Allreduce(&mine, &first, 1, (MPI_Datatype)p_mpi_int, (MPI_Op)p_op_min, SPRC_COMM_WORLD) != 0)
+        return status != SPRC_OK ? status : report(SPRC_INTERNAL, msg, len, "PETSc %s: MPI_Allreduce failed", what);
+    if (status == SPRC_OK && first < world_size)
+        return report(SPRC_INTERNAL, msg, len, "PETSc %s failed on rank %d (its message is on its standard error)",
+                      what, first);
+    return status;
+}
+
+/* A test hook, not reachable from a scene: SPRC_TEST_FAIL_SETUP_RANK=r in the
+ * environment makes the setup fail on rank r alone, as a rank-local failure
+ * (an allocation, a PETSc error on one rank) would, before the collective
+ * steps: tools/test-driver checks that every rank then returns the error. */
+static int injected_failure(char *msg, int64_t len)
+{
+    const char *r = getenv("SPRC_TEST_FAIL_SETUP_RANK");
+    if (r == NULL || *r == '\0' || atoi(r) != world_rank) return SPRC_OK;
+    return report(SPRC_INTERNAL, msg, len, "PETSc setup: failure injected on rank %d (SPRC_TEST_FAIL_SETUP_RANK)",
+                  world_rank);
 }
 
 typedef struct {
@@ -343,28 +391,20 @@ static int create_vector(sprc_petsc *s, PetscInt n, PetscInt dim, Vec *v, char *
     return SPRC_OK;
 }
 
-/* This rank's rows of the CSR matrix (rowptr, col, val of all n rows, as
- * every rank has them) as MATMPIAIJ, preallocated from the rows' pattern
- * (PETSc copies them). */
+/* This rank's rows (the CSR arrays of sprc_petsc_setup: n_local rows,
+ * global columns) as MATMPIAIJ, preallocated from their pattern (PETSc
+ * copies them). */
 static int set_rows(sprc_petsc *s, const PetscInt *rowptr, const PetscInt *col, const double *val, char *msg,
                     int64_t len)
 {
-    PetscInt *local, i, first;
-    PetscErrorCode ierr;
     TRY(MatSetType(s->a, "mpiaij"));
-    local = malloc(((size_t)s->n_local + 1) * sizeof(*local));
-    if (local == NULL) return report(SPRC_NO_MEMORY, msg, len, "PETSc setup: cannot allocate the local row starts");
-    first = rowptr[s->lo];
-    for (i = 0; i <= s->n_local; ++i) local[i] = rowptr[s->lo + i] - first;
-    ierr = MatMPIAIJSetPreallocationCSR(s->a, local, col + first, val + first);
-    free(local);
-    if (ierr != 0) return petsc_failure(ierr, "MatMPIAIJSetPreallocationCSR", msg, len);
+    TRY(MatMPIAIJSetPreallocationCSR(s->a, rowptr, col, val));
     return SPRC_OK;
 }
 
 /* Matrix with block size `dim` and its rigid-body near-null space from the
- * node coordinates coords(dim, n/dim). On one rank the matrix is the
- * caller's CSR arrays themselves (columns ascending in each row). */
+ * node coordinates coords(dim, n/dim) of all n rows. On one rank the matrix
+ * is the caller's CSR arrays themselves (columns ascending in each row). */
 static int build_matrix(sprc_petsc *s, PetscInt n, PetscInt dim, const PetscInt *rowptr, const PetscInt *col,
                         const double *val, const double *coords, char *msg, int64_t len)
 {
@@ -425,22 +465,35 @@ static int create_vectors(sprc_petsc *s, PetscInt n, PetscInt dim, char *msg, in
     return SPRC_OK;
 }
 
-/* This rank's rows: whole blocks, the blocks split into contiguous ranges
- * of nearly equal length in rank order. */
+/* This rank's blocks [first, last) of `blocks` (0-based): all of them unless
+ * the solves are distributed; then contiguous ranges of nearly equal length
+ * in rank order, blocks * r / R to blocks * (r + 1) / R, the split of the
+ * masters by sprc_study_partition's `owned_rows` (a block is a master node). */
+void sprc_petsc_own_blocks(int64_t blocks, int64_t *first, int64_t *last)
+{
+    int64_t rank = distributed ? world_rank : 0, size = distributed ? world_size : 1;
+    *first = blocks * rank / size;
+    *last = blocks * (rank + 1) / size;
+}
+
+/* This rank's rows: whole blocks (sprc_petsc_own_blocks). */
 static void own_rows(sprc_petsc *s, PetscInt n, PetscInt dim)
 {
-    int64_t blocks = n / dim, rank = distributed ? world_rank : 0, size = distributed ? world_size : 1;
-    int64_t first = blocks * rank / size, last = blocks * (rank + 1) / size;
+    int64_t first, last;
+    sprc_petsc_own_blocks(n / dim, &first, &last);
     s->comm = distributed ? SPRC_COMM_WORLD : PETSC_COMM_SELF;
     s->lo = (PetscInt)(first * dim);
     s->n_local = (PetscInt)((last - first) * dim);
 }
 
 /* Set up the solver of the order-n matrix given in 0-based CSR (rowptr,
- * col, val), blocks of `dim` unknowns at the node coordinates `coords`.
- * `borrowed` is set to 1 when PETSc uses the arrays in place (one rank):
- * they must then stay as they are until sprc_petsc_free; 0 when it copied
- * them (several ranks). */
+ * col, val), blocks of `dim` unknowns at the node coordinates `coords` (all
+ * n). Distributed solves: only this rank's rows (sprc_petsc_own_blocks),
+ * rowptr of n_local + 1 values from 0 and the columns global; no rank holds
+ * the whole matrix. `borrowed` is set to 1 when PETSc uses the arrays in
+ * place (one rank): they must then stay as they are until sprc_petsc_free;
+ * 0 when it copied them (several ranks). With several ranks every rank
+ * returns an error when any failed (agree_status). */
 int sprc_petsc_setup(void **handle, int64_t n, int dim, const int32_t *rowptr, const int32_t *col,
                      const double *val, const double *coords, int symmetric, int *borrowed, char *msg, int64_t len)
 {
@@ -449,19 +502,30 @@ int sprc_petsc_setup(void **handle, int64_t n, int dim, const int32_t *rowptr, c
 
     *handle = NULL;
     *borrowed = !distributed;
-    if (n < 1 || n > INT32_MAX || rowptr[n] < 0 || (dim != 2 && dim != 3) || n % dim != 0)
-        return report(SPRC_INVALID, msg, len, "PETSc setup: order %lld with block size %d does not fit", (long long)n,
-                      dim);
     status = ensure_petsc(msg, len);
-    if (status != SPRC_OK) return status;
-    s = calloc(1, sizeof(*s));
-    if (s == NULL) return report(SPRC_NO_MEMORY, msg, len, "PETSc setup: cannot allocate a handle");
+    if (status == SPRC_OK && (n < 1 || n > INT32_MAX || (dim != 2 && dim != 3) || n % dim != 0))
+        status = report(SPRC_INVALID, msg, len, "PETSc setup: order %lld with block size %d does not fit",
+                        (long long)n, dim);
+    s = status == SPRC_OK ? calloc(1, sizeof(*s)) : NULL;
+    if (status == SPRC_OK && s == NULL) status = report(SPRC_NO_MEMORY, msg, len, "PETSc setup: cannot allocate a handle");
+    if (status == SPRC_OK) {
+        own_rows(s, (PetscInt)n, dim);
+        if (rowptr[0] != 0 || rowptr[s->n_local] < 0)
+            status = report(SPRC_INVALID, msg, len, "PETSc setup: the row starts of rows %d..%d do not begin at 0 "
+                            "or overflow", (int)s->lo, (int)(s->lo + s->n_local - 1));
+    }
+    if (status == SPRC_OK) status = injected_failure(msg, len);
+    status = agree_status(status, "setup", msg, len);
+    if (status != SPRC_OK) {
+        free(s);
+        return status;
+    }
     s->symmetric = symmetric;
-    own_rows(s, (PetscInt)n, dim);
     *handle = s;
     status = build_matrix(s, (PetscInt)n, dim, rowptr, col, val, coords, msg, len);
     if (status == SPRC_OK) status = build_solver(s, msg, len);
     if (status == SPRC_OK) status = create_vectors(s, (PetscInt)n, dim, msg, len);
+    status = agree_status(status, "setup", msg, len);
     if (status != SPRC_OK) sprc_petsc_free(handle);
     return status;
 }
@@ -609,6 +673,9 @@ int sprc_petsc_solve(void *handle, int64_t n, const double *b, double *x, int gu
     status = run_ksp(s, max_it, guess, msg, len);
     if (status == SPRC_OK) status = ksp_outcome(s, iterations, msg, len);
     *bound = s->bound;
+    /* the outcome is the same on every rank (PETSc's reductions); a failure of
+     * this rank's own steps is made known before the gather of x */
+    status = agree_status(status, "solve", msg, len);
     if (status != SPRC_OK) return status;
     return copy_out(s, x, (PetscInt)n, msg, len);
 }

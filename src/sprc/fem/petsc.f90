@@ -46,8 +46,8 @@ module sprc_fem_petsc
       integer, allocatable :: slot(:)
       !> Coordinates of each block's node, dim values per block.
       real(wp), allocatable :: coords(:)
-      !> The blocked matrix in 0-based CSR (`padded_csr`). On one rank it is
-      !> PETSc's matrix itself, so it lives until `destroy`.
+      !> The blocked matrix in 0-based CSR (`padded_csr`), this rank's rows
+      !> only. On one rank it is PETSc's matrix itself, so it lives until `destroy`.
       integer(c_int32_t), allocatable :: rowptr(:), col(:)
       real(wp), allocatable :: val(:)
       !> Bound of the relative energy norm of the iteration error (CG; see
@@ -109,6 +109,12 @@ module sprc_fem_petsc
          character(kind=c_char), intent(inout) :: msg(*)
          integer(c_int64_t), value :: len
       end function sprc_petsc_ranks
+
+      subroutine sprc_petsc_own_blocks(blocks, first, last) bind(c)
+         import :: c_int64_t
+         integer(c_int64_t), value :: blocks
+         integer(c_int64_t), intent(out) :: first, last
+      end subroutine sprc_petsc_own_blocks
 
       subroutine sprc_petsc_free(handle) bind(c)
          import :: c_ptr
@@ -238,10 +244,11 @@ contains
       self%iterations = 0
    end subroutine petsc_factorize
 
-   !> `a` in blocked order with identity rows (the mean diagonal) at the
-   !> fixed components; 0-based 32-bit CSR with the columns of each row
-   !> ascending (as PETSc's matrix on the arrays needs), refused if PETSc's
-   !> 32-bit indices cannot hold it.
+   !> This rank's rows of `a` (those of its blocks, `sprc_petsc_own_blocks`:
+   !> all on one rank; `a` needs no other rows) in blocked order with identity
+   !> rows (the mean diagonal of these rows) at the fixed components; 0-based
+   !> 32-bit CSR from 0 with global columns, ascending in each row (as PETSc's
+   !> matrix on the arrays needs), refused if PETSc's 32-bit indices cannot hold it.
    subroutine padded_csr(self, a, rowptr, col, val, error)
       class(petsc_solver_type), intent(in) :: self
       type(csr_type), intent(in) :: a
@@ -250,34 +257,47 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer, allocatable :: row_of(:)
       integer(i8) :: nnz, q, k
-      integer :: p, i, stat
+      integer(c_int64_t) :: first, last
+      integer :: p, i, stat, p0, p1, n_own
       real(wp) :: mean_diag
       character(len=200) :: buf
 
-      nnz = a%rowptr(a%nrows + 1) - 1 + int(self%n_padded - a%nrows, i8)
+      call sprc_petsc_own_blocks(int(self%n_padded/self%dim, c_int64_t), first, last)
+      p0 = int(first)*self%dim + 1
+      p1 = int(last)*self%dim
+      allocate (row_of(self%n_padded), stat=stat)
+      call check_allocation(stat, 'iterative solver', 'the row of each blocked unknown', self%n_padded, 4, error)
+      if (allocated(error)) return
+      row_of = 0
+      do i = 1, a%nrows
+         row_of(self%slot(i)) = i
+      end do
+      nnz = 0
+      n_own = 0
+      mean_diag = 0.0_wp
+      do p = p0, p1
+         i = row_of(p)
+         nnz = nnz + 1
+         if (i == 0) cycle
+         n_own = n_own + 1
+         nnz = nnz + a%rowptr(i + 1) - a%rowptr(i) - 1
+         do q = a%rowptr(i), a%rowptr(i + 1) - 1
+            if (a%col(q) == i) mean_diag = mean_diag + abs(a%val(q))
+         end do
+      end do
+      mean_diag = max(mean_diag/real(max(n_own, 1), wp), tiny(1.0_wp))
       if (nnz > int(huge(1_c_int32_t), i8)) then
          write (buf, '("iterative solver: ",i0," nonzeros exceed the 32-bit indices of this PETSc build ", &
             & "(Debian libpetsc-real-dev); use solver = ''direct'' or a PETSc with 64-bit indices")') nnz
          call fatal_error(error, trim(buf), stat_unsupported)
          return
       end if
-      allocate (row_of(self%n_padded), rowptr(self%n_padded + 1), col(nnz), val(nnz), stat=stat)
+      allocate (rowptr(p1 - p0 + 2), col(nnz), val(nnz), stat=stat)
       call check_allocation(stat, 'iterative solver', 'the blocked matrix', nnz, 12, error)
       if (allocated(error)) return
-      row_of = 0
-      do i = 1, a%nrows
-         row_of(self%slot(i)) = i
-      end do
-      mean_diag = 0.0_wp
-      do i = 1, a%nrows
-         do q = a%rowptr(i), a%rowptr(i + 1) - 1
-            if (a%col(q) == i) mean_diag = mean_diag + abs(a%val(q))
-         end do
-      end do
-      mean_diag = max(mean_diag/real(max(a%nrows, 1), wp), tiny(1.0_wp))
       k = 0
-      do p = 1, self%n_padded
-         rowptr(p) = int(k, c_int32_t)
+      do p = p0, p1
+         rowptr(p - p0 + 1) = int(k, c_int32_t)
          i = row_of(p)
          if (i == 0) then
             k = k + 1
@@ -290,10 +310,11 @@ contains
             col(k) = int(self%slot(a%col(q)) - 1, c_int32_t)
             val(k) = a%val(q)
          end do
-         if (any(col(rowptr(p) + 2:k) <= col(rowptr(p) + 1:k - 1))) call sort_row(col(rowptr(p) + 1:k), &
-            & val(rowptr(p) + 1:k))
+         associate (r0 => rowptr(p - p0 + 1))
+            if (any(col(r0 + 2:k) <= col(r0 + 1:k - 1))) call sort_row(col(r0 + 1:k), val(r0 + 1:k))
+         end associate
       end do
-      rowptr(self%n_padded + 1) = int(k, c_int32_t)
+      rowptr(p1 - p0 + 2) = int(k, c_int32_t)
    end subroutine padded_csr
 
    subroutine petsc_solve(self, n, nrhs, b, x, transposed, error)

@@ -138,6 +138,14 @@ module sprc_fem_problem
       !> Reduced stiffness and load.
       type(csr_type) :: k
       real(wp), allocatable :: f(:)
+      !> A level shared out among ranks (`sprc_study_partition`'s `solve_level`):
+      !> `k` and `f` hold only this rank's reduced rows, row_bounds(r + 1) ..
+      !> row_bounds(r + 2) - 1 for rank r of `rows_share` (the other rows of k
+      !> are empty, of f zero; no rank holds the whole K), and only the
+      !> iterative solve, distributed over the ranks, can solve them. Not
+      !> allocated: k and f are whole.
+      class(share_type), allocatable :: rows_share
+      integer(i8), allocatable :: row_bounds(:)
       !> Reduced solution and nodal displacements (dim, n_nodes).
       real(wp), allocatable :: ubar(:), u(:, :)
       logical :: solved = .false.
@@ -1003,8 +1011,12 @@ contains
          return
       end if
       call self%rigid_modes(r, error)
-      if (allocated(error)) return
-      call free_motions(self%k, r, vec, nfree, error)
+      if (allocated(self%rows_share)) then
+         call self%rows_share%agree('the rigid-body check', error)
+         if (.not. allocated(error)) call free_motions(self%k, r, vec, nfree, error, self%rows_share, self%row_bounds)
+      else if (.not. allocated(error)) then
+         call free_motions(self%k, r, vec, nfree, error)
+      end if
       if (allocated(error) .or. nfree == 0) return
       ! Name every basic motion with a significant share in a free one, once.
       involved = .false.
@@ -1090,13 +1102,17 @@ contains
    !> (K first divided by its largest diagonal entry, so that the energies
    !> neither overflow nor underflow for any representable E); the
    !> eigenvectors of G with eigenvalue below `rigid_tol` are the free motions,
-   !> vec(nm, nfree) in the basis of the columns of r.
-   subroutine free_motions(k, r, vec, nfree, error)
+   !> vec(nm, nfree) in the basis of the columns of r. With `share`, k holds
+   !> this rank's rows of `bounds` (as `rows_share`, `row_bounds`): the rows
+   !> of K R and diag K are gathered, so G has the bits of the whole k's.
+   subroutine free_motions(k, r, vec, nfree, error, share, bounds)
       type(csr_type), intent(in) :: k
       real(wp), intent(in) :: r(:, :)
       real(wp), allocatable, intent(out) :: vec(:, :)
       integer, intent(out) :: nfree
       type(error_type), allocatable, intent(out) :: error
+      class(share_type), intent(in), optional :: share
+      integer(i8), intent(in), optional :: bounds(:)
       real(wp), allocatable :: kr(:, :), diag(:), work(:), g(:, :), s(:), lam(:)
       real(wp) :: kmax
       integer :: nm, nd, i, j, info, stat
@@ -1107,18 +1123,26 @@ contains
       nfree = 0
       allocate (kr(nd, nm), diag(nd), stat=stat)
       call check_allocation(stat, 'elasticity solve', 'the rigid-body check (K times each motion)', nd, 8*(nm + 1), error)
-      if (allocated(error)) return
       allocate (g(nm, nm), s(nm), lam(nm), vec(nm, 0))
       do i = 1, nm
-         call k%matvec(r(:, i), kr(:, i), error)
-         if (allocated(error)) return
+         if (.not. allocated(error)) call k%matvec(r(:, i), kr(:, i), error)
       end do
-      diag = 0.0_wp
-      do i = 1, nd
-         do q = k%rowptr(i), k%rowptr(i + 1) - 1
-            if (k%col(q) == i) diag(i) = k%val(q)
+      if (.not. allocated(error)) then
+         diag = 0.0_wp
+         do i = 1, nd
+            do q = k%rowptr(i), k%rowptr(i + 1) - 1
+               if (k%col(q) == i) diag(i) = k%val(q)
+            end do
          end do
-      end do
+      end if
+      if (present(share) .and. present(bounds)) then
+         call share%agree('the rigid-body check', error)
+         do i = 1, nm
+            if (.not. allocated(error)) call share%gather_slices(bounds, kr(:, i), error)
+         end do
+         if (.not. allocated(error)) call share%gather_slices(bounds, diag, error)
+      end if
+      if (allocated(error)) return
       kmax = maxval(abs(diag))
       if (.not. (kmax > 0.0_wp)) kmax = 1.0_wp
       diag = diag/kmax

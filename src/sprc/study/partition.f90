@@ -15,24 +15,28 @@
 !>   and one layer of ghosts, reached through hanging-node and aggregation
 !>   constraints by the element's reduced dofs) and sums its rows as the
 !>   serial assembly does, over the same blocks in element order
-!>   (`sprc_fem_problem`'s `assemble` with `rows`). The owned rows of K and f
-!>   are gathered in rank order: the reduced system of every rank is the
-!>   serial one, bit for bit (PETSc's stash would add a row's off-rank parts
-!>   in an order that is not fixed).
+!>   (`sprc_fem_problem`'s `assemble` with `rows`), so each row has the
+!>   serial bits (PETSc's stash would add a row's off-rank parts in an order
+!>   that is not fixed). It keeps only its rows (`keep_rows`): no rank holds
+!>   the whole K; the problem's `rows_share` and `row_bounds` say which rows
+!>   are where, PETSc's parallel matrix gets each rank's rows (the same split
+!>   of the masters, `sprc_petsc_own_blocks`), and the solution is gathered
+!>   to every rank (the recovery needs the displacements of its patches).
+!>   A forced direct solve is refused: the direct solvers need the whole K.
 !> - Recovery, estimate and exact error: `sprc_grid_share` (patches and
 !>   elements in contiguous ranges, the records and element terms gathered;
 !>   partition_type is the share whose gather is MPI's). A scene with
 !>   `&contact` keeps them (and its assembly) on the whole level on every rank.
 !>
-!> What is not partitioned: every rank holds the whole level (grid, points,
-!> K, the gathered solution), so the memory per rank is the serial run's
-!> plus its share of PETSc's. A serial run (one rank) takes none of these
+!> What is not partitioned: every rank holds the whole grid, points and the
+!> gathered solution and recovered fields (doc/distributed.md). A serial run (one rank) takes none of these
 !> paths: nothing of MPI is loaded. SPRC_PARTITION=0 in the environment keeps
 !> every rank on the whole level (`split`).
 module sprc_study_partition
    use, intrinsic :: iso_c_binding, only: c_int, c_int32_t, c_int64_t, c_double, c_char
    use sprc_core_kinds, only: wp, i8
-   use sprc_core_error, only: error_type
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
+   use sprc_core_text, only: itoa
    use sprc_core_alloc, only: check_allocation
    use sprc_core_timer, only: timer_type
    use sprc_geometry_region, only: cell_inside
@@ -41,12 +45,12 @@ module sprc_study_partition
    use sprc_grid_quadrature, only: cut_quadrature_type
    use sprc_fem_sparse, only: csr_type
    use sprc_fem_problem, only: elasticity_problem_type
-   use sprc_fem_linear_solver, only: backend_error, message_length, solve_ranks
+   use sprc_fem_linear_solver, only: backend_error, message_length, solve_ranks, solver_direct
    implicit none
    private
 
    public :: partition_type, start_partition, owned_rows, cut_cell_work
-   public :: integrate_level, solve_level
+   public :: integrate_level, solve_level, largest_over_ranks, fail_together
 
    !> This process's place among the ranks of a partitioned level (rank 0 of
    !> 1: serial).
@@ -84,6 +88,11 @@ module sprc_study_partition
          character(kind=c_char), intent(inout) :: msg(*)
          integer(c_int64_t), value :: len
       end function sprc_mpi_gather_double
+
+      integer(c_int) function sprc_mpi_fail_together(seconds) bind(c)
+         import :: c_int, c_double
+         real(c_double), value :: seconds
+      end function sprc_mpi_fail_together
 
       integer(c_int) function sprc_mpi_gather_int(send, count, recv, counts, size, msg, len) bind(c)
          import :: c_int, c_int32_t, c_int64_t, c_char
@@ -165,39 +174,76 @@ contains
    end subroutine integrate_level
 
    !> Assemble, solve and expand the solution of a body not in contact (`problem%solve`):
-   !> with several ranks each assembles its rows (`owned_rows`) and the rows are
-   !> gathered (t_assembly counts both) before the distributed solve.
+   !> with several ranks each assembles and keeps its rows (`owned_rows`,
+   !> `keep_rows`; t_assembly counts both), the iterative solve is distributed
+   !> and its solution gathered to every rank. A failure on any rank is an
+   !> error on all of them.
    subroutine solve_level(part, problem, error)
       type(partition_type), intent(in) :: part
       type(elasticity_problem_type), intent(inout) :: problem
       type(error_type), allocatable, intent(out) :: error
       type(timer_type) :: timer
       real(wp), allocatable :: ubar(:)
-      integer, allocatable :: rows(:, :)
-      integer :: r
+      integer(i8) :: bounds(part%ranks + 1)
+      integer :: r, rows(2)
 
       if (.not. part%shared()) then
          call problem%solve(error)
          return
       end if
-      allocate (rows(2, 0:part%ranks - 1))
+      if (problem%solver == solver_direct) then
+         call fatal_error(error, 'solver = ''direct'' under mpirun with '//itoa(part%ranks)//' ranks: the direct '// &
+            & 'solvers need the whole stiffness on one rank, and each rank holds only its rows; use solver = '// &
+            & '''iterative'' or ''auto'', or run the direct solve without mpirun', stat_invalid_input)
+         return
+      end if
       do r = 0, part%ranks - 1
-         rows(:, r) = owned_rows(problem%constraints%dof, r, part%ranks)
+         rows = owned_rows(problem%constraints%dof, r, part%ranks)
+         bounds(r + 1) = rows(1)
       end do
-      call problem%assemble(error, rows(:, part%rank))
-      call part%agree('the assembly', error)
-      if (allocated(error)) return
+      bounds(part%ranks + 1) = problem%n_dofs() + 1
+      rows = owned_rows(problem%constraints%dof, part%rank, part%ranks)
+      call problem%assemble(error, rows)
       call timer%start()
-      call gather_rows(part, rows, problem%k, problem%f, error)
+      if (.not. allocated(error)) call keep_rows(rows, problem%k, problem%f, error)
       call timer%stop()
       problem%t_assembly = problem%t_assembly + timer%elapsed
+      call part%agree('the assembly', error)
       if (allocated(error)) return
+      if (allocated(problem%rows_share)) deallocate (problem%rows_share)
+      allocate (problem%rows_share, source=part)
+      problem%row_bounds = bounds
       call problem%solve_reduced(error)
+      call part%agree('the solve', error)
       if (allocated(error)) return
       ! set_solution takes a copy: its argument may not be the problem's own ubar
       ubar = problem%ubar
       call problem%set_solution(ubar, error)
    end subroutine solve_level
+
+   !> Whether every rank calls this within `seconds`, as after a failure that
+   !> all of them know of (`agree`); false when this rank failed alone (the
+   !> others wait in a collective it will not enter): the driver then ends
+   !> the run on every rank. True in a serial run.
+   logical function fail_together(seconds)
+      real(wp), intent(in) :: seconds
+      fail_together = sprc_mpi_fail_together(real(seconds, c_double)) /= 0
+   end function fail_together
+
+   !> The largest `value` over the ranks (every rank calls it; with one rank,
+   !> `value`).
+   subroutine largest_over_ranks(part, value, top, error)
+      type(partition_type), intent(in) :: part
+      real(wp), intent(in) :: value
+      real(wp), intent(out) :: top
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: all(part%ranks)
+
+      top = value
+      if (part%ranks <= 1) return
+      call part%gather([value], spread(1_i8, 1, part%ranks), all, error)
+      if (.not. allocated(error)) top = maxval(all)
+   end subroutine largest_over_ranks
 
    !> The points and fractions of every rank's leaves (`first`, as `split_by_work`
    !> gave them) gathered in leaf order into `mesh`.
@@ -263,51 +309,37 @@ contains
       call move_alloc(fraction, mesh%fraction)
    end subroutine gather_points
 
-   !> The owned rows of k and f of every rank (`rows(:, r)`) gathered in rank
-   !> order: the whole k and f on every rank.
-   subroutine gather_rows(part, rows, k, f, error)
-      type(partition_type), intent(in) :: part
-      integer, intent(in) :: rows(:, 0:)
+   !> Only the rows [lo, hi] = `rows` of k and f are kept: the other rows of k
+   !> emptied (k keeps its order, its row starts cover all rows), of f zeroed.
+   subroutine keep_rows(rows, k, f, error)
+      integer, intent(in) :: rows(2)
       type(csr_type), intent(inout) :: k
-      real(wp), allocatable, intent(inout) :: f(:)
+      real(wp), intent(inout) :: f(:)
       type(error_type), allocatable, intent(out) :: error
-      type(csr_type) :: all
-      integer(i8) :: counts(part%ranks), nnz(part%ranks)
-      integer, allocatable :: lens(:)
-      real(wp), allocatable :: f_all(:)
-      integer :: n, r, i, stat
-      character(len=*), parameter :: who = 'partitioned assembly'
+      type(csr_type) :: mine
+      integer(i8) :: first, nnz
+      integer :: lo, hi, stat
 
-      n = k%nrows
-      counts = int(max(rows(2, :) - rows(1, :) + 1, 0), i8)
-      allocate (lens(n), f_all(n), all%rowptr(n + 1), stat=stat)
-      call check_allocation(stat, who, 'the rows of K', n, 20, error)
+      lo = rows(1)
+      hi = max(rows(2), lo - 1)
+      first = k%rowptr(lo)
+      nnz = k%rowptr(hi + 1) - first
+      mine%nrows = k%nrows
+      mine%ncols = k%ncols
+      allocate (mine%rowptr(k%nrows + 1), mine%col(nnz), mine%val(nnz), stat=stat)
+      call check_allocation(stat, 'partitioned assembly', 'the owned rows of K', nnz, 12, error)
       if (allocated(error)) return
-      associate (lo => rows(1, part%rank), hi => rows(2, part%rank))
-         call gather_int(part, int(k%rowptr(lo + 1:hi + 1) - k%rowptr(lo:hi)), counts, lens, error)
-         if (.not. allocated(error)) call part%gather(f(lo:hi), counts, f_all, error)
-         if (allocated(error)) return
-         all%rowptr(1) = 1
-         do i = 1, n
-            all%rowptr(i + 1) = all%rowptr(i) + lens(i)
-         end do
-         do r = 0, part%ranks - 1
-            nnz(r + 1) = all%rowptr(rows(2, r) + 1) - all%rowptr(rows(1, r))
-            if (counts(r + 1) == 0) nnz(r + 1) = 0
-         end do
-         allocate (all%col(all%rowptr(n + 1) - 1), all%val(all%rowptr(n + 1) - 1), stat=stat)
-         call check_allocation(stat, who, 'the entries of K', all%rowptr(n + 1) - 1, 12, error)
-         if (allocated(error)) return
-         call gather_int(part, k%col(k%rowptr(lo):k%rowptr(hi + 1) - 1), nnz, all%col, error)
-         if (.not. allocated(error)) call part%gather(k%val(k%rowptr(lo):k%rowptr(hi + 1) - 1), nnz, &
-            & all%val, error)
-      end associate
-      if (allocated(error)) return
-      call move_alloc(all%rowptr, k%rowptr)
-      call move_alloc(all%col, k%col)
-      call move_alloc(all%val, k%val)
-      call move_alloc(f_all, f)
-   end subroutine gather_rows
+      mine%rowptr(1:lo) = 1
+      mine%rowptr(lo + 1:hi + 1) = k%rowptr(lo + 1:hi + 1) - first + 1
+      mine%rowptr(hi + 2:) = nnz + 1
+      mine%col = k%col(first:first + nnz - 1)
+      mine%val = k%val(first:first + nnz - 1)
+      f(:lo - 1) = 0.0_wp
+      f(hi + 1:) = 0.0_wp
+      call move_alloc(mine%rowptr, k%rowptr)
+      call move_alloc(mine%col, k%col)
+      call move_alloc(mine%val, k%val)
+   end subroutine keep_rows
 
    !> all = the `local` arrays of the ranks concatenated in rank order (counts(r)
    !> values from rank r - 1; `local` has this rank's count).
