@@ -142,8 +142,8 @@ module sprc_fem_problem
       !> `k` and `f` hold only this rank's reduced rows, row_bounds(r + 1) ..
       !> row_bounds(r + 2) - 1 for rank r of `rows_share` (the other rows of k
       !> are empty, of f zero; no rank holds the whole K), and only the
-      !> iterative solve, distributed over the ranks, can solve them. Not
-      !> allocated: k and f are whole.
+      !> iterative solve, distributed over the ranks, can solve them
+      !> (`solve_level` frees them after it). Not allocated: k and f are whole.
       class(share_type), allocatable :: rows_share
       integer(i8), allocatable :: row_bounds(:)
       !> Reduced solution and nodal displacements (dim, n_nodes).

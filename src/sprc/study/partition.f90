@@ -216,6 +216,8 @@ contains
       call problem%solve_reduced(error)
       call part%agree('the solve', error)
       if (allocated(error)) return
+      ! Rows of K serve no one after the distributed solve: their room goes to the recovery.
+      deallocate (problem%k%rowptr, problem%k%col, problem%k%val, problem%f)
       ! set_solution takes a copy: its argument may not be the problem's own ubar
       ubar = problem%ubar
       call problem%set_solution(ubar, error)
