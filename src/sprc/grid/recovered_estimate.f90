@@ -40,7 +40,10 @@ module sprc_grid_recovered_estimate
       integer :: n_elements = 0
       !> Per element: ||sigma* - sigma_h||^2 and ||sigma_h||^2 (energy norm squares).
       real(wp), allocatable :: elem_err2(:), elem_norm_h2(:)
-      !> sigma* at the input's volume points (nstress, npts).
+      !> sigma* at the input's volume points (nstress, npts). Shared among ranks
+      !> (`share`): only at the points of this rank's elements, the others
+      !> untouched (never resident: nothing reads them; the report needs only
+      !> the element terms).
       real(wp), allocatable :: sigma_star(:, :)
       !> Global ZZ estimate, FE stress norm, estimated relative error.
       real(wp) :: err = 0.0_wp, norm_h = 0.0_wp, eta = 0.0_wp
@@ -120,7 +123,7 @@ contains
       end do
       !$omp end parallel do
       if (present(share)) then
-         call gather_terms(share, first, input%elem_ptr, est, error)
+         call gather_terms(share, first, est, error)
          if (allocated(error)) return
       end if
 
@@ -135,11 +138,12 @@ contains
       est%t_estimate = field%t_field + (wall_time() - t0)
    end subroutine estimate_error
 
-   !> The element terms and sigma* of every rank's elements (`first`, as
-   !> `split_by_work`) gathered in element order.
-   subroutine gather_terms(share, first, elem_ptr, est, error)
+   !> The element terms of every rank's elements (`first`, as `split_by_work`)
+   !> gathered in element order (not sigma*, which would make the whole
+   !> level's resident on every rank).
+   subroutine gather_terms(share, first, est, error)
       class(share_type), intent(in) :: share
-      integer, intent(in) :: first(:), elem_ptr(:)
+      integer, intent(in) :: first(:)
       type(zz_estimate_type), intent(inout) :: est
       type(error_type), allocatable, intent(out) :: error
       integer(i8) :: cells(size(first))
@@ -147,8 +151,6 @@ contains
       cells = int(first, i8)
       call share%gather_slices(cells, est%elem_err2, error)
       if (.not. allocated(error)) call share%gather_slices(cells, est%elem_norm_h2, error)
-      if (.not. allocated(error)) call share%gather_slices(size(est%sigma_star, 1, i8)*(elem_ptr(first) - 1) + 1, &
-         & est%sigma_star, error)
       if (allocated(error) .or. .not. est%has_exact) return
       call share%gather_slices(cells, est%elem_err_ex2, error)
       if (.not. allocated(error)) call share%gather_slices(cells, est%elem_err_star2, error)
