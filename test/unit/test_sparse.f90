@@ -60,7 +60,8 @@ contains
          new_unittest('rcond_diagonal', test_rcond_diagonal), &
          new_unittest('destroy_refactorize', test_destroy_refactorize), &
          new_unittest('zero_size_solve', test_zero_size_solve), &
-         new_unittest('same_bits_any_blas_threads', test_blas_threads_bits) &
+         new_unittest('same_bits_any_blas_threads', test_blas_threads_bits), &
+         new_unittest('cholmod_ordering_by_cost', test_cholmod_ordering) &
          ]
    end subroutine collect_sparse
 
@@ -592,6 +593,42 @@ contains
       end do
       call solver%destroy()
    end subroutine check_solves
+
+   !> CHOLMOD orders with AMD where its factorization is cheap (2D elasticity,
+   !> 20,402 unknowns) and with METIS where AMD's factorization would cost
+   !> enough for METIS's analysis to pay (3D elasticity, 24,000 unknowns);
+   !> either way the solve recovers a manufactured solution within
+   !> solve_margin eps / rcond.
+   subroutine test_cholmod_ordering(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(cholmod_solver_type) :: solver
+      type(csr_type) :: a
+      real(wp), allocatable :: xt(:), x(:), b(:)
+      integer :: dim
+      character(len=5), parameter :: expected(2:3) = [character(len=5) :: 'AMD', 'METIS']
+
+      do dim = 2, 3
+         call elasticity(dim, merge(100, 20, dim == 2), .true., a, error)
+         if (allocated(error)) return
+         call solver%factorize(a, error)
+         if (allocated(error)) return
+         call check(error, solver%ordering == expected(dim), achar(48 + dim)//'D: ordering '//trim(solver%ordering)// &
+            & ', expected '//trim(expected(dim)))
+         if (allocated(error)) return
+         xt = manufactured(a%nrows, 1)
+         allocate (x(a%nrows), b(a%nrows))
+         call a%matvec(xt, b, error)
+         if (allocated(error)) return
+         call solver%solve(b, x, error)
+         if (allocated(error)) return
+         call check(error, relerr(x, xt) <= solve_margin*epsilon(1.0_wp)/solver%rcond_estimate, 'solution')
+         if (allocated(error)) return
+         deallocate (x, b)
+         call solver%destroy()
+         call check(error, solver%ordering == '', 'no ordering after destroy')
+         if (allocated(error)) return
+      end do
+   end subroutine test_cholmod_ordering
 
    !> CHOLMOD reads the lower triangle only: garbage in the strict upper
    !> triangle changes nothing, and the lower triangle alone suffices.

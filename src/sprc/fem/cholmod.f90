@@ -18,13 +18,17 @@ module sprc_fem_cholmod
 
    public :: cholmod_solver_type
 
-   !> Supernodal Cholesky A = L L^T (fill-reducing ordering by CHOLMOD:
-   !> AMD, or METIS when it predicts much less fill). `factor_nnz` is nnz(L)
-   !> without supernodal padding; `peak_bytes` is CHOLMOD's peak during
-   !> analysis and factorization.
+   !> Supernodal Cholesky A = L L^T with a fill-reducing ordering: AMD, or
+   !> METIS where AMD's factorization would be costly enough for METIS's
+   !> dearer analysis to pay (3D systems from about 1.5e4 unknowns; the rule
+   !> is in src/shim/sprc_suitesparse.c). `factor_nnz` is nnz(L) without
+   !> supernodal padding; `peak_bytes` is CHOLMOD's peak during analysis and
+   !> factorization.
    type, extends(linear_solver_type) :: cholmod_solver_type
       private
       type(c_ptr) :: handle = c_null_ptr
+      !> The ordering of the current factor, 'AMD' or 'METIS' ('' without one); read-only.
+      character(len=5), public :: ordering = ''
    contains
       procedure :: factorize_backend => cholmod_factorize
       procedure :: solve_backend => cholmod_solve
@@ -67,6 +71,11 @@ module sprc_fem_cholmod
          character(kind=c_char), intent(inout) :: msg(*)
          integer(c_int64_t), value :: len
       end function sprc_cholmod_solve
+
+      integer(c_int) function sprc_cholmod_ordering(handle) bind(c)
+         import :: c_ptr, c_int
+         type(c_ptr), value :: handle
+      end function sprc_cholmod_ordering
    end interface
 
 contains
@@ -87,6 +96,13 @@ contains
       status = sprc_cholmod_factorize(self%handle, int(a%nrows, c_int64_t), a%rowptr, a%col, a%val, &
          self%factor_nnz, self%peak_bytes, self%pivot_ratio, msg, int(len(msg), c_int64_t))
       call backend_error(status, msg, error)
+      if (allocated(error)) return
+      select case (sprc_cholmod_ordering(self%handle))
+      case (1)
+         self%ordering = 'AMD'
+      case (2)
+         self%ordering = 'METIS'
+      end select
    end subroutine cholmod_factorize
 
    subroutine cholmod_solve(self, n, nrhs, b, x, transposed, error)
@@ -110,6 +126,7 @@ contains
    subroutine cholmod_destroy(self)
       class(cholmod_solver_type), intent(inout) :: self
       call sprc_cholmod_free(self%handle)
+      self%ordering = ''
    end subroutine cholmod_destroy
 
 end module sprc_fem_cholmod
