@@ -31,7 +31,8 @@ contains
          new_unittest('grid_sphere_octant', test_grid_octant), &
          new_unittest('body_beyond_box', test_body_beyond_box), &
          new_unittest('level_memory_estimate', test_level_memory), &
-         new_unittest('level_memory_follows_solver', test_level_memory_solver) &
+         new_unittest('level_memory_follows_solver', test_level_memory_solver), &
+         new_unittest('auto_iterative_when_direct_does_not_fit', test_level_memory_fallback) &
          ]
    end subroutine collect_model
 
@@ -204,6 +205,41 @@ contains
       if (allocated(error)) return
       call check(error, bytes(3) == bytes(2), 'auto takes the iterative estimate at this size')
    end subroutine test_level_memory_solver
+
+   !> 'auto' for 3D Q2 (direct at any size, `auto_min_dofs`; Lame sphere octant,
+   !> level 4) takes the direct estimate when it fits in the memory given, and
+   !> the iterative one (32 MB + 1.75 x 8 kB per dof) when one byte less is
+   !> available; 'direct' keeps the direct estimate (the level is then refused
+   !> by check_level_memory).
+   subroutine test_level_memory_fallback(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(body_type), allocatable :: bodies(:)
+      real(wp) :: cells, dofs, direct, bytes, iterative
+      logical :: fits
+
+      call load('example/scenes/lame_sphere.nml', scene, error)
+      if (allocated(error)) return
+      call build_bodies(scene, bodies, error)
+      if (allocated(error)) return
+      scene%order = 2
+      scene%solver = 'auto'
+      call level_memory(scene, bodies(1), 4, cells, dofs, direct, error, available=huge(1_i8), direct_fits=fits)
+      if (allocated(error)) return
+      iterative = 32.0e6_wp + 1.75_wp*8.0e3_wp*dofs
+      call check(error, fits .and. direct > iterative, 'room for it: the direct estimate, above the iterative one')
+      if (allocated(error)) return
+      call level_memory(scene, bodies(1), 4, cells, dofs, bytes, error, available=int(direct, i8) - 1, &
+         & direct_fits=fits)
+      if (allocated(error)) return
+      call check(error, .not. fits .and. abs(bytes - iterative) <= 1.0e-12_wp*bytes, &
+         & 'no room for the direct solve: auto takes the iterative estimate')
+      if (allocated(error)) return
+      scene%solver = 'direct'
+      call level_memory(scene, bodies(1), 4, cells, dofs, bytes, error, available=int(direct, i8) - 1)
+      if (allocated(error)) return
+      call check(error, bytes == direct, 'direct keeps its estimate')
+   end subroutine test_level_memory_fallback
 
    pure function replaced(text, old, new) result(out)
       character(len=*), intent(in) :: text, old, new

@@ -18,7 +18,7 @@ module sprc_test_petsc
    use sprc_fem_bc, only: fe_bc_type
    use sprc_fem_problem, only: elasticity_problem_type, solve_on_grid
    use sprc_fem_linear_solver, only: solver_direct, solver_iterative, solver_auto, use_iterative, &
-      & auto_iterative_min_dofs, solver_choice, set_solve_ranks
+      & auto_iterative_min_dofs, auto_never, solver_choice, set_solve_ranks
    use sprc_fem_petsc, only: petsc_solver_type, iteration_tolerance
    use sprc_fem_nested, only: fe_displacement_type
    use sprc_test_fem, only: sphere_octant, lame_quarter, young
@@ -49,23 +49,39 @@ contains
          ]
    end subroutine collect_petsc
 
-   !> 'auto' is direct in 2D and for small 3D systems, iterative from the threshold on.
+   !> 'auto' by dimension, degree and size (`auto_min_dofs`): 2D and 3D Q2
+   !> stay direct, 3D Q1 goes iterative from its threshold on, and any system
+   !> whose direct solve would not fit in memory goes iterative; explicit
+   !> choices are kept.
    subroutine test_choice(error)
       type(error_type), allocatable, intent(out) :: error
+      integer :: q1
+
       call check(error, solver_choice('iterative') == solver_iterative .and. solver_choice('direct') == &
          & solver_direct .and. solver_choice('auto') == solver_auto .and. solver_choice('cg') == 0, 'names')
       if (allocated(error)) return
-      call check(error, .not. use_iterative(solver_auto, 2, 10*auto_iterative_min_dofs), '2D stays direct')
+      call check(error, .not. use_iterative(solver_auto, 2, 1, 10**8) .and. .not. use_iterative(solver_auto, 2, 2, &
+         & 10**8), '2D stays direct')
       if (allocated(error)) return
-      call check(error, .not. use_iterative(solver_auto, 3, auto_iterative_min_dofs - 1) .and. &
-         & use_iterative(solver_auto, 3, auto_iterative_min_dofs), '3D threshold')
+      q1 = auto_iterative_min_dofs(3, 1)
+      call check(error, q1 < auto_never .and. .not. use_iterative(solver_auto, 3, 1, q1 - 1) .and. &
+         & use_iterative(solver_auto, 3, 1, q1), '3D Q1 threshold')
       if (allocated(error)) return
-      call check(error, use_iterative(solver_iterative, 2, 1) .and. .not. use_iterative(solver_direct, 3, 10**8), &
-         & 'explicit choices')
+      call check(error, .not. use_iterative(solver_auto, 3, 2, 10**8), '3D Q2 stays direct')
+      if (allocated(error)) return
+      call check(error, auto_iterative_min_dofs(4, 1) == auto_never .and. auto_iterative_min_dofs(3, 3) == &
+         & auto_never, 'outside the table: direct')
+      if (allocated(error)) return
+      call check(error, use_iterative(solver_auto, 2, 1, 10, direct_fits=.false.) .and. &
+         & use_iterative(solver_auto, 3, 2, 10, direct_fits=.false.) .and. &
+         & .not. use_iterative(solver_auto, 3, 2, 10, direct_fits=.true.), 'auto: no room for a direct solve')
+      if (allocated(error)) return
+      call check(error, use_iterative(solver_iterative, 2, 1, 1) .and. .not. use_iterative(solver_direct, 3, 1, 10**8) &
+         & .and. .not. use_iterative(solver_direct, 3, 1, 10**8, direct_fits=.false.), 'explicit choices')
       if (allocated(error)) return
       ! on several MPI ranks 'auto' distributes every solve; 'direct' stays direct
       call set_solve_ranks(2)
-      call check(error, use_iterative(solver_auto, 2, 10) .and. .not. use_iterative(solver_direct, 3, 10**8), &
+      call check(error, use_iterative(solver_auto, 2, 1, 10) .and. .not. use_iterative(solver_direct, 3, 1, 10**8), &
          & 'auto on 2 ranks')
       call set_solve_ranks(1)
    end subroutine test_choice

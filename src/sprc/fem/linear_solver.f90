@@ -24,17 +24,21 @@ module sprc_fem_linear_solver
 
    public :: linear_solver_type, backend_error, message_length, blas_threads, set_blas_threads
    public :: solver_auto, solver_direct, solver_iterative, solver_names, solver_choice, use_iterative, &
-      & auto_iterative_min_dofs, solve_ranks, set_solve_ranks
+      & auto_iterative_min_dofs, auto_never, solve_ranks, set_solve_ranks
 
    !> The scene's `solver`: 'auto', 'direct' (CHOLMOD, UMFPACK) or 'iterative'
    !> (Krylov + algebraic multigrid, `sprc_fem_petsc`); codes in `solver_names` order.
    integer, parameter :: solver_auto = 1, solver_direct = 2, solver_iterative = 3
    character(len=*), parameter :: solver_names = 'auto direct iterative'
 
-   !> 'auto' solves a 3D system iteratively from this many unknowns on (the
-   !> crossover of the two solve times on a 2-core machine, README); 2D
-   !> systems stay direct (CHOLMOD's fill is mild there).
-   integer, parameter :: auto_iterative_min_dofs = 50000
+   !> 'auto''s table: a system of dimension `dim` (2, 3) and element degree
+   !> `degree` (1, 2) is solved iteratively from `auto_min_dofs(dim, degree)`
+   !> unknowns on, directly below (`auto_never`: always directly). Each entry
+   !> is a measured crossover of the two solve times (README); re-tune here
+   !> when either solver changes. 2D stays direct (CHOLMOD's fill is mild
+   !> there); so does Q2 in 3D, where GAMG needs ~200 iterations.
+   integer, parameter :: auto_never = huge(1)
+   integer, parameter :: auto_min_dofs(2:3, 1:2) = reshape([auto_never, 25000, auto_never, auto_never], [2, 2])
 
    !> MPI ranks the iterative solves are distributed over (`mpirun -n R`,
    !> sprc_fem_petsc's `start_ranks`); 1 in a serial run. With several ranks
@@ -332,12 +336,30 @@ contains
    end function solver_choice
 
    !> Whether the solver `choice` means the iterative solver for a system of
-   !> `n` unknowns in dimension `dim` (on `solve_ranks` ranks).
-   pure logical function use_iterative(choice, dim, n)
-      integer, intent(in) :: choice, dim, n
+   !> `n` unknowns in dimension `dim` with elements of degree `degree` (on
+   !> `solve_ranks` ranks). 'auto' follows `auto_min_dofs`, and also goes
+   !> iterative when `direct_fits` is false: a direct solve of the system
+   !> would not fit in the memory available (sprc_study_budget).
+   pure logical function use_iterative(choice, dim, degree, n, direct_fits)
+      integer, intent(in) :: choice, dim, degree, n
+      logical, intent(in), optional :: direct_fits
+      logical :: fits
+
+      fits = .true.
+      if (present(direct_fits)) fits = direct_fits
       use_iterative = choice == solver_iterative .or. (choice == solver_auto .and. &
-         & (solve_ranks > 1 .or. (dim == 3 .and. n >= auto_iterative_min_dofs)))
+         & (solve_ranks > 1 .or. .not. fits .or. n >= auto_iterative_min_dofs(dim, degree)))
    end function use_iterative
+
+   !> 'auto''s threshold for `dim` and `degree` (`auto_min_dofs`; `auto_never`
+   !> outside the table: a degree or dimension it has not measured).
+   pure integer function auto_iterative_min_dofs(dim, degree) result(min_dofs)
+      integer, intent(in) :: dim, degree
+      min_dofs = auto_never
+      if (dim >= lbound(auto_min_dofs, 1) .and. dim <= ubound(auto_min_dofs, 1) .and. &
+         & degree >= lbound(auto_min_dofs, 2) .and. degree <= ubound(auto_min_dofs, 2)) &
+         & min_dofs = auto_min_dofs(dim, degree)
+   end function auto_iterative_min_dofs
 
    !> Set `solve_ranks` (by sprc_fem_petsc's `start_ranks` only).
    subroutine set_solve_ranks(ranks)

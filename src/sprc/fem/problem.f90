@@ -1178,7 +1178,7 @@ contains
       call check_allocation(stat, 'elasticity solve', 'the reduced solution', self%constraints%n_dofs, 8, error)
       if (allocated(error)) return
       self%solver_iterations = 0
-      if (use_iterative(self%solver, self%dim, self%constraints%n_dofs)) then
+      if (use_iterative(self%solver, self%dim, self%degree, self%constraints%n_dofs)) then
          call iterative_solve(self, error)
          return
       end if

@@ -7,7 +7,7 @@ module sprc_io_scene
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
    use sprc_core_kinds, only: wp, i8
    use sprc_fem_dilatation, only: projected_poisson
-   use sprc_fem_linear_solver, only: solver_names, auto_iterative_min_dofs
+   use sprc_fem_linear_solver, only: solver_names, auto_iterative_min_dofs, auto_never
    use sprc_fem_problem, only: default_gamma, gamma_note
    use sprc_core_text, only: itoa, real_text
    use sprc_core_error, only: error_type, fatal_error, stat_unsupported
@@ -1170,13 +1170,18 @@ contains
    !> What `solver` means for this scene's dimension (for `sprc check`).
    function solver_line(scene) result(text)
       type(scene_type), intent(in) :: scene
-      character(len=:), allocatable :: text
+      character(len=:), allocatable :: text, head
+      integer :: d
+
       text = ''
       if (scene%solver /= 'auto') return
-      if (scene%analysis == 'solid') then
-         text = ' (3D: CG + algebraic multigrid from '//itoa(auto_iterative_min_dofs)//' unknowns, CHOLMOD below)'
+      d = merge(3, 2, scene%analysis == 'solid')
+      head = ' ('//achar(48 + d)//'D Q'//achar(48 + scene%order)//': '
+      if (auto_iterative_min_dofs(d, scene%order) == auto_never) then
+         text = head//'CHOLMOD; CG + algebraic multigrid where CHOLMOD would not fit in memory)'
       else
-         text = ' (2D: CHOLMOD)'
+         text = head//'CG + algebraic multigrid from '//itoa(auto_iterative_min_dofs(d, scene%order))// &
+            & ' unknowns or where CHOLMOD would not fit in memory, CHOLMOD below)'
       end if
    end function solver_line
 

@@ -20,7 +20,10 @@
 !> A 3D level that the solver choice sends to the iterative solver (PETSc CG +
 !> GAMG, `use_iterative`) has no Cholesky factor: measured 7.2 kB per dof at
 !> 1.5e5 dofs (1.1 GB) and 7.0 kB at 1.16e6 (8.17 GB) on the Q1 sphere
-!> octant; the estimate takes 8 kB per dof (times 1.75 for Q2).
+!> octant; the estimate takes 8 kB per dof (times 1.75 for Q2). With
+!> `solver = 'auto'`, a 3D level whose direct estimate exceeds the memory
+!> available is solved iteratively (`check_level_memory`'s `solver`), and
+!> estimated so.
 !> The grid and its quadrature alone (`sprc mesh`, `grid_only`): about 12 MB
 !> plus 105 bytes per active cell (sphere octant level 7: 5.1e5 cells, 66 MB;
 !> cylinder quarter level 10: 5.0e5 cells, 64 MB); the estimate takes 16 MB +
@@ -41,7 +44,7 @@ module sprc_study_budget
    use sprc_geometry_body, only: body_type
    use sprc_grid_tree, only: grid_type
    use sprc_study_spec, only: scene_type
-   use sprc_fem_linear_solver, only: solver_auto, solver_choice, use_iterative
+   use sprc_fem_linear_solver, only: solver_auto, solver_iterative, solver_choice, use_iterative
    implicit none
    private
 
@@ -58,21 +61,27 @@ contains
 
    !> Estimated cells, dofs and peak bytes of `level` of the scene's study for `body`
    !> (module notes); with `grid_only`, the bytes of the grid and its quadrature alone.
-   subroutine level_memory(scene, body, level, cells, dofs, bytes, error, grid_only)
+   !> Given `available` (bytes, -1 unknown), 'auto' takes the iterative solver's
+   !> estimate when the direct one exceeds it (`direct_fits` false).
+   subroutine level_memory(scene, body, level, cells, dofs, bytes, error, grid_only, available, direct_fits)
       type(scene_type), intent(in) :: scene
       type(body_type), intent(in) :: body
       integer, intent(in) :: level
       real(wp), intent(out) :: cells, dofs, bytes
       type(error_type), allocatable, intent(out) :: error
       logical, intent(in), optional :: grid_only
+      integer(i8), intent(in), optional :: available
+      logical, intent(out), optional :: direct_fits
       type(grid_type) :: grid
-      integer :: d, coarse, up
-      real(wp) :: active, cut, per_dof, box_size
+      integer :: d, coarse, up, n
+      real(wp) :: active, cut, box_size, direct_bytes
       real(wp), allocatable :: box_min(:)
+      logical :: fits
 
       cells = 0.0_wp
       dofs = 0.0_wp
       bytes = 0.0_wp
+      if (present(direct_fits)) direct_fits = .true.
       d = scene%dim
       coarse = min(level, merge(6, 4, d == 2))
       call body_box(scene, body, box_min, box_size)
@@ -83,63 +92,88 @@ contains
       up = level - coarse
       cells = active*2.0_wp**(d*up) + cut*2.0_wp**((d - 1)*up)*(2.0_wp**(d*scene%refine_boundary) - 1.0_wp)
       dofs = real(d*scene%order**d, wp)*cells
-      if (d == 2) then
-         per_dof = per_dof_2d
-      else if (iterative(scene, dofs)) then
-         per_dof = per_dof_3d_iterative
-         if (scene%order == 2) per_dof = q2_factor_3d*per_dof
-      else
-         per_dof = per_dof_3d*(dofs/dofs_3d)**(1.0_wp/3.0_wp)
-         if (scene%order == 2) per_dof = q2_factor_3d*per_dof
-      end if
-      bytes = base_bytes + dofs*per_dof
       if (present(grid_only)) then
-         if (grid_only) bytes = grid_base_bytes + per_cell_grid*cells
+         if (grid_only) then
+            bytes = grid_base_bytes + per_cell_grid*cells
+            return
+         end if
       end if
+      direct_bytes = base_bytes + dofs*per_dof(d, scene%order, dofs, .false.)
+      fits = .true.
+      if (present(available)) fits = available < 0 .or. direct_bytes <= real(available, wp)
+      n = int(min(dofs, real(huge(n), wp)))
+      bytes = direct_bytes
+      if (use_iterative(scene_choice(scene), d, scene%order, n, direct_fits=fits)) &
+         & bytes = base_bytes + dofs*per_dof(d, scene%order, dofs, .true.)
+      if (present(direct_fits)) direct_fits = fits
    end subroutine level_memory
 
-   !> Whether the scene's solver choice takes the iterative solver for `dofs`
-   !> unknowns (the estimate's dofs, capped below the default integer's range).
-   logical function iterative(scene, dofs)
-      type(scene_type), intent(in) :: scene
+   !> Estimated bytes per dof of a level of `dofs` unknowns in dimension `d`
+   !> with elements of degree `order`, solved iteratively or not (module notes).
+   pure real(wp) function per_dof(d, order, dofs, iterative)
+      integer, intent(in) :: d, order
       real(wp), intent(in) :: dofs
-      integer :: choice, n
+      logical, intent(in) :: iterative
+      if (d == 2) then
+         per_dof = per_dof_2d
+         return
+      end if
+      if (iterative) then
+         per_dof = per_dof_3d_iterative
+      else
+         per_dof = per_dof_3d*(dofs/dofs_3d)**(1.0_wp/3.0_wp)
+      end if
+      if (order == 2) per_dof = q2_factor_3d*per_dof
+   end function per_dof
 
+   !> The scene's solver choice code ('auto' when unset).
+   pure integer function scene_choice(scene) result(choice)
+      type(scene_type), intent(in) :: scene
       choice = solver_auto
       if (allocated(scene%solver)) then
          if (len(scene%solver) > 0) choice = solver_choice(scene%solver)
       end if
-      n = int(min(dofs, real(huge(n), wp)))
-      iterative = use_iterative(choice, scene%dim, n)
-   end function iterative
+   end function scene_choice
 
    !> stat_out_of_memory when the estimate of `level` exceeds the memory this process
    !> may still use (sprc_core_memory); the message names the estimate, what is available
-   !> and what bounds it.
-   subroutine check_level_memory(scene, body, level, error, grid_only)
+   !> and what bounds it. `solver`: the solver choice code for the level's solve, the
+   !> scene's, or `solver_iterative` where 'auto' found that a direct solve would not fit.
+   subroutine check_level_memory(scene, body, level, error, grid_only, solver)
       type(scene_type), intent(in) :: scene
       type(body_type), intent(in) :: body
       integer, intent(in) :: level
       type(error_type), allocatable, intent(out) :: error
       !> Only the grid and its quadrature will be built (`sprc mesh`).
       logical, intent(in), optional :: grid_only
-      real(wp) :: cells, dofs, bytes
-      integer(i8) :: avail
+      integer, intent(out), optional :: solver
+      real(wp) :: cells, dofs, bytes, reserve
+      integer(i8) :: avail, usable
       character(len=:), allocatable :: source
       character(len=256) :: buf
       integer :: threads
-      logical :: wanted
+      logical :: wanted, direct_fits
 
+      if (present(solver)) solver = scene_choice(scene)
       call memory_check_wanted(wanted, error)
       if (allocated(error) .or. .not. wanted) return
-      call level_memory(scene, body, level, cells, dofs, bytes, error, grid_only)
-      if (allocated(error)) return
       call available_memory(avail, source)
       threads = 1
       !$ threads = omp_get_max_threads()
-      if (source == 'ulimit -v') bytes = bytes + real(max(0, threads + 1 - blas_reserved_threads()), wp)* &
+      reserve = 0.0_wp
+      if (source == 'ulimit -v') reserve = real(max(0, threads + 1 - blas_reserved_threads()), wp)* &
          & real(blas_buffer_bytes, wp)
-      if (avail < 0 .or. bytes <= real(avail, wp)) return
+      usable = avail
+      if (avail >= 0) usable = max(0_i8, avail - int(reserve, i8))
+      call level_memory(scene, body, level, cells, dofs, bytes, error, grid_only, usable, direct_fits)
+      if (allocated(error)) return
+      bytes = bytes + reserve
+      if (avail < 0 .or. bytes <= real(avail, wp)) then
+         if (present(solver) .and. .not. direct_fits) then
+            if (solver == solver_auto) solver = solver_iterative
+         end if
+         return
+      end if
       write (buf, '("needs about ",a," of memory (an estimate for ",es7.1," cells, ",es7.1, &
          & " dofs), but ",a," is available (",a,"); use a lower level")') byte_text(bytes), cells, dofs, &
          & byte_text(real(avail, wp)), source

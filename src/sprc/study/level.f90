@@ -50,7 +50,6 @@ module sprc_study_level
    use sprc_fem_nested, only: fe_displacement_type
    use sprc_fem_recovery_input, only: fe_recovery_input
    use sprc_fem_dilatation, only: dilatation_choice
-   use sprc_fem_linear_solver, only: solver_choice
    use sprc_study_spec, only: scene_type, contact_spec_type, recovery_degree, contact_unsupported
    use sprc_study_model, only: build_bodies, build_exact, body_conditions, analysis_kind, analysis_units_type, &
       & analysis_units, in_units
@@ -322,8 +321,9 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(fe_displacement_type), intent(in), optional :: start
       type(cut_mesh_type), allocatable :: mesh
+      integer :: solver
 
-      call check_level_memory(study%scene, sb%geometry, level, error)
+      call check_level_memory(study%scene, sb%geometry, level, error, solver=solver)
       if (allocated(error)) return
       allocate (mesh)
       call mesh%build(sb%geometry, sb%box_min, sb%box_size, level, study%refine_boundary, study%order, error)
@@ -348,7 +348,7 @@ contains
          call bl%problem%assemble(error)
          return
       end if
-      if (allocated(study%scene%solver)) bl%problem%solver = solver_choice(study%scene%solver)
+      bl%problem%solver = solver
       if (present(start)) allocate (bl%problem%start, source=start)
       call solve_level(study%partition, bl%problem, error)
       if (allocated(error)) return
