@@ -342,7 +342,7 @@ contains
       if (allocated(error)) return
       call check(error, s%solver, 'auto', 'solver default')
       if (allocated(error)) return
-      call check(error, index(scene_summary(s), 'solver          = auto (2D Q1: CHOLMOD;') > 0, 'summary: 2D auto')
+      call check(error, index(scene_summary(s), 'solver          = auto (2D Q1: CHOLMOD)') > 0, 'summary: 2D auto')
       if (allocated(error)) return
       call read_ok(replaced(minimal, 'box_size=4', "box_size=4 solver='Iterative'"), s, error)
       if (allocated(error)) return

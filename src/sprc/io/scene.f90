@@ -1177,7 +1177,10 @@ contains
       if (scene%solver /= 'auto') return
       d = merge(3, 2, scene%analysis == 'solid')
       head = ' ('//achar(48 + d)//'D Q'//achar(48 + scene%order)//': '
-      if (auto_iterative_min_dofs(d, scene%order) == auto_never) then
+      if (d == 2) then
+         ! the budget estimates a 2D level alike for both solvers: no memory fallback
+         text = head//'CHOLMOD)'
+      else if (auto_iterative_min_dofs(d, scene%order) == auto_never) then
          text = head//'CHOLMOD; CG + algebraic multigrid where CHOLMOD would not fit in memory)'
       else
          text = head//'CG + algebraic multigrid from '//itoa(auto_iterative_min_dofs(d, scene%order))// &
