@@ -150,8 +150,8 @@ contains
       problem%solver = solver_iterative
       call problem%solve_reduced(error)
       if (allocated(error)) return
-      call check(error, problem%solver_name == 'cg+gamg' .and. problem%solver_iterations > 0, &
-         & what//': solved by CG + GAMG, iterations counted')
+      call check(error, problem%solver_name == 'cg+gmg' .and. problem%solver_iterations > 0, &
+         & what//': solved by CG + geometric multigrid, iterations counted')
       if (allocated(error)) return
       u_iter = problem%ubar
       its = problem%solver_iterations

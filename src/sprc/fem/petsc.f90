@@ -23,13 +23,14 @@
 !> PETSc's indices are 32-bit in Debian's build: larger systems are refused.
 module sprc_fem_petsc
    use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_associated, c_int, c_int32_t, c_int64_t, &
-      & c_double, c_char
+      & c_double, c_char, c_loc
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_unsupported
    use sprc_core_blas_threads, only: blas_serial_begin, blas_serial_end
    use sprc_core_alloc, only: check_allocation
    use sprc_fem_sparse, only: csr_type, sort_row
-   use sprc_fem_linear_solver, only: linear_solver_type, backend_error, message_length, set_solve_ranks
+   use sprc_fem_linear_solver, only: linear_solver_type, backend_error, message_length, set_solve_ranks, solve_ranks
+   use sprc_fem_multigrid, only: prolongation_type, lattice_hierarchy
    implicit none
    private
 
@@ -46,6 +47,12 @@ module sprc_fem_petsc
       integer, allocatable :: slot(:)
       !> Coordinates of each block's node, dim values per block.
       real(wp), allocatable :: coords(:)
+      !> Grid lattice coordinates of each block's node (dim, blocks) and the
+      !> node step (`set_lattice`): geometric multigrid when allocated.
+      integer, allocatable :: lattice(:, :)
+      integer :: step = 0
+      !> True when the last `factorize` set up geometric multigrid (false: GAMG).
+      logical, public :: multigrid = .false.
       !> The blocked matrix in 0-based CSR (`padded_csr`), this rank's rows
       !> only. On one rank it is PETSc's matrix itself, so it lives until `destroy`.
       integer(c_int32_t), allocatable :: rowptr(:), col(:)
@@ -67,20 +74,28 @@ module sprc_fem_petsc
       real(wp), allocatable, public :: guess(:)
    contains
       procedure :: set_blocks
+      procedure :: set_lattice
       procedure :: factorize_backend => petsc_factorize
       procedure :: solve_backend => petsc_solve
       procedure :: destroy_backend => petsc_destroy
    end type petsc_solver_type
 
+   !> The multigrid hierarchy as the shim takes it (sprc_petsc_levels).
+   type, bind(c) :: petsc_levels_type
+      integer(c_int) :: n_levels = 0
+      type(c_ptr) :: n_coarse = c_null_ptr, rowptr = c_null_ptr, col = c_null_ptr, val = c_null_ptr
+   end type petsc_levels_type
+
    interface
-      integer(c_int) function sprc_petsc_setup(handle, n, dim, rowptr, col, val, coords, symmetric, borrowed, msg, &
-            & len) bind(c)
-         import :: c_ptr, c_int, c_int32_t, c_int64_t, c_double, c_char
+      integer(c_int) function sprc_petsc_setup(handle, n, dim, rowptr, col, val, coords, levels, symmetric, &
+            & borrowed, msg, len) bind(c)
+         import :: c_ptr, c_int, c_int32_t, c_int64_t, c_double, c_char, petsc_levels_type
          type(c_ptr), intent(out) :: handle
          integer(c_int64_t), value :: n
          integer(c_int), value :: dim
          integer(c_int32_t), intent(in) :: rowptr(*), col(*)
          real(c_double), intent(in) :: val(*), coords(*)
+         type(petsc_levels_type), intent(in) :: levels
          integer(c_int), value :: symmetric
          integer(c_int), intent(out) :: borrowed
          character(kind=c_char), intent(inout) :: msg(*)
@@ -115,6 +130,11 @@ module sprc_fem_petsc
          integer(c_int64_t), value :: blocks
          integer(c_int64_t), intent(out) :: first, last
       end subroutine sprc_petsc_own_blocks
+
+      integer(c_int) function sprc_petsc_multigrid(handle) bind(c)
+         import :: c_ptr, c_int
+         type(c_ptr), value :: handle
+      end function sprc_petsc_multigrid
 
       subroutine sprc_petsc_free(handle) bind(c)
          import :: c_ptr
@@ -212,7 +232,28 @@ contains
          return
       end if
       self%coords = reshape(x, [self%n_padded])
+      if (allocated(self%lattice)) deallocate (self%lattice)
    end subroutine set_blocks
+
+   !> Geometric multigrid (`sprc_fem_multigrid`) instead of GAMG, after
+   !> `set_blocks`: `lattice(:, m)` is block m's node on the grid's node
+   !> lattice (`grid_nodes_type%lattice`), `step` the lattice step between
+   !> neighbouring nodes of the finest elements (2 for Q1, 1 for Q2). A
+   !> distributed solve (several MPI ranks) keeps GAMG.
+   subroutine set_lattice(self, lattice, step, error)
+      class(petsc_solver_type), intent(inout) :: self
+      integer, intent(in) :: lattice(:, :), step
+      type(error_type), allocatable, intent(out) :: error
+
+      if (allocated(self%lattice)) deallocate (self%lattice)
+      if (size(lattice, 1) /= self%dim .or. size(lattice, 2)*self%dim /= self%n_padded .or. self%dim == 0) then
+         call fatal_error(error, 'iterative solver: the lattice points do not match the block layout (set_blocks '// &
+            & 'first, one point per block)', stat_invalid_input)
+         return
+      end if
+      self%lattice = lattice
+      self%step = step
+   end subroutine set_lattice
 
    subroutine petsc_factorize(self, a, error)
       class(petsc_solver_type), intent(inout) :: self
@@ -221,8 +262,13 @@ contains
       character(kind=c_char, len=message_length) :: msg
       integer(c_int) :: status, borrowed
       integer :: saved
+      type(prolongation_type), allocatable :: p(:)
+      type(petsc_levels_type) :: levels
+      integer(c_int32_t), allocatable, target :: n_coarse(:), rowptr(:), col(:)
+      real(c_double), allocatable, target :: val(:)
 
       call petsc_destroy(self)
+      self%multigrid = .false.
       if (.not. allocated(self%slot)) then
          call fatal_error(error, 'iterative solver: set_blocks was not called', stat_invalid_input)
          return
@@ -233,16 +279,71 @@ contains
       end if
       call padded_csr(self, a, self%rowptr, self%col, self%val, error)
       if (allocated(error)) return
+      if (allocated(self%lattice) .and. solve_ranks == 1) then
+         call lattice_hierarchy(self%lattice, self%step, p, error)
+         if (allocated(error)) return
+         call blocked_levels(p, self%dim, n_coarse, rowptr, col, val, error)
+         if (allocated(error)) return
+         levels%n_levels = int(size(p), c_int)
+         if (size(p) > 0) then
+            levels%n_coarse = c_loc(n_coarse)
+            levels%rowptr = c_loc(rowptr)
+            levels%col = c_loc(col)
+            levels%val = c_loc(val)
+         end if
+      end if
       msg = ''
       saved = blas_serial_begin()
       status = sprc_petsc_setup(self%handle, int(self%n_padded, c_int64_t), int(self%dim, c_int), self%rowptr, &
-         & self%col, self%val, self%coords, merge(1_c_int, 0_c_int, self%symmetric), borrowed, msg, &
+         & self%col, self%val, self%coords, levels, merge(1_c_int, 0_c_int, self%symmetric), borrowed, msg, &
          & int(len(msg), c_int64_t))
       call blas_serial_end(saved)
       if (borrowed == 0 .or. status /= 0) deallocate (self%rowptr, self%col, self%val)
       call backend_error(status, msg, error)
       self%iterations = 0
+      if (status == 0) self%multigrid = sprc_petsc_multigrid(self%handle) /= 0
    end subroutine petsc_factorize
+
+   !> The scalar prolongations p as the shim takes them: each coarse node a
+   !> block of dim unknowns, component c of a block interpolated from
+   !> component c of the coarse blocks; 0-based CSR arrays, level after level.
+   subroutine blocked_levels(p, dim, n_coarse, rowptr, col, val, error)
+      type(prolongation_type), intent(in) :: p(:)
+      integer, intent(in) :: dim
+      integer(c_int32_t), allocatable, intent(out) :: n_coarse(:), rowptr(:), col(:)
+      real(c_double), allocatable, intent(out) :: val(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: l, j, c, q, r, k, rows, nnz, stat
+
+      rows = sum(dim*p%n_fine + 1)
+      nnz = 0
+      do l = 1, size(p)
+         nnz = nnz + dim*(p(l)%rowptr(p(l)%n_fine + 1) - 1)
+      end do
+      allocate (n_coarse(size(p)), rowptr(rows), col(nnz), val(nnz), stat=stat)
+      call check_allocation(stat, 'iterative solver', 'the multigrid prolongations', nnz, 12, error)
+      if (allocated(error)) return
+      r = 0
+      k = 0
+      do l = 1, size(p)
+         n_coarse(l) = int(dim*p(l)%n_coarse, c_int32_t)
+         q = 0
+         do j = 1, p(l)%n_fine
+            do c = 1, dim
+               r = r + 1
+               rowptr(r) = int(q, c_int32_t)
+               associate (first => p(l)%rowptr(j), last => p(l)%rowptr(j + 1) - 1)
+                  col(k + 1:k + last - first + 1) = int(dim*(p(l)%col(first:last) - 1) + c - 1, c_int32_t)
+                  val(k + 1:k + last - first + 1) = p(l)%val(first:last)
+                  k = k + last - first + 1
+                  q = q + last - first + 1
+               end associate
+            end do
+         end do
+         r = r + 1
+         rowptr(r) = int(q, c_int32_t)
+      end do
+   end subroutine blocked_levels
 
    !> This rank's rows of `a` (those of its blocks, `sprc_petsc_own_blocks`:
    !> all on one rank; `a` needs no other rows) in blocked order with identity

@@ -152,7 +152,8 @@ module sprc_fem_problem
       !> Linear solver choice (`sprc_fem_linear_solver`: solver_auto, solver_direct,
       !> solver_iterative); a setting, read by `solve_reduced`.
       integer :: solver = solver_auto
-      !> 'cholmod', 'umfpack', 'cg+gamg' or 'gmres+gamg'; why the fallback was taken ('' if not).
+      !> 'cholmod', 'umfpack', 'cg+gmg', 'gmres+gmg' (geometric multigrid), 'cg+gamg' or 'gmres+gamg';
+      !> why the fallback was taken ('' if not).
       character(len=:), allocatable :: solver_name, solver_note
       !> Krylov iterations of the last solve (0 for a direct solve).
       integer :: solver_iterations = 0
@@ -1227,29 +1228,43 @@ contains
 
       call krylov%set_blocks(self%constraints%dof, self%mesh%nodes%x(:, self%constraints%master_node), error)
       if (allocated(error)) return
+      associate (nodes => self%mesh%nodes)
+         call krylov%set_lattice(nodes%lattice(:, self%constraints%master_node), &
+            & 2**(nodes%lattice_level - self%mesh%grid%max_level)/self%degree, error)
+      end associate
+      if (allocated(error)) return
       if (allocated(self%start)) then
          call start_guess(self, krylov%guess, error)
          if (allocated(error)) return
       end if
       krylov%tolerance = iteration_tolerance(0.5_wp**self%mesh%grid%max_level, self%degree)
-      self%solver_name = 'cg+gamg'
       self%solver_note = ''
       call solve_with(krylov, self%k, self%f, self%ubar, self%rcond, error)
+      self%solver_name = 'cg+'//preconditioner_name(krylov)
       self%solver_iterations = krylov%iterations
       if (.not. allocated(error)) return
       if (error%stat /= stat_not_positive_definite) then
          error%message = 'elasticity solve (iterative): '//error%message
          return
       end if
-      self%solver_name = 'gmres+gamg'
+      self%solver_name = 'gmres+'//preconditioner_name(krylov)
       self%solver_note = 'CG found the stiffness not positive definite ('//error%message// &
          & '); solved by GMRES. Raise gamma for an SPD system.'
       deallocate (error)
       krylov%symmetric = .false.
       call solve_with(krylov, self%k, self%f, self%ubar, self%rcond, error)
+      self%solver_name = 'gmres+'//preconditioner_name(krylov)
       self%solver_iterations = self%solver_iterations + krylov%iterations
       if (allocated(error)) error%message = 'elasticity solve (GMRES fallback): '//error%message
    end subroutine iterative_solve
+
+   !> 'gmg' (geometric multigrid on the node lattice) or 'gamg'.
+   pure function preconditioner_name(krylov) result(name)
+      type(petsc_solver_type), intent(in) :: krylov
+      character(len=:), allocatable :: name
+      name = merge('gmg ', 'gamg', krylov%multigrid)
+      name = trim(name)
+   end function preconditioner_name
 
    !> `start` at the masters: the reduced unknowns' initial guess.
    subroutine start_guess(self, guess, error)

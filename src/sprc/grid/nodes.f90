@@ -25,7 +25,7 @@ module sprc_grid_nodes
    implicit none
    private
 
-   public :: grid_nodes_type, element_node_index, element_shape, nodes_per_element
+   public :: grid_nodes_type, element_node_index, element_shape, nodes_per_element, lattice_slot
 
    integer(i8), parameter :: hash_prime = 2147483647_i8
    integer(i8), parameter :: hash_mult = 1103515245_i8
@@ -280,6 +280,7 @@ contains
       end do
    end subroutine rehash
 
+   !> Slot of the lattice point g (0 beyond dim) in a hash table of mask + 1 slots (a power of 2).
    pure integer(i8) function lattice_slot(g, mask)
       integer, intent(in) :: g(3)
       integer(i8), intent(in) :: mask

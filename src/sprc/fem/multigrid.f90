@@ -1,0 +1,463 @@
+!> Geometric multigrid hierarchy on the grid's node lattice: the
+!> prolongations of the iterative solver's PCMG (`sprc_fem_petsc`).
+!>
+!> The reduced unknowns are blocks of `dim` components at master nodes, and
+!> every node sits on the grid's integer node lattice (`grid_nodes_type`,
+!> lattice coordinates in units of box_size / 2**lattice_level; a Q1 node
+!> step is 2 there, a Q2 one 1). The coarse space of a level of spacing s
+!> (in lattice units: twice the node step, then 4, 8, ... times it) has one
+!> node per lattice point of spacing s that is a node of the finer level
+!> (a C-point, taken by injection). Every other node (F-point) gets its value
+!> from the corners of the coarse cell of side s that holds it:
+!> - all corners with a nonzero (tri/bi)linear weight are C-points: those
+!>   weights (a Q2 level is coarsened to the Q1-like vertex lattice this way);
+!> - otherwise (near cuts, where corners of the coarse cell are no nodes):
+!>   the weights w closest to the linear ones t, |w - t| least, among those
+!>   that reproduce every linear field exactly (sum w = 1, sum w x_k = x), on
+!>   the C-points of the coarse cells whose closure holds the node;
+!> - if those C-points cannot reproduce linear fields (fewer than dim + 1, or
+!>   affinely dependent) the node itself is a C-point of the coarse level.
+!> So the prolongation reproduces linear fields exactly, the rigid-body modes
+!> of elasticity included, on every level, and it has full column rank (the
+!> C-points' rows are the identity): the Galerkin coarse matrices P^T A P
+!> are symmetric positive definite whenever A is. Coarsening stops at
+!> `coarse_nodes` nodes or when a level no longer shrinks.
+module sprc_fem_multigrid
+   use sprc_core_kinds, only: wp, i8
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
+   use sprc_core_alloc, only: check_allocation
+   use sprc_grid_nodes, only: lattice_slot
+   implicit none
+   private
+
+   public :: prolongation_type, lattice_hierarchy, coarsen
+
+   !> A scalar prolongation from `n_coarse` coarse nodes to `n_fine` fine ones
+   !> in 1-based CSR (columns ascending in each row), and the coarse nodes'
+   !> lattice coordinates (dim, n_coarse).
+   type :: prolongation_type
+      integer :: n_fine = 0, n_coarse = 0
+      integer, allocatable :: rowptr(:), col(:)
+      real(wp), allocatable :: val(:)
+      integer, allocatable :: lattice(:, :)
+   end type prolongation_type
+
+   !> Stop coarsening at this many nodes or fewer (a coarse problem that a
+   !> direct factorization solves in well under a millisecond per cycle).
+   integer, parameter, public :: coarse_nodes = 200
+   !> A level that keeps more than this fraction of its finer level's nodes
+   !> ends the hierarchy (the coarsening no longer pays).
+   real(wp), parameter :: min_shrink = 0.8_wp
+   character(len=*), parameter :: who = 'multigrid hierarchy'
+
+   !> Points of a lattice (coordinates `at(3, n)`, 0 beyond dim) found by
+   !> open addressing: `table` holds point numbers (0: empty), at most half full.
+   type :: point_set_type
+      integer, allocatable :: at(:, :), table(:)
+      integer :: n = 0
+      integer(i8) :: mask = 0
+   end type point_set_type
+
+contains
+
+   !> The prolongations `p(1)` (finest to first coarse level), `p(2)`, ... of
+   !> the nodes at the lattice coordinates `lattice(dim, n)` (non-negative,
+   !> multiples of `step`, no two alike) whose node step is `step`. `p` is
+   !> empty when the nodes do not coarsen (at most `coarse_nodes` of them).
+   subroutine lattice_hierarchy(lattice, step, p, error)
+      integer, intent(in) :: lattice(:, :), step
+      type(prolongation_type), allocatable, intent(out) :: p(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(prolongation_type) :: next
+      integer :: s
+
+      allocate (p(0))
+      call check_lattice(lattice, step, error)
+      if (allocated(error)) return
+      if (size(lattice, 2) <= coarse_nodes) return
+      s = 2*step
+      do
+         if (size(p) == 0) then
+            call coarsen(lattice, s, next, error)
+         else
+            call coarsen(p(size(p))%lattice, s, next, error)
+         end if
+         if (allocated(error)) return
+         if (real(next%n_coarse, wp) > min_shrink*real(next%n_fine, wp)) exit
+         p = [p, next]
+         if (next%n_coarse <= coarse_nodes .or. s >= 2**22) exit
+         s = 2*s
+      end do
+   end subroutine lattice_hierarchy
+
+   !> Nodes on the lattice: non-negative, multiples of `step`, below 2**22
+   !> (the grid's lattice bound), no two at one point.
+   subroutine check_lattice(lattice, step, error)
+      integer, intent(in) :: lattice(:, :), step
+      type(error_type), allocatable, intent(out) :: error
+      type(point_set_type) :: points
+      integer :: d, j, other
+      character(len=160) :: buf
+
+      d = size(lattice, 1)
+      if (step < 1 .or. (d /= 2 .and. d /= 3)) then
+         call fatal_error(error, who//': the node step must be positive and the dimension 2 or 3', stat_invalid_input)
+         return
+      end if
+      if (any(lattice < 0) .or. any(lattice >= 2**22) .or. any(mod(lattice, step) /= 0)) then
+         call fatal_error(error, who//': a node is not on the node lattice (outside 0 .. 2**22 - 1, or not a '// &
+            & 'multiple of the node step)', stat_invalid_input)
+         return
+      end if
+      call new_point_set(points, size(lattice, 2), error)
+      if (allocated(error)) return
+      do j = 1, size(lattice, 2)
+         call add_point(points, lattice(:, j), other)
+         if (other /= 0) then
+            write (buf, '(a,": nodes ",i0," and ",i0," (0-based) share a lattice point")') who, other - 1, j - 1
+            call fatal_error(error, trim(buf), stat_invalid_input)
+            return
+         end if
+      end do
+   end subroutine check_lattice
+
+   !> An empty set for up to n points.
+   subroutine new_point_set(set, n, error)
+      type(point_set_type), intent(out) :: set
+      integer, intent(in) :: n
+      type(error_type), allocatable, intent(out) :: error
+      integer :: cap, stat
+      cap = 16
+      do while (cap < 2*n)
+         cap = 2*cap
+      end do
+      allocate (set%at(3, n), set%table(0:cap - 1), stat=stat)
+      call check_allocation(stat, who, 'a lattice point set', cap + 3*n, 4, error)
+      if (allocated(error)) return
+      set%table = 0
+      set%mask = int(cap, i8) - 1_i8
+   end subroutine new_point_set
+
+   !> Add the point g as number set%n + 1; `other` is the number of the point
+   !> already there (then nothing is added), 0 if none.
+   subroutine add_point(set, g, other)
+      type(point_set_type), intent(inout) :: set
+      integer, intent(in) :: g(:)
+      integer, intent(out) :: other
+      integer(i8) :: slot
+      integer :: p(3)
+      p = 0
+      p(1:size(g)) = g
+      slot = lattice_slot(p, set%mask)
+      do while (set%table(slot) /= 0)
+         other = set%table(slot)
+         if (all(set%at(:, other) == p)) return
+         slot = iand(slot + 1_i8, set%mask)
+      end do
+      other = 0
+      set%n = set%n + 1
+      set%at(:, set%n) = p
+      set%table(slot) = set%n
+   end subroutine add_point
+
+   !> Number of the point g in the set, 0 if absent.
+   pure integer function find_point(set, g) result(found)
+      type(point_set_type), intent(in) :: set
+      integer, intent(in) :: g(:)
+      integer(i8) :: slot
+      integer :: p(3)
+      p = 0
+      p(1:size(g)) = g
+      slot = lattice_slot(p, set%mask)
+      do while (set%table(slot) /= 0)
+         found = set%table(slot)
+         if (all(set%at(:, found) == p)) return
+         slot = iand(slot + 1_i8, set%mask)
+      end do
+      found = 0
+   end function find_point
+
+   !> One coarsening (module notes) of the nodes `lattice(dim, n)` to the
+   !> lattice of spacing `s`: the prolongation and the coarse nodes.
+   subroutine coarsen(lattice, s, p, error)
+      integer, intent(in) :: lattice(:, :), s
+      type(prolongation_type), intent(out) :: p
+      type(error_type), allocatable, intent(out) :: error
+      type(point_set_type) :: c_points
+      integer, allocatable :: coarse_of(:), col(:)
+      real(wp), allocatable :: val(:)
+      integer :: d, n, j, stat, nc, q, m, other, cols(4**size(lattice, 1))
+      real(wp) :: vals(4**size(lattice, 1))
+
+      d = size(lattice, 1)
+      n = size(lattice, 2)
+      allocate (coarse_of(n), p%rowptr(n + 1), col(2*n), val(2*n), stat=stat)
+      call check_allocation(stat, who, 'a prolongation', n, 24, error)
+      if (allocated(error)) return
+      call new_point_set(c_points, n, error)
+      if (allocated(error)) return
+      ! C-points on the coarse lattice, numbered in node order
+      coarse_of = 0
+      do j = 1, n
+         if (all(mod(lattice(:, j), s) == 0)) then
+            call add_point(c_points, lattice(:, j)/s, other)
+            coarse_of(j) = c_points%n
+         end if
+      end do
+      ! rows: injection at C-points; F-points get weights, or are C-points of their own
+      nc = c_points%n
+      q = 0
+      do j = 1, n
+         p%rowptr(j) = q + 1
+         if (coarse_of(j) == 0) then
+            call f_point_weights(lattice(:, j), s, c_points, cols, vals, m)
+            if (m == 0) then
+               nc = nc + 1
+               coarse_of(j) = nc
+            end if
+         end if
+         if (coarse_of(j) /= 0) then
+            m = 1
+            cols(1) = coarse_of(j)
+            vals(1) = 1.0_wp
+         end if
+         call append_row(cols(1:m), vals(1:m), q, col, val, error)
+         if (allocated(error)) return
+      end do
+      p%rowptr(n + 1) = q + 1
+      p%n_fine = n
+      p%n_coarse = nc
+      p%col = col(1:q)
+      p%val = val(1:q)
+      allocate (p%lattice(d, nc), stat=stat)
+      call check_allocation(stat, who, 'the coarse nodes', nc, 4*d, error)
+      if (allocated(error)) return
+      do j = 1, n
+         if (coarse_of(j) /= 0) p%lattice(:, coarse_of(j)) = lattice(:, j)
+      end do
+   end subroutine coarsen
+
+   !> Append a row (sorted by column) at position q of the growing arrays col, val.
+   subroutine append_row(cols, vals, q, col, val, error)
+      integer, intent(inout) :: cols(:)
+      real(wp), intent(inout) :: vals(:)
+      integer, intent(inout) :: q
+      integer, allocatable, intent(inout) :: col(:)
+      real(wp), allocatable, intent(inout) :: val(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer, allocatable :: col_new(:)
+      real(wp), allocatable :: val_new(:)
+      integer :: m, stat
+
+      m = size(cols)
+      if (q + m > size(col)) then
+         allocate (col_new(2*size(col) + m), val_new(2*size(col) + m), stat=stat)
+         call check_allocation(stat, who, 'a prolongation', 2*size(col) + m, 12, error)
+         if (allocated(error)) return
+         col_new(1:q) = col(1:q)
+         val_new(1:q) = val(1:q)
+         call move_alloc(col_new, col)
+         call move_alloc(val_new, val)
+      end if
+      call sort_by_column(cols, vals)
+      col(q + 1:q + m) = cols
+      val(q + 1:q + m) = vals
+      q = q + m
+   end subroutine append_row
+
+   !> Insertion sort of a row's entries by column (a row has at most 4**dim).
+   pure subroutine sort_by_column(cols, vals)
+      integer, intent(inout) :: cols(:)
+      real(wp), intent(inout) :: vals(:)
+      integer :: i, k, c
+      real(wp) :: v
+      do i = 2, size(cols)
+         c = cols(i)
+         v = vals(i)
+         k = i - 1
+         do while (k >= 1)
+            if (cols(k) <= c) exit
+            cols(k + 1) = cols(k)
+            vals(k + 1) = vals(k)
+            k = k - 1
+         end do
+         cols(k + 1) = c
+         vals(k + 1) = v
+      end do
+   end subroutine sort_by_column
+
+   !> The m weights `vals(1:m)` of the F-point at lattice point `q` from the
+   !> coarse nodes `cols(1:m)` of spacing `s` (`c_points`: their coarse
+   !> lattice points); m = 0 when no weights reproduce linear fields (module
+   !> notes). The (bi/tri)linear weights when the corners of the coarse cell
+   !> that have one are all C-points; otherwise the weights closest to them on
+   !> the cell's corners that are C-points and, while those do not span the
+   !> space affinely, the nearest C-points of the neighbouring cells (offsets
+   !> -1 .. 2): few weights, so the coarse matrices stay sparse.
+   subroutine f_point_weights(q, s, c_points, cols, vals, m)
+      integer, intent(in) :: q(:), s
+      type(point_set_type), intent(in) :: c_points
+      integer, intent(out) :: cols(:)
+      real(wp), intent(out) :: vals(:)
+      integer, intent(out) :: m
+      integer :: d, k, i, base(size(q)), off(size(q)), order(size(cols)), n_near, c, rank
+      real(wp) :: t(size(q)), x(size(q), size(cols)), w0(size(cols)), dist(size(cols)), basis(size(q), size(q))
+      logical :: complete, corner
+
+      d = size(q)
+      base = q/s
+      t = real(q - base*s, wp)/real(s, wp)
+      complete = .true.
+      m = 0
+      n_near = 0
+      rank = -1
+      do k = 0, 2**d - 1
+         off = [(mod(k/2**(i - 1), 2), i = 1, d)]
+         c = find_point(c_points, base + off)
+         if (c == 0) then
+            if (linear_weight(t, off) /= 0.0_wp) complete = .false.
+            cycle
+         end if
+         call take(c, off)
+      end do
+      if (complete) then
+         ! keep the corners with a weight
+         k = 0
+         do i = 1, m
+            if (w0(i) == 0.0_wp) cycle
+            k = k + 1
+            cols(k) = cols(i)
+            vals(k) = w0(i)
+         end do
+         m = k
+         return
+      end if
+      if (rank < d) then
+         ! the C-points among offsets -1 .. 2 outside the cell, nearest first
+         do k = 0, 4**d - 1
+            off = [(mod(k/4**(i - 1), 4) - 1, i = 1, d)]
+            corner = all(off == 0 .or. off == 1)
+            if (corner) cycle
+            c = find_point(c_points, base + off)
+            if (c == 0) cycle
+            n_near = n_near + 1
+            order(n_near) = c
+            x(:, size(cols) - n_near + 1) = real(off, wp)
+            dist(n_near) = sum((real(off, wp) - t)**2)
+         end do
+         do while (rank < d .and. n_near > 0)
+            k = minloc(dist(1:n_near), dim=1)
+            off = nint(x(:, size(cols) - k + 1))
+            call take(order(k), off)
+            dist(k) = huge(1.0_wp)
+            if (all(dist(1:n_near) == huge(1.0_wp))) exit
+         end do
+      end if
+      if (rank < d) then
+         m = 0
+         return
+      end if
+      call closest_linear_weights(x(:, 1:m), t, w0(1:m), vals(1:m), complete)
+      if (.not. complete) m = 0
+   contains
+      !> Add the coarse node c at offset off to the support and its direction to the affine basis.
+      subroutine take(c, off)
+         integer, intent(in) :: c, off(:)
+         real(wp) :: v(size(off))
+         integer :: j
+         m = m + 1
+         cols(m) = c
+         x(:, m) = real(off, wp)
+         w0(m) = linear_weight(t, off)
+         if (rank < 0) then
+            rank = 0
+            return
+         end if
+         if (rank >= d) return
+         v = x(:, m) - x(:, 1)
+         do j = 1, rank
+            v = v - dot_product(v, basis(:, j))*basis(:, j)
+         end do
+         if (norm2(v) < 1.0e-8_wp) return
+         rank = rank + 1
+         basis(:, rank) = v/norm2(v)
+      end subroutine take
+   end subroutine f_point_weights
+
+   !> The (bi/tri)linear weight of the corner at offset `off` (0 or 1 per
+   !> axis; -1 and 2 lie beyond the cell: weight 0) for local coordinates t.
+   pure real(wp) function linear_weight(t, off) result(w)
+      real(wp), intent(in) :: t(:)
+      integer, intent(in) :: off(:)
+      integer :: i
+      w = 1.0_wp
+      do i = 1, size(t)
+         select case (off(i))
+         case (0)
+            w = w*(1.0_wp - t(i))
+         case (1)
+            w = w*t(i)
+         case default
+            w = 0.0_wp
+         end select
+      end do
+   end function linear_weight
+
+   !> w = argmin |w - w0| subject to sum w = 1 and sum_k w_k x(:, k) = t:
+   !> w = w0 + A^T lambda with A = [1; x] and (A A^T) lambda = [1; t] - A w0.
+   !> `found` is false when A has not full row rank (A A^T is an integer
+   !> matrix, so a pivot below 1e-8 means it is singular).
+   pure subroutine closest_linear_weights(x, t, w0, w, found)
+      real(wp), intent(in) :: x(:, :), t(:), w0(:)
+      real(wp), intent(out) :: w(:)
+      logical, intent(out) :: found
+      real(wp) :: a(size(t) + 1, size(w0)), g(size(t) + 1, size(t) + 1), r(size(t) + 1)
+      integer :: d
+
+      d = size(t)
+      w = 0.0_wp
+      found = .false.
+      if (size(w0) < d + 1) return
+      a(1, :) = 1.0_wp
+      a(2:, :) = x
+      g = matmul(a, transpose(a))
+      r(1) = 1.0_wp
+      r(2:) = t
+      r = r - matmul(a, w0)
+      call small_solve(g, r, found)
+      if (found) w = w0 + matmul(r, a)
+   end subroutine closest_linear_weights
+
+   !> Solve g y = r in place (r := y) by Gaussian elimination with partial pivoting.
+   pure subroutine small_solve(g, r, found)
+      real(wp), intent(inout) :: g(:, :), r(:)
+      logical, intent(out) :: found
+      integer :: n, i, k, piv
+      real(wp) :: row(size(r)), f, tmp
+
+      n = size(r)
+      found = .false.
+      do k = 1, n
+         piv = k - 1 + maxloc(abs(g(k:, k)), dim=1)
+         if (abs(g(piv, k)) < 1.0e-8_wp) return
+         if (piv /= k) then
+            row = g(k, :)
+            g(k, :) = g(piv, :)
+            g(piv, :) = row
+            tmp = r(k)
+            r(k) = r(piv)
+            r(piv) = tmp
+         end if
+         do i = k + 1, n
+            f = g(i, k)/g(k, k)
+            g(i, k:) = g(i, k:) - f*g(k, k:)
+            r(i) = r(i) - f*r(k)
+         end do
+      end do
+      do k = n, 1, -1
+         r(k) = (r(k) - dot_product(g(k, k + 1:), r(k + 1:)))/g(k, k)
+      end do
+      found = .true.
+   end subroutine small_solve
+
+end module sprc_fem_multigrid
