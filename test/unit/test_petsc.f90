@@ -21,6 +21,7 @@ module sprc_test_petsc
       & auto_iterative_min_dofs, auto_never, solver_choice, set_solve_ranks
    use sprc_fem_petsc, only: petsc_solver_type, iteration_tolerance
    use sprc_fem_nested, only: fe_displacement_type
+   use sprc_fem_multigrid, only: prolongation_type, lattice_hierarchy, coarsen
    use sprc_test_fem, only: sphere_octant, lame_quarter, young
    use sprc_testsuite, only: unittest_type, new_unittest, check, error_type
    implicit none
@@ -45,7 +46,12 @@ contains
          new_unittest('not_converged', test_not_converged), &
          new_unittest('bad_layout', test_bad_layout), &
          new_unittest('nested_linear_field', test_nested_linear), &
-         new_unittest('nested_start', test_nested_start) &
+         new_unittest('nested_start', test_nested_start), &
+         new_unittest('multigrid_weights_by_hand', test_mg_by_hand), &
+         new_unittest('multigrid_linear_fields_q1', test_mg_linear_q1), &
+         new_unittest('multigrid_linear_fields_q2', test_mg_linear_q2), &
+         new_unittest('multigrid_iterations', test_mg_iterations), &
+         new_unittest('multigrid_bad_lattice', test_mg_bad_lattice) &
          ]
    end subroutine collect_petsc
 
@@ -371,5 +377,195 @@ contains
       call solve_on_grid(fine, body, box_min, box_size, 3, 0, 1, solid, young, poisson, [0.0_wp, 0.0_wp, 0.0_wp], &
          & bcs, error)
    end subroutine nested_pair
+
+   !> One coarsening of eight 2D nodes (step 1) on a 3 x 3 lattice whose
+   !> corner (2, 2) is missing, to spacing 2, against weights worked out by
+   !> hand: C-points (0,0), (2,0), (0,2) (coarse nodes 1, 2, 3); (1,0) and
+   !> (0,1) take the linear weights 1/2, 1/2; (1,1) misses its corner (2,2):
+   !> the weights closest to (1/4, 1/4, 1/4) that reproduce linear fields on
+   !> the three others are (0, 1/2, 1/2); (2,1) and (1,2) have one C-point
+   !> in their cell and take the nearest neighbour C-points: the linear
+   !> field through the three, u(2,1) = u(2,0) + (u(0,2) - u(0,0))/2 and
+   !> u(1,2) = u(0,2) + (u(2,0) - u(0,0))/2. Within 10 eps (a 3 x 3 solve).
+   subroutine test_mg_by_hand(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(prolongation_type) :: p
+      integer, parameter :: nodes(2, 8) = reshape([0, 0, 1, 0, 2, 0, 0, 1, 1, 1, 2, 1, 0, 2, 1, 2], [2, 8])
+      real(wp), parameter :: expected(8, 3) = reshape([ &
+         & 1.0_wp, 0.5_wp, 0.0_wp, 0.5_wp, 0.0_wp, -0.5_wp, 0.0_wp, -0.5_wp, &
+         & 0.0_wp, 0.5_wp, 1.0_wp, 0.0_wp, 0.5_wp, 1.0_wp, 0.0_wp, 0.5_wp, &
+         & 0.0_wp, 0.0_wp, 0.0_wp, 0.5_wp, 0.5_wp, 0.5_wp, 1.0_wp, 1.0_wp], [8, 3])
+      real(wp) :: dense(8, 3)
+      integer :: i, q
+
+      call coarsen(nodes, 2, p, error)
+      if (allocated(error)) return
+      call check(error, p%n_fine == 8 .and. p%n_coarse == 3, 'eight nodes to three: '//itoa(p%n_coarse))
+      if (allocated(error)) return
+      call check(error, all(p%lattice == reshape([0, 0, 2, 0, 0, 2], [2, 3])), 'the C-points in node order')
+      if (allocated(error)) return
+      dense = 0.0_wp
+      do i = 1, 8
+         do q = p%rowptr(i), p%rowptr(i + 1) - 1
+            dense(i, p%col(q)) = p%val(q)
+         end do
+      end do
+      call check(error, maxval(abs(dense - expected)), 0.0_wp, 10.0_wp*epsilon(1.0_wp), 'weights by hand')
+   end subroutine test_mg_by_hand
+
+   !> Q1 sphere octant, planes off the grid, one boundary refinement (hanging
+   !> nodes) and aggregated cuts: every level's prolongation reproduces
+   !> linear fields (`mg_linear_fields`).
+   subroutine test_mg_linear_q1(error)
+      type(error_type), allocatable, intent(out) :: error
+      call mg_linear_fields(1, 3, 1, error)
+   end subroutine test_mg_linear_q1
+
+   !> Q2: the first level is the p-coarsening to the vertex lattice.
+   subroutine test_mg_linear_q2(error)
+      type(error_type), allocatable, intent(out) :: error
+      call mg_linear_fields(2, 2, 0, error)
+   end subroutine test_mg_linear_q2
+
+   !> The masters' hierarchy of a sphere-octant grid has at least two levels
+   !> that shrink, and P applied to a linear field at the coarse nodes gives
+   !> that field at the fine ones within 100 eps of its size on every level
+   !> (the weights are exact or the solution of a 4 x 4 system).
+   subroutine mg_linear_fields(degree, level, refine, error)
+      integer, intent(in) :: degree, level, refine
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: body
+      type(fe_bc_type), allocatable :: bcs(:)
+      type(lame_sphere_type) :: exact
+      type(elasticity_problem_type) :: problem
+      type(prolongation_type), allocatable :: p(:)
+      integer, allocatable :: fine(:, :)
+      real(wp), allocatable :: uc(:), uf(:)
+      real(wp), parameter :: a(3) = [0.7_wp, -1.3_wp, 2.1_wp], c = 0.4_wp
+      real(wp) :: worst
+      integer :: l, i, q
+
+      call sphere_octant(body, bcs, exact, error)
+      if (allocated(error)) return
+      call solve_on_grid(problem, body, [-0.37_wp, -0.53_wp, -0.29_wp], 27.5_wp, level, refine, degree, solid, &
+         & young, poisson, [0.0_wp, 0.0_wp, 0.0_wp], bcs, error)
+      if (allocated(error)) return
+      fine = problem%mesh%nodes%lattice(:, problem%constraints%master_node)
+      call lattice_hierarchy(fine, 2/degree, p, error, coarse=10)
+      if (allocated(error)) return
+      call check(error, size(p) >= 2, 'levels: '//itoa(size(p)))
+      if (allocated(error)) return
+      worst = 0.0_wp
+      do l = 1, size(p)
+         call check(error, p(l)%n_coarse < p(l)%n_fine, 'level '//itoa(l)//' shrinks')
+         if (allocated(error)) return
+         uc = matmul(a, real(p(l)%lattice, wp)) + c
+         if (l == 1) then
+            uf = matmul(a, real(fine, wp)) + c
+         else
+            uf = matmul(a, real(p(l - 1)%lattice, wp)) + c
+         end if
+         do i = 1, p(l)%n_fine
+            q = p(l)%rowptr(i)
+            worst = max(worst, abs(dot_product(p(l)%val(q:p(l)%rowptr(i + 1) - 1), uc(p(l)%col(q:p(l)%rowptr(i + 1) &
+               & - 1))) - uf(i))/maxval(abs(uf)))
+         end do
+      end do
+      call check(error, worst, 0.0_wp, 100.0_wp*epsilon(1.0_wp), 'linear fields through every level')
+   end subroutine mg_linear_fields
+
+   !> Iterations on a small 3D problem (sphere octant, planes off the grid,
+   !> level 4: 11k unknowns, a hierarchy of three levels) from zero to the
+   !> same tolerance: geometric multigrid needs at most half of GAMG's
+   !> iterations and at most 12 (measured: 8 against 24).
+   subroutine test_mg_iterations(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: body
+      type(fe_bc_type), allocatable :: bcs(:)
+      type(lame_sphere_type) :: exact
+      type(elasticity_problem_type) :: problem
+      integer :: its(2), pass
+      real(wp), allocatable :: x(:)
+
+      call sphere_octant(body, bcs, exact, error)
+      if (allocated(error)) return
+      call solve_on_grid(problem, body, [-0.37_wp, -0.53_wp, -0.29_wp], 27.5_wp, 4, 0, 1, solid, young, poisson, &
+         & [0.0_wp, 0.0_wp, 0.0_wp], bcs, error)
+      if (allocated(error)) return
+      allocate (x(size(problem%f)))
+      do pass = 1, 2
+         block
+            type(petsc_solver_type) :: krylov
+            call krylov%set_blocks(problem%constraints%dof, problem%mesh%nodes%x(:, problem%constraints%master_node), &
+               & error)
+            if (allocated(error)) return
+            if (pass == 2) call krylov%set_lattice(problem%mesh%nodes%lattice(:, problem%constraints%master_node), 2, &
+               & error)
+            if (allocated(error)) return
+            krylov%tolerance = iteration_tolerance(0.5_wp**4, 1)
+            call krylov%factorize(problem%k, error)
+            if (allocated(error)) return
+            call krylov%solve(problem%f, x, error)
+            if (allocated(error)) return
+            its(pass) = krylov%iterations
+            call check(error, krylov%multigrid .eqv. (pass == 2), 'the preconditioner asked for')
+            call krylov%destroy()
+            if (allocated(error)) return
+         end block
+      end do
+      call check(error, 2*its(2) <= its(1) .and. its(2) <= 12, 'geometric multigrid '//itoa(its(2))// &
+         & ' iterations, GAMG '//itoa(its(1)))
+   end subroutine test_mg_iterations
+
+   !> Lattice points that do not fit the blocks, two blocks at one point,
+   !> or a point off the node step: each a clear error, never a crash.
+   subroutine test_mg_bad_lattice(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: body
+      type(fe_bc_type), allocatable :: bcs(:)
+      type(lame_sphere_type) :: exact
+      type(elasticity_problem_type) :: problem
+      type(petsc_solver_type) :: krylov
+      type(error_type), allocatable :: refused
+      integer, allocatable :: lattice(:, :)
+
+      call sphere_octant(body, bcs, exact, error)
+      if (allocated(error)) return
+      call solve_on_grid(problem, body, [-0.37_wp, -0.53_wp, -0.29_wp], 27.5_wp, 3, 0, 1, solid, young, poisson, &
+         & [0.0_wp, 0.0_wp, 0.0_wp], bcs, error)
+      if (allocated(error)) return
+      call krylov%set_blocks(problem%constraints%dof, problem%mesh%nodes%x(:, problem%constraints%master_node), error)
+      if (allocated(error)) return
+      lattice = problem%mesh%nodes%lattice(:, problem%constraints%master_node)
+      call krylov%set_lattice(lattice(:, 2:), 2, refused)
+      call check(error, allocated(refused), 'one point too few is refused')
+      if (allocated(error)) return
+      call check(error, refused%stat == stat_invalid_input, 'status: '//refused%message)
+      if (allocated(error)) return
+      deallocate (refused)
+      lattice(:, 2) = lattice(:, 1)
+      call factorize_refused(krylov, problem, lattice, 2, 'share a lattice point', error)
+      if (allocated(error)) return
+      lattice = problem%mesh%nodes%lattice(:, problem%constraints%master_node)
+      lattice(1, 1) = lattice(1, 1) + 1
+      call factorize_refused(krylov, problem, lattice, 2, 'not on the node lattice', error)
+   end subroutine test_mg_bad_lattice
+
+   subroutine factorize_refused(krylov, problem, lattice, step, what, error)
+      type(petsc_solver_type), intent(inout) :: krylov
+      type(elasticity_problem_type), intent(in) :: problem
+      integer, intent(in) :: lattice(:, :), step
+      character(len=*), intent(in) :: what
+      type(error_type), allocatable, intent(out) :: error
+      type(error_type), allocatable :: refused
+      call krylov%set_lattice(lattice, step, error)
+      if (allocated(error)) return
+      call krylov%factorize(problem%k, refused)
+      call krylov%destroy()
+      call check(error, allocated(refused), what//': refused')
+      if (allocated(error)) return
+      call check(error, refused%stat == stat_invalid_input .and. index(refused%message, what) > 0, &
+         & 'status and message: '//refused%message)
+   end subroutine factorize_refused
 
 end module sprc_test_petsc

@@ -63,18 +63,23 @@ contains
    !> The prolongations `p(1)` (finest to first coarse level), `p(2)`, ... of
    !> the nodes at the lattice coordinates `lattice(dim, n)` (non-negative,
    !> multiples of `step`, no two alike) whose node step is `step`. `p` is
-   !> empty when the nodes do not coarsen (at most `coarse_nodes` of them).
-   subroutine lattice_hierarchy(lattice, step, p, error)
+   !> empty when the nodes do not coarsen (at most `coarse` of them;
+   !> `coarse` defaults to `coarse_nodes`).
+   subroutine lattice_hierarchy(lattice, step, p, error, coarse)
       integer, intent(in) :: lattice(:, :), step
       type(prolongation_type), allocatable, intent(out) :: p(:)
       type(error_type), allocatable, intent(out) :: error
+      integer, intent(in), optional :: coarse
       type(prolongation_type) :: next
-      integer :: s
+      integer :: s, smallest
+
+      smallest = coarse_nodes
+      if (present(coarse)) smallest = coarse
 
       allocate (p(0))
       call check_lattice(lattice, step, error)
       if (allocated(error)) return
-      if (size(lattice, 2) <= coarse_nodes) return
+      if (size(lattice, 2) <= smallest) return
       s = 2*step
       do
          if (size(p) == 0) then
@@ -85,7 +90,7 @@ contains
          if (allocated(error)) return
          if (real(next%n_coarse, wp) > min_shrink*real(next%n_fine, wp)) exit
          p = [p, next]
-         if (next%n_coarse <= coarse_nodes .or. s >= 2**22) exit
+         if (next%n_coarse <= smallest .or. s >= 2**22) exit
          s = 2*s
       end do
    end subroutine lattice_hierarchy
