@@ -663,8 +663,10 @@ static int copy_out(sprc_petsc *s, double *a, PetscInt n, char *msg, int64_t len
  * sqrt(b^T B b) for CG (B the multigrid preconditioner), ||B b||_2 for GMRES;
  * 0 when b = 0. A b != 0 of no positive size means the preconditioner is
  * not positive definite (CG; the caller may take GMRES) or gave NaN or Inf:
- * an error, never a zero solution. */
-static int rhs_norm(sprc_petsc *s, double *bnorm, char *msg, int64_t len)
+ * an error, never a zero solution. CG from x = 0 computes sqrt(b^T B b) as
+ * its own first residual norm (r = b): then *bnorm is -1 and energy_test
+ * takes that norm, which saves one multigrid cycle (a tenth of a solve). */
+static int rhs_norm(sprc_petsc *s, int guess, double *bnorm, char *msg, int64_t len)
 {
     PC pc;
     PetscScalar bb;
@@ -672,6 +674,12 @@ static int rhs_norm(sprc_petsc *s, double *bnorm, char *msg, int64_t len)
     *bnorm = 0.0;
     TRY(VecNorm(s->b, NORM_2, &b2));
     if (b2 == 0.0) return SPRC_OK;
+    if (isinf(b2) || isnan(b2))
+        return report(SPRC_INTERNAL, msg, len, "PETSc solve: the right-hand side is NaN or Inf");
+    if (s->symmetric && !guess) {
+        *bnorm = -1.0;
+        return SPRC_OK;
+    }
     TRY(KSPGetPC(s->ksp, &pc));
     TRY(PCApply(pc, s->b, s->w));
     if (s->symmetric) {
@@ -710,6 +718,14 @@ static PetscErrorCode energy_test(KSP ksp, PetscInt it, PetscReal rnorm, KSPConv
     if (isnan(rnorm) || isinf(rnorm)) {
         *reason = KSP_DIVERGED_NANORINF;
         return 0;
+    }
+    if (s->bnorm < 0.0) {
+        /* from x = 0: CG's first norm is sqrt(b^T B b) (rhs_norm); b != 0 */
+        if (!(rnorm > 0.0)) {
+            *reason = KSP_DIVERGED_INDEFINITE_PC;
+            return 0;
+        }
+        s->bnorm = rnorm;
     }
     if (s->symmetric && it > 0 && KSPComputeExtremeSingularValues(ksp, &emax, &emin) == 0 && emin > 0.0 &&
         emax >= emin)
@@ -762,7 +778,7 @@ int sprc_petsc_solve(void *handle, int64_t n, const double *b, double *x, int gu
     *bound = 0.0;
     if (s == NULL) return report(SPRC_INVALID, msg, len, "PETSc solve: no solver was set up");
     status = copy_in(s, s->b, b, msg, len);
-    if (status == SPRC_OK) status = rhs_norm(s, &bnorm, msg, len);
+    if (status == SPRC_OK) status = rhs_norm(s, guess, &bnorm, msg, len);
     if (status == SPRC_OK && guess) status = copy_in(s, s->x, x, msg, len);
     if (status != SPRC_OK) return status;
     if (bnorm == 0.0) {
