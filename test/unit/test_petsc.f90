@@ -434,9 +434,6 @@ contains
    subroutine mg_linear_fields(degree, level, refine, error)
       integer, intent(in) :: degree, level, refine
       type(error_type), allocatable, intent(out) :: error
-      type(body_type) :: body
-      type(fe_bc_type), allocatable :: bcs(:)
-      type(lame_sphere_type) :: exact
       type(elasticity_problem_type) :: problem
       type(prolongation_type), allocatable :: p(:)
       integer, allocatable :: fine(:, :)
@@ -445,10 +442,7 @@ contains
       real(wp) :: worst
       integer :: l, i, q
 
-      call sphere_octant(body, bcs, exact, error)
-      if (allocated(error)) return
-      call solve_on_grid(problem, body, [-0.37_wp, -0.53_wp, -0.29_wp], 27.5_wp, level, refine, degree, solid, &
-         & young, poisson, [0.0_wp, 0.0_wp, 0.0_wp], bcs, error)
+      call off_grid_sphere(problem, level, refine, degree, error)
       if (allocated(error)) return
       fine = problem%mesh%nodes%lattice(:, problem%constraints%master_node)
       call lattice_hierarchy(fine, 2/degree, p, error, coarse=10)
@@ -480,17 +474,11 @@ contains
    !> iterations and at most 12 (measured: 8 against 24).
    subroutine test_mg_iterations(error)
       type(error_type), allocatable, intent(out) :: error
-      type(body_type) :: body
-      type(fe_bc_type), allocatable :: bcs(:)
-      type(lame_sphere_type) :: exact
       type(elasticity_problem_type) :: problem
       integer :: its(2), pass
       real(wp), allocatable :: x(:)
 
-      call sphere_octant(body, bcs, exact, error)
-      if (allocated(error)) return
-      call solve_on_grid(problem, body, [-0.37_wp, -0.53_wp, -0.29_wp], 27.5_wp, 4, 0, 1, solid, young, poisson, &
-         & [0.0_wp, 0.0_wp, 0.0_wp], bcs, error)
+      call off_grid_sphere(problem, 4, 0, 1, error)
       if (allocated(error)) return
       allocate (x(size(problem%f)))
       do pass = 1, 2
@@ -521,18 +509,12 @@ contains
    !> or a point off the node step: each a clear error, never a crash.
    subroutine test_mg_bad_lattice(error)
       type(error_type), allocatable, intent(out) :: error
-      type(body_type) :: body
-      type(fe_bc_type), allocatable :: bcs(:)
-      type(lame_sphere_type) :: exact
       type(elasticity_problem_type) :: problem
       type(petsc_solver_type) :: krylov
       type(error_type), allocatable :: refused
       integer, allocatable :: lattice(:, :)
 
-      call sphere_octant(body, bcs, exact, error)
-      if (allocated(error)) return
-      call solve_on_grid(problem, body, [-0.37_wp, -0.53_wp, -0.29_wp], 27.5_wp, 3, 0, 1, solid, young, poisson, &
-         & [0.0_wp, 0.0_wp, 0.0_wp], bcs, error)
+      call off_grid_sphere(problem, 3, 0, 1, error)
       if (allocated(error)) return
       call krylov%set_blocks(problem%constraints%dof, problem%mesh%nodes%x(:, problem%constraints%master_node), error)
       if (allocated(error)) return
@@ -550,6 +532,21 @@ contains
       lattice(1, 1) = lattice(1, 1) + 1
       call factorize_refused(krylov, problem, lattice, 2, 'not on the node lattice', error)
    end subroutine test_mg_bad_lattice
+
+   !> The sphere octant with its planes off the grid (Nitsche), solved
+   !> directly at `level` with `refine` boundary refinements, Q`degree`.
+   subroutine off_grid_sphere(problem, level, refine, degree, error)
+      type(elasticity_problem_type), intent(out) :: problem
+      integer, intent(in) :: level, refine, degree
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: body
+      type(fe_bc_type), allocatable :: bcs(:)
+      type(lame_sphere_type) :: exact
+      call sphere_octant(body, bcs, exact, error)
+      if (allocated(error)) return
+      call solve_on_grid(problem, body, [-0.37_wp, -0.53_wp, -0.29_wp], 27.5_wp, level, refine, degree, solid, &
+         & young, poisson, [0.0_wp, 0.0_wp, 0.0_wp], bcs, error)
+   end subroutine off_grid_sphere
 
    subroutine factorize_refused(krylov, problem, lattice, step, what, error)
       type(petsc_solver_type), intent(inout) :: krylov

@@ -14,9 +14,11 @@
 !> - otherwise (near cuts, where corners of the coarse cell are no nodes):
 !>   the weights w closest to the linear ones t, |w - t| least, among those
 !>   that reproduce every linear field exactly (sum w = 1, sum w x_k = x), on
-!>   the C-points of the coarse cells whose closure holds the node;
-!> - if those C-points cannot reproduce linear fields (fewer than dim + 1, or
-!>   affinely dependent) the node itself is a C-point of the coarse level.
+!>   the cell's corners that are C-points and, while these do not span the
+!>   space affinely, the nearest C-points of the neighbouring cells (few
+!>   weights per row, so the coarse matrices stay sparse);
+!> - if no C-points nearby can reproduce linear fields (fewer than dim + 1,
+!>   or affinely dependent) the node itself is a C-point of the coarse level.
 !> So the prolongation reproduces linear fields exactly, the rigid-body modes
 !> of elasticity included, on every level, and it has full column rank (the
 !> C-points' rows are the identity): the Galerkin coarse matrices P^T A P
@@ -27,6 +29,7 @@ module sprc_fem_multigrid
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_alloc, only: check_allocation
    use sprc_grid_nodes, only: lattice_slot
+   use sprc_fem_sparse, only: sort_row
    implicit none
    private
 
@@ -150,18 +153,11 @@ contains
       integer, intent(in) :: g(:)
       integer, intent(out) :: other
       integer(i8) :: slot
-      integer :: p(3)
-      p = 0
-      p(1:size(g)) = g
-      slot = lattice_slot(p, set%mask)
-      do while (set%table(slot) /= 0)
-         other = set%table(slot)
-         if (all(set%at(:, other) == p)) return
-         slot = iand(slot + 1_i8, set%mask)
-      end do
-      other = 0
+      call locate(set, g, slot, other)
+      if (other /= 0) return
       set%n = set%n + 1
-      set%at(:, set%n) = p
+      set%at(:, set%n) = 0
+      set%at(1:size(g), set%n) = g
       set%table(slot) = set%n
    end subroutine add_point
 
@@ -170,6 +166,15 @@ contains
       type(point_set_type), intent(in) :: set
       integer, intent(in) :: g(:)
       integer(i8) :: slot
+      call locate(set, g, slot, found)
+   end function find_point
+
+   !> The slot of the point g: its number `found` there, or 0 and the empty slot it would take.
+   pure subroutine locate(set, g, slot, found)
+      type(point_set_type), intent(in) :: set
+      integer, intent(in) :: g(:)
+      integer(i8), intent(out) :: slot
+      integer, intent(out) :: found
       integer :: p(3)
       p = 0
       p(1:size(g)) = g
@@ -180,7 +185,7 @@ contains
          slot = iand(slot + 1_i8, set%mask)
       end do
       found = 0
-   end function find_point
+   end subroutine locate
 
    !> One coarsening (module notes) of the nodes `lattice(dim, n)` to the
    !> lattice of spacing `s`: the prolongation and the coarse nodes.
@@ -242,7 +247,7 @@ contains
       end do
    end subroutine coarsen
 
-   !> Append a row (sorted by column) at position q of the growing arrays col, val.
+   !> Append a row (sorted by column) after position q of the growing arrays col, val.
    subroutine append_row(cols, vals, q, col, val, error)
       integer, intent(inout) :: cols(:)
       real(wp), intent(inout) :: vals(:)
@@ -264,32 +269,11 @@ contains
          call move_alloc(col_new, col)
          call move_alloc(val_new, val)
       end if
-      call sort_by_column(cols, vals)
+      call sort_row(cols, vals)
       col(q + 1:q + m) = cols
       val(q + 1:q + m) = vals
       q = q + m
    end subroutine append_row
-
-   !> Insertion sort of a row's entries by column (a row has at most 4**dim).
-   pure subroutine sort_by_column(cols, vals)
-      integer, intent(inout) :: cols(:)
-      real(wp), intent(inout) :: vals(:)
-      integer :: i, k, c
-      real(wp) :: v
-      do i = 2, size(cols)
-         c = cols(i)
-         v = vals(i)
-         k = i - 1
-         do while (k >= 1)
-            if (cols(k) <= c) exit
-            cols(k + 1) = cols(k)
-            vals(k + 1) = vals(k)
-            k = k - 1
-         end do
-         cols(k + 1) = c
-         vals(k + 1) = v
-      end do
-   end subroutine sort_by_column
 
    !> The m weights `vals(1:m)` of the F-point at lattice point `q` from the
    !> coarse nodes `cols(1:m)` of spacing `s` (`c_points`: their coarse
