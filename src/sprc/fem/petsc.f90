@@ -1,7 +1,10 @@
 !> Iterative solver for the reduced elasticity system: PETSc's conjugate
-!> gradients (GMRES when the system is not symmetric) preconditioned by
-!> smoothed-aggregation algebraic multigrid (GAMG) with the rigid-body
-!> near-null space, through the C shim src/shim/sprc_petsc.c.
+!> gradients (GMRES when the system is not symmetric), through the C shim
+!> src/shim/sprc_petsc.c, preconditioned by geometric multigrid on the grid's
+!> node lattice (`set_lattice`, `sprc_fem_multigrid`: PCMG with Galerkin
+!> coarse matrices) or, without a lattice and on several MPI ranks (the
+!> hierarchy is built for one rank), by smoothed-aggregation algebraic
+!> multigrid (GAMG) with the rigid-body near-null space.
 !>
 !> Blocks. GAMG aggregates whole nodes (block size = dim) and interpolates the
 !> rigid-body modes exactly, so it needs each unknown's node and component.

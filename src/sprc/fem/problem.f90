@@ -1218,9 +1218,10 @@ contains
       if (allocated(error)) error%message = ' (UMFPACK fallback): '//error%message
    end subroutine solve_spd_or_lu
 
-   !> CG + GAMG (`sprc_fem_petsc`) on the masters' blocks, stopped at
-   !> `iteration_tolerance` of the finest cell; GMRES + GAMG when CG finds K
-   !> indefinite (the iterative counterpart of the UMFPACK fallback).
+   !> CG (`sprc_fem_petsc`) on the masters' blocks, preconditioned by
+   !> geometric multigrid on the masters' node lattice (GAMG on several MPI
+   !> ranks), stopped at `iteration_tolerance` of the finest cell; GMRES when
+   !> CG finds K indefinite (the iterative counterpart of the UMFPACK fallback).
    subroutine iterative_solve(self, error)
       type(elasticity_problem_type), intent(inout) :: self
       type(error_type), allocatable, intent(out) :: error
@@ -1228,8 +1229,9 @@ contains
 
       call krylov%set_blocks(self%constraints%dof, self%mesh%nodes%x(:, self%constraints%master_node), error)
       if (allocated(error)) return
+      ! nodes without lattice coordinates (none are built so): GAMG
       associate (nodes => self%mesh%nodes)
-         call krylov%set_lattice(nodes%lattice(:, self%constraints%master_node), &
+         if (allocated(nodes%lattice)) call krylov%set_lattice(nodes%lattice(:, self%constraints%master_node), &
             & 2**(nodes%lattice_level - self%mesh%grid%max_level)/self%degree, error)
       end associate
       if (allocated(error)) return
