@@ -321,6 +321,11 @@ static int ensure_petsc(char *msg, int64_t len)
     return SPRC_OK;
 }
 
+/* Load and start PETSc now (once per process), so that its start-up is not
+ * paid inside the first iterative solve (the driver calls it before a study
+ * that will solve a level iteratively). */
+int sprc_petsc_start(char *msg, int64_t len) { return ensure_petsc(msg, len); }
+
 /* Start PETSc and MPI, give this process's rank and the number of ranks,
  * and distribute every later solve over them (sprc runs under `mpirun -n R`:
  * every rank runs the study and takes part in each solve). With several

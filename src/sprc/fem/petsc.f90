@@ -37,7 +37,7 @@ module sprc_fem_petsc
    implicit none
    private
 
-   public :: petsc_solver_type, iteration_tolerance, start_ranks
+   public :: petsc_solver_type, iteration_tolerance, start_ranks, start_petsc
 
    !> Krylov solver with GAMG (module notes). Set the blocks (`set_blocks`)
    !> before `factorize`; `tolerance`, `max_iterations` and `symmetric` are
@@ -121,6 +121,12 @@ module sprc_fem_petsc
          integer(c_int64_t), value :: len
       end function sprc_petsc_solve
 
+      integer(c_int) function sprc_petsc_start(msg, len) bind(c)
+         import :: c_int, c_int64_t, c_char
+         character(kind=c_char), intent(inout) :: msg(*)
+         integer(c_int64_t), value :: len
+      end function sprc_petsc_start
+
       integer(c_int) function sprc_petsc_ranks(rank, size, msg, len) bind(c)
          import :: c_int, c_int64_t, c_char
          integer(c_int), intent(out) :: rank, size
@@ -174,6 +180,20 @@ contains
       size = s
       call set_solve_ranks(size)
    end subroutine start_ranks
+
+   !> Loads and starts PETSc now (once per process; nothing happens when it is
+   !> up already). A program that will solve iteratively calls it before its
+   !> timed work: PETSc is loaded on first use (a serial run that never solves
+   !> iteratively loads nothing), and its start-up is a cost of the process,
+   !> like the loading of the linked libraries, not of the first solve.
+   subroutine start_petsc(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(kind=c_char, len=message_length) :: msg
+      integer(c_int) :: status
+      msg = ''
+      status = sprc_petsc_start(msg, int(len(msg), c_int64_t))
+      call backend_error(status, msg, error)
+   end subroutine start_petsc
 
    !> Stopping tolerance tied to the discretization: the iteration error in the
    !> energy norm, relative to the solution's, at most 1e-7 (h/L)^p (h the
