@@ -21,7 +21,7 @@ program sprc_main
    use sprc_io_svg, only: write_report_svg, write_contact_svg
    use sprc_io_contact, only: contact_level_type, write_contact_csv
    use sprc_io_hdf5, only: h5_output_type
-   use sprc_fem_petsc, only: start_ranks, start_petsc
+   use sprc_fem_petsc, only: start_ranks
    use sprc_study_partition, only: largest_over_ranks, fail_together
    use sprc_app_cli, only: cli_type, parse_cli, usage_text
    use sprc_app_progress, only: progress_level, print_contact_progress
@@ -145,10 +145,6 @@ contains
       if (cli%threads > 0) call omp_set_num_threads(cli%threads)
       call prepare_study(scene, cli%points, study, error)
       if (allocated(error)) call fail_with(error)
-      ! PETSc is loaded on first use; when a level will be solved iteratively, load it now, so that its
-      ! start-up (a cost of the process, like loading the linked libraries) is in no level's t_solve.
-      if (any_level_iterative(study, levels)) call start_petsc(error)
-      if (allocated(error)) call fail_with(error)
       ! A named copy: passing the strided component study%bodies%geometry made a hidden array temporary.
       if (rank == 0) then
          geometry = study%bodies%geometry
@@ -246,26 +242,6 @@ contains
          total = total + dofs
       end do
    end function study_dofs
-
-   !> Whether a body's system at one of `levels` is estimated to be solved iteratively
-   !> (`level_memory`, without the memory fallback: that one still loads PETSc when it happens).
-   logical function any_level_iterative(study, levels) result(any_iterative)
-      type(study_type), intent(in) :: study
-      integer, intent(in) :: levels(:)
-      real(wp) :: cells, dofs, bytes
-      type(error_type), allocatable :: error
-      integer :: b, i
-      logical :: iterative
-      any_iterative = .false.
-      do i = 1, size(levels)
-         do b = 1, size(study%bodies)
-            call level_memory(study%scene, study%bodies(b)%geometry, levels(i), cells, dofs, bytes, error, &
-               & iterative=iterative)
-            if (allocated(error)) call fail_with(error)
-            any_iterative = any_iterative .or. iterative
-         end do
-      end do
-   end function any_level_iterative
 
    !> Runs `level` (a coarse one) once, untimed, and drops the result, so that the run's one-off
    !> costs (first calls into the shared libraries, cold caches) stay out of the first level's

@@ -322,8 +322,7 @@ static int ensure_petsc(char *msg, int64_t len)
 }
 
 /* Load and start PETSc now (once per process), so that its start-up is not
- * paid inside the first iterative solve (the driver calls it before a study
- * that will solve a level iteratively). */
+ * timed as part of the first iterative solve (sprc_fem_petsc's start_petsc). */
 int sprc_petsc_start(char *msg, int64_t len) { return ensure_petsc(msg, len); }
 
 /* Start PETSc and MPI, give this process's rank and the number of ranks,

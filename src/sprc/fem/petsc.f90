@@ -182,10 +182,10 @@ contains
    end subroutine start_ranks
 
    !> Loads and starts PETSc now (once per process; nothing happens when it is
-   !> up already). A program that will solve iteratively calls it before its
-   !> timed work: PETSc is loaded on first use (a serial run that never solves
-   !> iteratively loads nothing), and its start-up is a cost of the process,
-   !> like the loading of the linked libraries, not of the first solve.
+   !> up already). PETSc is loaded on first use (a serial run that never solves
+   !> iteratively loads nothing); the elasticity solve calls this before its
+   !> timer starts, since the start-up is a cost of the process, like the
+   !> loading of the linked libraries, not of the first iterative solve.
    subroutine start_petsc(error)
       type(error_type), allocatable, intent(out) :: error
       character(kind=c_char, len=message_length) :: msg

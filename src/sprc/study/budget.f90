@@ -62,9 +62,8 @@ contains
    !> Estimated cells, dofs and peak bytes of `level` of the scene's study for `body`
    !> (module notes); with `grid_only`, the bytes of the grid and its quadrature alone.
    !> Given `available` (bytes, -1 unknown), 'auto' takes the iterative solver's
-   !> estimate when the direct one exceeds it (`direct_fits` false). `iterative`:
-   !> the level's system is solved iteratively (`use_iterative`).
-   subroutine level_memory(scene, body, level, cells, dofs, bytes, error, grid_only, available, direct_fits, iterative)
+   !> estimate when the direct one exceeds it (`direct_fits` false).
+   subroutine level_memory(scene, body, level, cells, dofs, bytes, error, grid_only, available, direct_fits)
       type(scene_type), intent(in) :: scene
       type(body_type), intent(in) :: body
       integer, intent(in) :: level
@@ -72,18 +71,17 @@ contains
       type(error_type), allocatable, intent(out) :: error
       logical, intent(in), optional :: grid_only
       integer(i8), intent(in), optional :: available
-      logical, intent(out), optional :: direct_fits, iterative
+      logical, intent(out), optional :: direct_fits
       type(grid_type) :: grid
       integer :: d, coarse, up, n
       real(wp) :: active, cut, box_size, direct_bytes
       real(wp), allocatable :: box_min(:)
-      logical :: fits, solve_iteratively
+      logical :: fits
 
       cells = 0.0_wp
       dofs = 0.0_wp
       bytes = 0.0_wp
       if (present(direct_fits)) direct_fits = .true.
-      if (present(iterative)) iterative = .false.
       d = scene%dim
       coarse = min(level, merge(6, 4, d == 2))
       call body_box(scene, body, box_min, box_size)
@@ -105,10 +103,9 @@ contains
       if (present(available)) fits = available < 0 .or. direct_bytes <= real(available, wp)
       n = int(min(dofs, real(huge(n), wp)))
       bytes = direct_bytes
-      solve_iteratively = use_iterative(scene_choice(scene), d, scene%order, n, direct_fits=fits)
-      if (solve_iteratively) bytes = base_bytes + dofs*per_dof(d, scene%order, dofs, .true.)
+      if (use_iterative(scene_choice(scene), d, scene%order, n, direct_fits=fits)) &
+         & bytes = base_bytes + dofs*per_dof(d, scene%order, dofs, .true.)
       if (present(direct_fits)) direct_fits = fits
-      if (present(iterative)) iterative = solve_iteratively
    end subroutine level_memory
 
    !> Estimated bytes per dof of a level of `dofs` unknowns in dimension `d`
