@@ -1198,8 +1198,8 @@ contains
 
    !> Same bits with 1 and 2 OpenMP threads (parallel quadrature, element matrices
    !> written to their places in the triplet list), 2D Q2 (Lame quarter, level 4) and
-   !> 3D Q1 (sphere octant, level 3): quadrature points and weights, matrix, load,
-   !> displacements.
+   !> 3D Q1 (sphere octant, level 3): quadrature pointers, points, weights, normals,
+   !> shape indices and volume fractions, matrix, load, displacements.
    subroutine test_threads(error)
       type(error_type), allocatable, intent(out) :: error
       type(body_type) :: body
@@ -1238,10 +1238,13 @@ contains
       logical function same_bits(a, b)
          type(elasticity_problem_type), intent(in) :: a, b
          same_bits = size(a%mesh%vol_w) == size(b%mesh%vol_w) .and. size(a%mesh%surf_w) == size(b%mesh%surf_w) &
-            & .and. size(a%k%val) == size(b%k%val)
+            & .and. size(a%k%val) == size(b%k%val) .and. size(a%mesh%fraction) == size(b%mesh%fraction)
          if (.not. same_bits) return
-         same_bits = all(a%mesh%vol_x == b%mesh%vol_x) .and. all(a%mesh%vol_w == b%mesh%vol_w) .and. &
+         same_bits = all(a%mesh%vol_ptr == b%mesh%vol_ptr) .and. all(a%mesh%surf_ptr == b%mesh%surf_ptr) .and. &
+            & all(a%mesh%vol_x == b%mesh%vol_x) .and. all(a%mesh%vol_w == b%mesh%vol_w) .and. &
             & all(a%mesh%surf_x == b%mesh%surf_x) .and. all(a%mesh%surf_w == b%mesh%surf_w) .and. &
+            & all(a%mesh%surf_n == b%mesh%surf_n) .and. all(a%mesh%surf_shape == b%mesh%surf_shape) .and. &
+            & all(a%mesh%fraction == b%mesh%fraction) .and. a%mesh%n_cut == b%mesh%n_cut .and. &
             & all(a%k%col == b%k%col) .and. all(a%k%val == b%k%val) .and. all(a%f == b%f) .and. all(a%u == b%u)
       end function same_bits
    end subroutine test_threads

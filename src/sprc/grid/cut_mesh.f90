@@ -28,12 +28,23 @@ module sprc_grid_cut_mesh
 
    public :: cut_mesh_type
 
-   !> Quadrature of one element while the rules are computed in parallel.
+   !> Cells per block of `integrate`: the unit of scheduling, and of storage for the points
+   !> of the cells that are not tensor cells.
+   integer, parameter :: block_cells = 64
+
+   character(len=*), parameter :: who = 'cut mesh quadrature'
+
+   !> The points of one cell that is not a tensor cell, while the rules are computed in parallel.
    type :: rule_store_type
-      integer :: nvol = 0, nsurf = 0
       real(wp), allocatable :: x(:, :), w(:), sx(:, :), sw(:), sn(:, :)
       integer, allocatable :: ss(:)
    end type rule_store_type
+
+   !> The kept points of the cells of one block (`cell(k)`: its k-th cell), allocated
+   !> when the block has a cell that is not a tensor cell.
+   type :: block_store_type
+      type(rule_store_type), allocatable :: cell(:)
+   end type block_store_type
 
    !> One body's cut mesh at one level (module notes).
    type :: cut_mesh_type
@@ -102,63 +113,118 @@ contains
       range = [1, self%grid%n_leaves]
       if (present(cells)) range = [max(cells(1), 1), min(cells(2), self%grid%n_leaves)]
       call timer%start()
+      call drop_rules(self)
       call integrate(self, range, error)
+      ! a mesh whose rules failed has none (what setup checks), and may be integrated again
+      if (allocated(error)) call drop_rules(self)
       call timer%stop()
       self%t_quadrature = timer%elapsed
    end subroutine mesh_integrate
 
-   !> The rules of all cells in parallel (a cut cell's kept in `store`, an inside cell
-   !> without boundary points only counted), then the points of every cell copied (or,
-   !> for such an inside cell, generated: the tensor rule, as `cell_rule` gives it) to
-   !> the places its index fixes, again in parallel: no serial pass over the points,
-   !> and no allocation for most cells.
+   !> Forget the cell rules (pointers, points, fractions), if any.
+   subroutine drop_rules(self)
+      type(cut_mesh_type), intent(inout) :: self
+      if (allocated(self%vol_ptr)) deallocate (self%vol_ptr)
+      if (allocated(self%surf_ptr)) deallocate (self%surf_ptr)
+      if (allocated(self%fraction)) deallocate (self%fraction)
+      if (allocated(self%vol_x)) deallocate (self%vol_x)
+      if (allocated(self%vol_w)) deallocate (self%vol_w)
+      if (allocated(self%surf_x)) deallocate (self%surf_x)
+      if (allocated(self%surf_w)) deallocate (self%surf_w)
+      if (allocated(self%surf_n)) deallocate (self%surf_n)
+      if (allocated(self%surf_shape)) deallocate (self%surf_shape)
+      self%n_cut = 0
+   end subroutine drop_rules
+
+   !> The rules of all cells in parallel, a block of `block_cells` consecutive cells at a
+   !> time: each cell's point counts go straight to its place in the pointers, and only a
+   !> cell whose rule is not the tensor rule of its cell (a cut cell, or an inside cell with
+   !> boundary points on its faces) keeps its points, in its block's store, allocated by
+   !> the thread that computes the block. Then the points of every cell are copied (or,
+   !> for a tensor cell, generated: the rule as `cell_rule` gives it) to the places its
+   !> index fixes, again in parallel. No serial pass over the cells but the sum of the
+   !> counts: nothing is allocated or initialised per cell for the tensor cells, which
+   !> are most of a level (a store per cell, allocated and freed serially, took as long
+   !> as computing the rules).
    subroutine integrate(self, range, error)
       type(cut_mesh_type), intent(inout) :: self
       integer, intent(in) :: range(2)
       type(error_type), allocatable, intent(out) :: error
-      type(rule_store_type), allocatable :: store(:)
+      type(block_store_type), allocatable :: store(:)
       type(cell_rule_type) :: rule
-      type(error_type), allocatable :: cell_error
-      logical, allocatable :: failed(:)
-      integer, allocatable :: stats(:)
-      integer :: e, n, d, stat
+      integer, allocatable :: bad(:), stats(:)
+      integer :: b, e, n, d, nb, stat
       real(wp) :: lo(3), hi(3)
-      character(len=*), parameter :: who = 'cut mesh quadrature'
 
       n = self%grid%n_leaves
       d = self%grid%dim
-      allocate (store(n), failed(n), stats(n), stat=stat)
-      call check_allocation(stat, who, 'the quadrature rule of each cell', n, storage_size(store)/8 + 8, error)
+      nb = (n + block_cells - 1)/block_cells
+      allocate (store(nb), bad(nb), stats(nb), self%vol_ptr(n + 1), self%surf_ptr(n + 1), self%fraction(n), &
+         & stat=stat)
+      call check_allocation(stat, who, 'the quadrature pointers and volume fractions', n + 1, 16, error)
       if (allocated(error)) return
-      failed = .false.
-      stats = 0
-      !$omp parallel do schedule(dynamic, 16) default(shared) private(e, rule, cell_error, lo, hi)
-      do e = range(1), range(2)
-         call self%grid%leaf_box(e, lo(1:d), hi(1:d))
-         call cell_rule(self%quad, self%body, lo(1:d), hi(1:d), rule, cell_error)
-         if (allocated(cell_error)) then
-            failed(e) = .true.
-            cycle
-         end if
-         call keep_rule(rule, d, tensor_only(rule, self%quad), store(e), stats(e))
+      !$omp parallel do schedule(dynamic, 1) default(shared) private(b, rule)
+      do b = 1, nb
+         call block_rules(self, b, range, rule, store(b), bad(b), stats(b))
       end do
       !$omp end parallel do
-      if (any(failed)) then
-         e = findloc(failed, .true., 1)
+      if (any(bad /= 0)) then
+         b = findloc(bad /= 0, .true., 1)
+         e = bad(b)
+         if (stats(b) /= 0) then
+            call check_allocation(stats(b), who, 'the quadrature points of cell '//itoa(e - 1)// &
+               & ' (coordinates, weights, normals)', self%vol_ptr(e + 1)*(d + 1) + self%surf_ptr(e + 1)*(2*d + 1), &
+               & 8, error)
+            return
+         end if
          call self%grid%leaf_box(e, lo(1:d), hi(1:d))
          call cell_rule(self%quad, self%body, lo(1:d), hi(1:d), rule, error)
-         return
-      end if
-      if (any(stats /= 0)) then
-         e = findloc(stats /= 0, .true., 1)
-         call check_allocation(stats(e), who, 'the quadrature points of cell '//itoa(e - 1)// &
-            & ' (coordinates, weights, normals)', store(e)%nvol*(d + 1) + store(e)%nsurf*(2*d + 1), 8, error)
          return
       end if
       call gather_points(self, store, error)
       if (allocated(error)) return
       self%n_cut = count(self%grid%leaf_class /= cell_inside)
    end subroutine integrate
+
+   !> The rules of the cells of block b (those in `range`; the others get no points):
+   !> their counts in vol_ptr(e + 1), surf_ptr(e + 1), the points of those that are not
+   !> tensor cells in `store`. bad = the first cell whose rule failed (0: none), with
+   !> `stat` nonzero when its points could not be kept.
+   subroutine block_rules(self, b, range, rule, store, bad, stat)
+      type(cut_mesh_type), intent(inout) :: self
+      integer, intent(in) :: b, range(2)
+      type(cell_rule_type), intent(inout) :: rule
+      type(block_store_type), intent(inout) :: store
+      integer, intent(out) :: bad, stat
+      type(error_type), allocatable :: cell_error
+      integer :: e, first, d
+      real(wp) :: lo(3), hi(3)
+
+      d = self%grid%dim
+      first = (b - 1)*block_cells + 1
+      bad = 0
+      stat = 0
+      do e = first, min(b*block_cells, self%grid%n_leaves)
+         self%vol_ptr(e + 1) = 0
+         self%surf_ptr(e + 1) = 0
+         if (e < range(1) .or. e > range(2)) cycle
+         call self%grid%leaf_box(e, lo(1:d), hi(1:d))
+         call cell_rule(self%quad, self%body, lo(1:d), hi(1:d), rule, cell_error)
+         if (allocated(cell_error)) then
+            bad = e
+            return
+         end if
+         self%vol_ptr(e + 1) = rule%nvol
+         self%surf_ptr(e + 1) = rule%nsurf
+         if (tensor_only(rule, self%quad) .or. rule%nvol + rule%nsurf == 0) cycle
+         if (.not. allocated(store%cell)) allocate (store%cell(block_cells), stat=stat)
+         if (stat == 0) call keep_rule(rule, d, store%cell(e - first + 1), stat)
+         if (stat /= 0) then
+            bad = e
+            return
+         end if
+      end do
+   end subroutine block_rules
 
    !> Whether `rule` is the plain tensor rule of its cell: an inside cell without
    !> boundary points on its faces.
@@ -169,25 +235,20 @@ contains
    end function tensor_only
 
    !> The points of all cells, concatenated in cell order (pointers from the counts, then
-   !> each cell's points to its places in parallel), and the volume fractions.
+   !> each block's points to their places in parallel), and the volume fractions.
    subroutine gather_points(self, store, error)
       type(cut_mesh_type), intent(inout) :: self
-      type(rule_store_type), intent(inout) :: store(:)
+      type(block_store_type), intent(inout) :: store(:)
       type(error_type), allocatable, intent(out) :: error
-      integer :: e, n, d, nv, ns, iv, is, k, stat
-      real(wp) :: lo(3), hi(3)
-      character(len=*), parameter :: who = 'cut mesh quadrature'
+      integer :: b, e, n, d, nv, ns, stat
 
-      n = size(store)
+      n = self%grid%n_leaves
       d = self%grid%dim
-      allocate (self%vol_ptr(n + 1), self%surf_ptr(n + 1), self%fraction(n), stat=stat)
-      call check_allocation(stat, who, 'the quadrature pointers and volume fractions', n + 1, 16, error)
-      if (allocated(error)) return
       self%vol_ptr(1) = 1
       self%surf_ptr(1) = 1
       do e = 1, n
-         self%vol_ptr(e + 1) = self%vol_ptr(e) + store(e)%nvol
-         self%surf_ptr(e + 1) = self%surf_ptr(e) + store(e)%nsurf
+         self%vol_ptr(e + 1) = self%vol_ptr(e) + self%vol_ptr(e + 1)
+         self%surf_ptr(e + 1) = self%surf_ptr(e) + self%surf_ptr(e + 1)
       end do
       nv = self%vol_ptr(n + 1) - 1
       ns = self%surf_ptr(n + 1) - 1
@@ -197,43 +258,65 @@ contains
       allocate (self%surf_x(d, ns), self%surf_w(ns), self%surf_n(d, ns), self%surf_shape(ns), stat=stat)
       call check_allocation(stat, who, 'the surface quadrature points', ns, 8*(2*d + 1) + 4, error)
       if (allocated(error)) return
-      !$omp parallel do schedule(dynamic, 64) default(shared) private(e, iv, is, k, lo, hi)
-      do e = 1, n
-         iv = self%vol_ptr(e) - 1
-         is = self%surf_ptr(e) - 1
-         call self%grid%leaf_box(e, lo(1:d), hi(1:d))
-         if (allocated(store(e)%w)) then
-            self%vol_x(:, iv + 1:iv + store(e)%nvol) = store(e)%x
-            self%vol_w(iv + 1:iv + store(e)%nvol) = store(e)%w
-            self%surf_x(:, is + 1:is + store(e)%nsurf) = store(e)%sx
-            self%surf_w(is + 1:is + store(e)%nsurf) = store(e)%sw
-            self%surf_n(:, is + 1:is + store(e)%nsurf) = store(e)%sn
-            self%surf_shape(is + 1:is + store(e)%nsurf) = store(e)%ss
-            deallocate (store(e)%x, store(e)%w, store(e)%sx, store(e)%sw, store(e)%sn, store(e)%ss)
-         else
-            do k = 1, store(e)%nvol
-               call tensor_point(self%quad, lo(1:d), hi(1:d), k, self%vol_x(:, iv + k), self%vol_w(iv + k))
-            end do
-         end if
-         self%fraction(e) = sum(self%vol_w(iv + 1:iv + store(e)%nvol))/product(hi(1:d) - lo(1:d))
+      !$omp parallel do schedule(dynamic, 1) default(shared) private(b)
+      do b = 1, size(store)
+         call block_points(self, b, store(b))
       end do
       !$omp end parallel do
    end subroutine gather_points
 
-   !> `store` = the points of `rule` (dimension d), or only their counts when `counts_only`
-   !> (the tensor rule, generated again by `gather_points`); `stat` nonzero when an array
-   !> could not be allocated (the points of all cells together grow with the grid).
-   pure subroutine keep_rule(rule, d, counts_only, store, stat)
+   !> The points and volume fractions of the cells of block b (pointers set); the
+   !> block's store is freed.
+   subroutine block_points(self, b, store)
+      type(cut_mesh_type), intent(inout) :: self
+      integer, intent(in) :: b
+      type(block_store_type), intent(inout) :: store
+      integer :: e, first, d, iv, is, nvol, nsurf, k
+      real(wp) :: lo(3), hi(3)
+
+      d = self%grid%dim
+      first = (b - 1)*block_cells + 1
+      do e = first, min(b*block_cells, self%grid%n_leaves)
+         iv = self%vol_ptr(e) - 1
+         is = self%surf_ptr(e) - 1
+         nvol = self%vol_ptr(e + 1) - 1 - iv
+         nsurf = self%surf_ptr(e + 1) - 1 - is
+         call self%grid%leaf_box(e, lo(1:d), hi(1:d))
+         if (kept(store, e - first + 1)) then
+            associate (cell => store%cell(e - first + 1))
+               self%vol_x(:, iv + 1:iv + nvol) = cell%x
+               self%vol_w(iv + 1:iv + nvol) = cell%w
+               self%surf_x(:, is + 1:is + nsurf) = cell%sx
+               self%surf_w(is + 1:is + nsurf) = cell%sw
+               self%surf_n(:, is + 1:is + nsurf) = cell%sn
+               self%surf_shape(is + 1:is + nsurf) = cell%ss
+            end associate
+         else
+            do k = 1, nvol
+               call tensor_point(self%quad, lo(1:d), hi(1:d), k, self%vol_x(:, iv + k), self%vol_w(iv + k))
+            end do
+         end if
+         self%fraction(e) = sum(self%vol_w(iv + 1:iv + nvol))/product(hi(1:d) - lo(1:d))
+      end do
+      if (allocated(store%cell)) deallocate (store%cell)
+   end subroutine block_points
+
+   !> Whether cell k of a block has its points in the block's store.
+   pure logical function kept(store, k)
+      type(block_store_type), intent(in) :: store
+      integer, intent(in) :: k
+      kept = .false.
+      if (allocated(store%cell)) kept = allocated(store%cell(k)%w)
+   end function kept
+
+   !> `store` = the points of `rule` (dimension d); `stat` nonzero when an array could
+   !> not be allocated (the points of all cells together grow with the grid).
+   pure subroutine keep_rule(rule, d, store, stat)
       type(cell_rule_type), intent(in) :: rule
       integer, intent(in) :: d
-      logical, intent(in) :: counts_only
       type(rule_store_type), intent(inout) :: store
       integer, intent(out) :: stat
 
-      store%nvol = rule%nvol
-      store%nsurf = rule%nsurf
-      stat = 0
-      if (counts_only) return
       allocate (store%x, source=rule%vol_x(1:d, 1:rule%nvol), stat=stat)
       if (stat == 0) allocate (store%w, source=rule%vol_w(1:rule%nvol), stat=stat)
       if (stat == 0) allocate (store%sx, source=rule%surf_x(1:d, 1:rule%nsurf), stat=stat)
