@@ -959,7 +959,8 @@ contains
       call expect_error(error, stat_singular, 'rank deficient', 'max_rounds = 0')
    end subroutine test_expansion_limit
 
-   !> 1 and 2 OpenMP threads give identical bits: patch coefficients, nodal output, estimate.
+   !> 1 and 2 OpenMP threads give identical bits: patches (nodes, rounds, coefficients) and
+   !> their counts, nodal output, estimate.
    subroutine test_threads(error)
       type(error_type), allocatable, intent(out) :: error
       type(problem_type) :: pb
@@ -993,6 +994,13 @@ contains
       end do
       !$ call omp_set_num_threads(nthreads0)
       if (blas0 > 0) call set_blas_threads(blas0)
+      if (allocated(error)) return
+      call check(error, field(1)%n_patches == field(2)%n_patches .and. &
+         & all(field(1)%patch_node == field(2)%patch_node) .and. all(field(1)%patch_of_node == field(2)%patch_of_node) &
+         & .and. all(field(1)%patch_rounds == field(2)%patch_rounds) .and. &
+         & all(field(1)%patch_elements == field(2)%patch_elements) .and. field(1)%n_expanded == field(2)%n_expanded &
+         & .and. field(1)%max_rounds_used == field(2)%max_rounds_used .and. &
+         & field(1)%n_tolerance_bites == field(2)%n_tolerance_bites, 'patches and their counts identical')
       if (allocated(error)) return
       do k = 1, field(1)%n_patches
          if (any(field(1)%recs(k)%coef /= field(2)%recs(k)%coef)) then

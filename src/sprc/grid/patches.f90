@@ -167,9 +167,11 @@ contains
       allocate (field%elem_lo(grid%dim, nodes%n_elements), field%elem_hi(grid%dim, nodes%n_elements), stat=stat)
       call check_allocation(stat, 'recover_grid', 'the element boxes', nodes%n_elements, 16*grid%dim, error)
       if (allocated(error)) return
+      !$omp parallel do schedule(static)
       do e = 1, nodes%n_elements
          call grid%leaf_box(e, field%elem_lo(:, e), field%elem_hi(:, e))
       end do
+      !$omp end parallel do
       call number_patches(nodes, hanging, field, error)
       if (allocated(error)) return
       allocate (field%recs(field%n_patches), field%patch_rounds(field%n_patches), &
@@ -197,8 +199,11 @@ contains
       ! Over all nodes, hanging ones included: the capacity (and with it the bits) of before.
       opt%cap = patch_capacity(src, grid%dim, degree, nodes%node_element_ptr, nodes%node_element, &
          & [(n, n=1, nodes%n_nodes)])
-      call share_range(share, patch_work(input, nodes, field%patch_node), first, lo, hi)
-      skip = [(ip < lo .or. ip > hi, ip=1, field%n_patches)]
+      ! Without `share` skip stays unallocated: an absent argument, nothing to set or read.
+      if (present(share)) then
+         call share_range(share, patch_work(input, nodes, field%patch_node), first, lo, hi)
+         skip = [(ip < lo .or. ip > hi, ip=1, field%n_patches)]
+      end if
       call run_patch_loop(opt, src, nodes%node_element_ptr, nodes%node_element, nodes%connectivity, &
          & field%patch_node, field%recs, field%patch_rounds, field%patch_elements, ip, error, skip)
       if (present(share)) then
@@ -219,16 +224,34 @@ contains
          end if
          return
       end if
-      field%n_expanded = count(field%patch_rounds > 0)
-      field%max_rounds_used = 0
-      if (field%n_patches > 0) field%max_rounds_used = maxval(field%patch_rounds)
-      field%n_tolerance_bites = count(field%recs%tolerance_bites)
+      call count_rounds(field)
       field%t_recovery = wall_time() - t0
 
       t0 = wall_time()
       call build_field(field, grid, nodes, hanging, error)
       field%t_field = wall_time() - t0
    end subroutine recover_grid
+
+   !> The patches expanded, the most rounds used, the patches whose rank a tolerance
+   !> decided (integer sums and a maximum: the same for any schedule).
+   subroutine count_rounds(field)
+      type(recovered_field_type), intent(inout) :: field
+      integer :: ip, expanded, most, bites
+
+      expanded = 0
+      most = 0
+      bites = 0
+      !$omp parallel do schedule(static) reduction(+:expanded, bites) reduction(max:most)
+      do ip = 1, field%n_patches
+         if (field%patch_rounds(ip) > 0) expanded = expanded + 1
+         most = max(most, field%patch_rounds(ip))
+         if (field%recs(ip)%tolerance_bites) bites = bites + 1
+      end do
+      !$omp end parallel do
+      field%n_expanded = expanded
+      field%max_rounds_used = most
+      field%n_tolerance_bites = bites
+   end subroutine count_rounds
 
    !> The work of each patch for sharing them out: its elements, those with
    !> boundary points counted four times (their constraints and expansions).
@@ -265,32 +288,38 @@ contains
       call fatal_error(error, 'recover_grid: '//trim(buf), stat_invalid_input)
    end subroutine check_options
 
-   !> Free vertex nodes in node order get patches 1, 2, ...
+   !> Free vertex nodes in node order get patches 1, 2, ... A node is a vertex when it is
+   !> a corner of one of its elements (VTK order puts the corners first): decided per
+   !> node, in parallel.
    subroutine number_patches(nodes, hanging, field, error)
       type(grid_nodes_type), intent(in) :: nodes
       type(hanging_type), intent(in) :: hanging
       type(recovered_field_type), intent(inout) :: field
       type(error_type), allocatable, intent(out) :: error
       logical, allocatable :: vertex(:)
-      integer :: n, nv, e, stat
+      integer :: n, nv, k, stat
 
       nv = 2**nodes%dim
       allocate (vertex(nodes%n_nodes), field%patch_of_node(nodes%n_nodes), stat=stat)
       call check_allocation(stat, 'recover_grid', 'the patch of each node', nodes%n_nodes, 8, error)
       if (allocated(error)) return
-      vertex = .false.
-      ! VTK order puts the corners first.
-      do e = 1, nodes%n_elements
-         vertex(nodes%connectivity(1:nv, e)) = .true.
+      !$omp parallel do schedule(static) private(k)
+      do n = 1, nodes%n_nodes
+         vertex(n) = .false.
+         if (hanging%free_index(n) <= 0) cycle
+         do k = nodes%node_element_ptr(n), nodes%node_element_ptr(n + 1) - 1
+            vertex(n) = any(nodes%connectivity(1:nv, nodes%node_element(k)) == n)
+            if (vertex(n)) exit
+         end do
       end do
-      vertex = vertex .and. hanging%free_index > 0
+      !$omp end parallel do
       field%n_patches = count(vertex)
       allocate (field%patch_node(field%n_patches), stat=stat)
       call check_allocation(stat, 'recover_grid', 'the node of each patch', field%n_patches, 4, error)
       if (allocated(error)) return
       field%n_patches = 0
-      field%patch_of_node = 0
       do n = 1, nodes%n_nodes
+         field%patch_of_node(n) = 0
          if (.not. vertex(n)) cycle
          field%n_patches = field%n_patches + 1
          field%patch_node(field%n_patches) = n

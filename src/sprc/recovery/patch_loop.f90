@@ -110,13 +110,19 @@ contains
       class(patch_source_type), intent(in) :: source
       integer, intent(in) :: dim, degree, ne_ptr(:), ne_list(:), nodes(:)
       integer :: cap(2)
-      integer :: i, n
+      integer :: i, n, counts(2), c1, c2
 
-      cap = [4*poly_nterms(dim, degree), 0]
+      c1 = 4*poly_nterms(dim, degree)
+      c2 = 0
+      !$omp parallel do schedule(static) private(n, counts) reduction(max:c1, c2)
       do i = 1, size(nodes)
          n = nodes(i)
-         cap = max(cap, source%points_of(ne_list(ne_ptr(n):ne_ptr(n + 1) - 1)))
+         counts = source%points_of(ne_list(ne_ptr(n):ne_ptr(n + 1) - 1))
+         c1 = max(c1, counts(1))
+         c2 = max(c2, counts(2))
       end do
+      !$omp end parallel do
+      cap = [c1, c2]
    end function patch_capacity
 
    !> Recover the patch of every node patch_node(ip) into recs(ip) (module notes), with its
@@ -140,8 +146,6 @@ contains
       allocate (status(size(patch_node)), stat=stat)
       call check_allocation(stat, 'patch loop', 'the status of each patch', size(patch_node), 4, error)
       if (allocated(error)) return
-      rounds = 0
-      nel = 0
       failed = 0
       saved_blas = blas_serial_begin()
       !$omp parallel default(shared)
@@ -179,6 +183,8 @@ contains
       !$omp do schedule(dynamic, 16)
       do ip = 1, size(patch_node)
          status(ip) = 0
+         rounds(ip) = 0
+         nel(ip) = 0
          if (present(skip)) then
             if (skip(ip)) cycle
          end if
