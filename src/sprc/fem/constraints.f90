@@ -75,6 +75,7 @@ contains
       integer, allocatable :: master_of(:), a_ptr(:), a_col(:), marker(:), row_col(:)
       real(wp), allocatable :: a_val(:), acc(:)
       integer :: d, e, j, k, i, m, c, nfree, p, q, nrow, r, na, nt, stat
+      logical :: done
       real(wp) :: lo(3), hi(3), xi(3), shape(27)
       character(len=*), parameter :: who = 'constraints'
 
@@ -92,13 +93,19 @@ contains
       call check_allocation(stat, who, 'the master flags of the free nodes', nfree, 8, error)
       if (allocated(error)) return
       supported = .false.
+      ! Only .true. is written: the same flags for any schedule.
+      !$omp parallel do schedule(static) private(j, i, q)
       do e = 1, nodes%n_elements
          if (root(e) /= e) cycle
          do j = 1, nodes%nodes_per_element
             i = nodes%connectivity(j, e)
-            supported(hanging%t_col(hanging%t_ptr(i):hanging%t_ptr(i + 1) - 1)) = .true.
+            do q = hanging%t_ptr(i), hanging%t_ptr(i + 1) - 1
+               !$omp atomic write
+               supported(hanging%t_col(q)) = .true.
+            end do
          end do
       end do
+      !$omp end parallel do
       m = 0
       do k = 1, nfree
          master_of(k) = 0
@@ -125,26 +132,28 @@ contains
       a_ptr(1) = 1
       do k = 1, nfree
          nrow = 0
-         if (.not. supported(k)) then
-            i = hanging%free_node(k)
-            e = nodes%node_element(nodes%node_element_ptr(i))
-            r = root(e)
-            call grid%leaf_box(r, lo(1:d), hi(1:d))
-            xi(1:d) = (nodes%x(:, i) - lo(1:d))/(hi(1:d) - lo(1:d))
-            call element_shape(d, nodes%degree, xi(1:d), shape)
-            do j = 1, nodes%nodes_per_element
-               p = nodes%connectivity(j, r)
-               do q = hanging%t_ptr(p), hanging%t_ptr(p + 1) - 1
-                  c = master_of(hanging%t_col(q))
-                  if (c == 0) then
-                     call fatal_error(error, 'constraints: a well-posed cell uses an unsupported node', &
-                        & stat_internal)
-                     return
-                  end if
-                  call accumulate(c, shape(j)*hanging%t_val(q))
-               end do
-            end do
+         if (supported(k)) then
+            a_ptr(k + 1) = na + 1
+            cycle
          end if
+         i = hanging%free_node(k)
+         e = nodes%node_element(nodes%node_element_ptr(i))
+         r = root(e)
+         call grid%leaf_box(r, lo(1:d), hi(1:d))
+         xi(1:d) = (nodes%x(:, i) - lo(1:d))/(hi(1:d) - lo(1:d))
+         call element_shape(d, nodes%degree, xi(1:d), shape)
+         do j = 1, nodes%nodes_per_element
+            p = nodes%connectivity(j, r)
+            do q = hanging%t_ptr(p), hanging%t_ptr(p + 1) - 1
+               c = master_of(hanging%t_col(q))
+               if (c == 0) then
+                  call fatal_error(error, 'constraints: a well-posed cell uses an unsupported node', &
+                     & stat_internal)
+                  return
+               end if
+               call accumulate(c, shape(j)*hanging%t_val(q))
+            end do
+         end do
          call flush_row(a_col, a_val, na)
          if (allocated(error)) return
          a_ptr(k + 1) = na + 1
@@ -161,6 +170,12 @@ contains
       self%t_ptr(1) = 1
       do i = 1, self%n_nodes
          nrow = 0
+         call master_row(i, done)
+         if (allocated(error)) return
+         if (done) then
+            self%t_ptr(i + 1) = nt + 1
+            cycle
+         end if
          do q = hanging%t_ptr(i), hanging%t_ptr(i + 1) - 1
             k = hanging%t_col(q)
             if (master_of(k) > 0) then
@@ -182,12 +197,14 @@ contains
       allocate (self%zero(d, self%n_nodes), self%dof(d, m), stat=stat)
       call check_allocation(stat, who, 'the dof numbers', self%n_nodes, 8*d, error)
       if (allocated(error)) return
-      self%zero = .false.
-      do k = 1, size(plane_axis)
-         do i = 1, self%n_nodes
+      !$omp parallel do schedule(static) private(k)
+      do i = 1, self%n_nodes
+         self%zero(:, i) = .false.
+         do k = 1, size(plane_axis)
             if (abs(nodes%x(plane_axis(k), i) - plane_coord(k)) <= tol) self%zero(plane_axis(k), i) = .true.
          end do
       end do
+      !$omp end parallel do
       self%n_dofs = 0
       do j = 1, m
          do c = 1, d
@@ -199,6 +216,27 @@ contains
       end do
 
    contains
+
+      !> Row i when it is one entry on a master (most nodes; done): that entry, appended
+      !> unless zero, as accumulate and flush_row give it (0 + v = v) without their work.
+      subroutine master_row(i, done)
+         integer, intent(in) :: i
+         logical, intent(out) :: done
+         integer :: q
+         done = .false.
+         if (hanging%t_ptr(i + 1) - hanging%t_ptr(i) /= 1) return
+         q = hanging%t_ptr(i)
+         if (master_of(hanging%t_col(q)) == 0) return
+         done = .true.
+         if (hanging%t_val(q) == 0.0_wp) return
+         if (nt == size(self%t_col)) then
+            call resize(self%t_col, self%t_val, 2*size(self%t_col), error)
+            if (allocated(error)) return
+         end if
+         nt = nt + 1
+         self%t_col(nt) = master_of(hanging%t_col(q))
+         self%t_val(nt) = hanging%t_val(q)
+      end subroutine master_row
 
       subroutine accumulate(col, val)
          integer, intent(in) :: col
