@@ -30,6 +30,7 @@ module sprc_fem_multigrid
    use sprc_core_alloc, only: check_allocation
    use sprc_grid_nodes, only: lattice_slot
    use sprc_fem_sparse, only: sort_row
+   use sprc_recovery_dense, only: qr_pivoted, apply_q, solve_upper
    implicit none
    private
 
@@ -392,61 +393,42 @@ contains
       end do
    end function linear_weight
 
-   !> w = argmin |w - w0| subject to sum w = 1 and sum_k w_k x(:, k) = t:
-   !> w = w0 + A^T lambda with A = [1; x] and (A A^T) lambda = [1; t] - A w0.
-   !> `found` is false when A has not full row rank (A A^T is an integer
-   !> matrix, so a pivot below 1e-8 means it is singular).
+   !> w = argmin |w - w0| subject to sum w = 1 and sum_k w_k x(:, k) = t: with
+   !> A = [1; x] (d + 1 rows, m >= d + 1 columns), w = w0 + delta where delta is
+   !> the least-norm solution of A delta = [1; t] - A w0, from the pivoted QR of
+   !> A^T (`sprc_recovery_dense`, the patch solves' kernel): A^T P = Q R gives
+   !> R^T (Q^T delta)(1:d+1) = P^T ([1; t] - A w0) and the rest of Q^T delta = 0.
+   !> `found` is false when A has not full row rank: |R_(d+1,d+1)| at most
+   !> sqrt(eps) |R_11| (the offsets are small integers, so a rank-deficient A
+   !> gives round-off there and a full-rank one a value of order one).
    pure subroutine closest_linear_weights(x, t, w0, w, found)
       real(wp), intent(in) :: x(:, :), t(:), w0(:)
       real(wp), intent(out) :: w(:)
       logical, intent(out) :: found
-      real(wp) :: a(size(t) + 1, size(w0)), g(size(t) + 1, size(t) + 1), r(size(t) + 1)
-      integer :: d
+      real(wp) :: at(size(w0), size(t) + 1), tau(size(t) + 1), vn(size(t) + 1, 2), r(size(t) + 1), &
+         & y(size(w0), 1)
+      integer :: d, m, n, jpvt(size(t) + 1), k
 
       d = size(t)
+      m = size(w0)
+      n = d + 1
       w = 0.0_wp
       found = .false.
-      if (size(w0) < d + 1) return
-      a(1, :) = 1.0_wp
-      a(2:, :) = x
-      g = matmul(a, transpose(a))
-      r(1) = 1.0_wp
-      r(2:) = t
-      r = r - matmul(a, w0)
-      call small_solve(g, r, found)
-      if (found) w = w0 + matmul(r, a)
-   end subroutine closest_linear_weights
-
-   !> Solve g y = r in place (r := y) by Gaussian elimination with partial pivoting.
-   pure subroutine small_solve(g, r, found)
-      real(wp), intent(inout) :: g(:, :), r(:)
-      logical, intent(out) :: found
-      integer :: n, i, k, piv
-      real(wp) :: row(size(r)), f, tmp
-
-      n = size(r)
-      found = .false.
+      if (m < n) return
+      at(:, 1) = 1.0_wp
+      at(:, 2:) = transpose(x)
+      r(1) = 1.0_wp - sum(w0)
+      r(2:) = t - matmul(x, w0)
+      call qr_pivoted(m, n, at, jpvt, tau, vn)
+      if (.not. abs(at(n, n)) > sqrt(epsilon(1.0_wp))*abs(at(1, 1))) return
+      y = 0.0_wp
       do k = 1, n
-         piv = k - 1 + maxloc(abs(g(k:, k)), dim=1)
-         if (abs(g(piv, k)) < 1.0e-8_wp) return
-         if (piv /= k) then
-            row = g(k, :)
-            g(k, :) = g(piv, :)
-            g(piv, :) = row
-            tmp = r(k)
-            r(k) = r(piv)
-            r(piv) = tmp
-         end if
-         do i = k + 1, n
-            f = g(i, k)/g(k, k)
-            g(i, k:) = g(i, k:) - f*g(k, k:)
-            r(i) = r(i) - f*r(k)
-         end do
+         y(k, 1) = r(jpvt(k))
       end do
-      do k = n, 1, -1
-         r(k) = (r(k) - dot_product(g(k, k + 1:), r(k + 1:)))/g(k, k)
-      end do
-      found = .true.
-   end subroutine small_solve
+      call solve_upper(n, at, 1, y, found, transposed=.true.)
+      if (.not. found) return
+      call apply_q(m, n, at, tau, 1, y)
+      w = w0 + y(:, 1)
+   end subroutine closest_linear_weights
 
 end module sprc_fem_multigrid
