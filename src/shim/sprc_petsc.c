@@ -381,6 +381,7 @@ typedef struct {
     PetscInt lo, n_local; /* this rank's rows: lo .. lo + n_local - 1 */
     int symmetric;
     const char *pc_name; /* "GAMG" or "geometric multigrid" (messages) */
+    int geometric;       /* 1: PCMG on the caller's hierarchy; 0: GAMG */
     double tau, bnorm; /* the solve's tolerance and size of b (energy_test) */
     double kappa;      /* condition estimate of B A (CG), 1 for GMRES */
     double bound;      /* the stopping quantity at the last iteration */
@@ -542,6 +543,7 @@ static int build_solver(sprc_petsc *s, PetscInt n, PetscInt dim, const sprc_pets
         int status = build_multigrid(pc, n, dim, mg, msg, len);
         if (status != SPRC_OK) return status;
         s->pc_name = "geometric multigrid";
+        s->geometric = 1;
     } else {
         TRY(PCSetType(pc, "gamg"));
         s->pc_name = "GAMG";
@@ -557,7 +559,7 @@ static int build_solver(sprc_petsc *s, PetscInt n, PetscInt dim, const sprc_pets
 int sprc_petsc_multigrid(const void *handle)
 {
     const sprc_petsc *s = handle;
-    return s != NULL && s->pc_name != NULL && s->pc_name[0] != 'G';
+    return s != NULL && s->geometric;
 }
 
 static int create_vectors(sprc_petsc *s, PetscInt n, PetscInt dim, char *msg, int64_t len)
