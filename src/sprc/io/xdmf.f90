@@ -84,6 +84,8 @@ module sprc_io_xdmf
       logical :: is_integer = .false.
       !> Component names, for kind = field_components.
       character(len=max_name_length), allocatable :: components(:)
+      !> The values' units in words ('' or not allocated: none given).
+      character(len=:), allocatable :: units
    end type xdmf_field_type
 
    !> One level's mesh and fields as stored in the HDF5 file; with several
@@ -328,16 +330,16 @@ contains
       text = ''
       select case (field%kind)
       case (field_scalar)
-         text = attribute_open(attribute_name(field, 1), 'Scalar', center)// &
+         text = attribute_open(attribute_name(field, 1), 'Scalar', center)//information(field)// &
             '     '//data_item(h5, path, [n], field%is_integer)//nl//'    </Attribute>'//nl
       case (field_vector)
-         text = attribute_open(attribute_name(field, 1), 'Vector', center)// &
+         text = attribute_open(attribute_name(field, 1), 'Vector', center)//information(field)// &
             '     '//data_item(h5, path, [n, field%ncomp], field%is_integer)//nl//'    </Attribute>'//nl
       case default
          item = data_item(h5, path, [n, field%ncomp], field%is_integer)
          do j = 1, field%ncomp
             ! HyperSlab parameters: start, stride, count, each in (row, column).
-            text = text//attribute_open(attribute_name(field, j), 'Scalar', center)// &
+            text = text//attribute_open(attribute_name(field, j), 'Scalar', center)//information(field)// &
                '     <DataItem ItemType="HyperSlab" Dimensions="'//itoa(n)//' 1" Type="HyperSlab">'//nl// &
                '      <DataItem Dimensions="3 2" NumberType="Int" Format="XML">0 '//itoa(j - 1)//' 1 1 '// &
                itoa(n)//' 1</DataItem>'//nl// &
@@ -345,6 +347,15 @@ contains
          end do
       end select
    end function attribute_text
+
+   !> `<Information Name="units" Value="..."/>` of a field with units ('' without).
+   function information(field) result(text)
+      type(xdmf_field_type), intent(in) :: field
+      character(len=:), allocatable :: text
+      text = ''
+      if (.not. allocated(field%units)) return
+      if (len(field%units) > 0) text = '     <Information Name="units" Value="'//escape(field%units)//'"/>'//nl
+   end function information
 
    !> XDMF needs the nodes per element of a Polyvertex topology (the other types fix it).
    pure function nodes_per_element(cell_type) result(text)
