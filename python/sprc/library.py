@@ -187,8 +187,8 @@ get_study_report = error_check(_prototype("sprc_get_study_report", _handle, _han
 get_study_grids = error_check(_prototype("sprc_get_study_grids", ctypes.c_int, _handle, _handle, ctypes.c_int))
 _get_study_grid = error_check(_prototype("sprc_get_study_grid", ctypes.c_int, _handle, _handle, ctypes.c_int,
                                          ctypes.c_int, ctypes.c_char_p, _c_int_p))
-get_study_fields = error_check(_prototype("sprc_get_study_fields", ctypes.c_int, _handle, _handle, ctypes.c_int,
-                                          ctypes.c_char_p))
+_get_study_fields = error_check(_prototype("sprc_get_study_fields", ctypes.c_int, _handle, _handle, ctypes.c_int,
+                                           ctypes.c_char_p))
 _get_study_field_name = error_check(_prototype("sprc_get_study_field_name", None, _handle, _handle, ctypes.c_int,
                                                ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, _c_int_p))
 _get_study_field_shape = error_check(_prototype("sprc_get_study_field_shape", ctypes.c_int, _handle, _handle,
@@ -208,6 +208,11 @@ def get_study_grid(study, row, index, size=256):
     buf = ctypes.create_string_buffer(size)
     kind = _get_study_grid(study, row, index, buf, ctypes.byref(ctypes.c_int(size)))
     return buf.value.decode(), kind
+
+
+def get_study_fields(study, row, grid):
+    """Number of fields of grid ``grid`` (str) at report row ``row``, the mesh arrays included."""
+    return _get_study_fields(study, row, grid.encode())
 
 
 def get_study_field_name(study, row, grid, index, size=256):

@@ -1,7 +1,8 @@
 """`pip install ./python` into a fresh virtual environment (offline: no
-index, no build isolation; pip and setuptools from ensurepip, numpy from the
-interpreter running the tests through a .pth file), then `python -m sprc
-SCENE.nml` from outside the source tree."""
+index; the in-tree backend build_sprc.py needs nothing else; pip from
+ensurepip, numpy from the interpreter running the tests through a .pth
+file), then `python -m sprc SCENE.nml` from outside the source tree; and
+the version in pyproject.toml is the package's."""
 
 import os
 import shutil
@@ -25,12 +26,11 @@ def test_pip_install_and_python_m_sprc(tmp_path):
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
     env["SPRC_LIBRARY"] = os.environ.get("SPRC_LIBRARY", str(ROOT / "build" / "lib" / "libsprc.so"))
     env["PIP_NO_INDEX"] = "1"
-    # a copy: setuptools builds in the source directory (build/, sprc.egg-info/)
+    # a copy: nothing is written into the source tree
     source = tmp_path / "python"
     shutil.copytree(ROOT / "python", source, ignore=shutil.ignore_patterns("tests", "__pycache__", "build",
                                                                           "*.egg-info"))
-    out = subprocess.run([str(python), "-m", "pip", "install", "--no-deps", "--no-build-isolation", "--no-index",
-                          str(source)], capture_output=True, text=True, env=env, cwd=tmp_path)
+    out = subprocess.run([str(python), "-m", "pip", "install", "--no-index", str(source)], capture_output=True, text=True, env=env, cwd=tmp_path)
     assert out.returncode == 0, out.stdout + out.stderr
     where = subprocess.run([str(python), "-c", "import sprc; print(sprc.__file__)"], capture_output=True, text=True,
                            env=env, cwd=tmp_path)
@@ -45,3 +45,10 @@ def test_pip_install_and_python_m_sprc(tmp_path):
     bad = subprocess.run([str(python), "-m", "sprc", str(tmp_path / "missing.nml")], capture_output=True, text=True,
                          env=env, cwd=tmp_path)
     assert bad.returncode == 2 and "missing.nml" in bad.stderr
+
+
+def test_pyproject_version_is_the_package_version():
+    import re
+    import sprc
+    text = (ROOT / "python" / "pyproject.toml").read_text()
+    assert re.search(r'^version = "([^"]+)"', text, re.M).group(1) == sprc.__version__
