@@ -10,6 +10,25 @@
 !> /level_LL/contact_<k>/mesh/x        float64 (n_points, dim)   slave points of &contact pair k
 !> /level_LL/contact_<k>/node/<name>   float64 or int32 (n_points) | (n_points, 3)
 !> ```
+!> The fields of `sprc run` (`sprc_io_fields`): per body node fields
+!> `displacement`, `sigma_fe`, `sigma_spr`, `sigma_sprc`, `inside`, cell
+!> fields `zz_error_spr`, `zz_error_sprc`, `exact_error_fe`, `cut`,
+!> `volume_fraction`, `cell_level`. Every field dataset carries string
+!> attributes `units` (in words: length, stress, energy norm; the scene's
+!> own units) and, with several columns, `components` ('xx yy xy (Voigt
+!> order)', 'x y z', or 'x y z (z = 0: a 2-D vector)'); the XDMF repeats
+!> the units as an Information element of the Attribute.
+!>
+!> **Only the body.** The grid's cells are the cells that meet the body, so
+!> a cut cell and its nodes reach beyond the boundary, where the FE and
+!> recovered fields are extrapolations. The node field `inside` is 1 for a
+!> node in the body or on its boundary (within the geometry's snapping
+!> tolerance) and 0 beyond: in ParaView, Threshold on `inside` from 1 to 1
+!> with "All Scalars" on shows the cells whose nodes all lie in the body
+!> (the cut cells go); statistics of a node field over the body take the
+!> nodes where `inside` = 1 (e.g. the largest sigma_sprc_xx). The cell field
+!> `volume_fraction` is the share of each cell in the body.
+!>
 !> LL is the level with two digits (`/level_04`), <body> the body's name
 !> (`sprc run` writes every body so, even a scene's only one); a writer that
 !> gives no body name gets `/level_LL/mesh/x` etc. A field with one component
