@@ -11,7 +11,7 @@ program sprc_main
    use sprc_version, only: sprc_version_string
    use sprc_io_scene, only: scene_type, read_scene, read_scene_text, scene_summary, default_scene_text
    use sprc_study_model, only: build_bodies, scene_warnings
-   use sprc_study_budget, only: level_memory
+   use sprc_study_threads, only: level_threads, study_dofs, serial_dofs
    use sprc_geometry_body, only: body_type
    use sprc_study_mesh, only: mesh_row_type, mesh_study, study_levels
    use sprc_study_level, only: study_type, prepare_study, run_level, level_type, hold_starts
@@ -36,11 +36,6 @@ program sprc_main
    character(len=*), parameter :: output_exts(6) = [character(len=12) :: '.csv', '.svg', '.h5', '.xdmf', &
       & '_contact.csv', '_contact.svg']
    character(len=*), parameter :: partial = '.partial'
-   !> With the default thread count, a level estimated below this many dofs runs on one
-   !> thread: its parallel regions are too short to pay for the threads' synchronisation,
-   !> which made small levels slower on two threads than on one and the error-against-time
-   !> curve run backwards (figures in the commit that set it). Same bits either way.
-   real(wp), parameter :: serial_dofs = 5000.0_wp
    !> The level of the warm-up run (`warm_up`): cheap, but through every library the study calls.
    integer, parameter :: warm_level = 2
    !> The MPI ranks of this run (`mpirun -n R`; 1 without).
@@ -164,8 +159,10 @@ contains
       n_contact = 0
       threads = omp_get_max_threads()
       do i = 1, size(levels)
-         total_dofs = study_dofs(study, levels(i))
-         if (cli%threads == 0) call omp_set_num_threads(merge(1, threads, total_dofs < serial_dofs))
+         total_dofs = study_dofs(study, levels(i), error)
+         if (.not. allocated(error)) call omp_set_num_threads(level_threads(study, levels(i), cli%threads, threads, &
+            & error))
+         if (allocated(error)) call fail_with(error)
          if (i == 1 .and. total_dofs < serial_dofs) call warm_up(study, min(levels(i), warm_level))
          if (.not. quiet) write (error_unit, '(a,i0,a,i0,a,i0,a)') 'sprc: level ', levels(i), &
             ' (', i, ' of ', size(levels), ')'
@@ -227,21 +224,6 @@ contains
          write (error_unit, '(a)') 'sprc: wrote '//prefix//'.csv, .svg, .h5, .xdmf'
       end if
    end subroutine run_study
-
-   !> The dofs of all bodies at `level`, as estimated before the level is built (sprc_study_budget).
-   function study_dofs(study, level) result(total)
-      type(study_type), intent(in) :: study
-      integer, intent(in) :: level
-      real(wp) :: total, cells, dofs, bytes
-      type(error_type), allocatable :: error
-      integer :: b
-      total = 0.0_wp
-      do b = 1, size(study%bodies)
-         call level_memory(study%scene, study%bodies(b)%geometry, level, cells, dofs, bytes, error)
-         if (allocated(error)) call fail_with(error)
-         total = total + dofs
-      end do
-   end function study_dofs
 
    !> Runs `level` (a coarse one) once, untimed, and drops the result, so that the run's one-off
    !> costs (first calls into the shared libraries, cold caches) stay out of the first level's

@@ -82,6 +82,102 @@ typedef struct _sprc_report *sprc_report;
  * SPRC_STAT_UNSUPPORTED; a failed analysis: its status). */
 sprc_report sprc_run_scene(sprc_error error, const char *path, const int *levels, int nlevels);
 
+/* sprc_run_scene on threads OpenMP threads: threads > 0 runs every level on
+ * that many; 0 chooses as the driver does (and as sprc_run_scene does): a
+ * level estimated below 5000 dofs on one thread, the others on the
+ * caller's omp_get_max_threads(). The caller's OpenMP thread count is
+ * restored on return. Same bits for any thread count. threads < 0:
+ * SPRC_STAT_INVALID_INPUT. */
+sprc_report sprc_run_scene_threads(sprc_error error, const char *path, const int *levels, int nlevels, int threads);
+
+/* ---------------------------------------------------------------- studies */
+
+/* A study run that keeps the fields of some of its levels as arrays: the
+ * arrays the driver writes to PREFIX.h5 (built by the same code, so a field
+ * read here has the bits of its dataset). Addressed by
+ *   row    the 0-based row of the study's report (one per level run);
+ *   grid   a body's name, or "contact_<k>" for &contact pair k (1-based, a
+ *          '_' put in front while a body has that name), as the HDF5 groups
+ *          /level_LL/<grid>/ are named;
+ *   field  for a body: "nodes" [n_nodes][dim] (double), "cells"
+ *          [n_cells][nodes_per_cell] (int, 0-based node indices, VTK order:
+ *          quad4 / quad9 / hex8 / hex27 by dim and order), then its fields as
+ *          named in the HDF5 file: node fields "displacement" [n_nodes][dim],
+ *          "sigma_fe", "sigma_spr", "sigma_sprc" [n_nodes][nstress] (nodal
+ *          stresses, Voigt xx yy xy or xx yy zz xy yz xz; sigma_spr and
+ *          sigma_sprc only where that recovery ran), "inside" [n_nodes] (int:
+ *          1 in the body or on its boundary, 0 for the grid's nodes beyond
+ *          it); cell fields "zz_error_spr", "zz_error_sprc" (ZZ indicator of
+ *          each element, energy norm; where run), "exact_error_fe" (with an
+ *          exact solution), "cut" (int), "volume_fraction", "cell_level"
+ *          (int) [n_cells];
+ *          for a contact pair: "points" [n_points][dim], then "p_fe",
+ *          "p_spr", "p_sprc", "p_exact", "gap", "ts_fe", "ts_sprc", "weight"
+ *          [n_points], "normal" [n_points][dim], "state" [n_points] (int: 0
+ *          open, 1 stick, 2 slip): the columns of PREFIX_contact.csv.
+ * Values in the scene's units; an empty value (not computed) is NaN. In the
+ * HDF5 file a 2-D vector is stored with a zero third column (ParaView's
+ * vectors have 3) and a field of one column is 1-D; here a field has the
+ * columns listed above. */
+
+typedef struct _sprc_study *sprc_study;
+
+/* Field types of sprc_get_study_field_shape. */
+#define SPRC_FIELD_REAL 1
+#define SPRC_FIELD_INT 2
+
+/* Run the scene at path as sprc_run_scene_threads does (levels[nlevels],
+ * NULL and 0: the scene's levels; threads as there) and keep the fields of
+ * the levels keep[nkeep], each one of the levels run (NULL and 0: of every
+ * level run). Fields of the other levels are freed as the run goes on.
+ * Returns a new study (free it with sprc_delete_study) or NULL with the
+ * error set (as sprc_run_scene; a level in keep that is not run:
+ * SPRC_STAT_INVALID_INPUT). */
+sprc_study sprc_run_study(sprc_error error, const char *path, const int *levels, int nlevels, const int *keep,
+                          int nkeep, int threads);
+
+/* The study's report as a new report handle (free it with
+ * sprc_delete_report); NULL on error. */
+sprc_report sprc_get_study_report(sprc_error error, sprc_study study);
+
+/* Number of grids of row: the bodies in scene order, then the contact
+ * pairs in &contact order; -1 on error (a row out of range or whose fields
+ * were not kept: SPRC_STAT_INVALID_INPUT). */
+int sprc_get_study_grids(sprc_error error, sprc_study study, int row);
+
+/* The name of grid index (0-based) of row into buf of *size bytes
+ * (truncated and NUL-terminated like sprc_get_error). Returns 0 for a body,
+ * 1 for a contact pair, -1 on error. */
+int sprc_get_study_grid(sprc_error error, sprc_study study, int row, int index, char *buf, const int *size);
+
+/* Number of fields of the named grid at row (mesh arrays included); -1 on
+ * error (an unknown grid: the message lists the grids). */
+int sprc_get_study_fields(sprc_error error, sprc_study study, int row, const char *grid);
+
+/* The name of field index (0-based) of the named grid at row into buf. */
+void sprc_get_study_field_name(sprc_error error, sprc_study study, int row, const char *grid, int index, char *buf,
+                               const int *size);
+
+/* The shape of a field into shape[2]: rows (nodes, cells or points) and
+ * columns. Returns SPRC_FIELD_REAL or SPRC_FIELD_INT, -1 on error (an
+ * unknown field, e.g. sigma_spr of a study that ran SPR-C only: the
+ * message lists the fields). */
+int sprc_get_study_field_shape(sprc_error error, sprc_study study, int row, const char *grid, const char *field,
+                               int *shape);
+
+/* A real field into values[n], row-major [rows][columns]; n must be
+ * rows * columns. An integer field, a wrong n or NULL values is an error
+ * and leaves values unchanged. */
+void sprc_get_study_field(sprc_error error, sprc_study study, int row, const char *grid, const char *field,
+                          double *values, int n);
+
+/* An integer field ("cells" 0-based) into values[n], as sprc_get_study_field. */
+void sprc_get_study_field_int(sprc_error error, sprc_study study, int row, const char *grid, const char *field,
+                              int *values, int n);
+
+/* Free *study and set it to NULL. */
+void sprc_delete_study(sprc_study *study);
+
 /* --------------------------------------------------------------- reports */
 
 /* A report has one row per level and the columns of the report CSV, in its

@@ -178,3 +178,60 @@ get_recovery_global_error = error_check(_prototype("sprc_get_recovery_global_err
 get_recovery_eta = error_check(_prototype("sprc_get_recovery_eta", ctypes.c_double, _handle, _handle))
 eval_recovery = error_check(_prototype("sprc_eval_recovery", None, _handle, _handle, ctypes.c_int, _c_double_p,
                                        _c_int_p, _c_double_p))
+
+run_scene_threads = error_check(_prototype("sprc_run_scene_threads", _handle, _handle, ctypes.c_char_p, _c_int_p,
+                                           ctypes.c_int, ctypes.c_int))
+run_study = error_check(_prototype("sprc_run_study", _handle, _handle, ctypes.c_char_p, _c_int_p, ctypes.c_int,
+                                   _c_int_p, ctypes.c_int, ctypes.c_int))
+get_study_report = error_check(_prototype("sprc_get_study_report", _handle, _handle, _handle))
+get_study_grids = error_check(_prototype("sprc_get_study_grids", ctypes.c_int, _handle, _handle, ctypes.c_int))
+_get_study_grid = error_check(_prototype("sprc_get_study_grid", ctypes.c_int, _handle, _handle, ctypes.c_int,
+                                         ctypes.c_int, ctypes.c_char_p, _c_int_p))
+_get_study_fields = error_check(_prototype("sprc_get_study_fields", ctypes.c_int, _handle, _handle, ctypes.c_int,
+                                           ctypes.c_char_p))
+_get_study_field_name = error_check(_prototype("sprc_get_study_field_name", None, _handle, _handle, ctypes.c_int,
+                                               ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, _c_int_p))
+_get_study_field_shape = error_check(_prototype("sprc_get_study_field_shape", ctypes.c_int, _handle, _handle,
+                                                ctypes.c_int, ctypes.c_char_p, ctypes.c_char_p, _c_int_p))
+_get_study_field = error_check(_prototype("sprc_get_study_field", None, _handle, _handle, ctypes.c_int,
+                                          ctypes.c_char_p, ctypes.c_char_p, _c_double_p, ctypes.c_int))
+_get_study_field_int = error_check(_prototype("sprc_get_study_field_int", None, _handle, _handle, ctypes.c_int,
+                                              ctypes.c_char_p, ctypes.c_char_p, _c_int_p, ctypes.c_int))
+delete_study = _prototype("sprc_delete_study", None, ctypes.POINTER(_handle))
+
+#: Field types of sprc_get_study_field_shape (SPRC_FIELD_REAL, SPRC_FIELD_INT).
+FIELD_REAL, FIELD_INT = 1, 2
+
+
+def get_study_grid(study, row, index, size=256):
+    """(name, kind) of grid ``index`` of report row ``row``: kind 0 a body, 1 a contact pair."""
+    buf = ctypes.create_string_buffer(size)
+    kind = _get_study_grid(study, row, index, buf, ctypes.byref(ctypes.c_int(size)))
+    return buf.value.decode(), kind
+
+
+def get_study_fields(study, row, grid):
+    """Number of fields of grid ``grid`` (str) at report row ``row``, the mesh arrays included."""
+    return _get_study_fields(study, row, grid.encode())
+
+
+def get_study_field_name(study, row, grid, index, size=256):
+    """The name of field ``index`` of grid ``grid`` (str) at report row ``row``."""
+    buf = ctypes.create_string_buffer(size)
+    _get_study_field_name(study, row, grid.encode(), index, buf, ctypes.byref(ctypes.c_int(size)))
+    return buf.value.decode()
+
+
+def get_study_field(study, row, grid, field):
+    """A field as a numpy array: float64 or int32, shape (rows, columns) in C
+    order, or (rows,) for a field of one column."""
+    shape = (ctypes.c_int * 2)()
+    kind = _get_study_field_shape(study, row, grid.encode(), field.encode(), shape)
+    rows, cols = shape[0], shape[1]
+    if kind == FIELD_INT:
+        values = np.empty((rows, cols), dtype=np.intc)
+        _get_study_field_int(study, row, grid.encode(), field.encode(), values.ctypes.data_as(_c_int_p), rows * cols)
+    else:
+        values = np.empty((rows, cols), dtype=np.float64)
+        _get_study_field(study, row, grid.encode(), field.encode(), values.ctypes.data_as(_c_double_p), rows * cols)
+    return values[:, 0].copy() if cols == 1 else values

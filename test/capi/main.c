@@ -2,11 +2,20 @@
  * NULL pointers and wrong sizes (an error comes back, nothing crashes), the
  * error buffer contract, and a real run of the Lamé cylinder example.
  * Prints one line per test and 'N passed, M failed' last; exits 1 on failure.
- * Usage: capi [ROOT]  (the project root holding example/ and test/; default .) */
+ * Usage: capi [ROOT]  (the project root holding example/ and test/; default .)
+ * The study tests compare the fields of sprc_run_study with the HDF5 file
+ * the driver writes for the same scene and levels: the driver is
+ * $SPRC_DRIVER (built from the same objects; tools/run-tests sets it), the
+ * files go to a directory under $TMPDIR (default /tmp). Without
+ * SPRC_DRIVER those comparisons fail, naming the variable. */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
+
+#include <hdf5.h>
 
 #include "sprc.h"
 
@@ -714,6 +723,283 @@ static void test_recovery_given_xi(void) {
   PASS();
 }
 
+
+/* ------------------------------------------------ fields of a study */
+
+/* One dataset of an HDF5 file: its dims and values (double or int), or
+ * ndims = -1 when it cannot be read. */
+typedef struct {
+  int ndims;
+  hsize_t dims[2];
+  double *reals;
+  int *ints;
+} h5_data;
+
+static h5_data read_dataset(const char *file, const char *path, int is_int) {
+  h5_data d = {-1, {0, 0}, NULL, NULL};
+  hid_t f, ds, sp;
+  size_t n = 1;
+  int k;
+  H5E_auto2_t func;
+  void *data;
+  H5Eget_auto2(H5E_DEFAULT, &func, &data);
+  H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+  f = H5Fopen(file, H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (f >= 0) {
+    ds = H5Dopen2(f, path, H5P_DEFAULT);
+    if (ds >= 0) {
+      sp = H5Dget_space(ds);
+      d.ndims = H5Sget_simple_extent_ndims(sp);
+      if (d.ndims >= 1 && d.ndims <= 2) {
+        H5Sget_simple_extent_dims(sp, d.dims, NULL);
+        for (k = 0; k < d.ndims; k++) n *= (size_t)d.dims[k];
+        if (is_int) {
+          d.ints = malloc(n * sizeof(int) + 1);
+          if (H5Dread(ds, H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, d.ints) < 0) d.ndims = -1;
+        } else {
+          d.reals = malloc(n * sizeof(double) + 1);
+          if (H5Dread(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, d.reals) < 0) d.ndims = -1;
+        }
+      } else {
+        d.ndims = -1;
+      }
+      H5Sclose(sp);
+      H5Dclose(ds);
+    }
+    H5Fclose(f);
+  }
+  H5Eset_auto2(H5E_DEFAULT, func, data);
+  return d;
+}
+
+static void free_dataset(h5_data *d) {
+  free(d->reals);
+  free(d->ints);
+  d->reals = NULL;
+  d->ints = NULL;
+}
+
+/* The HDF5 dataset of a field of grid at level: mesh/x, mesh/connectivity,
+ * node/<name> or cell/<name> (which one exists). */
+static h5_data field_dataset(const char *file, int level, const char *grid, const char *field, int is_int) {
+  char path[512];
+  h5_data d;
+  const char *where[2] = {"node", "cell"};
+  int k;
+  if (strcmp(field, "nodes") == 0 || strcmp(field, "points") == 0) {
+    snprintf(path, sizeof path, "/level_%02d/%s/mesh/x", level, grid);
+    return read_dataset(file, path, 0);
+  }
+  if (strcmp(field, "cells") == 0) {
+    snprintf(path, sizeof path, "/level_%02d/%s/mesh/connectivity", level, grid);
+    return read_dataset(file, path, 1);
+  }
+  for (k = 0; k < 2; k++) {
+    snprintf(path, sizeof path, "/level_%02d/%s/%s/%s", level, grid, where[k], field);
+    d = read_dataset(file, path, is_int);
+    if (d.ndims > 0) return d;
+  }
+  return d;
+}
+
+/* Every field of every grid of every row of study equals its dataset in
+ * file bit for bit (a padded 2-D vector: its first columns, the third
+ * zero); the file holds no field of those grids that the study lacks (the
+ * counts of fields agree). Returns the number of values compared, or -1
+ * with why[] set. */
+static long compare_with_hdf5(sprc_error err, sprc_study study, int nrows, const char *file, char *why, size_t nwhy) {
+  long compared = 0;
+  int row, g, f, k, c, ngrid, nfield, shape[2], type, level;
+  char grid[128], field[128];
+  int size_grid = (int)sizeof grid, size_field = (int)sizeof field;
+  sprc_report rep = sprc_get_study_report(err, study);
+  for (row = 0; row < nrows; row++) {
+    level = (int)sprc_get_report_value(err, rep, row, "level");
+    ngrid = sprc_get_study_grids(err, study, row);
+    if (ngrid <= 0) {
+      snprintf(why, nwhy, "row %d: %d grids", row, ngrid);
+      sprc_delete_report(&rep);
+      return -1;
+    }
+    for (g = 0; g < ngrid; g++) {
+      sprc_get_study_grid(err, study, row, g, grid, &size_grid);
+      nfield = sprc_get_study_fields(err, study, row, grid);
+      for (f = 0; f < nfield; f++) {
+        h5_data d;
+        size_t n, cols_h5;
+        double *vr = NULL;
+        int *vi = NULL, bad = 0;
+        sprc_get_study_field_name(err, study, row, grid, f, field, &size_field);
+        type = sprc_get_study_field_shape(err, study, row, grid, field, shape);
+        n = (size_t)shape[0] * (size_t)shape[1];
+        d = field_dataset(file, level, grid, field, type == SPRC_FIELD_INT);
+        cols_h5 = d.ndims == 2 ? (size_t)d.dims[1] : 1;
+        if (d.ndims < 0 || (size_t)d.dims[0] != (size_t)shape[0] ||
+            !(cols_h5 == (size_t)shape[1] || (cols_h5 == 3 && shape[1] == 2))) {
+          snprintf(why, nwhy, "level %d %s/%s: shape %dx%d, HDF5 %s", level, grid, field, shape[0], shape[1],
+                   d.ndims < 0 ? "unreadable" : "differs");
+          free_dataset(&d);
+          sprc_delete_report(&rep);
+          return -1;
+        }
+        if (type == SPRC_FIELD_REAL) {
+          vr = malloc(n * sizeof(double) + 1);
+          sprc_get_study_field(err, study, row, grid, field, vr, (int)n);
+        } else {
+          vi = malloc(n * sizeof(int) + 1);
+          sprc_get_study_field_int(err, study, row, grid, field, vi, (int)n);
+        }
+        for (k = 0; k < shape[0] && !bad; k++) {
+          for (c = 0; c < (int)cols_h5; c++) {
+            if (type == SPRC_FIELD_REAL) {
+              double h = d.reals[(size_t)k * cols_h5 + c], zero = 0.0;
+              /* bit for bit: NaN (empty) against NaN with the same bits too */
+              if (memcmp(c < shape[1] ? &vr[(size_t)k * shape[1] + c] : &zero, &h, sizeof h) != 0) bad = 1;
+            } else if (vi[(size_t)k * shape[1] + c] != d.ints[(size_t)k * cols_h5 + c]) {
+              bad = 1;
+            }
+          }
+        }
+        compared += (long)n;
+        free(vr);
+        free(vi);
+        free_dataset(&d);
+        if (bad || sprc_check_error(err) != 0) {
+          snprintf(why, nwhy, "level %d %s/%s differs from the HDF5 dataset at row %d", level, grid, field, k - 1);
+          sprc_delete_report(&rep);
+          return -1;
+        }
+      }
+    }
+  }
+  sprc_delete_report(&rep);
+  return compared;
+}
+
+/* Run the driver on scene at levels ("3,4") into dir/out.*; 0 on success. */
+static int run_driver(const char *scene, const char *levels, const char *dir) {
+  char cmd[4096];
+  const char *driver = getenv("SPRC_DRIVER");
+  if (driver == NULL || driver[0] == '\0') return -1;
+  snprintf(cmd, sizeof cmd, "mkdir -p '%s' && '%s' run '%s' --levels %s --output '%s/out' --quiet >/dev/null 2>&1",
+           dir, driver, scene, levels, dir);
+  return system(cmd);
+}
+
+/* The fields of sprc_run_study for a scene against the driver's HDF5. */
+static void study_against_hdf5(const char *name, const char *scene_rel, const char *levels_text, const int *levels,
+                               int nlevels, int min_grids) {
+  char scene[1024], dir[1024], file[1100], why[512] = "";
+  const char *tmp = getenv("TMPDIR");
+  sprc_error err = sprc_new_error();
+  sprc_study study;
+  long n;
+  snprintf(scene, sizeof scene, "%s/%s", root, scene_rel);
+  snprintf(dir, sizeof dir, "%s/sprc-capi-%s-%ld", tmp ? tmp : "/tmp", name, (long)getpid());
+  snprintf(file, sizeof file, "%s/out.h5", dir);
+  CHECK(getenv("SPRC_DRIVER") != NULL, "SPRC_DRIVER is not set (the driver built with this library)");
+  CHECK(run_driver(scene, levels_text, dir) == 0, "the driver failed on the scene");
+  study = sprc_run_study(err, scene, levels, nlevels, NULL, 0, 0);
+  CHECK(study != NULL, "sprc_run_study failed");
+  CHECK(sprc_get_study_grids(err, study, 0) >= min_grids, "fewer grids than bodies and contact pairs");
+  n = compare_with_hdf5(err, study, nlevels, file, why, sizeof why);
+  if (n < 0) printf("     %s\n", why);
+  CHECK(n > 0, "a field differs from the driver's HDF5 dataset");
+  sprc_delete_study(&study);
+  CHECK(study == NULL, "sprc_delete_study did not null the handle");
+  sprc_delete_error(&err);
+  snprintf(why, sizeof why, "rm -rf '%s'", dir);
+  if (system(why) != 0) printf("     could not remove %s\n", dir);
+  printf("     %ld values equal\n", n);
+  PASS();
+}
+
+static void test_study_fields_2d(void) {
+  const int levels[2] = {3, 4};
+  study_against_hdf5("study_fields_2d_lame_cylinder", "example/scenes/lame_cylinder.nml", "3,4", levels, 2, 1);
+}
+
+static void test_study_fields_3d(void) {
+  const int levels[1] = {2};
+  study_against_hdf5("study_fields_3d_lame_sphere", "example/scenes/lame_sphere.nml", "2", levels, 1, 1);
+}
+
+static void test_study_fields_contact(void) {
+  const int levels[1] = {3};
+  study_against_hdf5("study_fields_contact_shrink_fit", "example/scenes/shrink_fit.nml", "3", levels, 1, 3);
+}
+
+/* Bad requests are clean errors; kept levels only; NULL handles. */
+static void test_study_bad_requests(void) {
+  const char *name = "study_bad_requests";
+  char path[1024], buf[64] = "junk";
+  int levels[2] = {3, 4}, keep[1] = {4}, bad_keep[1] = {5}, shape[2] = {-7, -7}, size = (int)sizeof buf;
+  int cells[4] = {-5, -5, -5, -5};
+  double x[4] = {7.0, 7.0, 7.0, 7.0};
+  sprc_error err = sprc_new_error();
+  sprc_study study = NULL;
+  sprc_report rep;
+  snprintf(path, sizeof path, "%s/example/scenes/lame_cylinder.nml", root);
+  CHECK(sprc_run_study(NULL, path, levels, 2, keep, 1, 0) == NULL, "sprc_run_study without an error handle");
+  CHECK(sprc_run_study(err, path, levels, 2, bad_keep, 1, 0) == NULL, "keep = 5 of levels 3,4 gave a study");
+  CHECK(has_error(err, "level 5 is not one of the levels run (3, 4)"), "keep = 5: no error naming it");
+  CHECK(sprc_run_study(err, path, levels, 2, NULL, 1, 0) == NULL, "NULL keep with nkeep = 1 gave a study");
+  CHECK(has_error(err, "keep must be NULL"), "NULL keep with nkeep = 1: no error");
+  CHECK(sprc_run_study(err, path, levels, 2, keep, 1, -1) == NULL, "threads = -1 gave a study");
+  CHECK(has_error(err, "threads = -1"), "threads = -1: no error");
+  CHECK(sprc_run_scene_threads(err, path, levels, 2, -2) == NULL, "sprc_run_scene_threads(-2) gave a report");
+  CHECK(has_error(err, "threads = -2"), "sprc_run_scene_threads(-2): no error");
+  CHECK(sprc_run_study(err, NULL, levels, 2, keep, 1, 0) == NULL && has_error(err, "path is NULL"), "NULL path");
+  CHECK(sprc_get_study_grids(err, NULL, 0) == -1 && has_error(err, "study handle is NULL"), "NULL study");
+  CHECK(sprc_get_study_report(err, NULL) == NULL && has_error(err, "study handle is NULL"), "NULL study report");
+  sprc_get_study_field(err, NULL, 0, "pipe", "nodes", x, 4);
+  CHECK(has_error(err, "study handle is NULL") && x[0] == 7.0, "NULL study field");
+  sprc_delete_study(&study);
+  sprc_delete_study(NULL);
+
+  study = sprc_run_study(err, path, levels, 2, keep, 1, 1);
+  CHECK(study != NULL && sprc_check_error(err) == 0, "sprc_run_study of levels 3,4 keeping 4 failed");
+  rep = sprc_get_study_report(err, study);
+  CHECK(rep != NULL && sprc_get_report_rows(err, rep) == 2, "the study's report has not 2 rows");
+  sprc_delete_report(&rep);
+  CHECK(sprc_get_study_grids(err, study, 0) == -1, "row 0 (level 3, not kept) has grids");
+  CHECK(has_error(err, "row 0 (level 3) were not kept"), "row 0 not kept: no error saying so");
+  CHECK(sprc_get_study_grids(err, study, 2) == -1 && has_error(err, "row 2 is out of range 0..1"), "row 2 of 2");
+  CHECK(sprc_get_study_grids(err, study, -1) == -1 && has_error(err, "row -1 is out of range"), "row -1");
+  CHECK(sprc_get_study_grids(err, study, 1) == 1, "row 1 (level 4) has not 1 grid");
+  CHECK(sprc_get_study_grid(err, study, 1, 0, buf, &size) == 0, "grid 0 is not a body");
+  CHECK(sprc_get_study_grid(err, study, 1, 1, buf, &size) == -1 && has_error(err, "grid index 1 is out of range"),
+        "grid index 1 of 1");
+  CHECK(sprc_get_study_fields(err, study, 1, "nobody") == -1, "an unknown body has fields");
+  CHECK(has_error(err, "no body or contact pair named \"nobody\" (grids: "), "unknown body: no error listing grids");
+  CHECK(sprc_get_study_fields(err, study, 1, NULL) == -1 && has_error(err, "grid name is NULL"), "NULL grid name");
+  CHECK(sprc_get_study_field_shape(err, study, 1, buf, "stress", shape) == -1, "an unknown field has a shape");
+  CHECK(has_error(err, "has no field \"stress\" at row 1 (fields: nodes, cells, displacement"),
+        "unknown field: no error listing the fields");
+  CHECK(shape[0] == -7, "shape written for an unknown field");
+  CHECK(sprc_get_study_field_shape(err, study, 1, buf, "nodes", NULL) == -1 && has_error(err, "shape is NULL"),
+        "NULL shape");
+  CHECK(sprc_get_study_field_shape(err, study, 1, buf, "cells", shape) == SPRC_FIELD_INT && shape[1] == 4,
+        "cells are not int [n][4] for the Q1 example");
+  sprc_get_study_field(err, study, 1, buf, "cells", x, 4);
+  CHECK(has_error(err, "holds integers: read it with sprc_get_study_field_int") && x[0] == 7.0,
+        "an int field read as double");
+  sprc_get_study_field_int(err, study, 1, buf, "displacement", cells, 4);
+  CHECK(has_error(err, "holds doubles") && cells[0] == -5, "a real field read as int");
+  sprc_get_study_field_int(err, study, 1, buf, "cells", cells, 4);
+  CHECK(has_error(err, "n = 4 but field \"cells\""), "a wrong n: no error");
+  CHECK(sprc_get_study_field_shape(err, study, 1, buf, "nodes", shape) == SPRC_FIELD_REAL && shape[1] == 2,
+        "nodes are not double [n][2]");
+  sprc_get_study_field(err, study, 1, buf, "nodes", NULL, shape[0] * shape[1]);
+  CHECK(has_error(err, "values is NULL"), "NULL values: no error");
+  sprc_get_study_field_name(err, study, 1, buf, 99, buf, &size);
+  CHECK(has_error(err, "field index 99 is out of range"), "field index 99: no error");
+  sprc_delete_study(&study);
+  CHECK(study == NULL, "sprc_delete_study did not null the handle");
+  sprc_delete_error(&err);
+  PASS();
+}
+
 int main(int argc, char **argv) {
   /* `fpm test -- SUITE` passes the unit tests' suite name to every test
      program: take argv[1] as the root only if it holds example/scenes. */
@@ -739,6 +1025,10 @@ int main(int argc, char **argv) {
   test_recovery_facets();
   test_recovery_pressure_facets();
   test_recovery_given_xi();
+  test_study_bad_requests();
+  test_study_fields_2d();
+  test_study_fields_3d();
+  test_study_fields_contact();
   printf("%d passed, %d failed\n", passed, failed);
   return failed == 0 ? 0 : 1;
 }

@@ -6,7 +6,8 @@ module sprc_test_output
    use, intrinsic :: iso_c_binding, only: c_loc, c_ptr
    use hdf5, only: hid_t, hsize_t, size_t, h5fopen_f, h5fclose_f, h5dopen_f, h5dclose_f, h5dread_f, &
       & h5dget_space_f, h5sget_simple_extent_ndims_f, h5sget_simple_extent_dims_f, h5sclose_f, &
-      & h5fget_obj_count_f, h5eset_auto_f, H5F_ACC_RDONLY_F, H5F_OBJ_ALL_F, H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER
+      & h5fget_obj_count_f, h5eset_auto_f, H5F_ACC_RDONLY_F, H5F_OBJ_ALL_F, H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, &
+      & h5aopen_f, h5aclose_f, h5aget_type_f, h5aread_f, h5tget_size_f, h5tclose_f
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: stat_io, stat_invalid_input
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type
@@ -639,7 +640,17 @@ contains
          if (.not. allocated(error)) call check(error, all(u(1:2, :) == study%bodies(2)%units%strain*ub) .and. &
             & all(u(3, :) == 0.0_wp), 'displacement of the block at level 3 reads back (in the scene''s units)')
       end associate
+      if (.not. allocated(error)) call check_attribute(file, '/level_03/block/node/displacement', 'units', 'length', error)
+      if (.not. allocated(error)) call check_attribute(file, '/level_03/block/node/displacement', 'components', &
+         & 'x y z (z = 0: a 2-D vector)', error)
+      if (.not. allocated(error)) call check_attribute(file, '/level_04/cylinder/node/sigma_sprc', 'components', &
+         & 'xx yy xy (Voigt order)', error)
+      if (.not. allocated(error)) call check_attribute(file, '/level_04/cylinder/node/sigma_fe', 'units', 'stress', error)
+      if (.not. allocated(error)) call check_attribute(file, '/level_04/cylinder/cell/zz_error_spr', 'units', &
+         & 'energy norm, sqrt(stress*length^2)', error)
       call h5fclose_f(file, hdferr)
+      if (allocated(error)) return
+      call check(error, index(text, '<Information Name="units" Value="stress"/>') > 0, 'the XDMF names the units')
    end subroutine test_run_fields_bodies
 
    !> The slave points of a level's contact pairs (synthetic results: the 2D
@@ -813,6 +824,34 @@ contains
       call h5dread_f(dset, H5T_NATIVE_DOUBLE, buf, hdferr)
       call h5dclose_f(dset, hdferr)
    end subroutine read_real
+
+   !> The string attribute `name` of dataset `path` reads `expected`.
+   subroutine check_attribute(file, path, name, expected, error)
+      integer(hid_t), intent(in) :: file
+      character(len=*), intent(in) :: path, name, expected
+      type(error_type), allocatable, intent(out) :: error
+      integer(hid_t) :: dset, attr, atype
+      integer(size_t) :: n
+      character(len=256) :: value
+      integer :: hdferr, e2
+
+      value = ''
+      n = 0
+      call h5dopen_f(file, path, dset, hdferr)
+      if (hdferr >= 0) then
+         call h5aopen_f(dset, name, attr, hdferr)
+         if (hdferr >= 0) then
+            call h5aget_type_f(attr, atype, hdferr)
+            if (hdferr >= 0) call h5tget_size_f(atype, n, hdferr)
+            if (hdferr >= 0 .and. n <= len(value)) call h5aread_f(attr, atype, value(1:n), [1_hsize_t], hdferr)
+            call h5tclose_f(atype, e2)
+            call h5aclose_f(attr, e2)
+         end if
+         call h5dclose_f(dset, e2)
+      end if
+      call check(error, hdferr >= 0 .and. value(1:n) == expected, path//' attribute '//name//' = "'// &
+         & value(1:n)//'", expected "'//expected//'"')
+   end subroutine check_attribute
 
    subroutine read_int(file, path, shape_, values, error)
       integer(hid_t), intent(in) :: file

@@ -1,17 +1,10 @@
 !> C API, scenes: run the study of a scene file (SCENE.md) and return its
 !> report. The C run writes no files, whatever the scene's `output`; it
-!> computes exactly what `sprc run` computes and reports.
+!> computes exactly what `sprc run` computes and reports, on the threads
+!> the driver would use (`sprc_capi_study`).
 module sprc_capi_scene
-   use, intrinsic :: iso_c_binding, only: c_ptr, c_int, c_null_ptr, c_associated, c_f_pointer, c_loc
-   use sprc_core_error, only: error_type, stat_invalid_input, stat_out_of_memory
-   use sprc_io_scene, only: scene_type, read_scene
-   use sprc_study_mesh, only: study_levels
-   use sprc_study_level, only: study_type, prepare_study, run_level, level_type, hold_starts
-   use sprc_fem_nested, only: fe_displacement_type
-   use sprc_study_row, only: report_row_type
-   use sprc_capi_error, only: capi_error_type, get_capi_error, set_capi_error
-   use sprc_capi_report, only: capi_report_type
-   use sprc_capi_string, only: c_string
+   use, intrinsic :: iso_c_binding, only: c_ptr, c_int
+   use sprc_capi_study, only: run_scene_report
    implicit none
    private
 
@@ -22,83 +15,14 @@ contains
    !> Read the scene file `path` and analyse it at `levels[nlevels]` (NULL
    !> and 0 take the scene's own levels). Returns a new report, or NULL with
    !> the error set: bad arguments, an unreadable or invalid scene, a scene
-   !> this version cannot run, a failed level.
+   !> this version cannot run, a failed level. `sprc_run_scene_threads` with
+   !> the driver's choice of threads.
    function sprc_run_scene(errh, path, levels, nlevels) result(reph) bind(C, name='sprc_run_scene')
       type(c_ptr), value :: errh, path, levels
       integer(c_int), value :: nlevels
       type(c_ptr) :: reph
-      type(capi_error_type), pointer :: err
-      type(capi_report_type), pointer :: rep
-      type(report_row_type), allocatable :: rows(:)
-      type(error_type), allocatable :: error
-      character(len=:), allocatable :: file
-      integer(c_int), pointer :: override(:)
-      integer :: stat
-      logical :: ok
 
-      reph = c_null_ptr
-      if (.not. get_capi_error(errh, err)) return
-      call c_string(path, file, ok)
-      if (.not. ok) then
-         call set_capi_error(err, message='sprc_run_scene: the scene path is NULL', stat=stat_invalid_input)
-         return
-      end if
-      if (nlevels < 0 .or. (nlevels > 0 .and. .not. c_associated(levels))) then
-         call set_capi_error(err, message='sprc_run_scene: levels must be NULL with nlevels = 0, '// &
-            'or point to nlevels > 0 levels', stat=stat_invalid_input)
-         return
-      end if
-      if (nlevels > 0) then
-         call c_f_pointer(levels, override, [nlevels])
-         call run_study(file, rows, error, override)
-      else
-         call run_study(file, rows, error)
-      end if
-      if (allocated(error)) then
-         call set_capi_error(err, error)
-         return
-      end if
-      allocate (rep, stat=stat)
-      if (stat /= 0) then
-         call set_capi_error(err, message='sprc_run_scene: cannot allocate the report', stat=stat_out_of_memory)
-         return
-      end if
-      call move_alloc(rows, rep%rows)
-      reph = c_loc(rep)
+      reph = run_scene_report(errh, 'sprc_run_scene', path, levels, nlevels, 0_c_int)
    end function sprc_run_scene
-
-   !> Read the scene and run each level of the study.
-   subroutine run_study(path, rows, error, override)
-      character(len=*), intent(in) :: path
-      type(report_row_type), allocatable, intent(out) :: rows(:)
-      type(error_type), allocatable, intent(out) :: error
-      integer(c_int), intent(in), optional :: override(:)
-      type(scene_type) :: scene
-      type(study_type) :: study
-      type(level_type) :: result
-      !> The previous level's displacements, where the iterative solves start.
-      type(fe_displacement_type), allocatable :: starts(:)
-      integer, allocatable :: levels(:)
-      integer :: i
-
-      call read_scene(path, scene, error)
-      if (allocated(error)) return
-      if (present(override)) then
-         call study_levels(scene, int(override), levels, error)
-      else
-         call study_levels(scene, levels=levels, error=error)
-      end if
-      if (allocated(error)) return
-      call prepare_study(scene, 0, study, error)
-      if (allocated(error)) return
-      allocate (rows(size(levels)))
-      do i = 1, size(levels)
-         call run_level(study, levels(i), result, error, start=starts)
-         if (allocated(error)) return
-         rows(i) = result%row
-         call hold_starts(result, starts, error)
-         if (allocated(error)) return
-      end do
-   end subroutine run_study
 
 end module sprc_capi_scene

@@ -24,8 +24,9 @@
 module sprc_io_hdf5
    use, intrinsic :: iso_c_binding, only: c_ptr, c_funptr, c_int, c_int64_t, c_loc, c_null_ptr, c_null_funptr
    use hdf5, only: hid_t, hsize_t, h5open_f, h5iis_valid_f, h5fcreate_f, h5fclose_f, h5gcreate_f, h5gclose_f, &
-      & h5screate_simple_f, h5sclose_f, h5dcreate_f, h5dwrite_f, h5dclose_f, &
-      & H5F_ACC_TRUNC_F, H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER
+      & h5screate_simple_f, h5screate_f, h5sclose_f, h5dcreate_f, h5dwrite_f, h5dclose_f, &
+      & h5tcopy_f, h5tset_size_f, h5tclose_f, h5acreate_f, h5awrite_f, h5aclose_f, size_t, &
+      & H5F_ACC_TRUNC_F, H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, H5T_NATIVE_CHARACTER, H5S_SCALAR_F
    use sprc_core_kinds, only: wp
    use sprc_core_text, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_io, stat_invalid_input
@@ -247,7 +248,7 @@ contains
    !> 3, z = 0 in 2D); with `components` (one name per row of `values`,
    !> e.g. ['xx', 'yy', 'xy'] for 2D Voigt stresses) ParaView shows one
    !> scalar `<name>_<component>` per row.
-   subroutine h5_write_node_field(self, level, name, values, error, components, body)
+   subroutine h5_write_node_field(self, level, name, values, error, components, body, units)
       class(h5_output_type), intent(inout) :: self
       integer, intent(in) :: level
       character(len=*), intent(in) :: name
@@ -256,14 +257,16 @@ contains
       character(len=*), intent(in), optional :: components(:)
       !> The body of the level's grid (as given to write_level).
       character(len=*), intent(in), optional :: body
+      !> The values' units in words (an HDF5 attribute `units` and an XDMF Information; '' none).
+      character(len=*), intent(in), optional :: units
 
       call write_field(self, center_node, level, name, size(values, 1), size(values, 2), error, components, body, &
-         real_values=values)
+         real_values=values, units=units)
    end subroutine h5_write_node_field
 
    !> Write an integer node field `values(ncomp, n_nodes)` (e.g. the state of
    !> a contact point), stored as int32; components as for real node fields.
-   subroutine h5_write_node_field_int(self, level, name, values, error, components, body)
+   subroutine h5_write_node_field_int(self, level, name, values, error, components, body, units)
       class(h5_output_type), intent(inout) :: self
       integer, intent(in) :: level
       character(len=*), intent(in) :: name
@@ -272,14 +275,16 @@ contains
       character(len=*), intent(in), optional :: components(:)
       !> The body of the level's grid (as given to write_level).
       character(len=*), intent(in), optional :: body
+      !> The values' units in words (an HDF5 attribute `units` and an XDMF Information; '' none).
+      character(len=*), intent(in), optional :: units
 
       call write_field(self, center_node, level, name, size(values, 1), size(values, 2), error, components, body, &
-         int_values=values)
+         int_values=values, units=units)
    end subroutine h5_write_node_field_int
 
    !> Write a real cell field `values(ncomp, n_cells)` (e.g. element error
    !> indicators); components as for node fields.
-   subroutine h5_write_cell_field_real(self, level, name, values, error, components, body)
+   subroutine h5_write_cell_field_real(self, level, name, values, error, components, body, units)
       class(h5_output_type), intent(inout) :: self
       integer, intent(in) :: level
       character(len=*), intent(in) :: name
@@ -288,14 +293,16 @@ contains
       character(len=*), intent(in), optional :: components(:)
       !> The body of the level's grid (as given to write_level).
       character(len=*), intent(in), optional :: body
+      !> The values' units in words (an HDF5 attribute `units` and an XDMF Information; '' none).
+      character(len=*), intent(in), optional :: units
 
       call write_field(self, center_cell, level, name, size(values, 1), size(values, 2), error, components, body, &
-         real_values=values)
+         real_values=values, units=units)
    end subroutine h5_write_cell_field_real
 
    !> Write an integer cell field `values(ncomp, n_cells)` (e.g. the cell
    !> class: internal / cut), stored as int32.
-   subroutine h5_write_cell_field_int(self, level, name, values, error, components, body)
+   subroutine h5_write_cell_field_int(self, level, name, values, error, components, body, units)
       class(h5_output_type), intent(inout) :: self
       integer, intent(in) :: level
       character(len=*), intent(in) :: name
@@ -304,18 +311,20 @@ contains
       character(len=*), intent(in), optional :: components(:)
       !> The body of the level's grid (as given to write_level).
       character(len=*), intent(in), optional :: body
+      !> The values' units in words (an HDF5 attribute `units` and an XDMF Information; '' none).
+      character(len=*), intent(in), optional :: units
 
       call write_field(self, center_cell, level, name, size(values, 1), size(values, 2), error, components, body, &
-         int_values=values)
+         int_values=values, units=units)
    end subroutine h5_write_cell_field_int
 
    !> Check, store and record one field (real or integer values).
-   subroutine write_field(self, center, level, name, ncomp, n, error, components, body, real_values, int_values)
+   subroutine write_field(self, center, level, name, ncomp, n, error, components, body, real_values, int_values, units)
       type(h5_output_type), intent(inout) :: self
       integer, intent(in) :: center, level, ncomp, n
       character(len=*), intent(in) :: name
       type(error_type), allocatable, intent(out) :: error
-      character(len=*), intent(in), optional :: components(:), body
+      character(len=*), intent(in), optional :: components(:), body, units
       real(wp), intent(in), optional :: real_values(:, :)
       integer, intent(in), optional :: int_values(:, :)
       type(xdmf_field_type) :: field
@@ -382,6 +391,8 @@ contains
          return
       end if
       field%ncomp = stored
+      field%units = ''
+      if (present(units)) field%units = units
       call check_names_free(self%grids(g), field, where, error)
       if (allocated(error)) return
 
@@ -403,11 +414,11 @@ contains
       if (present(real_values)) then
          rbuf(:ncomp, :) = real_values
          call write_dataset(self%file, field_path(self%grids(g), center, name), dims, H5T_NATIVE_DOUBLE, c_loc(rbuf), &
-            where, error)
+            where, error, field_attributes(field, ncomp))
       else
          ibuf(:ncomp, :) = int_values
          call write_dataset(self%file, field_path(self%grids(g), center, name), dims, H5T_NATIVE_INTEGER, c_loc(ibuf), &
-            where, error)
+            where, error, field_attributes(field, ncomp))
       end if
       call quiet_end(quiet)
       if (allocated(error)) return
@@ -569,23 +580,57 @@ contains
       call check_hdf5(hdferr, 'create group '//path//' ('//where//')', error)
    end subroutine create_group
 
+   !> The string attributes of a field's dataset, as (name, value) rows:
+   !> `components` (the columns, e.g. 'xx yy xy' for Voigt stresses, 'x y z'
+   !> for a vector, 'x y z (z = 0: a 2-D vector)' when padded), `units`.
+   function field_attributes(field, ncomp) result(attrs)
+      type(xdmf_field_type), intent(in) :: field
+      integer, intent(in) :: ncomp
+      character(len=max_name_length*8), allocatable :: attrs(:, :)
+      character(len=:), allocatable :: columns
+      integer :: j
+
+      allocate (attrs(2, 0))
+      columns = ''
+      if (field%kind == field_components) then
+         columns = trim(field%components(1))
+         do j = 2, size(field%components)
+            columns = columns//' '//trim(field%components(j))
+         end do
+         if (field%components(1) == 'xx') columns = columns//' (Voigt order)'
+      else if (field%kind == field_vector) then
+         columns = 'x y z'
+         if (ncomp == 2) columns = 'x y z (z = 0: a 2-D vector)'
+      end if
+      if (len(columns) > 0) attrs = reshape([character(len=len(attrs)) :: 'components', columns], [2, 1])
+      if (len(field%units) > 0) attrs = reshape([character(len=len(attrs)) :: attrs, 'units', field%units], &
+         & [2, size(attrs, 2) + 1])
+   end function field_attributes
+
    !> Create dataset `path` of Fortran shape `dims` and memory type `mem_type`
-   !> from the buffer at `buf`; the file type is the native one. Every id
-   !> opened here is closed here, also on failure.
-   subroutine write_dataset(file, path, dims, mem_type, buf, where, error)
+   !> from the buffer at `buf`, with the string attributes `attrs` (name,
+   !> value); the file type is the native one. Every id opened here is
+   !> closed here, also on failure.
+   subroutine write_dataset(file, path, dims, mem_type, buf, where, error, attrs)
       integer(hid_t), intent(in) :: file, mem_type
       character(len=*), intent(in) :: path, where
       integer(hsize_t), intent(in) :: dims(:)
       type(c_ptr), intent(in) :: buf
       type(error_type), allocatable, intent(out) :: error
+      character(len=*), intent(in), optional :: attrs(:, :)
       integer(hid_t) :: space, dset
-      integer :: hdferr, closeerr
+      integer :: hdferr, closeerr, k
 
       call h5screate_simple_f(size(dims), dims, space, hdferr)
       if (hdferr >= 0) then
          call h5dcreate_f(file, path, mem_type, space, dset, hdferr)
          if (hdferr >= 0) then
             call h5dwrite_f(dset, mem_type, buf, hdferr)
+            if (present(attrs)) then
+               do k = 1, size(attrs, 2)
+                  if (hdferr >= 0) call write_string_attribute(dset, trim(attrs(1, k)), trim(attrs(2, k)), hdferr)
+               end do
+            end if
             call h5dclose_f(dset, closeerr)
             hdferr = min(hdferr, closeerr)
          end if
@@ -594,6 +639,32 @@ contains
       end if
       call check_hdf5(hdferr, 'write dataset '//path//' ('//where//')', error)
    end subroutine write_dataset
+
+   !> A scalar fixed-length string attribute `name` = `value` (not empty) of the object `obj`.
+   subroutine write_string_attribute(obj, name, value, hdferr)
+      integer(hid_t), intent(in) :: obj
+      character(len=*), intent(in) :: name, value
+      integer, intent(out) :: hdferr
+      integer(hid_t) :: space, stype, attr
+      integer :: closeerr
+
+      call h5screate_f(H5S_SCALAR_F, space, hdferr)
+      if (hdferr < 0) return
+      call h5tcopy_f(H5T_NATIVE_CHARACTER, stype, hdferr)
+      if (hdferr >= 0) then
+         call h5tset_size_f(stype, int(len(value), size_t), hdferr)
+         if (hdferr >= 0) call h5acreate_f(obj, name, stype, space, attr, hdferr)
+         if (hdferr >= 0) then
+            call h5awrite_f(attr, stype, value, [1_hsize_t], hdferr)
+            call h5aclose_f(attr, closeerr)
+            hdferr = min(hdferr, closeerr)
+         end if
+         call h5tclose_f(stype, closeerr)
+         hdferr = min(hdferr, closeerr)
+      end if
+      call h5sclose_f(space, closeerr)
+      hdferr = min(hdferr, closeerr)
+   end subroutine write_string_attribute
 
    !> Save HDF5's automatic error handler and switch it off.
    subroutine quiet_begin(quiet)

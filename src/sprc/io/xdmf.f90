@@ -10,6 +10,25 @@
 !> /level_LL/contact_<k>/mesh/x        float64 (n_points, dim)   slave points of &contact pair k
 !> /level_LL/contact_<k>/node/<name>   float64 or int32 (n_points) | (n_points, 3)
 !> ```
+!> The fields of `sprc run` (`sprc_io_fields`): per body node fields
+!> `displacement`, `sigma_fe`, `sigma_spr`, `sigma_sprc`, `inside`, cell
+!> fields `zz_error_spr`, `zz_error_sprc`, `exact_error_fe`, `cut`,
+!> `volume_fraction`, `cell_level`. Every field dataset carries string
+!> attributes `units` (in words: length, stress, energy norm; the scene's
+!> own units) and, with several columns, `components` ('xx yy xy (Voigt
+!> order)', 'x y z', or 'x y z (z = 0: a 2-D vector)'); the XDMF repeats
+!> the units as an Information element of the Attribute.
+!>
+!> **Only the body.** The grid's cells are the cells that meet the body, so
+!> a cut cell and its nodes reach beyond the boundary, where the FE and
+!> recovered fields are extrapolations. The node field `inside` is 1 for a
+!> node in the body or on its boundary (within the geometry's snapping
+!> tolerance) and 0 beyond: in ParaView, Threshold on `inside` from 1 to 1
+!> with "All Scalars" on shows the cells whose nodes all lie in the body
+!> (the cut cells go); statistics of a node field over the body take the
+!> nodes where `inside` = 1 (e.g. the largest sigma_sprc_xx). The cell field
+!> `volume_fraction` is the share of each cell in the body.
+!>
 !> LL is the level with two digits (`/level_04`), <body> the body's name
 !> (`sprc run` writes every body so, even a scene's only one); a writer that
 !> gives no body name gets `/level_LL/mesh/x` etc. A field with one component
@@ -84,6 +103,8 @@ module sprc_io_xdmf
       logical :: is_integer = .false.
       !> Component names, for kind = field_components.
       character(len=max_name_length), allocatable :: components(:)
+      !> The values' units in words ('' or not allocated: none given).
+      character(len=:), allocatable :: units
    end type xdmf_field_type
 
    !> One level's mesh and fields as stored in the HDF5 file; with several
@@ -328,16 +349,16 @@ contains
       text = ''
       select case (field%kind)
       case (field_scalar)
-         text = attribute_open(attribute_name(field, 1), 'Scalar', center)// &
+         text = attribute_open(attribute_name(field, 1), 'Scalar', center)//information(field)// &
             '     '//data_item(h5, path, [n], field%is_integer)//nl//'    </Attribute>'//nl
       case (field_vector)
-         text = attribute_open(attribute_name(field, 1), 'Vector', center)// &
+         text = attribute_open(attribute_name(field, 1), 'Vector', center)//information(field)// &
             '     '//data_item(h5, path, [n, field%ncomp], field%is_integer)//nl//'    </Attribute>'//nl
       case default
          item = data_item(h5, path, [n, field%ncomp], field%is_integer)
          do j = 1, field%ncomp
             ! HyperSlab parameters: start, stride, count, each in (row, column).
-            text = text//attribute_open(attribute_name(field, j), 'Scalar', center)// &
+            text = text//attribute_open(attribute_name(field, j), 'Scalar', center)//information(field)// &
                '     <DataItem ItemType="HyperSlab" Dimensions="'//itoa(n)//' 1" Type="HyperSlab">'//nl// &
                '      <DataItem Dimensions="3 2" NumberType="Int" Format="XML">0 '//itoa(j - 1)//' 1 1 '// &
                itoa(n)//' 1</DataItem>'//nl// &
@@ -345,6 +366,15 @@ contains
          end do
       end select
    end function attribute_text
+
+   !> `<Information Name="units" Value="..."/>` of a field with units ('' without).
+   function information(field) result(text)
+      type(xdmf_field_type), intent(in) :: field
+      character(len=:), allocatable :: text
+      text = ''
+      if (.not. allocated(field%units)) return
+      if (len(field%units) > 0) text = '     <Information Name="units" Value="'//escape(field%units)//'"/>'//nl
+   end function information
 
    !> XDMF needs the nodes per element of a Polyvertex topology (the other types fix it).
    pure function nodes_per_element(cell_type) result(text)
