@@ -13,13 +13,15 @@ module sprc_test_adapt
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_positive_inf
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: stat_invalid_input
+   use sprc_geometry_region, only: cell_inside
    use sprc_geometry_shape, only: shape_type, new_disk, new_sphere
    use sprc_geometry_body, only: body_type, new_body, csg_add
    use sprc_grid_tree, only: grid_type, grid_max_level
    use sprc_grid_cut_mesh, only: cut_mesh_type
    use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature
    use sprc_grid_adapt, only: optimal_levels, optimal_ratio, fraction_levels, default_max_change
-   use sprc_test_grid, only: check_balance, check_volume
+   use sprc_core_text, only: itoa
+   use sprc_test_grid, only: check_balance, check_volume, int_box
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type
    implicit none
    private
@@ -44,6 +46,7 @@ contains
          new_unittest('refine-at-point-3d', test_point_3d), &
          new_unittest('coarsen-half-2d', test_coarsen_2d), &
          new_unittest('coarsen-half-3d', test_coarsen_3d), &
+         new_unittest('level-after-balance', test_level_after_balance), &
          new_unittest('mesh-measure-2d', test_measure_2d), &
          new_unittest('mesh-measure-3d', test_measure_3d), &
          new_unittest('adapted-bad-input', test_adapted_bad_input), &
@@ -94,19 +97,6 @@ contains
          & all(a%box_min == b%box_min) .and. a%box_size == b%box_size, what//': level, finest level, box')
    end subroutine check_same_grid
 
-   !> Integer box of leaf i at resolution grid_max_level.
-   pure subroutine int_box(grid, i, lo, hi)
-      type(grid_type), intent(in) :: grid
-      integer, intent(in) :: i
-      integer, intent(out) :: lo(3), hi(3)
-      integer :: s
-      s = 2**(grid_max_level - grid%leaf_level(i))
-      lo = 0
-      hi = 0
-      lo(1:grid%dim) = grid%leaf_coord(:, i)*s
-      hi(1:grid%dim) = lo(1:grid%dim) + s
-   end subroutine int_box
-
    !> Brute force over all pairs (new leaf, old leaf) that overlap: the new leaf is at
    !> least as fine as the old leaf's target (clamped to max_level). With `exact`, a new
    !> leaf is also no finer than the largest such target unless the balance split it
@@ -131,13 +121,52 @@ contains
       end do
    end subroutine check_targets
 
-   pure function itoa(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=16) :: buf
-      write (buf, '(i0)') i
-      s = trim(buf)
-   end function itoa
+   !> Brute force: every leaf of level l > 0 is needed, i.e. its parent overlaps an old
+   !> leaf whose target (at most max_level) is >= l, or the balance split the parent:
+   !> a leaf of level >= l + 1 has its level-l ancestor touching the parent's box (the
+   !> balance makes a level-l cell exist next to the parent of a level-(l+1) leaf).
+   subroutine check_needed(error, new, old, target, max_level)
+      type(error_type), allocatable, intent(out) :: error
+      type(grid_type), intent(in) :: new, old
+      integer, intent(in) :: target(:), max_level
+      integer :: i, j, k, d, l, lo(3), hi(3), olo(3), ohi(3), s
+      logical :: needed
+      d = new%dim
+      do i = 1, new%n_leaves
+         l = new%leaf_level(i)
+         if (l == 0) cycle
+         s = 2**(grid_max_level - l + 1)
+         lo = 0
+         hi = 0
+         lo(1:d) = (new%leaf_coord(:, i)/2)*s
+         hi(1:d) = lo(1:d) + s
+         needed = .false.
+         do j = 1, old%n_leaves
+            call int_box(old, j, olo, ohi)
+            if (all(lo(1:d) < ohi(1:d) .and. olo(1:d) < hi(1:d)) .and. min(target(j), max_level) >= l) then
+               needed = .true.
+               exit
+            end if
+         end do
+         if (needed) cycle
+         do k = 1, new%n_leaves
+            if (new%leaf_level(k) <= l) cycle
+            olo = 0
+            ohi = 0
+            olo(1:d) = ishft(new%leaf_coord(:, k), l - new%leaf_level(k))*2**(grid_max_level - l)
+            ohi(1:d) = olo(1:d) + 2**(grid_max_level - l)
+            if (all(lo(1:d) <= ohi(1:d) .and. olo(1:d) <= hi(1:d))) then
+               needed = .true.
+               exit
+            end if
+         end do
+         if (.not. needed) then
+            call test_failed(error, 'leaf '//itoa(i)//' of level '//itoa(l)//' is finer than any target or '// &
+               & 'the balance needs')
+            return
+         end if
+      end do
+   end subroutine check_needed
 
    ! ------------------------------------------------------------ build_adapted
 
@@ -190,6 +219,10 @@ contains
       call check_same_grid(error, new, ref, 'one level finer')
       if (allocated(error)) return
       call check(error, new%refine_boundary, 0, 'uniform: no levels between coarsest and finest')
+      if (allocated(error)) return
+      call check(error, new%n_inside(level + 1) + new%n_cut(level + 1) + new%n_outside(level + 1) == &
+         & ishft(1_i8, dim*(level + 1)) .and. all(new%n_outside(:level) == 0_i8), &
+         & 'uniform: every cell of the level counted at that level')
       if (allocated(error)) return
       call old%build(body, dim, [0.0_wp, 0.0_wp, 0.0_wp], 1.0_wp, level, 1, error)
       if (.not. allocated(error)) call new%build_adapted(body, old, old%leaf_level + 1, grid_max_level, error)
@@ -245,6 +278,10 @@ contains
       if (allocated(error)) return
       call check_targets(error, new, old, target, level + 3)
       if (allocated(error)) return
+      call check_needed(error, new, old, target, level + 3)
+      if (allocated(error)) return
+      call check(error, new%level, minval(new%leaf_level), 'level = coarsest leaf level')
+      if (allocated(error)) return
       i = new%locate_point(p(1:dim))
       call check(error, new%leaf_level(i), level + 3, 'the point''s leaf')
       if (allocated(error)) return
@@ -278,12 +315,14 @@ contains
       call point_case(error, 3, 2)
    end subroutine test_point_3d
 
-   !> Targets one level coarser on the half x < 1/2: every leaf there is one level
-   !> coarser (no balance against the other half, one level apart), the other half
-   !> keeps its leaves; the coarse half has 1/2**dim of the old leaves' volume count.
-   subroutine coarsen_case(error, dim, level)
+   !> Targets one level coarser on the half x < 1/2. On a uniform grid every leaf
+   !> there is one level coarser (no balance against the other half, one level apart)
+   !> and the other half keeps its leaves. On a grid with boundary refinement (rb = 1)
+   !> the old leaves under one new cell want different levels: every target is met
+   !> and no leaf is finer than a target or the balance needs (brute force).
+   subroutine coarsen_case(error, dim, level, rb)
       type(error_type), allocatable, intent(out) :: error
-      integer, intent(in) :: dim, level
+      integer, intent(in) :: dim, level, rb
       type(body_type) :: body
       type(grid_type) :: old, new
       integer, allocatable :: target(:)
@@ -292,33 +331,36 @@ contains
 
       call round_body(dim, 0.31_wp, body, error)
       if (allocated(error)) return
-      call old%build(body, dim, [0.0_wp, 0.0_wp, 0.0_wp], 1.0_wp, level, 0, error)
+      call old%build(body, dim, [0.0_wp, 0.0_wp, 0.0_wp], 1.0_wp, level, rb, error)
       if (allocated(error)) return
       target = old%leaf_level
       n_left_old = 0
       do j = 1, old%n_leaves
          call old%leaf_box(j, lo(1:dim), hi(1:dim))
          if (hi(1) <= 0.5_wp) then
-            target(j) = level - 1
+            target(j) = old%leaf_level(j) - 1
             n_left_old = n_left_old + 1
          end if
       end do
-      call new%build_adapted(body, old, target, level, error)
+      call new%build_adapted(body, old, target, level + rb, error)
       if (allocated(error)) return
       call check_balance(error, new)
       if (allocated(error)) return
       call check_volume(error, new)
       if (allocated(error)) return
-      call check_targets(error, new, old, target, level)
+      call check_targets(error, new, old, target, level + rb)
+      if (allocated(error)) return
+      call check_needed(error, new, old, target, level + rb)
       if (allocated(error)) return
       n_left_new = 0
       do j = 1, new%n_leaves
          call new%leaf_box(j, lo(1:dim), hi(1:dim))
          if (hi(1) <= 0.5_wp) then
             n_left_new = n_left_new + 1
-            call check(error, new%leaf_level(j), level - 1, 'a leaf of the coarsened half')
+            if (rb == 0) call check(error, new%leaf_level(j), level - 1, 'a leaf of the coarsened half')
          else
-            call check(error, new%leaf_level(j), level, 'a leaf of the kept half')
+            call check(error, new%leaf_level(j), old%leaf_level(old%locate_point(lo(1:dim))), &
+               & 'a leaf of the kept half')
          end if
          if (allocated(error)) return
       end do
@@ -326,18 +368,53 @@ contains
       if (allocated(error)) return
       call check(error, n_left_new < n_left_old .and. n_left_new >= n_left_old/2**dim, 'fewer leaves on the left')
       if (allocated(error)) return
-      call check(error, new%level == level - 1 .and. new%refine_boundary == 1, 'coarsest level one below')
+      call check(error, new%level, minval(new%leaf_level), 'level = coarsest leaf level')
+      if (allocated(error)) return
+      if (rb == 0) call check(error, new%level == level - 1 .and. new%refine_boundary == 1, 'coarsest level one below')
    end subroutine coarsen_case
 
    subroutine test_coarsen_2d(error)
       type(error_type), allocatable, intent(out) :: error
-      call coarsen_case(error, 2, 4)
+      call coarsen_case(error, 2, 4, 0)
+      if (.not. allocated(error)) call coarsen_case(error, 2, 4, 1)
    end subroutine test_coarsen_2d
 
    subroutine test_coarsen_3d(error)
       type(error_type), allocatable, intent(out) :: error
-      call coarsen_case(error, 3, 3)
+      call coarsen_case(error, 3, 3, 0)
+      if (.not. allocated(error)) call coarsen_case(error, 3, 3, 1)
    end subroutine test_coarsen_3d
+
+   !> Inside leaves one level coarser next to boundary leaves two levels finer: the
+   !> balance splits the coarsened leaves again, and the grid's level is the coarsest
+   !> level left (what the hanging constraints and the external counts rely on).
+   subroutine test_level_after_balance(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: body
+      type(grid_type) :: old, new
+      integer, allocatable :: target(:)
+      real(wp) :: lo(2), hi(2)
+      integer :: j
+      call round_body(2, 0.31_wp, body, error)
+      if (.not. allocated(error)) call old%build(body, 2, [0.0_wp, 0.0_wp], 1.0_wp, 4, 1, error)
+      if (allocated(error)) return
+      ! inside leaves of the left half one coarser (level 3), the upper right quadrant one finer
+      target = old%leaf_level
+      do j = 1, old%n_leaves
+         call old%leaf_box(j, lo, hi)
+         if (hi(1) <= 0.5_wp .and. old%leaf_class(j) == cell_inside) target(j) = target(j) - 1
+         if (lo(2) >= 0.5_wp .and. lo(1) >= 0.5_wp) target(j) = target(j) + 1
+      end do
+      call new%build_adapted(body, old, target, 6, error)
+      if (allocated(error)) return
+      call check(error, new%n_balance_splits > 0, 'the balance split coarsened leaves')
+      if (allocated(error)) return
+      call check(error, new%level, minval(new%leaf_level), 'level = coarsest leaf level')
+      if (allocated(error)) return
+      call check_volume(error, new)
+      if (allocated(error)) return
+      call check_balance(error, new)
+   end subroutine test_level_after_balance
 
    !> The cut mesh on an adapted grid (refined at a point, coarsened on a half, boundary
    !> refined): its cell rules add up to the area or volume of the body.
@@ -374,6 +451,8 @@ contains
          if (hi(1) <= 0.5_wp) n_left_new = n_left_new + 1
       end do
       call check(error, n_left_new < n_left_old .and. mesh%grid%max_level == level + 2, 'coarsened and refined')
+      if (allocated(error)) return
+      call check(error, mesh%grid%level, minval(mesh%grid%leaf_level), 'level = coarsest leaf level')
       if (allocated(error)) return
       call check(error, mesh%nodes%degree == 2 .and. mesh%nodes%n_nodes > 0 .and. mesh%t_mesh >= 0.0_wp, &
          & 'nodes of degree 2 and the time')
@@ -453,8 +532,8 @@ contains
    subroutine test_optimal_equal(error)
       type(error_type), allocatable, intent(out) :: error
       integer, allocatable :: levels(:)
-      integer :: leaf(8)
-      real(wp) :: e2(8)
+      integer :: leaf(8), k, p, d
+      real(wp) :: e2(8), t
       leaf = 5
       e2 = 1.0_wp
       ! p = 1, eta/eta_t = 4: r = 1/4, two levels finer, in 2D and 3D alike
@@ -471,6 +550,23 @@ contains
       if (allocated(error)) return
       call check(error, all(levels == 6), 'p = 2: 1 level finer')
       if (allocated(error)) return
+      ! eta/eta_t = 4 through inexact numbers, p = 1 and 2, 2D and 3D: r = 4**(-1/p) up to
+      ! rounding, so 2/p levels finer (the computed change lands within ulps of 2/p, on
+      ! either side: without the sqrt(eps) allowance some of these would get 2/p + 1)
+      do k = 1, 39
+         t = 0.001_wp*k + 0.0037_wp
+         e2 = 0.1_wp*k + 0.07_wp
+         do p = 1, 2
+            do d = 2, 3
+               call optimal_levels(leaf, e2, 8*e2(1)/(4*t)**2, t, p, d, 12, levels, error)
+               if (allocated(error)) return
+               call check(error, all(levels == 5 + 2/p), 'eta = 4 eta_t, case '//itoa(k)//', p = '//itoa(p)// &
+                  & ', d = '//itoa(d))
+               if (allocated(error)) return
+            end do
+         end do
+      end do
+      e2 = 1.0_wp
       ! p = 1, eta/eta_t = 4.4: r = 1/4.4, rounded up to 3 levels, clamped to 2; 3 when allowed
       call optimal_levels(leaf, e2, 5000.0_wp, 0.04_wp/4.4_wp, 1, 2, 12, levels, error)
       if (allocated(error)) return
