@@ -20,7 +20,7 @@ HDF5_LDIR := $(shell pkg-config --libs-only-L hdf5 2>/dev/null || echo -L/usr/li
 DEP_LIBS := $(HDF5_LDIR) -lhdf5_fortran -lhdf5 -lcholmod -lumfpack -lsuitesparseconfig -llapack -lblas \
             -lgfortran -lgomp -lm
 
-.PHONY: all deps build run test bench clean help lib install fuzz
+.PHONY: all deps build run test bench clean help lib install fuzz doc
 
 all: build
 
@@ -29,6 +29,7 @@ help:
 	@echo "make test    install what is missing and run the whole test suite"
 	@echo "make bench   benchmarks (sparse direct solvers, grid build, recovery on a caller's mesh)"
 	@echo "make fuzz    5000 seeded mutants of the example scenes through sprc check and run (FUZZ_COUNT, FUZZ_SEED)"
+	@echo "make doc     the API reference and doc/ pages (FORD) in build/doc/index.html"
 	@echo "make build   build the release profile"
 	@echo "make lib     build/lib/libsprc.so and libsprc.a, Fortran modules in build/lib/mod"
 	@echo "make install PREFIX=DIR   lib, include (sprc.h, modules in include/sprc), pkg-config, bin/sprc"
@@ -45,6 +46,10 @@ run: deps
 
 test: deps
 	@tools/run-tests
+
+# The API reference (FORD): fails on a FORD warning about the public API.
+doc: deps
+	@tools/build-doc
 
 # Long seeded fuzz of the scene input (make test runs 300 mutants, seed 1).
 FUZZ_COUNT ?= 5000

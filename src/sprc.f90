@@ -1,4 +1,4 @@
-!> sprc: the one stable Fortran API. `use sprc` gives the public types and
+!> The one stable Fortran API of sprc. `use sprc` gives the public types and
 !> procedures of every layer; the layer modules (sprc_<layer>_<x>) stay
 !> available for finer-grained use, but only what is re-exported here is
 !> promised to stay source-compatible between minor versions.

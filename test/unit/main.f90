@@ -31,6 +31,7 @@ program sprc_unit_tests
    use sprc_test_petsc, only: collect_petsc
    use sprc_test_contact_recovery, only: collect_contact_recovery
    use sprc_test_partition, only: collect_partition
+   use sprc_test_testsuite, only: collect_testsuite
    implicit none
 
    type(testsuite_type), allocatable :: suites(:)
@@ -64,7 +65,8 @@ program sprc_unit_tests
       new_testsuite('contact_fe', collect_contact_fe), &
       new_testsuite('petsc', collect_petsc), &
       new_testsuite('contact_recovery', collect_contact_recovery), &
-      new_testsuite('partition', collect_partition) &
+      new_testsuite('partition', collect_partition), &
+      new_testsuite('testsuite', collect_testsuite) &
       ]
 
    call get_arg(1, suite_name)

@@ -10,7 +10,7 @@ module sprc_test_model
    use sprc_study_budget, only: level_memory, check_level_memory
    use sprc_core_memory, only: available_memory
    use sprc_grid_tree, only: grid_type
-   use sprc_testsuite, only: unittest_type, new_unittest, check
+   use sprc_testsuite, only: unittest_type, new_unittest, check, replaced
    implicit none
    private
 
@@ -240,18 +240,6 @@ contains
       if (allocated(error)) return
       call check(error, bytes == direct, 'direct keeps its estimate')
    end subroutine test_level_memory_fallback
-
-   pure function replaced(text, old, new) result(out)
-      character(len=*), intent(in) :: text, old, new
-      character(len=:), allocatable :: out
-      integer :: i
-      i = index(text, old)
-      if (i == 0) then
-         out = text
-      else
-         out = text(1:i - 1)//new//text(i + len(old):)
-      end if
-   end function replaced
 
    !> t = sigma.n = -p_in n on the inner surface (n = (-1, 0) at (5, 0)): t = (1, 0).
    subroutine test_default_exact(error)

@@ -1,6 +1,14 @@
 !> A small unit-test harness modelled on test-drive's API: tests are
 !> `subroutine test(error)` that allocate `error` on failure; suites collect
-!> tests; `check` compares values with stated tolerances.
+!> tests; `check` compares values with stated tolerances. A test registered
+!> with `should_fail` passes only when it fails (a negative test).
+!>
+!> `replaced` builds the variants of a base text (a scene with one key
+!> changed). A pattern that is not in the text is a defect of the test, not
+!> a variant: the variant would silently rerun the base case. `replaced` then
+!> returns the text unchanged and records the pattern, and `run_testsuite`
+!> fails the test that called it, naming the pattern (also a `should_fail`
+!> test: its expected failure must not come from a broken variant).
 module sprc_testsuite
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_internal
@@ -9,6 +17,7 @@ module sprc_testsuite
 
    public :: unittest_type, testsuite_type, new_unittest, new_testsuite
    public :: check, test_failed, run_testsuite, error_type, collect_interface, replaced
+   public :: take_replace_failure
 
    abstract interface
       !> A test: allocates `error` when it fails.
@@ -22,6 +31,8 @@ module sprc_testsuite
    type :: unittest_type
       character(len=:), allocatable :: name
       procedure(test_interface), pointer, nopass :: test => null()
+      !> A negative test: it passes when it fails.
+      logical :: should_fail = .false.
    end type unittest_type
 
    abstract interface
@@ -43,14 +54,21 @@ module sprc_testsuite
       module procedure :: check_logical, check_int, check_int8, check_real, check_string
    end interface check
 
+   !> Patterns that `replaced` did not find since the running test started
+   !> (the harness runs tests one at a time; `replaced` is called outside
+   !> parallel regions).
+   character(len=:), allocatable, save :: replace_failure
+
 contains
 
-   function new_unittest(name, test) result(self)
+   function new_unittest(name, test, should_fail) result(self)
       character(len=*), intent(in) :: name
       procedure(test_interface) :: test
+      logical, intent(in), optional :: should_fail
       type(unittest_type) :: self
       self%name = name
       self%test => test
+      if (present(should_fail)) self%should_fail = should_fail
    end function new_unittest
 
    function new_testsuite(name, collect) result(self)
@@ -141,17 +159,17 @@ contains
       integer, intent(in) :: unit
       integer, intent(inout) :: npass, nfail
       type(unittest_type), allocatable :: tests(:)
-      type(error_type), allocatable :: error
+      character(len=:), allocatable :: failure
       integer :: i
 
       call suite%collect(tests)
       do i = 1, size(tests)
          if (len(selection) > 0 .and. selection /= tests(i)%name) cycle
-         call tests(i)%test(error)
-         if (allocated(error)) then
+         call run_one(tests(i), failure)
+         if (allocated(failure)) then
             nfail = nfail + 1
-            write (unit, '(a)') 'FAIL '//suite%name//'/'//tests(i)%name//': '//error%message
-            deallocate (error)
+            write (unit, '(a)') 'FAIL '//suite%name//'/'//tests(i)%name//': '//failure
+            deallocate (failure)
          else
             npass = npass + 1
             write (unit, '(a)') 'ok   '//suite%name//'/'//tests(i)%name
@@ -160,14 +178,50 @@ contains
       end do
    end subroutine run_testsuite
 
-   !> `text` with the first `old` replaced by `new`.
+   !> Run one test; `failure` is allocated with the reason when it fails: its
+   !> own error (or, for a `should_fail` test, none), or a pattern that
+   !> `replaced` did not find.
+   subroutine run_one(test, failure)
+      type(unittest_type), intent(in) :: test
+      character(len=:), allocatable, intent(out) :: failure
+      type(error_type), allocatable :: error
+      character(len=:), allocatable :: missing
+
+      if (allocated(replace_failure)) deallocate (replace_failure)
+      call test%test(error)
+      call take_replace_failure(missing)
+      if (allocated(missing)) then
+         failure = missing
+         if (allocated(error)) failure = failure//'; then: '//error%message
+      else if (test%should_fail .and. .not. allocated(error)) then
+         failure = 'a negative test (should_fail) that passed'
+      else if (.not. test%should_fail .and. allocated(error)) then
+         failure = error%message
+      end if
+   end subroutine run_one
+
+   !> `text` with the first `old` replaced by `new`. When `old` is not in
+   !> `text`, the text comes back unchanged and the running test fails with
+   !> a message naming `old` (see the module comment).
    function replaced(text, old, new) result(out)
       character(len=*), intent(in) :: text, old, new
       character(len=:), allocatable :: out
       integer :: i
       i = index(text, old)
       out = text
-      if (i > 0) out = text(1:i - 1)//new//text(i + len(old):)
+      if (i > 0) then
+         out = text(1:i - 1)//new//text(i + len(old):)
+      else
+         if (.not. allocated(replace_failure)) replace_failure = 'replaced: pattern not found'
+         replace_failure = replace_failure//' "'//old//'"'
+      end if
    end function replaced
+
+   !> The patterns `replaced` missed since the test started, as a message
+   !> (unallocated when none), and forget them.
+   subroutine take_replace_failure(message)
+      character(len=:), allocatable, intent(out) :: message
+      if (allocated(replace_failure)) call move_alloc(replace_failure, message)
+   end subroutine take_replace_failure
 
 end module sprc_testsuite

@@ -7,7 +7,7 @@ module sprc_contact_result
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type
    use sprc_core_alloc, only: check_allocation
-   use sprc_study_row, only: report_empty
+   use sprc_core_empty, only: report_empty
    implicit none
    private
 

@@ -267,7 +267,7 @@ contains
       type(contact_solution_type), intent(out) :: sol
       type(error_type), allocatable, intent(out) :: error
       integer, intent(in), optional :: max_iterations
-      !> Coulomb: the friction coefficient and the load path (block loads at the
+      !> With Coulomb friction, the friction coefficient and the load path (block loads at the
       !> end of each increment, one column each; default one increment, the
       !> assembled loads).
       real(wp), intent(in), optional :: mu, loads(:, :)

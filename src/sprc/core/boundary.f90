@@ -30,6 +30,7 @@ module sprc_core_boundary
    integer, parameter :: bc_displacement = 5
    !> Traction sigma_exact n and displacement u_exact of an exact solution.
    integer, parameter :: bc_exact_traction = 6
+   !> Displacement u_exact of an exact solution (weakly).
    integer, parameter :: bc_exact_displacement = 7
    !> A contact surface (the contact layer's).
    integer, parameter :: bc_contact = 8

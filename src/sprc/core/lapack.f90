@@ -20,6 +20,7 @@ module sprc_core_lapack
    public :: dlacn2
 
    interface
+      !> Solve A X = B by LU with partial pivoting (A overwritten by its factors).
       subroutine dgesv(n, nrhs, a, lda, ipiv, b, ldb, info)
          import :: dp
          integer, intent(in) :: n, nrhs, lda, ldb
@@ -27,6 +28,7 @@ module sprc_core_lapack
          integer, intent(out) :: ipiv(*), info
       end subroutine dgesv
 
+      !> LU factorization with partial pivoting.
       subroutine dgetrf(m, n, a, lda, ipiv, info)
          import :: dp
          integer, intent(in) :: m, n, lda
@@ -34,6 +36,7 @@ module sprc_core_lapack
          integer, intent(out) :: ipiv(*), info
       end subroutine dgetrf
 
+      !> Solve with the LU factors of dgetrf.
       subroutine dgetrs(trans, n, nrhs, a, lda, ipiv, b, ldb, info)
          import :: dp
          character(len=1), intent(in) :: trans
@@ -43,6 +46,7 @@ module sprc_core_lapack
          integer, intent(out) :: info
       end subroutine dgetrs
 
+      !> Reciprocal condition number of an LU-factored matrix (1- or infinity-norm).
       subroutine dgecon(norm, n, a, lda, anorm, rcond, work, iwork, info)
          import :: dp
          character(len=1), intent(in) :: norm
@@ -52,6 +56,7 @@ module sprc_core_lapack
          integer, intent(out) :: iwork(*), info
       end subroutine dgecon
 
+      !> Norm of a general matrix (max, 1, infinity or Frobenius).
       function dlange(norm, m, n, a, lda, work) result(r)
          import :: dp
          character(len=1), intent(in) :: norm
@@ -61,6 +66,7 @@ module sprc_core_lapack
          real(dp) :: r
       end function dlange
 
+      !> Solve a symmetric indefinite system by Bunch-Kaufman LDL^T.
       subroutine dsysv(uplo, n, nrhs, a, lda, ipiv, b, ldb, work, lwork, info)
          import :: dp
          character(len=1), intent(in) :: uplo
@@ -70,6 +76,7 @@ module sprc_core_lapack
          real(dp), intent(inout) :: work(*)
       end subroutine dsysv
 
+      !> Bunch-Kaufman LDL^T factorization of a symmetric matrix.
       subroutine dsytrf(uplo, n, a, lda, ipiv, work, lwork, info)
          import :: dp
          character(len=1), intent(in) :: uplo
@@ -78,6 +85,7 @@ module sprc_core_lapack
          integer, intent(out) :: ipiv(*), info
       end subroutine dsytrf
 
+      !> Solve with the LDL^T factors of dsytrf.
       subroutine dsytrs(uplo, n, nrhs, a, lda, ipiv, b, ldb, info)
          import :: dp
          character(len=1), intent(in) :: uplo
@@ -87,6 +95,7 @@ module sprc_core_lapack
          integer, intent(out) :: info
       end subroutine dsytrs
 
+      !> Cholesky factorization of a symmetric positive definite matrix.
       subroutine dpotrf(uplo, n, a, lda, info)
          import :: dp
          character(len=1), intent(in) :: uplo
@@ -95,6 +104,7 @@ module sprc_core_lapack
          integer, intent(out) :: info
       end subroutine dpotrf
 
+      !> Solve with the Cholesky factor of dpotrf.
       subroutine dpotrs(uplo, n, nrhs, a, lda, b, ldb, info)
          import :: dp
          character(len=1), intent(in) :: uplo
@@ -104,6 +114,7 @@ module sprc_core_lapack
          integer, intent(out) :: info
       end subroutine dpotrs
 
+      !> Reciprocal condition number of a Cholesky-factored matrix.
       subroutine dpocon(uplo, n, a, lda, anorm, rcond, work, iwork, info)
          import :: dp
          character(len=1), intent(in) :: uplo
@@ -113,6 +124,7 @@ module sprc_core_lapack
          integer, intent(out) :: iwork(*), info
       end subroutine dpocon
 
+      !> QR factorization (Householder).
       subroutine dgeqrf(m, n, a, lda, tau, work, lwork, info)
          import :: dp
          integer, intent(in) :: m, n, lda, lwork
@@ -121,6 +133,7 @@ module sprc_core_lapack
          integer, intent(out) :: info
       end subroutine dgeqrf
 
+      !> QR factorization with column pivoting (rank-revealing).
       subroutine dgeqp3(m, n, a, lda, jpvt, tau, work, lwork, info)
          import :: dp
          integer, intent(in) :: m, n, lda, lwork
@@ -130,6 +143,7 @@ module sprc_core_lapack
          integer, intent(out) :: info
       end subroutine dgeqp3
 
+      !> Multiply by Q (or Q^T) of a QR factorization.
       subroutine dormqr(side, trans, m, n, k, a, lda, tau, c, ldc, work, lwork, info)
          import :: dp
          character(len=1), intent(in) :: side, trans
@@ -139,6 +153,7 @@ module sprc_core_lapack
          integer, intent(out) :: info
       end subroutine dormqr
 
+      !> Form the explicit Q of a QR factorization.
       subroutine dorgqr(m, n, k, a, lda, tau, work, lwork, info)
          import :: dp
          integer, intent(in) :: m, n, k, lda, lwork
@@ -147,6 +162,7 @@ module sprc_core_lapack
          integer, intent(out) :: info
       end subroutine dorgqr
 
+      !> Solve a triangular system.
       subroutine dtrtrs(uplo, trans, diag, n, nrhs, a, lda, b, ldb, info)
          import :: dp
          character(len=1), intent(in) :: uplo, trans, diag
@@ -156,6 +172,7 @@ module sprc_core_lapack
          integer, intent(out) :: info
       end subroutine dtrtrs
 
+      !> Singular value decomposition.
       subroutine dgesvd(jobu, jobvt, m, n, a, lda, s, u, ldu, vt, ldvt, work, lwork, info)
          import :: dp
          character(len=1), intent(in) :: jobu, jobvt
@@ -165,6 +182,7 @@ module sprc_core_lapack
          integer, intent(out) :: info
       end subroutine dgesvd
 
+      !> Minimum-norm least squares by the SVD (divide and conquer), with rank by rcond.
       subroutine dgelsd(m, n, nrhs, a, lda, b, ldb, s, rcond, rank, work, lwork, iwork, info)
          import :: dp
          integer, intent(in) :: m, n, nrhs, lda, ldb, lwork
@@ -174,6 +192,7 @@ module sprc_core_lapack
          integer, intent(out) :: rank, iwork(*), info
       end subroutine dgelsd
 
+      !> Eigenvalues (and vectors) of a symmetric matrix.
       subroutine dsyev(jobz, uplo, n, a, lda, w, work, lwork, info)
          import :: dp
          character(len=1), intent(in) :: jobz, uplo
@@ -183,6 +202,7 @@ module sprc_core_lapack
          integer, intent(out) :: info
       end subroutine dsyev
 
+      !> BLAS: C = alpha op(A) op(B) + beta C.
       subroutine dgemm(transa, transb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc)
          import :: dp
          character(len=1), intent(in) :: transa, transb
@@ -191,6 +211,7 @@ module sprc_core_lapack
          real(dp), intent(inout) :: c(ldc, *)
       end subroutine dgemm
 
+      !> BLAS: y = alpha op(A) x + beta y.
       subroutine dgemv(trans, m, n, alpha, a, lda, x, incx, beta, y, incy)
          import :: dp
          character(len=1), intent(in) :: trans
@@ -199,6 +220,7 @@ module sprc_core_lapack
          real(dp), intent(inout) :: y(*)
       end subroutine dgemv
 
+      !> BLAS: symmetric rank-k update C = alpha A A^T + beta C.
       subroutine dsyrk(uplo, trans, n, k, alpha, a, lda, beta, c, ldc)
          import :: dp
          character(len=1), intent(in) :: uplo, trans
@@ -207,6 +229,7 @@ module sprc_core_lapack
          real(dp), intent(inout) :: c(ldc, *)
       end subroutine dsyrk
 
+      !> Machine parameters (eps, safe minimum, ...).
       function dlamch(cmach) result(r)
          import :: dp
          character(len=1), intent(in) :: cmach

@@ -20,9 +20,11 @@ module sprc_core_material
    public :: voigt_size, analysis_name, check_material
    public :: material_matrix, compliance_matrix
 
-   !> Analysis kinds. Values are part of the C API; never renumber.
+   !> Analysis kinds. Values are part of the C API; never renumber. Plane stress (2D),
    integer, parameter :: plane_stress = 1
+   !> plane strain (2D),
    integer, parameter :: plane_strain = 2
+   !> three-dimensional.
    integer, parameter :: solid = 3
 
 contains

@@ -29,6 +29,7 @@ module sprc_fem_linear_solver
    !> The scene's `solver`: 'auto', 'direct' (CHOLMOD, UMFPACK) or 'iterative'
    !> (Krylov + algebraic multigrid, `sprc_fem_petsc`); codes in `solver_names` order.
    integer, parameter :: solver_auto = 1, solver_direct = 2, solver_iterative = 3
+   !> The names of the solver codes, blank-separated, in code order.
    character(len=*), parameter :: solver_names = 'auto direct iterative'
 
    !> 'auto''s table: a system of dimension `dim` (2, 3) and element degree

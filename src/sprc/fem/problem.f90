@@ -227,7 +227,7 @@ contains
       end if
    end function gamma_note
 
-   !> Convenience: build the cut mesh of `body` (uniform `level`,
+   !> A convenience: build the cut mesh of `body` (uniform `level`,
    !> `refine_boundary` extra levels on cut cells, Q`degree` nodes, hanging
    !> constraints, cut quadrature with `points` per direction, default
    !> `default_points`), then `setup` and `solve` the problem. `t_mesh`

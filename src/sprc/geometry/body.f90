@@ -31,9 +31,11 @@ module sprc_geometry_body
    public :: snap_ulps, snap_tolerance
    public :: body_name, shape_name
 
-   !> CSG operations (values are stable).
+   !> CSG operations (values are stable): union (min of the level sets),
    integer, parameter :: csg_add = 1
+   !> difference A minus B (max(a, -b)),
    integer, parameter :: csg_subtract = 2
+   !> intersection (max).
    integer, parameter :: csg_intersect = 3
 
    character(len=*), parameter :: op_names(3) = [character(len=9) :: 'add', 'subtract', 'intersect']

@@ -12,8 +12,11 @@ module sprc_geometry_region
 
    public :: region_type, cell_outside, cell_inside, cell_cut
 
+   !> Classes of a box: outside the region (zero measure in common),
    integer, parameter :: cell_outside = 0
+   !> inside it (the region covers the whole box),
    integer, parameter :: cell_inside = 1
+   !> or cut by its boundary (possibly conservatively).
    integer, parameter :: cell_cut = 2
 
    !> Anything that can classify boxes: a body built from shapes, or a test region.

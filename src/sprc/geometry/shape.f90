@@ -38,13 +38,19 @@ module sprc_geometry_shape
    public :: new_disk, new_sphere, new_ellipse, new_ellipsoid, new_box, new_halfspace, new_cylinder
    public :: shape_kind_name, shape_kind_from_name
 
-   !> Shape kinds (values are stable: scene and C API may store them).
+   !> Shape kinds (values are stable: scene and C API may store them): disk (2D).
    integer, parameter :: shape_disk = 1
+   !> Sphere (3D).
    integer, parameter :: shape_sphere = 2
+   !> Ellipse (2D).
    integer, parameter :: shape_ellipse = 3
+   !> Ellipsoid (3D).
    integer, parameter :: shape_ellipsoid = 4
+   !> Axis-aligned box.
    integer, parameter :: shape_box = 5
+   !> Halfspace.
    integer, parameter :: shape_halfspace = 6
+   !> Infinite cylinder (3D).
    integer, parameter :: shape_cylinder = 7
 
    character(len=*), parameter :: kind_names(7) = [character(len=9) :: &

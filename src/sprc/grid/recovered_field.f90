@@ -48,7 +48,7 @@ module sprc_grid_recovered_field
 
    !> Recovery methods (values are part of the C API; never renumber).
    integer, parameter :: method_spr = 1, method_sprc = 2
-   !> Interpolations: the method's own (nodal for SPR, union for SPR-C), eq. 101, eq. 102.
+   !> The interpolations: the method's own (nodal for SPR, union for SPR-C), eq. 101, eq. 102.
    integer, parameter :: interp_default = 0, interp_nodal = 1, interp_union = 2
 
    !> Recovered field of one grid: patches, interpolation data, nodal values, diagnostics.
@@ -343,8 +343,8 @@ contains
       end do
    end subroutine corner_weights
 
-   !> nodal_interp: patch values, unions at free non-vertex nodes, then hanging constraints;
-   !> nodal: the method's field at each node.
+   !> Nodal values of the field: for `nodal_interp`, patch values, unions at free non-vertex
+   !> nodes, then hanging constraints; for `nodal`, the method's field at each node.
    subroutine nodal_values(field, nodes, hanging, error)
       type(recovered_field_type), intent(inout) :: field
       type(grid_nodes_type), intent(in) :: nodes

@@ -583,7 +583,7 @@ contains
       end do
    end subroutine split_leaf
 
-   !> 2:1 balance across faces, edges and corners. A leaf of level l needs every
+   !> The 2:1 balance across faces, edges and corners. A leaf of level l needs every
    !> level-(l-1) neighbour of its parent to exist (or to be external): a coarser
    !> leaf covering such a cell is split down to level l-1. Levels are swept from
    !> the finest down, so leaves made while sweeping level l (all of level < l)

@@ -56,7 +56,7 @@ module sprc_io_svg
       real(wp) :: lo = 0.0_wp, hi = 1.0_wp, step = 0.5_wp
    end type linear_axis_type
 
-   !> Markers: pale wide disc (a reference drawn as a band), filled circle, open square, none.
+   !> The markers: pale wide disc (a reference drawn as a band), filled circle, open square, none.
    integer, parameter :: marker_band = 1, marker_dot = 2, marker_square = 3, marker_none = 4
 
    !> How a series is drawn: its name (legend, class), colour, stroke attributes and marker.
@@ -296,7 +296,7 @@ contains
       end do
    end subroutine gather_points
 
-   !> 2D: s, the coordinate of each point x(:, i) along the principal direction
+   !> In 2D, s is the coordinate of each point x(:, i) along the principal direction
    !> of the points (largest spread), from their centroid, the direction's first
    !> nonzero component positive.
    pure subroutine along_surface(x, s)
@@ -375,7 +375,7 @@ contains
       end do
    end subroutine loaded_window
 
-   !> 3D: s, the distance of each point from the point of largest exact pressure
+   !> In 3D, s is the distance of each point from the point of largest exact pressure
    !> (largest FE pressure without an exact one; the first point without either).
    pure subroutine from_peak(x, p, s)
       real(wp), intent(in) :: x(:, :), p(:, :)

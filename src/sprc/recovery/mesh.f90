@@ -108,7 +108,7 @@ module sprc_recovery_mesh
       !> Copy of the mesh: nodes x(dim, nnode), connectivity(nen, nelem), element boxes.
       real(wp), allocatable :: x(:, :), box_lo(:, :), box_hi(:, :)
       integer, allocatable :: connectivity(:, :)
-      !> Patches: node of each (ascending), patch of each node (0: none), recovered polynomials,
+      !> The patches: node of each (ascending), patch of each node (0: none), recovered polynomials,
       !> expansion rounds and final element count of each.
       integer :: n_patches = 0
       integer, allocatable :: patch_node(:), patch_of_node(:), patch_rounds(:), patch_elements(:)
@@ -187,8 +187,9 @@ contains
       type(error_type), allocatable, intent(out) :: error
       !> Constant body force (dim).
       real(wp), intent(in), optional :: body_force(:)
-      !> Boundary facets (nfn, nfacet), their kinds (nfacet) and tractions (dim, nfacet).
+      !> Boundary facets (nfn, nfacet) and their kinds (nfacet).
       integer, intent(in), optional :: facet_nodes(:, :), facet_kind(:)
+      !> The facets' tractions (dim, nfacet); for a pressure facet, p in row 1.
       real(wp), intent(in), optional :: facet_traction(:, :)
       !> Patch polynomial degree (1..3; default 'auto', module notes); expansion rounds (>= 0).
       integer, intent(in), optional :: degree, max_rounds

@@ -38,6 +38,7 @@ module sprc_recovery_mesh_element
 
    !> Element type codes (VTK cell type ids).
    integer, parameter :: elem_tri3 = 5, elem_quad4 = 9, elem_tet4 = 10, elem_hex8 = 12
+   !> Quadratic Lagrange quadrilateral and hexahedron (VTK ids).
    integer, parameter :: elem_quad9 = 28, elem_hex27 = 29
    !> Largest node counts of an element and of a facet, largest facet quadrature.
    integer, parameter :: max_element_nodes = 27, max_facet_nodes = 9, max_facet_points = 9

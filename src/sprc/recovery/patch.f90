@@ -49,6 +49,7 @@ module sprc_recovery_patch
 
    !> Constraint kinds, the index of the per-kind diagnostics of `recovered_patch_type`.
    integer, parameter :: kind_equilibrium = 1, kind_compatibility = 2, kind_traction = 3, kind_symmetry = 4
+   !> The number of constraint kinds.
    integer, parameter :: nconstraint_kinds = 4
 
    !> Input of one patch recovery. All components are public plain data.
@@ -94,7 +95,7 @@ module sprc_recovery_patch
       logical :: use_compatibility = .true.
       !> SPR-C: impose boundary constraints (traction / symmetry).
       logical :: use_boundary = .true.
-      !> SPR-C: if false (the seed's rule), only the boundary kind with the largest
+      !> For SPR-C, if false (the seed's rule), only the boundary kind with the largest
       !> measure in the patch is imposed (`dominant_boundary_kind`); if true, every kind
       !> present is imposed (dependent rows are dropped by the rank selection).
       logical :: all_boundary_kinds = .false.

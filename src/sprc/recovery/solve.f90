@@ -152,7 +152,7 @@ contains
       call least_squares(patch, ws, rec, .false., 0, 'recover_spr', error)
    end subroutine recover_spr
 
-   !> SPR-C: integral least squares with the constraints switched on in `patch`
+   !> SPR-C by integral least squares with the constraints switched on in `patch`
    !> (use_equilibrium, use_compatibility, use_boundary, all_boundary_kinds); see the module
    !> documentation. Errors: invalid patch (stat_invalid_input), rank-deficient patch or
    !> singular KKT system (stat_singular), contact boundaries (stat_invalid_input: not yet).

@@ -55,7 +55,7 @@ module sprc_study_partition
    !> This process's place among the ranks of a partitioned level (rank 0 of
    !> 1: serial).
    type, extends(share_type) :: partition_type
-      !> False: every rank does the whole level's per-cell work (only the solve
+      !> When false, every rank does the whole level's per-cell work (only the solve
       !> is distributed), as chosen by SPRC_PARTITION=0 in the environment; the
       !> test that the shared-out level gives the same bits compares the two.
       logical :: split = .true.

@@ -3,18 +3,15 @@
 !> table and CSV, `sprc_io_svg` plots them.
 !>
 !> A real cell that does not apply (no exact solution, recovery not run) is
-!> *empty*: it holds a quiet NaN (`report_empty`) and `is_empty` is true for
-!> it.
+!> *empty*: it holds a quiet NaN (`report_empty`, from `sprc_core_empty`,
+!> re-exported here) and `is_empty` is true for it.
 module sprc_study_row
-   use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
    use sprc_core_kinds, only: wp, i8
+   use sprc_core_empty, only: report_empty, is_empty
    implicit none
    private
 
    public :: report_row_type, report_empty, is_empty
-
-   !> The value of an empty real cell: the default quiet NaN (bits 0x7FF8000000000000).
-   real(wp), parameter :: report_empty = transfer(9221120237041090560_i8, 1.0_wp)
 
    !> One level of a study. Times are wall-clock seconds for that level alone;
    !> errors and estimates are relative, in the energy norm (SCENE.md).
@@ -47,13 +44,5 @@ module sprc_study_row
       !> Krylov iterations of the level's solves (0 for a direct solve).
       integer :: solver_iterations = 0
    end type report_row_type
-
-contains
-
-   !> True when `x` is an empty cell (any NaN).
-   elemental logical function is_empty(x)
-      real(wp), intent(in) :: x
-      is_empty = ieee_is_nan(x)
-   end function is_empty
 
 end module sprc_study_row
