@@ -1139,7 +1139,7 @@ contains
             text = text//'  SPR-C symmetry: off (no symmetry boundary)'//nl
          end if
          if (size(scene%contacts) > 0) then
-            text = text//'  SPR-C contact: on (NOT AVAILABLE in this version)'//nl
+            text = text//'  SPR-C contact: on (surfaces '//surfaces_of_type(scene, 'contact')//')'//nl
          else
             text = text//'  SPR-C contact: off (no &contact)'//nl
          end if
