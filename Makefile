@@ -32,7 +32,8 @@ help:
 	@echo "make doc     the API reference and doc/ pages (FORD) in build/doc/index.html"
 	@echo "make build   build the release profile"
 	@echo "make lib     build/lib/libsprc.so and libsprc.a, Fortran modules in build/lib/mod"
-	@echo "make install PREFIX=DIR   lib, include (sprc.h, modules in include/sprc), pkg-config, bin/sprc"
+	@echo "make install PREFIX=DIR   lib, include (sprc.h, modules in include/sprc), pkg-config, bin/sprc,"
+	@echo "                          the example scenes in share/sprc/scenes"
 	@echo "make clean   remove build outputs"
 
 deps:
@@ -89,12 +90,13 @@ lib: deps
 install: lib
 	@set -e; \
 	prefix=$(abspath $(PREFIX)); \
-	install -d "$(DESTDIR)$$prefix"/{bin,lib/pkgconfig,include/sprc}; \
+	install -d "$(DESTDIR)$$prefix"/{bin,lib/pkgconfig,include/sprc,share/sprc/scenes}; \
 	install -m 755 "$$(cat $(LIBDIR)/driver-path)" "$(DESTDIR)$$prefix/bin/sprc"; \
 	install -m 755 $(LIBDIR)/libsprc.so "$(DESTDIR)$$prefix/lib/"; \
 	install -m 644 $(LIBDIR)/libsprc.a "$(DESTDIR)$$prefix/lib/"; \
 	install -m 644 include/sprc.h "$(DESTDIR)$$prefix/include/"; \
 	install -m 644 $(LIBDIR)/mod/*.mod "$(DESTDIR)$$prefix/include/sprc/"; \
+	install -m 644 example/scenes/*.nml "$(DESTDIR)$$prefix/share/sprc/scenes/"; \
 	{ echo "prefix=$$prefix"; \
 	  echo 'libdir=$${prefix}/lib'; \
 	  echo 'includedir=$${prefix}/include'; \

@@ -66,6 +66,8 @@ contains
          cli%command = arg
       case default
          message = 'unknown command "'//arg//'" (try sprc --help)'
+         if (names_scene(arg)) message = 'unknown command "'//arg//'": to run this scene, sprc run '//arg// &
+            & ' (to validate it, sprc check '//arg//')'
          return
       end select
       if (nargs < 2) then
@@ -135,6 +137,19 @@ contains
          cli%solver = value
       end select
    end subroutine parse_option
+
+   !> Whether a first argument that is no command looks like a scene file
+   !> (ends in .nml or names an existing file): the user left out `run`.
+   logical function names_scene(arg)
+      character(len=*), intent(in) :: arg
+      logical :: exists
+      names_scene = .false.
+      if (len(arg) == 0) return
+      if (len(arg) >= 4) names_scene = arg(len(arg) - 3:) == '.nml'
+      if (names_scene) return
+      inquire (file=arg, exist=exists)
+      names_scene = exists .and. arg(1:1) /= '-'
+   end function names_scene
 
    pure logical function allowed(command, option)
       character(len=*), intent(in) :: command, option

@@ -523,7 +523,7 @@ contains
       if (allocated(error)) return
       call check_switch(error, summary, 'SPR-C traction equilibrium', 'off (no traction boundary)')
       if (allocated(error)) return
-      call check_switch(error, summary, 'SPR-C contact', 'on (NOT AVAILABLE in this version)')
+      call check_switch(error, summary, 'SPR-C contact', "on (surfaces 'tip', 'top')")
       if (allocated(error)) return
       call check_switch(error, summary, 'contact', "on (slave 'punch' on master 'block', friction coulomb; "// &
          & 'coupled solve of both bodies, active-set iteration)')

@@ -27,7 +27,7 @@ module sprc_fem_linear_solver
       & auto_iterative_min_dofs, auto_never, solve_ranks, set_solve_ranks
 
    !> The scene's `solver`: 'auto', 'direct' (CHOLMOD, UMFPACK) or 'iterative'
-   !> (Krylov + algebraic multigrid, `sprc_fem_petsc`); codes in `solver_names` order.
+   !> (Krylov + multigrid, `sprc_fem_petsc`, `sprc_fem_multigrid`); codes in `solver_names` order.
    integer, parameter :: solver_auto = 1, solver_direct = 2, solver_iterative = 3
    !> The names of the solver codes, blank-separated, in code order.
    character(len=*), parameter :: solver_names = 'auto direct iterative'

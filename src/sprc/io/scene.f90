@@ -1139,7 +1139,7 @@ contains
             text = text//'  SPR-C symmetry: off (no symmetry boundary)'//nl
          end if
          if (size(scene%contacts) > 0) then
-            text = text//'  SPR-C contact: on (NOT AVAILABLE in this version)'//nl
+            text = text//'  SPR-C contact: on (surfaces '//surfaces_of_type(scene, 'contact')//')'//nl
          else
             text = text//'  SPR-C contact: off (no &contact)'//nl
          end if
@@ -1181,9 +1181,9 @@ contains
          ! the budget estimates a 2D level alike for both solvers: no memory fallback
          text = head//'CHOLMOD)'
       else if (auto_iterative_min_dofs(d, scene%order) == auto_never) then
-         text = head//'CHOLMOD; CG + algebraic multigrid where CHOLMOD would not fit in memory)'
+         text = head//'CHOLMOD; CG + geometric multigrid where CHOLMOD would not fit in memory)'
       else
-         text = head//'CG + algebraic multigrid from '//itoa(auto_iterative_min_dofs(d, scene%order))// &
+         text = head//'CG + geometric multigrid from '//itoa(auto_iterative_min_dofs(d, scene%order))// &
             & ' unknowns or where CHOLMOD would not fit in memory, CHOLMOD below)'
       end if
    end function solver_line
