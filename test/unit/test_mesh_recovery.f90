@@ -24,6 +24,9 @@ module sprc_test_mesh_recovery
       & mesh_method_sprc, facet_traction, facet_symmetry, facet_free, facet_pressure, elem_tri3, elem_quad4, &
       & elem_tet4, elem_hex8, elem_quad9, elem_hex27
    use sprc_legacy, only: sprc_recover_mesh
+   use sprc_recovery_mesh_check, only: check_duplicate_nodes
+   use sprc_core_kinds, only: i8
+   use sprc_core_text, only: rtoa
    use sprc_recovery_mesh_element, only: facet_points, element_inverse_map
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reset, patch_add_point
    use sprc_recovery_patch_loop, only: patch_source_type, patch_loop_type, run_patch_loop, patch_capacity
@@ -95,6 +98,7 @@ contains
          new_unittest('huge_stresses', test_huge_stresses), &
          new_unittest('pressure_facets', test_pressure_facets), &
          new_unittest('duplicates', test_duplicates), &
+         new_unittest('duplicate_check_dyadic_lattices', test_duplicate_probes), &
          new_unittest('c_index_messages', test_c_index_messages), &
          new_unittest('patch_loop_skip', test_patch_loop_skip), &
          new_unittest('degree_auto', test_degree_auto), &
@@ -1161,6 +1165,57 @@ contains
       call recover_on_mesh(2, c%analysis, c%x, c%etype, conn, c%gp, c%gw, c%gs, 1.0e3_wp, 0.3_wp, 1, res, error)
       call expect(error, stat_invalid_input, 'elements 1 and 4 have the same vertices')
    end subroutine test_duplicates
+
+   !> The duplicate-node check's hash table on coordinates with structure: the 257^2 nodes
+   !> of the unit square's 256 x 256 lattice (dyadic fractions: their low mantissa bits are
+   !> all zero), the 33^3 and 41^3 nodes of cube lattices (ties in all three coordinates) and
+   !> the 256 x 256 lattice rotated (no structure, the control). Bound on the slots read per
+   !> node: linear probing at load a with keys spread as by a random function costs
+   !> (1 + 1/(1 - a)^2)/2 per insertion, 5 at the table's largest load 2/3 (2.5 at the load
+   !> 1/2 these sizes give). A hash that maps such keys to a few slots reads O(n) per node.
+   !> Then a duplicate among them is still found (the last node moved onto the first).
+   subroutine test_duplicate_probes(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: x(:, :)
+      integer(i8) :: probes
+      integer :: n
+
+      call lattice(2, 256, 0.0_wp)
+      if (allocated(error)) return
+      call lattice(3, 32, 0.0_wp)
+      if (allocated(error)) return
+      call lattice(3, 40, 0.0_wp)
+      if (allocated(error)) return
+      call lattice(2, 256, 0.3_wp)
+      if (allocated(error)) return
+      x(:, size(x, 2)) = x(:, 1)
+      call check_duplicate_nodes(x, [(.true., n=1, size(x, 2))], .false., error)
+      call expect(error, stat_invalid_input, 'nodes 1 and 66049 are at the same point')
+   contains
+      subroutine lattice(d, m, angle)
+         integer, intent(in) :: d, m
+         real(wp), intent(in) :: angle
+         integer :: i, j, k
+         real(wp) :: p(3)
+         if (allocated(x)) deallocate (x)
+         allocate (x(d, (m + 1)**d))
+         n = 0
+         do k = 0, merge(0, m, d == 2)
+            do j = 0, m
+               do i = 0, m
+                  n = n + 1
+                  p = [real(i, wp), real(j, wp), real(k, wp)]/m
+                  x(1:2, n) = [cos(angle)*p(1) - sin(angle)*p(2), sin(angle)*p(1) + cos(angle)*p(2)]
+                  if (d == 3) x(3, n) = p(3)
+               end do
+            end do
+         end do
+         call check_duplicate_nodes(x, [(.true., i=1, n)], .false., error, probes)
+         if (allocated(error)) return
+         call check(error, real(probes, wp)/n <= 5.0_wp, 'duplicate-node hash on a '//trim(merge('square', &
+            & 'cube  ', d == 2))//' lattice: '//rtoa(real(probes, wp)/n)//' slots read per node, bound 5')
+      end subroutine lattice
+   end subroutine test_duplicate_probes
 
    !> With c_indices (the C and Python entries) messages name entries 0-based in C order
    !> with the C argument names (issue 13, defect 5): gw(2, 3) is gauss_weights[2][1].

@@ -13,6 +13,7 @@ module sprc_recovery_mesh_check
    use sprc_core_kinds, only: wp, i8
    use sprc_core_text, only: itoa, rtoa
    use sprc_core_alloc, only: check_allocation
+   use sprc_core_hash, only: hash_real
    use sprc_core_boundary, only: bc_traction, bc_symmetry, bc_free, bc_pressure
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_material, only: plane_stress, plane_strain, solid, voigt_size, check_material
@@ -250,14 +251,20 @@ contains
 
    !> No two nodes used by elements at the same point (bitwise equal coordinates, -0 = +0):
    !> such a mesh is not connected there, and its patches would silently stop at the seam.
-   !> A hash table of the used nodes: O(nnode) expected.
-   pure subroutine check_duplicate_nodes(nodes, used, c_indices, error)
+   !> A hash table of the used nodes (sprc_core_hash: every bit of the coordinates reaches
+   !> the slot, so dyadic coordinates do not collide): O(nnode) expected. The first node
+   !> equal to an earlier one is reported, whatever the hash. `probes`: the table slots
+   !> read in all (the cost, for tests: about 2.5 per node at load 2/3 if the hash spreads
+   !> the keys as a random function would).
+   pure subroutine check_duplicate_nodes(nodes, used, c_indices, error, probes)
       real(wp), intent(in) :: nodes(:, :)
       logical, intent(in) :: used(:)
       logical, intent(in) :: c_indices
       type(error_type), allocatable, intent(out) :: error
+      integer(i8), intent(out), optional :: probes
       integer, allocatable :: table(:)
       integer :: n, nslot, slot, m, stat
+      integer(i8) :: nprobe
 
       ! A power of two at least 1.5 times the used nodes: load at most 2/3, short probe chains
       ! in adjacent slots, and a table half the size of one at load 1/2 (262,144 nodes: 2 MB,
@@ -270,22 +277,26 @@ contains
       call check_allocation(stat, 'mesh check', 'the duplicate-node hash table', nslot, 4, error)
       if (allocated(error)) return
       table = 0
+      nprobe = 0
       do n = 1, size(nodes, 2)
          if (.not. used(n)) cycle
-         slot = int(iand(coordinate_hash(nodes(:, n)), int(nslot - 1, i8))) + 1
+         slot = int(iand(hash_real(nodes(:, n)), int(nslot - 1, i8))) + 1
          do
+            nprobe = nprobe + 1
             m = table(slot)
             if (m == 0) exit
             if (all(nodes(:, m) == nodes(:, n))) then
                call fail(error, 'nodes '//index_name(c_indices, m)//' and '//index_name(c_indices, n)// &
                   & ' are at the same point '//vec_str(nodes(:, n))//' (duplicate nodes: merge them; a crack or '// &
                   & 'an interface is two meshes, recovered one at a time)')
+               if (present(probes)) probes = nprobe
                return
             end if
             slot = mod(slot, nslot) + 1
          end do
          table(slot) = n
       end do
+      if (present(probes)) probes = nprobe
    end subroutine check_duplicate_nodes
 
    !> No two elements on the same set of vertices (a repeated element would count its
@@ -323,19 +334,6 @@ contains
          o = 0
       end function twin
    end subroutine check_duplicate_elements
-
-   !> xorshift hash of the coordinates' bits (+0 for -0 so that equal points hash equal).
-   pure integer(i8) function coordinate_hash(x) result(h)
-      real(wp), intent(in) :: x(:)
-      integer :: i
-      h = 88172645463325252_i8
-      do i = 1, size(x)
-         h = ieor(h, transfer(x(i) + 0.0_wp, h))
-         h = ieor(h, shiftl(h, 13))
-         h = ieor(h, shiftr(h, 7))
-         h = ieor(h, shiftl(h, 17))
-      end do
-   end function coordinate_hash
 
    !> An array entry as the caller writes it. idx are Fortran indices (1-based, 0 for a
    !> whole dimension ':'): Fortran `fname(:, 3, 1)`; C (c_indices) `cname[0][2]`, the
