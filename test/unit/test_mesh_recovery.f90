@@ -22,7 +22,7 @@ module sprc_test_mesh_recovery
    use sprc_core_material, only: plane_stress, plane_strain, solid
    use sprc_recovery_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, mesh_method_spr, &
       & mesh_method_sprc, facet_traction, facet_symmetry, facet_free, facet_pressure, elem_tri3, elem_quad4, &
-      & elem_tet4, elem_hex8, elem_quad9, elem_hex27
+      & elem_tet4, elem_hex8, elem_quad9, elem_hex27, mesh_reference_symmetric
    use sprc_legacy, only: sprc_recover_mesh
    use sprc_recovery_mesh_check, only: check_duplicate_nodes
    use sprc_core_kinds, only: i8
@@ -788,6 +788,7 @@ contains
       type(case_type) :: c
       type(mesh_recovery_type) :: res
       integer, allocatable :: fn(:, :), fk(:)
+      real(wp), allocatable :: ref(:, :)
 
       call build_case(c, elem_hex8, 2, f_symmetry3, 0.0_wp)
       call side_facets(c, 3, 0, fn)
@@ -803,6 +804,15 @@ contains
          & mesh_method_sprc, res, error, body_force=c%body(1:3), facet_nodes=fn, facet_kind=fk)
       if (allocated(error)) return
       call check(error, maxval(abs(res%nodal(5:6, fn(1, :)))) <= tol*c%scale, 'SPR-C: zero shear on z = 0')
+      if (allocated(error)) return
+      ! The faces' nodes in an order that is no quad (two corners swapped): the same face,
+      ! parametrised in its own order; the same points up to their order, so the same field
+      ! to the round-off tier (a bow-tie parametrisation would have put them elsewhere).
+      ref = res%nodal
+      call recover_on_mesh(3, solid, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
+         & mesh_method_sprc, res, error, body_force=c%body(1:3), facet_nodes=fn([1, 3, 2, 4], :), facet_kind=fk)
+      if (allocated(error)) return
+      call check(error, maxval(abs(res%nodal - ref)) <= tol*c%scale, 'quad4 faces in any node order')
    end subroutine test_symmetry_facets_3d
 
    !> One point per quad4: corner patches hold one point (< 3 terms) and are expanded; the
@@ -1035,13 +1045,22 @@ contains
       ! Nodes 1 and 9 are opposite corners of the mesh; nodes 4 and 5 share the middle edge
       ! of elements 1 and 3.
       call go(reshape([1, 9, 4, 5], [2, 2]), [2, 2])
-      call expect(error, stat_invalid_input, 'facet 1 (nodes 1 9) is not a side')
+      call expect(error, stat_invalid_input, 'facet 1 is not a side of any element: facet_nodes(:, 1) = (1 9) are '// &
+         & 'not the nodes of one element')
       if (allocated(error)) return
       call go(reshape([4, 1, 4, 5], [2, 2]), [2, 3])
       call expect(error, stat_invalid_input, 'facet 2 is shared by elements 1 and 3')
       if (allocated(error)) return
       call go(reshape([1, 1, 4, 1], [2, 2]), [2, 3])
       call expect(error, stat_invalid_input, 'facet 1 is degenerate')
+      if (allocated(error)) return
+      ! Nodes 1 and 5 are opposite corners of element 1 (its diagonal), in either order.
+      call go(reshape([1, 2, 5, 1], [2, 2]), [3, 3])
+      call expect(error, stat_invalid_input, 'facet 2 is not a side of any element: facet_nodes(:, 2) = (5 1) are '// &
+         & 'nodes of element 1 but not one of its sides')
+      if (allocated(error)) return
+      call go(reshape([1, 5], [2, 1]), [3])
+      call expect(error, stat_invalid_input, 'facet_nodes(:, 1) = (1 5) are nodes of element 1 but not')
       if (allocated(error)) return
       call recover_on_mesh(2, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1.0e3_wp, 0.3_wp, 2, res, &
          & error, facet_nodes=fn)
@@ -1508,6 +1527,39 @@ contains
          call recover_on_mesh(c%dim, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
             & mesh_method_spr, res1, error, gauss_xi=gxi(:, 2:, :))
          call expect(error, stat_invalid_input, 'gxi has shape')
+         if (allocated(error)) return
+         ! The same points on [-1, 1]^dim with reference = symmetric: the same recovery (the
+         ! map xi = (s + 1)/2 rounds once, far below the tier); the [0, 1] coordinates read as
+         ! symmetric are inside [-1, 1] but map elsewhere; -0.5 read as unit is outside, and
+         ! the message says the convention.
+         call recover_on_mesh(c%dim, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
+            & mesh_method_sprc, res1, error, gauss_xi=2.0_wp*gxi - 1.0_wp, reference=mesh_reference_symmetric)
+         if (allocated(error)) return
+         call check(error, maxval(abs(res1%nodal - res0%nodal)) <= tol*c%scale .and. &
+            & abs(res1%err - res0%err) <= tol*res0%norm_h, 'reference symmetric: same recovery')
+         if (allocated(error)) return
+         call recover_on_mesh(c%dim, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
+            & mesh_method_spr, res1, error, gauss_xi=gxi, reference=mesh_reference_symmetric)
+         call expect(error, stat_invalid_input, 'is inside the reference cell but does not map onto gp(:, 1, 1)')
+         if (allocated(error)) return
+         call recover_on_mesh(c%dim, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
+            & mesh_method_spr, res1, error, gauss_xi=2.0_wp*gxi - 1.0_wp)
+         call expect(error, stat_invalid_input, 'is outside the reference cell [0, 1]^'//merge('2', '3', c%dim == 2)// &
+            & " (reference 'unit', the default; 'symmetric' takes [-1, 1]^")
+         if (allocated(error)) return
+         bad = 2.0_wp*gxi - 1.0_wp
+         bad(1, 1, 1) = 1.5_wp
+         call recover_on_mesh(c%dim, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
+            & mesh_method_spr, res1, error, gauss_xi=bad, reference=mesh_reference_symmetric, c_indices=.true.)
+         call expect(error, stat_invalid_input, 'gauss_xi[0][0] = (1.5')
+         if (allocated(error)) return
+         call recover_on_mesh(c%dim, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
+            & mesh_method_spr, res1, error, gauss_xi=bad, reference=mesh_reference_symmetric)
+         call expect(error, stat_invalid_input, "is outside the reference cell [-1, 1]^")
+         if (allocated(error)) return
+         call recover_on_mesh(c%dim, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
+            & mesh_method_spr, res1, error, gauss_xi=gxi, reference=7)
+         call expect(error, stat_invalid_input, 'reference = 7 is not unit (0) or symmetric (1)')
          if (allocated(error)) return
          deallocate (gxi)
       end do

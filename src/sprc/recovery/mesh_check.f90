@@ -25,10 +25,16 @@ module sprc_recovery_mesh_check
 
    public :: check_mesh_options, check_mesh_arrays, check_mesh_facets, check_duplicate_nodes, &
       & check_duplicate_elements, vec_str, entry_name, index_name
+   public :: mesh_reference_unit, mesh_reference_symmetric, reference_cell_name
    public :: mesh_method_spr, mesh_method_sprc, facet_traction, facet_symmetry, facet_free, facet_pressure
 
    !> Recovery methods (values are part of the C API; never renumber).
    integer, parameter :: mesh_method_spr = 1, mesh_method_sprc = 2
+   !> Conventions of the caller's reference coordinates (gauss_xi; values are part of the C
+   !> API, SPRC_REFERENCE_*): 'unit' quads and hexes on [0, 1]^dim (the element library's own),
+   !> 'symmetric' on [-1, 1]^dim (most FE codes'); triangles and tetrahedra are the unit
+   !> simplex (xi >= 0, sum xi <= 1) in both.
+   integer, parameter :: mesh_reference_unit = 0, mesh_reference_symmetric = 1
    !> Facet kinds, the boundary kinds of `sprc_core_boundary` a facet can have (values are
    !> part of the C API, SPRC_FACET_*): prescribed traction (its value per facet), symmetry
    !> plane (zero shear), free surface (zero traction), pressure p = facet_traction(1, f)
@@ -334,6 +340,26 @@ contains
          o = 0
       end function twin
    end subroutine check_duplicate_elements
+
+   !> The reference cell of element_type in the convention `reference`, for messages.
+   pure function reference_cell_name(element_type, reference) result(s)
+      integer, intent(in) :: element_type, reference
+      character(len=:), allocatable :: s
+      select case (element_type)
+      case (elem_tri3)
+         s = 'the unit triangle xi >= 0, xi_1 + xi_2 <= 1 (either reference)'
+      case (elem_tet4)
+         s = 'the unit tetrahedron xi >= 0, xi_1 + xi_2 + xi_3 <= 1 (either reference)'
+      case default
+         if (reference == mesh_reference_symmetric) then
+            s = '[-1, 1]^'//itoa(element_dim(element_type))//" (reference 'symmetric'; 'unit' takes [0, 1]^"// &
+               & itoa(element_dim(element_type))//')'
+         else
+            s = '[0, 1]^'//itoa(element_dim(element_type))//" (reference 'unit', the default; 'symmetric' takes "// &
+               & '[-1, 1]^'//itoa(element_dim(element_type))//')'
+         end if
+      end select
+   end function reference_cell_name
 
    !> An array entry as the caller writes it. idx are Fortran indices (1-based, 0 for a
    !> whole dimension ':'): Fortran `fname(:, 3, 1)`; C (c_indices) `cname[0][2]`, the
