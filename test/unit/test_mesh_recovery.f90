@@ -27,7 +27,7 @@ module sprc_test_mesh_recovery
    use sprc_recovery_mesh_check, only: check_duplicate_nodes
    use sprc_core_kinds, only: i8
    use sprc_core_text, only: rtoa
-   use sprc_recovery_mesh_element, only: facet_points, element_inverse_map
+   use sprc_recovery_mesh_element, only: facet_points, element_inverse_map, element_facet_order
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reset, patch_add_point
    use sprc_recovery_patch_loop, only: patch_source_type, patch_loop_type, run_patch_loop, patch_capacity
    !$ use omp_lib, only: omp_get_max_threads, omp_set_num_threads
@@ -94,6 +94,7 @@ contains
          new_unittest('thread_determinism', test_threads), &
          new_unittest('validation_errors', test_validation), &
          new_unittest('facet_errors', test_facet_errors), &
+         new_unittest('facet_node_order', test_facet_order), &
          new_unittest('far_from_origin', test_far_from_origin), &
          new_unittest('huge_stresses', test_huge_stresses), &
          new_unittest('pressure_facets', test_pressure_facets), &
@@ -788,7 +789,6 @@ contains
       type(case_type) :: c
       type(mesh_recovery_type) :: res
       integer, allocatable :: fn(:, :), fk(:)
-      real(wp), allocatable :: ref(:, :)
 
       call build_case(c, elem_hex8, 2, f_symmetry3, 0.0_wp)
       call side_facets(c, 3, 0, fn)
@@ -804,15 +804,6 @@ contains
          & mesh_method_sprc, res, error, body_force=c%body(1:3), facet_nodes=fn, facet_kind=fk)
       if (allocated(error)) return
       call check(error, maxval(abs(res%nodal(5:6, fn(1, :)))) <= tol*c%scale, 'SPR-C: zero shear on z = 0')
-      if (allocated(error)) return
-      ! The faces' nodes in an order that is no quad (two corners swapped): the same face,
-      ! parametrised in its own order; the same points up to their order, so the same field
-      ! to the round-off tier (a bow-tie parametrisation would have put them elsewhere).
-      ref = res%nodal
-      call recover_on_mesh(3, solid, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
-         & mesh_method_sprc, res, error, body_force=c%body(1:3), facet_nodes=fn([1, 3, 2, 4], :), facet_kind=fk)
-      if (allocated(error)) return
-      call check(error, maxval(abs(res%nodal - ref)) <= tol*c%scale, 'quad4 faces in any node order')
    end subroutine test_symmetry_facets_3d
 
    !> One point per quad4: corner patches hold one point (< 3 terms) and are expanded; the
@@ -1012,6 +1003,54 @@ contains
             & error)
       end subroutine run
    end subroutine test_validation
+
+   !> element_facet_order on the unit square / cube (hand values): a quad's diagonal and a
+   !> hex's face diagonal plane are no sides; the bottom face of hex8 / hex27 with its nodes
+   !> in an order that is no parametrisation (corners 2 and 3 swapped; hex27 also mid-sides
+   !> 5 and 7) is put in an order whose quadrature has the face's area 1 and its centroid
+   !> (1/2, 1/2, 0), to round-off (the bow-tie order as given has area 2/sqrt(3)); a side
+   !> given in order keeps it.
+   subroutine test_facet_order(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: xc(3, 27), x(3, 9), w(9), nrm(3, 9)
+      integer :: perm(9), loc(9), a, nq, k
+      logical :: ok
+
+      call element_facet_order(elem_quad4, [1, 3], perm(1:2), ok)
+      call check(error, .not. ok, 'the diagonal of a quad4 is no side')
+      if (allocated(error)) return
+      call element_facet_order(elem_hex8, [1, 2, 7, 8], perm(1:4), ok)
+      call check(error, .not. ok, 'a diagonal plane of a hex8 is no face')
+      if (allocated(error)) return
+      call element_facet_order(elem_quad4, [3, 2], perm(1:2), ok)
+      call check(error, ok .and. all(perm(1:2) == [1, 2]), 'a quad4 side in reverse order, kept')
+      if (allocated(error)) return
+      do k = 1, 2
+         if (k == 1) then
+            do a = 1, 8
+               xc(:, a) = real(vtk_hex8(:, a), wp)
+            end do
+            loc(1:4) = [1, 3, 2, 4]
+            call element_facet_order(elem_hex8, loc(1:4), perm(1:4), ok)
+            call facet_points(3, 4, xc(:, loc(perm(1:4))), nq, x, w, nrm)
+         else
+            do a = 1, 27
+               xc(:, a) = 0.5_wp*real(vtk_hex27(:, a), wp)
+            end do
+            loc = [1, 3, 2, 4, 11, 10, 9, 12, 25]
+            call element_facet_order(elem_hex27, loc, perm, ok)
+            call facet_points(3, 9, xc(:, loc(perm)), nq, x, w, nrm)
+         end if
+         call check(error, ok, 'the bottom face in a shuffled order is a face')
+         if (allocated(error)) return
+         call check(error, abs(sum(w(1:nq)) - 1.0_wp) <= 10*epsilon(1.0_wp) .and. &
+            & all(abs(matmul(x(:, 1:nq), w(1:nq)) - [0.5_wp, 0.5_wp, 0.0_wp]) <= 10*epsilon(1.0_wp)), &
+            & 'the reordered face has area 1 and centroid (1/2, 1/2, 0)')
+         if (allocated(error)) return
+      end do
+      call facet_points(3, 4, xc(:, [1, 3, 2, 4]), nq, x, w, nrm)
+      call check(error, abs(sum(w(1:nq)) - 1.0_wp) > 0.1_wp, 'the bow-tie order as given has the wrong area')
+   end subroutine test_facet_order
 
    !> Facet validation: kinds, shapes, node range, missing traction, not a side, interior.
    subroutine test_facet_errors(error)
