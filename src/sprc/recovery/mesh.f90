@@ -715,17 +715,15 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer :: k, e, a, b, n, holder, loc(max_element_nodes), perm(max_element_nodes)
       logical :: side
-      character(len=:), allocatable :: name
 
       n = size(fnodes)
-      name = entry_name(r%c_indices, 'facet_nodes', 'facet_nodes', [0, f])//' = ('//ivec_str(r%c_indices, fnodes)//')'
       owner = 0
       holder = 0
       do a = 2, n
          do b = 1, a - 1
             if (fnodes(a) /= fnodes(b)) cycle
             call fatal_error(error, 'recover_on_mesh: facet '//index_name(r%c_indices, f)//' is degenerate: '// &
-               & name//' repeats node '//index_name(r%c_indices, fnodes(a)), stat_invalid_input)
+               & facet_name()//' repeats node '//index_name(r%c_indices, fnodes(a)), stat_invalid_input)
             return
          end do
       end do
@@ -742,7 +740,7 @@ contains
          if (owner /= 0) then
             call fatal_error(error, 'recover_on_mesh: facet '//index_name(r%c_indices, f)//' is shared by elements '// &
                & index_name(r%c_indices, owner)//' and '//index_name(r%c_indices, e)//': not a boundary facet ('// &
-               & name//')', stat_invalid_input)
+               & facet_name()//')', stat_invalid_input)
             return
          end if
          owner = e
@@ -751,13 +749,20 @@ contains
       if (owner /= 0) return
       if (holder /= 0) then
          call fatal_error(error, 'recover_on_mesh: facet '//index_name(r%c_indices, f)//' is not a side of any '// &
-            & 'element: '//name//' are nodes of element '//index_name(r%c_indices, holder)//' but not one of its '// &
+            & 'element: '//facet_name()//' are nodes of element '//index_name(r%c_indices, holder)//' but not one of its '// &
             & trim(merge('sides', 'faces', r%dim == 2))//' (a boundary facet is an element side, its nodes in any '// &
             & 'order)', stat_invalid_input)
       else
          call fatal_error(error, 'recover_on_mesh: facet '//index_name(r%c_indices, f)//' is not a side of any '// &
-            & 'element: '//name//' are not the nodes of one element', stat_invalid_input)
+            & 'element: '//facet_name()//' are not the nodes of one element', stat_invalid_input)
       end if
+   contains
+      !> The facet as the caller wrote it (only for messages: facets are many).
+      pure function facet_name() result(s)
+         character(len=:), allocatable :: s
+         s = entry_name(r%c_indices, 'facet_nodes', 'facet_nodes', [0, f])//' = ('// &
+            & ivec_str(r%c_indices, fnodes)//')'
+      end function facet_name
    end subroutine facet_owner
 
    !> The shared patch loop (sprc_recovery_patch_loop) over the vertex nodes; a failing
