@@ -252,6 +252,13 @@ void sprc_delete_report(sprc_report *report);
 #define SPRC_FACET_FREE 3
 #define SPRC_FACET_PRESSURE 4
 
+/* Conventions of gauss_xi (sprc_recover_reference): SPRC_REFERENCE_UNIT, quads
+ * and hexes on [0,1]^dim (sprc_recover_xi's); SPRC_REFERENCE_SYMMETRIC, on
+ * [-1,1]^dim (most FE codes'). tri3 and tet4 use the unit simplex (xi >= 0,
+ * sum xi <= 1) in both. */
+#define SPRC_REFERENCE_UNIT 0
+#define SPRC_REFERENCE_SYMMETRIC 1
+
 typedef struct _sprc_recovery *sprc_recovery;
 
 /* Recover the stresses of a mesh and estimate the error. Shapes in C order:
@@ -263,9 +270,11 @@ typedef struct _sprc_recovery *sprc_recovery;
  *   gauss_weights  [nelem][ngp]       weight times |J|, > 0
  *   gauss_stress   [nelem][ngp][nstress]  FE stresses (Voigt, see above)
  *   body_force     [dim] or NULL      constant body force b (div sigma + b = 0)
- *   facet_nodes    [nfacet][facet_nnode]  0-based; a side of one element
+ *   facet_nodes    [nfacet][facet_nnode]  0-based; a side (face) of exactly
+ *                                     one element, its nodes in any order
  *                                     (line2 / line3 in 2D, tri3 / quad4 /
- *                                     quad9 faces in 3D); NULL with nfacet = 0
+ *                                     quad9 faces in 3D); else an error naming
+ *                                     facet_nodes[f]; NULL with nfacet = 0
  *   facet_kind     [nfacet]           SPRC_FACET_*
  *   facet_traction [nfacet][dim] or NULL  (needed if a facet is a traction or
  *                                     pressure one; pressure in [f][0])
@@ -302,6 +311,19 @@ sprc_recovery sprc_recover_xi(sprc_error error, int dim, int analysis, int nnode
                               double young, double poisson, int method, const double *body_force, int nfacet,
                               int facet_nnode, const int *facet_nodes, const int *facet_kind,
                               const double *facet_traction, const double *gauss_xi);
+
+/* sprc_recover_xi with the convention of gauss_xi: reference is
+ * SPRC_REFERENCE_UNIT (the same as sprc_recover_xi) or SPRC_REFERENCE_SYMMETRIC
+ * (quads and hexes on [-1,1]^dim); another value is SPRC_STAT_INVALID_INPUT.
+ * A point outside the chosen reference cell is SPRC_STAT_INVALID_INPUT naming
+ * gauss_xi[e][q] and the convention. */
+sprc_recovery sprc_recover_reference(sprc_error error, int dim, int analysis, int nnode, const double *nodes,
+                                     int element_type, int nen, int nelem, const int *connectivity, int ngp,
+                                     const double *gauss_points, const double *gauss_weights,
+                                     const double *gauss_stress, double young, double poisson, int method,
+                                     const double *body_force, int nfacet, int facet_nnode, const int *facet_nodes,
+                                     const int *facet_kind, const double *facet_traction, const double *gauss_xi,
+                                     int reference);
 
 /* Recovered stresses at the nodes into out[nnode][nstress]; n must equal
  * nnode (nodes of no element get zero). On error out is left unchanged. */

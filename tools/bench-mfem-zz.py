@@ -1,11 +1,15 @@
 #!/usr/bin/env python3
 """Optional yardstick (never in `make test`): MFEM's Zienkiewicz-Zhu estimator, timed on the
-quarter annulus 5 <= r <= 20 of N x N quad4 elements used by example/bench/bench_mesh_recovery.
+quarter annulus 5 <= r <= 20 of N x N quad4 elements used by example/bench/bench_mesh_recovery,
+or (word `square`) on its axis-aligned N x N unit square (`quad4 squareN` there).
 
 Needs PyMFEM (`pip install mfem`, serial). The displacement is the Lame solution interpolated at
 the nodes (pressure 1 inside, E = 1000, nu = 0.3, plane strain), so the estimator sees the same
 kind of field as sprc's benchmark. MFEM's flux space is H1 of the same order, as in its example 21.
-Usage: OMP_NUM_THREADS=1 python3 tools/bench-mfem-zz.py [N [RUNS]]  (an N x N mesh; default 512, 5 runs).
+On the square the displacement is the smooth field u = 1e-3 (x^2 y, x y^2 + x) (no Lame solution
+there: the square holds the origin).
+Usage: OMP_NUM_THREADS=1 python3 tools/bench-mfem-zz.py [N [RUNS [annulus|square]]]  (an N x N mesh;
+default 512, 5 runs, the annulus).
 Compare its cpu median with the cpu column of bench_mesh_recovery: on a shared machine CPU time is
 the figure that load does not inflate.
 """
@@ -33,6 +37,26 @@ def annulus(nr, nt):
     return mesh
 
 
+def square(n):
+    mesh = mfem.Mesh(2, (n + 1) * (n + 1), n * n, 0, 2)
+    for j in range(n + 1):
+        for i in range(n + 1):
+            mesh.AddVertex([i / n, j / n])
+    for j in range(n):
+        for i in range(n):
+            n0 = j * (n + 1) + i
+            mesh.AddQuad([n0, n0 + 1, n0 + n + 2, n0 + n + 1])
+    mesh.FinalizeQuadMesh(1, 1, True)
+    return mesh
+
+
+class Smooth(mfem.VectorPyCoefficient):
+    """A smooth displacement on the unit square."""
+
+    def EvalValue(self, x):
+        return [1e-3 * x[0] ** 2 * x[1], 1e-3 * (x[0] * x[1] ** 2 + x[0])]
+
+
 class Lame(mfem.VectorPyCoefficient):
     """Plane-strain Lame displacement of the thick cylinder under unit inner pressure."""
 
@@ -47,11 +71,12 @@ class Lame(mfem.VectorPyCoefficient):
 def main():
     n = int(sys.argv[1]) if len(sys.argv) > 1 else 512
     runs = int(sys.argv[2]) if len(sys.argv) > 2 else 5
-    mesh = annulus(n, n)
+    kind = sys.argv[3] if len(sys.argv) > 3 else "annulus"
+    mesh = square(n) if kind == "square" else annulus(n, n)
     fec = mfem.H1_FECollection(1, 2)
     fes = mfem.FiniteElementSpace(mesh, fec, 2)
     u = mfem.GridFunction(fes)
-    u.ProjectCoefficient(Lame(2))
+    u.ProjectCoefficient(Smooth(2) if kind == "square" else Lame(2))
     lam = YOUNG * NU / ((1 + NU) * (1 - 2 * NU))
     mu = YOUNG / (2 * (1 + NU))
     lam_c, mu_c = mfem.ConstantCoefficient(lam), mfem.ConstantCoefficient(mu)
@@ -65,7 +90,7 @@ def main():
         times.append(time.perf_counter() - t0)
         cpus.append(time.process_time() - c0)
         total = est.GetTotalError()
-    print(f"MFEM ZZ, {mesh.GetNE()} quad4: median {1e3 * float(np.median(times)):.1f} ms "
+    print(f"MFEM ZZ, {kind}, {mesh.GetNE()} quad4: median {1e3 * float(np.median(times)):.1f} ms "
           f"(min {1e3 * min(times):.1f}, max {1e3 * max(times):.1f}), cpu median {1e3 * float(np.median(cpus)):.1f} ms, "
           f"over {runs} runs; eta = {total:.6e}")
 

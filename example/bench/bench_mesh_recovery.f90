@@ -19,8 +19,16 @@
 !> The caller's reference coordinates of the points are passed (gauss_xi), as an FE code has
 !> them; the word `newton` derives them instead (Newton's method per point, the 'points' phase).
 !>
-!> Run: fpm run --profile release --example bench_mesh_recovery [-- NREP [quad4|hex8|all [spr|sprc|all
-!> [newton]]]] (the optional words restrict the runs to one mesh and one method).
+!> Lattices: the unit square of N x N quad4 (N = 64, 128, 256, 512) and the unit cube of
+!> N x N x N hex8 (N = 32, 40, 64), axis-aligned (every coordinate a dyadic fraction when N is
+!> a power of two, ties in every coordinate), and the 256 x 256 square and 32^3 cube rotated
+!> by 0.3 rad about z; a smooth field plus 1 % as FE stresses; SPR-C with free facets on the
+!> whole boundary. They are what a power-of-two grid gives, where a hash of coordinate bits
+!> or a search that degenerates on ties shows.
+!>
+!> Run: fpm run --profile release --example bench_mesh_recovery [-- NREP [MESH|all [spr|sprc|all
+!> [newton]]]] (the optional words restrict the runs to the meshes whose label holds MESH, e.g.
+!> annulus, cylinder, square, square256, cube, rotated, and to one method).
 program bench_mesh_recovery
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type
@@ -59,18 +67,48 @@ program bench_mesh_recovery
    end if
    nmax = 1
    !$ nmax = omp_get_max_threads()
-   call annulus(512, 512, 0, quad)
-   call annulus(48, 48, 46, hex)
+   if (selected('quad4 annulus')) call annulus(512, 512, 0, quad)
+   if (selected('hex8 cylinder')) call annulus(48, 48, 46, hex)
    write (*, '(a,i0,a,i0,a)') 'bench_mesh_recovery: medians of ', nrep, ' runs, milliseconds; ', nmax, &
       & ' threads available; reference coordinates '//trim(merge('by Newton  ', 'given (gxi)', newton))
-   write (*, '(a)') 'mesh            elements  method  threads   check  topology  points  patches  nodal  '// &
+   write (*, '(a)') 'mesh               elements  method  threads   check  topology  points  patches  nodal  '// &
       & 'estimate   total    cpu'
    call run(quad, 'quad4 annulus', mesh_method_spr)
    call run(quad, 'quad4 annulus', mesh_method_sprc)
    call run(hex, 'hex8 cylinder', mesh_method_spr)
    call run(hex, 'hex8 cylinder', mesh_method_sprc)
+   call run_lattice(2, 64, 0.0_wp, 'square64')
+   call run_lattice(2, 128, 0.0_wp, 'square128')
+   call run_lattice(2, 256, 0.0_wp, 'square256')
+   call run_lattice(2, 512, 0.0_wp, 'square512')
+   call run_lattice(2, 256, 0.3_wp, 'rotated256')
+   call run_lattice(3, 32, 0.0_wp, 'cube32')
+   call run_lattice(3, 40, 0.0_wp, 'cube40')
+   call run_lattice(3, 64, 0.0_wp, 'cube64')
+   call run_lattice(3, 32, 0.3_wp, 'rotated32^3')
 
 contains
+
+   !> Whether the command line selects the mesh `label`.
+   logical function selected(label)
+      character(len=*), intent(in) :: label
+      selected = len_trim(only_mesh) == 0 .or. trim(only_mesh) == 'all' .or. index(label, trim(only_mesh)) > 0
+   end function selected
+
+   !> Both methods on an n^dim lattice of the unit square / cube, rotated by `angle` about z.
+   subroutine run_lattice(d, n, angle, label)
+      integer, intent(in) :: d, n
+      real(wp), intent(in) :: angle
+      character(len=*), intent(in) :: label
+      type(mesh_type) :: m
+      character(len=17) :: full
+
+      full = trim(merge('quad4', 'hex8 ', d == 2))//' '//label
+      if (.not. selected(full)) return
+      call lattice_mesh(d, n, angle, m)
+      call run(m, full, mesh_method_spr)
+      call run(m, full, mesh_method_sprc)
+   end subroutine run_lattice
 
    !> Timings of one mesh and method with 1 and 2 threads.
    subroutine run(m, label, method)
@@ -85,7 +123,7 @@ contains
       integer(i8) :: bits, bits1
       logical :: same
 
-      if (len_trim(only_mesh) > 0 .and. trim(only_mesh) /= 'all' .and. index(label, trim(only_mesh)) == 0) return
+      if (.not. selected(label)) return
       if (len_trim(only_method) > 0 .and. trim(only_method) /= 'all' .and. trim(only_method) /= trim(merge('spr ', &
          & 'sprc', method == mesh_method_spr))) return
       ntmax = min(2, nmax)
@@ -119,7 +157,7 @@ contains
          do i = 1, 8
             med(i) = median(t(i, :, nt))
          end do
-         write (*, '(a14,i10,2x,a6,i9,6f9.1,f9.1,f7.0)') label, size(m%conn, 2), merge('spr   ', 'sprc  ', &
+         write (*, '(a17,i10,2x,a6,i9,6f9.1,f9.1,f7.0)') label, size(m%conn, 2), merge('spr   ', 'sprc  ', &
             & method == mesh_method_spr), nt, med
       end do
       if (ntmax == 2) write (*, '(a,f6.2,a,f6.2)') '   speedup on 2 threads (median of the paired runs): total', &
@@ -249,6 +287,108 @@ contains
       end do
       call facets(m, nr, nt, nz)
    end subroutine annulus
+
+   !> The unit square (d = 2: n x n quad4, plane strain) or cube (d = 3: n^3 hex8) rotated
+   !> by `angle` about z; 2^d Gauss points, a smooth field + 1 % as stresses, free facets on
+   !> the whole boundary.
+   subroutine lattice_mesh(d, n, angle, m)
+      integer, intent(in) :: d, n
+      real(wp), intent(in) :: angle
+      type(mesh_type), intent(out) :: m
+      integer :: i, j, k, e, nl, ne, ngp, a, g, f, nf, side, ax, b1, b2, lo(3), u(3), v(3)
+      real(wp) :: p(3), xi(3), gx(2), shp(8), dshp(3, 8), jac(3, 3), xe(3, 8)
+      integer, parameter :: corner(3, 8) = reshape([0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0, 0, 1, 1, 0, 1, 1, 1, 1, &
+         & 0, 1, 1], [3, 8])
+
+      m%dim = d
+      m%etype = merge(elem_quad4, elem_hex8, d == 2)
+      m%analysis = merge(plane_strain, solid, d == 2)
+      nl = merge(1, n + 1, d == 2)
+      ne = n**d
+      ngp = 2**d
+      allocate (m%x(d, (n + 1)**2*nl), m%conn(2**d, ne), m%gp(d, ngp, ne), m%gw(ngp, ne), m%gs(3*(d - 1), ngp, ne))
+      allocate (m%gxi(d, ngp, ne))
+      do k = 0, nl - 1
+         do j = 0, n
+            do i = 0, n
+               p = [real(i, wp), real(j, wp), real(k, wp)]/n
+               m%x(1:2, lattice(n, n, i, j, k)) = [cos(angle)*p(1) - sin(angle)*p(2), sin(angle)*p(1) + cos(angle)*p(2)]
+               if (d == 3) m%x(3, lattice(n, n, i, j, k)) = p(3)
+            end do
+         end do
+      end do
+      gx = 0.5_wp + [-0.5_wp, 0.5_wp]/sqrt(3.0_wp)
+      e = 0
+      do k = 0, max(nl - 1, 1) - 1
+         do j = 0, n - 1
+            do i = 0, n - 1
+               e = e + 1
+               do a = 1, 2**d
+                  m%conn(a, e) = lattice(n, n, i + corner(1, a), j + corner(2, a), k + corner(3, a))
+                  xe(1:d, a) = m%x(:, m%conn(a, e))
+               end do
+               do g = 1, ngp
+                  xi = [gx(1 + mod(g - 1, 2)), gx(1 + mod((g - 1)/2, 2)), gx(1 + (g - 1)/4)]
+                  call multilinear(d, xi, shp, dshp)
+                  m%gp(:, g, e) = matmul(xe(1:d, 1:2**d), shp(1:2**d))
+                  m%gxi(:, g, e) = xi(1:d)
+                  jac(1:d, 1:d) = matmul(xe(1:d, 1:2**d), transpose(dshp(1:d, 1:2**d)))
+                  m%gw(g, e) = abs(det(d, jac))/2**d
+                  call smooth(m%gp(:, g, e), m%gs(:, g, e))
+               end do
+            end do
+         end do
+      end do
+      ! Free facets: the element sides on each face of the square / cube.
+      nf = 2*d*n**(d - 1)
+      allocate (m%fn(2**(d - 1), nf), m%fk(nf), m%ft(d, nf))
+      m%fk = facet_free
+      m%ft = 0.0_wp
+      f = 0
+      do ax = 1, d
+         do side = 0, 1
+            do b2 = 0, merge(0, n - 1, d == 2)
+               do b1 = 0, n - 1
+                  ! u, v: the in-face axes; lo: the facet's lowest lattice corner.
+                  u = 0
+                  v = 0
+                  u(1 + mod(ax, d)) = 1
+                  if (d == 3) v(1 + mod(ax + 1, d)) = 1
+                  lo = b1*u + b2*v
+                  lo(ax) = side*n
+                  f = f + 1
+                  if (d == 2) then
+                     m%fn(:, f) = [lattice_node(n, lo), lattice_node(n, lo + u)]
+                  else
+                     m%fn(:, f) = [lattice_node(n, lo), lattice_node(n, lo + u), lattice_node(n, lo + u + v), &
+                        & lattice_node(n, lo + v)]
+                  end if
+               end do
+            end do
+         end do
+      end do
+   end subroutine lattice_mesh
+
+   !> Node of lattice point c of an n x n (x n) lattice mesh.
+   pure integer function lattice_node(n, c)
+      integer, intent(in) :: n, c(3)
+      lattice_node = lattice(n, n, c(1), c(2), c(3))
+   end function lattice_node
+
+   !> A smooth stress field plus a 1 % perturbation, Voigt.
+   pure subroutine smooth(x, s)
+      real(wp), intent(in) :: x(:)
+      real(wp), intent(out) :: s(:)
+      real(wp) :: noise, z
+      noise = 0.01_wp*sin(30.0_wp*x(1) + 20.0_wp*x(2))
+      z = 0.0_wp
+      if (size(x) == 3) z = x(3)
+      if (size(s) == 3) then
+         s = [1.0_wp + x(1)**2 - x(2), x(1)*x(2), 0.5_wp - x(2)**2] + noise
+      else
+         s = [1.0_wp + x(1)**2 - x(2), x(1)*x(2) + z, 0.5_wp - z**2, x(2)*z, x(1) - z, 0.2_wp*x(1)*x(2)] + noise
+      end if
+   end subroutine smooth
 
    !> Node of lattice point (i, j, k) of an nr x nt (x nz) annulus mesh.
    pure integer function lattice(nr, nt, i, j, k)

@@ -169,6 +169,8 @@ _RECOVER_ARGS = (
     ctypes.c_int, ctypes.c_int, _c_int_p, _c_int_p, _c_double_p)            # facets
 recover = error_check(_prototype("sprc_recover", _handle, _handle, *_RECOVER_ARGS))
 recover_xi = error_check(_prototype("sprc_recover_xi", _handle, _handle, *_RECOVER_ARGS, _c_double_p))  # gauss_xi
+recover_reference = error_check(_prototype("sprc_recover_reference", _handle, _handle, *_RECOVER_ARGS, _c_double_p,
+                                           ctypes.c_int))  # gauss_xi, reference
 get_recovery_nodal_stress = error_check(_prototype("sprc_get_recovery_nodal_stress", None, _handle, _handle,
                                                    _c_double_p, ctypes.c_int))
 get_recovery_element_error = error_check(_prototype("sprc_get_recovery_element_error", None, _handle, _handle,

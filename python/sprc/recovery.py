@@ -33,6 +33,8 @@ METHODS = {"spr": 1, "sprc": 2}
 DEGREES = {"auto": 0, "p": 512, "p+1": 256}
 #: Boundary facet kinds (SPRC_FACET_*).
 FACET_KINDS = {"traction": 1, "symmetry": 2, "free": 3, "pressure": 4}
+#: Conventions of gauss_xi (SPRC_REFERENCE_*): quads and hexes on [0, 1]^dim or [-1, 1]^dim.
+REFERENCES = {"unit": 0, "symmetric": 1}
 
 _INT_MIN, _INT_MAX = np.iinfo(np.intc).min, np.iinfo(np.intc).max
 _c_double_p = ctypes.POINTER(ctypes.c_double)
@@ -198,7 +200,8 @@ def _facets(boundary, dim, nfn):
 
 
 def recover(nodes, elements, element_type, gauss_points, gauss_weights, gauss_stress, *, young, poisson,
-            analysis=None, method="sprc", body_force=None, boundary=None, degree="auto", gauss_xi=None):
+            analysis=None, method="sprc", body_force=None, boundary=None, degree="auto", gauss_xi=None,
+            reference="unit"):
     """Recover the stresses of a finite-element solution on your own mesh
     and estimate its error (SPR or SPR-C with the ZZ estimate).
 
@@ -230,18 +233,24 @@ def recover(nodes, elements, element_type, gauss_points, gauss_weights, gauss_st
                        [{"nodes": [...], "kind": "traction", "traction": [tx, ty]},
                         {"nodes": [...], "kind": "pressure", "pressure": p},
                         {"nodes": [...], "kind": "symmetry"}, ...].
-                   A facet is a side of one element (nfn nodes: 2 for tri3 and
-                   quad4, 3 for quad9 and tet4, 4 for hex8, 9 for hex27, VTK
-                   order); "free" means zero traction, "symmetry" zero shear,
+                   A facet is a side (face) of exactly one element, its nodes in
+                   any order (nfn nodes: 2 for tri3 and quad4, 3 for quad9 and
+                   tet4, 4 for hex8, 9 for hex27); anything else (a diagonal, an
+                   interior side, nodes of no one element) raises SprcError
+                   naming boundary["nodes"][i]. "free" means zero traction, "symmetry" zero shear,
                    "pressure" t = -p n with the facet's own outward normal at
                    each of its points (right on curved facets, where the
                    traction turns). Only the facets given are constrained.
     gauss_xi       [nelem, ngp, dim] reference coordinates of the points in
-                   their elements ([0, 1]^dim for quads and hexes, the unit
-                   simplex for tri3 and tet4), as your FE code has them, or None
-                   (default: derived by Newton's method). Checked, not trusted:
-                   inside the element and mapped onto the point (tolerance 1e-6
-                   in reference units).
+                   their elements, as your FE code has them, or None (default:
+                   derived by Newton's method). Checked, not trusted: inside the
+                   reference cell and mapped onto the point (tolerance 1e-6 in
+                   [0, 1] units); the message of a point outside names the
+                   convention.
+    reference      the convention of gauss_xi for quads and hexes: "unit"
+                   (default, [0, 1]^dim) or "symmetric" ([-1, 1]^dim, as most
+                   FE codes). tri3 and tet4 use the unit simplex (xi >= 0,
+                   sum xi <= 1) either way.
 
     Returns a :class:`Recovery`. Raises ValueError for arrays of the wrong
     shape or type and unknown names, :class:`SprcError` with the library's
@@ -267,6 +276,7 @@ def recover(nodes, elements, element_type, gauss_points, gauss_weights, gauss_st
     gs = _doubles("gauss_stress", gauss_stress, (nelem, ngp, nstress))
     bf = None if body_force is None else _doubles("body_force", body_force, (edim,))
     gxi = None if gauss_xi is None else _doubles("gauss_xi", gauss_xi, (nelem, ngp, edim))
+    rcode = _code("reference", reference, REFERENCES)
     fn = fk = ft = None
     nfacet = 0
     if boundary is not None:
@@ -274,8 +284,14 @@ def recover(nodes, elements, element_type, gauss_points, gauss_weights, gauss_st
         nfacet = fn.shape[0]
         if nfacet == 0:
             fn = fk = ft = None
-    handle = library.recover_xi(edim, acode, nnode, _ptr(x, _c_double_p), etype, nen, nelem, _ptr(conn, _c_int_p),
-                                ngp, _ptr(gp, _c_double_p), _ptr(gw, _c_double_p), _ptr(gs, _c_double_p),
-                                float(young), float(poisson), mcode, _ptr(bf, _c_double_p), nfacet, nfn,
-                                _ptr(fn, _c_int_p), _ptr(fk, _c_int_p), _ptr(ft, _c_double_p), _ptr(gxi, _c_double_p))
+    try:
+        handle = library.recover_reference(edim, acode, nnode, _ptr(x, _c_double_p), etype, nen, nelem,
+                                           _ptr(conn, _c_int_p), ngp, _ptr(gp, _c_double_p), _ptr(gw, _c_double_p),
+                                           _ptr(gs, _c_double_p), float(young), float(poisson), mcode,
+                                           _ptr(bf, _c_double_p), nfacet, nfn, _ptr(fn, _c_int_p), _ptr(fk, _c_int_p),
+                                           _ptr(ft, _c_double_p), _ptr(gxi, _c_double_p), rcode)
+    except library.SprcError as e:
+        # The library names the C array; the caller wrote boundary["nodes"].
+        message = str(e).replace("facet_nodes[", 'boundary["nodes"][')
+        raise library.SprcError(message, e.status) from None
     return Recovery(handle, element_type, edim, nstress, nnode, nelem)

@@ -260,6 +260,19 @@ def test_given_reference_coordinates(etype):
         recover(case, gauss_xi=bad)
     with pytest.raises(ValueError, match="gauss_xi has shape"):
         recover(case, gauss_xi=case["gauss_xi"][:, 1:])
+    # The same points on [-1, 1]^dim, reference="symmetric": exact as well; read as the
+    # default "unit" they are outside [0, 1]^dim and the message says the convention.
+    symmetric = 2.0 * case["gauss_xi"] - 1.0
+    assert nodal_deviation(case, recover(case, gauss_xi=symmetric, reference="symmetric")) <= TOL
+    with pytest.raises(sprc.SprcError, match=r"gauss_xi\[0\]\[0\] = .* is outside the reference cell "
+                                             r"\[0, 1\]\^. \(reference 'unit', the default; 'symmetric' takes"):
+        recover(case, gauss_xi=symmetric)
+    outside = symmetric.copy()
+    outside[0, 0, 0] = 1.5
+    with pytest.raises(sprc.SprcError, match=r"outside the reference cell \[-1, 1\]\^. \(reference 'symmetric'"):
+        recover(case, gauss_xi=outside, reference="symmetric")
+    with pytest.raises(ValueError, match="reference = 'signed' is not one of 'unit', 'symmetric'"):
+        recover(case, gauss_xi=symmetric, reference="signed")
 
 
 def test_inexact_data_gives_positive_estimate():
@@ -446,10 +459,23 @@ def test_library_errors_raise_sprc_error(quad):
         call(quad, analysis="solid")
     with pytest.raises(sprc.SprcError, match="poisson"):
         call(quad, poisson=0.5)
-    with pytest.raises(sprc.SprcError, match=r"facet_nodes\[0\]\[1\] = 99"):
+    with pytest.raises(sprc.SprcError, match=r'boundary\["nodes"\]\[0\]\[1\] = 99'):
         call(quad, boundary={"nodes": [[0, 99]], "kind": "free"})
     with pytest.raises(sprc.SprcError, match="is not a side of any element"):
         call(quad, boundary={"nodes": [[0, 8]], "kind": "free"})
+
+
+@pytest.mark.parametrize("facet", [[0, 4], [4, 0]])
+def test_diagonal_facet_is_an_error(quad, facet):
+    """Nodes 0 and 4 are opposite corners of element 0: a diagonal, not a side. It was
+    accepted (and changed eta); now an error naming the caller's boundary["nodes"][i].
+    A real side in either order is accepted."""
+    with pytest.raises(sprc.SprcError, match=r'facet 1 is not a side of any element: boundary\["nodes"\]\[1\] = '
+                                             rf'\({facet[0]} {facet[1]}\) are nodes of element 0 but not one of its '
+                                             'sides'):
+        call(quad, boundary={"nodes": [[1, 0], facet], "kind": "free"})
+    eta = [call(quad, boundary={"nodes": [side], "kind": "free"}).eta for side in ([0, 1], [1, 0])]
+    assert eta[0] == eta[1]
 
 
 def test_thin_layer_reports_unknown_element_code(quad):

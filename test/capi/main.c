@@ -457,6 +457,15 @@ static void test_recovery_bad_input(void) {
   RECOVER_FAILS("facet_nodes[1][0] = -3", 2, 1, NNODE, x, 9, 4, NELEM, c, NGP, gp, gw, gs, 1e3, 0.3, 2, NULL, 2, 2,
                 &fn[0][0], fk, &ft[0][0]);
   fn[1][0] = 1;
+  /* A facet must be a side of exactly one element, in any node order: nodes 0 and
+     6 are opposite corners of element 0 (its diagonal), so facet 1 = {6, 0} is
+     none (it used to be accepted and changed the estimate). */
+  {
+    int fd[2][2] = {{1, 0}, {6, 0}}, fkd[2] = {SPRC_FACET_FREE, SPRC_FACET_FREE};
+    RECOVER_FAILS("facet 1 is not a side of any element: facet_nodes[1] = (6 0) are nodes of element 0 but not one "
+                  "of its sides", 2, 1, NNODE, x, 9, 4, NELEM, c, NGP, gp, gw, gs, 1e3, 0.3, 2, NULL, 2, 2, &fd[0][0],
+                  fkd, NULL);
+  }
   /* Non-finite data and a point outside its element. */
   /* Named 0-based in C order with the C argument names, as the caller wrote them. */
   bad = m;
@@ -719,6 +728,31 @@ static void test_recovery_given_xi(void) {
                         &m.gp[0][0][0], &m.gw[0][0], &m.gs[0][0][0], 1000.0, 0.3, SPRC_METHOD_SPRC, m.body, 0, 2,
                         NULL, NULL, NULL, &gxi[0][0][0]);
   CHECK(rec == NULL && has_error(err, "gauss_xi[3][1] = "), "a moved reference coordinate was accepted");
+  /* sprc_recover_reference: the same rule on [-1,1]^2 with SPRC_REFERENCE_SYMMETRIC is
+     exact; read as SPRC_REFERENCE_UNIT it is outside [0,1]^2 and the message says the
+     convention; SPRC_REFERENCE_UNIT on the [0,1] rule is sprc_recover_xi. */
+  for (e = 0; e < NELEM; e++)
+    for (q = 0; q < NGP; q++) {
+      gxi[e][q][0] = 2.0 * rule[q][0] - 1.0;
+      gxi[e][q][1] = 2.0 * rule[q][1] - 1.0;
+    }
+  rec = sprc_recover_reference(err, 2, SPRC_PLANE_STRESS, NNODE, &m.nodes[0][0], SPRC_QUAD4, 4, NELEM, &m.conn[0][0],
+                               NGP, &m.gp[0][0][0], &m.gw[0][0], &m.gs[0][0][0], 1000.0, 0.3, SPRC_METHOD_SPRC, m.body,
+                               0, 2, NULL, NULL, NULL, &gxi[0][0][0], SPRC_REFERENCE_SYMMETRIC);
+  CHECK(rec != NULL && sprc_check_error(err) == 0, "recovery with symmetric reference coordinates failed");
+  sprc_get_recovery_nodal_stress(err, rec, &nodal[0][0], NNODE);
+  CHECK(nodal_deviation(&m, nodal) <= 5e-10, "nodal stresses with symmetric reference coordinates are not exact");
+  sprc_delete_recovery(&rec);
+  rec = sprc_recover_reference(err, 2, SPRC_PLANE_STRESS, NNODE, &m.nodes[0][0], SPRC_QUAD4, 4, NELEM, &m.conn[0][0],
+                               NGP, &m.gp[0][0][0], &m.gw[0][0], &m.gs[0][0][0], 1000.0, 0.3, SPRC_METHOD_SPRC, m.body,
+                               0, 2, NULL, NULL, NULL, &gxi[0][0][0], SPRC_REFERENCE_UNIT);
+  CHECK(rec == NULL && has_error(err, ") is outside the reference cell [0, 1]^2 (reference 'unit'"),
+        "symmetric coordinates read as unit: no error naming the convention");
+  rec = sprc_recover_reference(err, 2, SPRC_PLANE_STRESS, NNODE, &m.nodes[0][0], SPRC_QUAD4, 4, NELEM, &m.conn[0][0],
+                               NGP, &m.gp[0][0][0], &m.gw[0][0], &m.gs[0][0][0], 1000.0, 0.3, SPRC_METHOD_SPRC, m.body,
+                               0, 2, NULL, NULL, NULL, &gxi[0][0][0], 5);
+  CHECK(rec == NULL && has_error(err, "reference = 5 is not SPRC_REFERENCE_UNIT (0) or SPRC_REFERENCE_SYMMETRIC (1)"),
+        "an unknown reference code was accepted");
   sprc_delete_error(&err);
   PASS();
 }

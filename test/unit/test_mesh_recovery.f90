@@ -22,9 +22,12 @@ module sprc_test_mesh_recovery
    use sprc_core_material, only: plane_stress, plane_strain, solid
    use sprc_recovery_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, mesh_method_spr, &
       & mesh_method_sprc, facet_traction, facet_symmetry, facet_free, facet_pressure, elem_tri3, elem_quad4, &
-      & elem_tet4, elem_hex8, elem_quad9, elem_hex27
+      & elem_tet4, elem_hex8, elem_quad9, elem_hex27, mesh_reference_symmetric
    use sprc_legacy, only: sprc_recover_mesh
-   use sprc_recovery_mesh_element, only: facet_points, element_inverse_map
+   use sprc_recovery_mesh_check, only: check_duplicate_nodes
+   use sprc_core_kinds, only: i8
+   use sprc_core_text, only: rtoa
+   use sprc_recovery_mesh_element, only: facet_points, element_inverse_map, element_facet_order
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reset, patch_add_point
    use sprc_recovery_patch_loop, only: patch_source_type, patch_loop_type, run_patch_loop, patch_capacity
    !$ use omp_lib, only: omp_get_max_threads, omp_set_num_threads
@@ -91,10 +94,12 @@ contains
          new_unittest('thread_determinism', test_threads), &
          new_unittest('validation_errors', test_validation), &
          new_unittest('facet_errors', test_facet_errors), &
+         new_unittest('facet_node_order', test_facet_order), &
          new_unittest('far_from_origin', test_far_from_origin), &
          new_unittest('huge_stresses', test_huge_stresses), &
          new_unittest('pressure_facets', test_pressure_facets), &
          new_unittest('duplicates', test_duplicates), &
+         new_unittest('duplicate_check_dyadic_lattices', test_duplicate_probes), &
          new_unittest('c_index_messages', test_c_index_messages), &
          new_unittest('patch_loop_skip', test_patch_loop_skip), &
          new_unittest('degree_auto', test_degree_auto), &
@@ -999,6 +1004,54 @@ contains
       end subroutine run
    end subroutine test_validation
 
+   !> element_facet_order on the unit square / cube (hand values): a quad's diagonal and a
+   !> hex's face diagonal plane are no sides; the bottom face of hex8 / hex27 with its nodes
+   !> in an order that is no parametrisation (corners 2 and 3 swapped; hex27 also mid-sides
+   !> 5 and 7) is put in an order whose quadrature has the face's area 1 and its centroid
+   !> (1/2, 1/2, 0), to round-off (the bow-tie order as given has area 2/sqrt(3)); a side
+   !> given in order keeps it.
+   subroutine test_facet_order(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: xc(3, 27), x(3, 9), w(9), nrm(3, 9)
+      integer :: perm(9), loc(9), a, nq, k
+      logical :: ok
+
+      call element_facet_order(elem_quad4, [1, 3], perm(1:2), ok)
+      call check(error, .not. ok, 'the diagonal of a quad4 is no side')
+      if (allocated(error)) return
+      call element_facet_order(elem_hex8, [1, 2, 7, 8], perm(1:4), ok)
+      call check(error, .not. ok, 'a diagonal plane of a hex8 is no face')
+      if (allocated(error)) return
+      call element_facet_order(elem_quad4, [3, 2], perm(1:2), ok)
+      call check(error, ok .and. all(perm(1:2) == [1, 2]), 'a quad4 side in reverse order, kept')
+      if (allocated(error)) return
+      do k = 1, 2
+         if (k == 1) then
+            do a = 1, 8
+               xc(:, a) = real(vtk_hex8(:, a), wp)
+            end do
+            loc(1:4) = [1, 3, 2, 4]
+            call element_facet_order(elem_hex8, loc(1:4), perm(1:4), ok)
+            call facet_points(3, 4, xc(:, loc(perm(1:4))), nq, x, w, nrm)
+         else
+            do a = 1, 27
+               xc(:, a) = 0.5_wp*real(vtk_hex27(:, a), wp)
+            end do
+            loc = [1, 3, 2, 4, 11, 10, 9, 12, 25]
+            call element_facet_order(elem_hex27, loc, perm, ok)
+            call facet_points(3, 9, xc(:, loc(perm)), nq, x, w, nrm)
+         end if
+         call check(error, ok, 'the bottom face in a shuffled order is a face')
+         if (allocated(error)) return
+         call check(error, abs(sum(w(1:nq)) - 1.0_wp) <= 10*epsilon(1.0_wp) .and. &
+            & all(abs(matmul(x(:, 1:nq), w(1:nq)) - [0.5_wp, 0.5_wp, 0.0_wp]) <= 10*epsilon(1.0_wp)), &
+            & 'the reordered face has area 1 and centroid (1/2, 1/2, 0)')
+         if (allocated(error)) return
+      end do
+      call facet_points(3, 4, xc(:, [1, 3, 2, 4]), nq, x, w, nrm)
+      call check(error, abs(sum(w(1:nq)) - 1.0_wp) > 0.1_wp, 'the bow-tie order as given has the wrong area')
+   end subroutine test_facet_order
+
    !> Facet validation: kinds, shapes, node range, missing traction, not a side, interior.
    subroutine test_facet_errors(error)
       type(error_type), allocatable, intent(out) :: error
@@ -1031,13 +1084,22 @@ contains
       ! Nodes 1 and 9 are opposite corners of the mesh; nodes 4 and 5 share the middle edge
       ! of elements 1 and 3.
       call go(reshape([1, 9, 4, 5], [2, 2]), [2, 2])
-      call expect(error, stat_invalid_input, 'facet 1 (nodes 1 9) is not a side')
+      call expect(error, stat_invalid_input, 'facet 1 is not a side of any element: facet_nodes(:, 1) = (1 9) are '// &
+         & 'not the nodes of one element')
       if (allocated(error)) return
       call go(reshape([4, 1, 4, 5], [2, 2]), [2, 3])
       call expect(error, stat_invalid_input, 'facet 2 is shared by elements 1 and 3')
       if (allocated(error)) return
       call go(reshape([1, 1, 4, 1], [2, 2]), [2, 3])
       call expect(error, stat_invalid_input, 'facet 1 is degenerate')
+      if (allocated(error)) return
+      ! Nodes 1 and 5 are opposite corners of element 1 (its diagonal), in either order.
+      call go(reshape([1, 2, 5, 1], [2, 2]), [3, 3])
+      call expect(error, stat_invalid_input, 'facet 2 is not a side of any element: facet_nodes(:, 2) = (5 1) are '// &
+         & 'nodes of element 1 but not one of its sides')
+      if (allocated(error)) return
+      call go(reshape([1, 5], [2, 1]), [3])
+      call expect(error, stat_invalid_input, 'facet_nodes(:, 1) = (1 5) are nodes of element 1 but not')
       if (allocated(error)) return
       call recover_on_mesh(2, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1.0e3_wp, 0.3_wp, 2, res, &
          & error, facet_nodes=fn)
@@ -1161,6 +1223,57 @@ contains
       call recover_on_mesh(2, c%analysis, c%x, c%etype, conn, c%gp, c%gw, c%gs, 1.0e3_wp, 0.3_wp, 1, res, error)
       call expect(error, stat_invalid_input, 'elements 1 and 4 have the same vertices')
    end subroutine test_duplicates
+
+   !> The duplicate-node check's hash table on coordinates with structure: the 257^2 nodes
+   !> of the unit square's 256 x 256 lattice (dyadic fractions: their low mantissa bits are
+   !> all zero), the 33^3 and 41^3 nodes of cube lattices (ties in all three coordinates) and
+   !> the 256 x 256 lattice rotated (no structure, the control). Bound on the slots read per
+   !> node: linear probing at load a with keys spread as by a random function costs
+   !> (1 + 1/(1 - a)^2)/2 per insertion, 5 at the table's largest load 2/3 (2.5 at the load
+   !> 1/2 these sizes give). A hash that maps such keys to a few slots reads O(n) per node.
+   !> Then a duplicate among them is still found (the last node moved onto the first).
+   subroutine test_duplicate_probes(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: x(:, :)
+      integer(i8) :: probes
+      integer :: n
+
+      call lattice(2, 256, 0.0_wp)
+      if (allocated(error)) return
+      call lattice(3, 32, 0.0_wp)
+      if (allocated(error)) return
+      call lattice(3, 40, 0.0_wp)
+      if (allocated(error)) return
+      call lattice(2, 256, 0.3_wp)
+      if (allocated(error)) return
+      x(:, size(x, 2)) = x(:, 1)
+      call check_duplicate_nodes(x, [(.true., n=1, size(x, 2))], .false., error)
+      call expect(error, stat_invalid_input, 'nodes 1 and 66049 are at the same point')
+   contains
+      subroutine lattice(d, m, angle)
+         integer, intent(in) :: d, m
+         real(wp), intent(in) :: angle
+         integer :: i, j, k
+         real(wp) :: p(3)
+         if (allocated(x)) deallocate (x)
+         allocate (x(d, (m + 1)**d))
+         n = 0
+         do k = 0, merge(0, m, d == 2)
+            do j = 0, m
+               do i = 0, m
+                  n = n + 1
+                  p = [real(i, wp), real(j, wp), real(k, wp)]/m
+                  x(1:2, n) = [cos(angle)*p(1) - sin(angle)*p(2), sin(angle)*p(1) + cos(angle)*p(2)]
+                  if (d == 3) x(3, n) = p(3)
+               end do
+            end do
+         end do
+         call check_duplicate_nodes(x, [(.true., i=1, n)], .false., error, probes)
+         if (allocated(error)) return
+         call check(error, real(probes, wp)/n <= 5.0_wp, 'duplicate-node hash on a '//trim(merge('square', &
+            & 'cube  ', d == 2))//' lattice: '//rtoa(real(probes, wp)/n)//' slots read per node, bound 5')
+      end subroutine lattice
+   end subroutine test_duplicate_probes
 
    !> With c_indices (the C and Python entries) messages name entries 0-based in C order
    !> with the C argument names (issue 13, defect 5): gw(2, 3) is gauss_weights[2][1].
@@ -1453,6 +1566,39 @@ contains
          call recover_on_mesh(c%dim, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
             & mesh_method_spr, res1, error, gauss_xi=gxi(:, 2:, :))
          call expect(error, stat_invalid_input, 'gxi has shape')
+         if (allocated(error)) return
+         ! The same points on [-1, 1]^dim with reference = symmetric: the same recovery (the
+         ! map xi = (s + 1)/2 rounds once, far below the tier); the [0, 1] coordinates read as
+         ! symmetric are inside [-1, 1] but map elsewhere; -0.5 read as unit is outside, and
+         ! the message says the convention.
+         call recover_on_mesh(c%dim, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
+            & mesh_method_sprc, res1, error, gauss_xi=2.0_wp*gxi - 1.0_wp, reference=mesh_reference_symmetric)
+         if (allocated(error)) return
+         call check(error, maxval(abs(res1%nodal - res0%nodal)) <= tol*c%scale .and. &
+            & abs(res1%err - res0%err) <= tol*res0%norm_h, 'reference symmetric: same recovery')
+         if (allocated(error)) return
+         call recover_on_mesh(c%dim, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
+            & mesh_method_spr, res1, error, gauss_xi=gxi, reference=mesh_reference_symmetric)
+         call expect(error, stat_invalid_input, 'is inside the reference cell but does not map onto gp(:, 1, 1)')
+         if (allocated(error)) return
+         call recover_on_mesh(c%dim, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
+            & mesh_method_spr, res1, error, gauss_xi=2.0_wp*gxi - 1.0_wp)
+         call expect(error, stat_invalid_input, 'is outside the reference cell [0, 1]^'//merge('2', '3', c%dim == 2)// &
+            & " (reference 'unit', the default; 'symmetric' takes [-1, 1]^")
+         if (allocated(error)) return
+         bad = 2.0_wp*gxi - 1.0_wp
+         bad(1, 1, 1) = 1.5_wp
+         call recover_on_mesh(c%dim, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
+            & mesh_method_spr, res1, error, gauss_xi=bad, reference=mesh_reference_symmetric, c_indices=.true.)
+         call expect(error, stat_invalid_input, 'gauss_xi[0][0] = (1.5')
+         if (allocated(error)) return
+         call recover_on_mesh(c%dim, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
+            & mesh_method_spr, res1, error, gauss_xi=bad, reference=mesh_reference_symmetric)
+         call expect(error, stat_invalid_input, "is outside the reference cell [-1, 1]^")
+         if (allocated(error)) return
+         call recover_on_mesh(c%dim, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
+            & mesh_method_spr, res1, error, gauss_xi=gxi, reference=7)
+         call expect(error, stat_invalid_input, 'reference = 7 is not unit (0) or symmetric (1)')
          if (allocated(error)) return
          deallocate (gxi)
       end do

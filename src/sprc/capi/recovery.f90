@@ -15,7 +15,8 @@ module sprc_capi_recovery
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_out_of_memory
    use sprc_core_alloc, only: check_allocation
    use sprc_core_material, only: voigt_size
-   use sprc_recovery_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, mesh_method_sprc
+   use sprc_recovery_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, mesh_method_sprc, &
+      & mesh_reference_unit, mesh_reference_symmetric
    use sprc_recovery_patch_loop, only: auto_degree
    use sprc_recovery_mesh_element, only: element_known, element_nodes, element_facet_nodes, element_name, &
       & element_degree
@@ -24,7 +25,8 @@ module sprc_capi_recovery
    private
 
    public :: capi_recovery_type
-   public :: sprc_recover, sprc_recover_xi, sprc_get_recovery_nodal_stress, sprc_get_recovery_element_error, &
+   public :: sprc_recover, sprc_recover_xi, sprc_recover_reference, sprc_get_recovery_nodal_stress, &
+      & sprc_get_recovery_element_error, &
       & sprc_get_recovery_global_error, sprc_get_recovery_eta, sprc_eval_recovery, sprc_delete_recovery
 
    !> What an `sprc_recovery` handle points to.
@@ -59,7 +61,7 @@ contains
 
       rech = recover_c(errh, dim, analysis, nnode, nodes, element_type, nen, nelem, connectivity, ngp, &
          & gauss_points, gauss_weights, gauss_stress, young, poisson, method, body_force, nfacet, facet_nnode, &
-         & facet_nodes, facet_kind, facet_traction, c_null_ptr)
+         & facet_nodes, facet_kind, facet_traction, c_null_ptr, int(mesh_reference_unit, c_int))
    end function sprc_recover
 
    !> `sprc_recover` with the reference coordinates of the points (gauss_xi [nelem][ngp][dim],
@@ -77,13 +79,34 @@ contains
 
       rech = recover_c(errh, dim, analysis, nnode, nodes, element_type, nen, nelem, connectivity, ngp, &
          & gauss_points, gauss_weights, gauss_stress, young, poisson, method, body_force, nfacet, facet_nnode, &
-         & facet_nodes, facet_kind, facet_traction, gauss_xi)
+         & facet_nodes, facet_kind, facet_traction, gauss_xi, int(mesh_reference_unit, c_int))
    end function sprc_recover_xi
 
-   !> The one implementation of both entries (gauss_xi may be NULL).
+   !> `sprc_recover_xi` with the convention of gauss_xi: SPRC_REFERENCE_UNIT (quads and
+   !> hexes on [0, 1]^dim, as sprc_recover_xi) or SPRC_REFERENCE_SYMMETRIC ([-1, 1]^dim).
+   function sprc_recover_reference(errh, dim, analysis, nnode, nodes, element_type, nen, nelem, connectivity, ngp, &
+         & gauss_points, gauss_weights, gauss_stress, young, poisson, method, body_force, nfacet, facet_nnode, &
+         & facet_nodes, facet_kind, facet_traction, gauss_xi, reference) result(rech) &
+         & bind(C, name='sprc_recover_reference')
+      type(c_ptr), value :: errh
+      integer(c_int), value :: dim, analysis, nnode, element_type, nen, nelem, ngp
+      type(c_ptr), value :: nodes, connectivity, gauss_points, gauss_weights, gauss_stress
+      real(c_double), value :: young, poisson
+      integer(c_int), value :: method, nfacet, facet_nnode
+      type(c_ptr), value :: body_force, facet_nodes, facet_kind, facet_traction, gauss_xi
+      integer(c_int), value :: reference
+      type(c_ptr) :: rech
+
+      rech = recover_c(errh, dim, analysis, nnode, nodes, element_type, nen, nelem, connectivity, ngp, &
+         & gauss_points, gauss_weights, gauss_stress, young, poisson, method, body_force, nfacet, facet_nnode, &
+         & facet_nodes, facet_kind, facet_traction, gauss_xi, reference)
+   end function sprc_recover_reference
+
+   !> The one implementation of the entries (gauss_xi may be NULL).
    function recover_c(errh, dim, analysis, nnode, nodes, element_type, nen, nelem, connectivity, ngp, &
          & gauss_points, gauss_weights, gauss_stress, young, poisson, method, body_force, nfacet, facet_nnode, &
-         & facet_nodes, facet_kind, facet_traction, gauss_xi) result(rech)
+         & facet_nodes, facet_kind, facet_traction, gauss_xi, reference) result(rech)
+      integer(c_int), value :: reference
       type(c_ptr), value :: errh
       integer(c_int), value :: dim, analysis, nnode, element_type, nen, nelem, ngp
       type(c_ptr), value :: nodes, connectivity, gauss_points, gauss_weights, gauss_stress
@@ -114,6 +137,9 @@ contains
       if (.not. allocated(error) .and. iand(method, flag_p_plus_1) /= 0 .and. iand(method, flag_p) /= 0) &
          & call fail(error, 'sprc_recover: method = '//itoa(method)//' sets both SPRC_RECOVERY_P_PLUS_1 and '// &
          & 'SPRC_RECOVERY_P')
+      if (.not. allocated(error) .and. reference /= mesh_reference_unit .and. reference /= mesh_reference_symmetric) &
+         & call fail(error, 'sprc_recover: reference = '//itoa(reference)//' is not SPRC_REFERENCE_UNIT ('// &
+         & itoa(mesh_reference_unit)//') or SPRC_REFERENCE_SYMMETRIC ('//itoa(mesh_reference_symmetric)//')')
       if (.not. allocated(error)) call check_pointers(sz, nodes, connectivity, gauss_points, gauss_weights, &
          & gauss_stress, facet_nodes, facet_kind, error)
       if (allocated(error)) then
@@ -172,7 +198,7 @@ contains
          call c_f_pointer(gauss_xi, gxi, [dim, ngp, nelem])
          call recover_on_mesh(dim, analysis, x, element_type, conn, gp, gw, gs, young, poisson, &
             & int(iand(method, method_mask)), rec%result, error, body_force=bf, facet_nodes=fn, facet_kind=fk, &
-            & facet_traction=ft, degree=degree, c_indices=.true., gauss_xi=gxi)
+            & facet_traction=ft, degree=degree, c_indices=.true., gauss_xi=gxi, reference=int(reference))
       else
          call recover_on_mesh(dim, analysis, x, element_type, conn, gp, gw, gs, young, poisson, &
             & int(iand(method, method_mask)), rec%result, error, body_force=bf, facet_nodes=fn, facet_kind=fk, &

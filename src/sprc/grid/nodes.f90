@@ -21,14 +21,13 @@ module sprc_grid_nodes
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_alloc, only: check_allocation
+   use sprc_core_hash, only: hash_int
    use sprc_grid_tree, only: grid_type
    implicit none
    private
 
    public :: grid_nodes_type, element_node_index, element_shape, nodes_per_element, lattice_slot
 
-   integer(i8), parameter :: hash_prime = 2147483647_i8
-   integer(i8), parameter :: hash_mult = 1103515245_i8
    !> The routine named in messages.
    character(len=*), parameter :: who = 'grid nodes'
 
@@ -281,15 +280,12 @@ contains
    end subroutine rehash
 
    !> Slot of the lattice point g (0 beyond dim) in a hash table of mask + 1 slots (a power of 2).
+   !> Lattice coordinates are multiples of powers of two: every bit must reach the slot
+   !> (sprc_core_hash).
    pure integer(i8) function lattice_slot(g, mask)
       integer, intent(in) :: g(3)
       integer(i8), intent(in) :: mask
-      integer(i8) :: h
-      ! Lattice coordinates are below 2**22 and h below 2**31: products stay below 2**62.
-      h = int(g(1), i8)
-      h = modulo(h*hash_mult + int(g(2), i8), hash_prime)
-      h = modulo(h*hash_mult + int(g(3), i8), hash_prime)
-      lattice_slot = iand(h, mask)
+      lattice_slot = iand(hash_int(g), mask)
    end function lattice_slot
 
    !> Node -> elements adjacency (CSR), elements ascending.

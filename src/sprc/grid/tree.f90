@@ -37,6 +37,7 @@ module sprc_grid_tree
    use sprc_core_text, only: itoa
    use sprc_geometry_region, only: region_type, cell_outside, cell_inside, cell_cut
    use sprc_grid_morton, only: morton_encode
+   use sprc_core_hash, only: hash_seed, hash_i8
    implicit none
    private
 
@@ -44,8 +45,6 @@ module sprc_grid_tree
 
    !> Finest level a grid may hold (level + refine_boundary <= grid_max_level).
    integer, parameter :: grid_max_level = 20
-
-   integer(i8), parameter :: hash_prime = 2147483647_i8
 
    !> The active leaves of one body's grid, sorted by Morton key.
    type :: grid_type
@@ -735,8 +734,8 @@ contains
 
    pure integer(i8) function hash_slot(key, mask)
       integer(i8), intent(in) :: key, mask
-      ! Both products stay below 2**62: no integer overflow.
-      hash_slot = iand(modulo(modulo(key, hash_prime)*1103515245_i8 + ishft(key, -31)*40503_i8, hash_prime), mask)
+      ! Morton keys of one level differ in a few bits: every bit must reach the slot.
+      hash_slot = iand(hash_i8(hash_seed, key), mask)
    end function hash_slot
 
    integer function hash_get(b, key) result(val)

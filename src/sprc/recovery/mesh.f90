@@ -12,7 +12,11 @@
 !> (div sigma + b = 0) and boundary facets. Every point must lie in its element (checked by
 !> the inverse isoparametric map, tolerance 1e-6 in reference coordinates). A caller that
 !> has the points' reference coordinates passes them (gauss_xi): they are checked (inside,
-!> and mapped onto the point) instead of derived by Newton's method. Two used nodes
+!> and mapped onto the point) instead of derived by Newton's method. Their convention
+!> (`reference`): mesh_reference_unit, quads and hexes on [0, 1]^dim (the default, the element
+!> library's), or mesh_reference_symmetric, on [-1, 1]^dim (most FE codes'; mapped onto
+!> [0, 1]^dim once); tri3 and tet4 are the unit simplex in both. A point outside the chosen
+!> cell is an error that names the convention. Two used nodes
 !> at one point and two elements on the same vertices are input errors.
 !>
 !> Facets: facet_nodes(nfn, nfacet) (a side of an element: line2 / line3 in 2D, tri3 /
@@ -20,10 +24,12 @@
 !> ones), facet_kind(nfacet) (facet_traction 1 with the constant vector facet_traction(:, f);
 !> facet_symmetry 2; facet_free 3 = traction zero; facet_pressure 4 with p = facet_traction(1, f):
 !> t = -p n with the facet's own outward normal at each of its points, so that the traction
-!> turns along a curved facet). A facet belongs to exactly one element,
-!> the one holding all its nodes (else an error: not a boundary facet). Its quadrature points
-!> (sprc_recovery_mesh_element) get normals oriented away from that element's vertex centroid,
-!> so the caller's facet node order does not matter for the orientation. Boundary
+!> turns along a curved facet). A facet is a side (face) of exactly one element, its nodes
+!> in any order (element_facet_order: on one face of the reference cell; else an error naming
+!> facet_nodes(:, f): a diagonal, an interior side, nodes of no one element). Its quadrature
+!> points (sprc_recovery_mesh_element) follow the caller's node order if it parametrises the
+!> facet, else the face's own, and get normals oriented away from that element's vertex
+!> centroid, so the caller's facet node order matters for neither. Boundary
 !> constraints apply only where the caller gives facets: a surface without facets is not
 !> constrained. SPR ignores facets (they are validated all the same). All traction and free
 !> facets form boundary piece 1 and all symmetry facets piece 2: the recovery core
@@ -73,6 +79,7 @@ module sprc_recovery_mesh
    use sprc_recovery_estimate, only: eval_recovered_points, energy_norms, scaled_norm, relative_error
    use sprc_recovery_mesh_element, only: elem_tri3, elem_quad4, elem_tet4, elem_hex8, elem_quad9, elem_hex27, &
       & element_dim, element_nodes, element_vertices, element_degree, element_facet_nodes, element_shape, &
+      & element_facet_order, element_simplex, &
       & element_vertex_shape, element_node_xi, element_inside, element_inverse_map, element_name, &
       & facet_points, facet_npoints, max_facet_points, max_element_nodes
    use sprc_core_text, only: itoa
@@ -80,12 +87,14 @@ module sprc_recovery_mesh
    use sprc_recovery_mesh_bins, only: element_bins_type, build_element_bins, bin_of_point
    use sprc_recovery_mesh_check, only: check_mesh_options, check_mesh_arrays, check_mesh_facets, &
       & check_duplicate_nodes, check_duplicate_elements, vec_str, entry_name, index_name, &
+      & mesh_reference_unit, mesh_reference_symmetric, reference_cell_name, &
       & mesh_method_spr, mesh_method_sprc, facet_traction, facet_symmetry, facet_free, facet_pressure
    implicit none
    private
 
    public :: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, mesh_default_max_rounds
    public :: mesh_method_spr, mesh_method_sprc, facet_traction, facet_symmetry, facet_free, facet_pressure
+   public :: mesh_reference_unit, mesh_reference_symmetric
    public :: elem_tri3, elem_quad4, elem_tet4, elem_hex8, elem_quad9, elem_hex27
 
    !> Default limit of expansion rounds per patch.
@@ -172,7 +181,7 @@ contains
    !> `max_rounds` expansions (stat_singular, naming the node).
    subroutine recover_on_mesh(dim, analysis, nodes, element_type, connectivity, gp, gw, gs, young, poisson, method, &
          & result, error, body_force, facet_nodes, facet_kind, facet_traction, degree, max_rounds, c_indices, &
-         & gauss_xi)
+         & gauss_xi, reference)
       integer, intent(in) :: dim, analysis
       !> Node coordinates (dim, nnode).
       real(wp), intent(in) :: nodes(:, :)
@@ -199,11 +208,17 @@ contains
       !> Reference coordinates (dim, ngp, nelem) of the integration points in their elements
       !> (the element library's reference cells), if the caller has them: then they are
       !> checked (`given_coordinates`) instead of derived by Newton's method.
-      real(wp), intent(in), optional :: gauss_xi(:, :, :)
+      real(wp), intent(in), optional, target :: gauss_xi(:, :, :)
+      !> The convention of gauss_xi: mesh_reference_unit (default: quads and hexes on
+      !> [0, 1]^dim) or mesh_reference_symmetric ([-1, 1]^dim); simplices are the unit simplex
+      !> in both.
+      integer, intent(in), optional :: reference
       type(topology_type), target :: topo
       type(rule_type) :: rule
       real(wp), allocatable :: xi(:, :, :)
-      integer :: deg, rounds
+      real(wp), allocatable, target :: xi_unit(:, :, :)
+      real(wp), pointer, contiguous :: gxi(:, :, :)
+      integer :: deg, rounds, ref, st
       logical :: ci
       real(wp) :: t(0:6)
 
@@ -213,9 +228,16 @@ contains
       if (present(max_rounds)) rounds = max_rounds
       ci = .false.
       if (present(c_indices)) ci = c_indices
+      ref = mesh_reference_unit
+      if (present(reference)) ref = reference
       t(0) = wall_time()
       call check_mesh_options(dim, analysis, element_type, method, deg, rounds, young, poisson, error)
       if (allocated(error)) return
+      if (ref /= mesh_reference_unit .and. ref /= mesh_reference_symmetric) then
+         call fatal_error(error, 'recover_on_mesh: reference = '//itoa(ref)//' is not unit ('// &
+            & itoa(mesh_reference_unit)//') or symmetric ('//itoa(mesh_reference_symmetric)//')', stat_invalid_input)
+         return
+      end if
       call check_mesh_arrays(dim, analysis, nodes, element_type, connectivity, gp, gw, gs, ci, error, body_force)
       if (allocated(error)) return
       call check_mesh_facets(dim, element_type, size(nodes, 2), ci, error, facet_nodes, facet_kind, facet_traction)
@@ -235,9 +257,18 @@ contains
       call boundary_points(result, topo, error, facet_nodes, facet_kind, facet_traction)
       if (allocated(error)) return
       t(2) = wall_time()
-      ! The caller's reference coordinates are used in place (checked, not copied).
+      ! The caller's reference coordinates are used in place (checked, not copied), or on
+      ! [-1, 1]^dim mapped onto the element library's [0, 1]^dim once.
       if (present(gauss_xi)) then
-         call given_coordinates(result, gp, gauss_xi, rule, error)
+         gxi => gauss_xi
+         if (ref == mesh_reference_symmetric .and. .not. element_simplex(element_type)) then
+            allocate (xi_unit, mold=gauss_xi, stat=st)
+            call check_allocation(st, 'recover_on_mesh', 'the reference coordinates on [0, 1]', size(gauss_xi), 8, error)
+            if (allocated(error)) return
+            xi_unit = 0.5_wp*(gauss_xi + 1.0_wp)
+            gxi => xi_unit
+         end if
+         call given_coordinates(result, gp, gxi, rule, error, ref, gauss_xi)
       else
          call point_coordinates(result, gp, xi, error)
       end if
@@ -250,7 +281,7 @@ contains
       if (allocated(error)) return
       t(5) = wall_time()
       if (present(gauss_xi)) then
-         call estimate(result, gp, gw, gs, gauss_xi, rule, error)
+         call estimate(result, gp, gw, gs, gxi, rule, error)
       else
          call estimate(result, gp, gw, gs, xi, rule, error)
       end if
@@ -454,11 +485,15 @@ contains
    !> test, sprc_recovery_mesh_element). `rule`: the shape values of element 1's points, and
    !> whether every element has the same points (then its shape values serve every element).
    !> OpenMP over elements; the first bad point (element order) is named.
-   subroutine given_coordinates(r, gp, gxi, rule, error)
+   subroutine given_coordinates(r, gp, gxi, rule, error, reference, shown)
       type(mesh_recovery_type), intent(in) :: r
       real(wp), intent(in) :: gp(:, :, :), gxi(:, :, :)
       type(rule_type), intent(out) :: rule
       type(error_type), allocatable, intent(out) :: error
+      !> The caller's convention and coordinates (gxi mapped onto [0, 1]^dim), for messages.
+      integer, intent(in) :: reference
+      real(wp), intent(in) :: shown(:, :, :)
+      character(len=:), allocatable :: what
       integer, allocatable :: bad(:)
       logical, allocatable :: ok1(:)
       real(wp), allocatable :: nsum1(:)
@@ -496,10 +531,18 @@ contains
       if (all(bad == 0)) return
       e = findloc(bad /= 0, .true., dim=1)
       i = bad(e)
+      if (.not. all(abs(gxi(:, i, e)) <= huge(1.0_wp))) then
+         what = ' is not finite'
+      else if (.not. point_ok(gxi(:, i, e))) then
+         what = ' is outside the reference cell '//reference_cell_name(r%element_type, reference)// &
+            & ' (tolerance 1e-6 on [0, 1])'
+      else
+         what = ' is inside the reference cell but does not map onto '// &
+            & entry_name(r%c_indices, 'gp', 'gauss_points', [0, i, e])//' = '//vec_str(gp(:, i, e))// &
+            & ' in element '//index_name(r%c_indices, e)
+      end if
       call fatal_error(error, 'recover_on_mesh: '//entry_name(r%c_indices, 'gxi', 'gauss_xi', [0, i, e])//' = '// &
-         & vec_str(gxi(:, i, e))//' is not finite, not inside element '//index_name(r%c_indices, e)// &
-         & ' or does not map onto '//entry_name(r%c_indices, 'gp', 'gauss_points', [0, i, e])//' = '// &
-         & vec_str(gp(:, i, e)), stat_invalid_input)
+         & vec_str(shown(:, i, e))//what, stat_invalid_input)
    contains
       !> 0, or the first point of e whose coordinates fail; shared = .false. if e's points
       !> differ from element 1's.
@@ -594,7 +637,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer, intent(in), optional :: facet_nodes(:, :), facet_kind(:)
       real(wp), intent(in), optional :: facet_traction_value(:, :)
-      integer, allocatable :: owner(:), fill(:)
+      integer, allocatable :: owner(:), fill(:), ordered(:, :)
       real(wp) :: xq(3, max_facet_points), wq(max_facet_points), nq(3, max_facet_points), c(3)
       integer :: nf, nfn, f, e, q, nq_f, k, d, st
 
@@ -602,12 +645,13 @@ contains
       nf = 0
       if (present(facet_nodes)) nf = size(facet_nodes, 2)
       nfn = element_facet_nodes(r%element_type)
-      allocate (owner(nf), fill(r%nelem), topo%bptr(r%nelem + 1), stat=st)
-      call check_allocation(st, 'recover_on_mesh', 'the facet owners and boundary pointers', nf + 2*r%nelem + 1, 4, error)
+      allocate (owner(nf), ordered(nfn, nf), fill(r%nelem), topo%bptr(r%nelem + 1), stat=st)
+      call check_allocation(st, 'recover_on_mesh', 'the facet owners and boundary pointers', &
+         & (nfn + 1)*nf + 2*r%nelem + 1, 4, error)
       if (allocated(error)) return
       fill = 0
       do f = 1, nf
-         call facet_owner(r, topo, facet_nodes(:, f), f, owner(f), error)
+         call facet_owner(r, topo, facet_nodes(:, f), f, owner(f), ordered(:, f), error)
          if (allocated(error)) return
          fill(owner(f)) = fill(owner(f)) + 1
       end do
@@ -625,7 +669,7 @@ contains
       fill = 0
       do f = 1, nf
          e = owner(f)
-         call facet_points(d, nfn, r%x(:, facet_nodes(:, f)), nq_f, xq, wq, nq)
+         call facet_points(d, nfn, r%x(:, ordered(:, f)), nq_f, xq, wq, nq)
          if (.not. all(wq(1:nq_f) > 0.0_wp)) then
             call fatal_error(error, 'recover_on_mesh: facet '//index_name(r%c_indices, f)// &
                & ' is degenerate (zero length or area)', stat_invalid_input)
@@ -661,29 +705,65 @@ contains
       end do
    end subroutine boundary_points
 
-   !> The one element holding every node of a facet.
-   subroutine facet_owner(r, topo, fnodes, f, owner, error)
+   !> The one element that has the facet as a side (face), its nodes in any order
+   !> (element_facet_order), and the facet's nodes in an order that parametrises it.
+   !> Candidates are the elements of the facet's first node (node -> element CSR): O(valence).
+   subroutine facet_owner(r, topo, fnodes, f, owner, ordered, error)
       type(mesh_recovery_type), intent(in) :: r
       type(topology_type), intent(in) :: topo
       integer, intent(in) :: fnodes(:), f
-      integer, intent(out) :: owner
+      integer, intent(out) :: owner, ordered(:)
       type(error_type), allocatable, intent(out) :: error
-      integer :: k, e, a
+      integer :: k, e, a, b, n, holder, loc(max_element_nodes), perm(max_element_nodes)
+      logical :: side
 
+      n = size(fnodes)
       owner = 0
+      holder = 0
+      do a = 2, n
+         do b = 1, a - 1
+            if (fnodes(a) /= fnodes(b)) cycle
+            call fatal_error(error, 'recover_on_mesh: facet '//index_name(r%c_indices, f)//' is degenerate: '// &
+               & facet_name()//' repeats node '//index_name(r%c_indices, fnodes(a)), stat_invalid_input)
+            return
+         end do
+      end do
       do k = topo%ne_ptr(fnodes(1)), topo%ne_ptr(fnodes(1) + 1) - 1
          e = topo%ne_list(k)
-         if (.not. all([(any(r%connectivity(:, e) == fnodes(a)), a=1, size(fnodes))])) cycle
+         do a = 1, n
+            loc(a) = findloc(r%connectivity(:, e), fnodes(a), dim=1)
+            if (loc(a) == 0) exit
+         end do
+         if (a <= n) cycle
+         holder = e
+         call element_facet_order(r%element_type, loc(1:n), perm(1:n), side)
+         if (.not. side) cycle
          if (owner /= 0) then
             call fatal_error(error, 'recover_on_mesh: facet '//index_name(r%c_indices, f)//' is shared by elements '// &
-               & index_name(r%c_indices, owner)//' and '//index_name(r%c_indices, e)//': not a boundary facet', &
-               & stat_invalid_input)
+               & index_name(r%c_indices, owner)//' and '//index_name(r%c_indices, e)//': not a boundary facet ('// &
+               & facet_name()//')', stat_invalid_input)
             return
          end if
          owner = e
+         ordered = fnodes(perm(1:n))
       end do
-      if (owner == 0) call fatal_error(error, 'recover_on_mesh: facet '//index_name(r%c_indices, f)//' (nodes '// &
-         & ivec_str(r%c_indices, fnodes)//') is not a side of any element', stat_invalid_input)
+      if (owner /= 0) return
+      if (holder /= 0) then
+         call fatal_error(error, 'recover_on_mesh: facet '//index_name(r%c_indices, f)//' is not a side of any '// &
+            & 'element: '//facet_name()//' are nodes of element '//index_name(r%c_indices, holder)//' but not one of its '// &
+            & trim(merge('sides', 'faces', r%dim == 2))//' (a boundary facet is an element side, its nodes in any '// &
+            & 'order)', stat_invalid_input)
+      else
+         call fatal_error(error, 'recover_on_mesh: facet '//index_name(r%c_indices, f)//' is not a side of any '// &
+            & 'element: '//facet_name()//' are not the nodes of one element', stat_invalid_input)
+      end if
+   contains
+      !> The facet as the caller wrote it (only for messages: facets are many).
+      pure function facet_name() result(s)
+         character(len=:), allocatable :: s
+         s = entry_name(r%c_indices, 'facet_nodes', 'facet_nodes', [0, f])//' = ('// &
+            & ivec_str(r%c_indices, fnodes)//')'
+      end function facet_name
    end subroutine facet_owner
 
    !> The shared patch loop (sprc_recovery_patch_loop) over the vertex nodes; a failing

@@ -13,6 +13,7 @@ module sprc_recovery_mesh_check
    use sprc_core_kinds, only: wp, i8
    use sprc_core_text, only: itoa, rtoa
    use sprc_core_alloc, only: check_allocation
+   use sprc_core_hash, only: hash_real
    use sprc_core_boundary, only: bc_traction, bc_symmetry, bc_free, bc_pressure
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_material, only: plane_stress, plane_strain, solid, voigt_size, check_material
@@ -24,10 +25,16 @@ module sprc_recovery_mesh_check
 
    public :: check_mesh_options, check_mesh_arrays, check_mesh_facets, check_duplicate_nodes, &
       & check_duplicate_elements, vec_str, entry_name, index_name
+   public :: mesh_reference_unit, mesh_reference_symmetric, reference_cell_name
    public :: mesh_method_spr, mesh_method_sprc, facet_traction, facet_symmetry, facet_free, facet_pressure
 
    !> Recovery methods (values are part of the C API; never renumber).
    integer, parameter :: mesh_method_spr = 1, mesh_method_sprc = 2
+   !> Conventions of the caller's reference coordinates (gauss_xi; values are part of the C
+   !> API, SPRC_REFERENCE_*): 'unit' quads and hexes on [0, 1]^dim (the element library's own),
+   !> 'symmetric' on [-1, 1]^dim (most FE codes'); triangles and tetrahedra are the unit
+   !> simplex (xi >= 0, sum xi <= 1) in both.
+   integer, parameter :: mesh_reference_unit = 0, mesh_reference_symmetric = 1
    !> Facet kinds, the boundary kinds of `sprc_core_boundary` a facet can have (values are
    !> part of the C API, SPRC_FACET_*): prescribed traction (its value per facet), symmetry
    !> plane (zero shear), free surface (zero traction), pressure p = facet_traction(1, f)
@@ -250,14 +257,20 @@ contains
 
    !> No two nodes used by elements at the same point (bitwise equal coordinates, -0 = +0):
    !> such a mesh is not connected there, and its patches would silently stop at the seam.
-   !> A hash table of the used nodes: O(nnode) expected.
-   pure subroutine check_duplicate_nodes(nodes, used, c_indices, error)
+   !> A hash table of the used nodes (sprc_core_hash: every bit of the coordinates reaches
+   !> the slot, so dyadic coordinates do not collide): O(nnode) expected. The first node
+   !> equal to an earlier one is reported, whatever the hash. `probes`: the table slots
+   !> read in all (the cost, for tests: about 2.5 per node at load 2/3 if the hash spreads
+   !> the keys as a random function would).
+   pure subroutine check_duplicate_nodes(nodes, used, c_indices, error, probes)
       real(wp), intent(in) :: nodes(:, :)
       logical, intent(in) :: used(:)
       logical, intent(in) :: c_indices
       type(error_type), allocatable, intent(out) :: error
+      integer(i8), intent(out), optional :: probes
       integer, allocatable :: table(:)
       integer :: n, nslot, slot, m, stat
+      integer(i8) :: nprobe
 
       ! A power of two at least 1.5 times the used nodes: load at most 2/3, short probe chains
       ! in adjacent slots, and a table half the size of one at load 1/2 (262,144 nodes: 2 MB,
@@ -270,22 +283,26 @@ contains
       call check_allocation(stat, 'mesh check', 'the duplicate-node hash table', nslot, 4, error)
       if (allocated(error)) return
       table = 0
+      nprobe = 0
       do n = 1, size(nodes, 2)
          if (.not. used(n)) cycle
-         slot = int(iand(coordinate_hash(nodes(:, n)), int(nslot - 1, i8))) + 1
+         slot = int(iand(hash_real(nodes(:, n)), int(nslot - 1, i8))) + 1
          do
+            nprobe = nprobe + 1
             m = table(slot)
             if (m == 0) exit
             if (all(nodes(:, m) == nodes(:, n))) then
                call fail(error, 'nodes '//index_name(c_indices, m)//' and '//index_name(c_indices, n)// &
                   & ' are at the same point '//vec_str(nodes(:, n))//' (duplicate nodes: merge them; a crack or '// &
                   & 'an interface is two meshes, recovered one at a time)')
+               if (present(probes)) probes = nprobe
                return
             end if
             slot = mod(slot, nslot) + 1
          end do
          table(slot) = n
       end do
+      if (present(probes)) probes = nprobe
    end subroutine check_duplicate_nodes
 
    !> No two elements on the same set of vertices (a repeated element would count its
@@ -324,18 +341,25 @@ contains
       end function twin
    end subroutine check_duplicate_elements
 
-   !> xorshift hash of the coordinates' bits (+0 for -0 so that equal points hash equal).
-   pure integer(i8) function coordinate_hash(x) result(h)
-      real(wp), intent(in) :: x(:)
-      integer :: i
-      h = 88172645463325252_i8
-      do i = 1, size(x)
-         h = ieor(h, transfer(x(i) + 0.0_wp, h))
-         h = ieor(h, shiftl(h, 13))
-         h = ieor(h, shiftr(h, 7))
-         h = ieor(h, shiftl(h, 17))
-      end do
-   end function coordinate_hash
+   !> The reference cell of element_type in the convention `reference`, for messages.
+   pure function reference_cell_name(element_type, reference) result(s)
+      integer, intent(in) :: element_type, reference
+      character(len=:), allocatable :: s
+      select case (element_type)
+      case (elem_tri3)
+         s = 'the unit triangle xi >= 0, xi_1 + xi_2 <= 1 (either reference)'
+      case (elem_tet4)
+         s = 'the unit tetrahedron xi >= 0, xi_1 + xi_2 + xi_3 <= 1 (either reference)'
+      case default
+         if (reference == mesh_reference_symmetric) then
+            s = '[-1, 1]^'//itoa(element_dim(element_type))//" (reference 'symmetric'; 'unit' takes [0, 1]^"// &
+               & itoa(element_dim(element_type))//')'
+         else
+            s = '[0, 1]^'//itoa(element_dim(element_type))//" (reference 'unit', the default; 'symmetric' takes "// &
+               & '[-1, 1]^'//itoa(element_dim(element_type))//')'
+         end if
+      end select
+   end function reference_cell_name
 
    !> An array entry as the caller writes it. idx are Fortran indices (1-based, 0 for a
    !> whole dimension ':'): Fortran `fname(:, 3, 1)`; C (c_indices) `cname[0][2]`, the

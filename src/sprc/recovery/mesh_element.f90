@@ -31,7 +31,7 @@ module sprc_recovery_mesh_element
 
    public :: elem_tri3, elem_quad4, elem_tet4, elem_hex8, elem_quad9, elem_hex27
    public :: element_known, element_name, element_dim, element_nodes, element_vertices, element_degree
-   public :: element_facet_nodes, element_simplex
+   public :: element_facet_nodes, element_simplex, element_facet_order
    public :: element_shape, element_vertex_shape, element_node_xi, element_center_xi, element_inside
    public :: element_map, element_inverse_map, max_element_nodes
    public :: facet_points, facet_npoints, max_facet_points, max_facet_nodes
@@ -214,6 +214,77 @@ contains
          element_inside = all(xi(1:d) >= -tol) .and. all(xi(1:d) <= 1.0_wp + tol)
       end if
    end function element_inside
+
+   !> Whether the distinct local nodes loc(1:nfn) of an element are the nodes of one of its
+   !> sides (2D) / faces (3D): on one face of the reference cell (any d distinct vertices of
+   !> a simplex are), and `perm`, an order of them that parametrises the facet as
+   !> facet_points expects (VTK line2 / line3 / tri3 / quad4 / quad9): the given order if it
+   !> does (corners in cyclic order, then mid-sides between them, then the centre), else the
+   !> face's own order in its two in-face reference axes.
+   pure subroutine element_facet_order(etype, loc, perm, ok)
+      integer, intent(in) :: etype, loc(:)
+      integer, intent(out) :: perm(:)
+      logical, intent(out) :: ok
+      ! Reference facet nodes in VTK order: a line's in u, a quad's in (u, v).
+      real(wp), parameter :: ref(2, 9) = reshape([0.0_wp, 0.0_wp, 1.0_wp, 0.0_wp, 1.0_wp, 1.0_wp, 0.0_wp, 1.0_wp, &
+         & 0.5_wp, 0.0_wp, 1.0_wp, 0.5_wp, 0.5_wp, 1.0_wp, 0.0_wp, 0.5_wp, 0.5_wp, 0.5_wp], [2, 9])
+      real(wp), parameter :: ref_line(3) = [0.0_wp, 1.0_wp, 0.5_wp]
+      real(wp) :: xi(3, max_facet_nodes), uv(2, max_facet_nodes), r(2)
+      integer :: n, d, a, j, k, m, slot(max_facet_nodes)
+
+      n = size(loc)
+      d = element_dim(etype)
+      perm(1:n) = [(a, a=1, n)]
+      ok = element_simplex(etype)
+      if (ok) return
+      do a = 1, n
+         call element_node_xi(etype, loc(a), xi(:, a))
+      end do
+      do k = 1, d
+         if (all(xi(k, 1:n) == 0.0_wp) .or. all(xi(k, 1:n) == 1.0_wp)) exit
+      end do
+      if (k > d) return
+      m = 0
+      do j = 1, d
+         if (j == k) cycle
+         m = m + 1
+         uv(m, 1:n) = xi(j, 1:n)
+      end do
+      ! The slot of each node among the reference facet's nodes; distinct nodes, distinct slots.
+      slot(1:n) = 0
+      do a = 1, n
+         do j = 1, n
+            r = ref(:, j)
+            if (d == 2) r(1) = ref_line(j)
+            if (all(uv(1:d - 1, a) == r(1:d - 1))) slot(a) = j
+         end do
+      end do
+      if (any(slot(1:n) == 0)) return
+      ok = .true.
+      if (parametrises()) return
+      do a = 1, n
+         perm(slot(a)) = a
+      end do
+   contains
+      !> The given order parametrises the facet.
+      pure logical function parametrises() result(yes)
+         integer :: c, cn
+         if (d == 2) then
+            yes = n == 2 .or. uv(1, 3) == 0.5_wp
+            return
+         end if
+         yes = .false.
+         do c = 1, 4
+            cn = mod(c, 4) + 1
+            if (any(uv(1:2, c) == 0.5_wp)) return
+            if (count(uv(1:2, c) /= uv(1:2, cn)) /= 1) return
+            if (n == 9) then
+               if (any(uv(1:2, c + 4) /= 0.5_wp*(uv(1:2, c) + uv(1:2, cn)))) return
+            end if
+         end do
+         yes = .true.
+      end function parametrises
+   end subroutine element_facet_order
 
    !> Physical point x(1:dim) of reference point xi; xe(1:dim, 1:nen) are the element's nodes.
    pure subroutine element_map(etype, xe, xi, x)
