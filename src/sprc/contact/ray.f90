@@ -1,5 +1,5 @@
 !> Where a line meets a body's named surface on its exact implicit geometry:
-!> the root finder of the contact gap (seed eq. 3).
+!> the root finder of the contact gap (thesis eq. 3).
 !>
 !> The line is x(t) = x0 + t n (n a unit vector); the surface is the zero set
 !> of shape s's level set f(t) = phi_s(x(t)), restricted to the part that

@@ -32,7 +32,7 @@
 !> | 19    |         |        | yz^2    | (0,1,2) |
 !> | 20    |         |        | z^3     | (0,0,3) |
 !>
-!> The seed thesis uses three different quadratic orders (its table of p(x),
+!> The thesis uses three different quadratic orders (its table of p(x),
 !> eq. 40 and eq. 54/62); sprc uses only this one, exported as the parameter
 !> tables `poly_exponents_2d` and `poly_exponents_3d`.
 !>

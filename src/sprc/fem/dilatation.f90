@@ -36,8 +36,8 @@
 !> (3D) grows without bound; plane stress does not lock (its D stays bounded)
 !> and `dilatation_auto` never projects it. `dilatation_auto` projects at
 !> nu >= `projected_poisson` = 0.4: on the Kirsch plate in plane strain the
-!> projection lowers err_fe from nu = 0.4 up (Q1 level 6: 1.51e-2 -> 1.21e-2),
-!> leaves it equal at 0.3 and raises it at 0 (1.20e-2 -> 1.40e-2).
+!> projection lowers err_fe from nu = 0.4 up, leaves it equal at 0.3 and
+!> raises it at 0.
 !> The stiffness keeps the kappa scale: its condition number still grows like
 !> kappa / mu (a displacement-only formulation cannot avoid it).
 module sprc_fem_dilatation

@@ -531,7 +531,7 @@ contains
          call fatal_error(error, 'elasticity solve: the system is not assembled', stat_invalid_input)
          return
       end if
-      ! PETSc is loaded on first use. Its one-off start-up (the library and MPI, 0.35-0.45 s once per
+      ! PETSc is loaded on first use. Its one-off start-up (the library and MPI, once per
       ! process) is a cost of the process, as loading the linked CHOLMOD is, not of this solve.
       if (use_iterative(self%solver, self%dim, self%degree, self%constraints%n_dofs)) call start_petsc(error)
       if (allocated(error)) return

@@ -1,4 +1,4 @@
-!> The Cartesian grid as a producer of SPR / SPR-C vertex patches (seed eqs. 8-11,
+!> The Cartesian grid as a producer of SPR / SPR-C vertex patches (thesis eqs. 8-11,
 !> 19-24, 99-100; Figure 15 for patch expansion).
 !>
 !> Input (`recovery_input_type`, plain data the FE layer fills; element e is leaf e of
@@ -28,7 +28,7 @@
 !> core imposes the dominant boundary kind (`dominant_boundary_kind`: contact wins, else
 !> the largest measure).
 !>
-!> Expansion (seed Figure 15): a patch whose basis matrix lacks rank (the core returns
+!> Expansion (thesis Figure 15): a patch whose basis matrix lacks rank (the core returns
 !> stat_singular: too few or aligned points, e.g. a corner node with one small cut
 !> element) gets one more ring of leaves, those sharing a node with the patch, and is
 !> solved again; at most `max_rounds` rounds (default `default_max_rounds` = 3: a ring
@@ -44,7 +44,7 @@
 !> Contact (SPR-C with a `grid_contact_type`, sprc_grid_contact): the body's boundary points
 !> on the contact shape are contact points where their law is closed and free-surface
 !> (zero-traction) points where it is open; a patch holding a contact point is solved by
-!> the coupled contact solve (contact wins, seed), expanded like any other patch when it
+!> the coupled contact solve (contact wins, the thesis), expanded like any other patch when it
 !> lacks rank.
 module sprc_grid_patches
    use sprc_core_kinds, only: wp

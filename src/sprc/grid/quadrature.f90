@@ -273,7 +273,7 @@ contains
    end subroutine boundary_face_rule
 
    !> The error of a rule whose arrays could not grow (`failed`): out of memory, never
-   !> a crash (issue 15); the rule is then empty.
+   !> a crash; the rule is then empty.
    pure subroutine check_failed(rule, where, lo, hi, error)
       type(cell_rule_type), intent(inout) :: rule
       character(len=*), intent(in) :: where
@@ -746,7 +746,7 @@ contains
          end if
       else
          ! A loop, not overlapping sections: gfortran copies those through a heap
-         ! temporary that it never checks, a crash when memory runs out (issue 15).
+         ! temporary that it never checks, a crash when memory runs out.
          nnew = rule%ns - s1
          do i = 1, nnew
             rule%sy(:, s0 + i) = rule%sy(:, s1 + i)
