@@ -62,7 +62,7 @@ contains
    !> dgemm with a transposed operand) now, while there is room, and not in the
    !> middle of a level: when that allocation fails OpenBLAS retries for ever
    !> (blas_memory_alloc), a hang instead of an error (seen under ulimit -v with
-   !> the memory estimate off: 3D level 5 at 350 MB). Each thread first
+   !> the memory estimate off). Each thread first
    !> allocates and frees as much itself: when that fails, `error` says so and
    !> BLAS is not called.
    subroutine blas_reserve_buffers(error)

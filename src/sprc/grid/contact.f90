@@ -226,9 +226,8 @@ contains
    !> the prism's axes within its bounds, by a margin far above the round-off of
    !> aux_contains) is taken without a test per point, and one outside it is skipped; only
    !> the points of cells that straddle a face are tested. (The prism of an oblique normal
-   !> fills a fraction of its bounding box: 3D compound sphere level 4, 2975 points in the
-   !> box and 784 in the prism per patch on average, and the test per point was most of the
-   !> contact patches' time.)
+   !> fills a fraction of its bounding box, and the test per point was most of the contact
+   !> patches' time.)
    pure subroutine cells_prism(cells, y, aux, idx, n)
       type(point_cells_type), intent(in) :: cells
       real(wp), intent(in) :: y(:, :)
