@@ -1,5 +1,5 @@
 !> Operators of the SPR-C contact constraint (thesis eqs. 103-128, with the errata of
-!> eqs. 118, 119 and 127 in DESIGN.md), built generically from the traction operator
+!> eqs. 118, 119 and 127 in doc/theory.md, section 11), built generically from the traction operator
 !> G(n) of sprc_recovery_operators, never from the thesis's written-out matrices.
 !>
 !> At a contact point of body (1) with outward unit normal n and the frame

@@ -1,7 +1,7 @@
 !> Operator matrices of the SPR-C constraints, built generically from the Voigt
 !> index pairs, the normal / tangent vectors and the coefficient-space derivative
 !> matrices of sprc_core_poly — never from the thesis's expanded coefficient lists
-!> (eqs. 52-53, 61, 97 and the symmetry lists have typos, DESIGN.md "Errata").
+!> (eqs. 52-53, 61, 97 and the symmetry lists have typos, doc/theory.md, section 11).
 !>
 !> One rule builds both the traction operator G(n) (eqs. 72-73) and the
 !> equilibrium operator L^T (eq. 33, with the erratum of eq. 39): the i-th
