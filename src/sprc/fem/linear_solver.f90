@@ -354,7 +354,7 @@ contains
    end function use_iterative
 
    !> 'auto''s threshold for `dim` and `degree` (`auto_min_dofs`; `auto_never`
-   !> outside the table: a degree or dimension it has not measured).
+   !> outside the table: a degree or dimension without a known crossover).
    pure integer function auto_iterative_min_dofs(dim, degree) result(min_dofs)
       integer, intent(in) :: dim, degree
       min_dofs = auto_never

@@ -1,6 +1,5 @@
-!> Linear elasticity on one body's cut Cartesian grid: Q1 / Q2 elements,
-!> immersed boundary conditions, small-cut robustness, sparse direct or iterative solve and
-!> the post-processing the recovery and the report need.
+!> Linear elasticity on one body's cut Cartesian grid: Q1 / Q2 elements, immersed boundary
+!> conditions, small-cut robustness, sparse solves and the post-processing recovery needs.
 !>
 !> Use:
 !> ```
