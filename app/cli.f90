@@ -1,4 +1,4 @@
-!> Command line of the sprc driver (SCENE.md, "Driver"): parsed and validated
+!> Command line of the sprc driver (doc/scene.md, "The driver"): parsed and validated
 !> before any scene is read, so a bad option exits 2 at once.
 module sprc_app_cli
    use sprc_fem_linear_solver, only: solver_choice, solver_names

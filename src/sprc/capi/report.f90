@@ -1,4 +1,4 @@
-!> C API, study reports: `sprc_report` holds the rows of a study (SCENE.md,
+!> C API, study reports: `sprc_report` holds the rows of a study (doc/scene.md,
 !> "Report"), one per level, and is read cell by cell or column by column.
 !> Rows and columns are 0-based; columns are named as in the report's CSV
 !> header. Every value is a double (integer columns converted exactly); an

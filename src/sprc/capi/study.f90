@@ -1,4 +1,4 @@
-!> C API, studies: run the study of a scene file (SCENE.md) as `sprc run`
+!> C API, studies: run the study of a scene file (doc/scene.md) as `sprc run`
 !> does and keep the fields of the levels the caller asks for, as arrays
 !> (`sprc_study`). The arrays are those the driver writes to PREFIX.h5
 !> (`sprc_io_fields` builds both), so a field read here has the bits of its

@@ -1,5 +1,5 @@
 !> Where a line meets a body's named surface on its exact implicit geometry:
-!> the root finder of the contact gap (seed eq. 3).
+!> the root finder of the contact gap (thesis eq. 3).
 !>
 !> The line is x(t) = x0 + t n (n a unit vector); the surface is the zero set
 !> of shape s's level set f(t) = phi_s(x(t)), restricted to the part that
@@ -30,23 +30,13 @@
 !>    is asked by the caller through `facing`); otherwise the search goes on
 !>    beyond it.
 !> Segments shorter than t_tol are not split further: a sign change there is
-!> a crossing at the midpoint; no sign change means the line touches the
-!> surface without a resolved crossing (grazing within the position
-!> tolerance) and is not a root. A line that runs in the surface (phi within
-!> rounding of 0 over a whole segment, e.g. along a box face) has no
-!> isolated crossing: such segments are split only down to 2^-12 of the
-!> search interval and each is one candidate at its midpoint, with half its
-!> length in the tolerance, so the work stays bounded (at most 2^13 visits)
-!> where a face is refused (not bounding the body, or not facing).
-!>
-!> Tolerances: t_tol = 8 eps (|x0|_inf + max(|a|, |b|)) on a segment [a, b],
-!> a few ulps of the coordinates there (the line's points cannot be placed
-!> more finely), so a root's accuracy does not depend on how far the search
-!> could have gone. The reported `tolerance` of a root bounds |t - t_exact|: half the final
-!> bracket plus the level-set rounding tol_f over |f'(t)| (the shift of the
-!> root that a rounding of f by tol_f can cause); it grows as the line
-!> approaches tangency. A search that visits more than `max_visits` segments
-!> (impossible with exact enclosures; a guard against hangs) reports failure.
+!> a crossing at the midpoint, none a grazing touch (not a root). A line that
+!> runs in the surface (e.g. along a box face) is split only down to 2^-12 of
+!> the search interval, each piece one candidate, so the work stays bounded.
+!> Tolerances: t_tol = 8 eps (|x0|_inf + max(|a|, |b|)) on a segment [a, b], a
+!> few ulps of the coordinates there. A root's reported `tolerance` bounds
+!> |t - t_exact|: half the final bracket plus tol_f/|f'(t)| (it grows towards
+!> tangency). More than `max_visits` segments (a guard against hangs) fails.
 module sprc_contact_ray
    use sprc_core_kinds, only: wp
    use sprc_geometry_body, only: body_type, snap_tolerance

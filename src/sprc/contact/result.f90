@@ -1,5 +1,5 @@
 !> What a contact solve gives at one level, per slave-surface point, for the
-!> report (SCENE.md contact columns), `PREFIX_contact.csv` / `.svg` and the
+!> report (doc/scene.md "The report"), `PREFIX_contact.csv` / `.svg` and the
 !> HDF5/XDMF point set. Producers: the contact FE (p_fe, ts_fe, gap, state)
 !> and the recoveries (p_spr, p_sprc, ts_sprc); the exact solution gives
 !> p_exact. A real value that does not apply is empty (`report_empty`).
@@ -14,7 +14,7 @@ module sprc_contact_result
    public :: contact_result_type, new_contact_result, state_name
    public :: contact_open, contact_stick, contact_slip
 
-   !> States of a slave point (SCENE.md `state`: open, stick, slip). Frictionless
+   !> States of a slave point (doc/scene.md "Output files", `state`: open, stick, slip). Frictionless
    !> closed points are `contact_slip` (they slide freely).
    integer, parameter :: contact_open = 0, contact_stick = 1, contact_slip = 2
 
@@ -74,7 +74,7 @@ contains
          & 8*(3*self%dim + 8) + 4, error)
    end subroutine new_contact_result
 
-   !> The SCENE.md name of a state.
+   !> The doc/scene.md name of a state.
    pure function state_name(state) result(name)
       integer, intent(in) :: state
       character(len=:), allocatable :: name

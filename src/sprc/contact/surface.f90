@@ -1,6 +1,6 @@
 !> The contact surface of a slave/master pair: the slave surface's quadrature
-!> points and, for each, the initial gap to the master surface (seed eq. 3,
-!> SCENE.md `&contact`).
+!> points and, for each, the initial gap to the master surface (thesis eq. 3,
+!> doc/scene.md `&contact`).
 !>
 !> Slave points are the surface points of the cut-cell rules
 !> (sprc_grid_quadrature) on the slave surface: coordinates, weights (surface

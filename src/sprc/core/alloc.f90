@@ -1,4 +1,4 @@
-!> An allocation that fails is an error, never a crash (issue 15): a routine
+!> An allocation that fails is an error, never a crash: a routine
 !> allocates with `stat=` and passes the status to `check_allocation`, which
 !> leaves `error` unallocated on success and otherwise returns
 !> `stat_out_of_memory` with a message naming the routine, what was being

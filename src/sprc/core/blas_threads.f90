@@ -6,8 +6,8 @@
 !>   (the sparse solvers' factorizations);
 !> - speed: the recovery calls small LAPACK routines from every thread of an OpenMP loop
 !>   over patches; with an OpenBLAS thread pool of 2 or more, those concurrent calls contend
-!>   for OpenBLAS's shared buffers and threads and spin in the kernel (measured: sphere octant
-!>   Q1 level 5, 2 threads, t_recovery 0.87 - 3.4 s against 0.25 s with one BLAS thread).
+!>   for OpenBLAS's shared buffers and threads and spin in the kernel (several times slower
+!>   than with one BLAS thread).
 !> `blas_serial_begin` / `blas_serial_end` bracket such regions and restore the caller's
 !> count. The count is process-global: a caller running its own BLAS work in other threads
 !> at the same time sees it at 1 meanwhile.
@@ -62,7 +62,7 @@ contains
    !> dgemm with a transposed operand) now, while there is room, and not in the
    !> middle of a level: when that allocation fails OpenBLAS retries for ever
    !> (blas_memory_alloc), a hang instead of an error (seen under ulimit -v with
-   !> the memory estimate off: 3D level 5 at 350 MB). Each thread first
+   !> the memory estimate off). Each thread first
    !> allocates and frees as much itself: when that fails, `error` says so and
    !> BLAS is not called.
    subroutine blas_reserve_buffers(error)

@@ -9,30 +9,11 @@
 !> graded, the basis of degree p is the first C(p+dim, dim) terms of the
 !> degree-3 basis (lower degrees are prefixes of higher ones).
 !>
-!> | index | 2D term | (a,b)  | 3D term | (a,b,c) |
-!> |------:|---------|--------|---------|---------|
-!> |  1    | 1       | (0,0)  | 1       | (0,0,0) |
-!> |  2    | x       | (1,0)  | x       | (1,0,0) |
-!> |  3    | y       | (0,1)  | y       | (0,1,0) |
-!> |  4    | x^2     | (2,0)  | z       | (0,0,1) |
-!> |  5    | xy      | (1,1)  | x^2     | (2,0,0) |
-!> |  6    | y^2     | (0,2)  | xy      | (1,1,0) |
-!> |  7    | x^3     | (3,0)  | xz      | (1,0,1) |
-!> |  8    | x^2y    | (2,1)  | y^2     | (0,2,0) |
-!> |  9    | xy^2    | (1,2)  | yz      | (0,1,1) |
-!> | 10    | y^3     | (0,3)  | z^2     | (0,0,2) |
-!> | 11    |         |        | x^3     | (3,0,0) |
-!> | 12    |         |        | x^2y    | (2,1,0) |
-!> | 13    |         |        | x^2z    | (2,0,1) |
-!> | 14    |         |        | xy^2    | (1,2,0) |
-!> | 15    |         |        | xyz     | (1,1,1) |
-!> | 16    |         |        | xz^2    | (1,0,2) |
-!> | 17    |         |        | y^3     | (0,3,0) |
-!> | 18    |         |        | y^2z    | (0,2,1) |
-!> | 19    |         |        | yz^2    | (0,1,2) |
-!> | 20    |         |        | z^3     | (0,0,3) |
+!> 2D: 1, x, y, x^2, xy, y^2, x^3, x^2y, xy^2, y^3.
+!> 3D: 1, x, y, z, x^2, xy, xz, y^2, yz, z^2, x^3, x^2y, x^2z, xy^2, xyz, xz^2, y^3, y^2z,
+!> yz^2, z^3.
 !>
-!> The seed thesis uses three different quadratic orders (its table of p(x),
+!> The thesis uses three different quadratic orders (its table of p(x),
 !> eq. 40 and eq. 54/62); sprc uses only this one, exported as the parameter
 !> tables `poly_exponents_2d` and `poly_exponents_3d`.
 !>

@@ -14,7 +14,7 @@
 !> s (r) is the distance of x from the line (2D: point) through `point` along
 !> `normal`, i.e. the length of (x - point) projected on the contact plane;
 !> p = 0 for s >= a. `load` is the force of the whole contact: a symmetric
-!> half model carries P/2 and a quarter model F/4 (SCENE.md). Pressure only:
+!> half model carries P/2 and a quarter model F/4 (doc/scene.md). Pressure only:
 !> no stress or displacement field, so the energy-norm columns stay empty.
 module sprc_exact_hertz
    use sprc_core_kinds, only: wp

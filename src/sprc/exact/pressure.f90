@@ -2,7 +2,7 @@
 !> report's p_max_exact and err_p_* columns.
 !>
 !> p = -n.sigma.n, positive in compression, with n the slave body's outward
-!> normal (SCENE.md). Two sources: a field solution of the slave body
+!> normal (doc/scene.md). Two sources: a field solution of the slave body
 !> (`field_pressure_type`: uniform, the rings of compound_cylinder /
 !> compound_sphere), or a closed-form pressure distribution without a stress
 !> field (`sprc_exact_hertz`). The study holds one `class(exact_pressure_type)`

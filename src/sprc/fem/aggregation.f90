@@ -1,5 +1,5 @@
-!> Cell aggregation for small cut cells (AgFEM: Badia, Verdugo & Martin,
-!> CMAME 336 (2018) 533-553).
+!> Cell aggregation for small cut cells (AgFEM: Badia, Verdugo & Martin 2018;
+!> doc/theory.md, section 4).
 !>
 !> A cell is well posed when it is inside the body, or cut with a volume
 !> fraction |cell ∩ body| / |cell| >= eta. Every other (ill-posed) cell is

@@ -1,4 +1,4 @@
-!> Boundary conditions of the FE layer on a body's shape surfaces (SCENE.md
+!> Boundary conditions of the FE layer on a body's shape surfaces (doc/scene.md
 !> `&bc`), as plain data: which shape, which kind (`sprc_core_boundary`'s
 !> vocabulary, re-exported here), a value and a vector.
 !>

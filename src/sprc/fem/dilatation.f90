@@ -1,45 +1,33 @@
 !> Projected dilatation (B-bar / mean dilatation) on cell aggregates: the
-!> locking-free formulation for nearly incompressible materials.
+!> locking-free formulation for nearly incompressible materials
+!> (doc/theory.md, section 5).
 !>
-!> Formulation. For an isotropic D, D m = k kappa m with m the volumetric
-!> vector (1, 1, 0) in 2D (k = 2) and (1, 1, 1, 0, 0, 0) in 3D (k = 3), and
-!> kappa = m^T D m / k^2 (lambda + mu in plane strain, the bulk modulus in 3D).
-!> With theta = m^T eps(u) the dilatation and D_dev = D - kappa m m^T (the
-!> deviatoric part: D_dev m = 0),
-!>   eps^T D eps = eps^T D_dev eps + kappa theta^2.
-!> The projected formulation replaces theta by its L2 projection
-!> theta_bar = Pi_A theta onto P_k(A) on each aggregate A (a well-posed cell
-!> and the small cut cells attached to it, `sprc_fem_aggregation`):
+!> Formulation. With m the volumetric vector, kappa = m^T D m / k^2, the
+!> dilatation theta = m^T eps(u) and D_dev = D - kappa m m^T (D_dev m = 0),
+!> theta is replaced by its L2 projection theta_bar onto P_k(A) on each
+!> aggregate A (a well-posed cell and its attached small cut cells,
+!> `sprc_fem_aggregation`):
 !>   a(u, v) = int eps(v)^T D_dev eps(u) + int kappa theta_bar(v) theta_bar(u),
-!>   sigma_bar(u) = D_dev eps(u) + kappa theta_bar(u) m,
-!> which is B-bar (Hughes, IJNME 15 (1980) 1413; eps_bar = eps + m (theta_bar -
-!> theta)/k, sigma_bar = D eps_bar) and the mean-dilatation method for k = 0
-!> (Nagtegaal, Parks & Rice, CMAME 4 (1974) 153). It is the displacement form
-!> of the mixed method with pressure p = kappa theta_bar in P_k per aggregate:
-!> Q1 with P0 (k = 0: one dilatation per aggregate) and Q2 with P1
-!> discontinuous (k = 1), the inf-sup stable pair of optimal order for Q2
-!> (Brezzi & Fortin 1991, VI.5; P0 with Q2 would cost one order of the
-!> stress). On a cut mesh the pressure space lives on the aggregates, as in
-!> the aggregated unfitted Stokes elements of Badia, Martin & Verdugo
-!> (SISC 40 (2018) B1541): a small cut cell carries no dilatation of its
-!> own, so the number of incompressibility constraints is that of the
-!> well-posed cells and does not grow with how the boundary cuts the grid.
-!> The projection uses each cell's own cut-cell volume rule, so the Gram
-!> matrix M_A = int_A p p^T and the moments are integrals over the true domain.
+!>   sigma_bar(u) = D_dev eps(u) + kappa theta_bar(u) m.
+!> This is B-bar (Hughes 1980), the mean dilatation for k = 0 (Nagtegaal,
+!> Parks & Rice 1974), and the displacement form of the mixed method with
+!> pressure kappa theta_bar: Q1/P0 and Q2/P1-discontinuous, the inf-sup stable
+!> pair of optimal order for Q2 (Brezzi & Fortin 1991). The pressure space
+!> lives on the aggregates (as in Badia, Martin & Verdugo 2018, for Stokes):
+!> a small cut cell carries no dilatation of its own, so the number of
+!> incompressibility constraints does not grow with how the boundary cuts
+!> the grid. The Gram matrices use each cell's cut-cell volume rule.
 !>
 !> Nitsche terms use the stress of the formulation, sigma_bar(v) n, so the
 !> method stays consistent: a rank-np coupling between the surface points of
 !> an aggregate and its dilatation (`add_aggregate_block`).
 !>
 !> When. The displacement formulation locks as nu -> 1/2 in plane strain and
-!> 3D, where kappa / mu = 1/(1 - 2 nu) (plane strain) or 2(1 + nu)/(3(1 - 2 nu))
-!> (3D) grows without bound; plane stress does not lock (its D stays bounded)
-!> and `dilatation_auto` never projects it. `dilatation_auto` projects at
-!> nu >= `projected_poisson` = 0.4: on the Kirsch plate in plane strain the
-!> projection lowers err_fe from nu = 0.4 up (Q1 level 6: 1.51e-2 -> 1.21e-2),
-!> leaves it equal at 0.3 and raises it at 0 (1.20e-2 -> 1.40e-2).
-!> The stiffness keeps the kappa scale: its condition number still grows like
-!> kappa / mu (a displacement-only formulation cannot avoid it).
+!> 3D (kappa / mu grows without bound); plane stress does not lock and
+!> `dilatation_auto` never projects it. It projects from nu >=
+!> `projected_poisson` = 0.4, where the projection starts to lower err_fe
+!> (doc/benchmarks.md). The stiffness keeps the kappa scale: its condition
+!> number still grows like kappa / mu.
 module sprc_fem_dilatation
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_singular

@@ -35,7 +35,8 @@ module sprc_fem_linear_solver
    !> 'auto''s table: a system of dimension `dim` (2, 3) and element degree
    !> `degree` (1, 2) is solved iteratively from `auto_min_dofs(dim, degree)`
    !> unknowns on, directly below (`auto_never`: always directly). Each entry
-   !> is a measured crossover of the two solve times (README); re-tune here
+   !> is a crossover of the two solve times (doc/benchmarks.md, "Linear
+   !> solvers"); re-tune here
    !> when either solver changes. 2D stays direct (CHOLMOD's fill is mild
    !> there); so does Q2 in 3D, where GAMG needs ~200 iterations.
    integer, parameter :: auto_never = huge(1)
@@ -353,7 +354,7 @@ contains
    end function use_iterative
 
    !> 'auto''s threshold for `dim` and `degree` (`auto_min_dofs`; `auto_never`
-   !> outside the table: a degree or dimension it has not measured).
+   !> outside the table: a degree or dimension without a known crossover).
    pure integer function auto_iterative_min_dofs(dim, degree) result(min_dofs)
       integer, intent(in) :: dim, degree
       min_dofs = auto_never

@@ -1,6 +1,5 @@
-!> Linear elasticity on one body's cut Cartesian grid: Q1 / Q2 elements,
-!> immersed boundary conditions, small-cut robustness, sparse direct or iterative solve and
-!> the post-processing the recovery and the report need.
+!> Linear elasticity on one body's cut Cartesian grid: Q1 / Q2 elements, immersed boundary
+!> conditions, small-cut robustness, sparse solves and the post-processing recovery needs.
 !>
 !> Use:
 !> ```
@@ -12,39 +11,18 @@
 !> ! problem%element_points(e, x, w, sigma), problem%energy_error(...),
 !> ! problem%mesh (grid, nodes, cell rules), problem%t_assembly, t_solve
 !> ```
-!> The inputs are the body's cut mesh (`sprc_grid_cut_mesh`: body, grid,
-!> Q`degree` nodes, hanging-node constraints and cut-cell rules), which setup
-!> takes over without a copy (`move_alloc`), and plain data: the material, a
-!> constant body force, boundary conditions by shape index (`sprc_fem_bc`) and
-!> optionally an exact solution (for exact_* kinds and for `energy_error`).
+!> The inputs are the body's cut mesh (`sprc_grid_cut_mesh`), which setup takes over
+!> without a copy (`move_alloc`), and plain data: the material, a constant body force,
+!> boundary conditions by shape index (`sprc_fem_bc`), optionally an exact solution.
 !>
-!> Formulation. Find u_h in V_h = {T ubar} with
-!>   a(u, v) + N(u, v) = l(v) for all v in V_h,
-!>   a(u, v) = int_Omega eps(v)^T D eps(u),  l(v) = int_Omega v.b + int_GN v.t,
-!> where Omega is the true (curved) domain integrated by the cut-cell
-!> quadrature and GN the Neumann surfaces (free, pressure t = -p n, traction,
-!> exact traction sigma_ex n). Dirichlet (u = g: displacement, exact
-!> displacement; P = I) and weak symmetry (u.n = 0 with zero shear: P = n n^T,
-!> g = 0) surfaces add the symmetric Nitsche terms
-!>   N(u, v) = -int_GD (v.P sigma(u)n + u.P sigma(v)n) + int_GD (gamma dmax/h) u.P v,
-!>   l(v)   += -int_GD g.P sigma(v)n + int_GD (gamma dmax/h) g.P v,
-!> with h the cell size and dmax the largest diagonal entry of D (the
-!> material's stiffness scale, 1.35 E for nu = 0.3 in plane strain). Symmetry
-!> on a halfspace with an axis normal lying on grid planes (no cell straddles
-!> it: every quarter / octant scene) is strong: u_k = 0 at the nodes on the
-!> plane, and its surface points add nothing (zero shear is natural).
-!>
-!> Penalty. Coercivity of a + N needs gamma dmax/h > 2 sup ||sigma(v)n||^2_GD /
-!> a(v, v) over V_h, i.e. gamma > 2 C_I with the trace-inverse constant C_I of
-!> h ||sigma(v) n||^2_{Gamma ∩ A} <= C_I dmax a_A(v, v) on an aggregate A.
-!> Aggregation makes C_I independent of the cut (the function on a small cell
-!> is the root cell's polynomial, whose trace anywhere within a few cell sizes
-!> is bounded by its energy on the root cell); for Q_p on a cell C_I is about
-!> (p + 1)^2 times a small geometric factor (surface measure per cell up to
-!> ~sqrt(dim) h^(dim-1), extrapolation over one cell). `default_gamma` =
-!> 10 (p + 1)^2 (40 for Q1, 90 for Q2) leaves a margin of 2 or more over that;
-!> if the system still comes out indefinite CHOLMOD says so and UMFPACK
-!> solves it (`solver_note`).
+!> Formulation (doc/theory.md, section 3): a(u, v) + N(u, v) = l(v) on V_h = {T ubar},
+!> integrated over the true domain by the cut-cell rules; Dirichlet and off-grid symmetry
+!> surfaces add the symmetric Nitsche terms with penalty gamma dmax/h (dmax the largest
+!> diagonal entry of D: the material's stiffness scale). Symmetry on a halfspace lying on
+!> grid planes (every quarter / octant scene) is strong: u_k = 0 at its nodes.
+!> `default_gamma` = 10 (p + 1)^2 leaves a margin of 2 or more over twice the trace-inverse
+!> constant, which aggregation makes independent of the cut; if the system still comes out
+!> indefinite CHOLMOD says so and UMFPACK solves it (`solver_note`).
 !>
 !> Small cut cells: cell aggregation (`sprc_fem_aggregation`, threshold `eta`)
 !> through the constraint machinery (`sprc_fem_constraints`).
@@ -531,7 +509,7 @@ contains
          call fatal_error(error, 'elasticity solve: the system is not assembled', stat_invalid_input)
          return
       end if
-      ! PETSc is loaded on first use. Its one-off start-up (the library and MPI, 0.35-0.45 s once per
+      ! PETSc is loaded on first use. Its one-off start-up (the library and MPI, once per
       ! process) is a cost of the process, as loading the linked CHOLMOD is, not of this solve.
       if (use_iterative(self%solver, self%dim, self%degree, self%constraints%n_dofs)) call start_petsc(error)
       if (allocated(error)) return

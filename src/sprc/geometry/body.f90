@@ -1,4 +1,4 @@
-!> A body: shapes combined in file order by CSG (SCENE.md, `&shape`).
+!> A body: shapes combined in file order by CSG (doc/scene.md, `&shape`).
 !>
 !> body = (((s_1 op_2 s_2) op_3 s_3) ... ), op_1 = add; add is union (min of
 !> the level sets), intersect is intersection (max), subtract is A minus B

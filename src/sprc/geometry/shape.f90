@@ -1,4 +1,4 @@
-!> Implicit primitive shapes of the scene (`&shape` in SCENE.md): disk/sphere,
+!> Implicit primitive shapes of the scene (`&shape` in doc/scene.md): disk/sphere,
 !> ellipse/ellipsoid, axis-aligned box, halfspace and infinite cylinder.
 !>
 !> Each shape is a level set phi, negative inside; the closed set phi <= 0 is

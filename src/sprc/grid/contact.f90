@@ -1,5 +1,5 @@
-!> A body's contact surface as the grid recovery sees it (seed eqs. 103-138, "Formulación
-!> del SPR-C en contacto"; issue 12): which boundary points are in contact and under which
+!> A body's contact surface as the grid recovery sees it (thesis eqs. 103-138, "Formulación
+!> del SPR-C en contacto"): which boundary points are in contact and under which
 !> law, and the other body's FE stresses for the auxiliary domains Omega_aux.
 !>
 !> The grid producer (sprc_grid_patches) marks the body's boundary points on `shape` with a
@@ -9,14 +9,10 @@
 !> get a description, each with the other as body (2): the master-side patches are the
 !> mirrored ones, so both recovered fields near the contact surface are contact-aware.
 !>
-!> Omega_aux depth: `depth` times the patch size h, default 3 h (measured, Q1, levels 5..7,
-!> depth h / 2h / 3h / 4h: on the shrink fit the pressure error at level 7 is 4.0e-3 /
-!> 2.2e-3 / 1.7e-3 / 1.6e-3 (err_p_fe 2.5e-3) and err_sprc 5.30e-4 / 5.17e-4 / 5.17e-4 /
-!> 5.20e-4; on the Hertz cylinder err_p_sprc 0.0529 / 0.0532 / 0.0536 and p_max_sprc
-!> 13.70 / 13.69 / 13.71 (p0 13.74): a prism of one patch size holds mostly the other
-!> body's cut cells, whose stresses are the poorest, deeper ones stop gaining at 3h and do
-!> not over-smooth the Hertz peak at these levels). The solve doubles it while the Omega_aux
-!> fit lacks rank.
+!> Omega_aux depth: `depth` times the patch size h, default 3 h: a prism of one patch size
+!> holds mostly the other body's cut cells, whose stresses are the poorest; deeper ones stop
+!> gaining at 3 h and do not over-smooth the Hertz peak. The solve doubles it while the
+!> Omega_aux fit lacks rank.
 !>
 !> The other body's volume and boundary points are sorted into uniform cells once (a
 !> counting sort, `point_cells_type`): a patch passes the solve only those in the bounding
@@ -230,9 +226,8 @@ contains
    !> the prism's axes within its bounds, by a margin far above the round-off of
    !> aux_contains) is taken without a test per point, and one outside it is skipped; only
    !> the points of cells that straddle a face are tested. (The prism of an oblique normal
-   !> fills a fraction of its bounding box: 3D compound sphere level 4, 2975 points in the
-   !> box and 784 in the prism per patch on average, and the test per point was most of the
-   !> contact patches' time.)
+   !> fills a fraction of its bounding box, and the test per point was most of the contact
+   !> patches' time.)
    pure subroutine cells_prism(cells, y, aux, idx, n)
       type(point_cells_type), intent(in) :: cells
       real(wp), intent(in) :: y(:, :)

@@ -1,22 +1,10 @@
-!> The Cartesian grid as a producer of SPR / SPR-C vertex patches (seed eqs. 8-11,
+!> The Cartesian grid as a producer of SPR / SPR-C vertex patches (thesis eqs. 8-11,
 !> 19-24, 99-100; Figure 15 for patch expansion).
 !>
 !> Input (`recovery_input_type`, plain data the FE layer fills; element e is leaf e of
-!> the grid, in the grid's Morton order):
-!> - material: analysis (plane_stress, plane_strain, solid), young, poisson, and a
-!>   constant body force (div sigma + b = 0);
-!> - volume integration points per element, CSR: the points of element e are
-!>   elem_ptr(e) .. elem_ptr(e+1)-1 (elem_ptr(1) = 1, non-decreasing, size n_elements+1),
-!>   with coordinates x(dim, npts), weight*|J| w(npts) > 0 and the FE stress
-!>   stress(nstress, npts) in Voigt order;
-!> - boundary points per element, CSR likewise (belem_ptr, bx(dim, nb), bw(nb) >= 0,
-!>   unit outward normals bn(dim, nb), shape index bshape(nb) in 1..size(bc_kind));
-!> - per shape index s the boundary kind for recovery, bc_kind(s):
-!>   bc_none (not constrained: Dirichlet surfaces, or surfaces left alone),
-!>   bc_traction (t = bc_traction(1:dim, s), constant), bc_pressure
-!>   (t = -bc_pressure(s) n), bc_exact_traction (t = sigma_exact(x) n; needs the `exact`
-!>   argument), bc_symmetry (zero shear on the plane). Free surfaces are bc_traction
-!>   with t = 0.
+!> the grid, in Morton order): the material, volume and boundary points per element (CSR),
+!> and per shape index the boundary kind for recovery (bc_none for Dirichlet surfaces or
+!> surfaces left alone; free surfaces are bc_traction with t = 0).
 !>
 !> Patches (`recover_grid`): one per free vertex node, i.e. per corner node of an active
 !> leaf that does not hang (for Q2 only corner nodes; mid-edge, face and centre nodes
@@ -28,12 +16,11 @@
 !> core imposes the dominant boundary kind (`dominant_boundary_kind`: contact wins, else
 !> the largest measure).
 !>
-!> Expansion (seed Figure 15): a patch whose basis matrix lacks rank (the core returns
+!> Expansion (thesis Figure 15): a patch whose basis matrix lacks rank (the core returns
 !> stat_singular: too few or aligned points, e.g. a corner node with one small cut
 !> element) gets one more ring of leaves, those sharing a node with the patch, and is
-!> solved again; at most `max_rounds` rounds (default `default_max_rounds` = 3: a ring
-!> of a 2:1 grid at least doubles the patch extent in every direction it can grow, so
-!> three rings reach about 8 cells from the node). Beyond that the recovery fails with
+!> solved again; at most `max_rounds` rounds (`default_max_rounds` = 3: each ring of a
+!> 2:1 grid at least doubles the extent, so three reach ~8 cells). Beyond that the recovery fails with
 !> stat_singular naming the node. `field%patch_rounds`, `field%n_expanded` tell how many
 !> patches needed it.
 !>
@@ -44,7 +31,7 @@
 !> Contact (SPR-C with a `grid_contact_type`, sprc_grid_contact): the body's boundary points
 !> on the contact shape are contact points where their law is closed and free-surface
 !> (zero-traction) points where it is open; a patch holding a contact point is solved by
-!> the coupled contact solve (contact wins, seed), expanded like any other patch when it
+!> the coupled contact solve (contact wins, the thesis), expanded like any other patch when it
 !> lacks rank.
 module sprc_grid_patches
    use sprc_core_kinds, only: wp

@@ -4,66 +4,32 @@
 !> with exact unit outward normals and the shape index (hence the surface
 !> name) at every surface point. All weights are positive.
 !>
-!> Method (Saye 2015, SIAM J. Sci. Comput. 37(2):A993, dimension reduction):
-!> the active shapes of the cell become quadrics in reference coordinates
-!> (sprc_grid_quadric). On a box with a set of quadrics:
-!> 1. quadrics of one sign over the box are dropped; none left: tensor Gauss;
-!> 2. a height direction k is sought such that every quadric either does not
-!>    involve y_k or has dp/dy_k certified nonzero over the box (so a height
-!>    line meets each surface at most once), and every pair of surfaces that
-!>    both involve y_k has a crossing quadric (one of them a plane, or both
-!>    with proportional quadratic parts such as two spheres; CSG edges and
-!>    corners are thus resolved exactly). Beyond Saye's condition the
-!>    direction must be strong: min |dp/dy_k| >= min_ratio * (variation of
-!>    dp/dy_k over the box), which keeps the turning points of the height
-!>    function (its square-root singularities) at least min_ratio box widths
-!>    away, so Gauss converges like rho^(-2q) with rho >= 13.9 for the
-!>    default min_ratio = 3 (about 1e-13 relative at q = 6 on any level);
-!> 3. the base (the box without direction k) gets the restrictions of the
-!>    quadrics to the two faces y_k = lo, hi (rebuilt from the shape there,
-!>    without cancellation), the quadrics free of y_k, and the crossing
-!>    quadrics; its rule comes from the same algorithm one dimension lower.
-!>    On a base piece between these zero sets the roots along height lines
-!>    are smooth, so Gauss points integrate accurately;
-!> 4. each base point is lifted: the roots of the quadrics on its height line
-!>    (closed-form, cancellation-free) split it into pieces; at the top level
-!>    a piece belongs to the body if the body's level set is negative at its
-!>    midpoint (exact CSG membership), gets q Gauss points if so, and a root
-!>    where membership changes is a surface point with weight
-!>    w_base / |n_k| (n the exact outward normal from body%outward_normal).
-!> A surface free of y_k (a wall parallel to the height lines, e.g. a
-!> z-cylinder next to a z-cap) is met by no height line: the volume pass may
-!> still use k, and each such surface gets its own pass with a direction
-!> that crosses it (and no volume points).
-!> Fallback: where no valid height direction exists (a turning point in or
-!> near the box, near-tangency, two non-proportional quadrics meeting, such
-!> as a sphere and a cylinder, or two derived conics in a 3D base where a
-!> CSG edge crosses a cell face) the box is split into its 2^m halves, up to
-!> max_depth times (20 in 2D, 10 in 3D); beyond that the best direction is
-!> used as is on a box 2^-max_depth of the cell wide (counted in
-!> `nunresolved`; its error is bounded by that box's measure). `nsplit`
-!> counts the subdivisions of a cell.
+!> Method (Saye 2015, dimension reduction; doc/theory.md, section 2): the
+!> active shapes become quadrics in reference coordinates (sprc_grid_quadric);
+!> a height direction k is sought in which every quadric is monotone and every
+!> pair of surfaces meets in a quadric (CSG edges resolved exactly); the base
+!> gets its rule one dimension lower and each base point is lifted through the
+!> closed-form roots on its height line. Beyond Saye's condition the direction
+!> must be strong, min |dp/dy_k| >= min_ratio * (variation of dp/dy_k), which
+!> keeps the height function's square-root singularities min_ratio box widths
+!> away, so Gauss converges geometrically on every level. A surface free of
+!> y_k (a wall parallel to the height lines) gets its own pass in a direction
+!> that crosses it. Where no direction qualifies the box is halved, up to
+!> max_depth times (20 in 2D, 10 in 3D); beyond that the best direction is used
+!> as is (`nunresolved`; error bounded by that box's measure); `nsplit` counts
+!> the subdivisions.
 !>
-!> Boundaries on grid planes. A halfspace with an axis normal, or a box face,
-!> lying on a cell face (within the body's snapping tolerance) is never a cut
-!> shape of either neighbour. Its part on the face enters the surface rule of
-!> the cell on the body side only: a face point is a boundary point of this
-!> cell if the body is inside just on the cell side and outside just across,
-!> which is decided by CSG membership with the coinciding shape's sign
-!> replaced by its one-sided value. The face part is itself a (dim-1)
-!> dimensional cut quadrature. `boundary_face_rule` gives only these points
-!> (for a cell classified inside); `cut_cell_rule` and `cell_rule` include them.
+!> Boundaries on grid planes (a halfspace or box face on a cell face, within
+!> the snapping tolerance) are never a cut: their face part enters only the
+!> surface rule of the cell on the body side, decided by CSG membership with
+!> that shape's one-sided value. `boundary_face_rule` gives only these points.
 !>
-!> Points per direction: `default_points(order)` = order + 2 (3 for Q1, 4 for
-!> Q2): exact for the stiffness, load and mass integrands of a full cell (degree
-!> <= 2p per direction needs p + 1), one more for error norms of non-polynomial
-!> exact solutions; on cut cells the geometry is then integrated to order
-!> 2q >= 6, above the FE convergence order. Any q in 1..max_gauss_points may be
-!> set instead (the `--points` option).
+!> Points per direction: `default_points(order)` = order + 2: exact for the
+!> full-cell integrands (degree <= 2p needs p + 1), one more for error norms of
+!> non-polynomial exact solutions (the `--points` option sets any other q).
 !>
 !> No module state; every procedure is pure. A `cell_rule_type` holds the
-!> result and its own work arrays, grown on demand and reused across cells:
-!> use one per thread.
+!> result and its work arrays, reused across cells: use one per thread.
 module sprc_grid_quadrature
    use sprc_core_kinds, only: wp
    use sprc_core_text, only: itoa, rtoa
@@ -273,7 +239,7 @@ contains
    end subroutine boundary_face_rule
 
    !> The error of a rule whose arrays could not grow (`failed`): out of memory, never
-   !> a crash (issue 15); the rule is then empty.
+   !> a crash; the rule is then empty.
    pure subroutine check_failed(rule, where, lo, hi, error)
       type(cell_rule_type), intent(inout) :: rule
       character(len=*), intent(in) :: where
@@ -746,7 +712,7 @@ contains
          end if
       else
          ! A loop, not overlapping sections: gfortran copies those through a heap
-         ! temporary that it never checks, a crash when memory runs out (issue 15).
+         ! temporary that it never checks, a crash when memory runs out.
          nnew = rule%ns - s1
          do i = 1, nnew
             rule%sy(:, s0 + i) = rule%sy(:, s1 + i)

@@ -1,4 +1,4 @@
-!> Zienkiewicz-Zhu error estimate of a recovered field on a grid (seed eq. 1) and,
+!> Zienkiewicz-Zhu error estimate of a recovered field on a grid (thesis eq. 1) and,
 !> with an exact solution, the error norms of the report.
 !>
 !> With ||s||_E^2 = sum over the volume points of w |J| s^T D^-1 s (energy norm of a

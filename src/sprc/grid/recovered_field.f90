@@ -2,7 +2,7 @@
 !> SPR / SPR-C (filled by `sprc_grid_patches`) and their interpolation over the
 !> elements, evaluable at any point of any element without the grid objects.
 !>
-!> Two interpolations (seed eqs. 101, 102):
+!> Two interpolations (thesis eqs. 101, 102):
 !> - nodal (eq. 101, the SPR field): sigma*(x) = sum_J N_J(x) sigma*_J over all
 !>   nodes J of the element with the element's own Q1 / Q2 shape functions N_J.
 !>   The nodal values sigma*_J (`nodal_interp`) are

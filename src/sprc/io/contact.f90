@@ -1,7 +1,7 @@
-!> `PREFIX_contact.csv` (SCENE.md "Report"): one row per slave-surface
+!> `PREFIX_contact.csv` (doc/scene.md "The report"): one row per slave-surface
 !> quadrature point and level,
 !> `level,x,y,z,weight,gap,state,p_fe,p_spr,p_sprc,p_exact,ts_fe,ts_sprc`,
-!> then (an extension of SCENE.md, trailing) `tx_fe,ty_fe,tz_fe`, the FE
+!> then (trailing) `tx_fe,ty_fe,tz_fe`, the FE
 !> tangential traction on the slave body as a vector (`tz_fe` empty in 2D),
 !> reals as in the report CSV (read back bit for bit), `z` empty in
 !> 2D, `state` open / stick / slip, an empty value (not computed) an empty
@@ -17,7 +17,7 @@ module sprc_io_contact
 
    public :: contact_level_type, contact_csv_header, write_contact_csv
 
-   !> The CSV header: SCENE.md's columns, then the signed tangential traction.
+   !> The CSV header: doc/scene.md's columns, then the signed tangential traction.
    character(len=*), parameter :: contact_csv_header = 'level,x,y,z,weight,gap,state,p_fe,p_spr,p_sprc,p_exact,'// &
       & 'ts_fe,ts_sprc,tx_fe,ty_fe,tz_fe'
 

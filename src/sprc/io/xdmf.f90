@@ -10,65 +10,31 @@
 !> /level_LL/contact_<k>/mesh/x        float64 (n_points, dim)   slave points of &contact pair k
 !> /level_LL/contact_<k>/node/<name>   float64 or int32 (n_points) | (n_points, 3)
 !> ```
-!> The fields of `sprc run` (`sprc_io_fields`): per body node fields
-!> `displacement`, `sigma_fe`, `sigma_spr`, `sigma_sprc`, `inside`, cell
-!> fields `zz_error_spr`, `zz_error_sprc`, `exact_error_fe`, `cut`,
-!> `volume_fraction`, `cell_level`. Every field dataset carries string
-!> attributes `units` (in words: length, stress, energy norm; the scene's
-!> own units) and, with several columns, `components` ('xx yy xy (Voigt
-!> order)', 'x y z', or 'x y z (z = 0: a 2-D vector)'); the XDMF repeats
-!> the units as an Information element of the Attribute.
+!> LL is the level with two digits; a writer with no body name gets `/level_LL/mesh/x`.
+!> The fields are `sprc_io_fields`'s. Every field dataset carries the string attributes
+!> `units` (the scene's own, in words) and, with several columns, `components`. A vector
+!> has 3 components (a 2-D one gets z = 0): ParaView treats only those as vectors. A
+!> contact pair's slave points are a grid of Polyvertex cells beside the bodies' grids.
 !>
-!> **Only the body.** The grid's cells are the cells that meet the body, so
-!> a cut cell and its nodes reach beyond the boundary, where the FE and
-!> recovered fields are extrapolations. The node field `inside` is 1 for a
-!> node in the body or on its boundary (within the geometry's snapping
-!> tolerance) and 0 beyond: in ParaView, Threshold on `inside` from 1 to 1
-!> with "All Scalars" on shows the cells whose nodes all lie in the body
-!> (the cut cells go); statistics of a node field over the body take the
-!> nodes where `inside` = 1 (e.g. the largest sigma_sprc_xx). The cell field
-!> `volume_fraction` is the share of each cell in the body.
+!> **Only the body.** A cut cell's nodes reach beyond the boundary, where the fields are
+!> extrapolations: the node field `inside` is 1 in the body or on its boundary, 0 beyond
+!> (ParaView: Threshold `inside` 1..1 with "All Scalars"); `volume_fraction` is each
+!> cell's share in the body.
 !>
-!> LL is the level with two digits (`/level_04`), <body> the body's name
-!> (`sprc run` writes every body so, even a scene's only one); a writer that
-!> gives no body name gets `/level_LL/mesh/x` etc. A field with one component
-!> is a 1-D dataset. The slave-surface points of a contact pair are a grid
-!> of Polyvertex cells (one point each, connectivity (n_points, 1)) beside
-!> the bodies' grids of the level, named `contact_<k>` (with leading `_`
-!> added while a body has that name); its node fields are the contact
-!> pressures, gap, state, tangential tractions, weights and normals
-!> (`sprc_io_fields`). A vector field is stored with 3 components (a 2-D vector
-!> gets z = 0) because ParaView only treats 3-component arrays as vectors
-!> (warp, glyphs). A field with named components (e.g. Voigt stresses
-!> xx, yy, xy) is one (n, ncomp) dataset.
+!> **XDMF** (3.0, also read by ParaView's legacy reader): one temporal collection whose
+!> Time is the level; per level one Uniform grid, or a Spatial collection of one grid per
+!> body. Topologies Quadrilateral(_9), Hexahedron(_27); attributes Scalar, Vector, and for
+!> named components one Scalar per component (`<name>_<component>`, an XDMF HyperSlab):
+!> ParaView loads Tensor6 as an unnamed array, and 2-D Voigt stresses have no XDMF tensor.
+!> (Checked with VTK's vtkXdmfReader for one unnamed grid per level; the per-body Spatial
+!> collection was not opened in a reader.)
 !>
-!> **XDMF** (version 3.0, also read by ParaView's legacy XDMF reader): one
-!> temporal collection whose Time is the level, so ParaView's time control
-!> steps through the levels; per level one Uniform grid, or for bodies a
-!> Spatial collection (Time = level) of one Uniform grid per body, named
-!> after it, in level order. (Checked by hand with VTK 9.7's vtkXdmfReader,
-!> for one unnamed grid per level: cell types, named component scalars, the
-!> displacement as active vectors, hex27 volumes; the per-body Spatial
-!> collection, XDMF's way of grouping blocks, was not opened in a reader
-!> here.) Geometry is XY or
-!> XYZ. Topology types: Quadrilateral, Quadrilateral_9, Hexahedron,
-!> Hexahedron_27. Attributes: Scalar, Vector (3 components), and for named
-!> components one Scalar per component, `<name>_<component>`, cut out of the
-!> dataset by an XDMF HyperSlab. Separate scalars were chosen over Tensor6
-!> because ParaView's readers load Tensor6 as an unnamed 6-component array,
-!> and 2-D Voigt stresses (3 components) have no XDMF tensor type at all.
-!>
-!> **Node order.** Connectivity is stored in VTK's local node order, which
-!> is what both ParaView XDMF readers expect: they copy XDMF connectivity
-!> into VTK cells without reordering. quad4: corners counter-clockwise
-!> (0,0) (1,0) (1,1) (0,1). quad9 (VTK_BIQUADRATIC_QUAD): corners, midpoints
-!> of edges 0-1, 1-2, 2-3, 3-0, centre. hex8: bottom face z=0 as quad4, then
-!> top face. hex27 (VTK_TRIQUADRATIC_HEXAHEDRON): 8 corners; midpoints of the
-!> bottom edges (01 12 23 30), top edges (45 56 67 74), vertical edges (04 15
-!> 26 37); face centres x=0, x=1, y=0, y=1, z=0, z=1; body centre. This is
-!> the order `sprc_grid_nodes` uses, so its connectivity goes out unchanged.
-!> (Other codes differ in the face-centre order of the 27-node hexahedron,
-!> e.g. Gmsh; XDMF's own documentation does not fix it.)
+!> **Node order** is VTK's, which both ParaView XDMF readers copy without reordering, and
+!> `sprc_grid_nodes`'s. quad4: corners counter-clockwise from (0,0). quad9: corners,
+!> midpoints of edges 0-1, 1-2, 2-3, 3-0, centre. hex8: bottom face z=0 as quad4, then top.
+!> hex27: 8 corners; midpoints of the bottom edges (01 12 23 30), top edges (45 56 67 74),
+!> vertical edges (04 15 26 37); face centres x=0, x=1, y=0, y=1, z=0, z=1; body centre.
+!> (Gmsh and others order the 27-node face centres differently; XDMF does not fix it.)
 module sprc_io_xdmf
    use sprc_core_error, only: error_type, fatal_error, stat_io, stat_invalid_input
    use sprc_core_text, only: itoa

@@ -1,9 +1,9 @@
-!> The auxiliary domain Omega_aux of a contact patch in the other body (seed eq. 116,
+!> The auxiliary domain Omega_aux of a contact patch in the other body (thesis eq. 116,
 !> Figures 28-31): geometry and the selection of the other body's sampling points.
 !>
 !> A contact patch of body (1) holds contact points x_i (the patch's part of the
 !> contact surface, Gamma_C^p) with outward unit normals n_i and surface weights w_i.
-!> - Mean normal (eq. 116): nbar = sum w_i n_i / |sum w_i n_i|. The seed divides by the
+!> - Mean normal (eq. 116): nbar = sum w_i n_i / |sum w_i n_i|. The thesis divides by the
 !>   measure sum w_i, which leaves nbar shorter than unit on a curved surface; only its
 !>   direction is used, so sprc normalises it. It points from body (1) into body (2).
 !> - Frame: [nbar t1 (t2)] with the tangents of `plane_tangents(nbar)` (on a Cartesian
@@ -20,10 +20,10 @@
 !>   the box all lie above lo whether the surface is convex or concave seen from body (1)
 !>   (test: a disc and a ring), so lo cuts nothing of body (2) next to Gamma_C^p; it only
 !>   stops the prism from reaching through body (1) to another part of body (2).
-!> Small deformations: undeformed points and normals (the seed projects the deformed
+!> Small deformations: undeformed points and normals (the thesis projects the deformed
 !> perimeter; the difference is of the order of the displacement gradient).
 !>
-!> Size (the seed: too small an Omega_aux holds only boundary cells, whose FE stresses are
+!> Size (the thesis: too small an Omega_aux holds only boundary cells, whose FE stresses are
 !> the poorest; too large a one over-smooths). The caller chooses `depth`. The grid recovery
 !> takes 3 patch sizes (sprc_grid_contact, which gives the measurements: depth h, 2h, 3h, 4h
 !> on the shrink fit and the Hertz cylinder). A fit on Omega_aux that is rank deficient (too

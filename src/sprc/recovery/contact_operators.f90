@@ -1,6 +1,6 @@
-!> Operators of the SPR-C contact constraint (seed eqs. 103-128, with the errata of
-!> eqs. 118, 119 and 127 in DESIGN.md), built generically from the traction operator
-!> G(n) of sprc_recovery_operators, never from the seed's written-out matrices.
+!> Operators of the SPR-C contact constraint (thesis eqs. 103-128, with the errata of
+!> eqs. 118, 119 and 127 in doc/theory.md, section 11), built generically from the traction operator
+!> G(n) of sprc_recovery_operators, never from the thesis's written-out matrices.
 !>
 !> At a contact point of body (1) with outward unit normal n and the frame
 !> R = [n s] (2D) or [n s p] (3D), the traction of a stress sigma in that frame is
@@ -31,7 +31,7 @@
 !> across a contact surface.
 !>
 !> Small deformations: n, s and p are those of the undeformed slave surface (the
-!> seed's deformed normals n^d coincide with them to first order in the displacement
+!> thesis's deformed normals n^d coincide with them to first order in the displacement
 !> gradient, which linear elasticity neglects).
 !>
 !> Coefficient rows (eqs. 128-132): with sigma(x) = P(s(x)) A, A stacked by component

@@ -1,4 +1,4 @@
-!> The coupled SPR-C solve of a contact patch (seed eqs. 129-138): body (1)'s patch and
+!> The coupled SPR-C solve of a contact patch (thesis eqs. 129-138): body (1)'s patch and
 !> the fit of body (2)'s stresses on Omega_aux (sprc_recovery_contact_aux) recovered
 !> together, coupled by the contact law on the patch's contact points.
 !>
@@ -23,7 +23,7 @@
 !> Contact points are the boundary points of patch (1) of kind boundary_contact, with the
 !> law, mu and slip direction given per boundary point (sprc_recovery_contact_operators:
 !> s is the slip of body (1) relative to body (2)). A patch (1) with contact points imposes
-!> contact and no other boundary rows (seed, "contact always wins"). Patch (2) is an
+!> contact and no other boundary rows (the thesis, "contact always wins"). Patch (2) is an
 !> ordinary patch (no contact points), e.g. body (2)'s sampling points in Omega_aux with its
 !> other boundaries' traction points there.
 !>

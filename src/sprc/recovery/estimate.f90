@@ -1,5 +1,5 @@
 !> Evaluation of recovered patch polynomials, the polynomial-union field of an
-!> element (seed eq. 102) and the Zienkiewicz-Zhu element error integral (eq. 1).
+!> element (thesis eq. 102) and the Zienkiewicz-Zhu element error integral (eq. 1).
 !> Mesh-agnostic: the caller supplies points, shape-function values and weights.
 !> All procedures are pure and allocate nothing.
 module sprc_recovery_estimate
@@ -135,7 +135,7 @@ contains
       end if
    end subroutine check_rec
 
-   !> Polynomial union (seed eq. 102) at a point x of an element:
+   !> Polynomial union (thesis eq. 102) at a point x of an element:
    !> sigma*(x) = sum_J shape_values(J) sigma*_J(x), with sigma*_J the recovered polynomial of
    !> the patch of the element's vertex J and shape_values(J) = N_J(x) its (linear) shape
    !> function at x. The nodal interpolation (eq. 101) is the same sum with each sigma*_J
@@ -176,7 +176,7 @@ contains
    end subroutine eval_union
 
    !> ZZ error integral of one element: err2 = sum_i w_i (s*_i - s_h,i)^T D^-1 (s*_i - s_h,i),
-   !> the square of the energy norm of the estimated error (seed eq. 1), with w_i = weight*|J|
+   !> the square of the energy norm of the estimated error (thesis eq. 1), with w_i = weight*|J|
    !> and D^-1 the closed-form compliance of `analysis`. Overflows where the squared norm
    !> does (stresses ~1e154 and more): `zz_error_norm` does not.
    pure subroutine zz_error_integral(analysis, young, poisson, w, sigma_star, sigma_h, err2, error)
@@ -195,7 +195,7 @@ contains
    end subroutine zz_error_integral
 
    !> The energy norm err = sqrt(err2) of `zz_error_integral`, computed without overflow for
-   !> any finite stresses (issue 13: stresses ~1e160 gave NaN): the differences are scaled
+   !> any finite stresses (stresses ~1e160 would overflow to NaN): the differences are scaled
    !> by a power of two before squaring, so the result has the same bits as sqrt(err2)
    !> wherever err2 does not overflow or underflow.
    pure subroutine zz_error_norm(analysis, young, poisson, w, sigma_star, sigma_h, err, error)

@@ -1,7 +1,7 @@
 !> Operator matrices of the SPR-C constraints, built generically from the Voigt
 !> index pairs, the normal / tangent vectors and the coefficient-space derivative
-!> matrices of sprc_core_poly — never from the seed's expanded coefficient lists
-!> (eqs. 52-53, 61, 97 and the symmetry lists have typos, DESIGN.md "Errata").
+!> matrices of sprc_core_poly — never from the thesis's expanded coefficient lists
+!> (eqs. 52-53, 61, 97 and the symmetry lists have typos, doc/theory.md, section 11).
 !>
 !> One rule builds both the traction operator G(n) (eqs. 72-73) and the
 !> equilibrium operator L^T (eq. 33, with the erratum of eq. 39): the i-th
@@ -11,7 +11,7 @@
 !>
 !> Compatibility uses the incompatibility tensor S_ij = e_ikm e_jln eps_kl,mn
 !> (Levi-Civita e): its six components in 3D are the six Saint-Venant equations
-!> (seed eq. 55/57) and S_33 in 2D is eq. 44. Strains come from the stresses by the
+!> (thesis eq. 55/57) and S_33 in 2D is eq. 44. Strains come from the stresses by the
 !> compliance (plane stress, reduced plane strain, or solid), eps = C sigma,
 !> so the operator is L'C (eqs. 45, 56) for every analysis kind.
 !>
@@ -161,7 +161,7 @@ contains
       real(wp), intent(out) :: op(:, :, :)
       integer :: r, i, j, k, l, m, n, nr
       real(wp) :: f, s
-      ! Component (i, j) of S and its factor per equation, in the seed's order and scaling
+      ! Component (i, j) of S and its factor per equation, in the thesis's order and scaling
       ! of eq. 57 (row 1 is S_33, the 2D equation 44; rows 4-6 are -2 S_23, -2 S_13, -2 S_12).
       integer, parameter :: eq57_pairs(2, 6) = reshape([3, 3, 1, 1, 2, 2, 2, 3, 1, 3, 1, 2], [2, 6])
       real(wp), parameter :: eq57_factor(6) = [1.0_wp, 1.0_wp, 1.0_wp, -2.0_wp, -2.0_wp, -2.0_wp]

@@ -95,7 +95,7 @@ module sprc_recovery_patch
       logical :: use_compatibility = .true.
       !> SPR-C: impose boundary constraints (traction / symmetry).
       logical :: use_boundary = .true.
-      !> For SPR-C, if false (the seed's rule), only the boundary kind with the largest
+      !> For SPR-C, if false (the thesis's rule), only the boundary kind with the largest
       !> measure in the patch is imposed (`dominant_boundary_kind`); if true, every kind
       !> present is imposed (dependent rows are dropped by the rank selection).
       logical :: all_boundary_kinds = .false.
@@ -248,7 +248,7 @@ contains
       end do
    end function boundary_measure
 
-   !> The boundary kind SPR-C imposes on a patch (seed, "Formulación del SPR-C"): contact
+   !> The boundary kind SPR-C imposes on a patch (the thesis, "Formulación del SPR-C"): contact
    !> whenever present, otherwise the kind with the largest measure inside the patch (ties:
    !> traction before symmetry); boundary_none if the patch has no boundary points.
    pure integer function dominant_boundary_kind(patch) result(kind)

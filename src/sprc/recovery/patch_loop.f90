@@ -1,6 +1,6 @@
 !> The patch loop of SPR / SPR-C, shared by every producer of patches (the Cartesian grid,
 !> sprc_grid_patches; a caller's mesh, sprc_recovery_mesh). A producer may solve some patches
-!> its own way (`recover`: the grid's contact patches) or skip them (`skip`). Seed eqs. 8-11,
+!> its own way (`recover`: the grid's contact patches) or skip them (`skip`). Thesis eqs. 8-11,
 !> 19-24, 99-100; Figure 15.
 !>
 !> A producer describes its mesh by plain arrays: the node -> element CSR (ne_ptr, ne_list;
@@ -94,9 +94,9 @@ module sprc_recovery_patch_loop
 contains
 
    !> The default patch degree ('auto', every producer): SPR at the FE degree p; SPR-C at
-   !> p + 1 for quadratic elements (measured on Q2 rings: effectivity 1.31, 1.19, 1.06 at p,
-   !> 1.03, 1.03, 1.007 at p + 1, with errors 2-3 times smaller) and at p for linear ones
-   !> (their stresses are too rough for quadratic patches); SPR at p + 1 gets worse.
+   !> p + 1 for quadratic elements (effectivity closer to 1 and errors 2-3 times smaller on
+   !> Q2 rings) and at p for linear ones (their stresses are too rough for quadratic
+   !> patches); SPR at p + 1 gets worse.
    pure integer function auto_degree(sprc, fe_degree)
       logical, intent(in) :: sprc
       integer, intent(in) :: fe_degree

@@ -1,103 +1,39 @@
-!> SPR and SPR-C patch solves (seed eqs. 8-11, 19-24, 35-42, 44-62, 77-80, 88-94, 99-100).
+!> SPR and SPR-C patch solves (the thesis, doc/theory.md, eqs. 8-11, 19-24, 35-42, 44-62,
+!> 77-80, 88-94, 99-100).
 !>
-!> Both fit sigma*(x) = P(s) A, s = (x - x0)/h, with the complete polynomial of degree p
-!> in patch-scaled coordinates (sprc_core_poly's term order).
+!> Both fit sigma*(x) = P(s) A, s = (x - x0)/h, with the complete polynomial of degree p in
+!> patch-scaled coordinates (sprc_core_poly's term order).
 !>
-!> - `recover_spr` (Zienkiewicz-Zhu 1992): unweighted least squares per component at the
-!>   patch's integration points. Solved by QR with column pivoting of the design matrix
-!>   P (npoints x nterms), not by normal equations: the pivoted QR is needed anyway for the
-!>   rank decision, and it solves with cond(P) instead of cond(P)^2, for the same O(m n^2)
-!>   cost; all components are right-hand sides of one factorisation.
-!> - `recover_sprc`: all components at once, integral least squares with the weights w|J|
-!>   (normalised by their sum, which leaves the minimiser unchanged), plus equality
-!>   constraints by Lagrange multipliers:
-!>   (a) internal equilibrium in least-squares form (eq. 42):
-!>       sum_j w_j T'(s_j)^T T'(s_j) A = -h sum_j w_j T'(s_j)^T b, with T'(s) = L^T P(s).
-!>       Because L^T P(s) A = (I_dim x p(s)) B A with B the exact coefficient-space divergence
-!>       built from the derivative matrices, the sums are B^T (I x Mp) B and
-!>       B^T (b x Mp(:,1)) with Mp the one-component Gram matrix: no per-point work.
-!>       (The factor h: derivatives in s are h times physical ones.)
-!>   (b) compatibility for p >= 2, exact: all coefficients of L'C P(s) A vanish (operators
-!>       module), from the compliance (plane stress, reduced plane strain, solid).
-!>   (c) traction equilibrium, least-squares form (eq. 80), only for patches whose node lies on
-!>       the traction boundary: within traction_reach h (0.1) of the tangent plane at the
-!>       nearest traction point. (The seed's boundary patches are those of boundary nodes; on
-!>       a cut grid, the traction rows of a patch whose node is a cell or more away from the
-!>       boundary pin the polynomial far from the node, and measured on Lame / Kirsch / sphere
-!>       FE solutions SPR-C then lost to SPR at several levels; reach 0.2 was worse than 0.1.)
-!>       The same test applies per face (`face_near_node`): a face of the patch on which the
-!>       node does not lie (e.g. the 0.02 h arc a cut corner leaves in a neighbouring cell)
-!>       adds no rows. Such a face's rows pin the polynomial far from the node just the same,
-!>       and with its own full rank (its rows are normalised and rank-decided face by face):
-!>       on a Q2 grid whose traction plane lay on a grid line, a 0.02 h arc of the outer
-!>       circle 3 h away gave 6 more rows, the 29 constraints of the 30 degree-3
-!>       coefficients left the data one degree of freedom, and the patch came out with
-!>       coefficients ~1e3 (Lame Q2 with a plane cut at x = 5 h: theta_sprc 1541 -> 1.24).
-!>       Per boundary face (traction points grouped by piece `bpiece`, and within a piece by
-!>       normal, so box corners give separate faces), E = rows sqrt(bw_j f_j) G(n_j) P(s_j) is
-!>       factored by QR with column pivoting, E Pi = Q R, and eq. 80, E^T E A = E^T t, becomes
-!>       R Pi^T A = Q^T t. The leading rows of R with |R_kk| > traction_rank_tol |R_11|
-!>       (1e-8: a ratio of E, not of the squared E^T E) are kept, at most the rank of the
-!>       rows on a flat face, dim C(p + dim - 1, dim - 1) (`flat_traction_rank`): on a flat
-!>       face the traction of a degree-p field is a degree-p polynomial along it, matched
-!>       whole. On a curved face (normals not all parallel, `face_is_curved`) at most the flat
-!>       rank of degree p - 1: the traction is matched up to degree p - 1 along the face. The
-!>       further rows (pivots of the order of the curvature) would pin a degree-p polynomial
-!>       to the traction of a curved arc and ignore the interior data; rows of E^T E with
-!>       pivots 1e-10 carried their data only to ~1e-6 (round-off amplification). Measured
-!>       on the acceptance studies, the degree p - 1 cap on curved faces lowered err_sprc at
-!>       every level of all five (e.g. Lame Q1 level 4 6.06e-2 -> 5.10e-2, sphere Q1 level 4
-!>       2.69e-2 -> 2.30e-2, Kirsch Q2 level 5 4.83e-3 -> 4.31e-3) and the largest
-!>       boundary-node error (sphere level 4 0.090 -> 0.071, Lame Q2 level 5 0.0073 ->
-!>       0.0048); capping flat faces as well changed nothing measurable, so they keep the
-!>       exact rank.
-!>       The weights f_j = (1 - |x_j - x0|/h)^4 (`traction_focus`, the quartic weight of moving
-!>       least squares, floored at 0.05^4) centre the fit on the node: on a curved face the
-!>       flat-rank rows cannot match the traction everywhere, and the union (eq. 102) uses
-!>       the patch polynomial mostly near its node. Measured on the acceptance studies
-!>       (recovery_study): exponents 0, 1, 2, 3, 4 lowered the largest boundary-node error
-!>       monotonically (sphere octant Q1 level 4: 0.116, 0.107, 0.097, 0.092, 0.090; Lame
-!>       Q2 level 5: 0.0102 ... 0.0073) and err_sprc slightly at every level.
-!>   (d) symmetry, exact: for each symmetry plane of the patch (its symmetry points grouped by
-!>       normal and offset) and each unit tangent t of the plane, n^T sigma*(s) t = 0 at the
-!>       principal lattice of degree p on the plane, which is unisolvent for the degree-p
-!>       restriction of sigma* to the plane, so the shear vanishes on the whole plane.
-!>   Each block's rows are rank-reduced by QR with column pivoting (`qr_pivoted` on the
-!>   transposed rows): rows jpvt(1:r) are kept, r = #{k : |R_kk| > recovery_rank_tol |R_11|}. The kept
-!>   rows of all blocks are stacked, normalised to unit length and reduced once more the same
-!>   way (blocks can depend on each other, e.g. traction and symmetry rows at a corner).
-!>   Constrained least squares: the minimiser of the KKT system [M C^T; C 0][A; lambda] =
-!>   [H; Lambda] (M = I_ns x Mp, H = P^T W sigma) is computed without forming it, by
-!>   orthogonal transformations only (`project_constraints`): with the basis QR
-!>   sqrt(W) P Pi = Q R and z_c = R Pi^T A_c the objective is |z - g|^2, g_c = Q^T sqrt(W)
-!>   sigma_c, and the constraints W z = Lambda with W = C (I x Pi R^-1); a pivoted QR of W^T
-!>   gives the projection of g onto them. This solves with cond(sqrt(W) P) where the KKT
-!>   matrix had cond(P)^2, and without LAPACK (sprc_recovery_dense: the per-call overhead
-!>   and OpenBLAS's lock dominated the small dsysv). Without constraint rows SPR-C is the
-!>   weighted QR least squares (as SPR with weights).
+!> - `recover_spr` (Zienkiewicz-Zhu 1992): least squares per component at the integration
+!>   points, by QR with column pivoting of P (not normal equations: the pivoted QR decides
+!>   the rank anyway and solves with cond(P), not cond(P)^2); components share one factor.
+!> - `recover_sprc` (Rodenas et al. 2007): all components at once, integral least squares
+!>   with weights w|J| (normalised by their sum), plus equality constraints:
+!>   (a) internal equilibrium, least-squares form (eq. 42), formed in coefficient space as
+!>       B^T (I x Mp) B with B the exact divergence: no per-point work;
+!>   (b) compatibility for p >= 2, exact, from the compliance;
+!>   (c) traction equilibrium, least-squares form (eq. 80), only on faces the node lies on
+!>       (within traction_reach h): rows far from the node pin the polynomial away from it.
+!>       Per face, a pivoted QR keeps at most the flat-face rank (degree p), or degree p - 1
+!>       on a curved face, where the further rows would fit the arc and ignore the interior
+!>       data. Rows are weighted (1 - |x - x0|/h)^4 (`traction_focus`) to centre the fit on
+!>       the node, which the union (eq. 102) uses most;
+!>   (d) symmetry, exact: zero shear at a unisolvent lattice on each symmetry plane.
+!>   Each block, then the stacked normalised rows, is rank-reduced by pivoted QR. The KKT
+!>   minimiser is computed by orthogonal transformations only (`project_constraints`):
+!>   cond(sqrt(W) P) instead of the KKT matrix's cond(P)^2, and no LAPACK call overhead.
 !>
-!> Rank tolerance: `recovery_rank_tol` = 1e-10, relative to the largest pivot (traction rows:
-!> traction_rank_tol, see (c)). Exactly dependent
-!> rows and basis columns leave pivots at round-off (~1e-16 relative); a discarded pivot above
-!> `recovery_bite_ratio` = 1e-12 means the tolerance, not exact dependence, decided a rank:
-!> the result reports it (`tolerance_bites`, `max_dropped_ratio`).
+!> Rank: pivots below `recovery_rank_tol` |R_11| are dropped; a dropped pivot above
+!> `recovery_bite_ratio` means the tolerance, not exact dependence, decided a rank, and is
+!> reported (`tolerance_bites`, `max_dropped_ratio`). A basis of rank < nterms returns
+!> stat_singular naming the rank: the producer grows the patch (the thesis, Figure 15) and
+!> calls again; SPR-C needs full rank too, so that M is positive definite.
 !>
-!> Rank-deficient patches (the contract with the producer): if the (weighted) basis matrix at
-!> the integration points has rank < nterms (too few points, or points on a line / plane), the
-!> solves return an error with stat = stat_singular naming the rank, and set
-!> rec%basis_rank. The core has no mesh and cannot grow the patch: the producer adds
-!> neighbouring elements (seed Figure 15) and calls again. SPR-C requires the full rank too,
-!> even where constraints would fix the missing directions, so that its M is positive definite.
+!> Timing (ws%timing): each dense kernel adds its wall time to ws%lapack_seconds and the
+!> flop count of the equivalent LAPACK/BLAS call to ws%flops (design matrix: ws%design_flops).
 !>
-!> Timing (ws%timing): each dense kernel (QR, Q application, triangular solve, the Gram and
-!> equilibrium products) adds its wall time to ws%lapack_seconds and its nominal flop count
-!> (sprc_recovery_flops: that of the LAPACK/BLAS call doing the same, from the sizes) to
-!> ws%flops. Forming the design matrix is counted apart (ws%design_flops); the other loops
-!> (constraint rows, row norms) are not counted.
-!>
-!> Thread safety: no module state; everything a solve writes is in its arguments. Use one
-!> workspace per thread. The solves call no BLAS or LAPACK (sprc_recovery_dense), so they
-!> neither take OpenBLAS's lock nor depend on its thread count.
+!> Thread safety: no module state; one workspace per thread; no BLAS or LAPACK calls, so
+!> no OpenBLAS lock and no dependence on its thread count.
 module sprc_recovery_solve
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular
@@ -122,7 +58,7 @@ module sprc_recovery_solve
    real(wp), parameter :: recovery_rank_tol = 1.0e-10_wp
    !> A discarded pivot above this ratio means the tolerance decided the rank.
    real(wp), parameter :: recovery_bite_ratio = 1.0e-12_wp
-   !> Relative pivot tolerance of the traction rows (QR of the weighted E, module notes).
+   !> Relative pivot tolerance of the traction rows: a ratio of the weighted E, not of E^T E.
    real(wp), parameter :: traction_rank_tol = 1.0e-8_wp
    !> Traction rows only for patches with a traction point within traction_reach h of the node.
    real(wp), parameter :: traction_reach = 0.1_wp
@@ -172,7 +108,7 @@ contains
    !> SPR-C up to its solve: the validated patch's weighted basis QR (ws%qr, ws%jpvt_p, ws%tau_p,
    !> the weights ws%wn) and the rank-selected constraint rows ws%c(1:mc, 1:ws%n) A = ws%lam(1:mc)
    !> of the kinds switched on in `patch`. With contact_by_caller, contact boundary points are
-   !> accepted and add no rows here (a patch with contact imposes contact only, seed): the
+   !> accepted and add no rows here (a patch with contact imposes contact only, as in the thesis): the
    !> coupled contact solve (sprc_recovery_contact_solve) adds them. Errors as recover_sprc.
    subroutine sprc_constraints(patch, degree, ws, rec, mc, contact_by_caller, error)
       type(patch_type), intent(in) :: patch
@@ -506,7 +442,7 @@ contains
             call fatal_error(error, 'recover_sprc: a patch with contact boundary points '// &
                & 'needs the coupled contact solve (recover_sprc_contact)', stat_invalid_input)
          else if (any(patch%bkind(1:patch%nbpoints) == boundary_symmetry)) then
-            ! Contact wins over tractions (seed); a symmetry plane agrees with any contact law
+            ! Contact wins over tractions (the thesis); a symmetry plane agrees with any contact law
             ! (zero shear on the plane), so a contact patch at one keeps it.
             call symmetry_block(patch, ws, rec, mc, error)
          end if

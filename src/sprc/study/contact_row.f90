@@ -1,4 +1,4 @@
-!> The contact columns of a level's report row (SCENE.md "Report") from the
+!> The contact columns of a level's report row (doc/scene.md "The report") from the
 !> level's contact results, and the exact pressure of a contact result.
 !>
 !> Over the slave points i of every pair, with weights w_i (surface measure):

@@ -66,8 +66,8 @@ module sprc_study_partition
 
    !> Quadrature work of a cut cell in units of an inside cell's (whose tensor
    !> rule is only counted, then generated when the points are gathered): the
-   !> ratio of `cell_rule`'s times measured on the 3D sphere octant (5.2 at
-   !> level 6; 2.7 on the 2D Kirsch plate, where cut cells are few).
+   !> ratio of `cell_rule`'s times on the 3D sphere octant, where cut cells
+   !> weigh most (doc/benchmarks.md).
    integer, parameter :: cut_cell_work = 5
 
    interface
