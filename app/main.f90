@@ -25,7 +25,7 @@ program sprc_main
    use sprc_fem_petsc, only: start_ranks
    use sprc_study_partition, only: largest_over_ranks, fail_together
    use sprc_app_cli, only: cli_type, parse_cli, usage_text
-   use sprc_app_progress, only: progress_level, print_contact_progress
+   use sprc_app_progress, only: progress_level, progress_unit, print_contact_progress
    implicit none
 
    type(cli_type) :: cli
@@ -263,6 +263,7 @@ contains
       allocate (rows(study%scene%adapt%max_steps), contact_levels(study%scene%adapt%max_steps))
       eta_name = trim(merge('eta_sprc', 'eta_spr ', study%run(2)))
       call start_adapt(study, start_level, run)
+      progress_unit = 'step'
       n_rows = 0
       do while (.not. run%finished)
          if (run%step < 0) then
