@@ -227,6 +227,9 @@ contains
          if (allocated(error)) then
             if (error%stat /= stat_out_of_memory) return
             memory_message = "body '"//study%bodies(b)%name//"': the next mesh "//error%message
+            ! the estimate's advice is for a uniform level
+            if (index(memory_message, '; use a lower level') > 0) &
+               & memory_message = memory_message(1:index(memory_message, '; use a lower level') - 1)
             deallocate (error)
             exit
          end if
