@@ -12,7 +12,7 @@ module sprc_test_adaptive
    use sprc_io_scene, only: read_scene_text
    use sprc_study_level, only: study_type, prepare_study, run_level, level_type
    use sprc_study_adapt, only: adapt_run_type, start_adapt, adapt_step, adapt_warning, reason_target, &
-      & reason_max_dofs, reason_max_steps
+      & reason_max_dofs, reason_max_steps, reason_max_level
    use sprc_study_row, only: report_row_type
    use sprc_io_report, only: report_header, write_report_csv, read_report_csv, report_table
    use sprc_testsuite, only: unittest_type, new_unittest, check
@@ -34,6 +34,7 @@ contains
          new_unittest('fraction_converges', test_fraction), &
          new_unittest('max_dofs_stops', test_max_dofs), &
          new_unittest('max_steps_stops', test_max_steps), &
+         new_unittest('max_level_stops', test_max_level), &
          new_unittest('sphere_3d_runs', test_sphere), &
          new_unittest('contact_adapts_both_bodies', test_contact), &
          new_unittest('same_bits_1_2_threads', test_threads), &
@@ -216,6 +217,18 @@ contains
       if (allocated(error)) return
       call check(error, run%best_eta == minval(rows%eta_sprc), 'best eta is the smallest')
    end subroutine test_max_steps
+
+   !> max_level: once every cell the estimate would refine stands at it, the
+   !> run stops (uniform level 4 everywhere, for a target far below its error).
+   subroutine test_max_level(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(report_row_type), allocatable :: rows(:)
+      type(adapt_run_type) :: run
+      call run_adaptive(kirsch_text(1, 3, '&adapt target=0.001 max_level=4 /'), rows, run, error)
+      if (allocated(error)) return
+      call check(error, run%reason == reason_max_level .and. run%capped > 0 .and. all(rows%level <= 4), &
+         & 'stopped by max_level with cells held back, not: '//run%reason)
+   end subroutine test_max_level
 
    !> The Lame sphere octant (3D) from level 2: one adapted step refines
    !> where the estimate is, and the error falls.

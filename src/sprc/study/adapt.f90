@@ -24,8 +24,9 @@
 !> cell); a prediction over `max_dofs`, or over the memory budget
 !> (sprc_study_budget, on any rank), ends the run before the step; so do
 !> `max_steps` analyses, and a size field that asks for the mesh already
-!> there (`max_level` when a leaf stands at it). A run ended by a limit is
-!> not an error: `reason` names the limit, `best_eta` the best estimate.
+!> there (`max_level` when cells wanted to be finer than it). A run ended
+!> by a limit is not an error: `reason` names the limit, `best_eta` the best
+!> estimate; the warning also counts the cells `max_level` held back.
 !>
 !> The iterative solver's start: every step starts from the previous step's
 !> displacement evaluated at the new nodes (sprc_fem_nested's `values_at`,
@@ -40,6 +41,7 @@ module sprc_study_adapt
    use sprc_core_timer, only: wall_time
    use sprc_core_text, only: itoa, real_text
    use sprc_grid_adapt, only: optimal_levels, fraction_levels
+   use sprc_grid_tree, only: grid_max_level
    use sprc_study_level, only: study_type, level_type, run_level, hold_starts, mesh_source_type, finest_cells
    use sprc_study_budget, only: check_level_memory
    use sprc_study_partition, only: largest_over_ranks
@@ -74,6 +76,8 @@ module sprc_study_adapt
       type(fe_displacement_type), allocatable :: starts(:)
       !> Seconds of the size field of the next step.
       real(wp) :: t_adapt = 0.0_wp
+      !> Cells of the last size field that wanted to be finer than `max_level`.
+      integer :: capped = 0
    end type adapt_run_type
 
 contains
@@ -166,7 +170,7 @@ contains
       type(adapt_run_type), intent(inout) :: run
       type(level_type), intent(in) :: result
       type(error_type), allocatable, intent(out) :: error
-      integer, allocatable :: leaf_level(:), levels(:)
+      integer, allocatable :: leaf_level(:), levels(:), free(:)
       real(wp), allocatable :: err_sq(:), dofs(:)
       real(wp) :: norm_sq, out_of_memory
       integer :: b, m, n, k, nb
@@ -190,15 +194,16 @@ contains
          end associate
       end do
       associate (a => study%scene%adapt)
-         if (a%strategy == 'fraction') then
-            call fraction_levels(leaf_level, err_sq, a%fraction, a%max_level, levels, error)
-         else
-            call optimal_levels(leaf_level, err_sq, norm_sq, a%target, study%order, study%dim, a%max_level, levels, &
-               & error)
+         call wanted_levels(study, leaf_level, err_sq, norm_sq, a%max_level, levels, error)
+         ! The cells that max_level holds back: the levels wanted without it.
+         run%capped = 0
+         if (.not. allocated(error) .and. a%max_level < grid_max_level) then
+            call wanted_levels(study, leaf_level, err_sq, norm_sq, grid_max_level, free, error)
+            if (.not. allocated(error)) run%capped = count(free > a%max_level)
          end if
          if (allocated(error)) return
          if (all(levels == leaf_level)) then
-            if (any(leaf_level >= a%max_level)) then
+            if (run%capped > 0) then
                call finish(run, reason_max_level, 'max_level = '//itoa(a%max_level)//': the cells the estimate '// &
                   & 'would refine stand at it')
             else
@@ -258,6 +263,23 @@ contains
       run%next_dofs = sum(dofs)
    end subroutine next_meshes
 
+   !> The level wanted per leaf by the scene's strategy, at most `max_level`.
+   subroutine wanted_levels(study, leaf_level, err_sq, norm_sq, max_level, levels, error)
+      type(study_type), intent(in) :: study
+      integer, intent(in) :: leaf_level(:), max_level
+      real(wp), intent(in) :: err_sq(:), norm_sq
+      integer, allocatable, intent(out) :: levels(:)
+      type(error_type), allocatable, intent(out) :: error
+      associate (a => study%scene%adapt)
+         if (a%strategy == 'fraction') then
+            call fraction_levels(leaf_level, err_sq, a%fraction, max_level, levels, error)
+         else
+            call optimal_levels(leaf_level, err_sq, norm_sq, a%target, study%order, study%dim, max_level, levels, &
+               & error)
+         end if
+      end associate
+   end subroutine wanted_levels
+
    !> The warning of a run that a limit ended (empty when it reached its target):
    !> the limit and the best eta, e.g. "adaptive run stopped by max_steps = 10
    !> analyses before eta_sprc <= 1e-3; best eta_sprc = 2.1e-3 at step 9 (the
@@ -277,6 +299,8 @@ contains
       text = 'adaptive run stopped by '//run%reason//' ('//run%detail//') before '//eta//' <= '// &
          & real_text(study%scene%adapt%target)//'; best '//eta//' = '//trim(adjustl(best))//' at step '// &
          & itoa(run%best_step)//' (the last row of the report is step '//itoa(run%step)//')'
+      if (run%capped > 0 .and. run%reason /= reason_max_level) text = text//'; '//itoa(run%capped)// &
+         & ' cells wanted to be finer than max_level = '//itoa(study%scene%adapt%max_level)
    end function adapt_warning
 
 end module sprc_study_adapt
