@@ -557,24 +557,36 @@ contains
 
    ! ---------------------------------------------------------------- &exact
 
-   subroutine read_exact(groups, scene, error)
-      type(nml_group_type), intent(inout) :: groups(:)
-      type(scene_type), intent(inout) :: scene
+   !> The index of the one group `name` (0 when there is none); a second one
+   !> is an error, `rule` saying why ('at most one exact solution').
+   subroutine optional_group(groups, name, rule, ig, error)
+      type(nml_group_type), intent(in) :: groups(:)
+      character(len=*), intent(in) :: name, rule
+      integer, intent(out) :: ig
       type(error_type), allocatable, intent(out) :: error
-      integer :: ig, i
-      logical :: found
+      integer :: i
 
       ig = 0
       do i = 1, size(groups)
-         if (groups(i)%name /= 'exact') cycle
+         if (groups(i)%name /= name) cycle
          if (ig > 0) then
-            call nml_group_error(groups(i), 'a second &exact group (the first is on line '// &
-               & itoa(groups(ig)%line)//'): at most one exact solution', error)
+            call nml_group_error(groups(i), 'a second &'//name//' group (the first is on line '// &
+               & itoa(groups(ig)%line)//'): '//rule, error)
             return
          end if
          ig = i
       end do
-      if (ig == 0) return
+   end subroutine optional_group
+
+   subroutine read_exact(groups, scene, error)
+      type(nml_group_type), intent(inout) :: groups(:)
+      type(scene_type), intent(inout) :: scene
+      type(error_type), allocatable, intent(out) :: error
+      integer :: ig
+      logical :: found
+
+      call optional_group(groups, 'exact', 'at most one exact solution', ig, error)
+      if (allocated(error) .or. ig == 0) return
       associate (g => groups(ig), exact => scene%exact)
          call check_keys(g, exact_keys, error)
          if (allocated(error)) return
@@ -618,20 +630,11 @@ contains
       type(nml_group_type), intent(inout) :: groups(:)
       type(scene_type), intent(inout) :: scene
       type(error_type), allocatable, intent(out) :: error
-      integer :: ig, i
+      integer :: ig
       logical :: found
 
-      ig = 0
-      do i = 1, size(groups)
-         if (groups(i)%name /= 'adapt') cycle
-         if (ig > 0) then
-            call nml_group_error(groups(i), 'a second &adapt group (the first is on line '// &
-               & itoa(groups(ig)%line)//'): at most one', error)
-            return
-         end if
-         ig = i
-      end do
-      if (ig == 0) return
+      call optional_group(groups, 'adapt', 'at most one', ig, error)
+      if (allocated(error) .or. ig == 0) return
       associate (g => groups(ig), a => scene%adapt)
          call check_keys(g, adapt_keys, error)
          if (allocated(error)) return
