@@ -14,6 +14,7 @@ program sprc_unit_tests
    use sprc_test_scene, only: collect_scene
    use sprc_test_geometry, only: collect_geometry
    use sprc_test_grid, only: collect_grid
+   use sprc_test_adapt, only: collect_adapt
    use sprc_test_model, only: collect_model
    use sprc_test_quadrature, only: collect_quadrature
    use sprc_test_recovery, only: collect_recovery
@@ -48,6 +49,7 @@ program sprc_unit_tests
       new_testsuite('scene', collect_scene), &
       new_testsuite('geometry', collect_geometry), &
       new_testsuite('grid', collect_grid), &
+      new_testsuite('adapt', collect_adapt), &
       new_testsuite('model', collect_model), &
       new_testsuite('quadrature', collect_quadrature), &
       new_testsuite('recovery', collect_recovery), &

@@ -133,7 +133,7 @@ contains
       root = 0
       root_class = classify(b, region, 0, root)
       call descend(b, region, 0, root, root_class)
-      call complete(self, b, region, error)
+      call complete(self, b, region, .false., error)
       self%refine_boundary = refine_boundary
    end subroutine grid_build
 
@@ -166,17 +166,19 @@ contains
       root_class = classify(b, region, 0, root)
       call descend(b, region, 0, root, root_class, old, target)
       if (b%n > 0) b%level = minval(b%lev(1:b%n))
-      call complete(self, b, region, error)
+      call complete(self, b, region, .true., error)
       if (allocated(error)) return
       self%refine_boundary = self%max_level - self%level
    end subroutine grid_build_adapted
 
-   !> After the descent: 2:1 balance (levels above b%level, the coarsest leaf
-   !> level), external counts folded to b%level, the leaves sorted into `self`.
-   subroutine complete(self, b, region, error)
+   !> After the descent: 2:1 balance (levels above b%level, no leaf being coarser),
+   !> with `coarsest` b%level raised to the coarsest leaf level left by the balance,
+   !> external counts folded to b%level, the leaves sorted into `self`.
+   subroutine complete(self, b, region, coarsest, error)
       type(grid_type), intent(inout) :: self
       type(builder_type), intent(inout) :: b
       class(region_type), intent(in) :: region
+      logical, intent(in) :: coarsest
       type(error_type), allocatable, intent(out) :: error
       integer :: l
 
@@ -190,6 +192,7 @@ contains
             & 'cell_inside or cell_cut', stat_invalid_input)
          return
       end if
+      if (coarsest .and. any(b%alive(1:b%n))) b%level = minval(b%lev(1:b%n), mask=b%alive(1:b%n))
       ! External cells coarser than the uniform level count as the cells of that level they cover.
       do l = 0, b%level - 1
          b%n_outside(b%level) = b%n_outside(b%level) + b%n_outside(l)*ishft(1_i8, b%dim*(b%level - l))
