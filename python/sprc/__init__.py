@@ -28,7 +28,8 @@ __all__ = ["__version__", "SprcError", "get_version", "run_scene", "run", "Study
 __version__ = "0.1.0"
 
 #: Report columns that hold integers (returned as int; every other column is float).
-INTEGER_COLUMNS = frozenset({"level", "elements", "cut_elements", "dofs", "contact_iterations", "solver_iterations"})
+INTEGER_COLUMNS = frozenset({"level", "elements", "cut_elements", "dofs", "contact_iterations", "solver_iterations",
+                             "step"})
 
 
 def get_version():
@@ -41,7 +42,8 @@ def run_scene(path, levels=None, threads=None):
     """Run the study of the scene file ``path`` (SCENE.md) and return its
     report: one dict per level, keyed by the report's columns in the order
     of its CSV header (``level, h, elements, ..., theta_sprc``, the contact
-    columns in a study with contact, ``solver_iterations``). Integer
+    columns in a study with contact, ``solver_iterations``, and ``step``,
+    ``t_adapt`` in an adaptive study: one dict per step). Integer
     columns are ``int``, the others ``float``; a cell that does not apply is
     ``None``. ``levels`` (an int or a sequence of ints) overrides the
     scene's levels; ``threads`` (a positive int) runs every level on that

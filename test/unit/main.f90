@@ -25,6 +25,7 @@ program sprc_unit_tests
    use sprc_test_mesh_recovery, only: collect_mesh_recovery
    use sprc_test_stiff, only: collect_stiff
    use sprc_test_study, only: collect_study
+   use sprc_test_adaptive, only: collect_adaptive
    use sprc_test_contact_model, only: collect_contact_model
    use sprc_test_contact_output, only: collect_contact_output
    use sprc_test_contact_fe, only: collect_contact_fe
@@ -60,6 +61,7 @@ program sprc_unit_tests
       new_testsuite('mesh_recovery', collect_mesh_recovery), &
       new_testsuite('stiff', collect_stiff), &
       new_testsuite('study', collect_study), &
+      new_testsuite('adaptive', collect_adaptive), &
       new_testsuite('contact_model', collect_contact_model), &
       new_testsuite('contact_output', collect_contact_output), &
       new_testsuite('contact_fe', collect_contact_fe), &

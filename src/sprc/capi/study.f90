@@ -13,7 +13,8 @@ module sprc_capi_study
    use sprc_io_fields, only: level_fields_type, grid_fields_type, field_array_type, level_fields
    use sprc_study_mesh, only: study_levels
    use sprc_study_level, only: study_type, prepare_study, run_level, level_type, hold_starts
-   use sprc_study_threads, only: level_threads
+   use sprc_study_threads, only: level_threads, serial_dofs
+   use sprc_study_adapt, only: adapt_run_type, start_adapt, adapt_step
    use sprc_fem_nested, only: fe_displacement_type
    use sprc_study_row, only: report_row_type
    use sprc_capi_error, only: capi_error_type, get_capi_error, set_capi_error
@@ -206,6 +207,12 @@ contains
          call study_levels(scene, levels=levels, error=error)
       end if
       if (allocated(error)) return
+      if (scene%adapt%present) then
+         call prepare_study(scene, 0, study, error)
+         if (.not. allocated(error)) call run_steps(study, levels(1), threads, available, fields, rows, error, keep, &
+            & kept, kept_fields)
+         return
+      end if
       allocate (kept(size(levels)), kept_fields(size(levels)))
       kept = fields
       if (fields .and. present(keep)) then
@@ -236,6 +243,62 @@ contains
          if (allocated(error)) return
       end do
    end subroutine run_levels
+
+   !> The adaptive study (`&adapt`) from `start_level`: one row per step; with
+   !> `fields`, the fields of the steps in `keep` (step numbers, 0 the start
+   !> mesh; absent: every step). A step in `keep` that the run did not reach
+   !> is an error once the run has ended (the steps are not known before).
+   subroutine run_steps(study, start_level, threads, available, fields, rows, error, keep, kept, kept_fields)
+      type(study_type), intent(in) :: study
+      integer, intent(in) :: start_level, threads, available
+      logical, intent(in) :: fields
+      type(report_row_type), allocatable, intent(out) :: rows(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer, intent(in), optional :: keep(:)
+      logical, allocatable, intent(out) :: kept(:)
+      type(level_fields_type), allocatable, intent(out) :: kept_fields(:)
+      type(adapt_run_type) :: run
+      type(level_type) :: result
+      type(report_row_type), allocatable :: step_rows(:)
+      type(level_fields_type), allocatable :: all_fields(:)
+      logical, allocatable :: all_kept(:)
+      integer :: m, s, n
+
+      m = study%scene%adapt%max_steps
+      allocate (step_rows(m), all_fields(m), all_kept(m))
+      call start_adapt(study, start_level, run)
+      do while (.not. run%finished)
+         if (run%step < 0) then
+            n = level_threads(study, start_level, threads, available, error)
+            if (allocated(error)) return
+         else
+            n = threads
+            if (n <= 0) n = merge(1, max(1, available), run%next_dofs < serial_dofs)
+         end if
+         !$ call omp_set_num_threads(n)
+         call adapt_step(study, run, result, error)
+         if (allocated(error)) return
+         s = run%step + 1
+         step_rows(s) = result%row
+         all_kept(s) = fields
+         if (fields .and. present(keep)) all_kept(s) = any(keep == run%step)
+         if (all_kept(s)) call level_fields(study, result, all_fields(s), error)
+         if (allocated(error)) return
+      end do
+      n = run%step + 1
+      if (fields .and. present(keep)) then
+         do s = 1, size(keep)
+            if (keep(s) < 0 .or. keep(s) >= n) then
+               call fatal_error(error, 'keep: step '//itoa(keep(s))//' is not one of the steps run (0 to '// &
+                  & itoa(n - 1)//')', stat_invalid_input)
+               return
+            end if
+         end do
+      end if
+      rows = step_rows(:n)
+      kept = all_kept(:n)
+      kept_fields = all_fields(:n)
+   end subroutine run_steps
 
    function level_list(levels) result(s)
       integer, intent(in) :: levels(:)

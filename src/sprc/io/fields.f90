@@ -22,6 +22,8 @@
 !> slave normal `normal` (dim).
 !> Values in the scene's units (the analysis ran in `units`); an empty value
 !> (not computed) is NaN. Each field carries its units in words (`units`).
+!> An adaptive study (`&adapt`) writes each step under `/level_SS/`, SS the
+!> step (0 the start mesh), not a level (the steps' finest levels repeat).
 module sprc_io_fields
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type
@@ -80,19 +82,23 @@ module sprc_io_fields
 
 contains
 
-   !> Write every body and contact pair of `result` (a level of `study`) into `h5`.
-   subroutine write_level_fields(h5, study, result, error)
+   !> Write every body and contact pair of `result` (a level of `study`) into `h5`;
+   !> with `step` (an adaptive study's step), under that number instead of the level.
+   subroutine write_level_fields(h5, study, result, error, step)
       type(h5_output_type), intent(inout) :: h5
       type(study_type), intent(in) :: study
       type(level_type), intent(in) :: result
       type(error_type), allocatable, intent(out) :: error
+      integer, intent(in), optional :: step
       type(level_fields_type) :: fields
-      integer :: g
+      integer :: g, key
 
       call level_fields(study, result, fields, error)
       if (allocated(error)) return
+      key = fields%level
+      if (present(step)) key = step
       do g = 1, size(fields%grids)
-         call write_grid_fields(h5, fields%level, fields%grids(g), error)
+         call write_grid_fields(h5, key, fields%grids(g), error)
          if (allocated(error)) return
       end do
    end subroutine write_level_fields
