@@ -47,6 +47,23 @@
 !> is that of its cell, p = -n_i.lambda_c (0 open); `ts_fe` the magnitude of
 !> the tangential part of lambda_c (0 frictionless).
 !>
+!> Constant in the surface's frame, not in Cartesian components. The
+!> frictionless multiplier is a scalar: its traction lambda_c n_i turns with
+!> the surface. The vector multiplier of stick and Coulomb is constant in the
+!> same sense: at point i it is R_i lambda_c, R_i the least rotation carrying
+!> the cell's mean normal nbar to the point's normal n_i (`frame_rotation`),
+!> so lambda_c.nbar is the pressure and its part normal to nbar the shear,
+!> each constant over the cell as the frictionless pressure is. Every point
+!> operator (gap, traction, the recovered traction p*) enters the cell's
+!> means rotated back by R_i^T, and the formulation below is unchanged. A
+!> Cartesian constant instead cannot carry a uniform pressure on a curved
+!> surface: the traction p n_i of a cell of angle h/R has a tangential part
+!> varying by p h/R across the cell, which the constant misses; the
+!> interface then carries a spurious shear of size p h/R, harmless at Q1
+!> (O(h) like the discretization) but a consistency error of order h^(3/2)
+!> in energy at Q2 (a shrink fit with stick converged at rate 1.5 with the
+!> estimate seeing half the error, where frictionless converged at 2).
+!>
 !> kappa. gamma = kappa E_s/h (SCENE.md: effective stiffness kappa E/h), with
 !> E_s the slave body's Young's modulus and h the smallest edge of the slave
 !> cell (of its aggregate's root). The block system is SPD when gamma exceeds
@@ -196,6 +213,10 @@ module sprc_contact_solve
       real(wp), allocatable :: gbar(:, :), g0bar(:), tbar(:, :)
       !> Per point: the traction operator minus its mean, (rows, nu, npoints), and the weights.
       real(wp), allocatable :: tdev(:, :, :), w(:)
+      !> Per point (stick): the rotation R_i (dim, dim, npoints) carrying the
+      !> cell frame to the point's, R_i nbar = n_i; the multiplier at the
+      !> point is R_i lambda_c (module notes).
+      real(wp), allocatable :: rot(:, :, :)
    end type cell_operators_type
 
    !> One point's operators of both bodies while they are built.
@@ -606,7 +627,7 @@ contains
       integer, allocatable :: pos(:)
       real(wp), allocatable :: g(:, :)
       integer :: j, i, q, q0, q1, np, d, stat
-      real(wp) :: nrm(surface%dim)
+      real(wp) :: nrm(surface%dim), rt(surface%dim, surface%dim), npt(surface%dim, ops%cell_ptr(c + 1) - ops%cell_ptr(c))
 
       d = surface%dim
       np = ops%cell_ptr(c + 1) - ops%cell_ptr(c)
@@ -622,9 +643,18 @@ contains
       end do
       cell%nu = size(cell%dofs)
       allocate (cell%gbar(cell%rows, cell%nu), cell%tbar(cell%rows, cell%nu), cell%g0bar(cell%rows), &
-         & cell%tdev(cell%rows, cell%nu, np), cell%w(np), g(cell%rows, cell%nu), stat=stat)
-      call check_allocation(stat, 'contact cell '//itoa(c), 'its operators', cell%rows*cell%nu*(np + 3), 8, error)
+         & cell%tdev(cell%rows, cell%nu, np), cell%w(np), g(cell%rows, cell%nu), cell%rot(d, d, np), stat=stat)
+      call check_allocation(stat, 'contact cell '//itoa(c), 'its operators', cell%rows*cell%nu*(np + 3) + d*d*np, &
+         & 8, error)
       if (allocated(error)) return
+      associate (pts => ops%cell_point(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1))
+         cell%w = surface%weight(pts)
+         do j = 1, np
+            npt(:, j) = contact_normal(surface, pts(j), friction)
+         end do
+         cell%nbar = matmul(npt, cell%w)
+         cell%nbar = cell%nbar/norm2(cell%nbar)
+      end associate
       cell%gbar = 0.0_wp
       cell%tbar = 0.0_wp
       cell%g0bar = 0.0_wp
@@ -634,31 +664,24 @@ contains
          q0 = ops%ptr(i)
          q1 = ops%ptr(i + 1) - 1
          nrm = surface%normal(:, i)
+         cell%rot(:, :, j) = frame_rotation(cell%nbar, npt(:, j))
          pos = [(findloc(cell%dofs, ops%dofs(q), 1), q = q0, q1)]
          g = 0.0_wp
          if (friction == friction_stick) then
-            g(:, pos) = ops%gop(:, q0:q1)
-            cell%tdev(:, pos, j) = ops%top(:, q0:q1)
+            rt = transpose(cell%rot(:, :, j))
+            g(:, pos) = matmul(rt, ops%gop(:, q0:q1))
+            cell%tdev(:, pos, j) = matmul(rt, ops%top(:, q0:q1))
             cell%g0bar = cell%g0bar + surface%weight(i)*surface%g0(i)*dot_product(nrm, surface%master_normal(:, i))* &
-               & surface%master_normal(:, i)
+               & matmul(rt, surface%master_normal(:, i))
          else
             g(1, pos) = matmul(nrm, ops%gop(:, q0:q1))
             cell%tdev(1, pos, j) = matmul(nrm, ops%top(:, q0:q1))
             cell%g0bar = cell%g0bar + surface%weight(i)*surface%g0(i)
          end if
-         cell%w(j) = surface%weight(i)
          cell%gbar = cell%gbar + surface%weight(i)*g
          cell%tbar = cell%tbar + surface%weight(i)*cell%tdev(:, :, j)
       end do
       cell%measure = sum(cell%w)
-      associate (pts => ops%cell_point(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1))
-         if (friction == friction_stick) then
-            cell%nbar = matmul(surface%normal(:, pts) - surface%master_normal(:, pts), cell%w)
-         else
-            cell%nbar = matmul(surface%normal(:, pts), cell%w)
-         end if
-      end associate
-      cell%nbar = cell%nbar/norm2(cell%nbar)
       cell%gbar = cell%gbar/cell%measure
       cell%tbar = cell%tbar/cell%measure
       cell%g0bar = cell%g0bar/cell%measure
@@ -666,6 +689,38 @@ contains
          cell%tdev(:, :, j) = cell%tdev(:, :, j) - cell%tbar
       end do
    end subroutine cell_operators
+
+   !> The unit contact normal of point i: the slave normal (frictionless) or
+   !> the bisector n_s - n_m of both surfaces' normals (stick and Coulomb:
+   !> the contact plane, the same whichever body is the slave).
+   pure function contact_normal(surface, i, friction) result(n)
+      type(contact_surface_type), intent(in) :: surface
+      integer, intent(in) :: i, friction
+      real(wp) :: n(surface%dim)
+      if (friction == friction_stick) then
+         n = surface%normal(:, i) - surface%master_normal(:, i)
+         n = n/norm2(n)
+      else
+         n = surface%normal(:, i)
+      end if
+   end function contact_normal
+
+   !> The rotation R in the plane of the unit vectors a and b that carries a
+   !> to b (identity on the complement; 2D and 3D alike):
+   !>   R = I - (a + b)(a + b)^T/(1 + a.b) + 2 b a^T.
+   !> Its columns move the cell frame to a point's by the least rotation, so
+   !> that a multiplier R_i lambda_c keeps its normal and tangential parts
+   !> along the curved surface (module notes).
+   pure function frame_rotation(a, b) result(r)
+      real(wp), intent(in) :: a(:), b(:)
+      real(wp) :: r(size(a), size(a))
+      integer :: k
+      r = 2.0_wp*spread(b, 2, size(a))*spread(a, 1, size(a)) &
+         & - spread(a + b, 2, size(a))*spread(a + b, 1, size(a))/(1.0_wp + dot_product(a, b))
+      do k = 1, size(a)
+         r(k, k) = r(k, k) + 1.0_wp
+      end do
+   end function frame_rotation
 
    !> Reduced operators of `problem` at x in element e: dofs(1:m), the
    !> displacement n(dim, m) and the traction sigma(u) nrm, t(dim, m).
@@ -1081,7 +1136,7 @@ contains
             if (state(c) == contact_open) cycle
             sol%pressure(i) = -lam_n
             if (state(c) == contact_slip) lam_t = -mu*lam_n*tau(:, c)
-            sol%traction_t(:, i) = lam_t
+            sol%traction_t(:, i) = matmul(cells(c)%rot(:, :, j - ops%cell_ptr(c) + 1), lam_t)
             sol%tangential(i) = norm2(lam_t)
          end do
       end do
@@ -1205,7 +1260,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       !> The cells' mean stabilization tractions (recovered stabilization).
       real(wp), intent(in), optional :: pstar(:, :)
-      real(wp) :: lam(surface%dim), nrm(surface%dim)
+      real(wp) :: lam(surface%dim), lami(surface%dim), nrm(surface%dim)
       integer :: i, c, j
 
       call point_gaps(surface, ops, size(cells), x, sol, error)
@@ -1231,8 +1286,9 @@ contains
                if (cell%rows == 1) then
                   sol%pressure(i) = -lam(1)
                else
-                  sol%pressure(i) = -dot_product(lam, nrm)
-                  sol%traction_t(:, i) = lam - dot_product(lam, nrm)*nrm
+                  lami = matmul(cell%rot(:, :, j), lam)
+                  sol%pressure(i) = -dot_product(lami, nrm)
+                  sol%traction_t(:, i) = lami - dot_product(lami, nrm)*nrm
                   sol%tangential(i) = norm2(sol%traction_t(:, i))
                end if
             end do
@@ -1289,7 +1345,8 @@ contains
             if (cells(c)%rows == 1) then
                pstar(1, c) = pstar(1, c) + surface%weight(i)*dot_product(surface%normal(:, i), recovered(:, i))
             else
-               pstar(:, c) = pstar(:, c) + surface%weight(i)*recovered(:, i)
+               pstar(:, c) = pstar(:, c) + surface%weight(i)* &
+                  & matmul(transpose(cells(c)%rot(:, :, j - ops%cell_ptr(c) + 1)), recovered(:, i))
             end if
          end do
          pstar(:, c) = pstar(:, c)/cells(c)%measure
