@@ -29,7 +29,11 @@
 !> spanning at least two master cells (a shaft slave on a grid half the size
 !> of a soft hub's pressure alternated by 5 % from cell to cell). The price:
 !> the open/closed boundary is resolved to a contact cell, two slave cells
-!> (or two master cells). The multiplier is
+!> (or two master cells). A contact cell turns at most a quarter turn (its
+!> normals within 45 degrees of its mean normal; else its roots go one
+!> ancestor level down, to single roots at the least): on a coarse grid the
+!> ancestor of a ring's cells can be the whole ring, whose mean gap holds
+!> neither a translation nor the rotation (`turns_too_far`). The multiplier is
 !> eliminated cell by cell: stationarity in lambda_c gives
 !>   lambda_c = pbar + gamma gbar,
 !> with pbar, gbar the means over the cell's points of p_N and g, and the
@@ -86,9 +90,10 @@
 !> element matrix.
 !>
 !> Active set (primal-dual / semi-smooth Newton), per contact cell. First
-!> active set: the cells with a point with g0 <= h (one slave cell: touching
-!> and near surfaces, every cell of an interference fit); this holds a
-!> load-controlled body from the start. Each iteration assembles and
+!> active set: the cells with a point with g0 <= h, h the smallest edge of
+!> the slave root cell of the cell's first point (one slave cell: touching
+!> and near surfaces, every cell of a fit with or without interference);
+!> this holds a load-controlled body from the start. Each iteration assembles and
 !> factorizes the block system once (CHOLMOD; UMFPACK if CHOLMOD finds it not
 !> positive definite), solves, and takes as the next set the cells with
 !> nbar.lambda_c < 0 (nbar the cell's mean normal). The iteration ends when
@@ -187,6 +192,10 @@ module sprc_contact_solve
    !> A slip direction counts as settled when it moves by less than this
    !> between iterations (unit vectors; in 2D it only flips).
    real(wp), parameter :: direction_tol = 1.0e-8_wp
+   !> A contact cell's normals stay within 45 degrees of its mean normal
+   !> (`turns_too_far`): cos 45 degrees, less a round-off margin so that an
+   !> exact quarter turn (a quarter model's one cell) stays one cell.
+   real(wp), parameter :: cos_max_turn = sqrt(0.5_wp) - 1.0e-12_wp
 
    !> The contact operators of the points with a master point (local dofs in
    !> the block numbering, gap and traction operators) and their contact cells.
@@ -374,7 +383,8 @@ contains
          else
             call block_system(slave, master, ops, cells, closed, k, f, error)
          end if
-         if (.not. (allocated(error) .or. kept)) call check_held(slave, master, k, names, count(closed), it, error)
+         if (.not. (allocated(error) .or. kept)) &
+            & call check_held(slave, master, k, names, closed_points(ops, closed), it, error)
          if (.not. (allocated(error) .or. kept)) call solve_block(k, f, x, sol, error)
          call timer%stop()
          sol%t_solve = sol%t_solve + timer%elapsed
@@ -407,6 +417,13 @@ contains
       call slave%set_solution(x(1:slave%n_dofs()), error)
       if (.not. allocated(error)) call master%set_solution(x(slave%n_dofs() + 1:), error)
    end subroutine solve_contact_pair
+
+   !> The points of the closed contact cells.
+   pure integer function closed_points(ops, closed)
+      type(point_operators_type), intent(in) :: ops
+      logical, intent(in) :: closed(:)
+      closed_points = sum(ops%cell_ptr(2:) - ops%cell_ptr(:size(closed)), mask=closed)
+   end function closed_points
 
    pure real(wp) function cell_size(problem, e)
       type(elasticity_problem_type), intent(in) :: problem
@@ -580,17 +597,18 @@ contains
    !> macro(e): the representative of slave root e's contact macro cell, the
    !> first root of the contact (in leaf order) with the same ancestor `shift`
    !> levels up: the parent (shift 1), or the ancestor at least twice as large
-   !> as the master cells of the root's points (module notes).
+   !> as the master cells of the root's points (module notes). A macro cell
+   !> whose surface turns too far (`turns_too_far`) goes one level down for
+   !> all its roots, to the roots themselves at the least.
    subroutine macro_cells(surface, slave, master, macro)
       type(contact_surface_type), intent(in) :: surface
       type(elasticity_problem_type), intent(in) :: slave, master
       integer, intent(out) :: macro(:)
       integer, allocatable :: roots(:)
-      logical :: used(size(macro))
+      logical :: used(size(macro)), wide(size(macro))
       integer :: shift(size(macro))
-      integer :: i, j, e, d, r
+      integer :: i, e, r
 
-      d = surface%dim
       used = .false.
       shift = 1
       do i = 1, surface%npoint
@@ -601,6 +619,25 @@ contains
             & cell_size(slave, r))/log(2.0_wp) - 1.0e-6_wp)))
       end do
       roots = pack([(e, e=1, size(macro))], used)
+      do
+         call group_roots(slave, surface%dim, roots, shift, macro)
+         call turns_too_far(surface, slave, macro, wide)
+         wide = wide .and. shift > 0
+         if (.not. any(wide(roots))) exit
+         do i = 1, size(roots)
+            if (wide(macro(roots(i)))) shift(roots(i)) = shift(roots(i)) - 1
+         end do
+      end do
+   end subroutine macro_cells
+
+   !> macro(e) for the roots `roots` with their ancestor shifts: the first
+   !> root with the same level, shift and ancestor (e itself elsewhere).
+   subroutine group_roots(slave, d, roots, shift, macro)
+      type(elasticity_problem_type), intent(in) :: slave
+      integer, intent(in) :: d, roots(:), shift(:)
+      integer, intent(out) :: macro(:)
+      integer :: i, j, e
+
       macro = [(e, e=1, size(macro))]
       do i = 1, size(roots)
          do j = 1, i - 1
@@ -613,7 +650,40 @@ contains
             end if
          end do
       end do
-   end subroutine macro_cells
+   end subroutine group_roots
+
+   !> wide(m): the points of macro cell m (representative m) have a normal
+   !> more than `max_turn` from the cell's mean normal. A cell's multiplier is
+   !> one vector in the cell's frame (module notes), its constraint the mean
+   !> gap over the cell: a cell around a whole ring (a coarse level, a fit
+   !> with no symmetry planes) has no mean normal and constrains neither a
+   !> translation nor, with stick, the rotation; at most a quarter turn each,
+   !> a closed curve has at least four cells whose mean normals hold both
+   !> translations and, with stick, the rotation (a closed surface at least
+   !> six).
+   subroutine turns_too_far(surface, slave, macro, wide)
+      type(contact_surface_type), intent(in) :: surface
+      type(elasticity_problem_type), intent(in) :: slave
+      integer, intent(in) :: macro(:)
+      logical, intent(out) :: wide(:)
+      real(wp) :: nsum(surface%dim, size(macro)), len
+      integer :: i, m
+
+      nsum = 0.0_wp
+      do i = 1, surface%npoint
+         if (.not. surface%has_master(i)) cycle
+         m = macro(slave%root(surface%slave_cell(i)))
+         nsum(:, m) = nsum(:, m) + surface%weight(i)*surface%normal(:, i)
+      end do
+      wide = .false.
+      do i = 1, surface%npoint
+         if (.not. surface%has_master(i)) cycle
+         m = macro(slave%root(surface%slave_cell(i)))
+         len = norm2(nsum(:, m))
+         if (wide(m)) cycle
+         wide(m) = .not. dot_product(surface%normal(:, i), nsum(:, m)) >= cos_max_turn*len
+      end do
+   end subroutine turns_too_far
 
    !> The means and deviations of cell c's operators on the union of its
    !> points' dofs (module notes): normal rows (frictionless) or all
@@ -850,7 +920,7 @@ contains
       else
          call factor%destroy()
          call block_system(slave, master, ops, cells, closed, k, f, error, pstar)
-         if (.not. allocated(error)) call check_held(slave, master, k, names, count(closed), it, error)
+         if (.not. allocated(error)) call check_held(slave, master, k, names, closed_points(ops, closed), it, error)
          if (.not. allocated(error)) call factor%chol%factorize(k, error)
          if (allocated(error)) return
          factor%closed = closed
@@ -952,7 +1022,8 @@ contains
             ! The rigid-mode check on the symmetric part without the friction
             ! terms (which resist no rigid motion): the system with mu = 0.
             call coulomb_system(slave, master, ops, cells, state, tau, slip, 0.0_wp, loads(:, n), k, f, error)
-            if (.not. allocated(error)) call check_held(slave, master, k, names, count(state /= contact_open), &
+            if (.not. allocated(error)) &
+               & call check_held(slave, master, k, names, closed_points(ops, state /= contact_open), &
                & sol%iterations, error)
             if (.not. allocated(error) .and. any(state == contact_slip)) &
                & call coulomb_system(slave, master, ops, cells, state, tau, slip, mu, loads(:, n), k, f, error)
