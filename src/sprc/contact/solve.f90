@@ -29,7 +29,11 @@
 !> spanning at least two master cells (a shaft slave on a grid half the size
 !> of a soft hub's pressure alternated by 5 % from cell to cell). The price:
 !> the open/closed boundary is resolved to a contact cell, two slave cells
-!> (or two master cells). The multiplier is
+!> (or two master cells). A contact cell turns at most a quarter turn (its
+!> normals within 45 degrees of its mean normal; else its roots go one
+!> ancestor level down, to single roots at the least): on a coarse grid the
+!> ancestor of a ring's cells can be the whole ring, whose mean gap holds
+!> neither a translation nor the rotation (`turns_too_far`). The multiplier is
 !> eliminated cell by cell: stationarity in lambda_c gives
 !>   lambda_c = pbar + gamma gbar,
 !> with pbar, gbar the means over the cell's points of p_N and g, and the
@@ -46,6 +50,23 @@
 !> lambda = 0 and nothing is added. The pressure reported per point (`p_fe`)
 !> is that of its cell, p = -n_i.lambda_c (0 open); `ts_fe` the magnitude of
 !> the tangential part of lambda_c (0 frictionless).
+!>
+!> Constant in the surface's frame, not in Cartesian components. The
+!> frictionless multiplier is a scalar: its traction lambda_c n_i turns with
+!> the surface. The vector multiplier of stick and Coulomb is constant in the
+!> same sense: at point i it is R_i lambda_c, R_i the least rotation carrying
+!> the cell's mean normal nbar to the point's normal n_i (`frame_rotation`),
+!> so lambda_c.nbar is the pressure and its part normal to nbar the shear,
+!> each constant over the cell as the frictionless pressure is. Every point
+!> operator (gap, traction, the recovered traction p*) enters the cell's
+!> means rotated back by R_i^T, and the formulation below is unchanged. A
+!> Cartesian constant instead cannot carry a uniform pressure on a curved
+!> surface: the traction p n_i of a cell of angle h/R has a tangential part
+!> varying by p h/R across the cell, which the constant misses; the
+!> interface then carries a spurious shear of size p h/R, harmless at Q1
+!> (O(h) like the discretization) but a consistency error of order h^(3/2)
+!> in energy at Q2 (a shrink fit with stick converged at rate 1.5 with the
+!> estimate seeing half the error, where frictionless converged at 2).
 !>
 !> kappa. gamma = kappa E_s/h (SCENE.md: effective stiffness kappa E/h), with
 !> E_s the slave body's Young's modulus and h the smallest edge of the slave
@@ -69,9 +90,10 @@
 !> element matrix.
 !>
 !> Active set (primal-dual / semi-smooth Newton), per contact cell. First
-!> active set: the cells with a point with g0 <= h (one slave cell: touching
-!> and near surfaces, every cell of an interference fit); this holds a
-!> load-controlled body from the start. Each iteration assembles and
+!> active set: the cells with a point with g0 <= h, h the smallest edge of
+!> the slave root cell of the cell's first point (one slave cell: touching
+!> and near surfaces, every cell of a fit with or without interference);
+!> this holds a load-controlled body from the start. Each iteration assembles and
 !> factorizes the block system once (CHOLMOD; UMFPACK if CHOLMOD finds it not
 !> positive definite), solves, and takes as the next set the cells with
 !> nbar.lambda_c < 0 (nbar the cell's mean normal). The iteration ends when
@@ -170,6 +192,10 @@ module sprc_contact_solve
    !> A slip direction counts as settled when it moves by less than this
    !> between iterations (unit vectors; in 2D it only flips).
    real(wp), parameter :: direction_tol = 1.0e-8_wp
+   !> A contact cell's normals stay within 45 degrees of its mean normal
+   !> (`turns_too_far`): cos 45 degrees, less a round-off margin so that an
+   !> exact quarter turn (a quarter model's one cell) stays one cell.
+   real(wp), parameter :: cos_max_turn = sqrt(0.5_wp) - 1.0e-12_wp
 
    !> The contact operators of the points with a master point (local dofs in
    !> the block numbering, gap and traction operators) and their contact cells.
@@ -196,6 +222,10 @@ module sprc_contact_solve
       real(wp), allocatable :: gbar(:, :), g0bar(:), tbar(:, :)
       !> Per point: the traction operator minus its mean, (rows, nu, npoints), and the weights.
       real(wp), allocatable :: tdev(:, :, :), w(:)
+      !> Per point (stick): the rotation R_i (dim, dim, npoints) carrying the
+      !> cell frame to the point's, R_i nbar = n_i; the multiplier at the
+      !> point is R_i lambda_c (module notes).
+      real(wp), allocatable :: rot(:, :, :)
    end type cell_operators_type
 
    !> One point's operators of both bodies while they are built.
@@ -353,7 +383,8 @@ contains
          else
             call block_system(slave, master, ops, cells, closed, k, f, error)
          end if
-         if (.not. (allocated(error) .or. kept)) call check_held(slave, master, k, names, count(closed), it, error)
+         if (.not. (allocated(error) .or. kept)) &
+            & call check_held(slave, master, k, names, closed_points(ops, closed), it, error)
          if (.not. (allocated(error) .or. kept)) call solve_block(k, f, x, sol, error)
          call timer%stop()
          sol%t_solve = sol%t_solve + timer%elapsed
@@ -386,6 +417,13 @@ contains
       call slave%set_solution(x(1:slave%n_dofs()), error)
       if (.not. allocated(error)) call master%set_solution(x(slave%n_dofs() + 1:), error)
    end subroutine solve_contact_pair
+
+   !> The points of the closed contact cells.
+   pure integer function closed_points(ops, closed)
+      type(point_operators_type), intent(in) :: ops
+      logical, intent(in) :: closed(:)
+      closed_points = sum(ops%cell_ptr(2:) - ops%cell_ptr(:size(closed)), mask=closed)
+   end function closed_points
 
    pure real(wp) function cell_size(problem, e)
       type(elasticity_problem_type), intent(in) :: problem
@@ -559,17 +597,18 @@ contains
    !> macro(e): the representative of slave root e's contact macro cell, the
    !> first root of the contact (in leaf order) with the same ancestor `shift`
    !> levels up: the parent (shift 1), or the ancestor at least twice as large
-   !> as the master cells of the root's points (module notes).
+   !> as the master cells of the root's points (module notes). A macro cell
+   !> whose surface turns too far (`turns_too_far`) goes one level down for
+   !> all its roots, to the roots themselves at the least.
    subroutine macro_cells(surface, slave, master, macro)
       type(contact_surface_type), intent(in) :: surface
       type(elasticity_problem_type), intent(in) :: slave, master
       integer, intent(out) :: macro(:)
       integer, allocatable :: roots(:)
-      logical :: used(size(macro))
+      logical :: used(size(macro)), wide(size(macro))
       integer :: shift(size(macro))
-      integer :: i, j, e, d, r
+      integer :: i, e, r
 
-      d = surface%dim
       used = .false.
       shift = 1
       do i = 1, surface%npoint
@@ -580,6 +619,25 @@ contains
             & cell_size(slave, r))/log(2.0_wp) - 1.0e-6_wp)))
       end do
       roots = pack([(e, e=1, size(macro))], used)
+      do
+         call group_roots(slave, surface%dim, roots, shift, macro)
+         call turns_too_far(surface, slave, macro, wide)
+         wide = wide .and. shift > 0
+         if (.not. any(wide(roots))) exit
+         do i = 1, size(roots)
+            if (wide(macro(roots(i)))) shift(roots(i)) = shift(roots(i)) - 1
+         end do
+      end do
+   end subroutine macro_cells
+
+   !> macro(e) for the roots `roots` with their ancestor shifts: the first
+   !> root with the same level, shift and ancestor (e itself elsewhere).
+   subroutine group_roots(slave, d, roots, shift, macro)
+      type(elasticity_problem_type), intent(in) :: slave
+      integer, intent(in) :: d, roots(:), shift(:)
+      integer, intent(out) :: macro(:)
+      integer :: i, j, e
+
       macro = [(e, e=1, size(macro))]
       do i = 1, size(roots)
          do j = 1, i - 1
@@ -592,7 +650,40 @@ contains
             end if
          end do
       end do
-   end subroutine macro_cells
+   end subroutine group_roots
+
+   !> wide(m): the points of macro cell m (representative m) have a normal
+   !> more than `max_turn` from the cell's mean normal. A cell's multiplier is
+   !> one vector in the cell's frame (module notes), its constraint the mean
+   !> gap over the cell: a cell around a whole ring (a coarse level, a fit
+   !> with no symmetry planes) has no mean normal and constrains neither a
+   !> translation nor, with stick, the rotation; at most a quarter turn each,
+   !> a closed curve has at least four cells whose mean normals hold both
+   !> translations and, with stick, the rotation (a closed surface at least
+   !> six).
+   subroutine turns_too_far(surface, slave, macro, wide)
+      type(contact_surface_type), intent(in) :: surface
+      type(elasticity_problem_type), intent(in) :: slave
+      integer, intent(in) :: macro(:)
+      logical, intent(out) :: wide(:)
+      real(wp) :: nsum(surface%dim, size(macro)), len
+      integer :: i, m
+
+      nsum = 0.0_wp
+      do i = 1, surface%npoint
+         if (.not. surface%has_master(i)) cycle
+         m = macro(slave%root(surface%slave_cell(i)))
+         nsum(:, m) = nsum(:, m) + surface%weight(i)*surface%normal(:, i)
+      end do
+      wide = .false.
+      do i = 1, surface%npoint
+         if (.not. surface%has_master(i)) cycle
+         m = macro(slave%root(surface%slave_cell(i)))
+         len = norm2(nsum(:, m))
+         if (wide(m)) cycle
+         wide(m) = .not. dot_product(surface%normal(:, i), nsum(:, m)) >= cos_max_turn*len
+      end do
+   end subroutine turns_too_far
 
    !> The means and deviations of cell c's operators on the union of its
    !> points' dofs (module notes): normal rows (frictionless) or all
@@ -606,7 +697,7 @@ contains
       integer, allocatable :: pos(:)
       real(wp), allocatable :: g(:, :)
       integer :: j, i, q, q0, q1, np, d, stat
-      real(wp) :: nrm(surface%dim)
+      real(wp) :: nrm(surface%dim), rt(surface%dim, surface%dim), npt(surface%dim, ops%cell_ptr(c + 1) - ops%cell_ptr(c))
 
       d = surface%dim
       np = ops%cell_ptr(c + 1) - ops%cell_ptr(c)
@@ -622,9 +713,18 @@ contains
       end do
       cell%nu = size(cell%dofs)
       allocate (cell%gbar(cell%rows, cell%nu), cell%tbar(cell%rows, cell%nu), cell%g0bar(cell%rows), &
-         & cell%tdev(cell%rows, cell%nu, np), cell%w(np), g(cell%rows, cell%nu), stat=stat)
-      call check_allocation(stat, 'contact cell '//itoa(c), 'its operators', cell%rows*cell%nu*(np + 3), 8, error)
+         & cell%tdev(cell%rows, cell%nu, np), cell%w(np), g(cell%rows, cell%nu), cell%rot(d, d, np), stat=stat)
+      call check_allocation(stat, 'contact cell '//itoa(c), 'its operators', cell%rows*cell%nu*(np + 3) + d*d*np, &
+         & 8, error)
       if (allocated(error)) return
+      associate (pts => ops%cell_point(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1))
+         cell%w = surface%weight(pts)
+         do j = 1, np
+            npt(:, j) = contact_normal(surface, pts(j), friction)
+         end do
+         cell%nbar = matmul(npt, cell%w)
+         cell%nbar = cell%nbar/norm2(cell%nbar)
+      end associate
       cell%gbar = 0.0_wp
       cell%tbar = 0.0_wp
       cell%g0bar = 0.0_wp
@@ -634,31 +734,24 @@ contains
          q0 = ops%ptr(i)
          q1 = ops%ptr(i + 1) - 1
          nrm = surface%normal(:, i)
+         cell%rot(:, :, j) = frame_rotation(cell%nbar, npt(:, j))
          pos = [(findloc(cell%dofs, ops%dofs(q), 1), q = q0, q1)]
          g = 0.0_wp
          if (friction == friction_stick) then
-            g(:, pos) = ops%gop(:, q0:q1)
-            cell%tdev(:, pos, j) = ops%top(:, q0:q1)
+            rt = transpose(cell%rot(:, :, j))
+            g(:, pos) = matmul(rt, ops%gop(:, q0:q1))
+            cell%tdev(:, pos, j) = matmul(rt, ops%top(:, q0:q1))
             cell%g0bar = cell%g0bar + surface%weight(i)*surface%g0(i)*dot_product(nrm, surface%master_normal(:, i))* &
-               & surface%master_normal(:, i)
+               & matmul(rt, surface%master_normal(:, i))
          else
             g(1, pos) = matmul(nrm, ops%gop(:, q0:q1))
             cell%tdev(1, pos, j) = matmul(nrm, ops%top(:, q0:q1))
             cell%g0bar = cell%g0bar + surface%weight(i)*surface%g0(i)
          end if
-         cell%w(j) = surface%weight(i)
          cell%gbar = cell%gbar + surface%weight(i)*g
          cell%tbar = cell%tbar + surface%weight(i)*cell%tdev(:, :, j)
       end do
       cell%measure = sum(cell%w)
-      associate (pts => ops%cell_point(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1))
-         if (friction == friction_stick) then
-            cell%nbar = matmul(surface%normal(:, pts) - surface%master_normal(:, pts), cell%w)
-         else
-            cell%nbar = matmul(surface%normal(:, pts), cell%w)
-         end if
-      end associate
-      cell%nbar = cell%nbar/norm2(cell%nbar)
       cell%gbar = cell%gbar/cell%measure
       cell%tbar = cell%tbar/cell%measure
       cell%g0bar = cell%g0bar/cell%measure
@@ -666,6 +759,38 @@ contains
          cell%tdev(:, :, j) = cell%tdev(:, :, j) - cell%tbar
       end do
    end subroutine cell_operators
+
+   !> The unit contact normal of point i: the slave normal (frictionless) or
+   !> the bisector n_s - n_m of both surfaces' normals (stick and Coulomb:
+   !> the contact plane, the same whichever body is the slave).
+   pure function contact_normal(surface, i, friction) result(n)
+      type(contact_surface_type), intent(in) :: surface
+      integer, intent(in) :: i, friction
+      real(wp) :: n(surface%dim)
+      if (friction == friction_stick) then
+         n = surface%normal(:, i) - surface%master_normal(:, i)
+         n = n/norm2(n)
+      else
+         n = surface%normal(:, i)
+      end if
+   end function contact_normal
+
+   !> The rotation R in the plane of the unit vectors a and b that carries a
+   !> to b (identity on the complement; 2D and 3D alike):
+   !>   R = I - (a + b)(a + b)^T/(1 + a.b) + 2 b a^T.
+   !> Its columns move the cell frame to a point's by the least rotation, so
+   !> that a multiplier R_i lambda_c keeps its normal and tangential parts
+   !> along the curved surface (module notes).
+   pure function frame_rotation(a, b) result(r)
+      real(wp), intent(in) :: a(:), b(:)
+      real(wp) :: r(size(a), size(a))
+      integer :: k
+      r = 2.0_wp*spread(b, 2, size(a))*spread(a, 1, size(a)) &
+         & - spread(a + b, 2, size(a))*spread(a + b, 1, size(a))/(1.0_wp + dot_product(a, b))
+      do k = 1, size(a)
+         r(k, k) = r(k, k) + 1.0_wp
+      end do
+   end function frame_rotation
 
    !> Reduced operators of `problem` at x in element e: dofs(1:m), the
    !> displacement n(dim, m) and the traction sigma(u) nrm, t(dim, m).
@@ -795,7 +920,7 @@ contains
       else
          call factor%destroy()
          call block_system(slave, master, ops, cells, closed, k, f, error, pstar)
-         if (.not. allocated(error)) call check_held(slave, master, k, names, count(closed), it, error)
+         if (.not. allocated(error)) call check_held(slave, master, k, names, closed_points(ops, closed), it, error)
          if (.not. allocated(error)) call factor%chol%factorize(k, error)
          if (allocated(error)) return
          factor%closed = closed
@@ -897,7 +1022,8 @@ contains
             ! The rigid-mode check on the symmetric part without the friction
             ! terms (which resist no rigid motion): the system with mu = 0.
             call coulomb_system(slave, master, ops, cells, state, tau, slip, 0.0_wp, loads(:, n), k, f, error)
-            if (.not. allocated(error)) call check_held(slave, master, k, names, count(state /= contact_open), &
+            if (.not. allocated(error)) &
+               & call check_held(slave, master, k, names, closed_points(ops, state /= contact_open), &
                & sol%iterations, error)
             if (.not. allocated(error) .and. any(state == contact_slip)) &
                & call coulomb_system(slave, master, ops, cells, state, tau, slip, mu, loads(:, n), k, f, error)
@@ -1081,7 +1207,7 @@ contains
             if (state(c) == contact_open) cycle
             sol%pressure(i) = -lam_n
             if (state(c) == contact_slip) lam_t = -mu*lam_n*tau(:, c)
-            sol%traction_t(:, i) = lam_t
+            sol%traction_t(:, i) = matmul(cells(c)%rot(:, :, j - ops%cell_ptr(c) + 1), lam_t)
             sol%tangential(i) = norm2(lam_t)
          end do
       end do
@@ -1205,7 +1331,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       !> The cells' mean stabilization tractions (recovered stabilization).
       real(wp), intent(in), optional :: pstar(:, :)
-      real(wp) :: lam(surface%dim), nrm(surface%dim)
+      real(wp) :: lam(surface%dim), lami(surface%dim), nrm(surface%dim)
       integer :: i, c, j
 
       call point_gaps(surface, ops, size(cells), x, sol, error)
@@ -1231,8 +1357,9 @@ contains
                if (cell%rows == 1) then
                   sol%pressure(i) = -lam(1)
                else
-                  sol%pressure(i) = -dot_product(lam, nrm)
-                  sol%traction_t(:, i) = lam - dot_product(lam, nrm)*nrm
+                  lami = matmul(cell%rot(:, :, j), lam)
+                  sol%pressure(i) = -dot_product(lami, nrm)
+                  sol%traction_t(:, i) = lami - dot_product(lami, nrm)*nrm
                   sol%tangential(i) = norm2(sol%traction_t(:, i))
                end if
             end do
@@ -1289,7 +1416,8 @@ contains
             if (cells(c)%rows == 1) then
                pstar(1, c) = pstar(1, c) + surface%weight(i)*dot_product(surface%normal(:, i), recovered(:, i))
             else
-               pstar(:, c) = pstar(:, c) + surface%weight(i)*recovered(:, i)
+               pstar(:, c) = pstar(:, c) + surface%weight(i)* &
+                  & matmul(transpose(cells(c)%rot(:, :, j - ops%cell_ptr(c) + 1)), recovered(:, i))
             end if
          end do
          pstar(:, c) = pstar(:, c)/cells(c)%measure
