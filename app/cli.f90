@@ -21,6 +21,8 @@ module sprc_app_cli
       !> --solver: overrides the scene's `solver` ('' when not given)
       character(len=:), allocatable :: solver
       logical :: quiet = .false.
+      !> --wide: print every report column (the default table is the compact one)
+      logical :: wide = .false.
    end type cli_type
 
 contains
@@ -31,7 +33,7 @@ contains
       text = 'usage:'//nl// &
          '  sprc                          run the built-in default scene (Lame cylinder study)'//nl// &
          '  sprc run SCENE.nml [--output PREFIX] [--levels 3,4,5] [--threads N] [--points Q]'//nl// &
-         '                     [--solver auto|direct|iterative] [--quiet]'//nl// &
+         '                     [--solver auto|direct|iterative] [--quiet] [--wide]'//nl// &
          '  sprc check SCENE.nml          validate; print the scene and what it switches on and off'//nl// &
          '  sprc mesh SCENE.nml [--levels 3,4] [--points Q]   grid, classification, quadrature per level'//nl// &
          '  sprc --help | --version'//nl//nl// &
@@ -95,6 +97,10 @@ contains
 
       if (arg == '--quiet' .and. cli%command == 'run') then
          cli%quiet = .true.
+         return
+      end if
+      if (arg == '--wide' .and. cli%command == 'run') then
+         cli%wide = .true.
          return
       end if
       if (.not. allowed(cli%command, arg)) then

@@ -204,10 +204,11 @@ contains
       end if
       if (rank > 0) return
       write (output_unit, '(a)') scene%title
-      write (output_unit, '(a)', advance='no') report_table(rows)
+      write (output_unit, '(a)', advance='no') report_table(rows, wide=cli%wide)
       if (len(prefix) == 0) return
       call write_report_csv(prefix//'.csv'//partial, rows, error)
-      if (.not. allocated(error)) call write_report_svg(prefix//'.svg'//partial, rows, scene%title, error)
+      if (.not. allocated(error)) call write_report_svg(prefix//'.svg'//partial, rows, scene%title, error, &
+         & order=study%order, dim=study%dim)
       if (.not. allocated(error)) call h5%close(error)
       if (.not. allocated(error)) call h5%write_xdmf(prefix//'.xdmf'//partial, error, data_path=prefix//'.h5')
       n_outputs = 4

@@ -34,6 +34,7 @@ contains
          new_unittest('svg_3d_and_empty', test_svg_3d_empty), &
          new_unittest('svg_many_points', test_svg_many_points), &
          new_unittest('svg_loaded_window', test_svg_window), &
+         new_unittest('svg_zoom_on_closed_points', test_svg_zoom), &
          new_unittest('svg_unwritable_path', test_svg_unwritable) &
          ]
    end subroutine collect_contact_output
@@ -261,7 +262,8 @@ contains
       if (allocated(error)) return
       call check(error, index(text, '<polyline') == 0, 'no lines through a surface')
       if (allocated(error)) return
-      call check(error, count_sub(text, 'class="point p_fe"'), 3, 'a marker per FE point')
+      ! The open point, 0.3 from the peak, lies beyond the closed points' stretch (0.1) and its quarter.
+      call check(error, count_sub(text, 'class="point p_fe"'), 2, 'a marker per FE point of the contact zone')
       if (allocated(error)) return
       call check(error, index(text, 'distance from the point of peak pressure') > 0, '3D abscissa')
       if (allocated(error)) return
@@ -327,6 +329,41 @@ contains
       end do
       call check(error, (cx(12) - cx(11)) - (cx(2) - cx(1)), 0.0_wp, 0.05_wp, 'arc length abscissa')
    end subroutine test_svg_window
+
+   !> The contact plot zooms on the closed points: the quarter circle of
+   !> test_svg_window closed (stick) on phi < 0.1, the recovered pressure
+   !> smeared over the whole surface (above 1e-3 of the peak everywhere). The
+   !> plot keeps the closed stretch s <= 0.09 and a quarter of it (points
+   !> 0 .. 0.11: 12 markers per series); the abscissa, 0 .. 0.11 in steps of
+   !> 0.05 (about five steps), ends at 0.15.
+   subroutine test_svg_zoom(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_result_type) :: c(1)
+      character(len=:), allocatable :: text
+      real(wp) :: x(2, 101), phi(101), cx
+      integer :: i, pos
+
+      phi = [(0.01_wp*(i - 1), i=1, 101)]
+      x(1, :) = sin(phi)
+      x(2, :) = 1.0_wp - cos(phi)
+      call new_contact_result(c(1), x, spread(0.01_wp, 1, 101), x, 1, 2, error)
+      if (allocated(error)) return
+      c(1)%p_fe = merge(1.0_wp - (phi/0.1_wp)**2, 0.0_wp, phi < 0.1_wp)
+      c(1)%p_spr = c(1)%p_fe + 0.01_wp
+      where (phi < 0.1_wp) c(1)%state = contact_stick
+      call contact_svg(c, 'zoom', text, error)
+      if (allocated(error)) return
+      call check(error, count_sub(text, 'class="point p_fe"'), 12, 'FE markers of the contact zone and margins')
+      if (allocated(error)) return
+      call check(error, count_sub(text, 'class="point p_spr"'), 12, 'SPR markers of the contact zone and margins')
+      if (allocated(error)) return
+      call check(error, index(text, '>0.15</text>') > 0 .and. index(text, '>0.20</text>') == 0, &
+         & 'abscissa ends at 0.15')
+      if (allocated(error)) return
+      pos = index(text, 'class="point p_spr"', back=.true.)
+      cx = attribute_real(text(pos:), 'cx')
+      call check(error, cx <= 975.0_wp, 'last SPR marker inside the panel')
+   end subroutine test_svg_zoom
 
    subroutine test_svg_unwritable(error)
       type(error_type), allocatable, intent(out) :: error

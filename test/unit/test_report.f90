@@ -38,9 +38,13 @@ contains
          new_unittest('table_levels_aligned', test_table), &
          new_unittest('table_contact_columns', test_table_contact), &
          new_unittest('table_significant_digits', test_table_digits), &
+         new_unittest('table_compact_default', test_table_compact), &
+         new_unittest('table_compact_adaptive', test_table_compact_adaptive), &
          new_unittest('xml_checker_rejects_bad', test_xml_checker), &
          new_unittest('svg_well_formed', test_svg_well_formed), &
          new_unittest('svg_log_scale_positions', test_svg_positions), &
+         new_unittest('svg_time_axis_cumulative', test_svg_cumulative_time), &
+         new_unittest('svg_reference_slope', test_svg_reference_slope), &
          new_unittest('svg_omits_empty_columns', test_svg_omits_empty), &
          new_unittest('svg_single_row', test_svg_single_row), &
          new_unittest('svg_non_positive_skipped', test_svg_non_positive), &
@@ -400,7 +404,7 @@ contains
       character(len=:), allocatable :: name
       real(wp) :: v(3)
 
-      table = report_table(rows)
+      table = report_table(rows, wide=.true.)
       columns = report_column_indices(rows)
       call check(error, size(columns), ncolumns, 'columns of the rows')
       if (allocated(error)) return
@@ -477,7 +481,7 @@ contains
       rows(1)%t_recovery = 2.5e-7_wp
       rows(1)%err_fe = 0.012345_wp
       rows(1)%theta_sprc = 0.98765_wp
-      table = report_table(rows)
+      table = report_table(rows, wide=.true.)
       call check(error, index(table, ' 0.00123 ') > 0, 't_mesh 3 digits: '//table)
       if (allocated(error)) return
       call check(error, index(table, ' 12.3 ') > 0, 't_solve 3 digits')
@@ -541,9 +545,14 @@ contains
          ! One polyline per panel and a legend entry per column with values.
          call check(error, count_sub(text, 'class="line '//trim(series(k))//'"'), 2, trim(series(k))//' lines')
          if (allocated(error)) return
-         call check(error, index(text, '>'//trim(series(k))//'</text>') > 0, trim(series(k))//' in legend')
+         call check(error, index(text, '('//trim(series(k))//')</text>') > 0, trim(series(k))//' in legend')
          if (allocated(error)) return
       end do
+      ! The legend says in words what each series is, naming the energy norm.
+      call check(error, index(text, '>FE error ‖σ−σ_h‖_E / ‖σ‖_E (err_fe)</text>') > 0 .and. &
+         & index(text, '>ZZ estimate, SPR-C (eta_sprc)</text>') > 0 .and. &
+         & index(text, '>SPR-C error ‖σ−σ*‖_E / ‖σ‖_E (err_sprc)</text>') > 0, 'legend in words')
+      if (allocated(error)) return
       ! 5 columns x 3 rows x 2 panels of markers.
       call check(error, count_sub(text, 'class="point'), 30, 'markers')
       if (allocated(error)) return
@@ -584,9 +593,15 @@ contains
          cx(k) = attribute_real(text(pos:), 'cx')
          cy(k) = attribute_real(text(pos:), 'cy')
       end do
+      ! The time panel: cumulative times 10, 110, 1110 s on decades 10^1..10^4, 390 px.
+      call check(error, cx(2) - cx(1), 130.0_wp*log10(11.0_wp), 0.05_wp, 'cumulative time, first step')
+      if (allocated(error)) return
+      call check(error, cx(3) - cx(2), 130.0_wp*log10(1110.0_wp/110.0_wp), 0.05_wp, 'cumulative time, second step')
+      if (allocated(error)) return
       do k = 1, 4, 3
          ! 0.05 px: coordinates are written with 2 decimals.
-         call check(error, (cx(k + 2) - cx(k + 1)) - (cx(k + 1) - cx(k)), 0.0_wp, 0.05_wp, 'equal x steps')
+         if (k == 4) call check(error, (cx(k + 2) - cx(k + 1)) - (cx(k + 1) - cx(k)), 0.0_wp, 0.05_wp, &
+            & 'equal x steps')
          if (allocated(error)) return
          call check(error, (cy(k + 2) - cy(k + 1)) - (cy(k + 1) - cy(k)), 0.0_wp, 0.05_wp, 'equal y steps')
          if (allocated(error)) return
@@ -616,8 +631,10 @@ contains
       if (allocated(error)) return
       call check(error, index(text, 'err_fe') == 0 .and. index(text, 'err_spr') == 0, 'err_* columns omitted')
       if (allocated(error)) return
-      call check(error, index(text, '>eta_spr</text>') > 0 .and. index(text, '>eta_sprc</text>') > 0, &
+      call check(error, index(text, '(eta_spr)</text>') > 0 .and. index(text, '(eta_sprc)</text>') > 0, &
          'eta_* in the legend')
+      if (allocated(error)) return
+      call check(error, index(text, 'measured rate of eta_sprc') > 0, 'without err_fe the rate is eta_sprc''s')
       if (allocated(error)) return
       call check(error, count_sub(text, 'class="point'), 12, '2 columns x 3 rows x 2 panels')
    end subroutine test_svg_omits_empty
@@ -697,7 +714,163 @@ contains
       call check_error(error, err, stat_io, path)
    end subroutine test_svg_unwritable
 
+   !> The compact table (the default) fits a terminal: level, dofs, err_fe, the
+   !> estimates and effectivities, t_total, in that order, lines <= 90
+   !> characters; columns empty in every row are left out; `wide` prints
+   !> every column of the report.
+   subroutine test_table_compact(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=600) :: lines(5)
+      character(len=:), allocatable :: table
+      type(report_row_type) :: rows(3)
+      integer :: n, i, j
+      integer, allocatable :: columns(:)
+
+      table = report_table(contact_rows())
+      call split_lines(table, lines, n)
+      call check(error, n, 5, 'header, rule, 3 rows')
+      if (allocated(error)) return
+      call check(error, words(lines(1)), 'level dofs err_fe eta_spr eta_sprc theta_spr theta_sprc t_total', &
+         & 'compact header')
+      if (allocated(error)) return
+      do i = 1, n
+         call check(error, len_trim(lines(i)) <= 90, 'line '//itoa(i)//' of '//itoa(len_trim(lines(i)))// &
+            & ' characters fits a terminal')
+         if (allocated(error)) return
+      end do
+      rows = contact_rows()
+      call check(error, index(words(lines(3)), itoa(rows(1)%level)//' '//itoa(int(rows(1)%dofs))//' ') == 1, &
+         & 'level and dofs of row 1: '//trim(lines(3)))
+      if (allocated(error)) return
+      call split_lines(report_table(no_exact_rows()), lines, n)
+      call check(error, words(lines(1)), 'level dofs eta_spr eta_sprc t_total', 'empty columns left out')
+      if (allocated(error)) return
+      call split_lines(report_table(contact_rows(), wide=.true.), lines, n)
+      columns = report_column_indices(contact_rows())
+      table = ''
+      do j = 1, size(columns)
+         table = table//' '//trim(report_columns(columns(j)))
+      end do
+      call check(error, words(lines(1)), table(2:), 'wide: every column')
+   end subroutine test_table_compact
+
+   !> An adaptive study's compact table starts with `step`, still <= 100 characters.
+   subroutine test_table_compact_adaptive(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(report_row_type) :: rows(3)
+      character(len=600) :: lines(5)
+      integer :: n, i
+
+      rows = sample_rows()
+      do i = 1, 3
+         rows(i)%step = i - 1
+         rows(i)%dofs = 123456789_i8
+      end do
+      call split_lines(report_table(rows), lines, n)
+      call check(error, words(lines(1)), 'step level dofs err_fe eta_spr eta_sprc theta_spr theta_sprc t_total', &
+         & 'adaptive compact header')
+      if (allocated(error)) return
+      do i = 1, n
+         call check(error, len_trim(lines(i)) <= 100, 'line '//itoa(i)//' fits a terminal')
+         if (allocated(error)) return
+      end do
+   end subroutine test_table_compact_adaptive
+
+   !> The time panel's abscissa is the cumulative run time: with t_total
+   !> falling from row to row (timing noise, or a cheap level after a costly
+   !> one), the err_fe markers still go right, and the axis says so.
+   subroutine test_svg_cumulative_time(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(report_row_type) :: rows(3)
+      character(len=:), allocatable :: text
+      real(wp) :: cx(3)
+      integer :: i, pos, k
+
+      rows = sample_rows()
+      rows%t_total = [5.0_wp, 1.0_wp, 2.0_wp]
+      text = report_svg(rows, 'noise')
+      pos = 1
+      do k = 1, 3
+         i = index(text(pos:), 'class="point err_fe"')
+         call check(error, i > 0, 'err_fe marker '//itoa(k))
+         if (allocated(error)) return
+         pos = pos + i
+         cx(k) = attribute_real(text(pos:), 'cx')
+      end do
+      ! 5, 6, 8 s on the decade 10^0..10^1, 390 px.
+      call check(error, cx(2) - cx(1), 390.0_wp*log10(6.0_wp/5.0_wp), 0.05_wp, 'first step')
+      if (allocated(error)) return
+      call check(error, cx(3) - cx(2), 390.0_wp*log10(8.0_wp/6.0_wp), 0.05_wp, 'second step')
+      if (allocated(error)) return
+      call check(error, index(text, 'cumulative run time, sum of t_total [s]') > 0, 'time axis title')
+   end subroutine test_svg_cumulative_time
+
+   !> With the order and dimension, the dofs panel has a reference line of
+   !> slope -p/d and the legend names it and the measured rate: err_fe halves
+   !> per level while the dofs grow tenfold, rate log10(2) = 0.30; the line's
+   !> pixel slope to that of the err_fe markers is (p/d)/log10(2).
+   subroutine test_svg_reference_slope(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(report_row_type) :: rows(3)
+      character(len=*), parameter :: path = dir//'test_report_slope.svg'
+      character(len=:), allocatable :: text, msg
+      real(wp) :: cx(2), cy(2), x1, y1, x2, y2
+      integer :: i, pos, k
+
+      rows = sample_rows()
+      do i = 1, 3
+         rows(i)%dofs = 100_i8*10_i8**(i - 1)
+      end do
+      call write_report_svg(path, rows, 'slope', error, order=2, dim=3)
+      if (allocated(error)) return
+      call read_text_file(path, text, error)
+      if (allocated(error)) return
+      call check(error, xml_well_formed(text, 'svg', msg), 'SVG well-formed: '//msg)
+      if (allocated(error)) return
+      call check(error, count_sub(text, 'class="reference-slope"'), 1, 'one reference line, in the dofs panel')
+      if (allocated(error)) return
+      call check(error, index(text, 'optimal rate p/d = 2/3') > 0, 'reference rate in the legend')
+      if (allocated(error)) return
+      call check(error, index(text, 'measured rate of err_fe: 0.30 (last two rows)') > 0, 'measured rate')
+      if (allocated(error)) return
+      pos = index(text, 'class="reference-slope"')
+      x1 = attribute_real(text(pos:), 'x1')
+      y1 = attribute_real(text(pos:), 'y1')
+      x2 = attribute_real(text(pos:), 'x2')
+      y2 = attribute_real(text(pos:), 'y2')
+      ! The dofs panel's err_fe markers: the 4th and 5th.
+      pos = 1
+      do k = 1, 5
+         i = index(text(pos:), 'class="point err_fe"')
+         pos = pos + i
+         if (k >= 4) cx(k - 3) = attribute_real(text(pos:), 'cx')
+         if (k >= 4) cy(k - 3) = attribute_real(text(pos:), 'cy')
+      end do
+      call check(error, x1 >= 500.0_wp .and. x2 > x1, 'the line lies in the dofs panel')
+      if (allocated(error)) return
+      call check(error, ((y2 - y1)/(x2 - x1))/((cy(2) - cy(1))/(cx(2) - cx(1))), &
+         & (2.0_wp/3.0_wp)/log10(2.0_wp), 1.0e-3_wp, 'slope -p/d')
+      if (allocated(error)) return
+      ! Without the order and dimension: no reference line, the measured rate still.
+      text = report_svg(rows, 'no slope')
+      call check(error, index(text, 'reference-slope') == 0 .and. index(text, 'measured rate of err_fe') > 0, &
+         & 'no reference without p and d')
+   end subroutine test_svg_reference_slope
+
    ! ---------------------------------------------------------------- helpers
+
+   !> The blank-separated words of `line`, joined by one blank.
+   function words(line) result(w)
+      character(len=*), intent(in) :: line
+      character(len=:), allocatable :: w
+      integer :: i
+      w = ''
+      do i = 1, len_trim(line)
+         if (line(i:i) == ' ' .and. (len(w) == 0 .or. w(max(1, len(w)):) == ' ')) cycle
+         w = w//line(i:i)
+      end do
+      w = trim(w)
+   end function words
 
    !> `err` must be allocated with status `stat` and a message containing `part`.
    subroutine check_error(error, err, stat, part)

@@ -222,8 +222,11 @@ contains
    !> each line ended by a newline (trailing blanks dropped). Columns are right-aligned to a common
    !> width; times, h and theta have 3 significant digits, errors and
    !> estimates es notation; empty cells are blank.
-   function report_table(rows) result(table)
+   !> By default the compact table (`compact_columns`), which fits a terminal;
+   !> with `wide`, every column of the report, as in the CSV.
+   function report_table(rows, wide) result(table)
       type(report_row_type), intent(in) :: rows(:)
+      logical, intent(in), optional :: wide
       character(len=:), allocatable :: table
       type :: cell_type
          character(len=:), allocatable :: s
@@ -234,7 +237,10 @@ contains
       character(len=:), allocatable :: line
       character, parameter :: nl = new_line('a')
 
-      columns = report_column_indices(rows)
+      columns = compact_columns(rows)
+      if (present(wide)) then
+         if (wide) columns = report_column_indices(rows)
+      end if
       n = size(columns)
       allocate (cells(n, size(rows)), width(n))
       do j = 1, n
@@ -263,6 +269,27 @@ contains
          table = table//trim(line(3:))//nl
       end do
    end function report_table
+
+   !> The columns a user reads first, as indices into `report_columns`: `step`
+   !> (adaptive studies), level, dofs, err_fe, the estimates and effectivities
+   !> of the recoveries, t_total; of these, the error columns empty in every
+   !> row are left out (no exact solution, a recovery not run).
+   pure function compact_columns(rows) result(indices)
+      type(report_row_type), intent(in) :: rows(:)
+      integer, allocatable :: indices(:)
+      character(len=*), parameter :: optional_columns(5) = [character(len=10) :: 'err_fe', 'eta_spr', &
+         & 'eta_sprc', 'theta_spr', 'theta_sprc']
+      integer :: k, i, j
+
+      indices = [integer ::]
+      if (any(rows%step >= 0)) indices = [first_adapt_column]
+      indices = [indices, findloc(report_columns, 'level'), findloc(report_columns, 'dofs')]
+      do k = 1, size(optional_columns)
+         j = findloc(report_columns, optional_columns(k), dim=1)
+         if (any([(.not. is_empty(row_values(rows(i), j)), i=1, size(rows))])) indices = [indices, j]
+      end do
+      indices = [indices, findloc(report_columns, 't_total')]
+   end function compact_columns
 
    !> `s` right-aligned in a field of `w` characters.
    pure function right(s, w) result(r)

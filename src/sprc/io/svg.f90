@@ -10,9 +10,14 @@
 !> show empty cells or values <= 0: such points are skipped and listed in a
 !> comment in the file. A series with one point gets a marker, no line.
 !> No scripts, no external fonts or references (generic `sans-serif`).
-!> An adaptive study's rows (`step` set) are drawn against the cumulative
-!> run time (the sum of t_total up to each step): the time that accuracy
-!> cost, where a uniform level's own time is what that level costs alone.
+!> The time panel's abscissa is the cumulative run time, the sum of t_total
+!> over the rows so far: what reaching that accuracy cost (for an adaptive
+!> study, the steps so far; for a uniform one, the levels run in order). It
+!> grows from row to row, so timing noise cannot fold a curve back on itself.
+!> The legend names each series in words (the energy norm of the error or
+!> the ZZ estimate). Given the order p and the dimension d, the dofs panel
+!> has a dotted reference line of slope -p/d, the optimal rate, and the
+!> legend the rate measured between the last two rows.
 !>
 !> The contact plot (`contact_svg`, PREFIX_contact.svg) is one panel with
 !> linear axes: the contact pressure p_fe, p_spr, p_sprc and p_exact at the
@@ -29,8 +34,8 @@ module sprc_io_svg
    use sprc_core_text, only: fixed_text
    use sprc_core_alloc, only: check_allocation
    use sprc_core_error, only: error_type, fatal_error, stat_io
-   use sprc_io_report, only: report_row_type, report_column, is_empty
-   use sprc_contact_result, only: contact_result_type
+   use sprc_io_report, only: report_row_type, report_column, is_empty, report_empty
+   use sprc_contact_result, only: contact_result_type, contact_open
    implicit none
    private
 
@@ -39,12 +44,17 @@ module sprc_io_svg
    integer, parameter :: n_series = 5
    character(len=8), parameter :: series_name(n_series) = [character(len=8) :: &
       & 'err_fe', 'err_spr', 'err_sprc', 'eta_spr', 'eta_sprc']
+   !> The legend's words for each series.
+   character(len=*), parameter :: series_label(n_series) = [character(len=64) :: &
+      & 'FE error ‖σ−σ_h‖_E / ‖σ‖_E (err_fe)', 'SPR error ‖σ−σ*‖_E / ‖σ‖_E (err_spr)', &
+      & 'SPR-C error ‖σ−σ*‖_E / ‖σ‖_E (err_sprc)', 'ZZ estimate, SPR (eta_spr)', &
+      & 'ZZ estimate, SPR-C (eta_sprc)']
    character(len=7), parameter :: series_colour(n_series) = [character(len=7) :: &
       & '#1f77b4', '#ff7f0e', '#2ca02c', '#ff7f0e', '#2ca02c']
    logical, parameter :: series_estimate(n_series) = [.false., .false., .false., .true., .true.]
 
    !> Page and panel geometry in px. Panel p occupies x in [(p-1)*panel_width, p*panel_width].
-   real(wp), parameter :: page_width = 1000.0_wp, page_height = 480.0_wp, panel_width = 500.0_wp
+   real(wp), parameter :: page_width = 1000.0_wp, page_height = 510.0_wp, panel_width = 500.0_wp
    real(wp), parameter :: plot_left = 85.0_wp, plot_right = 475.0_wp, plot_top = 70.0_wp, plot_bottom = 370.0_wp
 
    character(len=*), parameter :: nl = new_line('a')
@@ -62,11 +72,17 @@ module sprc_io_svg
    !> The markers: pale wide disc (a reference drawn as a band), filled circle, open square, none.
    integer, parameter :: marker_band = 1, marker_dot = 2, marker_square = 3, marker_none = 4
 
-   !> How a series is drawn: its name (legend, class), colour, stroke attributes and marker.
+   !> How a series is drawn: its name (class), colour, stroke attributes, marker
+   !> and its words in the legend (the name when not set).
    type :: series_style_type
       character(len=:), allocatable :: name, colour, stroke
       integer :: marker = marker_dot
+      character(len=:), allocatable :: label
    end type series_style_type
+
+   !> The reference line of the optimal rate.
+   character(len=*), parameter :: reference_colour = '#555555', &
+      & reference_stroke = ' stroke-width="1.5" stroke-dasharray="2,3"'
 
    !> The contact plot's series: FE, SPR, SPR-C and the exact pressure.
    integer, parameter :: n_contact_series = 4
@@ -95,14 +111,16 @@ module sprc_io_svg
 contains
 
    !> Write the plot of `rows` to `path` (replacing it). Fails with stat_io naming the path.
-   subroutine write_report_svg(path, rows, title, error)
+   subroutine write_report_svg(path, rows, title, error, order, dim)
       character(len=*), intent(in) :: path
       type(report_row_type), intent(in) :: rows(:)
       !> Title on top of the picture (plain text; escaped here).
       character(len=*), intent(in) :: title
       type(error_type), allocatable, intent(out) :: error
+      !> FE order and dimension: with both, the reference slope -order/dim.
+      integer, intent(in), optional :: order, dim
 
-      call write_text(path, 'report SVG', report_svg(rows, title), error)
+      call write_text(path, 'report SVG', report_svg(rows, title, order, dim), error)
    end subroutine write_report_svg
 
    !> Write the contact plot of `contacts` (one level's pairs) to `path`
@@ -151,6 +169,7 @@ contains
          styles(k)%name = trim(series_name(k))
          styles(k)%colour = series_colour(k)
          styles(k)%stroke = series_stroke(k)
+         styles(k)%label = trim(series_label(k))
          if (k == 1) then
             styles(k)%marker = marker_band
          else if (series_estimate(k)) then
@@ -162,23 +181,22 @@ contains
    end function report_styles
 
    !> The SVG text of the plot of `rows`.
-   function report_svg(rows, title) result(svg)
+   function report_svg(rows, title, order, dim) result(svg)
       type(report_row_type), intent(in) :: rows(:)
       character(len=*), intent(in) :: title
+      !> FE order and dimension: with both, the reference slope -order/dim.
+      integer, intent(in), optional :: order, dim
       character(len=:), allocatable :: svg
-      real(wp) :: y(size(rows), n_series), x(size(rows), 2), levels(size(rows))
-      logical :: active(n_series), cumulative
+      real(wp) :: y(size(rows), n_series), x(size(rows), 2), levels(size(rows)), rate
+      logical :: active(n_series), shown(n_series + 2)
+      type(series_style_type) :: styles(n_series + 2)
       integer :: k, p
 
       levels = report_column(rows, 'level')
-      x(:, 1) = report_column(rows, 't_total')
+      x(:, 1) = cumulative_time(report_column(rows, 't_total'))
       x(:, 2) = report_column(rows, 'dofs')
-      cumulative = any(rows%step >= 0)
-      if (cumulative) then
-         do k = 2, size(rows)
-            x(k, 1) = x(k - 1, 1) + x(k, 1)
-         end do
-      end if
+      rate = report_empty
+      if (present(order) .and. present(dim)) rate = real(order, wp)/dim
       do k = 1, n_series
          y(:, k) = report_column(rows, trim(series_name(k)))
          active(k) = any(.not. is_empty(y(:, k)))
@@ -188,10 +206,78 @@ contains
          'axes. Empty cells and values <= 0 are skipped: a log scale cannot show them.', &
          skipped_comment(x, y, active, levels), title)
       do p = 1, 2
-         svg = svg//panel(p, x(:, p), y, active, cumulative)
+         svg = svg//panel(p, x(:, p), y, active, rate)
       end do
-      svg = svg//legend(report_styles(), active)//'</g>'//nl//'</svg>'//nl
+      styles(:n_series) = report_styles()
+      shown(:n_series) = active
+      k = reference_series(active)
+      shown(n_series + 1) = .not. is_empty(rate) .and. k > 0
+      shown(n_series + 2) = k > 0
+      styles(n_series + 1)%name = 'reference'
+      styles(n_series + 1)%colour = reference_colour
+      styles(n_series + 1)%stroke = reference_stroke
+      styles(n_series + 1)%marker = marker_none
+      if (shown(n_series + 1)) styles(n_series + 1)%label = 'optimal rate p/d = '//inum(real(order, wp))//'/'// &
+         & inum(real(dim, wp))//' (dotted)'
+      styles(n_series + 2)%name = 'measured'
+      styles(n_series + 2)%colour = 'none'
+      styles(n_series + 2)%stroke = ''
+      styles(n_series + 2)%marker = marker_none
+      if (k > 0) styles(n_series + 2)%label = measured_rate(x(:, 2), y(:, k), trim(series_name(k)))
+      svg = svg//legend(styles, shown)//'</g>'//nl//'</svg>'//nl
    end function report_svg
+
+   !> The running sum of `t` (empty cells add nothing and stay empty).
+   pure function cumulative_time(t) result(c)
+      real(wp), intent(in) :: t(:)
+      real(wp) :: c(size(t)), total
+      integer :: i
+      total = 0.0_wp
+      do i = 1, size(t)
+         c(i) = t(i)
+         if (is_empty(t(i))) cycle
+         total = total + t(i)
+         c(i) = total
+      end do
+   end function cumulative_time
+
+   !> The series the rates refer to: err_fe, else eta_sprc, else eta_spr (0: none active).
+   pure integer function reference_series(active)
+      logical, intent(in) :: active(:)
+      integer, parameter :: preference(3) = [1, 5, 4]
+      integer :: k
+      reference_series = 0
+      do k = 1, size(preference)
+         if (.not. active(preference(k))) cycle
+         reference_series = preference(k)
+         return
+      end do
+   end function reference_series
+
+   !> The legend's words for the rate of `y` against the dofs `n` between the
+   !> last two rows where both can be shown on log axes: -d log y / d log n.
+   function measured_rate(n, y, name) result(text)
+      real(wp), intent(in) :: n(:), y(:)
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable :: text
+      integer :: i, last, before
+
+      last = 0
+      before = 0
+      do i = 1, size(n)
+         if (.not. (positive(n(i)) .and. positive(y(i)))) cycle
+         before = last
+         last = i
+      end do
+      text = 'measured rate of '//name//': '
+      if (before == 0) then
+         text = text//'needs two rows'
+      else if (.not. (n(last) > n(before) .or. n(last) < n(before))) then
+         text = text//'needs two dof counts'
+      else
+         text = text//fixed_text(-log(y(last)/y(before))/log(n(last)/n(before)), 2)//' (last two rows)'
+      end if
+   end function measured_rate
 
    !> The start of a page: XML declaration, svg element, a comment, `extra`
    !> (comments), title, white background, the group of text defaults, the
@@ -238,11 +324,12 @@ contains
       type(series_style_type) :: styles(n_contact_series)
       real(wp), allocatable :: x(:, :), p(:, :), s(:)
       integer, allocatable :: order(:), work(:)
+      logical, allocatable :: closed(:)
       logical :: active(n_contact_series)
       integer :: dim, k, n, stat
 
       styles = contact_styles()
-      call gather_points(contacts, x, p, error)
+      call gather_points(contacts, x, p, closed, error)
       if (allocated(error)) return
       dim = 2
       if (size(contacts) > 0) dim = contacts(1)%dim
@@ -257,13 +344,13 @@ contains
       end if
       call sort_order(s, order, work)
       if (dim == 2) call arc_length(x, order, s)
-      call loaded_window(s, p, order, n)
+      call contact_window(s, p, closed, order, n)
       do k = 1, n_contact_series
          active(k) = any(.not. is_empty(p(:, k)))
       end do
       call append(buf, page_open('sprc contact pressure along the slave surface (p = -n.sigma.n, positive in '// &
-         'compression). Empty values (not computed) are left out; the abscissa spans the loaded part of the '// &
-         'surface and a quarter of it on either side.', '', title))
+         'compression). Empty values (not computed) are left out; the abscissa spans the contact zone (the closed '// &
+         'points; without any, the loaded ones) and a quarter of it on either side.', '', title))
       call contact_panel(buf, s, p, order(:n), styles, active, dim == 2, error)
       if (allocated(error)) return
       call append(buf, legend(styles, active)//'</g>'//nl//'</svg>'//nl)
@@ -279,19 +366,21 @@ contains
       styles(4) = series_style_type('p_exact', '#000000', ' stroke-width="1.5"', marker_none)
    end function contact_styles
 
-   !> Every slave point of every pair: coordinates x(dim, n) and pressures
-   !> p(n, 4) in the order of `contact_styles`.
-   subroutine gather_points(contacts, x, p, error)
+   !> Every slave point of every pair: coordinates x(dim, n), pressures
+   !> p(n, 4) in the order of `contact_styles`, whether it is closed (stick or slip).
+   subroutine gather_points(contacts, x, p, closed, error)
       type(contact_result_type), intent(in) :: contacts(:)
       real(wp), allocatable, intent(out) :: x(:, :), p(:, :)
+      logical, allocatable, intent(out) :: closed(:)
       type(error_type), allocatable, intent(out) :: error
       integer :: k, n, m, dim, stat
 
       dim = 2
       if (size(contacts) > 0) dim = contacts(1)%dim
-      allocate (x(dim, sum(contacts%npoint)), p(sum(contacts%npoint), n_contact_series), stat=stat)
-      call check_allocation(stat, 'contact SVG', 'the slave points', sum(contacts%npoint), 8*(dim + n_contact_series), &
-         & error)
+      allocate (x(dim, sum(contacts%npoint)), p(sum(contacts%npoint), n_contact_series), &
+         & closed(sum(contacts%npoint)), stat=stat)
+      call check_allocation(stat, 'contact SVG', 'the slave points', sum(contacts%npoint), &
+         & 8*(dim + n_contact_series) + 4, error)
       if (allocated(error)) return
       n = 0
       do k = 1, size(contacts)
@@ -301,6 +390,7 @@ contains
          p(n + 1:n + m, 2) = contacts(k)%p_spr
          p(n + 1:n + m, 3) = contacts(k)%p_sprc
          p(n + 1:n + m, 4) = contacts(k)%p_exact
+         closed(n + 1:n + m) = contacts(k)%state(:m) /= contact_open
          n = n + m
       end do
    end subroutine gather_points
@@ -349,30 +439,35 @@ contains
    end subroutine arc_length
 
    !> The points to plot: of `order` (s ascending), the first `m` on return are
-   !> those within a quarter of the loaded stretch (where some pressure exceeds
-   !> 1e-3 of the largest) on either side of it, in the same order, so that a
-   !> Hertz contact a few per cent of the surface long fills the picture; every
-   !> point when nothing is loaded.
-   pure subroutine loaded_window(s, p, order, m)
+   !> those within the contact zone and a quarter of its length on either side,
+   !> in the same order, so that a Hertz contact a few per cent of the surface
+   !> long fills the picture. The zone is the stretch of the closed points;
+   !> without any, of the loaded ones (some pressure above 1e-3 of the
+   !> largest); without either, every point is plotted.
+   pure subroutine contact_window(s, p, closed, order, m)
       real(wp), intent(in) :: s(:), p(:, :)
+      logical, intent(in) :: closed(:)
       integer, intent(inout) :: order(:)
       integer, intent(out) :: m
       real(wp) :: p_max, lo, hi, margin
       integer :: i, j
+      logical :: in_zone(size(s))
 
       m = size(order)
-      p_max = 0.0_wp
-      do i = 1, size(s)
-         p_max = max(p_max, maxval(abs(p(i, :)), mask=.not. is_empty(p(i, :))))
-      end do
-      if (.not. (p_max > 0.0_wp)) return
-      lo = huge(1.0_wp)
-      hi = -huge(1.0_wp)
-      do i = 1, size(s)
-         if (.not. any(abs(p(i, :)) > 1.0e-3_wp*p_max .and. .not. is_empty(p(i, :)))) cycle
-         lo = min(lo, s(i))
-         hi = max(hi, s(i))
-      end do
+      if (any(closed)) then
+         in_zone = closed
+      else
+         p_max = 0.0_wp
+         do i = 1, size(s)
+            p_max = max(p_max, maxval(abs(p(i, :)), mask=.not. is_empty(p(i, :))))
+         end do
+         if (.not. (p_max > 0.0_wp)) return
+         do i = 1, size(s)
+            in_zone(i) = any(abs(p(i, :)) > 1.0e-3_wp*p_max .and. .not. is_empty(p(i, :)))
+         end do
+      end if
+      lo = minval(s, mask=in_zone)
+      hi = maxval(s, mask=in_zone)
       margin = 0.25_wp*(hi - lo)
       if (.not. (margin > 0.0_wp)) margin = 0.05_wp*(s(order(size(order))) - s(order(1)))
       m = 0
@@ -382,7 +477,7 @@ contains
          m = m + 1
          order(m) = j
       end do
-   end subroutine loaded_window
+   end subroutine contact_window
 
    !> In 3D, s is the distance of each point from the point of largest exact pressure
    !> (largest FE pressure without an exact one; the first point without either).
@@ -645,19 +740,18 @@ contains
    end function skipped_comment
 
    !> One panel: frame, grid, decade ticks and labels, axis titles, series.
-   function panel(p, x, y, active, cumulative) result(text)
+   !> In panel 2 (dofs), a `rate` not empty draws the reference line of slope -rate.
+   function panel(p, x, y, active, rate) result(text)
       integer, intent(in) :: p
       real(wp), intent(in) :: x(:), y(:, :)
       logical, intent(in) :: active(:)
-      !> Panel 1's abscissa is the cumulative run time.
-      logical, intent(in) :: cumulative
+      real(wp), intent(in) :: rate
       character(len=:), allocatable :: text
       logical :: valid(size(x), n_series)
       type(axis_type) :: ax, ay
       type(series_style_type) :: styles(n_series)
       real(wp) :: x0, left, right, xs(size(x)), ys(size(x))
       integer :: k, i, m
-      character(len=:), allocatable :: pts
 
       styles = report_styles()
       x0 = (p - 1)*panel_width
@@ -670,8 +764,8 @@ contains
          '" font-size="14" text-anchor="middle">'//pick(p == 1, 'error against run time', &
          'error against dofs')//'</text>'//nl
       text = text//'<text x="'//num((left + right)/2)//'" y="'//num(plot_bottom + 42)// &
-         '" text-anchor="middle">'//pick(p == 1, pick(cumulative, 'cumulative run time, sum of t_total [s]', &
-         'run time t_total [s]'), 'degrees of freedom')//'</text>'//nl// &
+         '" text-anchor="middle">'//pick(p == 1, 'cumulative run time, sum of t_total [s]', &
+         'degrees of freedom')//'</text>'//nl// &
          '<text x="'//num(x0 + 22)//'" y="'//num((plot_top + plot_bottom)/2)//'" text-anchor="middle" '// &
          'transform="rotate(-90 '//num(x0 + 22)//' '//num((plot_top + plot_bottom)/2)//')">relative error</text>'//nl
       if (.not. any(valid)) then
@@ -682,6 +776,9 @@ contains
       ax = log_axis(pack(spread(x, 2, n_series), valid))
       ay = log_axis(pack(y, valid))
       text = text//ticks(ax, left, right, .true.)//ticks(ay, left, right, .false.)//frame(left, right)
+      k = reference_series(any(valid, dim=1))
+      if (p == 2 .and. .not. is_empty(rate) .and. k > 0) text = text//reference_line(ax, ay, left, right, &
+         & pack(x, valid(:, k)), pack(y(:, k), valid(:, k)), rate)
       do k = 1, n_series
          m = 0
          do i = 1, size(x)
@@ -697,6 +794,28 @@ contains
       end do
       text = text//'</g>'//nl
    end function panel
+
+   !> The reference line of slope -rate on log axes through the point a factor
+   !> 2 below the last of (xv, yv), clipped to the panel.
+   function reference_line(ax, ay, left, right, xv, yv, rate) result(text)
+      type(axis_type), intent(in) :: ax, ay
+      real(wp), intent(in) :: left, right, xv(:), yv(:), rate
+      character(len=:), allocatable :: text
+      real(wp) :: lx, ly, lo, hi
+
+      text = ''
+      lx = log10(xv(size(xv)))
+      ly = log10(yv(size(yv))/2)
+      ! log10 y = ly - rate*(s - lx) within [ay%lo, ay%hi] for s in [lo, hi]
+      lo = max(real(ax%lo, wp), lx + (ly - ay%hi)/rate)
+      hi = min(real(ax%hi, wp), lx + (ly - ay%lo)/rate)
+      if (.not. (hi > lo)) return
+      text = '<line class="reference-slope" x1="'//num(map(ax, 10.0_wp**lo, left, right))//'" y1="'// &
+         & num(map(ay, 10.0_wp**(ly - rate*(lo - lx)), plot_bottom, plot_top))//'" x2="'// &
+         & num(map(ax, 10.0_wp**hi, left, right))//'" y2="'// &
+         & num(map(ay, 10.0_wp**(ly - rate*(hi - lx)), plot_bottom, plot_top))//'" stroke="'//reference_colour// &
+         & '"'//reference_stroke//'/>'//nl
+   end function reference_line
 
    !> True where v is a value a log axis can show.
    elemental logical function positive(v)
@@ -832,27 +951,80 @@ contains
       end if
    end function series_stroke
 
-   !> One row of legend entries under the panels, centred: the active series.
+   !> Legend entries under the panels, the active series in rows of at most
+   !> the page's width, each row centred: a line and marker (none for a
+   !> colour 'none': words only) and the series' words.
    function legend(styles, active) result(text)
       type(series_style_type), intent(in) :: styles(:)
       logical, intent(in) :: active(:)
       character(len=:), allocatable :: text
-      real(wp), parameter :: entry_width = 130.0_wp, y = 450.0_wp
-      real(wp) :: x
-      integer :: k
+      real(wp), parameter :: top = 440.0_wp, row_height = 24.0_wp, room = page_width - 40.0_wp
+      real(wp) :: width(size(styles)), x, y
+      integer :: k, first, last
 
       text = ''
-      if (.not. any(active)) return
-      x = (page_width - count(active)*entry_width)/2
       do k = 1, size(styles)
-         if (.not. active(k)) cycle
-         text = text//'<line x1="'//num(x)//'" y1="'//num(y)//'" x2="'//num(x + 36)//'" y2="'//num(y)// &
-            '" stroke="'//styles(k)%colour//'"'//styles(k)%stroke//'/>'//nl// &
-            marker(styles(k), x + 18, y, 'legend')// &
-            '<text x="'//num(x + 44)//'" y="'//num(y + 4)//'">'//styles(k)%name//'</text>'//nl
-         x = x + entry_width
+         width(k) = 0.0_wp
+         if (active(k)) width(k) = entry_width(styles(k))
+      end do
+      y = top
+      first = 1
+      do while (first <= size(styles))
+         last = first
+         do while (last < size(styles))
+            if (sum(width(first:last + 1)) > room) exit
+            last = last + 1
+         end do
+         x = (page_width - sum(width(first:last)))/2
+         do k = first, last
+            if (.not. active(k)) cycle
+            text = text//legend_entry(styles(k), x, y)
+            x = x + width(k)
+         end do
+         if (any(active(first:last))) y = y + row_height
+         first = last + 1
       end do
    end function legend
+
+   !> The legend's words of a series.
+   function legend_label(style) result(label)
+      type(series_style_type), intent(in) :: style
+      character(len=:), allocatable :: label
+      label = style%name
+      if (allocated(style%label)) label = style%label
+   end function legend_label
+
+   !> Width in px of a legend entry: the sample line and the words (about 6.5 px
+   !> per character at font size 12; UTF-8 continuation bytes are no characters).
+   function entry_width(style) result(w)
+      type(series_style_type), intent(in) :: style
+      real(wp) :: w
+      character(len=:), allocatable :: label
+      integer :: i, n
+      label = legend_label(style)
+      n = 0
+      do i = 1, len(label)
+         if (iand(ichar(label(i:i)), 192) /= 128) n = n + 1
+      end do
+      w = 6.5_wp*n + merge(24.0_wp, 68.0_wp, style%colour == 'none')
+   end function entry_width
+
+   !> One legend entry at (x, y).
+   function legend_entry(style, x, y) result(text)
+      type(series_style_type), intent(in) :: style
+      real(wp), intent(in) :: x, y
+      character(len=:), allocatable :: text
+      if (style%colour == 'none') then
+         text = '<text class="legend '//style%name//'" x="'//num(x)//'" y="'//num(y + 4)//'">'// &
+            & escape(legend_label(style))//'</text>'//nl
+         return
+      end if
+      text = '<line x1="'//num(x)//'" y1="'//num(y)//'" x2="'//num(x + 36)//'" y2="'//num(y)// &
+         '" stroke="'//style%colour//'"'//style%stroke//'/>'//nl// &
+         marker(style, x + 18, y, 'legend')// &
+         '<text class="legend '//style%name//'" x="'//num(x + 44)//'" y="'//num(y + 4)//'">'// &
+         & escape(legend_label(style))//'</text>'//nl
+   end function legend_entry
 
    !> `a` if `condition`, else `b`.
    pure function pick(condition, a, b) result(s)
