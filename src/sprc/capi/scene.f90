@@ -1,4 +1,4 @@
-!> C API, scenes: run the study of a scene file (SCENE.md) and return its
+!> C API, scenes: run the study of a scene file (doc/scene.md) and return its
 !> report. The C run writes no files, whatever the scene's `output`; it
 !> computes exactly what `sprc run` computes and reports, on the threads
 !> the driver would use (`sprc_capi_study`).

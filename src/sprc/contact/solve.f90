@@ -1,17 +1,21 @@
 !> The coupled FE solve of one contact pair: both bodies' reduced systems in
 !> one block system plus the contact terms on the slave surface points
-!> (seed eqs. 2-5, Tur et al. 2015; SCENE.md `&contact`).
+!> (thesis eqs. 2-5, Tur et al. 2015; doc/theory.md, section 6; doc/scene.md
+!> `&contact`).
 !>
-!> Formulation. Seed eq. 5 adds to the potential energy of both bodies
-!>   int_Gc lambda.g  -  int_Gc 1/(2 gamma) |lambda - p_N(u)|^2,   gamma = kappa E/h,
-!> with the multiplier lambda the contact traction on the slave body (its
-!> normal part lambda_n <= 0 in compression), p_N the stabilization traction
-!> and g the gap (frictionless: the normal gap g_n = g0 + (u_m - u_s).n, with
-!> lambda and p_N their normal parts; stick: the vector g = g0 n + u_m - u_s).
-!> Here p_N is the slave body's FE traction sigma(u_s) n (a Nitsche-type
-!> method) or, with `recovered`, a known traction: the slave body's
-!> recovered traction sigma* n of the previous solution (Tur's variant,
-!> below).
+!> Formulation: the stabilized multiplier of thesis eq. 5 (with the sign
+!> erratum), gamma = kappa E_s/h, p_N the slave's FE traction (Nitsche-type)
+!> or, with `recovered`, its recovered traction of the previous solution.
+!> The multiplier is P0 on contact cells (slave aggregates sharing a parent
+!> cell, spanning at least two master cells where those are larger): P0 on
+!> the slave cells is not inf-sup stable against the trace (the pressure
+!> alternates from cell to cell), and a constraint per quadrature point
+!> over-constrains the interface. It is eliminated cell by cell,
+!> lambda_c = pbar + gamma gbar; the cell's block is the second variation of
+!> W_c [pbar.gbar + gamma/2 |gbar|^2] - 1/(2 gamma) sum_i w_i |p_N,i - pbar|^2.
+!> The system is SPD when gamma exceeds the slave traction's trace-inverse
+!> bound; `default_kappa` (sprc_study_spec) is the centre in decades of the
+!> plateau where err_fe and p_max do not depend on kappa.
 !>
 !> Discrete multiplier space: lambda constant on each contact cell c (P0): the
 !> slave points with a master point whose slave aggregates (cell
@@ -138,22 +142,11 @@
 !> two directions for ever (a roller under a normal then a tangential load).
 !> The rigid-mode check uses the system without the friction terms.
 !>
-!> Recovered stabilization (Tur et al. 2015; SCENE.md `stabilization =
-!> 'recovered'`). p_N is a given traction p*_i per point (the caller's
-!> recovery of the previous solution), not a function of u. Then
-!> lambda_c = pbar* + gamma gbar and the cell's energy is
-!>   W_c [pbar*.gbar + gamma/2 |gbar|^2]   (+ a constant),
-!> so the cell's block is the penalty W gamma G^T G alone (the symmetric
-!> Nitsche terms T^T G + G^T T and the variance term drop out) and the known
-!> traction moves to the load: -W G^T (pbar* + gamma g0bar). The matrix
-!> depends on the active set only, not on p*: an update of p* with the same
-!> set changes the load alone. It is SPD for every gamma > 0 (no trace
-!> inverse bound to beat), and with p* the exact traction the exact solution
-!> satisfies it (gbar = 0, lambda = p*): the method is consistent when the
-!> recovery is exact. Frictionless and stick; Coulomb is refused. A caller
-!> that updates p* passes a `contact_factor_type`: the solve starts from the
-!> active set of the previous one and, while the set repeats, reuses its
-!> CHOLMOD factor (one back substitution per update, no assembly).
+!> Recovered stabilization (`stabilization = 'recovered'`): the cell's block
+!> is the penalty W gamma G^T G alone and p* moves to the load, SPD for every
+!> gamma > 0 and consistent when the recovery is exact; frictionless and
+!> stick only. With a `contact_factor_type` the CHOLMOD factor is reused
+!> while the active set repeats (one back substitution per update).
 module sprc_contact_solve
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_not_converged, stat_singular, &
@@ -185,7 +178,7 @@ module sprc_contact_solve
       end subroutine contact_progress
    end interface
 
-   !> Friction laws (SCENE.md `friction`).
+   !> Friction laws (doc/scene.md `friction`).
    integer, parameter :: friction_frictionless = 0, friction_stick = 1, friction_coulomb = 2
    !> Active-set iterations before giving up.
    integer, parameter :: default_max_iterations = 50
@@ -272,7 +265,7 @@ module sprc_contact_solve
 
 contains
 
-   !> The friction constant of a SCENE.md `friction` name (-1 if unknown).
+   !> The friction constant of a doc/scene.md `friction` name (-1 if unknown).
    pure integer function friction_kind(name)
       character(len=*), intent(in) :: name
       select case (name)

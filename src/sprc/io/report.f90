@@ -1,4 +1,4 @@
-!> The study report (SCENE.md "Report"): one row per level, printed as a
+!> The study report (doc/scene.md "The report"): one row per level, printed as a
 !> fixed-width table and written as a CSV file whose reals round-trip bit for
 !> bit; a CSV reader for tests and comparisons. The SVG plot of the same rows
 !> is `sprc_io_svg`.
@@ -25,7 +25,7 @@ module sprc_io_report
    !> contact columns, `solver_iterations` and the 2 adaptive columns.
    integer, parameter :: n_report_columns = 32
 
-   !> Column names, in the contract's order (SCENE.md "Report").
+   !> Column names, in the contract's order (doc/scene.md "The report").
    character(len=18), parameter :: report_columns(n_report_columns) = [character(len=18) :: &
       & 'level', 'h', 'elements', 'cut_elements', 'dofs', 't_mesh', 't_quadrature', 't_assembly', &
       & 't_solve', 't_recovery', 't_estimate', 't_total', 'err_fe', 'err_spr', 'err_sprc', &
@@ -41,7 +41,7 @@ module sprc_io_report
    integer, parameter :: n_base_columns = 19, first_contact_column = 20, last_contact_column = 29, &
       & first_adapt_column = 31
 
-   !> The CSV header of the columns every report starts with, exactly as SCENE.md
+   !> The CSV header of the columns every report starts with, exactly as doc/scene.md
    !> states it (`report_header` gives a report's whole header).
    character(len=*), parameter :: report_csv_header = 'level,h,elements,cut_elements,dofs,t_mesh,'// &
       & 't_quadrature,t_assembly,t_solve,t_recovery,t_estimate,t_total,err_fe,err_spr,err_sprc,'// &
@@ -607,7 +607,7 @@ contains
       end if
    end subroutine read_line
 
-   !> `level=4 body=cylinder internal=1234 cut=210 external=604 ...` (SCENE.md).
+   !> `level=4 body=cylinder internal=1234 cut=210 external=604 ...` (doc/scene.md).
    function format_mesh_row(row) result(line)
       type(mesh_row_type), intent(in) :: row
       character(len=:), allocatable :: line

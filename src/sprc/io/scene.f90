@@ -1,4 +1,4 @@
-!> Scene files (SCENE.md): read every group, validate everything before any
+!> Scene files (doc/scene.md): read every group, validate everything before any
 !> computation, and describe what the scene switches on and off.
 !>
 !> Every error names the file, line, group, field and offending value, e.g.
@@ -118,7 +118,7 @@ contains
       call read_adapt(groups, scene, error)
    end subroutine read_scene_text
 
-   !> The built-in default scene: the Lamé cylinder study of SCENE.md,
+   !> The built-in default scene: the Lamé cylinder study of doc/scene.md,
    !> byte-identical to example/scenes/lame_cylinder.nml.
    function default_scene_text() result(text)
       character(len=:), allocatable :: text
@@ -515,7 +515,7 @@ contains
    !> The last of `bcs` against the earlier ones on its surface (their groups on
    !> lines `line_of`): a surface takes several &bc only as loads of one type
    !> (pressure, traction or displacement), each in its own stage; their loads
-   !> add up (SCENE.md `&bc stage`).
+   !> add up (doc/scene.md `&bc stage`).
    subroutine check_same_surface(g, bcs, line_of, error)
       type(nml_group_type), intent(in) :: g
       type(bc_spec_type), intent(in) :: bcs(:)
@@ -1139,7 +1139,7 @@ contains
    ! -------------------------------------------------------------- summary
 
    !> The validated scene, defaults filled in, and what it switches on and
-   !> off (SCENE.md); lines separated by new_line('a'), for `sprc check`.
+   !> off (doc/scene.md); lines separated by new_line('a'), for `sprc check`.
    function scene_summary(scene) result(text)
       type(scene_type), intent(in) :: scene
       character(len=:), allocatable :: text
@@ -1233,7 +1233,7 @@ contains
       end associate
    end function adapt_text
 
-   !> The list of SCENE.md 'What a scene switches on', one `label: state` per line.
+   !> The list of doc/scene.md 'What a scene switches on', one `label: state` per line.
    function switches(scene) result(text)
       type(scene_type), intent(in) :: scene
       character(len=:), allocatable :: text
@@ -1478,7 +1478,7 @@ contains
       text = text//', steps = '//itoa(c%steps)//', stabilization = '//c%stabilization
    end function contact_line
 
-   !> The contact part of 'what a scene switches on' (SCENE.md).
+   !> The contact part of 'what a scene switches on' (doc/scene.md).
    function contact_switches(scene) result(text)
       type(scene_type), intent(in) :: scene
       character(len=:), allocatable :: text

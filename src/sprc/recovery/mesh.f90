@@ -1,69 +1,35 @@
-!> SPR / SPR-C recovery and the ZZ estimate on a caller's own unstructured mesh (seed
+!> SPR / SPR-C recovery and the ZZ estimate on a caller's own unstructured mesh (thesis
 !> eqs. 1, 8-11, 19-24, 99-102; Figure 15 for patch expansion). For legacy FE codes: the
 !> mesh is plain arrays, the result one object (`mesh_recovery_type`, opaque to bindings).
 !>
-!> Input (`recover_on_mesh`): nodes(dim, nnode); one element type for the whole mesh
-!> (sprc_recovery_mesh_element: tri3, quad4, quad9, tet4, hex8, hex27; VTK codes and VTK node
-!> order) with connectivity(nen, nelem) of 1-based node indices; per element ngp
-!> integration points with physical coordinates gp(dim, ngp, nelem), weights times |J|
-!> gw(ngp, nelem) > 0 and FE stresses gs(nstress, ngp, nelem) (Voigt: 2D xx, yy, xy; 3D
-!> xx, yy, zz, xy, yz, xz); analysis (plane_stress 1, plane_strain 2, solid 3), E, nu;
-!> method (mesh_method_spr 1, mesh_method_sprc 2); optionally a constant body force
-!> (div sigma + b = 0) and boundary facets. Every point must lie in its element (checked by
-!> the inverse isoparametric map, tolerance 1e-6 in reference coordinates). A caller that
-!> has the points' reference coordinates passes them (gauss_xi): they are checked (inside,
-!> and mapped onto the point) instead of derived by Newton's method. Their convention
-!> (`reference`): mesh_reference_unit, quads and hexes on [0, 1]^dim (the default, the element
-!> library's), or mesh_reference_symmetric, on [-1, 1]^dim (most FE codes'; mapped onto
-!> [0, 1]^dim once); tri3 and tet4 are the unit simplex in both. A point outside the chosen
-!> cell is an error that names the convention. Two used nodes
-!> at one point and two elements on the same vertices are input errors.
+!> Input (`recover_on_mesh`, whose arguments say the shapes): one element type for the mesh
+!> (sprc_recovery_mesh_element: tri3, quad4, quad9, tet4, hex8, hex27; VTK codes and node
+!> order), 1-based connectivity, per element the integration points, weights times |J| and
+!> FE stresses (Voigt), the material and method, optionally a body force and boundary
+!> facets. Every point must lie in its element (inverse isoparametric map, 1e-6 in reference
+!> coordinates). Given reference coordinates `gauss_xi` are checked instead, in the
+!> convention `reference` names (mesh_reference_unit [0, 1]^dim, the default, or
+!> mesh_reference_symmetric [-1, 1]^dim; simplices are the unit simplex in both). Two used
+!> nodes at one point and two elements on the same vertices are input errors.
 !>
-!> Facets: facet_nodes(nfn, nfacet) (a side of an element: line2 / line3 in 2D, tri3 /
-!> quad4 / quad9 faces in 3D, nfn fixed by the element type, VTK order for the quadratic
-!> ones), facet_kind(nfacet) (facet_traction 1 with the constant vector facet_traction(:, f);
-!> facet_symmetry 2; facet_free 3 = traction zero; facet_pressure 4 with p = facet_traction(1, f):
-!> t = -p n with the facet's own outward normal at each of its points, so that the traction
-!> turns along a curved facet). A facet is a side (face) of exactly one element, its nodes
-!> in any order (element_facet_order: on one face of the reference cell; else an error naming
-!> facet_nodes(:, f): a diagonal, an interior side, nodes of no one element). Its quadrature
-!> points (sprc_recovery_mesh_element) follow the caller's node order if it parametrises the
-!> facet, else the face's own, and get normals oriented away from that element's vertex
-!> centroid, so the caller's facet node order matters for neither. Boundary
-!> constraints apply only where the caller gives facets: a surface without facets is not
-!> constrained. SPR ignores facets (they are validated all the same). All traction and free
-!> facets form boundary piece 1 and all symmetry facets piece 2: the recovery core
-!> separates faces within a piece by their normals (box corners) and symmetry points into
-!> planes, and caps the traction rank per flat face.
+!> Facets: each a side of exactly one element, nodes in any order (else an error naming
+!> it); kinds traction, symmetry, free, pressure (turning with a curved facet's normal).
+!> Normals point away from the element's vertex centroid. Only surfaces given as facets are
+!> constrained; SPR validates and ignores them. Traction and free facets are boundary piece
+!> 1, symmetry facets piece 2: the core separates faces and planes by their normals.
 !>
-!> Patches: one per vertex node (a node in a vertex position of some element), holding the
-!> elements that contain the node (in element order); x0 = the node, h = the largest
-!> distance from x0 to a node of those elements. SPR-C adds the boundary points of facets
-!> owned by those elements. A patch whose basis matrix lacks rank is expanded by one ring
-!> (every element sharing a node with the patch) up to `max_rounds` times (default
-!> mesh_default_max_rounds = 3), as on the grid (sprc_grid_patches). Degree: unless `degree`
-!> is given, 'auto' (sprc_recovery_patch_loop's auto_degree): SPR at the element degree p
-!> (1 for tri3, quad4, tet4, hex8; 2 for quad9, hex27), SPR-C at p + 1 for quad9 and hex27
-!> and at p for the linear elements.
+!> Patches: one per vertex node, holding the elements that contain it; h = the largest
+!> distance from the node to a node of those elements; SPR-C adds the facets' points of
+!> those elements. A rank-deficient patch grows by rings up to `max_rounds` (default
+!> mesh_default_max_rounds), as on the grid. Degree 'auto' is `auto_degree`'s.
 !>
-!> Output fields:
-!> - nodal(nstress, nnode): at a vertex node its patch polynomial at the node (SPR and SPR-C
-!>   alike: the union equals it there); at a mid-side / face / centre node of quad9 / hex27
-!>   the union (eq. 102) at the node in its first element (the linear vertex partition of
-!>   unity restricted to a shared side is the same in both elements). Nodes referenced by
-!>   no element get zero.
-!> - the recovered field sigma*(x): SPR the nodal interpolation sum_a N_a(xi) nodal(:, a)
-!>   with the element's own shape functions (eq. 101); SPR-C the union
-!>   sum_J Nv_J(xi) sigma*_J(x) over the element's vertices (eq. 102).
-!> - elem_err(e) = sqrt(sum_i gw (s* - s_h)^T D^-1 (s* - s_h)) over the caller's points of e,
-!>   elem_norm_h(e) the same of s_h; err = sqrt(sum elem_err^2), norm_h likewise,
-!>   eta = err / sqrt(norm_h^2 + err^2); all scaled by powers of two before squaring, so
-!>   any finite stresses give finite results (same bits as the plain formulas otherwise).
-!> Evaluation at points (`mesh_recovery_eval`): with the element of each point given, one
-!> inverse map per point; otherwise a search over the elements whose bounding box holds the
-!> point, one inverse map per candidate, the lowest-index element holding it: with 4 or more
-!> points to search, among the elements of the point's bin (sprc_recovery_mesh_bins, built
-!> per call in O(nelem)), else over all elements.
+!> Output: nodal values (a vertex node's patch polynomial at the node; a mid-side, face or
+!> centre node the union, eq. 102, in its first element; unused nodes zero); the field
+!> sigma*(x) (SPR: nodal interpolation, eq. 101; SPR-C: the union, eq. 102); the element
+!> and total ZZ errors and eta = err / sqrt(norm_h^2 + err^2), summed scaled by powers of
+!> two so any finite stresses give finite results (the plain formulas' bits otherwise).
+!> `mesh_recovery_eval` takes each point's element if given, else the lowest-index element
+!> holding it, searched through bins (sprc_recovery_mesh_bins) from 4 points on.
 !>
 !> Parallelism and determinism: the patch loop is sprc_recovery_patch_loop's (shared with
 !> the grid); the bits do not depend on the thread count.
@@ -1055,7 +1021,7 @@ contains
       end do
       !$omp end do
       !$omp end parallel
-      ! Scaled sums: finite stresses never overflow to NaN (issue 13, defect 2).
+      ! Scaled sums: finite stresses never overflow to NaN.
       r%err = scaled_norm(r%elem_err)
       r%norm_h = scaled_norm(r%elem_norm_h)
       r%eta = relative_error(r%err, r%norm_h)

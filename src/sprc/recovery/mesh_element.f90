@@ -14,7 +14,7 @@
 !>   face (as quad9's 4..7), of the top face, then of the vertical edges above corners 0..3;
 !>   face centres x=0, x=1, y=0, y=1, z=0, z=1; the centre.
 !> The vertices are the first 2^dim (dim+1 for simplices) nodes; the vertex partition of
-!> unity (for the polynomial union, seed eq. 102) is the linear element on them (quad4 for
+!> unity (for the polynomial union, thesis eq. 102) is the linear element on them (quad4 for
 !> quad9, hex8 for hex27).
 !>
 !> Facets (boundary pieces the caller names by their nodes) by their node count:

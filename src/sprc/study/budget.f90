@@ -9,30 +9,21 @@
 !> those into 2^(dim refine_boundary). An upper estimate of the cells (the
 !> cut cells at level c count whole).
 !> Dofs: dim nodes per cell for Q1, dim 2^dim for Q2.
-!> Bytes: peak resident memory measured with the release build on the
-!> example scenes (Lame cylinder, Lame sphere; Q1, Q2): about 25 MB plus, in
-!> 2D, 2.3 kB per dof (Q1 level 8, 62k dofs: 171 MB; Q2 level 7, 63k dofs:
-!> 155 MB) and, in 3D, where the Cholesky factor fills more, 6 kB per dof at
-!> 4e3 dofs and 10 kB at 2.7e4 (Q1 levels 4, 5: 49 MB, 295 MB), i.e. growing
-!> as dofs^(1/3), and 1.2-1.75 times that for Q2 (levels 3, 4: 69 MB, 373 MB).
-!> The estimate below takes the upper figures: 32 MB + dofs * 2.5 kB (2D) or
-!> 10 kB (dofs / 3e4)^(1/3) (3D; times 1.75 for Q2).
-!> A 3D level that the solver choice sends to the iterative solver (PETSc CG +
-!> GAMG, `use_iterative`) has no Cholesky factor: measured 7.2 kB per dof at
-!> 1.5e5 dofs (1.1 GB) and 7.0 kB at 1.16e6 (8.17 GB) on the Q1 sphere
-!> octant; the estimate takes 8 kB per dof (times 1.75 for Q2). With
+!> Bytes: an upper fit of the peak resident memory of the release build on
+!> the example scenes (doc/benchmarks.md): 32 MB + dofs * 2.5 kB (2D) or
+!> 10 kB (dofs / 3e4)^(1/3) (3D, where the Cholesky factor fills more; times
+!> 1.75 for Q2). A 3D level sent to the iterative solver (`use_iterative`)
+!> has no factor: 8 kB per dof (times 1.75 for Q2). With
 !> `solver = 'auto'`, a 3D level whose direct estimate exceeds the memory
 !> available is solved iteratively (`check_level_memory`'s `solver`), and
 !> estimated so.
-!> The grid and its quadrature alone (`sprc mesh`, `grid_only`): about 12 MB
-!> plus 105 bytes per active cell (sphere octant level 7: 5.1e5 cells, 66 MB;
-!> cylinder quarter level 10: 5.0e5 cells, 64 MB); the estimate takes 16 MB +
-!> 128 bytes per cell.
+!> The grid and its quadrature alone (`sprc mesh`, `grid_only`): 16 MB + 128
+!> bytes per cell.
 !> Under an address-space limit (ulimit -v) the virtual size counts, and
 !> OpenBLAS reserves a buffer of 128 MiB for each thread that calls it, when it
 !> first does (sprc_core_blas_threads); without that reserve a level that
-!> passed the check hung in OpenBLAS's retry loop of blas_memory_alloc (3D
-!> level 5 under ulimit -v 600000). Buffers already taken
+!> passed the check hung in OpenBLAS's retry loop of blas_memory_alloc.
+!> Buffers already taken
 !> (blas_reserve_buffers) are in the virtual size and do not count again.
 module sprc_study_budget
    !$ use omp_lib, only: omp_get_max_threads

@@ -1,7 +1,7 @@
 !> One level of a study (`sprc run`): for every body its cut mesh (grid,
 !> nodes, hanging-node constraints), cut-cell quadrature, FE solve, SPR /
 !> SPR-C recovery and ZZ estimate, and the level's report row with the norms
-!> summed over the bodies (SCENE.md "Report": ||.||^2 added, then the ratio).
+!> summed over the bodies (doc/scene.md "The report": ||.||^2 added, then the ratio).
 !>
 !> ```fortran
 !> call prepare_study(scene, points, study, error)   ! once: bodies, conditions, exact solutions
@@ -206,7 +206,7 @@ contains
       study%run = [scene%recovery == 'spr' .or. scene%recovery == 'both', &
          & scene%recovery == 'sprc' .or. scene%recovery == 'both']
       ! The error columns need a stress field: an exact kind that gives the
-      ! contact pressure only (hertz_*) leaves them empty (SCENE.md).
+      ! contact pressure only (hertz_*) leaves them empty (doc/scene.md).
       study%have_exact = .false.
       do b = 1, size(study%bodies)
          study%have_exact = study%have_exact .or. allocated(study%bodies(b)%exact)
@@ -556,7 +556,7 @@ contains
    !> the slave surface) by at most sqrt(eps) of its norm: the fixed point's
    !> own round-off tier, as the update contracts by about C_I/kappa (the
    !> traction operator's bound over the penalty). `sol%iterations` sums every
-   !> active-set iteration of every solve (SCENE.md contact_iterations), and
+   !> active-set iteration of every solve (doc/scene.md contact_iterations), and
    !> `sol%t_contact` the stabilization's recoveries (the stabilization
    !> traction is a contact term; t_recovery stays the reported fields'); an
    !> iteration that has not settled after default_max_iterations updates is
@@ -797,7 +797,7 @@ contains
             ! The direction of the contact's own tangential traction at the slave point (the
             ! multiplier, of magnitude mu p_fe on a slipping point), not that of the slave's FE
             ! stress there: near the edge of the contact zone the stress of a cut cell gave a
-            ! tangential traction of the wrong sign (Cattaneo-Mindlin level 3, x > 0.043).
+            ! tangential traction of the wrong sign (Cattaneo-Mindlin).
             t(1:d) = result%t_fe(:, inear)
             ! No tangential traction to give a direction: then mu p ~ 0, and stick is safe.
             if (.not. (norm2(t(1:d)) > sqrt(epsilon(1.0_wp))*abs(result%p_fe(inear)))) then
@@ -829,7 +829,7 @@ contains
          & minval(nodes%x(:, nodes%connectivity(1:nv, e)), dim=2))
    end function element_size
 
-   !> The load path of a Coulomb pair (SCENE.md `&bc stage`, `&contact
+   !> The load path of a Coulomb pair (doc/scene.md `&bc stage`, `&contact
    !> steps`): the block load at the end of each increment, stage k's loads
    !> applied in `steps` equal increments once the stages before it are
    !> applied. Stage k's cumulative loads come from an assembly of each body
@@ -944,7 +944,7 @@ contains
       end do
    end subroutine recovered_tractions
 
-   !> Action-reaction of a pair's stresses (seed eq. 107): over the closed slave points i with
+   !> Action-reaction of a pair's stresses (thesis eq. 107): over the closed slave points i with
    !> a master point, jump = sqrt(sum w_i (t1_i - t2_i)^2) / sqrt(sum w_i t1_i^2), with t1 the
    !> slave's normal traction n.sigma1.n at x_i and t2 the master's n.sigma2.n at its master
    !> point (n the slave normal): for the FE stresses, SPR and SPR-C (jump(m + 1), -1 where

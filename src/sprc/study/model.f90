@@ -356,7 +356,7 @@ contains
    !> The &bc groups on the surfaces of body `b` as FE conditions on the
    !> body's own shape indices (its shapes in file order of their first &bc);
    !> surfaces without &bc are free. A surface with several &bc (one load type,
-   !> one per stage; SCENE.md `&bc stage`) gets one condition carrying the sum
+   !> one per stage; doc/scene.md `&bc stage`) gets one condition carrying the sum
    !> of their loads; with `stage`, of those in stages <= stage only (the
    !> cumulative load at the end of that stage; the condition stays, with a
    !> zero load before its first stage).

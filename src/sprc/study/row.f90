@@ -1,4 +1,4 @@
-!> One row of a study's report (SCENE.md "Report"): what one level of the
+!> One row of a study's report (doc/scene.md "The report"): what one level of the
 !> study gives, summed over the bodies. `sprc_io_report` writes rows as a
 !> table and CSV, `sprc_io_svg` plots them.
 !>
@@ -14,7 +14,7 @@ module sprc_study_row
    public :: report_row_type, report_empty, is_empty
 
    !> One level of a study. Times are wall-clock seconds for that level alone;
-   !> errors and estimates are relative, in the energy norm (SCENE.md).
+   !> errors and estimates are relative, in the energy norm (doc/scene.md).
    !> Real components start empty: set only those that apply.
    type :: report_row_type
       integer :: level = 0
@@ -31,7 +31,7 @@ module sprc_study_row
       real(wp) :: eta_spr = report_empty, eta_sprc = report_empty
       !> Global effectivity indices.
       real(wp) :: theta_spr = report_empty, theta_sprc = report_empty
-      !> Contact columns (SCENE.md; only scenes with `&contact`, `has_contact`):
+      !> Contact columns (doc/scene.md; only scenes with `&contact`, `has_contact`):
       !> contact iterations summed over increments, contact time (search, gaps,
       !> contact terms), measure of the closed slave surface, maximum pressures and
       !> relative L2 pressure errors over the slave surface.

@@ -1,4 +1,4 @@
-!> What a scene asks for, as plain validated data (SCENE.md): the scene, its
+!> What a scene asks for, as plain validated data (doc/scene.md): the scene, its
 !> bodies, shapes, boundary conditions, exact solution and contact pairs.
 !> These are *specifications*: the geometry objects built from them live in
 !> `sprc_geometry_*`, the FE conditions in `sprc_fem_bc`. `sprc_io_scene`
@@ -16,28 +16,21 @@ module sprc_study_spec
    public :: default_kappa, default_stabilization, kappa_range, kappa_note
 
    !> Default of `&contact kappa`, the dimensionless factor of the contact
-   !> stabilization (effective stiffness kappa*E/h, seed eq. 5): the centre,
+   !> stabilization (effective stiffness kappa*E/h, thesis eq. 5): the centre,
    !> in decades, of the safe range `kappa_range`, so that every kappa from a
-   !> hundredth to a hundred times the default is safe (issue 11's four
-   !> decades; test kappa_decades). The previous default, 1000, had 10 in
-   !> them, where a stiff Q2 slave loses coercivity.
+   !> hundredth to a hundred times the default is safe (test kappa_decades);
+   !> a lower default put a stiff Q2 slave's loss of coercivity in that range.
    real(wp), parameter :: default_kappa = 1.0e4_wp
-   !> Safe range of `&contact kappa`, from sweeps 0.1 ... 1e12 (shrink fit
-   !> levels 5-7, Hertz roller levels 5-6; the stability study, README) and
-   !> 1 ... 1e8 at the finest levels (shrink fit Q1, and Q2 with a slave 1000
-   !> times stiffer; Hertz roller level 8; README "Contact"). Inside, err_fe
-   !> and p_max_fe do not move (0.02 %), err_p_fe moves by at most 1.6 %
-   !> except where it is itself near the round-off floor, which grows in
-   !> proportion to kappa. Below, the stabilization no longer dominates the
-   !> slave's trace-inverse bound (coercivity is lost: err_fe of the stiff Q2
-   !> slave grows by 30-160 % at 10). Above, the block system's rcond falls
-   !> in proportion to kappa until the rigid-mode check (1e10, shrink fit) or
-   !> the factorization (1e12, Hertz) fails.
+   !> Safe range of `&contact kappa` (sweeps in doc/benchmarks.md, "Contact"):
+   !> inside, err_fe and p_max_fe do not depend on kappa. Below, the
+   !> stabilization no longer dominates the slave's trace-inverse bound
+   !> (coercivity is lost); above, the block system's rcond falls in proportion
+   !> to kappa until the rigid-mode check or the factorization fails.
    real(wp), parameter :: kappa_range(2) = [100.0_wp, 1.0e6_wp]
    !> Lower end of the safe range with `stabilization = 'recovered'`, whose
    !> cell blocks are a plain penalty (no trace-inverse bound to beat): on the
-   !> shrink fit it settles down to kappa = 0.1 (22-26 updates) and stalls at
-   !> 0.01 (README "Contact").
+   !> shrink fit it settles down to kappa = 0.1 and stalls below
+   !> (doc/benchmarks.md, "Contact").
    real(wp), parameter :: kappa_min_recovered = 0.1_wp
    !> Default of `&contact stabilization`: the FE stress. At the default kappa
    !> the recovered variant gives the same results to 4 digits at 1.0-1.15x
@@ -106,7 +99,7 @@ module sprc_study_spec
       real(wp) :: value = 0.0_wp
       !> Traction or displacement (types 'traction', 'displacement'), `dim` values.
       real(wp), allocatable :: vector(:)
-      !> Load stage, >= 1: applied once the stages before it are (SCENE.md).
+      !> Load stage, >= 1: applied once the stages before it are (doc/scene.md).
       integer :: stage = 1
    end type bc_spec_type
 
