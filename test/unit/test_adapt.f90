@@ -567,14 +567,44 @@ contains
          end do
       end do
       e2 = 1.0_wp
-      ! p = 1, eta/eta_t = 4.4: r = 1/4.4, rounded up to 3 levels, clamped to 2; 3 when allowed
-      call optimal_levels(leaf, e2, 5000.0_wp, 0.04_wp/4.4_wp, 1, 2, 12, levels, error)
+      ! p = 1, eta/eta_t = 2**2.6: x = 2.6 levels, rounded up to 3, clamped to 2; 3 when allowed
+      call optimal_levels(leaf, e2, 5000.0_wp, 0.04_wp/2.0_wp**2.6_wp, 1, 2, 12, levels, error)
       if (allocated(error)) return
       call check(error, all(levels == 5 + default_max_change) .and. default_max_change == 2, 'clamped to 2 finer')
       if (allocated(error)) return
-      call optimal_levels(leaf, e2, 5000.0_wp, 0.04_wp/4.4_wp, 1, 2, 12, levels, error, max_change=3)
+      call optimal_levels(leaf, e2, 5000.0_wp, 0.04_wp/2.0_wp**2.6_wp, 1, 2, 12, levels, error, max_change=3)
       if (allocated(error)) return
-      call check(error, all(levels == 8), 'rounded up to 3 finer')
+      call check(error, all(levels == 8), 'x = 2.6: rounded up to 3 finer')
+      if (allocated(error)) return
+      ! A refinement rounds to the nearer error (module notes: up iff its fraction exceeds
+      ! theta_p = 0.339 for p = 1, 0.228 for p = 2), not always up: p = 1, x = 1.2 gives the
+      ! squared error 2**-2 eta^2 = 1.32 eta_t^2 at 1 level, 2**-4 eta^2 = 0.33 eta_t^2 at 2
+      ! levels; x = 1.4: 1.74 against 0.44 eta_t^2, 2 levels.
+      call optimal_levels(leaf, e2, 5000.0_wp, 0.04_wp/2.0_wp**2.14_wp, 1, 2, 12, levels, error, max_change=3)
+      if (allocated(error)) return
+      call check(error, all(levels == 7), 'x = 2.14: 2 finer, the nearer error')
+      if (allocated(error)) return
+      call optimal_levels(leaf, e2, 5000.0_wp, 0.04_wp/2.0_wp**1.2_wp, 1, 2, 12, levels, error)
+      if (allocated(error)) return
+      call check(error, all(levels == 6), 'p = 1, x = 1.2: 1 finer')
+      if (allocated(error)) return
+      call optimal_levels(leaf, e2, 5000.0_wp, 0.04_wp/2.0_wp**1.4_wp, 1, 2, 12, levels, error)
+      if (allocated(error)) return
+      call check(error, all(levels == 7), 'p = 1, x = 1.4: 2 finer')
+      if (allocated(error)) return
+      ! p = 2: x = log2(eta/eta_t)/2
+      call optimal_levels(leaf, e2, 5000.0_wp, 0.04_wp/2.0_wp**2.4_wp, 2, 3, 12, levels, error)
+      if (allocated(error)) return
+      call check(error, all(levels == 6), 'p = 2, x = 1.2: 1 finer')
+      if (allocated(error)) return
+      call optimal_levels(leaf, e2, 5000.0_wp, 0.04_wp/2.0_wp**2.5_wp, 2, 3, 12, levels, error)
+      if (allocated(error)) return
+      call check(error, all(levels == 7), 'p = 2, x = 1.25: 2 finer')
+      if (allocated(error)) return
+      ! no fraction above theta_p (x = 0.2 everywhere): rounded up, the step still refines
+      call optimal_levels(leaf, e2, 5000.0_wp, 0.04_wp/2.0_wp**0.2_wp, 1, 2, 12, levels, error)
+      if (allocated(error)) return
+      call check(error, all(levels == 6), 'x = 0.2 everywhere: 1 finer')
       if (allocated(error)) return
       ! at the target: r = 1, no change; a hair above: one level finer
       call optimal_levels(leaf, e2, 5000.0_wp, 0.04_wp, 1, 2, 12, levels, error)

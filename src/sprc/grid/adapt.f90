@@ -20,12 +20,21 @@
 !>
 !> Evaluated in base-2 logarithms (no overflow for any finite input; an
 !> element with zero estimate has r_K = huge). Size h = box / 2^level, so the
-!> level change is -log2 r_K, rounded up: the new level is the coarsest whose
-!> cells are no larger than the predicted size (a change within sqrt(eps) of
-!> an integer counts as that integer, far above the rounding of the logarithms
-!> and far below any size that matters). Rounding up never leaves an element
-!> coarser than predicted, and whenever η > η_t some r_K < 1, so a step always
-!> refines something. The change is clamped to [-1, max_change]
+!> level change is x_K = -log2 r_K, made an integer (a change within sqrt(eps)
+!> of an integer counts as that integer, far above the rounding of the
+!> logarithms and far below any size that matters). A coarsening (x_K <= 0)
+!> is rounded up: a cell never becomes coarser than predicted. A refinement
+!> is rounded to the nearer error, not up: c levels leave the region of K
+!> the error ‖e‖_K² 2^(-2pc) against the wanted ‖e‖_K² 2^(-2p x_K), and
+!> between ⌊x_K⌋ and ⌈x_K⌉ the finer is nearer iff the fraction of x_K exceeds
+!>
+!>     θ_p = -log2((1 + 2^(-2p))/2) / (2p)      (0.339 for p = 1, 0.228 for p = 2),
+!>
+!> so the errors of the new mesh sum to the target to first order. Rounding
+!> every refinement up instead lands the step well below the target with up
+!> to (2^d - 1)/(d ln 2) times the predicted cells (2.2 in 2D, 3.4 in 3D).
+!> Whenever η > η_t some x_K > 0; if no x_K exceeds θ_p, the refinements are
+!> rounded up, so a step always refines something. The change is clamped to [-1, max_change]
 !> (`default_max_change` = 2): where the local rate is below p (re-entrant
 !> corners, contact edges) ‖e‖_K does not fall like h^(p+d/2), and a one-shot
 !> prediction subdivides the whole of K many levels deep where only the cells
@@ -74,6 +83,7 @@ contains
       character(len=*), parameter :: who = 'optimal_levels: '
       real(wp), allocatable :: lr(:)
       integer :: up, k, change, stat
+      real(wp) :: theta
 
       up = default_max_change
       if (present(max_change)) up = max_change
@@ -88,15 +98,36 @@ contains
       call check_allocation(stat, 'optimal_levels', 'the levels', size(err_sq), 12, error)
       if (allocated(error)) return
       call log2_ratio(err_sq, norm_sq, target, degree, dim, lr)
+      theta = nearer_error_threshold(degree)
+      if (.not. any(err_sq > 0.0_wp .and. -lr > theta)) theta = 0.0_wp
       do k = 1, size(err_sq)
          if (err_sq(k) > 0.0_wp) then
-            change = max(-1, min(up, ceiling(-lr(k) - change_tol)))
+            change = max(-1, min(up, level_change(-lr(k), theta)))
          else
             change = -1
          end if
          levels(k) = max(0, min(max_level, leaf_level(k) + change))
       end do
    end subroutine optimal_levels
+
+   !> θ_p of the module notes: a refinement rounds up when the fraction of its
+   !> change exceeds it.
+   pure real(wp) function nearer_error_threshold(degree) result(theta)
+      integer, intent(in) :: degree
+      theta = -log((1.0_wp + 2.0_wp**(-2*degree))/2.0_wp)/(2*degree*log(2.0_wp))
+   end function nearer_error_threshold
+
+   !> The integer level change for the wanted change `x`: a coarsening rounded
+   !> up, a refinement rounded up when its fraction exceeds `theta` (0: always).
+   pure integer function level_change(x, theta) result(change)
+      real(wp), intent(in) :: x, theta
+      if (x <= change_tol) then
+         change = ceiling(x - change_tol)
+      else
+         change = floor(x + change_tol)
+         if (x - change > max(theta, change_tol)) change = change + 1
+      end if
+   end function level_change
 
    !> The predicted size ratio r_K = h_new / h_K of each element (module notes;
    !> huge for an element whose estimate is zero), before rounding and clamping.
