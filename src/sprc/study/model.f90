@@ -20,6 +20,7 @@ module sprc_study_model
    use sprc_exact_compound, only: compound_type, new_compound_cylinder, new_compound_sphere
    use sprc_exact_pressure, only: exact_pressure_type, field_pressure_type, new_field_pressure
    use sprc_exact_hertz, only: hertz_type, new_hertz_cylinder, new_hertz_sphere
+   use sprc_exact_corner, only: corner_type, new_corner
    use sprc_core_text, only: itoa, real_text
    use sprc_study_spec, only: scene_type, shape_spec_type, kappa_note
    use sprc_fem_bc, only: fe_bc_type, new_fe_bc, bc_kind_from_name
@@ -455,6 +456,13 @@ contains
             end select
          case ('compound_cylinder', 'compound_sphere')
             call build_compound_ring(scene, b, exact, error)
+         case ('corner')
+            allocate (corner_type :: exact)
+            select type (exact)
+            type is (corner_type)
+               call new_corner(exact, spec%point, spec%direction, spec%angle, spec%mode1, spec%mode2, young, nu, &
+                  & analysis_kind(scene), error)
+            end select
          case ('hertz_cylinder', 'hertz_sphere')
          case default
             call fatal_error(error, 'kind '''//spec%kind//''' is not available in this version', stat_unsupported)
