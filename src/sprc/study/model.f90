@@ -183,7 +183,7 @@ contains
             load = max(load, maxval([0.0_wp, abs(scene%bcs(i)%vector)]))
          case ('exact_traction', 'exact_displacement')
             load = max(load, abs(scene%exact%p_in), abs(scene%exact%p_out), abs(scene%exact%s_inf), &
-               & abs(scene%exact%interference))
+               & abs(scene%exact%interference), abs(scene%exact%mode1), abs(scene%exact%mode2))
             if (allocated(scene%exact%stress)) load = max(load, maxval([0.0_wp, abs(scene%exact%stress)]))
          end select
       end do
