@@ -73,7 +73,7 @@ module sprc_exact_corner
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_material, only: plane_stress, plane_strain
    use sprc_exact_solution, only: exact_solution_type, init_exact_solution, check_center, check_field, &
-      & is_finite
+      & is_finite, kolosov_constants
    implicit none
    private
 
@@ -298,12 +298,7 @@ contains
       integer :: k
 
       call local_polar(self, x, r, t)
-      mu = self%young/(2.0_wp*(1.0_wp + self%poisson))
-      if (self%analysis == plane_stress) then
-         kappa = (3.0_wp - self%poisson)/(1.0_wp + self%poisson)
-      else
-         kappa = 3.0_wp - 4.0_wp*self%poisson
-      end if
+      call kolosov_constants(self, mu, kappa)
       w = (0.0_wp, 0.0_wp)
       do k = 1, 2
          if (self%amplitude(k) == 0.0_wp) cycle
