@@ -192,9 +192,8 @@ contains
    !> The L-shape examples: the corner exact kind read (bisector normalised),
    !> its eigenvalues in the summary, and the apex at least 0.2 of a cell
    !> (0.19 allows for rounding) from every grid line at levels 0..20 (the
-   !> deepest an adaptive run may reach): the
-   !> convergence rate the examples show is that of a corner inside a cell,
-   !> not on a node or near a sliver.
+   !> deepest an adaptive run may reach): the convergence rate the examples
+   !> show is that of a corner inside a cell, not on a node or near a sliver.
    subroutine test_lshape(error)
       type(error_type), allocatable, intent(out) :: error
       type(scene_type) :: s
