@@ -15,6 +15,7 @@ program sprc_main
    use sprc_geometry_body, only: body_type
    use sprc_study_mesh, only: mesh_row_type, mesh_study, study_levels
    use sprc_study_level, only: study_type, prepare_study, run_level, level_type, hold_starts
+   use sprc_study_adapt, only: adapt_run_type, start_adapt, adapt_step, adapt_warning, step_eta
    use sprc_fem_nested, only: fe_displacement_type
    use sprc_io_report, only: report_row_type, report_table, write_report_csv, format_mesh_row
    use sprc_io_fields, only: write_level_fields
@@ -24,7 +25,7 @@ program sprc_main
    use sprc_fem_petsc, only: start_ranks
    use sprc_study_partition, only: largest_over_ranks, fail_together
    use sprc_app_cli, only: cli_type, parse_cli, usage_text
-   use sprc_app_progress, only: progress_level, print_contact_progress
+   use sprc_app_progress, only: progress_level, progress_unit, print_contact_progress
    implicit none
 
    type(cli_type) :: cli
@@ -132,6 +133,8 @@ contains
       real(wp) :: total_dofs
       logical :: quiet
       type(body_type), allocatable :: geometry(:)
+      integer :: n_rows
+      character(len=:), allocatable :: contact_title
 
       call study_levels(scene, cli%levels, levels, error)
       if (allocated(error)) call fail(2, error%message)
@@ -159,42 +162,49 @@ contains
          call h5%create(prefix//'.h5'//partial, error)
          if (allocated(error)) call fail_with(error)
       end if
-      ! One slot per level: the levels' contact results move in, not copied (they are sized by the slave points).
-      allocate (rows(size(levels)), contact_levels(size(levels)))
       n_contact = 0
       threads = omp_get_max_threads()
-      do i = 1, size(levels)
-         total_dofs = study_dofs(study, levels(i))
-         if (cli%threads == 0) call omp_set_num_threads(merge(1, threads, total_dofs < serial_dofs))
-         if (i == 1 .and. total_dofs < serial_dofs) call warm_up(study, min(levels(i), warm_level))
-         if (.not. quiet) write (error_unit, '(a,i0,a,i0,a,i0,a)') 'sprc: level ', levels(i), &
-            ' (', i, ' of ', size(levels), ')'
-         if (cli%quiet) then
-            call run_level(study, levels(i), result, error, start=starts)
-         else
-            progress_level = levels(i)
-            call run_level(study, levels(i), result, error, progress=print_contact_progress, start=starts)
-         end if
-         if (.not. allocated(error)) call hold_starts(result, starts, error)
-         if (.not. allocated(error)) then
-            rows(i) = result%row
-            if (h5%opened()) call write_level_fields(h5, study, result, error)
-         end if
-         if (.not. allocated(error) .and. allocated(result%contacts)) then
-            n_contact = n_contact + 1
-            contact_levels(n_contact)%level = levels(i)
-            call move_alloc(result%contacts, contact_levels(n_contact)%contacts)
-         end if
-         if (allocated(error)) then
-            write (buf, '("level ",i0,":")') levels(i)
-            error%message = trim(buf)//' '//error%message
-            call fail_with(error)
-         end if
-         text = peak_text(study, ranks, error)
-         if (allocated(error)) call fail_with(error)
-         if (.not. quiet) write (error_unit, '(a,i0,a)') 'sprc: level ', levels(i), ' done in '// &
-            fixed_text(rows(i)%t_total, 3)//' s'//text
-      end do
+      if (scene%adapt%present) then
+         call run_steps(study, levels(1), cli, quiet, rank, ranks, threads, h5, rows, n_rows, contact_levels, &
+            & n_contact)
+         rows = rows(:n_rows)
+      else
+         ! One slot per level: the levels' contact results move in, not copied (they are sized by the slave points).
+         allocate (rows(size(levels)), contact_levels(size(levels)))
+         do i = 1, size(levels)
+            total_dofs = study_dofs(study, levels(i))
+            if (cli%threads == 0) call omp_set_num_threads(merge(1, threads, total_dofs < serial_dofs))
+            if (i == 1 .and. total_dofs < serial_dofs) call warm_up(study, min(levels(i), warm_level))
+            if (.not. quiet) write (error_unit, '(a,i0,a,i0,a,i0,a)') 'sprc: level ', levels(i), &
+               ' (', i, ' of ', size(levels), ')'
+            if (cli%quiet) then
+               call run_level(study, levels(i), result, error, start=starts)
+            else
+               progress_level = levels(i)
+               call run_level(study, levels(i), result, error, progress=print_contact_progress, start=starts)
+            end if
+            if (.not. allocated(error)) call hold_starts(result, starts, error)
+            if (.not. allocated(error)) then
+               rows(i) = result%row
+               if (h5%opened()) call write_level_fields(h5, study, result, error)
+            end if
+            if (.not. allocated(error) .and. allocated(result%contacts)) then
+               n_contact = n_contact + 1
+               contact_levels(n_contact)%level = levels(i)
+               call move_alloc(result%contacts, contact_levels(n_contact)%contacts)
+            end if
+            if (allocated(error)) then
+               write (buf, '("level ",i0,":")') levels(i)
+               error%message = trim(buf)//' '//error%message
+               call fail_with(error)
+            end if
+            text = peak_text(study, ranks, error)
+            if (allocated(error)) call fail_with(error)
+            if (.not. quiet) write (error_unit, '(a,i0,a)') 'sprc: level ', levels(i), ' done in '// &
+               fixed_text(rows(i)%t_total, 3)//' s'//text
+         end do
+         n_rows = size(levels)
+      end if
       if (rank > 0) return
       write (output_unit, '(a)') scene%title
       write (output_unit, '(a)', advance='no') report_table(rows)
@@ -208,8 +218,10 @@ contains
          n_outputs = 6
          call write_contact_csv(prefix//'_contact.csv'//partial, contact_levels(:n_contact), error)
          associate (finest => contact_levels(n_contact))
+            contact_title = scene%title//', contact pressure at level '//itoa(finest%level)
+            if (scene%adapt%present) contact_title = scene%title//', contact pressure at step '//itoa(finest%level)
             if (.not. allocated(error)) call write_contact_svg(prefix//'_contact.svg'//partial, finest%contacts, &
-               & scene%title//', contact pressure at level '//itoa(finest%level), error)
+               & contact_title, error)
          end associate
       end if
       if (allocated(error)) call fail_with(error)
@@ -227,6 +239,77 @@ contains
          write (error_unit, '(a)') 'sprc: wrote '//prefix//'.csv, .svg, .h5, .xdmf'
       end if
    end subroutine run_study
+
+   !> The adaptive study (`&adapt`) from `start_level`: one row per step
+   !> (sprc_study_adapt); progress names each step, its dofs and eta; a run
+   !> that a limit ended warns, naming the limit and the best eta.
+   subroutine run_steps(study, start_level, cli, quiet, rank, ranks, threads, h5, rows, n_rows, contact_levels, &
+      & n_contact)
+      type(study_type), intent(in) :: study
+      integer, intent(in) :: start_level, rank, ranks, threads
+      type(cli_type), intent(in) :: cli
+      logical, intent(in) :: quiet
+      type(h5_output_type), intent(inout) :: h5
+      type(report_row_type), allocatable, intent(out) :: rows(:)
+      integer, intent(out) :: n_rows
+      type(contact_level_type), allocatable, intent(out) :: contact_levels(:)
+      integer, intent(inout) :: n_contact
+      type(adapt_run_type) :: run
+      type(level_type) :: result
+      type(error_type), allocatable :: error
+      character(len=:), allocatable :: text, eta_name
+      real(wp) :: total_dofs
+
+      allocate (rows(study%scene%adapt%max_steps), contact_levels(study%scene%adapt%max_steps))
+      eta_name = trim(merge('eta_sprc', 'eta_spr ', study%run(2)))
+      call start_adapt(study, start_level, run)
+      progress_unit = 'step'
+      n_rows = 0
+      do while (.not. run%finished)
+         if (run%step < 0) then
+            total_dofs = study_dofs(study, start_level)
+            if (total_dofs < serial_dofs) call warm_up(study, min(start_level, warm_level))
+         else
+            total_dofs = run%next_dofs
+         end if
+         if (cli%threads == 0) call omp_set_num_threads(merge(1, threads, total_dofs < serial_dofs))
+         if (.not. quiet) write (error_unit, '(a,i0,a,i0,a)') 'sprc: step ', run%step + 1, ' (about ', &
+            & nint(total_dofs), ' dofs)'
+         progress_level = run%step + 1
+         if (cli%quiet) then
+            call adapt_step(study, run, result, error)
+         else
+            call adapt_step(study, run, result, error, progress=print_contact_progress)
+         end if
+         if (allocated(error)) call fail_with(error)
+         n_rows = n_rows + 1
+         rows(n_rows) = result%row
+         if (h5%opened()) call write_level_fields(h5, study, result, error, step=run%step)
+         if (allocated(error)) call fail_with(error)
+         if (allocated(result%contacts)) then
+            n_contact = n_contact + 1
+            contact_levels(n_contact)%level = run%step
+            call move_alloc(result%contacts, contact_levels(n_contact)%contacts)
+         end if
+         text = peak_text(study, ranks, error)
+         if (allocated(error)) call fail_with(error)
+         if (.not. quiet) write (error_unit, '(a,i0,a,i0,a,i0,a)') 'sprc: step ', run%step, ' done: ', &
+            & result%row%dofs, ' dofs, finest level ', result%row%level, ', '//eta_name//' = '// &
+            & sci_text(step_eta(study, result))//' (target '//sci_text(study%scene%adapt%target)//') in '// &
+            & fixed_text(result%row%t_total, 3)//' s'//text
+      end do
+      if (rank == 0 .and. len(adapt_warning(study, run)) > 0) &
+         & write (error_unit, '(a)') 'sprc: warning: '//adapt_warning(study, run)
+   end subroutine run_steps
+
+   !> `x` as 1.234e-02.
+   function sci_text(x) result(text)
+      real(wp), intent(in) :: x
+      character(len=:), allocatable :: text
+      character(len=16) :: buf
+      write (buf, '(es10.3)') x
+      text = trim(adjustl(buf))
+   end function sci_text
 
    !> The dofs of all bodies at `level`, as estimated before the level is built (sprc_study_budget).
    function study_dofs(study, level) result(total)

@@ -6,10 +6,12 @@ module sprc_app_progress
    implicit none
    private
 
-   public :: progress_level, print_contact_progress
+   public :: progress_level, progress_unit, print_contact_progress
 
-   !> The level being run, for the lines.
+   !> The level (or adaptive step) being run, for the lines.
    integer :: progress_level = 0
+   !> 'level', or 'step' in an adaptive study.
+   character(len=5) :: progress_unit = 'level'
 
 contains
 
@@ -22,7 +24,7 @@ contains
 
       where = ''
       if (increments > 1) where = 'increment '//itoa(increment)//' of '//itoa(increments)//', '
-      write (error_unit, '(a)') 'sprc: level '//itoa(progress_level)//': contact '//where//'iteration '// &
+      write (error_unit, '(a)') 'sprc: '//trim(progress_unit)//' '//itoa(progress_level)//': contact '//where//'iteration '// &
          & itoa(iteration)//' ('//itoa(switched)//' points switched)'
       flush (error_unit)
    end subroutine print_contact_progress

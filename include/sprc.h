@@ -75,8 +75,11 @@ typedef struct _sprc_report *sprc_report;
 /* Read the scene file at path (SCENE.md) and analyse it at levels[nlevels];
  * levels = NULL with nlevels = 0 takes the scene's own levels. Runs exactly
  * what `sprc run` runs, with the scene's defaults; writes no files (the
- * scene's output prefix is ignored). Returns the report, one row per level,
- * or NULL with the error set (bad arguments: SPRC_STAT_INVALID_INPUT; scene
+ * scene's output prefix is ignored). Returns the report, one row per level
+ * (for a scene with &adapt, one row per adaptive step; levels then holds one
+ * value, the start level; a run that a limit such as max_steps ended is a
+ * success, its last row the last step), or NULL with the error set (bad
+ * arguments: SPRC_STAT_INVALID_INPUT; scene
  * file missing or unreadable: SPRC_STAT_IO; invalid scene:
  * SPRC_STAT_INVALID_INPUT; not runnable by this version:
  * SPRC_STAT_UNSUPPORTED; a failed analysis: its status). */
@@ -90,9 +93,11 @@ sprc_report sprc_run_scene(sprc_error error, const char *path, const int *levels
  * err_sprc, eta_spr, eta_sprc, theta_spr, theta_sprc, then for a study
  * with contact contact_iterations, t_contact, contact_measure, p_max_fe,
  * p_max_spr, p_max_sprc, p_max_exact, err_p_fe, err_p_spr, err_p_sprc, then
- * solver_iterations (more may follow in later versions; read columns by
- * name). Every value is a double; integer columns (level, elements,
- * cut_elements, dofs, contact_iterations, solver_iterations) are exact. A cell that does not apply (no
+ * solver_iterations, then for an adaptive study (&adapt: one row per step)
+ * step (0 the start mesh) and t_adapt (more may follow in later versions;
+ * read columns by name). Every value is a double; integer columns (level,
+ * elements, cut_elements, dofs, contact_iterations, solver_iterations, step)
+ * are exact. A cell that does not apply (no
  * exact solution, recovery not run) is EMPTY and reads as a quiet NaN:
  * test it with isnan(). */
 

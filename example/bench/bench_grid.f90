@@ -1,6 +1,8 @@
 !> Benchmark of the grid layer: build + classify + 2:1 balance of a 2D grid of
 !> about 1M cells and a 3D grid of about 2M cells around a disk / sphere with
-!> two extra boundary levels, then Q1 / Q2 nodes and hanging-node constraints.
+!> two extra boundary levels, then Q1 / Q2 nodes and hanging-node constraints,
+!> then `build_adapted` from that grid: the same levels (the same grid back),
+!> and one level finer on the half x < 1/2 and one coarser on the rest.
 !> Prints wall times, leaf counts, cells per second and peak memory (VmHWM).
 !>
 !> The body is a disk / sphere from the geometry layer (certified box
@@ -75,7 +77,41 @@ contains
          write (*, '(a,i0,a,i0,a,f8.3,a,i0,a,f8.3,a,f9.1,a)') '  Q', p, ': nodes ', nodes%n_nodes, ' in ', t_nodes, &
             & ' s; hanging ', hang%n_hanging, ' in ', t_hang, ' s, peak ', peak_mib(), ' MiB'
       end do
+      call adapted(ball, grid, t_grid, level + refine)
    end subroutine run
+
+   !> `build_adapted` from `grid` (built in t_build seconds): the same levels, then one
+   !> level finer where x < 1/2 and one coarser elsewhere.
+   subroutine adapted(ball, grid, t_build, max_level)
+      type(body_type), intent(in) :: ball
+      type(grid_type), intent(in) :: grid
+      real(wp), intent(in) :: t_build
+      integer, intent(in) :: max_level
+      type(grid_type) :: new
+      type(error_type), allocatable :: error
+      integer, allocatable :: target(:)
+      real(wp) :: t0, t, lo(3), hi(3)
+      integer :: j, d
+
+      d = grid%dim
+      t0 = wall_time()
+      call new%build_adapted(ball, grid, grid%leaf_level, max_level, error)
+      t = wall_time() - t0
+      if (allocated(error)) return
+      write (*, '(a,i0,a,f8.3,a,f6.2,a)') '  build_adapted, same levels: leaves ', new%n_leaves, ' in ', t, &
+         & ' s (', t/t_build, ' x build)'
+      target = grid%leaf_level
+      do j = 1, grid%n_leaves
+         call grid%leaf_box(j, lo(1:d), hi(1:d))
+         target(j) = target(j) + merge(1, -1, hi(1) <= 0.5_wp)
+      end do
+      t0 = wall_time()
+      call new%build_adapted(ball, grid, target, max_level + 1, error)
+      t = wall_time() - t0
+      if (allocated(error)) return
+      write (*, '(a,i0,a,i0,a,f8.3,a,f9.1,a)') '  build_adapted, finer | coarser halves: leaves ', new%n_leaves, &
+         & ', balance splits ', new%n_balance_splits, ' in ', t, ' s, peak ', peak_mib(), ' MiB'
+   end subroutine adapted
 
    !> Reset the peak-memory mark (Linux: write 5 to /proc/self/clear_refs); harmless if refused.
    subroutine reset_peak()

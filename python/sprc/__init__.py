@@ -24,7 +24,8 @@ __all__ = ["__version__", "SprcError", "get_version", "run_scene", "recover", "R
 __version__ = "0.1.0"
 
 #: Report columns that hold integers (returned as int; every other column is float).
-INTEGER_COLUMNS = frozenset({"level", "elements", "cut_elements", "dofs", "contact_iterations", "solver_iterations"})
+INTEGER_COLUMNS = frozenset({"level", "elements", "cut_elements", "dofs", "contact_iterations", "solver_iterations",
+                             "step"})
 
 
 def get_version():
@@ -37,7 +38,8 @@ def run_scene(path, levels=None):
     """Run the study of the scene file ``path`` (SCENE.md) and return its
     report: one dict per level, keyed by the report's columns in the order
     of its CSV header (``level, h, elements, ..., theta_sprc``, the contact
-    columns in a study with contact, ``solver_iterations``). Integer
+    columns in a study with contact, ``solver_iterations``, and ``step``,
+    ``t_adapt`` in an adaptive study: one dict per step). Integer
     columns are ``int``, the others ``float``; a cell that does not apply is
     ``None``. ``levels`` (a sequence of ints) overrides the scene's levels.
     Writes no files. Raises :class:`SprcError` with the library's message

@@ -82,6 +82,31 @@ def test_run_scene_matches_driver_csv(tmp_path):
     assert all(0.0 < r["err_fe"] < 1.0 for r in rows)
 
 
+def test_run_adaptive_scene_matches_driver_csv(tmp_path):
+    """An adaptive scene (&adapt): one dict per step with the step and t_adapt
+    columns, every cell but the times equal to the driver's CSV (the same
+    meshes step by step), the last step within the target."""
+    scene = ROOT / "test" / "data" / "scenes" / "valid" / "kirsch_adaptive.nml"
+    prefix = tmp_path / "adaptive"
+    subprocess.run([str(driver()), "run", str(scene), "--output", str(prefix), "--quiet"], check=True,
+                   capture_output=True)
+    with open(f"{prefix}.csv", newline="") as f:
+        table = list(csv.reader(f))
+    assert table[0] == COLUMNS + ["step", "t_adapt"]
+    rows = sprc.run_scene(scene)
+    assert len(rows) == len(table) - 1 >= 2
+    assert [r["step"] for r in rows] == list(range(len(rows)))
+    for row, cells in zip(rows, table[1:]):
+        for name, cell in zip(table[0], cells):
+            if not name.startswith("t_"):
+                assert row[name] == (int(cell) if name in sprc.INTEGER_COLUMNS else float(cell)), name
+    assert rows[-1]["eta_sprc"] <= 0.03 < rows[0]["eta_sprc"]
+    assert rows[-1]["err_fe"] < rows[0]["err_fe"]
+    assert all(0.0 <= r["t_adapt"] <= r["t_total"] for r in rows)
+    with pytest.raises(sprc.SprcError, match="start level"):
+        sprc.run_scene(scene, levels=[3, 4])
+
+
 def test_scene_levels_by_default(tmp_path):
     rows = sprc.run_scene(scene_variant(tmp_path, levels="2, 3"))
     assert [r["level"] for r in rows] == [2, 3]

@@ -227,6 +227,44 @@ static void test_run_lame(void) {
   PASS();
 }
 
+static void test_run_adaptive(void) {
+  const char *name = "run_adaptive";
+  char path[1024], col[32];
+  int size, nrows, ncols, i, levels[2] = {3, 4};
+  double x;
+  sprc_error err = sprc_new_error();
+  sprc_report rep;
+  snprintf(path, sizeof path, "%s/test/data/scenes/valid/kirsch_adaptive.nml", root);
+  rep = sprc_run_scene(err, path, NULL, 0);
+  CHECK(rep != NULL, "sprc_run_scene failed on the adaptive Kirsch scene");
+  nrows = sprc_get_report_rows(err, rep);
+  ncols = sprc_get_report_columns(err, rep);
+  /* The 20 columns of a report without contact, then step and t_adapt. */
+  CHECK(ncols == 22, "not 22 columns in an adaptive report");
+  size = (int)sizeof col;
+  sprc_get_report_column(err, rep, 20, col, &size);
+  CHECK(strcmp(col, "step") == 0, "column 20 is not 'step'");
+  size = (int)sizeof col;
+  sprc_get_report_column(err, rep, 21, col, &size);
+  CHECK(strcmp(col, "t_adapt") == 0, "column 21 is not 't_adapt'");
+  CHECK(nrows >= 2 && nrows <= 10, "not 2 to max_steps rows");
+  for (i = 0; i < nrows; i++) {
+    CHECK(sprc_get_report_value(err, rep, i, "step") == i, "step is not the row index");
+    x = sprc_get_report_value(err, rep, i, "t_adapt");
+    CHECK(x >= 0.0 && x <= sprc_get_report_value(err, rep, i, "t_total"), "t_adapt not within t_total");
+  }
+  CHECK(sprc_get_report_value(err, rep, nrows - 1, "eta_sprc") <= 0.03, "the last step is above the target");
+  CHECK(sprc_get_report_value(err, rep, nrows - 1, "err_fe") < sprc_get_report_value(err, rep, 0, "err_fe"),
+        "err_fe did not fall");
+  CHECK(sprc_check_error(err) == 0, "reading the report set the error");
+  sprc_delete_report(&rep);
+  /* With &adapt the levels are one start level. */
+  CHECK(sprc_run_scene(err, path, levels, 2) == NULL, "two levels for an adaptive scene gave a report");
+  CHECK(has_error(err, "start level"), "no error naming the start level");
+  sprc_delete_error(&err);
+  PASS();
+}
+
 static void test_run_invalid_scene(void) {
   const char *name = "run_invalid_scene";
   char path[1024];
@@ -730,6 +768,7 @@ int main(int argc, char **argv) {
   test_error_buffer();
   test_run_bad_arguments();
   test_run_lame();
+  test_run_adaptive();
   test_run_invalid_scene();
   test_recovery_null_handles();
   test_recovery_bad_input();

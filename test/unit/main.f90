@@ -15,6 +15,7 @@ program sprc_unit_tests
    use sprc_test_scene, only: collect_scene
    use sprc_test_geometry, only: collect_geometry
    use sprc_test_grid, only: collect_grid
+   use sprc_test_adapt, only: collect_adapt
    use sprc_test_model, only: collect_model
    use sprc_test_quadrature, only: collect_quadrature
    use sprc_test_recovery, only: collect_recovery
@@ -25,6 +26,7 @@ program sprc_unit_tests
    use sprc_test_mesh_recovery, only: collect_mesh_recovery
    use sprc_test_stiff, only: collect_stiff
    use sprc_test_study, only: collect_study
+   use sprc_test_adaptive, only: collect_adaptive
    use sprc_test_contact_model, only: collect_contact_model
    use sprc_test_contact_output, only: collect_contact_output
    use sprc_test_contact_fe, only: collect_contact_fe
@@ -49,6 +51,7 @@ program sprc_unit_tests
       new_testsuite('scene', collect_scene), &
       new_testsuite('geometry', collect_geometry), &
       new_testsuite('grid', collect_grid), &
+      new_testsuite('adapt', collect_adapt), &
       new_testsuite('model', collect_model), &
       new_testsuite('quadrature', collect_quadrature), &
       new_testsuite('recovery', collect_recovery), &
@@ -59,6 +62,7 @@ program sprc_unit_tests
       new_testsuite('mesh_recovery', collect_mesh_recovery), &
       new_testsuite('stiff', collect_stiff), &
       new_testsuite('study', collect_study), &
+      new_testsuite('adaptive', collect_adaptive), &
       new_testsuite('contact_model', collect_contact_model), &
       new_testsuite('contact_output', collect_contact_output), &
       new_testsuite('contact_fe', collect_contact_fe), &

@@ -14,7 +14,7 @@ module sprc_test_grid
    implicit none
    private
 
-   public :: collect_grid
+   public :: collect_grid, check_balance, check_volume, int_box
 
    !> Closed ball |x - centre| <= radius, classified exactly: nearest point of the
    !> box (clamped centre) and farthest corner.

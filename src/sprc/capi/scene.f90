@@ -1,12 +1,16 @@
 !> C API, scenes: run the study of a scene file (SCENE.md) and return its
 !> report. The C run writes no files, whatever the scene's `output`; it
-!> computes exactly what `sprc run` computes and reports.
+!> computes exactly what `sprc run` computes and reports: a scene with
+!> `&adapt` gives one row per adaptive step (`step`, `t_adapt` columns);
+!> a run that a limit ended is a success, as for the driver (its last row
+!> is the last step; the driver's warning is not repeated here).
 module sprc_capi_scene
    use, intrinsic :: iso_c_binding, only: c_ptr, c_int, c_null_ptr, c_associated, c_f_pointer, c_loc
    use sprc_core_error, only: error_type, stat_invalid_input, stat_out_of_memory
    use sprc_io_scene, only: scene_type, read_scene
    use sprc_study_mesh, only: study_levels
    use sprc_study_level, only: study_type, prepare_study, run_level, level_type, hold_starts
+   use sprc_study_adapt, only: adapt_run_type, start_adapt, adapt_step
    use sprc_fem_nested, only: fe_displacement_type
    use sprc_study_row, only: report_row_type
    use sprc_capi_error, only: capi_error_type, get_capi_error, set_capi_error
@@ -67,7 +71,7 @@ contains
       reph = c_loc(rep)
    end function sprc_run_scene
 
-   !> Read the scene and run each level of the study.
+   !> Read the scene and run each level (or adaptive step) of the study.
    subroutine run_study(path, rows, error, override)
       character(len=*), intent(in) :: path
       type(report_row_type), allocatable, intent(out) :: rows(:)
@@ -91,6 +95,10 @@ contains
       if (allocated(error)) return
       call prepare_study(scene, 0, study, error)
       if (allocated(error)) return
+      if (scene%adapt%present) then
+         call run_steps(study, levels(1), rows, error)
+         return
+      end if
       allocate (rows(size(levels)))
       do i = 1, size(levels)
          call run_level(study, levels(i), result, error, start=starts)
@@ -100,5 +108,25 @@ contains
          if (allocated(error)) return
       end do
    end subroutine run_study
+
+   !> The adaptive study from `start_level`: one row per step.
+   subroutine run_steps(study, start_level, rows, error)
+      type(study_type), intent(in) :: study
+      integer, intent(in) :: start_level
+      type(report_row_type), allocatable, intent(out) :: rows(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(adapt_run_type) :: run
+      type(level_type) :: result
+      type(report_row_type), allocatable :: all(:)
+
+      allocate (all(study%scene%adapt%max_steps))
+      call start_adapt(study, start_level, run)
+      do while (.not. run%finished)
+         call adapt_step(study, run, result, error)
+         if (allocated(error)) return
+         all(run%step + 1) = result%row
+      end do
+      rows = all(:run%step + 1)
+   end subroutine run_steps
 
 end module sprc_capi_scene

@@ -7,6 +7,7 @@
 !>
 !> ```fortran
 !> call mesh%build(body, box_min, box_size, level, refine_boundary, degree, error)   ! t_mesh
+!> call mesh%build_adapted(body, old_grid, target, max_level, degree, error)         ! t_mesh
 !> call mesh%integrate(quad, error)                                                   ! t_quadrature
 !> ```
 !> The FE problem (`sprc_fem_problem`) takes the mesh over (`move_alloc`, no
@@ -69,6 +70,7 @@ module sprc_grid_cut_mesh
       real(wp) :: t_mesh = 0.0_wp, t_quadrature = 0.0_wp
    contains
       procedure :: build => mesh_build
+      procedure :: build_adapted => mesh_build_adapted
       procedure :: integrate => mesh_integrate
    end type cut_mesh_type
 
@@ -89,11 +91,40 @@ contains
       self%body = body
       call timer%start()
       call self%grid%build(body, body%dim, box_min, box_size, level, refine_boundary, error)
+      call complete_mesh(self, degree, timer, error)
+   end subroutine mesh_build
+
+   !> The grid of `body` adapted from `old` (`grid_type%build_adapted`: the level
+   !> `target(j)` wanted where old leaf j was, at most `max_level`, same box), its
+   !> Q`degree` nodes and hanging-node constraints (t_mesh). `old` must not be
+   !> this mesh's own grid.
+   subroutine mesh_build_adapted(self, body, old, target, max_level, degree, error)
+      class(cut_mesh_type), intent(out) :: self
+      type(body_type), intent(in) :: body
+      type(grid_type), intent(in) :: old
+      integer, intent(in) :: target(:), max_level, degree
+      type(error_type), allocatable, intent(out) :: error
+      type(timer_type) :: timer
+
+      self%body = body
+      call timer%start()
+      call self%grid%build_adapted(body, old, target, max_level, error)
+      call complete_mesh(self, degree, timer, error)
+   end subroutine mesh_build_adapted
+
+   !> Nodes and constraints on the grid just built (unless `error` says it failed),
+   !> then the time since `timer` started into t_mesh.
+   subroutine complete_mesh(self, degree, timer, error)
+      type(cut_mesh_type), intent(inout) :: self
+      integer, intent(in) :: degree
+      type(timer_type), intent(inout) :: timer
+      type(error_type), allocatable, intent(inout) :: error
+
       if (.not. allocated(error)) call self%nodes%build(self%grid, degree, error)
       if (.not. allocated(error)) call self%hanging%build(self%grid, self%nodes, error)
       call timer%stop()
       self%t_mesh = timer%elapsed
-   end subroutine mesh_build
+   end subroutine complete_mesh
 
    !> Cut-cell quadrature of every element with the settings `quad` (parallel,
    !> one rule object per thread), concatenated in element order; volume

@@ -9,6 +9,17 @@
 !> between active leaves (a ripple that sweeps the levels from the finest one
 !> down; new leaves are classified when they appear).
 !>
+!> `build_adapted` builds a grid of the same box from a level wanted per leaf
+!> of an existing grid `old` (the size field of an adaptive step): top-down
+!> from level 0, a non-external cell splits while its level is below the
+!> largest level wanted by the old leaves it overlaps (one `find_cell` on the
+!> Morton-sorted old leaves per cell), so it refines and coarsens; then the
+!> same 2:1 balance. A non-external cell that no old leaf overlaps (the old
+!> grid split it into external cells only) splits like the old grid did, down
+!> to the old finest level. Its `level` is the coarsest leaf level (every
+!> leaf is at least that fine, what the uniform level of `build` promises),
+!> `refine_boundary` = `max_level` - `level`.
+!>
 !> Only active leaves (internal and cut) are stored: external space is never
 !> materialised. They are sorted by the Morton key of their lowest corner at
 !> the common resolution `grid_max_level`, so the descendants of any cell are
@@ -23,6 +34,7 @@ module sprc_grid_tree
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_alloc, only: check_allocation
+   use sprc_core_text, only: itoa
    use sprc_geometry_region, only: region_type, cell_outside, cell_inside, cell_cut
    use sprc_grid_morton, only: morton_encode
    implicit none
@@ -43,7 +55,9 @@ module sprc_grid_tree
       real(wp) :: box_min(3) = 0.0_wp
       !> Edge length of the level-0 cell.
       real(wp) :: box_size = 0.0_wp
-      !> Uniform level and number of extra boundary levels asked for.
+      !> Uniform level and number of extra boundary levels asked for; no leaf is
+      !> coarser than `level`. For `build_adapted`: the coarsest leaf level and
+      !> the levels between it and the finest.
       integer :: level = 0, refine_boundary = 0
       !> Finest level among the leaves.
       integer :: max_level = 0
@@ -65,6 +79,7 @@ module sprc_grid_tree
       integer :: n_balance_splits = 0
    contains
       procedure :: build => grid_build
+      procedure :: build_adapted => grid_build_adapted
       procedure :: copy => grid_copy
       procedure :: cell_width => grid_cell_width
       procedure :: leaf_box => grid_leaf_box
@@ -118,6 +133,55 @@ contains
       root = 0
       root_class = classify(b, region, 0, root)
       call descend(b, region, 0, root, root_class)
+      call complete(self, b, region, .false., error)
+      self%refine_boundary = refine_boundary
+   end subroutine grid_build
+
+   !> Build the grid of `region` in the box of `old` from the level `target(j)`
+   !> wanted for the cells covering old leaf j (module notes): a non-external
+   !> cell of level l splits iff l < max{target(j) : old leaf j overlaps it},
+   !> clamped to [0, max_level]; then 2:1 balance. Refines and coarsens.
+   !> `old` must not be `self`.
+   subroutine grid_build_adapted(self, region, old, target, max_level, error)
+      class(grid_type), intent(out) :: self
+      class(region_type), intent(in) :: region
+      type(grid_type), intent(in) :: old
+      integer, intent(in) :: target(:)
+      integer, intent(in) :: max_level
+      type(error_type), allocatable, intent(out) :: error
+      type(builder_type) :: b
+      integer :: root(3), root_class
+
+      call check_adapt_input(old, target, max_level, error)
+      if (allocated(error)) return
+
+      b%dim = old%dim
+      b%level = 0
+      b%top = max_level
+      b%box_min = old%box_min
+      b%box_size = old%box_size
+      call builder_init(b)
+
+      root = 0
+      root_class = classify(b, region, 0, root)
+      call descend(b, region, 0, root, root_class, old, target)
+      if (b%n > 0) b%level = minval(b%lev(1:b%n))
+      call complete(self, b, region, .true., error)
+      if (allocated(error)) return
+      self%refine_boundary = self%max_level - self%level
+   end subroutine grid_build_adapted
+
+   !> After the descent: 2:1 balance (levels above b%level, no leaf being coarser),
+   !> with `coarsest` b%level raised to the coarsest leaf level left by the balance,
+   !> external counts folded to b%level, the leaves sorted into `self`.
+   subroutine complete(self, b, region, coarsest, error)
+      type(grid_type), intent(inout) :: self
+      type(builder_type), intent(inout) :: b
+      class(region_type), intent(in) :: region
+      logical, intent(in) :: coarsest
+      type(error_type), allocatable, intent(out) :: error
+      integer :: l
+
       if (.not. allocated(b%error)) call balance(b, region)
       if (allocated(b%error)) then
          call move_alloc(b%error, error)
@@ -128,16 +192,21 @@ contains
             & 'cell_inside or cell_cut', stat_invalid_input)
          return
       end if
+      if (coarsest .and. any(b%alive(1:b%n))) b%level = minval(b%lev(1:b%n), mask=b%alive(1:b%n))
+      ! External cells coarser than the uniform level count as the cells of that level they cover.
+      do l = 0, b%level - 1
+         b%n_outside(b%level) = b%n_outside(b%level) + b%n_outside(l)*ishft(1_i8, b%dim*(b%level - l))
+         b%n_outside(l) = 0_i8
+      end do
 
-      self%dim = dim
-      self%box_min(1:dim) = box_min(1:dim)
-      self%box_size = box_size
-      self%level = level
-      self%refine_boundary = refine_boundary
+      self%dim = b%dim
+      self%box_min = b%box_min
+      self%box_size = b%box_size
+      self%level = b%level
       self%n_outside = b%n_outside
       self%n_balance_splits = b%n_splits
       call finalize(self, b, error)
-   end subroutine grid_build
+   end subroutine complete
 
    !> `copy` = the grid, with a failed allocation returned as an error (the intrinsic
    !> assignment copy = grid stops the program when it cannot allocate, or crashes).
@@ -166,6 +235,47 @@ contains
       copy%n_outside = self%n_outside
       copy%n_balance_splits = self%n_balance_splits
    end subroutine grid_copy
+
+   subroutine check_adapt_input(old, target, max_level, error)
+      type(grid_type), intent(in) :: old
+      integer, intent(in) :: target(:)
+      integer, intent(in) :: max_level
+      type(error_type), allocatable, intent(out) :: error
+      integer :: j
+      character(len=*), parameter :: who = 'grid build_adapted: '
+
+      if (old%dim /= 2 .and. old%dim /= 3) then
+         call fatal_error(error, who//'the old grid has dim '//itoa(old%dim)//' (not built?), expected 2 or 3', &
+            & stat_invalid_input)
+      else if (.not. (old%box_size > 0.0_wp .and. old%box_size <= huge(1.0_wp)) .or. &
+         & .not. all(abs(old%box_min(1:old%dim)) <= huge(1.0_wp))) then
+         call fatal_error(error, who//'the old grid''s box is not finite and positive', stat_invalid_input)
+      else if (.not. leaves_consistent(old)) then
+         call fatal_error(error, who//'the old grid''s leaf arrays do not hold n_leaves = '//itoa(old%n_leaves)// &
+            & ' leaves', stat_invalid_input)
+      else if (size(target) /= old%n_leaves) then
+         call fatal_error(error, who//'target has '//itoa(size(target))//' entries, the old grid '// &
+            & itoa(old%n_leaves)//' leaves', stat_invalid_input)
+      else if (max_level < 0 .or. max_level > grid_max_level) then
+         call fatal_error(error, who//'max_level must be in [0, '//itoa(grid_max_level)//'], got '// &
+            & itoa(max_level), stat_invalid_input)
+      else if (any(target < 0)) then
+         j = findloc(target < 0, .true., 1)
+         call fatal_error(error, who//'target('//itoa(j)//') = '//itoa(target(j))//' is negative', &
+            & stat_invalid_input)
+      end if
+   end subroutine check_adapt_input
+
+   pure logical function leaves_consistent(grid) result(ok)
+      type(grid_type), intent(in) :: grid
+      integer :: n
+      n = grid%n_leaves
+      ok = n >= 0 .and. allocated(grid%leaf_level) .and. allocated(grid%leaf_coord) .and. &
+         & allocated(grid%leaf_class) .and. allocated(grid%leaf_key)
+      if (.not. ok) return
+      ok = size(grid%leaf_level) == n .and. size(grid%leaf_coord, 2) == n .and. &
+         & size(grid%leaf_coord, 1) == grid%dim .and. size(grid%leaf_key) == n
+   end function leaves_consistent
 
    subroutine check_input(dim, box_min, box_size, level, refine_boundary, error)
       integer, intent(in) :: dim
@@ -357,39 +467,62 @@ contains
       off = [iand(k, 1), iand(ishft(k, -1), 1), iand(ishft(k, -2), 1)]
    end function child_offset
 
-   recursive subroutine descend(b, region, level, coord, cls)
+   !> Descend from cell (level, coord) of class `cls`: split as `build` asks, or,
+   !> with `old` and `target`, as `build_adapted` asks.
+   recursive subroutine descend(b, region, level, coord, cls, old, target)
       type(builder_type), intent(inout) :: b
       class(region_type), intent(in) :: region
       integer, intent(in) :: level, coord(3), cls
+      type(grid_type), intent(in), optional :: old
+      integer, intent(in), optional :: target(:)
       integer :: k, child(3), child_class
+      logical :: split
 
       if (allocated(b%error)) return
       if (cls == cell_outside) then
          call add_outside(b, level)
-      else if (level < b%level .or. (cls == cell_cut .and. level < b%top)) then
+         return
+      end if
+      if (present(old)) then
+         split = level < wanted_level(old, target, level, coord, b%top)
+      else
+         split = level < b%level .or. (cls == cell_cut .and. level < b%top)
+      end if
+      if (split) then
          call hash_put(b, cell_key(b%dim, level, coord), -1)
          do k = 0, 2**b%dim - 1
             child = 2*coord + child_offset(k)
             if (b%dim == 2) child(3) = 0
             child_class = cell_inside
             if (cls == cell_cut) child_class = classify(b, region, level + 1, child)
-            call descend(b, region, level + 1, child, child_class)
+            call descend(b, region, level + 1, child, child_class, old, target)
          end do
       else
          call add_leaf(b, level, coord, cls)
       end if
    end subroutine descend
 
-   !> Count an external cell; one coarser than the uniform level counts as the
-   !> uniform-level cells it covers.
+   !> The level wanted for the cell (level, coord) of an adapted grid: the largest
+   !> target of the old leaves it overlaps (one leaf covering it, or the Morton run of
+   !> those inside it), the old finest level if none does, clamped to [0, top].
+   integer function wanted_level(old, target, level, coord, top) result(want)
+      type(grid_type), intent(in) :: old
+      integer, intent(in) :: target(:), level, coord(3), top
+      integer :: first, last
+      call old%find_cell(level, coord(1:old%dim), first, last)
+      if (first <= last) then
+         want = maxval(target(first:last))
+      else
+         want = old%max_level
+      end if
+      want = max(0, min(want, top))
+   end function wanted_level
+
+   !> Count an external cell at its level (`complete` folds the coarse ones).
    subroutine add_outside(b, level)
       type(builder_type), intent(inout) :: b
       integer, intent(in) :: level
-      if (level < b%level) then
-         b%n_outside(b%level) = b%n_outside(b%level) + ishft(1_i8, b%dim*(b%level - level))
-      else
-         b%n_outside(level) = b%n_outside(level) + 1_i8
-      end if
+      b%n_outside(level) = b%n_outside(level) + 1_i8
    end subroutine add_outside
 
    subroutine add_leaf(b, level, coord, cls)

@@ -6,6 +6,10 @@
 !> `/level_LL/contact_<k>/`, its slave-surface points as a point set with
 !> the contact pressures, gap, state, tangential tractions, weights and
 !> normals (scene units; an empty value, not computed, is NaN).
+!> An adaptive study (`&adapt`) writes each step under `/level_SS/`, SS the
+!> step (0 the start mesh), not a level (the steps' finest levels repeat),
+!> and each body's cells carry their grid level, `cell_level`, to show where
+!> the run refined.
 module sprc_io_fields
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type
@@ -27,13 +31,18 @@ module sprc_io_fields
 
 contains
 
-   !> Write every body of `result` (a level of `study`) into `h5`.
-   subroutine write_level_fields(h5, study, result, error)
+   !> Write every body of `result` (a level of `study`) into `h5`; with `step`
+   !> (an adaptive study's step), under that number, with `cell_level`.
+   subroutine write_level_fields(h5, study, result, error, step)
       type(h5_output_type), intent(inout) :: h5
       type(study_type), intent(in) :: study
       type(level_type), intent(in) :: result
       type(error_type), allocatable, intent(out) :: error
-      integer :: cell_type, b
+      integer, intent(in), optional :: step
+      integer :: cell_type, b, key
+
+      key = result%level
+      if (present(step)) key = step
 
       if (study%dim == 2) then
          cell_type = merge(cell_quad4, cell_quad9, study%order == 1)
@@ -41,16 +50,37 @@ contains
          cell_type = merge(cell_hex8, cell_hex27, study%order == 1)
       end if
       do b = 1, size(result%bodies)
-         call write_body(h5, result%level, study%bodies(b)%name, study%bodies(b)%units, cell_type, &
+         call write_body(h5, key, study%bodies(b)%name, study%bodies(b)%units, cell_type, &
             & result%bodies(b), result%done, error)
+         if (allocated(error)) return
+         if (present(step)) call write_cell_level(h5, key, study%bodies(b)%name, result%bodies(b), error)
          if (allocated(error)) return
       end do
       if (.not. allocated(result%contacts)) return
       do b = 1, size(result%contacts)
-         call write_contact(h5, result%level, contact_grid_name(b, study), result%contacts(b), error)
+         call write_contact(h5, key, contact_grid_name(b, study), result%contacts(b), error)
          if (allocated(error)) return
       end do
    end subroutine write_level_fields
+
+   !> The grid level of each cell of a body, `cell_level`.
+   subroutine write_cell_level(h5, key, body, bl, error)
+      type(h5_output_type), intent(inout) :: h5
+      integer, intent(in) :: key
+      character(len=*), intent(in) :: body
+      type(body_level_type), intent(in) :: bl
+      type(error_type), allocatable, intent(out) :: error
+      integer, allocatable :: levels(:, :)
+      integer :: stat
+
+      associate (grid => bl%problem%mesh%grid)
+         allocate (levels(1, grid%n_leaves), stat=stat)
+         call check_allocation(stat, who, 'the level of each cell', grid%n_leaves, 4, error)
+         if (allocated(error)) return
+         levels(1, :) = grid%leaf_level(1:grid%n_leaves)
+      end associate
+      call h5%write_cell_field(key, 'cell_level', levels, error, body=body)
+   end subroutine write_cell_level
 
    !> `contact_<k>`, with '_' put in front while a body has that name.
    function contact_grid_name(k, study) result(name)

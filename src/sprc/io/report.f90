@@ -22,8 +22,8 @@ module sprc_io_report
    public :: n_report_columns, report_columns, report_csv_header, report_column_indices, report_header, csv_real
 
    !> Number of columns a report may have: the 19 of every study, the 10
-   !> contact columns and `solver_iterations`.
-   integer, parameter :: n_report_columns = 30
+   !> contact columns, `solver_iterations` and the 2 adaptive columns.
+   integer, parameter :: n_report_columns = 32
 
    !> Column names, in the contract's order (SCENE.md "Report").
    character(len=18), parameter :: report_columns(n_report_columns) = [character(len=18) :: &
@@ -31,12 +31,15 @@ module sprc_io_report
       & 't_solve', 't_recovery', 't_estimate', 't_total', 'err_fe', 'err_spr', 'err_sprc', &
       & 'eta_spr', 'eta_sprc', 'theta_spr', 'theta_sprc', &
       & 'contact_iterations', 't_contact', 'contact_measure', 'p_max_fe', 'p_max_spr', 'p_max_sprc', &
-      & 'p_max_exact', 'err_p_fe', 'err_p_spr', 'err_p_sprc', 'solver_iterations']
+      & 'p_max_exact', 'err_p_fe', 'err_p_spr', 'err_p_sprc', 'solver_iterations', 'step', 't_adapt']
 
    !> Columns 1..n_base_columns are in every report, in this order, first; the
    !> contact columns (first_contact_column..last_contact_column) only in a
-   !> study with contact; `solver_iterations` (the last) in every report.
-   integer, parameter :: n_base_columns = 19, first_contact_column = 20, last_contact_column = 29
+   !> study with contact; `solver_iterations` in every report; the adaptive
+   !> columns (`step`, `t_adapt`, from first_adapt_column) last, only in an
+   !> adaptive study, so that a uniform study's report is what it was.
+   integer, parameter :: n_base_columns = 19, first_contact_column = 20, last_contact_column = 29, &
+      & first_adapt_column = 31
 
    !> The CSV header of the columns every report starts with, exactly as SCENE.md
    !> states it (`report_header` gives a report's whole header).
@@ -50,23 +53,23 @@ module sprc_io_report
       & kind_integer, kind_integer, kind_sig3, kind_sig3, kind_sig3, kind_sig3, kind_sig3, kind_sig3, &
       & kind_sig3, kind_error, kind_error, kind_error, kind_error, kind_error, kind_sig3, kind_sig3, &
       & kind_integer, kind_sig3, kind_error, kind_error, kind_error, kind_error, kind_error, kind_error, &
-      & kind_error, kind_error, kind_integer]
+      & kind_error, kind_error, kind_integer, kind_integer, kind_sig3]
 
 contains
 
-   !> The columns `rows` carry, as indices into `report_columns`: every column
-   !> but the contact ones, which come (after theta_sprc, before
-   !> solver_iterations) when any row has contact.
+   !> The columns `rows` carry, as indices into `report_columns`: the 19 of
+   !> every report, the contact ones (after theta_sprc) when any row has
+   !> contact, solver_iterations, and the adaptive ones (`step`, `t_adapt`)
+   !> when any row is an adaptive step.
    pure function report_column_indices(rows) result(indices)
       type(report_row_type), intent(in) :: rows(:)
       integer, allocatable :: indices(:)
       integer :: j
 
-      if (any(rows%has_contact)) then
-         indices = [(j, j=1, n_report_columns)]
-      else
-         indices = [(j, j=1, n_base_columns), (j, j=last_contact_column + 1, n_report_columns)]
-      end if
+      indices = [(j, j=1, n_base_columns)]
+      if (any(rows%has_contact)) indices = [indices, (j, j=first_contact_column, last_contact_column)]
+      indices = [indices, last_contact_column + 1]
+      if (any(rows%step >= 0)) indices = [indices, (j, j=first_adapt_column, n_report_columns)]
    end function report_column_indices
 
    !> The CSV header line of `rows`: their columns' names, comma-separated.
@@ -139,6 +142,10 @@ contains
       case (27); x = row%err_p_fe
       case (28); x = row%err_p_spr
       case (29); x = row%err_p_sprc
+      case (31)
+         x = report_empty
+         if (row%step >= 0) x = real(row%step, wp)
+      case (32); x = row%t_adapt
       case default; x = real(row%solver_iterations, wp)
       end select
    end function row_values
@@ -174,6 +181,7 @@ contains
       case (27); row%err_p_fe = x
       case (28); row%err_p_spr = x
       case (29); row%err_p_sprc = x
+      case (32); row%t_adapt = x
       end select
    end subroutine set_real
 
@@ -190,6 +198,7 @@ contains
       case (5); row%dofs = n
       case (20); row%contact_iterations = int(n)
       case (30); row%solver_iterations = int(n)
+      case (31); row%step = int(n)
       end select
    end subroutine set_integer
 
@@ -204,6 +213,7 @@ contains
       case (4); n = row%cut_elements
       case (5); n = row%dofs
       case (20); n = int(row%contact_iterations, i8)
+      case (31); n = int(row%step, i8)
       case default; n = int(row%solver_iterations, i8)
       end select
    end function row_integer
@@ -505,7 +515,10 @@ contains
          stat = 0
          if (len(field) > len(buf)) stat = 1
          buf = field
-         if (column_kind(j) == kind_integer) then
+         if (column_kind(j) == kind_integer .and. j == first_adapt_column .and. len(field) == 0) then
+            ! an empty step: a uniform row
+            row%step = -1
+         else if (column_kind(j) == kind_integer) then
             if (len(field) == 0) stat = 1
             if (stat == 0) read (buf, '(i64)', iostat=stat) n
             ! every integer column but elements, cut_elements and dofs is a default integer

@@ -13,7 +13,8 @@ module sprc_io_scene
    use sprc_core_error, only: error_type, fatal_error, stat_unsupported
    use sprc_exact_corner, only: corner_eigenvalues
    use sprc_study_spec, only: scene_type, body_spec_type, shape_spec_type, bc_spec_type, exact_spec_type, &
-      & contact_spec_type, recovery_degree, default_stabilization, contact_unsupported
+      & contact_spec_type, recovery_degree, default_stabilization, contact_unsupported, default_max_level
+   use sprc_grid_tree, only: grid_max_level
    use sprc_io_namelist, only: nml_group_type, parse_namelist, read_text_file, nml_get, nml_get_array, &
       & nml_has, nml_check_consumed, nml_field_error, nml_group_error, nml_item_text
    implicit none
@@ -22,8 +23,8 @@ module sprc_io_scene
    public :: scene_type, body_spec_type, shape_spec_type, bc_spec_type, exact_spec_type, contact_spec_type
    public :: read_scene, read_scene_text, default_scene_text, scene_summary, recovery_degree, real_text
 
-   character(len=*), parameter :: known_groups(6) = [character(len=7) :: 'scene', 'body', 'shape', 'bc', &
-      & 'exact', 'contact']
+   character(len=*), parameter :: known_groups(7) = [character(len=7) :: 'scene', 'body', 'shape', 'bc', &
+      & 'exact', 'contact', 'adapt']
    character(len=*), parameter :: scene_keys = 'title analysis order levels refine_boundary box_min box_size '// &
       & 'recovery recovery_degree output dilatation nitsche_gamma solver'
    character(len=*), parameter :: body_keys = 'name young poisson body_force box_min box_size'
@@ -36,6 +37,9 @@ module sprc_io_scene
    character(len=*), parameter :: exact_keys = 'kind '//exact_fields
    character(len=*), parameter :: contact_keys = 'slave master slave_surface master_surface friction mu kappa '// &
       & 'steps stabilization'
+
+   character(len=*), parameter :: adapt_keys = 'target max_steps max_dofs strategy fraction max_level'
+   character(len=*), parameter :: strategies = 'optimal fraction'
 
    character(len=*), parameter :: analyses = 'plane_stress plane_strain solid'
    character(len=*), parameter :: recoveries = 'none spr sprc both'
@@ -111,6 +115,8 @@ contains
       call read_bcs(groups, scene, error)
       if (allocated(error)) return
       call read_contacts(groups, scene, error)
+      if (allocated(error)) return
+      call read_adapt(groups, scene, error)
    end subroutine read_scene_text
 
    !> The built-in default scene: the Lamé cylinder study of SCENE.md,
@@ -552,24 +558,36 @@ contains
 
    ! ---------------------------------------------------------------- &exact
 
-   subroutine read_exact(groups, scene, error)
-      type(nml_group_type), intent(inout) :: groups(:)
-      type(scene_type), intent(inout) :: scene
+   !> The index of the one group `name` (0 when there is none); a second one
+   !> is an error, `rule` saying why ('at most one exact solution').
+   subroutine optional_group(groups, name, rule, ig, error)
+      type(nml_group_type), intent(in) :: groups(:)
+      character(len=*), intent(in) :: name, rule
+      integer, intent(out) :: ig
       type(error_type), allocatable, intent(out) :: error
-      integer :: ig, i
-      logical :: found
+      integer :: i
 
       ig = 0
       do i = 1, size(groups)
-         if (groups(i)%name /= 'exact') cycle
+         if (groups(i)%name /= name) cycle
          if (ig > 0) then
-            call nml_group_error(groups(i), 'a second &exact group (the first is on line '// &
-               & itoa(groups(ig)%line)//'): at most one exact solution', error)
+            call nml_group_error(groups(i), 'a second &'//name//' group (the first is on line '// &
+               & itoa(groups(ig)%line)//'): '//rule, error)
             return
          end if
          ig = i
       end do
-      if (ig == 0) return
+   end subroutine optional_group
+
+   subroutine read_exact(groups, scene, error)
+      type(nml_group_type), intent(inout) :: groups(:)
+      type(scene_type), intent(inout) :: scene
+      type(error_type), allocatable, intent(out) :: error
+      integer :: ig
+      logical :: found
+
+      call optional_group(groups, 'exact', 'at most one exact solution', ig, error)
+      if (allocated(error) .or. ig == 0) return
       associate (g => groups(ig), exact => scene%exact)
          call check_keys(g, exact_keys, error)
          if (allocated(error)) return
@@ -606,6 +624,77 @@ contains
          exact%present = .true.
       end associate
    end subroutine read_exact
+
+   ! ---------------------------------------------------------------- &adapt
+
+   !> The optional `&adapt` group (after `&scene`): its fields, and what it
+   !> asks of `&scene` (one level, the start; a recovery to estimate with).
+   subroutine read_adapt(groups, scene, error)
+      type(nml_group_type), intent(inout) :: groups(:)
+      type(scene_type), intent(inout) :: scene
+      type(error_type), allocatable, intent(out) :: error
+      integer :: ig
+      logical :: found
+
+      call optional_group(groups, 'adapt', 'at most one', ig, error)
+      if (allocated(error) .or. ig == 0) return
+      associate (g => groups(ig), a => scene%adapt)
+         call check_keys(g, adapt_keys, error)
+         if (allocated(error)) return
+         if (size(scene%levels) /= 1) then
+            call nml_group_error(g, '&scene levels holds '//itoa(size(scene%levels))//' levels; with &adapt '// &
+               & 'it holds one, the start level of the adaptive run', error)
+            return
+         end if
+         if (scene%recovery == 'none') then
+            call nml_group_error(g, "&scene recovery = 'none': &adapt needs a recovery (spr, sprc or both) "// &
+               & 'for the estimate that drives it', error)
+            return
+         end if
+         call get_positive(g, 'target', .true., a%target, error)
+         if (allocated(error)) return
+         if (a%target >= 1.0_wp) then
+            call nml_field_error(g, 'target', 'must be < 1 (a relative error in the energy norm)', error)
+            return
+         end if
+         call nml_get(g, 'max_steps', a%max_steps, found, error)
+         if (allocated(error)) return
+         if (a%max_steps < 1) then
+            call nml_field_error(g, 'max_steps', 'must be >= 1 (the start mesh is step 0)', error)
+            return
+         end if
+         call nml_get(g, 'max_dofs', a%max_dofs, found, error)
+         if (allocated(error)) return
+         if (found .and. a%max_dofs < 1) then
+            call nml_field_error(g, 'max_dofs', 'must be >= 1 (omit it for what the memory budget allows)', error)
+            return
+         end if
+         a%strategy = 'optimal'
+         call get_choice(g, 'strategy', strategies, .false., a%strategy, error)
+         if (allocated(error)) return
+         call nml_get(g, 'fraction', a%fraction, found, error)
+         if (allocated(error)) return
+         if (found .and. a%strategy /= 'fraction') then
+            call nml_field_error(g, 'fraction', "applies to strategy = 'fraction' only", error)
+            return
+         end if
+         if (.not. (a%fraction > 0.0_wp .and. a%fraction <= 1.0_wp)) then
+            call nml_field_error(g, 'fraction', 'must lie in (0, 1] (the share of the squared estimate)', error)
+            return
+         end if
+         a%max_level = default_max_level(scene%dim)
+         call nml_get(g, 'max_level', a%max_level, found, error)
+         if (allocated(error)) return
+         if (a%max_level < scene%levels(1) .or. a%max_level > grid_max_level) then
+            call nml_field_error(g, 'max_level', 'must be from the start level ('//itoa(scene%levels(1))// &
+               & ') to '//itoa(grid_max_level)//' (the grid''s deepest level)', error)
+            return
+         end if
+         call nml_check_consumed(g, error)
+         if (allocated(error)) return
+         a%present = .true.
+      end associate
+   end subroutine read_adapt
 
    subroutine read_kirsch(g, scene, exact, error)
       type(nml_group_type), intent(inout) :: g
@@ -1132,6 +1221,7 @@ contains
          text = text//'contact: '//contact_line(scene%contacts(i))//nl
       end do
       text = text//switches(scene)
+      text = text//adapt_text(scene)
       if (len(contact_unsupported(scene)) > 0) then
          text = text//'NOT RUNNABLE: '//contact_unsupported(scene)//'; the scene is valid but sprc run '// &
             & 'refuses it.'//nl
@@ -1139,6 +1229,43 @@ contains
       ! Lines are separated, not terminated: the driver prints the text as one record.
       text = text(1:len(text) - 1)
    end function scene_summary
+
+   !> What the study will do: the uniform levels, or the adaptive run of `&adapt`
+   !> (its fields, defaults filled in, and when it stops).
+   function adapt_text(scene) result(text)
+      type(scene_type), intent(in) :: scene
+      character(len=:), allocatable :: text
+      character(len=*), parameter :: nl = new_line('a')
+      character(len=:), allocatable :: eta
+
+      if (.not. scene%adapt%present) then
+         text = 'study: uniform, one analysis per level of &scene levels'//nl
+         return
+      end if
+      associate (a => scene%adapt)
+         eta = 'eta_spr'
+         if (scene%recovery == 'sprc' .or. scene%recovery == 'both') eta = 'eta_sprc'
+         text = 'study: adaptive (&adapt), step 0 the uniform level '//itoa(scene%levels(1))//', then each '// &
+            & 'step a new grid per body from the element indicators of '//eta//nl
+         text = text//'  target    = '//real_text(a%target)//' (stop when '//eta//' <= target: success)'//nl
+         text = text//"  strategy  = '"//a%strategy//"'"
+         if (a%strategy == 'fraction') then
+            text = text//' (refine the fewest cells carrying '//real_text(a%fraction)// &
+               & ' of the squared estimate, coarsen none)'//nl
+         else
+            text = text//' (cell sizes for the error equidistributed at the target: refines and coarsens)'//nl
+         end if
+         text = text//'  max_steps = '//itoa(a%max_steps)//' (analyses, the start mesh included)'//nl
+         if (a%max_dofs > 0) then
+            text = text//'  max_dofs  = '//itoa(a%max_dofs)//nl
+         else
+            text = text//'  max_dofs  = what the memory budget allows (checked before each step)'//nl
+         end if
+         text = text//'  max_level = '//itoa(a%max_level)//' (deepest cell)'//nl
+         text = text//'  reaching max_steps, max_dofs, max_level or the memory budget first ends the run '// &
+            & 'with exit 0 and a warning naming the limit and the best eta'//nl
+      end associate
+   end function adapt_text
 
    !> The list of SCENE.md 'What a scene switches on', one `label: state` per line.
    function switches(scene) result(text)

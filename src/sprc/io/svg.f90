@@ -10,6 +10,9 @@
 !> show empty cells or values <= 0: such points are skipped and listed in a
 !> comment in the file. A series with one point gets a marker, no line.
 !> No scripts, no external fonts or references (generic `sans-serif`).
+!> An adaptive study's rows (`step` set) are drawn against the cumulative
+!> run time (the sum of t_total up to each step): the time that accuracy
+!> cost, where a uniform level's own time is what that level costs alone.
 !>
 !> The contact plot (`contact_svg`, PREFIX_contact.svg) is one panel with
 !> linear axes: the contact pressure p_fe, p_spr, p_sprc and p_exact at the
@@ -164,12 +167,18 @@ contains
       character(len=*), intent(in) :: title
       character(len=:), allocatable :: svg
       real(wp) :: y(size(rows), n_series), x(size(rows), 2), levels(size(rows))
-      logical :: active(n_series)
+      logical :: active(n_series), cumulative
       integer :: k, p
 
       levels = report_column(rows, 'level')
       x(:, 1) = report_column(rows, 't_total')
       x(:, 2) = report_column(rows, 'dofs')
+      cumulative = any(rows%step >= 0)
+      if (cumulative) then
+         do k = 2, size(rows)
+            x(k, 1) = x(k - 1, 1) + x(k, 1)
+         end do
+      end if
       do k = 1, n_series
          y(:, k) = report_column(rows, trim(series_name(k)))
          active(k) = any(.not. is_empty(y(:, k)))
@@ -179,7 +188,7 @@ contains
          'axes. Empty cells and values <= 0 are skipped: a log scale cannot show them.', &
          skipped_comment(x, y, active, levels), title)
       do p = 1, 2
-         svg = svg//panel(p, x(:, p), y, active)
+         svg = svg//panel(p, x(:, p), y, active, cumulative)
       end do
       svg = svg//legend(report_styles(), active)//'</g>'//nl//'</svg>'//nl
    end function report_svg
@@ -636,10 +645,12 @@ contains
    end function skipped_comment
 
    !> One panel: frame, grid, decade ticks and labels, axis titles, series.
-   function panel(p, x, y, active) result(text)
+   function panel(p, x, y, active, cumulative) result(text)
       integer, intent(in) :: p
       real(wp), intent(in) :: x(:), y(:, :)
       logical, intent(in) :: active(:)
+      !> Panel 1's abscissa is the cumulative run time.
+      logical, intent(in) :: cumulative
       character(len=:), allocatable :: text
       logical :: valid(size(x), n_series)
       type(axis_type) :: ax, ay
@@ -659,7 +670,8 @@ contains
          '" font-size="14" text-anchor="middle">'//pick(p == 1, 'error against run time', &
          'error against dofs')//'</text>'//nl
       text = text//'<text x="'//num((left + right)/2)//'" y="'//num(plot_bottom + 42)// &
-         '" text-anchor="middle">'//pick(p == 1, 'run time t_total [s]', 'degrees of freedom')//'</text>'//nl// &
+         '" text-anchor="middle">'//pick(p == 1, pick(cumulative, 'cumulative run time, sum of t_total [s]', &
+         'run time t_total [s]'), 'degrees of freedom')//'</text>'//nl// &
          '<text x="'//num(x0 + 22)//'" y="'//num((plot_top + plot_bottom)/2)//'" text-anchor="middle" '// &
          'transform="rotate(-90 '//num(x0 + 22)//' '//num((plot_top + plot_bottom)/2)//')">relative error</text>'//nl
       if (.not. any(valid)) then

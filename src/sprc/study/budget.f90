@@ -62,8 +62,11 @@ contains
    !> Estimated cells, dofs and peak bytes of `level` of the scene's study for `body`
    !> (module notes); with `grid_only`, the bytes of the grid and its quadrature alone.
    !> Given `available` (bytes, -1 unknown), 'auto' takes the iterative solver's
-   !> estimate when the direct one exceeds it (`direct_fits` false).
-   subroutine level_memory(scene, body, level, cells, dofs, bytes, error, grid_only, available, direct_fits)
+   !> estimate when the direct one exceeds it (`direct_fits` false). With
+   !> `known_dofs` (an adapted mesh, whose dofs are predicted by its size
+   !> field), those dofs instead of the estimate from `level`.
+   subroutine level_memory(scene, body, level, cells, dofs, bytes, error, grid_only, available, direct_fits, &
+      & known_dofs)
       type(scene_type), intent(in) :: scene
       type(body_type), intent(in) :: body
       integer, intent(in) :: level
@@ -72,6 +75,7 @@ contains
       logical, intent(in), optional :: grid_only
       integer(i8), intent(in), optional :: available
       logical, intent(out), optional :: direct_fits
+      real(wp), intent(in), optional :: known_dofs
       type(grid_type) :: grid
       integer :: d, coarse, up, n
       real(wp) :: active, cut, box_size, direct_bytes
@@ -83,15 +87,20 @@ contains
       bytes = 0.0_wp
       if (present(direct_fits)) direct_fits = .true.
       d = scene%dim
-      coarse = min(level, merge(6, 4, d == 2))
-      call body_box(scene, body, box_min, box_size)
-      call grid%build(body, d, box_min, box_size, coarse, 0, error)
-      if (allocated(error)) return
-      active = real(sum(grid%n_inside) + sum(grid%n_cut), wp)
-      cut = real(sum(grid%n_cut), wp)
-      up = level - coarse
-      cells = active*2.0_wp**(d*up) + cut*2.0_wp**((d - 1)*up)*(2.0_wp**(d*scene%refine_boundary) - 1.0_wp)
-      dofs = real(d*scene%order**d, wp)*cells
+      if (present(known_dofs)) then
+         dofs = known_dofs
+         cells = dofs/real(d*scene%order**d, wp)
+      else
+         coarse = min(level, merge(6, 4, d == 2))
+         call body_box(scene, body, box_min, box_size)
+         call grid%build(body, d, box_min, box_size, coarse, 0, error)
+         if (allocated(error)) return
+         active = real(sum(grid%n_inside) + sum(grid%n_cut), wp)
+         cut = real(sum(grid%n_cut), wp)
+         up = level - coarse
+         cells = active*2.0_wp**(d*up) + cut*2.0_wp**((d - 1)*up)*(2.0_wp**(d*scene%refine_boundary) - 1.0_wp)
+         dofs = real(d*scene%order**d, wp)*cells
+      end if
       if (present(grid_only)) then
          if (grid_only) then
             bytes = grid_base_bytes + per_cell_grid*cells
@@ -139,7 +148,8 @@ contains
    !> may still use (sprc_core_memory); the message names the estimate, what is available
    !> and what bounds it. `solver`: the solver choice code for the level's solve, the
    !> scene's, or `solver_iterative` where 'auto' found that a direct solve would not fit.
-   subroutine check_level_memory(scene, body, level, error, grid_only, solver)
+   !> `known_dofs`: as for `level_memory`.
+   subroutine check_level_memory(scene, body, level, error, grid_only, solver, known_dofs)
       type(scene_type), intent(in) :: scene
       type(body_type), intent(in) :: body
       integer, intent(in) :: level
@@ -147,6 +157,7 @@ contains
       !> Only the grid and its quadrature will be built (`sprc mesh`).
       logical, intent(in), optional :: grid_only
       integer, intent(out), optional :: solver
+      real(wp), intent(in), optional :: known_dofs
       real(wp) :: cells, dofs, bytes, reserve
       integer(i8) :: avail, usable
       character(len=:), allocatable :: source
@@ -165,7 +176,7 @@ contains
          & real(blas_buffer_bytes, wp)
       usable = avail
       if (avail >= 0) usable = max(0_i8, avail - int(reserve, i8))
-      call level_memory(scene, body, level, cells, dofs, bytes, error, grid_only, usable, direct_fits)
+      call level_memory(scene, body, level, cells, dofs, bytes, error, grid_only, usable, direct_fits, known_dofs)
       if (allocated(error)) return
       bytes = bytes + reserve
       if (avail < 0 .or. bytes <= real(avail, wp)) then

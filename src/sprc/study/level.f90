@@ -35,6 +35,7 @@ module sprc_study_level
    use sprc_geometry_body, only: body_type
    use sprc_exact_solution, only: exact_solution_type
    use sprc_grid_nodes, only: grid_nodes_type
+   use sprc_grid_tree, only: grid_type
    use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature, default_points
    use sprc_grid_cut_mesh, only: cut_mesh_type
    use sprc_grid_patches, only: recovery_input_type, recover_grid, boundary_points
@@ -69,7 +70,7 @@ module sprc_study_level
    private
 
    public :: study_type, study_body_type, prepare_study, run_level, level_type, body_level_type, hold_starts
-   public :: nodal_fe_stress
+   public :: nodal_fe_stress, mesh_source_type, finest_cells
 
    !> What every level needs of one body, built once from the scene.
    type :: study_body_type
@@ -88,6 +89,17 @@ module sprc_study_level
       real(wp), allocatable :: box_min(:)
       real(wp) :: box_size = 0.0_wp
    end type study_body_type
+
+   !> Where an adapted mesh of one body comes from (`run_level`'s `source`):
+   !> the grid of the body's previous mesh and the level wanted for each of its
+   !> leaves (sprc_grid_adapt), at most `max_level`; `dofs`, the dofs predicted
+   !> for the new mesh (its memory estimate).
+   type :: mesh_source_type
+      type(grid_type) :: old
+      integer, allocatable :: levels(:)
+      integer :: max_level = 0
+      real(wp) :: dofs = 0.0_wp
+   end type mesh_source_type
 
    !> A prepared study: its bodies and the settings every level shares.
    type :: study_type
@@ -226,7 +238,10 @@ contains
    end subroutine shared_units
 
    !> One level of the study: every body analysed, the report row summed.
-   subroutine run_level(study, level, result, error, progress, start)
+   !> With `source` (one per body), each body's mesh is the adapted one it
+   !> describes instead of the uniform `level`; the row's `level` is then
+   !> the finest level present and `h` the smallest cell.
+   subroutine run_level(study, level, result, error, progress, start, source)
       type(study_type), intent(in) :: study
       integer, intent(in) :: level
       type(level_type), intent(out) :: result
@@ -236,6 +251,7 @@ contains
       !> Per body, its displacement at another level (`hold_displacement`),
       !> where an iterative solve of the body starts (`sprc_fem_nested`).
       type(fe_displacement_type), intent(in), optional :: start(:)
+      type(mesh_source_type), intent(in), optional :: source(:)
       type(cut_quadrature_type) :: quad
       real(wp) :: t_start, t_contact
       integer :: b, k
@@ -252,9 +268,10 @@ contains
          end associate
          if (starts_given(start, size(study%bodies))) then
             call run_body(study, study%bodies(b), level, quad, result%bodies(b), in_contact(study, b), error, &
-               & start(b))
+               & start(b), source, b)
          else
-            call run_body(study, study%bodies(b), level, quad, result%bodies(b), in_contact(study, b), error)
+            call run_body(study, study%bodies(b), level, quad, result%bodies(b), in_contact(study, b), error, &
+               & source=source, b=b)
          end if
          if (allocated(error)) then
             if (size(study%bodies) > 1) error%message = 'body '''//study%bodies(b)%name//''': '//error%message
@@ -270,6 +287,7 @@ contains
          if (allocated(error)) return
       end do
       call sum_row(study, result, result%row)
+      if (present(source)) call finest_cells(study, result)
       if (allocated(result%contacts)) then
          result%row%has_contact = .true.
          result%row%contact_iterations = sum(result%contacts%iterations)
@@ -300,6 +318,24 @@ contains
       end do
    end subroutine hold_starts
 
+   !> An adapted level's `level` and row columns `level` and `h`: the finest
+   !> level among the bodies' leaves and the smallest cell.
+   subroutine finest_cells(study, result)
+      type(study_type), intent(in) :: study
+      type(level_type), intent(inout) :: result
+      integer :: b
+
+      result%level = 0
+      result%row%h = huge(1.0_wp)
+      do b = 1, size(result%bodies)
+         associate (grid => result%bodies(b)%problem%mesh%grid)
+            result%level = max(result%level, grid%max_level)
+            result%row%h = min(result%row%h, study%bodies(b)%box_size/real(2**grid%max_level, wp))
+         end associate
+      end do
+      result%row%level = result%level
+   end subroutine finest_cells
+
    !> Whether `start` holds one displacement per body (run_level).
    pure logical function starts_given(start, n_bodies)
       type(fe_displacement_type), intent(in), optional :: start(:)
@@ -308,10 +344,10 @@ contains
       if (present(start)) starts_given = size(start) == n_bodies
    end function starts_given
 
-   !> Mesh, FE solve, recoveries and estimates of one body at `level`; a
-   !> body `in_contact` is only meshed and assembled (its pair solves it,
-   !> `run_contact`).
-   subroutine run_body(study, sb, level, quad, bl, in_contact, error, start)
+   !> Mesh, FE solve, recoveries and estimates of one body at `level` (or, with
+   !> `source`, on the adapted mesh `source(b)` describes); a body `in_contact`
+   !> is only meshed and assembled (its pair solves it, `run_contact`).
+   subroutine run_body(study, sb, level, quad, bl, in_contact, error, start, source, b)
       type(study_type), intent(in) :: study
       type(study_body_type), intent(in) :: sb
       integer, intent(in) :: level
@@ -320,13 +356,22 @@ contains
       logical, intent(in) :: in_contact
       type(error_type), allocatable, intent(out) :: error
       type(fe_displacement_type), intent(in), optional :: start
+      type(mesh_source_type), intent(in), optional :: source(:)
+      integer, intent(in) :: b
       type(cut_mesh_type), allocatable :: mesh
       integer :: solver
 
-      call check_level_memory(study%scene, sb%geometry, level, error, solver=solver)
-      if (allocated(error)) return
       allocate (mesh)
-      call mesh%build(sb%geometry, sb%box_min, sb%box_size, level, study%refine_boundary, study%order, error)
+      if (present(source)) then
+         call check_level_memory(study%scene, sb%geometry, level, error, solver=solver, known_dofs=source(b)%dofs)
+         if (allocated(error)) return
+         call mesh%build_adapted(sb%geometry, source(b)%old, source(b)%levels, source(b)%max_level, study%order, &
+            & error)
+      else
+         call check_level_memory(study%scene, sb%geometry, level, error, solver=solver)
+         if (allocated(error)) return
+         call mesh%build(sb%geometry, sb%box_min, sb%box_size, level, study%refine_boundary, study%order, error)
+      end if
       if (allocated(error)) return
       if (any(study%run) .and. sum(mesh%grid%n_inside) + sum(mesh%grid%n_cut) < 2) then
          call fatal_error(error, 'one cell holds the whole body at this level, so every recovery patch is that '// &

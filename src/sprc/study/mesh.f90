@@ -49,6 +49,11 @@ contains
       levels = scene%levels
       if (.not. present(override)) return
       if (size(override) == 0) return
+      if (scene%adapt%present .and. size(override) /= 1) then
+         call fatal_error(error, '--levels: '//itoa(size(override))//' levels; a scene with &adapt takes one, '// &
+            & 'the start level', stat_invalid_input)
+         return
+      end if
       top = merge(14, 9, scene%dim == 2)
       do i = 1, size(override)
          if (override(i) < 0 .or. override(i) > top) then
@@ -59,6 +64,11 @@ contains
             return
          end if
       end do
+      if (scene%adapt%present .and. override(1) > scene%adapt%max_level) then
+         call fatal_error(error, '--levels: start level '//itoa(override(1))//' lies above &adapt max_level = '// &
+            & itoa(scene%adapt%max_level), stat_invalid_input)
+         return
+      end if
       levels = override
    end subroutine study_levels
 

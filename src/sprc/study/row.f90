@@ -46,6 +46,11 @@ module sprc_study_row
       real(wp) :: err_p_fe = report_empty, err_p_spr = report_empty, err_p_sprc = report_empty
       !> Krylov iterations of the level's solves (0 for a direct solve).
       integer :: solver_iterations = 0
+      !> Adaptive studies (`&adapt`): the step (0 the start mesh; -1, empty, in a
+      !> uniform study) and the seconds to build it from the previous step's
+      !> estimate (size field and new grids; inside t_total, 0 at step 0).
+      integer :: step = -1
+      real(wp) :: t_adapt = report_empty
    end type report_row_type
 
 contains

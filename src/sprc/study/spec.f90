@@ -11,6 +11,7 @@ module sprc_study_spec
    private
 
    public :: scene_type, body_spec_type, shape_spec_type, bc_spec_type, exact_spec_type, contact_spec_type
+   public :: adapt_spec_type, default_max_level
    public :: recovery_degree, contact_unsupported
    public :: default_kappa, default_stabilization, kappa_range, kappa_note
 
@@ -162,6 +163,31 @@ module sprc_study_spec
       character(len=:), allocatable :: stabilization
    end type contact_spec_type
 
+   !> Default of `&adapt max_level`, 2D and 3D: the deepest cell an adaptive
+   !> run may make. Local refinement keeps the cell count far below that of a
+   !> uniform grid of the same level, so it lies above the uniform limits of
+   !> `&scene levels` (14, 9), yet below the grid's own limit (`grid_max_level`)
+   !> with room left for `refine_boundary`.
+   integer, parameter :: default_max_level(2:3) = [16, 12]
+
+   !> Error-driven adaptivity (`&adapt`; absent: the uniform study of `levels`).
+   type :: adapt_spec_type
+      !> Whether the scene has an `&adapt` group.
+      logical :: present = .false.
+      !> Stop when eta <= target (eta_sprc where SPR-C runs, else eta_spr); 0 < target < 1.
+      real(wp) :: target = 0.0_wp
+      !> Analyses at most, the start mesh included; >= 1.
+      integer :: max_steps = 10
+      !> Dofs at most (over all bodies); 0: what the memory budget allows.
+      integer :: max_dofs = 0
+      !> 'optimal' (the size field of equidistributed error) | 'fraction' (Doerfler marking).
+      character(len=:), allocatable :: strategy
+      !> 'fraction': the share of the squared estimate the refined cells carry, 0 < fraction <= 1.
+      real(wp) :: fraction = 0.5_wp
+      !> Deepest cell level, start level <= max_level <= grid_max_level.
+      integer :: max_level = 0
+   end type adapt_spec_type
+
    !> A validated scene, defaults filled in.
    type :: scene_type
       !> Name of the source (file name) it was read from.
@@ -173,7 +199,7 @@ module sprc_study_spec
       integer :: dim = 0
       !> FE degree, 1 or 2.
       integer :: order = 1
-      !> Uniform grid levels, strictly increasing.
+      !> Uniform grid levels, strictly increasing; with `&adapt` one value, the start level.
       integer, allocatable :: levels(:)
       !> Extra levels on cut elements, 0..6.
       integer :: refine_boundary = 0
@@ -199,6 +225,8 @@ module sprc_study_spec
       type(bc_spec_type), allocatable :: bcs(:)
       type(exact_spec_type) :: exact
       type(contact_spec_type), allocatable :: contacts(:)
+      !> Adaptivity; `adapt%present` false: the uniform study.
+      type(adapt_spec_type) :: adapt
    end type scene_type
 
 contains
