@@ -18,6 +18,7 @@ module sprc
    use sprc_exact_compound, only: compound_type, new_compound_cylinder, new_compound_sphere
    use sprc_exact_pressure, only: exact_pressure_type, field_pressure_type, new_field_pressure
    use sprc_exact_hertz, only: hertz_type, new_hertz_cylinder, new_hertz_sphere
+   use sprc_exact_corner, only: corner_type, new_corner, corner_eigenvalues
    use sprc_geometry_region, only: region_type, cell_outside, cell_inside, cell_cut
    use sprc_geometry_shape, only: geometry_shape_type => shape_type
    use sprc_geometry_body, only: geometry_body_type => body_type, new_body

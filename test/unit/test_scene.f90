@@ -17,7 +17,7 @@ module sprc_test_scene
    character(len=*), parameter :: nl = new_line('a')
    character(len=*), parameter :: bad_dir = 'test/data/scenes/bad/'
    !> Minimum number of malformed scene files the suite must hold.
-   integer, parameter :: min_bad_files = 116
+   integer, parameter :: min_bad_files = 127
 
    !> A small valid 2D scene; tests edit it with `replaced`.
    character(len=*), parameter :: minimal = &
@@ -42,6 +42,7 @@ contains
          new_unittest('default_equals_example_file', test_default_file), &
          new_unittest('default_scene_validates', test_default_scene), &
          new_unittest('kirsch_example', test_kirsch), &
+         new_unittest('lshape_examples', test_lshape), &
          new_unittest('lame_sphere_example', test_lame_sphere), &
          new_unittest('defaults_filled', test_defaults), &
          new_unittest('directions_normalised', test_normalised), &
@@ -187,6 +188,46 @@ contains
       if (allocated(error)) return
       call check_switch(error, summary, 'SPR-C traction equilibrium', "on (surfaces 'edges', 'hole')")
    end subroutine test_kirsch
+
+   !> The L-shape examples: the corner exact kind read (bisector normalised),
+   !> its eigenvalues in the summary, and the apex at least 0.2 of a cell
+   !> (0.19 allows for rounding) from every grid line at levels 0..20 (the
+   !> deepest an adaptive run may reach): the convergence rate the examples
+   !> show is that of a corner inside a cell, not on a node or near a sliver.
+   subroutine test_lshape(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: s
+      character(len=:), allocatable :: summary
+      character(len=*), parameter :: files(2) = ['example/scenes/lshape_q1.nml', 'example/scenes/lshape_q2.nml']
+      real(wp) :: cells
+      integer :: i, level, k
+      do i = 1, 2
+         call read_file_ok(files(i), s, error)
+         if (allocated(error)) return
+         call check(error, s%order, i, 'order')
+         if (allocated(error)) return
+         call check(error, s%exact%kind, 'corner', 'exact kind')
+         if (allocated(error)) return
+         call check(error, maxval(abs(s%exact%direction - [-1.0_wp, 1.0_wp]/sqrt(2.0_wp))), 0.0_wp, &
+            & 2.0_wp*epsilon(1.0_wp), 'bisector normalised')
+         if (allocated(error)) return
+         call check(error, s%exact%angle == 270.0_wp .and. s%exact%mode1 == 1.0_wp .and. s%exact%mode2 == 1.0_wp, &
+            & 'angle 270, mode1 = mode2 = 1')
+         if (allocated(error)) return
+         summary = scene_summary(s)
+         call check(error, index(summary, 'lambda1 = 0.544483736782464, lambda2 = 0.908529189846099') > 0, &
+            & 'eigenvalues in the summary')
+         if (allocated(error)) return
+         do level = 0, 20
+            do k = 1, 2
+               cells = (s%exact%point(k) - s%box_min(k))/s%box_size*2.0_wp**level
+               call check(error, abs(cells - anint(cells)) > 0.19_wp, 'apex off the grid lines of level '// &
+                  & itoa(level)//', '//files(i))
+               if (allocated(error)) return
+            end do
+         end do
+      end do
+   end subroutine test_lshape
 
    subroutine test_lame_sphere(error)
       type(error_type), allocatable, intent(out) :: error

@@ -32,7 +32,7 @@ module sprc_exact_kirsch
    use sprc_core_error, only: error_type
    use sprc_core_material, only: plane_stress, plane_strain
    use sprc_exact_solution, only: exact_solution_type, init_exact_solution, check_center, check_field, &
-      & is_finite, radial_frame, radius_floor
+      & is_finite, radial_frame, radius_floor, kolosov_constants
    implicit none
    private
 
@@ -103,12 +103,7 @@ contains
 
       call radial_frame(x(1:2) - self%center, radius_floor*self%radius, r, e)
       q = self%radius/r
-      mu = self%young/(2.0_wp*(1.0_wp + self%poisson))
-      if (self%analysis == plane_stress) then
-         kappa = (3.0_wp - self%poisson)/(1.0_wp + self%poisson)
-      else
-         kappa = 3.0_wp - 4.0_wp*self%poisson
-      end if
+      call kolosov_constants(self, mu, kappa)
       c1 = e(1)
       s1 = e(2)
       c3 = c1*(4.0_wp*c1**2 - 3.0_wp)

@@ -14,12 +14,12 @@
 module sprc_exact_solution
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
-   use sprc_core_material, only: voigt_size, analysis_name, check_material, solid
+   use sprc_core_material, only: voigt_size, analysis_name, check_material, solid, plane_stress
    implicit none
    private
 
    public :: exact_solution_type
-   public :: init_exact_solution, check_center, check_field, is_finite, radial_frame, radius_floor
+   public :: init_exact_solution, check_center, check_field, is_finite, radial_frame, radius_floor, kolosov_constants
 
    !> Points closer to the center than `radius_floor` times the solution's
    !> reference length are evaluated at that distance (same direction; e_1 at
@@ -135,6 +135,20 @@ contains
       end function names
 
    end subroutine init_exact_solution
+
+   !> Shear modulus mu = E/(2(1 + nu)) and Kolosov's constant kappa of a 2D
+   !> solution: (3 - nu)/(1 + nu) in plane stress, 3 - 4 nu in plane strain.
+   pure subroutine kolosov_constants(self, mu, kappa)
+      class(exact_solution_type), intent(in) :: self
+      real(wp), intent(out) :: mu, kappa
+
+      mu = self%young/(2.0_wp*(1.0_wp + self%poisson))
+      if (self%analysis == plane_stress) then
+         kappa = (3.0_wp - self%poisson)/(1.0_wp + self%poisson)
+      else
+         kappa = 3.0_wp - 4.0_wp*self%poisson
+      end if
+   end subroutine kolosov_constants
 
    !> Check that `center` has `dim` finite entries.
    pure subroutine check_center(context, center, dim, error)

@@ -11,6 +11,7 @@ module sprc_io_scene
    use sprc_fem_problem, only: default_gamma, gamma_note
    use sprc_core_text, only: itoa, real_text
    use sprc_core_error, only: error_type, fatal_error, stat_unsupported
+   use sprc_exact_corner, only: corner_eigenvalues
    use sprc_study_spec, only: scene_type, body_spec_type, shape_spec_type, bc_spec_type, exact_spec_type, &
       & contact_spec_type, recovery_degree, default_stabilization, contact_unsupported, default_max_level
    use sprc_grid_tree, only: grid_max_level
@@ -32,7 +33,7 @@ module sprc_io_scene
    character(len=*), parameter :: bc_fields = 'value vector'
    character(len=*), parameter :: bc_keys = 'on type stage '//bc_fields
    character(len=*), parameter :: exact_fields = 'center r_in r_out p_in p_out radius s_inf stress r_contact '// &
-      & 'inner outer interference point normal load'
+      & 'inner outer interference point normal load direction angle mode1 mode2'
    character(len=*), parameter :: exact_keys = 'kind '//exact_fields
    character(len=*), parameter :: contact_keys = 'slave master slave_surface master_surface friction mu kappa '// &
       & 'steps stabilization'
@@ -49,7 +50,7 @@ module sprc_io_scene
    character(len=*), parameter :: bc_types = 'free pressure traction displacement symmetry exact_traction '// &
       & 'exact_displacement'
    character(len=*), parameter :: exact_kinds = 'lame_cylinder lame_sphere kirsch uniform compound_cylinder '// &
-      & 'compound_sphere hertz_cylinder hertz_sphere'
+      & 'compound_sphere hertz_cylinder hertz_sphere corner'
    character(len=*), parameter :: frictions = 'frictionless coulomb stick'
    character(len=*), parameter :: stabilizations = 'fe recovered'
 
@@ -444,7 +445,7 @@ contains
    pure integer function kind_dim(kind)
       character(len=*), intent(in) :: kind
       select case (kind)
-      case ('disk', 'ellipse', 'lame_cylinder', 'kirsch', 'compound_cylinder', 'hertz_cylinder'); kind_dim = 2
+      case ('disk', 'ellipse', 'lame_cylinder', 'kirsch', 'compound_cylinder', 'hertz_cylinder', 'corner'); kind_dim = 2
       case ('sphere', 'ellipsoid', 'cylinder', 'lame_sphere', 'compound_sphere', 'hertz_sphere'); kind_dim = 3
       case default; kind_dim = 0
       end select
@@ -608,6 +609,8 @@ contains
             call read_compound(g, scene, exact, error)
          case ('hertz_cylinder', 'hertz_sphere')
             call read_hertz(g, scene, exact, error)
+         case ('corner')
+            call read_corner(g, exact, error)
          case default
             call check_fields(g, exact_fields, 'center r_in r_out p_in', 'p_out', "kind = '"//exact%kind//"'", error)
             if (allocated(error)) return
@@ -788,6 +791,37 @@ contains
       if (allocated(error)) return
       call get_positive(g, 'load', .true., exact%load, error)
    end subroutine read_hertz
+
+   !> The apex, the bisector of the material wedge (normalised), the opening
+   !> in degrees and the two amplitudes (absent = 0, not both 0).
+   subroutine read_corner(g, exact, error)
+      type(nml_group_type), intent(inout) :: g
+      type(exact_spec_type), intent(inout) :: exact
+      type(error_type), allocatable, intent(out) :: error
+      logical :: found1, found2
+      call check_fields(g, exact_fields, 'point direction angle', 'mode1 mode2', "kind = 'corner'", error)
+      if (allocated(error)) return
+      call get_vector(g, 'point', 2, .true., exact%point, error)
+      if (allocated(error)) return
+      call get_direction(g, 'direction', 2, exact%direction, error)
+      if (allocated(error)) return
+      call nml_get(g, 'angle', exact%angle, found1, error)
+      if (allocated(error)) return
+      if (.not. (exact%angle > 180.0_wp .and. exact%angle <= 360.0_wp)) then
+         call nml_field_error(g, 'angle', 'must satisfy 180 < angle <= 360 (the opening of the material '// &
+            & 'wedge in degrees: 270 for an L-shape, 360 for a crack)', error)
+         return
+      end if
+      call nml_get(g, 'mode1', exact%mode1, found1, error)
+      if (allocated(error)) return
+      call nml_get(g, 'mode2', exact%mode2, found2, error)
+      if (allocated(error)) return
+      if (exact%mode1 == 0.0_wp .and. exact%mode2 == 0.0_wp) then
+         call nml_field_error(g, merge('mode1', 'mode2', found1 .or. .not. found2), &
+            & 'mode1 and mode2 are both 0 (absent is 0): the corner field would vanish; give at least one '// &
+            & 'nonzero amplitude', error)
+      end if
+   end subroutine read_corner
 
    ! -------------------------------------------------------------- &contact
 
@@ -1456,6 +1490,10 @@ contains
             & ', r_contact = '//real_text(exact%r_contact)//', r_out = '//real_text(exact%r_out)// &
             & ', p_in = '//real_text(exact%p_in)//", inner = '"//exact%inner//"', outer = '"//exact%outer// &
             & "', interference = "//real_text(exact%interference)
+      case ('corner')
+         text = text//', point = '//real_list(exact%point)//', direction = '//real_list(exact%direction)// &
+            & ', angle = '//real_text(exact%angle)//', mode1 = '//real_text(exact%mode1)//', mode2 = '// &
+            & real_text(exact%mode2)//corner_note(exact%angle)
       case ('hertz_cylinder', 'hertz_sphere')
          text = text//', point = '//real_list(exact%point)//', normal = '//real_list(exact%normal)// &
             & ', radius = '//real_text(exact%radius)//', load = '//real_text(exact%load)// &
@@ -1466,6 +1504,17 @@ contains
             & real_text(exact%p_out)
       end select
    end function exact_line
+
+   !> The corner's eigenvalues and the uniform-refinement rate they imply.
+   function corner_note(angle) result(text)
+      real(wp), intent(in) :: angle
+      character(len=:), allocatable :: text
+      real(wp) :: lambda(2)
+      call corner_eigenvalues(angle, lambda)
+      text = ' (lambda1 = '//real_text(lambda(1))//', lambda2 = '//real_text(lambda(2))// &
+         & ': stress ~ r^(lambda - 1); under uniform refinement the energy error falls like '// &
+         & 'dofs^(-min(order, lambda)/2), lambda of the modes present)'
+   end function corner_note
 
    function contact_line(c) result(text)
       type(contact_spec_type), intent(in) :: c

@@ -20,6 +20,7 @@ module sprc_study_model
    use sprc_exact_compound, only: compound_type, new_compound_cylinder, new_compound_sphere
    use sprc_exact_pressure, only: exact_pressure_type, field_pressure_type, new_field_pressure
    use sprc_exact_hertz, only: hertz_type, new_hertz_cylinder, new_hertz_sphere
+   use sprc_exact_corner, only: corner_type, new_corner
    use sprc_core_text, only: itoa, real_text
    use sprc_study_spec, only: scene_type, shape_spec_type, kappa_note
    use sprc_fem_bc, only: fe_bc_type, new_fe_bc, bc_kind_from_name
@@ -160,7 +161,8 @@ contains
    !> (u = 0: err_fe 1, eta 0, theta 0 mean nothing), and an &exact whose domain does not fit
    !> the first body (its distances from the solution's centre, sampled on a lattice of
    !> 64^2 / 32^3 points of the box, do not reach the solution's radii within two lattice
-   !> steps; the errors would compare with the solution of another problem); a contact
+   !> steps, or for a corner: material outside its wedge, `corner_misfit`; the errors would
+   !> compare with the solution of another problem); a contact
    !> kappa outside its safe range (`kappa_note`).
    function scene_warnings(scene, bodies) result(text)
       type(scene_type), intent(in) :: scene
@@ -182,7 +184,7 @@ contains
             load = max(load, maxval([0.0_wp, abs(scene%bcs(i)%vector)]))
          case ('exact_traction', 'exact_displacement')
             load = max(load, abs(scene%exact%p_in), abs(scene%exact%p_out), abs(scene%exact%s_inf), &
-               & abs(scene%exact%interference))
+               & abs(scene%exact%interference), abs(scene%exact%mode1), abs(scene%exact%mode2))
             if (allocated(scene%exact%stress)) load = max(load, maxval([0.0_wp, abs(scene%exact%stress)]))
          end select
       end do
@@ -197,6 +199,9 @@ contains
       ! compound_* and hertz_* solutions span two bodies.
       select case (scene%exact%kind)
       case ('lame_cylinder', 'lame_sphere', 'kirsch')
+      case ('corner')
+         text = text//corner_misfit(scene, bodies(1))
+         return
       case default
          return
       end select
@@ -258,9 +263,28 @@ contains
       type(body_type), intent(in) :: body
       real(wp), intent(in) :: center(:)
       real(wp), intent(out) :: r(2), step
-      real(wp) :: x(3), h, dist, box_size
+      real(wp), allocatable :: x(:, :)
+      real(wp) :: dist
+      integer :: i
+
+      call material_samples(scene, body, x, step)
+      r = [huge(1.0_wp), 0.0_wp]
+      do i = 1, size(x, 2)
+         dist = norm2(x(:, i) - center(1:size(x, 1)))
+         r = [min(r(1), dist), max(r(2), dist)]
+      end do
+   end subroutine distance_range
+
+   !> The points of a lattice of 64^2 / 32^3 cell centres of the first body's
+   !> level-0 cell that lie in `body`, x(dim, m), and the lattice diagonal.
+   subroutine material_samples(scene, body, x, step)
+      type(scene_type), intent(in) :: scene
+      type(body_type), intent(in) :: body
+      real(wp), allocatable, intent(out) :: x(:, :)
+      real(wp), intent(out) :: step
+      real(wp) :: y(3), h, box_size
       real(wp), allocatable :: box_min(:)
-      integer :: n, i, j, k, d, nk
+      integer :: n, i, j, k, d, nk, m
 
       d = scene%dim
       n = merge(64, 32, d == 2)
@@ -276,19 +300,90 @@ contains
       end if
       h = box_size/real(n, wp)
       step = h*sqrt(real(d, wp))
-      r = [huge(1.0_wp), 0.0_wp]
+      allocate (x(d, n*n*nk))
+      m = 0
       do k = 1, nk
          do j = 1, n
             do i = 1, n
-               x = h*([real(i, wp), real(j, wp), real(k, wp)] - 0.5_wp)
-               x(1:d) = box_min(1:d) + x(1:d)
-               if (.not. (body%phi(x(1:d)) < 0.0_wp)) cycle
-               dist = norm2(x(1:d) - center(1:d))
-               r = [min(r(1), dist), max(r(2), dist)]
+               y = h*([real(i, wp), real(j, wp), real(k, wp)] - 0.5_wp)
+               y(1:d) = box_min(1:d) + y(1:d)
+               if (.not. (body%phi(y(1:d)) < 0.0_wp)) cycle
+               m = m + 1
+               x(:, m) = y(1:d)
             end do
          end do
       end do
-   end subroutine distance_range
+      x = x(:, 1:m)
+   end subroutine material_samples
+
+   !> A warning ('' if none) when the first body does not fit the corner
+   !> solution: material sampled on the lattice of `material_samples` outside
+   !> the wedge (beyond rounding: 1e-9 of the lattice step), or, on a lattice
+   !> of the same spacing within 8 spacings of the apex, points inside the
+   !> wedge that are not material (the wedge wider than the body's corner, or
+   !> an apex away from the body). A bisector pointing into the notch instead
+   !> of the material is the mistake this catches first.
+   function corner_misfit(scene, body) result(text)
+      type(scene_type), intent(in) :: scene
+      type(body_type), intent(in) :: body
+      character(len=:), allocatable :: text
+      real(wp), parameter :: pi = acos(-1.0_wp)
+      real(wp), allocatable :: x(:, :)
+      real(wp) :: step, beta, d(2), rho, t, gap, h
+      integer :: i, j, outside, missing
+
+      text = ''
+      call material_samples(scene, body, x, step)
+      if (size(x, 2) == 0) return
+      beta = 0.5_wp*scene%exact%angle*pi/180.0_wp
+      outside = 0
+      do i = 1, size(x, 2)
+         call wedge_polar(x(:, i), rho, t)
+         if (t <= beta) cycle
+         gap = rho
+         if (t - beta < 0.5_wp*pi) gap = rho*sin(t - beta)
+         if (gap > 1.0e-9_wp*step) outside = outside + 1
+      end do
+      h = step/sqrt(2.0_wp)
+      missing = 0
+      do j = -8, 7
+         do i = -8, 7
+            d = scene%exact%point + h*[i + 0.5_wp, j + 0.5_wp]
+            call wedge_polar(d, rho, t)
+            if (rho > 8.0_wp*h .or. t >= beta) cycle
+            gap = rho
+            if (beta - t < 0.5_wp*pi) gap = rho*sin(beta - t)
+            if (gap > 1.0e-9_wp*step .and. .not. (body%phi(d) < 0.0_wp)) missing = missing + 1
+         end do
+      end do
+      if (outside > 0) then
+         text = "warning: &exact 'corner' does not fit body '"//body%name//"': "//itoa(outside)//' of its '// &
+            & itoa(size(x, 2))//' sampled points lie outside the material wedge (angle '// &
+            & real_text(scene%exact%angle)//' about direction '//real_text(scene%exact%direction(1))//', '// &
+            & real_text(scene%exact%direction(2))//' from point '//real_text(scene%exact%point(1))//', '// &
+            & real_text(scene%exact%point(2))//'); check point, angle and direction (the bisector of the '// &
+            & 'material, not of the notch)'//new_line('a')
+      else if (missing > 0) then
+         text = "warning: &exact 'corner' does not fit body '"//body%name//"': "//itoa(missing)//' points '// &
+            & 'of the wedge within 8 lattice steps ('//real_text(h)//') of the apex are not in the body (the '// &
+            & "body's corner is narrower, or the apex is not on it); check point and angle"//new_line('a')
+      end if
+
+   contains
+
+      !> Distance from the apex and |angle| from the bisector of a point.
+      pure subroutine wedge_polar(y, rho, t)
+         real(wp), intent(in) :: y(2)
+         real(wp), intent(out) :: rho, t
+         real(wp) :: dy(2)
+         dy = y - scene%exact%point
+         rho = norm2(dy)
+         associate (e => scene%exact%direction)
+            t = abs(atan2(-e(2)*dy(1) + e(1)*dy(2), e(1)*dy(1) + e(2)*dy(2)))
+         end associate
+      end subroutine wedge_polar
+
+   end function corner_misfit
 
    !> v to six significant digits (sampled distances: more digits would be noise).
    pure real(wp) function rounded(v)
@@ -455,6 +550,13 @@ contains
             end select
          case ('compound_cylinder', 'compound_sphere')
             call build_compound_ring(scene, b, exact, error)
+         case ('corner')
+            allocate (corner_type :: exact)
+            select type (exact)
+            type is (corner_type)
+               call new_corner(exact, spec%point, spec%direction, spec%angle, spec%mode1, spec%mode2, young, nu, &
+                  & analysis_kind(scene), error)
+            end select
          case ('hertz_cylinder', 'hertz_sphere')
          case default
             call fatal_error(error, 'kind '''//spec%kind//''' is not available in this version', stat_unsupported)

@@ -108,7 +108,7 @@ module sprc_study_spec
       !> Whether the scene has an `&exact` group.
       logical :: present = .false.
       !> 'lame_cylinder' | 'lame_sphere' | 'kirsch' | 'uniform' | 'compound_cylinder' |
-      !> 'compound_sphere' | 'hertz_cylinder' | 'hertz_sphere'.
+      !> 'compound_sphere' | 'hertz_cylinder' | 'hertz_sphere' | 'corner'.
       character(len=:), allocatable :: kind
       !> Centre, `dim` values.
       real(wp), allocatable :: center(:)
@@ -127,6 +127,12 @@ module sprc_study_spec
       real(wp), allocatable :: point(:), normal(:)
       !> Hertz: the whole contact force (per unit thickness in 2D), > 0.
       real(wp) :: load = 0.0_wp
+      !> Corner: unit bisector of the material wedge (`point` is the apex), 2 values.
+      real(wp), allocatable :: direction(:)
+      !> Corner: opening of the material wedge in degrees, 180 < angle <= 360.
+      real(wp) :: angle = 0.0_wp
+      !> Corner: amplitudes of the mode 1 (symmetric) and mode 2 (antisymmetric) fields, not both 0.
+      real(wp) :: mode1 = 0.0_wp, mode2 = 0.0_wp
    end type exact_spec_type
 
    !> A contact pair between two bodies.
