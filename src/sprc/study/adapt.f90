@@ -41,7 +41,7 @@ module sprc_study_adapt
    use sprc_core_timer, only: wall_time
    use sprc_core_text, only: itoa, real_text
    use sprc_grid_adapt, only: optimal_levels, fraction_levels
-   use sprc_grid_tree, only: grid_max_level
+   use sprc_grid_tree, only: grid_type, grid_max_level
    use sprc_study_level, only: study_type, level_type, run_level, hold_starts, mesh_source_type, finest_cells
    use sprc_study_budget, only: check_level_memory
    use sprc_study_partition, only: largest_over_ranks
@@ -202,7 +202,7 @@ contains
             if (.not. allocated(error)) run%capped = count(free > a%max_level)
          end if
          if (allocated(error)) return
-         if (all(levels == leaf_level)) then
+         if (same_meshes(study, result, levels, a%max_level, error)) then
             if (run%capped > 0) then
                call finish(run, reason_max_level, 'max_level = '//itoa(a%max_level)//': the cells the estimate '// &
                   & 'would refine stand at it')
@@ -262,6 +262,40 @@ contains
       end do
       run%next_dofs = sum(dofs)
    end subroutine next_meshes
+
+   !> Whether the wanted `levels` (all bodies' leaves, concatenated) give every
+   !> body its present grid again. Comparing the levels is not enough: a cell
+   !> coarsens only when all its siblings want it, and the 2:1 balance can undo
+   !> a coarsening, so wanted levels that differ from the present ones can still
+   !> build the same grid (the run would then repeat one mesh until max_steps).
+   !> The grids are built here to compare them; it is the grid alone, a small
+   !> share of a step.
+   logical function same_meshes(study, result, levels, max_level, error) result(same)
+      type(study_type), intent(in) :: study
+      type(level_type), intent(in) :: result
+      integer, intent(in) :: levels(:), max_level
+      type(error_type), allocatable, intent(out) :: error
+      type(grid_type) :: trial
+      integer :: b, k
+
+      same = all(levels == [(result%bodies(b)%problem%mesh%grid%leaf_level( &
+         & 1:result%bodies(b)%problem%mesh%grid%n_leaves), b = 1, size(result%bodies))])
+      if (same) return
+      same = .true.
+      k = 0
+      do b = 1, size(result%bodies)
+         associate (old => result%bodies(b)%problem%mesh%grid)
+            call trial%build_adapted(study%bodies(b)%geometry, old, levels(k + 1:k + old%n_leaves), max_level, &
+               & error)
+            if (allocated(error)) return
+            same = trial%n_leaves == old%n_leaves
+            if (same) same = all(trial%leaf_key(1:trial%n_leaves) == old%leaf_key(1:old%n_leaves)) .and. &
+               & all(trial%leaf_level(1:trial%n_leaves) == old%leaf_level(1:old%n_leaves))
+            k = k + old%n_leaves
+         end associate
+         if (.not. same) return
+      end do
+   end function same_meshes
 
    !> The level wanted per leaf by the scene's strategy, at most `max_level`.
    subroutine wanted_levels(study, leaf_level, err_sq, norm_sq, max_level, levels, error)

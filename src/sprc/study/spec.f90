@@ -159,9 +159,11 @@ module sprc_study_spec
    !> Default of `&adapt max_level`, 2D and 3D: the deepest cell an adaptive
    !> run may make. Local refinement keeps the cell count far below that of a
    !> uniform grid of the same level, so it lies above the uniform limits of
-   !> `&scene levels` (14, 9), yet below the grid's own limit (`grid_max_level`)
-   !> with room left for `refine_boundary`.
-   integer, parameter :: default_max_level(2:3) = [16, 12]
+   !> `&scene levels` (14, 9). In 2D it is the grid's own limit
+   !> (`grid_max_level`): the apex of a re-entrant corner asks for the deepest
+   !> cells a target of 0.1 % with Q2 needs; in 3D the budget stops a run
+   !> long before level 12 anywhere but at a point.
+   integer, parameter :: default_max_level(2:3) = [20, 12]
 
    !> Error-driven adaptivity (`&adapt`; absent: the uniform study of `levels`).
    type :: adapt_spec_type
