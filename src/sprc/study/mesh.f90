@@ -196,8 +196,8 @@ contains
    !> first level of the study): a load on a surface the body does not have
    !> would be dropped silently. The measures are those of `sprc mesh`: the
    !> body's volume quadrature and the surface points the cut-cell quadrature
-   !> tags with each shape (a boundary point belongs to the one shape that
-   !> decides the body's membership there; see the rule in SCENE.md). The
+   !> tags with each shape, which are those a load is applied on (where two
+   !> shapes' surfaces coincide the quadrature tags one of them: SCENE.md). The
    !> quadrature resolves the geometry inside a cell, so a coarse level decides
    !> as well as a fine one, except for features below 2^-max_depth of a cell.
    !> Errors (stat_invalid_input) name the body or the surface and why: the
@@ -292,7 +292,8 @@ contains
          & "' (boundary measure 0 at level "//itoa(level)//'): '
       if (k > i) then
          why = "shape '"//shape_name(body%shapes(k))//"' ("//csg_op_name(body%ops(k))// &
-            & ') covers the last of it (where a later shape coincides with it, the later shape owns the boundary)'
+            & ') covers the last of it, or takes it where their surfaces coincide (sprc mesh shows each named '// &
+            & "surface's measure)"
       else if (i == 1) then
          why = "its surface lies wholly outside the box of the body's grid (box_min, box_size)"
       else
