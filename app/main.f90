@@ -13,7 +13,7 @@ program sprc_main
    use sprc_study_model, only: build_bodies, scene_warnings
    use sprc_study_threads, only: level_threads, study_dofs, serial_dofs
    use sprc_geometry_body, only: body_type
-   use sprc_study_mesh, only: mesh_row_type, mesh_study, study_levels
+   use sprc_study_mesh, only: mesh_row_type, mesh_study, study_levels, check_surfaces
    use sprc_study_level, only: study_type, prepare_study, run_level, level_type, hold_starts
    use sprc_study_adapt, only: adapt_run_type, start_adapt, adapt_step, adapt_warning, step_eta
    use sprc_fem_nested, only: fe_displacement_type
@@ -144,10 +144,10 @@ contains
       call prepare_study(scene, cli%points, study, error)
       if (allocated(error)) call fail_with(error)
       ! A named copy: passing the strided component study%bodies%geometry made a hidden array temporary.
-      if (rank == 0) then
-         geometry = study%bodies%geometry
-         call print_warnings(scene_warnings(scene, geometry))
-      end if
+      geometry = study%bodies%geometry
+      call check_surfaces(scene, geometry, minval(levels), cli%points, error)
+      if (allocated(error)) call fail_with(error)
+      if (rank == 0) call print_warnings(scene_warnings(scene, geometry))
       prefix = scene%output
       if (len(cli%output) > 0) prefix = cli%output
       if (rank > 0) prefix = ''
@@ -367,6 +367,7 @@ contains
       call read_scene(path, scene, error)
       if (allocated(error)) call fail(2, error%message)
       call build_bodies(scene, bodies, error)
+      if (.not. allocated(error)) call check_surfaces(scene, bodies, minval(scene%levels), 0, error)
       if (allocated(error)) call fail_with(error)
       call print_warnings(scene_warnings(scene, bodies))
       write (output_unit, '(a)') scene_summary(scene)
@@ -378,6 +379,7 @@ contains
       type(scene_type) :: scene
       type(error_type), allocatable :: error
       type(mesh_row_type), allocatable :: rows(:)
+      type(body_type), allocatable :: bodies(:)
       integer, allocatable :: levels(:)
       integer :: i
 
@@ -390,6 +392,10 @@ contains
       do i = 1, size(rows)
          write (output_unit, '(a)') format_mesh_row(rows(i))
       end do
+      ! After the rows, so that the measures show what is missing.
+      call build_bodies(scene, bodies, error)
+      if (.not. allocated(error)) call check_surfaces(scene, bodies, minval(levels), cli%points, error, grid_only=.true.)
+      if (allocated(error)) call fail_with(error)
    end subroutine mesh_scene
 
 

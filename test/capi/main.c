@@ -287,6 +287,11 @@ static void test_run_invalid_scene(void) {
   CHECK(sprc_run_scene(err, path, NULL, 0) == NULL, "a contact scene gave a report");
   CHECK(sprc_get_error_status(err) == SPRC_STAT_UNSUPPORTED, "a contact scene is not SPRC_STAT_UNSUPPORTED");
   CHECK(has_error(err, "contact"), "the message does not name contact");
+  /* A traction on a surface the body does not have (later halfspaces cut every face away). */
+  snprintf(path, sizeof path, "%s/test/data/scenes/bad/surface_covered_box.nml", root);
+  CHECK(sprc_run_scene(err, path, NULL, 0) == NULL, "a load on a covered surface gave a report");
+  CHECK(sprc_get_error_status(err) == SPRC_STAT_INVALID_INPUT, "a covered surface is not SPRC_STAT_INVALID_INPUT");
+  CHECK(has_error(err, "surface 'outer' does not bound body 'plate'"), "the message does not name the surface");
   sprc_delete_error(&err);
   PASS();
 }

@@ -11,7 +11,8 @@ module sprc_capi_study
    use sprc_core_text, only: itoa
    use sprc_io_scene, only: scene_type, read_scene
    use sprc_io_fields, only: level_fields_type, grid_fields_type, field_array_type, level_fields
-   use sprc_study_mesh, only: study_levels
+   use sprc_study_mesh, only: study_levels, check_surfaces
+   use sprc_geometry_body, only: body_type
    use sprc_study_level, only: study_type, prepare_study, run_level, level_type, hold_starts
    use sprc_study_threads, only: level_threads, serial_dofs
    use sprc_study_adapt, only: adapt_run_type, start_adapt, adapt_step
@@ -197,6 +198,7 @@ contains
       !> The previous level's displacements, where the iterative solves start.
       type(fe_displacement_type), allocatable :: starts(:)
       integer, allocatable :: levels(:)
+      type(body_type), allocatable :: geometry(:)
       integer :: i, j, n
 
       call read_scene(path, scene, error)
@@ -228,6 +230,9 @@ contains
          end do
       end if
       call prepare_study(scene, 0, study, error)
+      if (allocated(error)) return
+      geometry = study%bodies%geometry
+      call check_surfaces(scene, geometry, minval(levels), 0, error)
       if (allocated(error)) return
       allocate (rows(size(levels)))
       do i = 1, size(levels)

@@ -612,6 +612,7 @@ contains
       type(mesh_row_type), intent(in) :: row
       character(len=:), allocatable :: line
       character(len=32) :: t, tq, m, bm
+      integer :: i
 
       write (t, '(es10.3)') row%t_mesh
       write (tq, '(es10.3)') row%t_quadrature
@@ -621,6 +622,11 @@ contains
          ' cut='//itoa(row%cut)//' external='//itoa(row%external)//' measure='//trim(adjustl(m))// &
          ' boundary_measure='//trim(adjustl(bm))//' points='//itoa(row%points)//' t_mesh='//trim(adjustl(t))// &
          ' t_quadrature='//trim(adjustl(tq))
+      if (.not. allocated(row%surfaces)) return
+      do i = 1, size(row%surfaces)
+         write (m, '(es24.16)') row%surfaces(i)%measure
+         line = line//' surface_measure['//row%surfaces(i)%name//']='//trim(adjustl(m))
+      end do
    end function format_mesh_row
 
 end module sprc_io_report
