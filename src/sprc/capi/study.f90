@@ -211,6 +211,9 @@ contains
       if (allocated(error)) return
       if (scene%adapt%present) then
          call prepare_study(scene, 0, study, error)
+         if (allocated(error)) return
+         geometry = study%bodies%geometry
+         call check_surfaces(scene, geometry, levels(1), 0, error)
          if (.not. allocated(error)) call run_steps(study, levels(1), threads, available, fields, rows, error, keep, &
             & kept, kept_fields)
          return
