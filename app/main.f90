@@ -4,7 +4,7 @@ program sprc_main
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
    use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
    use omp_lib, only: omp_set_num_threads, omp_get_max_threads
-   use sprc_core_kinds, only: wp
+   use sprc_core_kinds, only: wp, i8
    use sprc_core_text, only: fixed_text, itoa, byte_text
    use sprc_core_memory, only: peak_memory
    use sprc_core_error, only: error_type, stat_invalid_input, stat_io
@@ -273,7 +273,7 @@ contains
          end if
          if (cli%threads == 0) call omp_set_num_threads(merge(1, threads, total_dofs < serial_dofs))
          if (.not. quiet) write (error_unit, '(a,i0,a,i0,a)') 'sprc: step ', run%step + 1, ' (about ', &
-            & nint(total_dofs), ' dofs)'
+            & nint(total_dofs, i8), ' dofs)'
          progress_level = run%step + 1
          if (cli%quiet) then
             call adapt_step(study, run, result, error)

@@ -132,7 +132,9 @@ typedef struct _sprc_study *sprc_study;
 /* Run the scene at path as sprc_run_scene_threads does (levels[nlevels],
  * NULL and 0: the scene's levels; threads as there) and keep the fields of
  * the levels keep[nkeep], each one of the levels run (NULL and 0: of every
- * level run). Fields of the other levels are freed as the run goes on.
+ * level run; in an adaptive study, &adapt, keep names steps, 0 the start
+ * mesh, as the report's step column). Fields of the other levels are freed
+ * as the run goes on.
  * Returns a new study (free it with sprc_delete_study) or NULL with the
  * error set (as sprc_run_scene; a level in keep that is not run:
  * SPRC_STAT_INVALID_INPUT). */

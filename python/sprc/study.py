@@ -139,7 +139,8 @@ def run_arguments(path, levels, threads):
 def run(path, levels=None, keep=None, threads=None):
     """Run the study of the scene file ``path`` as :func:`sprc.run_scene` does
     and return a :class:`Study` holding the fields of the levels ``keep``
-    (an int or ints among those run; None: every level run) as numpy arrays
+    (an int or ints among those run; None: every level run; in an adaptive
+    study, ``&adapt``, the steps, 0 the start mesh) as numpy arrays
     (module notes). ``levels`` (an int or ints) overrides the scene's levels;
     ``threads`` (a positive int) runs on that many threads, None as the
     driver does. Writes no files. Raises :class:`SprcError` when the scene
@@ -160,7 +161,9 @@ def run(path, levels=None, keep=None, threads=None):
             rows = _report_rows(report)
         finally:
             library.delete_report(ctypes.byref(report))
-        kept = set(range(len(rows))) if kp is None else {i for i, r in enumerate(rows) if r["level"] in set(kp.tolist())}
+        # keep names levels, or steps in an adaptive study (its rows carry a step)
+        key = "step" if rows and "step" in rows[0] else "level"
+        kept = set(range(len(rows))) if kp is None else {i for i, r in enumerate(rows) if r[key] in set(kp.tolist())}
         levels_kept = [_level(study, i, rows[i]) for i in sorted(kept)]
     finally:
         library.delete_study(ctypes.byref(study))

@@ -182,3 +182,14 @@ def test_run_scene_threads_and_int_levels():
 def test_thin_layer_study_null_handle():
     with pytest.raises(sprc.SprcError, match="study handle is NULL"):
         sprc.library.get_study_grids(None, 0)
+
+
+def test_keep_steps_of_an_adaptive_study():
+    """In an adaptive study keep names steps (as the C API's keep does), not
+    levels: the kept step's fields come back, and no other step's."""
+    scene = ROOT / "test" / "data" / "scenes" / "valid" / "kirsch_adaptive.nml"
+    study = sprc.run(scene, keep=[1], threads=1)
+    assert len(study.report) >= 2
+    assert [lv.report["step"] for lv in study.levels] == [1]
+    assert study.levels[0].level == study.report[1]["level"]
+    assert study.levels[0].bodies["plate"]["cell_level"].max() == study.report[1]["level"]

@@ -153,6 +153,7 @@ module sprc_contact_solve
       & stat_unsupported
    use sprc_core_text, only: itoa
    use sprc_core_alloc, only: check_allocation
+   use sprc_core_hash, only: hash_int
    use sprc_core_timer, only: timer_type
    use sprc_fem_sparse, only: coo_type, csr_type
    use sprc_fem_element, only: shape_functions, strain_matrix, traction_matrix, displacement_matrix
@@ -624,25 +625,48 @@ contains
    end subroutine macro_cells
 
    !> macro(e) for the roots `roots` with their ancestor shifts: the first
-   !> root with the same level, shift and ancestor (e itself elsewhere).
+   !> root with the same level, shift and ancestor (e itself elsewhere). The
+   !> groups go through a hash table of their keys (sprc_core_hash), linear
+   !> in the roots: the contact surface is a user-scaled size.
    subroutine group_roots(slave, d, roots, shift, macro)
       type(elasticity_problem_type), intent(in) :: slave
       integer, intent(in) :: d, roots(:), shift(:)
       integer, intent(out) :: macro(:)
-      integer :: i, j, e
+      integer, allocatable :: table(:)
+      integer :: i, e, r, slot, nslot, key(d + 2)
 
       macro = [(e, e=1, size(macro))]
+      nslot = 2
+      do while (nslot < 2*size(roots))
+         nslot = 2*nslot
+      end do
+      allocate (table(0:nslot - 1))
+      table = 0
       do i = 1, size(roots)
-         do j = 1, i - 1
-            if (slave%mesh%grid%leaf_level(roots(j)) == slave%mesh%grid%leaf_level(roots(i)) .and. &
-               & shift(roots(j)) == shift(roots(i)) .and. &
-               & all(slave%mesh%grid%leaf_coord(1:d, roots(j))/2**shift(roots(j)) == &
-               & slave%mesh%grid%leaf_coord(1:d, roots(i))/2**shift(roots(i)))) then
-               macro(roots(i)) = macro(roots(j))
+         r = roots(i)
+         key = root_key(r)
+         slot = int(iand(hash_int(key), int(nslot - 1, i8)))
+         do
+            if (table(slot) == 0) then
+               table(slot) = r
                exit
             end if
+            if (all(root_key(table(slot)) == key)) then
+               macro(r) = macro(table(slot))
+               exit
+            end if
+            slot = iand(slot + 1, nslot - 1)
          end do
       end do
+   contains
+      !> A root's group: its level, its shift and its ancestor's coordinates.
+      pure function root_key(e) result(k)
+         integer, intent(in) :: e
+         integer :: k(d + 2)
+         k(1) = slave%mesh%grid%leaf_level(e)
+         k(2) = shift(e)
+         k(3:) = slave%mesh%grid%leaf_coord(1:d, e)/2**shift(e)
+      end function root_key
    end subroutine group_roots
 
    !> wide(m): the points of macro cell m (representative m) have a normal

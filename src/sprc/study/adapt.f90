@@ -36,7 +36,7 @@
 !> indicator (sprc_grid_share), so every rank builds the same meshes; the
 !> memory decision is the ranks' common one.
 module sprc_study_adapt
-   use sprc_core_kinds, only: wp
+   use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_out_of_memory, stat_internal
    use sprc_core_timer, only: wall_time
    use sprc_core_text, only: itoa, real_text
@@ -222,7 +222,7 @@ contains
          end do
          if (a%max_dofs > 0 .and. sum(dofs) > real(a%max_dofs, wp)) then
             call finish(run, reason_max_dofs, 'max_dofs = '//itoa(a%max_dofs)//': the next mesh would have about '// &
-               & itoa(nint(sum(dofs)))//' dofs')
+               & itoa(nint(sum(dofs), i8))//' dofs')
             return
          end if
       end associate
