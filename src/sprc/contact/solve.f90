@@ -698,7 +698,8 @@ contains
          m = macro(slave%root(surface%slave_cell(i)))
          len = norm2(nsum(:, m))
          if (wide(m)) cycle
-         wide(m) = .not. dot_product(surface%normal(:, i), nsum(:, m)) >= cos_max_turn*len
+         ! A mean normal of exactly zero (normals that cancel) is the widest turn of all.
+         wide(m) = .not. (len > 0.0_wp .and. dot_product(surface%normal(:, i), nsum(:, m)) >= cos_max_turn*len)
       end do
    end subroutine turns_too_far
 
