@@ -69,6 +69,8 @@ class Level:
     def __init__(self, report, bodies, contacts):
         self.report = report
         self.level = report["level"]
+        #: the adaptive step (0 the start mesh); None in a uniform study
+        self.step = report.get("step")
         self.bodies = bodies
         self.contacts = contacts
 
@@ -92,9 +94,25 @@ class Study:
         self.report = report
         self.levels = levels
 
+    def step(self, number):
+        """The :class:`Level` of adaptive step ``number`` (0 the start mesh);
+        ValueError in a uniform study, or when that step was not run or its
+        fields were not kept. Several steps can share a finest level: name
+        them by step."""
+        run = [r.get("step") for r in self.report]
+        if not run or run[0] is None:
+            raise ValueError("a uniform study has no steps: use level(number)")
+        for lv in self.levels:
+            if lv.step == number:
+                return lv
+        if number in run:
+            raise ValueError(f"the fields of step {number} were not kept (kept: {[lv.step for lv in self.levels]})")
+        raise ValueError(f"step {number} was not run (steps run: 0 to {len(run) - 1})")
+
     def level(self, number):
-        """The :class:`Level` of level ``number``; ValueError when that level
-        was not run or its fields were not kept."""
+        """The :class:`Level` of level ``number`` (in an adaptive study, the
+        first step whose finest level it is; :meth:`step` names one step);
+        ValueError when that level was not run or its fields were not kept."""
         for lv in self.levels:
             if lv.level == number:
                 return lv

@@ -193,3 +193,23 @@ def test_keep_steps_of_an_adaptive_study():
     assert [lv.report["step"] for lv in study.levels] == [1]
     assert study.levels[0].level == study.report[1]["level"]
     assert study.levels[0].bodies["plate"]["cell_level"].max() == study.report[1]["level"]
+
+
+def test_step_names_one_adaptive_step():
+    """Study.step(k) returns step k (several steps may share a finest level,
+    which Study.level cannot tell apart); a uniform study has no steps."""
+    import pytest
+
+    scene = ROOT / "test" / "data" / "scenes" / "valid" / "kirsch_adaptive.nml"
+    study = sprc.run(scene, keep=[0, 1], threads=1)
+    last = len(study.report) - 1
+    assert last >= 2
+    assert study.step(0).step == 0 and study.step(1).step == 1
+    assert study.step(1).report == study.report[1]
+    with pytest.raises(ValueError, match="not kept"):
+        study.step(last)
+    with pytest.raises(ValueError, match="not run"):
+        study.step(last + 1)
+    uniform = sprc.run(ROOT / "example" / "scenes" / "lame_cylinder.nml", levels=[3], threads=1)
+    with pytest.raises(ValueError, match="no steps"):
+        uniform.step(0)
