@@ -31,6 +31,7 @@
 !> plot.
 module sprc_io_svg
    use sprc_core_kinds, only: wp, i8
+   use sprc_core_sort, only: sort_order
    use sprc_core_text, only: fixed_text
    use sprc_core_alloc, only: check_allocation
    use sprc_core_error, only: error_type, fatal_error, stat_io
@@ -504,44 +505,6 @@ contains
          s(i) = norm2(x(:, i) - x(:, peak))
       end do
    end subroutine from_peak
-
-   !> `order`, the permutation sorting `v` ascending: a stable bottom-up merge
-   !> sort (a 3D slave surface has tens of thousands of points in no order);
-   !> `work` is scratch of the same size.
-   pure subroutine sort_order(v, order, work)
-      real(wp), intent(in) :: v(:)
-      integer, intent(out) :: order(:), work(:)
-      integer :: width, lo, mid, hi, i, j, k, n
-
-      n = size(v)
-      order = [(i, i=1, n)]
-      width = 1
-      do while (width < n)
-         do lo = 1, n, 2*width
-            mid = min(lo + width - 1, n)
-            hi = min(lo + 2*width - 1, n)
-            i = lo
-            j = mid + 1
-            do k = lo, hi
-               if (j > hi) then
-                  work(k) = order(i)
-                  i = i + 1
-               else if (i > mid) then
-                  work(k) = order(j)
-                  j = j + 1
-               else if (v(order(j)) < v(order(i))) then
-                  work(k) = order(j)
-                  j = j + 1
-               else
-                  work(k) = order(i)
-                  i = i + 1
-               end if
-            end do
-         end do
-         order = work
-         width = 2*width
-      end do
-   end subroutine sort_order
 
    !> The one panel of the contact plot, appended to `buf`: frame, grid, ticks,
    !> axis titles, one series per active column of p over the points `shown`
