@@ -10,7 +10,7 @@ module sprc_io_scene
    use sprc_fem_linear_solver, only: solver_names, auto_iterative_min_dofs, auto_never
    use sprc_fem_problem, only: default_gamma, gamma_note
    use sprc_core_text, only: itoa, real_text
-   use sprc_core_error, only: error_type, fatal_error, stat_unsupported
+   use sprc_core_error, only: error_type, fatal_error
    use sprc_exact_corner, only: corner_eigenvalues
    use sprc_study_spec, only: scene_type, body_spec_type, shape_spec_type, bc_spec_type, exact_spec_type, &
       & contact_spec_type, recovery_degree, default_stabilization, contact_unsupported, default_max_level
@@ -68,8 +68,7 @@ module sprc_io_scene
 contains
 
    !> Read and validate a scene file. A missing or unreadable file is
-   !> `stat_io`; a bad scene `stat_invalid_input`; a request this version
-   !> cannot take (a second &contact pair) `stat_unsupported`.
+   !> `stat_io`; a bad scene `stat_invalid_input`.
    subroutine read_scene(path, scene, error)
       !> Path of the scene file; messages name it.
       character(len=*), intent(in) :: path
@@ -837,12 +836,6 @@ contains
       do ig = 1, size(groups)
          if (groups(ig)%name /= 'contact') cycle
          n = n + 1
-         if (n > 1) then
-            call nml_group_error(groups(ig), 'a second &contact group (the first is on line '// &
-               & itoa(groups(first_group(groups, 'contact'))%line)//'): this version takes one contact pair', &
-               & error, stat_unsupported)
-            return
-         end if
          associate (g => groups(ig), c => scene%contacts(n))
             call check_keys(g, contact_keys, error)
             if (allocated(error)) return
@@ -891,11 +884,47 @@ contains
             call get_choice(g, 'stabilization', stabilizations, .false., c%stabilization, error)
             if (allocated(error)) return
             call nml_check_consumed(g, error)
+            if (.not. allocated(error)) call check_pair_unique(g, scene%contacts(1:n), error)
             if (allocated(error)) return
          end associate
       end do
       call check_exact_pair(groups, scene, error)
    end subroutine read_contacts
+
+   !> Pair `pairs(n)` against the pairs before it (doc/scene.md `&contact`):
+   !> two bodies touch through one pair (either way round), a slave surface
+   !> belongs to one pair (its points have one master), and a surface is not
+   !> the slave of one pair and the master of another. A master surface may
+   !> serve several pairs (a rail under two rollers).
+   subroutine check_pair_unique(g, pairs, error)
+      type(nml_group_type), intent(in) :: g
+      type(contact_spec_type), intent(in) :: pairs(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: k, n
+
+      n = size(pairs)
+      associate (c => pairs(n))
+         do k = 1, n - 1
+            associate (o => pairs(k))
+               if ((o%slave_index == c%slave_index .and. o%master_index == c%master_index) .or. &
+                  & (o%slave_index == c%master_index .and. o%master_index == c%slave_index)) then
+                  call nml_field_error(g, 'master', "bodies '"//c%slave//"' and '"//c%master//"' are already "// &
+                     & 'a pair (&contact '//itoa(k)//'): two bodies touch through one pair', error)
+               else if (o%slave_surface_index == c%slave_surface_index) then
+                  call nml_field_error(g, 'slave_surface', 'is already the slave surface of &contact '//itoa(k)// &
+                     & ': a slave point has one master', error)
+               else if (o%master_surface_index == c%slave_surface_index) then
+                  call nml_field_error(g, 'slave_surface', 'is the master surface of &contact '//itoa(k)// &
+                     & ': a surface is the slave or the master of its pairs, not both', error)
+               else if (o%slave_surface_index == c%master_surface_index) then
+                  call nml_field_error(g, 'master_surface', 'is the slave surface of &contact '//itoa(k)// &
+                     & ': a surface is the slave or the master of its pairs, not both', error)
+               end if
+            end associate
+            if (allocated(error)) return
+         end do
+      end associate
+   end subroutine check_pair_unique
 
    !> A compound exact solution needs a &contact between its inner and outer
    !> bodies, a Hertz one a &contact at all: without it their fields do not hold.
