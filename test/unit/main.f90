@@ -10,6 +10,7 @@ program sprc_unit_tests
    use sprc_test_exact, only: collect_exact
    use sprc_test_exact_contact, only: collect_exact_contact
    use sprc_test_exact_corner, only: collect_exact_corner
+   use sprc_test_exact_layered, only: collect_exact_layered
    use sprc_test_contact_surface, only: collect_contact_surface
    use sprc_test_namelist, only: collect_namelist
    use sprc_test_scene, only: collect_scene
@@ -48,6 +49,7 @@ program sprc_unit_tests
       new_testsuite('exact', collect_exact), &
       new_testsuite('exact_contact', collect_exact_contact), &
       new_testsuite('exact_corner', collect_exact_corner), &
+      new_testsuite('exact_layered', collect_exact_layered), &
       new_testsuite('contact_surface', collect_contact_surface), &
       new_testsuite('namelist', collect_namelist), &
       new_testsuite('scene', collect_scene), &

@@ -18,11 +18,12 @@ module sprc_study_model
    use sprc_exact_kirsch, only: kirsch_type, new_kirsch
    use sprc_exact_uniform, only: uniform_type, new_uniform
    use sprc_exact_compound, only: compound_type, new_compound_cylinder, new_compound_sphere
+   use sprc_exact_layered, only: layered_type, new_layered
    use sprc_exact_pressure, only: exact_pressure_type, field_pressure_type, new_field_pressure
    use sprc_exact_hertz, only: hertz_type, new_hertz_cylinder, new_hertz_sphere
    use sprc_exact_corner, only: corner_type, new_corner
    use sprc_core_text, only: itoa, real_text
-   use sprc_study_spec, only: scene_type, shape_spec_type, kappa_note
+   use sprc_study_spec, only: scene_type, shape_spec_type, kappa_note, exact_spec_type, contact_spec_type
    use sprc_fem_bc, only: fe_bc_type, new_fe_bc, bc_kind_from_name
    use sprc_fem_problem, only: gamma_note
    implicit none
@@ -144,6 +145,7 @@ contains
       scaled%exact%s_inf = stress1(scene%exact%s_inf)
       scaled%exact%load = stress1(scene%exact%load)
       scaled%exact%interference = scene%exact%interference/units%strain
+      if (allocated(scene%exact%interferences)) scaled%exact%interferences = scene%exact%interferences/units%strain
       if (allocated(scene%exact%stress)) scaled%exact%stress = stress(scene%exact%stress)
    contains
       pure function stress(v) result(w)
@@ -550,6 +552,8 @@ contains
             end select
          case ('compound_cylinder', 'compound_sphere')
             call build_compound_ring(scene, b, exact, error)
+         case ('layered_cylinder', 'layered_sphere')
+            call build_layered_ring(scene, b, exact, error)
          case ('corner')
             allocate (corner_type :: exact)
             select type (exact)
@@ -597,6 +601,25 @@ contains
       end if
    end subroutine build_compound_ring
 
+   !> Body b's ring of the scene's layered solution, with every ring body's
+   !> material (not allocated for a body that is not a ring).
+   subroutine build_layered_ring(scene, b, exact, error)
+      type(scene_type), intent(in) :: scene
+      integer, intent(in) :: b
+      class(exact_solution_type), allocatable, intent(out) :: exact
+      type(error_type), allocatable, intent(out) :: error
+      type(layered_type) :: layered
+      integer :: i
+
+      i = findloc(scene%exact%ring_index, b, 1)
+      if (i == 0) return
+      associate (spec => scene%exact, rings => scene%bodies(scene%exact%ring_index))
+         call new_layered(layered, scene%dim, analysis_kind(scene), spec%center, spec%radii, spec%interferences, &
+            & spec%p_in, spec%p_out, rings%young, rings%poisson, error)
+      end associate
+      if (.not. allocated(error)) call move_alloc(layered%rings(i)%field, exact)
+   end subroutine build_layered_ring
+
    !> The exact contact pressure on the slave surface of `&contact` pair `k`,
    !> in the units of `scene` (the scene's own for a contact result): hertz_*
    !> from the closed form with E* of the pair's two bodies; every other kind
@@ -631,6 +654,8 @@ contains
             if (allocated(error) .or. .not. allocated(field)) return
             if (spec%kind == 'compound_cylinder' .or. spec%kind == 'compound_sphere') then
                call new_field_pressure(from_field, field, spec%center, spec%r_contact)
+            else if (spec%kind == 'layered_cylinder' .or. spec%kind == 'layered_sphere') then
+               call new_field_pressure(from_field, field, spec%center, interface_radius(spec, scene%contacts(k)))
             else
                call new_field_pressure(from_field, field)
             end if
@@ -640,5 +665,17 @@ contains
       end associate
       if (allocated(error)) error%message = '&exact: '//error%message
    end subroutine build_exact_pressure
+
+   !> The radius of the layered solution's interface between the two bodies
+   !> of `pair` (neighbouring rings i and i + 1: radii(i + 1)); the slave's
+   !> outer or inner radius when they are not neighbours.
+   pure real(wp) function interface_radius(spec, pair) result(r)
+      type(exact_spec_type), intent(in) :: spec
+      type(contact_spec_type), intent(in) :: pair
+      integer :: i, j
+      i = findloc(spec%ring_index, pair%slave_index, 1)
+      j = findloc(spec%ring_index, pair%master_index, 1)
+      r = spec%radii(min(i, j) + 1)
+   end function interface_radius
 
 end module sprc_study_model

@@ -108,7 +108,8 @@ module sprc_study_spec
       !> Whether the scene has an `&exact` group.
       logical :: present = .false.
       !> 'lame_cylinder' | 'lame_sphere' | 'kirsch' | 'uniform' | 'compound_cylinder' |
-      !> 'compound_sphere' | 'hertz_cylinder' | 'hertz_sphere' | 'corner'.
+      !> 'compound_sphere' | 'layered_cylinder' | 'layered_sphere' | 'hertz_cylinder' | 'hertz_sphere' |
+      !> 'corner'.
       character(len=:), allocatable :: kind
       !> Centre, `dim` values.
       real(wp), allocatable :: center(:)
@@ -123,6 +124,11 @@ module sprc_study_spec
       !> Compound: the inner and outer bodies and their indices in `scene%bodies`.
       character(len=:), allocatable :: inner, outer
       integer :: inner_index = 0, outer_index = 0
+      !> Layered: radii r_0 < ... < r_n (n + 1 values, inside out), the n ring bodies inside
+      !> out (names and indices in `scene%bodies`) and the n - 1 radial interferences.
+      real(wp), allocatable :: radii(:), interferences(:)
+      character(len=:), allocatable :: ring_names
+      integer, allocatable :: ring_index(:)
       !> Hertz: first-contact point and the unit normal of the contact plane, `dim` values.
       real(wp), allocatable :: point(:), normal(:)
       !> Hertz: the whole contact force (per unit thickness in 2D), > 0.
