@@ -31,6 +31,7 @@ program sprc_unit_tests
    use sprc_test_contact_model, only: collect_contact_model
    use sprc_test_contact_output, only: collect_contact_output
    use sprc_test_contact_fe, only: collect_contact_fe
+   use sprc_test_contact_assembly, only: collect_contact_assembly
    use sprc_test_contact_friction, only: collect_contact_friction
    use sprc_test_petsc, only: collect_petsc
    use sprc_test_contact_recovery, only: collect_contact_recovery
@@ -70,6 +71,7 @@ program sprc_unit_tests
       new_testsuite('contact_model', collect_contact_model), &
       new_testsuite('contact_output', collect_contact_output), &
       new_testsuite('contact_fe', collect_contact_fe), &
+      new_testsuite('contact_assembly', collect_contact_assembly), &
       new_testsuite('contact_friction', collect_contact_friction), &
       new_testsuite('petsc', collect_petsc), &
       new_testsuite('contact_recovery', collect_contact_recovery), &

@@ -37,6 +37,7 @@ contains
          new_unittest('layered_boundary', test_layered_boundary), &
          new_unittest('layered_two_rings_is_compound', test_layered_compound), &
          new_unittest('layered_open_interface', test_layered_open), &
+         new_unittest('layered_real_radii', test_layered_real), &
          new_unittest('layered_errors', test_layered_errors) &
          ]
    end subroutine collect_exact_layered
@@ -228,6 +229,64 @@ contains
       call ly%rings(3)%field%displacement(x, uo)
       call check(error, uo(1) - ui(1) >= 0.0_wp, 'the open rings do not overlap')
    end subroutine test_layered_open
+
+   !> With real radii (ring j ends at r_j + delta_j): the gap along the
+   !> radius closes, u_(j+1)(r_j) - u_j(r_j + delta_j) = delta_j, the two
+   !> surfaces exchange equal forces, t_j (r_j + delta_j)^(d-1) = t_(j+1)
+   !> r_j^(d-1) (radial tractions of the fields themselves), the boundary
+   !> tractions hold, and equilibrium and compatibility hold in every ring.
+   subroutine test_layered_real(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(layered_type) :: ly
+      real(wp) :: x(3), e(3), ui(3), uo(3), ti(3), to(3), ri, ro, s_scale
+      integer(i8) :: seed
+      integer :: k, j, d
+
+      seed = 31_i8
+      do k = 1, 3
+         d = merge(3, 2, k == 3)
+         call new_layered(ly, d, analyses(k), spread(0.0_wp, 1, d), radii, fits, p_in, p_out, young, poisson, error, &
+            & shifts=fits)
+         if (allocated(error)) return
+         s_scale = maxval(abs(ly%pressure))
+         e = 0.0_wp
+         e(1:d) = 1.0_wp/sqrt(real(d, wp))
+         do j = 1, 2
+            ri = radii(j + 1) + fits(j)
+            ro = radii(j + 1)
+            call check(error, ly%outer_radii(j), ri, 0.0_wp, 'ring outer radius r_j + delta_j')
+            if (allocated(error)) return
+            x(1:d) = ri*e(1:d)
+            call ly%rings(j)%field%displacement(x(1:d), ui(1:d))
+            call ly%rings(j)%field%traction(x(1:d), e(1:d), ti(1:d))
+            x(1:d) = ro*e(1:d)
+            call ly%rings(j + 1)%field%displacement(x(1:d), uo(1:d))
+            call ly%rings(j + 1)%field%traction(x(1:d), e(1:d), to(1:d))
+            call check(error, dot_product(uo(1:d) - ui(1:d), e(1:d)), fits(j), roundoff*max(norm2(ui(1:d)), norm2(uo(1:d))), &
+               & analysis_name(analyses(k))//': the gap closes at the real radii')
+            if (allocated(error)) return
+            call check(error, dot_product(ti(1:d), e(1:d))*ri**(d - 1), dot_product(to(1:d), e(1:d))*ro**(d - 1), &
+               & roundoff*s_scale*ro**(d - 1), analysis_name(analyses(k))//': equal forces')
+            if (allocated(error)) return
+            call check(error, ly%pressure(j + 1) > 0.0_wp, 'closed interface')
+            if (allocated(error)) return
+            call check_equilibrium_fd(error, ly%rings(j)%field, shell_points(spread(0.0_wp, 1, d), radii(j), ri, &
+               & seed), radii(1), s_scale, 'real radii ring')
+            if (allocated(error)) return
+            call check_compatibility_fd(error, ly%rings(j)%field, shell_points(spread(0.0_wp, 1, d), radii(j), ri, &
+               & seed), radii(1), s_scale, 'real radii ring')
+            if (allocated(error)) return
+         end do
+         x(1:d) = radii(1)*e(1:d)
+         call ly%rings(1)%field%traction(x(1:d), -e(1:d), ti(1:d))
+         call check(error, norm2(ti(1:d) - p_in*e(1:d)), 0.0_wp, roundoff*s_scale, 'p_in on r_0 (real radii)')
+         if (allocated(error)) return
+         x(1:d) = radii(4)*e(1:d)
+         call ly%rings(3)%field%traction(x(1:d), e(1:d), to(1:d))
+         call check(error, norm2(to(1:d) + p_out*e(1:d)), 0.0_wp, roundoff*s_scale, 'p_out on r_n (real radii)')
+         if (allocated(error)) return
+      end do
+   end subroutine test_layered_real
 
    !> Bad input is an error naming the field.
    subroutine test_layered_errors(error)

@@ -28,6 +28,19 @@
 !> this active set is iterated until it repeats (at most 2 (n - 1) + 1 solves
 !> for the monotone cases; more is an error).
 !>
+!> Real radii. A scene models interface j with the inner ring's outer
+!> surface at r_j + delta_j and the outer ring's bore at r_j (the shapes
+!> overlap by delta_j: the slave surface is where the mesh has it). The
+!> closed form on the nominal radii puts both at r_j, which bounds the FE
+!> error from below by about delta/r. With `shifts` = delta ring j ends at
+!> r_j + delta_j, and the interface conditions are the ones the contact
+!> formulation converges to: the gap along the radius closes,
+!>   u_(j+1)(r_j) - u_j(r_j + delta_j) = delta_j,
+!> and the two surfaces exchange equal forces (the multiplier acts on the
+!> slave surface and its reaction on the master), so the inner ring's outer
+!> pressure is p_j (r_j/(r_j + delta_j))^(dim - 1), p_j the bore pressure of
+!> ring j + 1. Only the radii and this ratio change in the system above.
+!>
 !> The result is one exact solution per ring (`rings(i)%field`), each with
 !> its own material, as the per-body error norms need.
 module sprc_exact_layered
@@ -55,8 +68,11 @@ module sprc_exact_layered
       real(wp) :: center(3) = 0.0_wp
       !> Radii r_0 < ... < r_n (n + 1 values).
       real(wp), allocatable :: radii(:)
-      !> Pressures p_0 = p_in, the interface pressures p_1 .. p_(n-1) (>= 0), p_n = p_out.
+      !> Pressures p_0 = p_in, the interface pressures p_1 .. p_(n-1) (>= 0) on the
+      !> outer rings' bores, p_n = p_out.
       real(wp), allocatable :: pressure(:)
+      !> Each ring's outer radius: r_i, or with real radii r_i + delta_i (i < n).
+      real(wp), allocatable :: outer_radii(:)
       !> Each ring's field (n).
       type(ring_type), allocatable :: rings(:)
    end type layered_type
@@ -66,13 +82,18 @@ contains
    !> n = size(radii) - 1 rings: a cylinder (dim 2, plane stress or plane
    !> strain) or a sphere (dim 3, solid); interference(j) of interface j
    !> (n - 1 values), young(i) and poisson(i) of ring i.
-   subroutine new_layered(self, dim, analysis, center, radii, interference, p_in, p_out, young, poisson, error)
+   !> With `shifts` (n - 1 lengths, normally the interferences in length
+   !> units) ring j ends at r_j + shifts(j): the rings lie on their real radii
+   !> (module notes, "Real radii"); without, on the nominal ones.
+   subroutine new_layered(self, dim, analysis, center, radii, interference, p_in, p_out, young, poisson, error, &
+         & shifts)
       type(layered_type), intent(out) :: self
       integer, intent(in) :: dim, analysis
       real(wp), intent(in) :: center(:), radii(:), interference(:), p_in, p_out, young(:), poisson(:)
       type(error_type), allocatable, intent(out) :: error
+      real(wp), intent(in), optional :: shifts(:)
       character(len=:), allocatable :: context
-      real(wp), allocatable :: alpha(:, :), beta(:, :)
+      real(wp), allocatable :: alpha(:, :), beta(:, :), ratio(:)
       integer :: n, i
 
       context = merge('layered_cylinder', 'layered_sphere  ', dim == 2)
@@ -80,16 +101,29 @@ contains
       call check_input(context, dim, analysis, center, radii, interference, p_in, p_out, young, poisson, error)
       if (allocated(error)) return
       n = size(radii) - 1
+      if (present(shifts)) then
+         if (size(shifts) /= n - 1 .or. .not. all(abs(shifts) < radii(3:) - radii(2:n))) then
+            call fatal_error(error, context//': shifts must be n - 1 = '//itoa(n - 1)//' lengths, each less than '// &
+               & 'the next ring''s width', stat_invalid_input)
+            return
+         end if
+      end if
       self%dim = dim
       self%center(1:dim) = center
       self%radii = radii
+      self%outer_radii = radii(2:)
+      if (present(shifts)) self%outer_radii(1:n - 1) = radii(2:n) + shifts(1:n - 1)
+      ! ratio(i): ring i's outer pressure over the next ring's bore pressure (force balance).
+      ratio = [((radii(i + 1)/self%outer_radii(i))**(dim - 1), i=1, n)]
       ! alpha(s, i), beta(s, i): ring i's radial displacement at its inner (s = 1) and
-      ! outer (s = 2) radius under a unit inner or outer pressure.
+      ! outer (s = 2) radius under a unit inner pressure, or under its outer pressure
+      ! for a unit pressure on the next ring's bore.
       allocate (alpha(2, n), beta(2, n), self%rings(n))
       do i = 1, n
-         call unit_response(dim, analysis, center, radii(i), radii(i + 1), young(i), poisson(i), alpha(:, i), &
+         call unit_response(dim, analysis, center, radii(i), self%outer_radii(i), young(i), poisson(i), alpha(:, i), &
             & beta(:, i), error)
          if (allocated(error)) return
+         beta(:, i) = ratio(i)*beta(:, i)
       end do
       call interface_pressures(n, alpha, beta, interference, p_in, p_out, self%pressure, error)
       if (allocated(error)) then
@@ -97,8 +131,8 @@ contains
          return
       end if
       do i = 1, n
-         call make_shell(dim, center, radii(i), radii(i + 1), self%pressure(i), self%pressure(i + 1), young(i), &
-            & poisson(i), analysis, self%rings(i)%field, error)
+         call make_shell(dim, center, radii(i), self%outer_radii(i), self%pressure(i), ratio(i)*self%pressure(i + 1), &
+            & young(i), poisson(i), analysis, self%rings(i)%field, error)
          if (allocated(error)) return
       end do
    end subroutine new_layered

@@ -855,6 +855,11 @@ contains
          call nml_field_error(g, 'interference', 'must be >= 0 (the radial overlaps of neighbouring rings)', error)
          return
       end if
+      if (.not. all(exact%interferences < exact%radii(3:) - exact%radii(2:n))) then
+         call nml_field_error(g, 'interference', 'each must be less than the width of the ring outside it', error)
+         return
+      end if
+      exact%ring_shifts = exact%interferences
       call nml_get(g, 'p_in', exact%p_in, found, error)
       if (allocated(error)) return
       call nml_get(g, 'p_out', exact%p_out, found, error)

@@ -615,7 +615,7 @@ contains
       if (i == 0) return
       associate (spec => scene%exact, rings => scene%bodies(scene%exact%ring_index))
          call new_layered(layered, scene%dim, analysis_kind(scene), spec%center, spec%radii, spec%interferences, &
-            & spec%p_in, spec%p_out, rings%young, rings%poisson, error)
+            & spec%p_in, spec%p_out, rings%young, rings%poisson, error, shifts=spec%ring_shifts)
       end associate
       if (.not. allocated(error)) call move_alloc(layered%rings(i)%field, exact)
    end subroutine build_layered_ring
@@ -655,6 +655,7 @@ contains
             if (spec%kind == 'compound_cylinder' .or. spec%kind == 'compound_sphere') then
                call new_field_pressure(from_field, field, spec%center, spec%r_contact)
             else if (spec%kind == 'layered_cylinder' .or. spec%kind == 'layered_sphere') then
+               ! On the slave's real surface, where its ring of the closed form ends.
                call new_field_pressure(from_field, field, spec%center, interface_radius(spec, scene%contacts(k)))
             else
                call new_field_pressure(from_field, field)
@@ -666,16 +667,18 @@ contains
       if (allocated(error)) error%message = '&exact: '//error%message
    end subroutine build_exact_pressure
 
-   !> The radius of the layered solution's interface between the two bodies
-   !> of `pair` (neighbouring rings i and i + 1: radii(i + 1)); the slave's
-   !> outer or inner radius when they are not neighbours.
+   !> The radius of the slave surface of `pair` in the layered solution on
+   !> real radii (sprc_exact_layered): between rings i and i + 1, the inner
+   !> ring's r_i + delta_i when it is the slave, the outer ring's bore r_i
+   !> when that is.
    pure real(wp) function interface_radius(spec, pair) result(r)
       type(exact_spec_type), intent(in) :: spec
       type(contact_spec_type), intent(in) :: pair
       integer :: i, j
       i = findloc(spec%ring_index, pair%slave_index, 1)
       j = findloc(spec%ring_index, pair%master_index, 1)
-      r = spec%radii(min(i, j) + 1)
+      r = spec%radii(max(1, min(i, j) + 1))
+      if (i < j .and. i >= 1 .and. i <= size(spec%ring_shifts)) r = r + spec%ring_shifts(i)
    end function interface_radius
 
 end module sprc_study_model

@@ -127,6 +127,9 @@ module sprc_study_spec
       !> Layered: radii r_0 < ... < r_n (n + 1 values, inside out), the n ring bodies inside
       !> out (names and indices in `scene%bodies`) and the n - 1 radial interferences.
       real(wp), allocatable :: radii(:), interferences(:)
+      !> Layered: the interferences as lengths (the inner rings' outer surfaces lie that far
+      !> out; not scaled with the analysis units, as lengths are not).
+      real(wp), allocatable :: ring_shifts(:)
       character(len=:), allocatable :: ring_names
       integer, allocatable :: ring_index(:)
       !> Hertz: first-contact point and the unit normal of the contact plane, `dim` values.
