@@ -147,6 +147,14 @@
 !> gamma > 0 and consistent when the recovery is exact; frictionless and
 !> stick only. With a `contact_factor_type` the CHOLMOD factor is reused
 !> while the active set repeats (one back substitution per update).
+!>
+!> Assemblies (`solve_contact_assembly`): several bodies and the pairs between
+!> them, one block system with every body's reduced system on the diagonal
+!> (offsets in body order) and the cells of every pair, built as a pair's
+!> alone (`point_operators` with the bodies' offsets); one active set over
+!> all cells, the rigid-mode check over every body. Frictionless and stick
+!> with the FE stabilization stress: Coulomb's load path and the recovered
+!> stabilization stay per pair (`solve_contact_pair`).
 module sprc_contact_solve
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_not_converged, stat_singular, &

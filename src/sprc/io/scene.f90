@@ -1065,6 +1065,10 @@ contains
          else if (index(e%kind, 'hertz_') == 1 .and. size(scene%contacts) == 0) then
             ig = first_group(groups, 'exact')
             call nml_field_error(groups(ig), 'kind', 'needs a &contact (it is the pressure of a contact)', error)
+         else if (index(e%kind, 'hertz_') == 1 .and. size(scene%contacts) > 1) then
+            ig = first_group(groups, 'exact')
+            call nml_field_error(groups(ig), 'kind', 'is the pressure of one contact at one point; the scene has '// &
+               & itoa(size(scene%contacts))//' &contact pairs', error)
          end if
       end associate
    end subroutine check_exact_pair
