@@ -8,9 +8,12 @@
 !>   every closed point of both pairs to round-off, C eps/rcond with rcond
 !>   the block solver's condition estimate and C = 10 (as the one-pair patch
 !>   test, sprc_test_contact_fe); with SPR and SPR-C the recovered fields
-!>   too. At level 2 the middle block (0.65 tall, cells 0.36) has vertex
-!>   patches that hold contact points of both pairs, the case where one
-!>   pair's coupled contact patch wins (sprc_grid_patches).
+!>   too. The middle block (0.3 tall, cells 0.36 at level 2) has vertex
+!>   patches holding contact points of both pairs (10 at levels 2 and 3),
+!>   where one pair's coupled contact patch wins and the other's points are
+!>   left out (sprc_grid_patches): keeping them fails Q2 (the patch's
+!>   contact normals cancel), letting the pair with fewer points win fails
+!>   Q1.
 !> - Three concentric rings with two interference fits and a bore pressure
 !>   against the layered_cylinder closed form (on the real radii): err_fe
 !>   at a rate of at least 0.95 p over the last two levels, theta_sprc in
