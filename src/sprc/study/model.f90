@@ -609,13 +609,19 @@ contains
       class(exact_solution_type), allocatable, intent(out) :: exact
       type(error_type), allocatable, intent(out) :: error
       type(layered_type) :: layered
-      integer :: i
+      real(wp), allocatable :: young(:), poisson(:)
+      integer :: i, j
 
       i = findloc(scene%exact%ring_index, b, 1)
       if (i == 0) return
-      associate (spec => scene%exact, rings => scene%bodies(scene%exact%ring_index))
+      allocate (young(size(scene%exact%ring_index)), poisson(size(scene%exact%ring_index)))
+      do j = 1, size(young)
+         young(j) = scene%bodies(scene%exact%ring_index(j))%young
+         poisson(j) = scene%bodies(scene%exact%ring_index(j))%poisson
+      end do
+      associate (spec => scene%exact)
          call new_layered(layered, scene%dim, analysis_kind(scene), spec%center, spec%radii, spec%interferences, &
-            & spec%p_in, spec%p_out, rings%young, rings%poisson, error, shifts=spec%ring_shifts)
+            & spec%p_in, spec%p_out, young, poisson, error, shifts=spec%ring_shifts)
       end associate
       if (.not. allocated(error)) call move_alloc(layered%rings(i)%field, exact)
    end subroutine build_layered_ring

@@ -124,11 +124,11 @@ module sprc_study_spec
       !> Compound: the inner and outer bodies and their indices in `scene%bodies`.
       character(len=:), allocatable :: inner, outer
       integer :: inner_index = 0, outer_index = 0
-      !> Layered: radii r_0 < ... < r_n (n + 1 values, inside out), the n ring bodies inside
-      !> out (names and indices in `scene%bodies`) and the n - 1 radial interferences.
+      !> For layered_*, the radii r_0 < ... < r_n (n + 1 values, inside out), the n ring bodies
+      !> inside out (names and indices in `scene%bodies`) and the n - 1 radial interferences.
       real(wp), allocatable :: radii(:), interferences(:)
-      !> Layered: the interferences as lengths (the inner rings' outer surfaces lie that far
-      !> out; not scaled with the analysis units, as lengths are not).
+      !> For layered_* and compound_*, the interferences as lengths (the inner rings' outer
+      !> surfaces lie that far out; not scaled with the analysis units, as lengths are not).
       real(wp), allocatable :: ring_shifts(:)
       character(len=:), allocatable :: ring_names
       integer, allocatable :: ring_index(:)
