@@ -776,8 +776,13 @@ contains
       end if
       call nml_get(g, 'interference', exact%interference, found, error)
       if (allocated(error)) return
-      if (exact%interference < 0.0_wp) call nml_field_error(g, 'interference', &
-         & 'must be >= 0 (the radial overlap of the rings; a clearance has no closed-form solution here)', error)
+      if (exact%interference < 0.0_wp) then
+         call nml_field_error(g, 'interference', &
+            & 'must be >= 0 (the radial overlap of the rings; a clearance has no closed-form solution here)', error)
+      else if (.not. exact%interference < exact%r_out - exact%r_contact) then
+         call nml_field_error(g, 'interference', 'must be less than r_out - r_contact (the outer ring''s width)', error)
+      end if
+      exact%ring_shifts = [exact%interference]
    end subroutine read_compound
 
    !> n concentric rings: radii (n + 1, increasing), the ring bodies (n different
