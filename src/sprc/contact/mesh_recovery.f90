@@ -50,6 +50,7 @@ module sprc_contact_mesh_recovery
       & mesh_recovery_eval, mesh_recovery_eval_near, mesh_method_sprc, mesh_method_spr, mesh_reference_unit, &
       & facet_traction, facet_pressure, facet_symmetry, facet_free
    use sprc_recovery_patch_loop, only: auto_degree
+   use sprc_recovery_mesh_check, only: check_mesh_arrays, check_mesh_facets
    use sprc_grid_contact, only: grid_contact_type, new_grid_contact, contact_patch_solve
    implicit none
    private
@@ -434,11 +435,20 @@ contains
             else if (element_facet_nodes(x%element_type) == 0) then
                call fail(body_name(ci, b)//': element_type = '//itoa(x%element_type)//' is unknown')
             end if
+            if (allocated(error)) return
+            ! The arrays before any recovery: a body's bad values are read by the other's contact patches.
+            call check_mesh_arrays(x%dim, x%analysis, x%nodes, x%element_type, x%connectivity, x%gp, x%gw, x%gs, ci, &
+               & error, x%body_force)
+            if (.not. allocated(error)) call check_mesh_facets(x%dim, x%element_type, size(x%nodes, 2), ci, error, &
+               & x%facet_nodes, x%facet_kind, x%facet_traction)
+            if (allocated(error)) error%message = 'recover_contact: '//body_name(ci, b)//': '//error%message
          end associate
          if (allocated(error)) return
       end do
       do k = 1, size(pairs)
          call check_pair(bodies, pairs(k), k, ci, error)
+         if (allocated(error)) return
+         call check_facing(bodies, pairs(k), k, ci, error)
          if (allocated(error)) return
       end do
    contains
@@ -447,6 +457,58 @@ contains
          call fatal_error(error, 'recover_contact: '//message, stat_invalid_input)
       end subroutine fail
    end subroutine check_input
+
+   !> The two sides of a pair face each other: each side's facets are sides of its body's
+   !> elements (mesh_facet_points, which names the facet), and the boxes of the two sides'
+   !> facet nodes, padded by the largest facet extent, overlap (else the facets of one side
+   !> are not where the other's are: a facet of the wrong body, or of another pair).
+   subroutine check_facing(bodies, pair, k, ci, error)
+      type(contact_body_type), intent(in) :: bodies(:)
+      type(contact_pair_type), intent(in) :: pair
+      integer, intent(in) :: k
+      logical, intent(in) :: ci
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: x(:, :), w(:), n(:, :)
+      integer, allocatable :: owner(:), facet(:)
+      real(wp) :: lo(3, 2), hi(3, 2), pad
+      integer :: d, s, b, f
+
+      d = bodies(pair%slave)%dim
+      pad = 0.0_wp
+      do s = 1, 2
+         b = merge(pair%slave, pair%master, s == 1)
+         associate (fn => merge_facets(s))
+            call mesh_facet_points(d, bodies(b)%nodes, bodies(b)%element_type, bodies(b)%connectivity, fn, ci, &
+               & pair_field(ci, k, trim(merge('slave_facets ', 'master_facets', s == 1))), x, w, n, owner, facet, error)
+            if (allocated(error)) then
+               error%message = 'recover_contact: '//error%message
+               return
+            end if
+            lo(1:d, s) = huge(1.0_wp)
+            hi(1:d, s) = -huge(1.0_wp)
+            do f = 1, size(fn, 2)
+               lo(1:d, s) = min(lo(1:d, s), minval(bodies(b)%nodes(:, fn(:, f)), dim=2))
+               hi(1:d, s) = max(hi(1:d, s), maxval(bodies(b)%nodes(:, fn(:, f)), dim=2))
+               pad = max(pad, maxval(maxval(bodies(b)%nodes(:, fn(:, f)), dim=2) - &
+                  & minval(bodies(b)%nodes(:, fn(:, f)), dim=2)))
+            end do
+         end associate
+      end do
+      if (any(lo(1:d, 1) > hi(1:d, 2) + pad) .or. any(lo(1:d, 2) > hi(1:d, 1) + pad)) &
+         & call fatal_error(error, 'recover_contact: '//pair_field(ci, k, '')//': the slave and master facets do '// &
+         & 'not face each other (the boxes of their nodes, padded by the largest facet, are apart): a facet of '// &
+         & 'the wrong body?', stat_invalid_input)
+   contains
+      function merge_facets(s) result(fn)
+         integer, intent(in) :: s
+         integer, pointer, contiguous :: fn(:, :)
+         if (s == 1) then
+            fn => pair%slave_facets
+         else
+            fn => pair%master_facets
+         end if
+      end function merge_facets
+   end subroutine check_facing
 
    !> One pair: bodies, facets (shapes, node ranges), laws, mu, slip directions, pressure.
    subroutine check_pair(bodies, pair, k, ci, error)
