@@ -32,6 +32,7 @@ module sprc_test_contact_mesh
    use sprc_contact_mesh_recovery, only: contact_body_type, contact_pair_type, mesh_contact_recovery_type, &
       & recover_contact_on_mesh, contact_law_frictionless, contact_law_slip, contact_law_stick
    use sprc_test_mesh_recovery, only: case_type, build_case, node_id
+   use sprc_legacy, only: sprc_recover_contact_mesh
    implicit none
    private
 
@@ -64,7 +65,8 @@ contains
          new_unittest('exact_hex27_stick_uniform', test_hex27_stick), &
          new_unittest('contact_rows_act', test_rows_act), &
          new_unittest('wrong_slip_direction_not_exact', test_wrong_slip), &
-         new_unittest('validation_errors', test_validation) &
+         new_unittest('validation_errors', test_validation), &
+         new_unittest('legacy_wrapper', test_legacy) &
          ]
    end subroutine collect_contact_mesh
 
@@ -467,5 +469,72 @@ contains
          end if
       end subroutine expect
    end subroutine test_validation
+
+   !> The legacy entry gives the modern one's bits (slip, per-facet arrays), and an error
+   !> for too little room.
+   subroutine test_legacy(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(problem_type), target :: pb
+      type(contact_body_type) :: bodies(2)
+      type(contact_pair_type) :: pairs(1)
+      type(mesh_contact_recovery_type) :: res
+      integer, target :: laws(1)
+      real(wp), allocatable, target :: slip(:, :)
+      integer, allocatable :: law1(:), law2(:)
+      real(wp), allocatable :: slip1(:, :), slip2(:, :), nodal1(:, :), nodal2(:, :), e1(:), e2(:), xc(:, :), pc(:), &
+         & pcm(:), jc(:, :)
+      real(wp) :: g1, g2, eta1, eta2
+      integer :: npts, stat, n1, n2
+      character(len=200) :: msg
+
+      call build_problem(pb, elem_quad4, elem_tri3, 3, contact_law_slip, .true., 0.05_wp)
+      laws = contact_law_slip
+      allocate (slip(2, 1))
+      slip(:, 1) = pb%rot(1:2, 1)
+      call describe(pb, contact_law_slip, bodies, pairs(1), laws, slip)
+      call recover_contact_on_mesh(bodies, pairs, mesh_method_sprc, res, error)
+      if (allocated(error)) return
+      n1 = size(pb%facets1, 2)
+      n2 = size(pb%facets2, 2)
+      allocate (law1(n1), law2(n2))
+      law1 = contact_law_slip
+      law2 = contact_law_slip
+      slip1 = spread(slip(:, 1), 2, n1)
+      slip2 = spread(-slip(:, 1), 2, n2)
+      allocate (nodal1(3, size(pb%c(1)%x, 2)), nodal2(3, size(pb%c(2)%x, 2)), e1(size(pb%c(1)%gw, 2)), &
+         & e2(size(pb%c(2)%gw, 2)), xc(2, 2*n1), pc(2*n1), pcm(2*n1), jc(2, 2*n1))
+      associate (c1 => pb%c(1), c2 => pb%c(2))
+         call sprc_recover_contact_mesh(2, 3, c1%analysis, mesh_method_sprc, size(c1%x, 2), c1%x, c1%etype, &
+            & size(c1%conn, 1), size(c1%conn, 2), c1%conn, size(c1%gw, 1), c1%gp, c1%gw, c1%gs, 1.0d3, 0.3d0, &
+            & size(c2%x, 2), c2%x, c2%etype, size(c2%conn, 1), size(c2%conn, 2), c2%conn, size(c2%gw, 1), c2%gp, &
+            & c2%gw, c2%gs, 1.0d3, 0.3d0, 2, n1, pb%facets1, law1, slip1, 2, n2, pb%facets2, law2, slip2, mu, 2*n1, &
+            & nodal1, e1, g1, eta1, nodal2, e2, g2, eta2, npts, xc, pc, pcm, jc, stat, msg)
+      end associate
+      call check(error, stat == 0, 'legacy stat: '//trim(msg))
+      if (allocated(error)) return
+      call check(error, npts == res%pairs(1)%npoints .and. same(nodal1, res%bodies(1)%nodal) .and. &
+         & same(nodal2, res%bodies(2)%nodal) .and. same1(pc, res%pairs(1)%pressure) .and. &
+         & same1(pcm, res%pairs(1)%pressure_master) .and. same(jc, res%pairs(1)%jump) .and. &
+         & same1([g1, eta2], [res%bodies(1)%err, res%bodies(2)%eta]), 'legacy and modern results differ')
+      if (allocated(error)) return
+      associate (c1 => pb%c(1), c2 => pb%c(2))
+         call sprc_recover_contact_mesh(2, 3, c1%analysis, mesh_method_sprc, size(c1%x, 2), c1%x, c1%etype, &
+            & size(c1%conn, 1), size(c1%conn, 2), c1%conn, size(c1%gw, 1), c1%gp, c1%gw, c1%gs, 1.0d3, 0.3d0, &
+            & size(c2%x, 2), c2%x, c2%etype, size(c2%conn, 1), size(c2%conn, 2), c2%conn, size(c2%gw, 1), c2%gp, &
+            & c2%gw, c2%gs, 1.0d3, 0.3d0, 2, n1, pb%facets1, law1, slip1, 2, n2, pb%facets2, law2, slip2, mu, 3, &
+            & nodal1, e1, g1, eta1, nodal2, e2, g2, eta2, npts, xc, pc, pcm, jc, stat, msg)
+      end associate
+      call check(error, stat == stat_invalid_input .and. index(msg, 'mpts = 3') > 0 .and. .not. any(abs(nodal1) > 0.0_wp), &
+         & 'legacy with too little room: '//trim(msg))
+   contains
+      pure logical function same(a, b)
+         real(wp), intent(in) :: a(:, :), b(:, :)
+         same = .not. any(abs(a - b) > 0.0_wp)
+      end function same
+      pure logical function same1(a, b)
+         real(wp), intent(in) :: a(:), b(:)
+         same1 = .not. any(abs(a - b) > 0.0_wp)
+      end function same1
+   end subroutine test_legacy
 
 end module sprc_test_contact_mesh

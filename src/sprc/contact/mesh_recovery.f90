@@ -618,11 +618,16 @@ contains
                   & 'the opposite of a uniform slave_slip only)')
             end if
          else
-            if (.not. all(abs(slip) <= huge(1.0_wp))) then
-               call fail(field(sname//'_slip')//' is not finite')
-            else if (any(.not. (norm2(slip, dim=1) > 0.0_wp))) then
-               call fail(field(sname//'_slip')//' has a zero direction')
-            end if
+            do f = 1, nf
+               if (law(min(f, size(law))) /= contact_law_slip) cycle
+               a = min(f, size(slip, 2))
+               if (.not. all(abs(slip(:, a)) <= huge(1.0_wp))) then
+                  call fail(field(sname//'_slip')//' is not finite ('//entry2(sname//'_slip', 0, a)//')')
+               else if (.not. (norm2(slip(:, a)) > 0.0_wp)) then
+                  call fail(field(sname//'_slip')//' is zero on a slip facet ('//entry2(sname//'_slip', 0, a)//')')
+               end if
+               if (allocated(error)) return
+            end do
          end if
       end subroutine check_side
       subroutine fail(message)
@@ -654,9 +659,14 @@ contains
          integer, intent(in) :: a, f
          character(len=:), allocatable :: s
          if (ci) then
-            s = pair_field(ci, k, name)//'['//itoa(f - 1)//']['//itoa(a - 1)//']'
+            s = pair_field(ci, k, name)//'['//itoa(f - 1)//']'
+            if (a > 0) s = s//'['//itoa(a - 1)//']'
          else
-            s = pair_field(ci, k, name)//'('//itoa(a)//', '//itoa(f)//')'
+            if (a > 0) then
+               s = pair_field(ci, k, name)//'('//itoa(a)//', '//itoa(f)//')'
+            else
+               s = pair_field(ci, k, name)//'(:, '//itoa(f)//')'
+            end if
          end if
       end function entry2
       pure function rstr(x) result(s)
