@@ -75,7 +75,7 @@ module sprc_contact_mesh_recovery
       integer, pointer, contiguous :: connectivity(:, :) => null()
       !> Integration points (dim, ngp, nelem), weight*|J| (ngp, nelem), FE stresses (nstress, ngp, nelem).
       real(wp), pointer, contiguous :: gp(:, :, :) => null(), gw(:, :) => null(), gs(:, :, :) => null()
-      !> Optional: body force (dim); boundary facets (nfn, nfacet), kinds, tractions (dim, nfacet);
+      !> Given or not: body force (dim); boundary facets (nfn, nfacet), kinds, tractions (dim, nfacet);
       !> reference coordinates of the points (dim, ngp, nelem) in the convention `reference`.
       real(wp), pointer, contiguous :: body_force(:) => null(), facet_traction(:, :) => null(), &
          & gauss_xi(:, :, :) => null()
