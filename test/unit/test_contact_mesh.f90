@@ -66,7 +66,8 @@ contains
          new_unittest('contact_rows_act', test_rows_act), &
          new_unittest('wrong_slip_direction_not_exact', test_wrong_slip), &
          new_unittest('validation_errors', test_validation), &
-         new_unittest('legacy_wrapper', test_legacy) &
+         new_unittest('legacy_wrapper', test_legacy), &
+         new_unittest('three_bodies_two_pairs', test_two_pairs) &
          ]
    end subroutine collect_contact_mesh
 
@@ -536,5 +537,85 @@ contains
          same1 = .not. any(abs(a - b) > 0.0_wp)
       end function same1
    end subroutine test_legacy
+
+   !> Three bodies stacked (quad4, m, m + 1, m + 2 cells per side), two pairs (body 1 on 2,
+   !> frictionless; body 2 on 3, stick: the linear frictionless field has shear on the upper
+   !> interface): exact in one call. With body 2 two cells
+   !> thick, its middle patches hold contact points of both pairs: an error naming them.
+   subroutine test_two_pairs(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(problem_type), target :: pb, top
+      type(contact_body_type) :: bodies(3), two(2)
+      type(contact_pair_type) :: pairs(2)
+      type(mesh_contact_recovery_type) :: res
+      type(error_type), allocatable :: err
+      integer, target :: laws(1), stick(1)
+      real(wp), allocatable, target :: slip(:, :), x3(:, :), gp3(:, :, :), gs3(:, :, :)
+      integer, allocatable, target :: mid_top(:, :), top_bottom(:, :)
+      real(wp) :: s(6), worst
+      integer :: k, n, i, j
+
+      laws = contact_law_frictionless
+      allocate (slip(2, 1))
+      slip = 0.0_wp
+      do k = 1, 2
+         call build_problem(pb, elem_quad4, elem_quad4, merge(3, 1, k == 1), contact_law_frictionless, .true., &
+            & 0.0_wp)
+         ! Body 3: body 2's lattice case with m + 1 cells moved up by 1 (in the rotated frame).
+         call build_problem(top, elem_quad4, elem_quad4, merge(4, 3, k == 1), contact_law_frictionless, .true., &
+            & 0.0_wp)
+         x3 = top%c(2)%x + spread(pb%rot(1:2, 2), 2, size(top%c(2)%x, 2))
+         gp3 = top%c(2)%gp
+         allocate (gs3, mold=top%c(2)%gs)
+         do j = 1, size(gp3, 3)
+            do i = 1, size(gp3, 2)
+               gp3(:, i, j) = gp3(:, i, j) + pb%rot(1:2, 2)
+               call exact(pb, 2, gp3(:, i, j), s)
+               gs3(:, i, j) = s(1:3)
+            end do
+         end do
+         call describe(pb, contact_law_frictionless, two, pairs(1), laws, slip)
+         bodies(1:2) = two
+         bodies(3) = bodies(2)
+         bodies(3)%nodes => x3
+         bodies(3)%connectivity => top%c(2)%conn
+         bodies(3)%gp => gp3
+         bodies(3)%gw => top%c(2)%gw
+         bodies(3)%gs => gs3
+         call plane_facets(pb%c(2), .true., mid_top)
+         call plane_facets(top%c(2), .false., top_bottom)
+         pairs(2) = pairs(1)
+         pairs(2)%slave = 2
+         pairs(2)%master = 3
+         pairs(2)%slave_facets => mid_top
+         pairs(2)%master_facets => top_bottom
+         stick = contact_law_stick
+         pairs(2)%slave_law => stick
+         pairs(2)%master_law => stick
+         if (k == 1) then
+            call recover_contact_on_mesh(bodies, pairs, mesh_method_sprc, res, error)
+            if (allocated(error)) return
+            worst = 0.0_wp
+            do n = 1, size(x3, 2)
+               call exact(pb, 2, x3(:, n), s)
+               worst = max(worst, maxval(abs(res%bodies(3)%nodal(:, n) - s(1:3))))
+            end do
+            do n = 1, size(pb%c(2)%x, 2)
+               call exact(pb, 2, pb%c(2)%x(:, n), s)
+               worst = max(worst, maxval(abs(res%bodies(2)%nodal(:, n) - s(1:3))))
+            end do
+            worst = max(worst, maxval(abs(res%pairs(2)%jump)), maxval(abs(res%pairs(1)%jump)))
+            call check(error, worst <= tol*maxval(abs(pb%f)), 'three bodies: deviation '//rtoa(worst))
+            if (allocated(error)) return
+         else
+            call recover_contact_on_mesh(bodies, pairs, mesh_method_sprc, res, err)
+            call check(error, allocated(err), 'no error for a patch between two pairs')
+            if (allocated(error)) return
+            call check(error, index(err%message, 'contact points of pairs 1 and 2') > 0, err%message)
+            if (allocated(error)) return
+         end if
+         deallocate (gs3)
+      end do
+   end subroutine test_two_pairs
 
 end module sprc_test_contact_mesh
