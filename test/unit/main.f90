@@ -24,6 +24,7 @@ program sprc_unit_tests
    use sprc_test_fem, only: collect_fem
    use sprc_test_patches, only: collect_patches
    use sprc_test_mesh_recovery, only: collect_mesh_recovery
+   use sprc_test_contact_mesh, only: collect_contact_mesh
    use sprc_test_stiff, only: collect_stiff
    use sprc_test_study, only: collect_study
    use sprc_test_adaptive, only: collect_adaptive
@@ -62,6 +63,7 @@ program sprc_unit_tests
       new_testsuite('output', collect_output), &
       new_testsuite('fem', collect_fem), &
       new_testsuite('mesh_recovery', collect_mesh_recovery), &
+      new_testsuite('contact_mesh', collect_contact_mesh), &
       new_testsuite('stiff', collect_stiff), &
       new_testsuite('study', collect_study), &
       new_testsuite('adaptive', collect_adaptive), &
