@@ -5,7 +5,7 @@ module sprc_test_core
    use sprc_core_error, only: error_type, fatal_error, stat_name, stat_invalid_input, &
       & stat_singular, stat_not_positive_definite
    use sprc_core_timer, only: timer_type, wall_time
-   use sprc_core_text, only: fixed_text, itoa, rtoa
+   use sprc_core_text, only: fixed_text, itoa, rtoa, lower, xml_escape
    use sprc_core_boundary, only: bc_none, bc_traction, bc_symmetry, bc_free, bc_pressure, bc_contact, bc_kind_name, &
       & bc_kind_from_name
    use sprc_core_lapack, only: dgesv, dgecon, dgetrf, dlange, dpotrf, dpotrs, dgeqp3, dgesvd, &
@@ -35,6 +35,7 @@ contains
          new_unittest('dsysv_indefinite', test_dsysv), &
          new_unittest('lapack_info_translation', test_info_translation), &
          new_unittest('strings', test_strings), &
+         new_unittest('lower_and_xml_escape', test_lower_escape), &
          new_unittest('boundary_kinds', test_boundary_kinds) &
          ]
    end subroutine collect_core
@@ -227,6 +228,21 @@ contains
    end subroutine test_info_translation
 
    !> Integers and reals as text, checked against literal strings.
+   !> lower touches A-Z only; xml_escape writes all five XML entities (the apostrophe
+   !> too, so the text may sit in single-quoted attributes) and leaves the rest alone.
+   subroutine test_lower_escape(error)
+      type(error_type), allocatable, intent(out) :: error
+      call check(error, lower('Kind = "Hertz_3D" @[Z]`{'), 'kind = "hertz_3d" @[z]`{', 'lower')
+      if (allocated(error)) return
+      call check(error, len(lower('AB  ')), 4, 'lower keeps the length')
+      if (allocated(error)) return
+      call check(error, xml_escape('a<b & "c" > it''s'), 'a&lt;b &amp; &quot;c&quot; &gt; it&apos;s', 'xml_escape')
+      if (allocated(error)) return
+      call check(error, xml_escape('&amp;'), '&amp;amp;', 'xml_escape escapes an entity once more')
+      if (allocated(error)) return
+      call check(error, len(xml_escape('')), 0, 'xml_escape of nothing')
+   end subroutine test_lower_escape
+
    subroutine test_strings(error)
       type(error_type), allocatable, intent(out) :: error
       call check(error, itoa(0)//' '//itoa(-12)//' '//itoa(huge(1_i4))//' '//itoa(-huge(1_i8)), &
