@@ -10,6 +10,8 @@ module sprc_test_core
       & bc_kind_from_name
    use sprc_core_lapack, only: dgesv, dgecon, dgetrf, dlange, dpotrf, dpotrs, dgeqp3, dgesvd, &
       & dgemm, dsyrk, dsysv, lapack_info_error
+   use sprc_core_lagrange, only: lagrange_1d, tensor_shape, element_node_index, vtk_line2, vtk_line3, &
+      & vtk_quad4, vtk_quad9, vtk_hex8, vtk_hex27
    use sprc_testsuite, only: unittest_type, new_unittest, check
    implicit none
    private
@@ -36,6 +38,9 @@ contains
          new_unittest('lapack_info_translation', test_info_translation), &
          new_unittest('strings', test_strings), &
          new_unittest('lower_and_xml_escape', test_lower_escape), &
+         new_unittest('lagrange_vtk_tables', test_lagrange_tables), &
+         new_unittest('lagrange_kronecker_unity', test_lagrange_kronecker), &
+         new_unittest('lagrange_derivative_fd', test_lagrange_derivative), &
          new_unittest('boundary_kinds', test_boundary_kinds) &
          ]
    end subroutine collect_core
@@ -242,6 +247,138 @@ contains
       if (allocated(error)) return
       call check(error, len(xml_escape('')), 0, 'xml_escape of nothing')
    end subroutine test_lower_escape
+
+   !> Each VTK table is a permutation of the Lagrange indices {0..p}^dim with the
+   !> vertices first, and a few nodes sit where VTK puts them (by hand from the
+   !> VTK file-format figures).
+   subroutine test_lagrange_tables(error)
+      type(error_type), allocatable, intent(out) :: error
+      call check_table(vtk_line2, 1)
+      if (allocated(error)) return
+      call check_table(vtk_line3, 2)
+      if (allocated(error)) return
+      call check_table(vtk_quad4, 1)
+      if (allocated(error)) return
+      call check_table(vtk_quad9, 2)
+      if (allocated(error)) return
+      call check_table(vtk_hex8, 1)
+      if (allocated(error)) return
+      call check_table(vtk_hex27, 2)
+      if (allocated(error)) return
+      call check(error, all(vtk_quad9(:, 6) == [2, 1]) .and. all(vtk_quad9(:, 9) == [1, 1]) .and. &
+         & all(vtk_hex27(:, 17) == [0, 0, 1]) .and. all(vtk_hex27(:, 18) == [2, 0, 1]) .and. &
+         & all(vtk_hex27(:, 21) == [0, 1, 1]) .and. all(vtk_hex27(:, 23) == [1, 0, 1]) .and. &
+         & all(vtk_hex27(:, 25) == [1, 1, 0]), 'quad9 and hex27 edge and face nodes where VTK puts them')
+      if (allocated(error)) return
+      call check(error, all(element_node_index(2, 2) == vtk_quad9) .and. all(element_node_index(3, 1) == vtk_hex8), &
+         & 'element_node_index picks the table')
+   contains
+      subroutine check_table(idx, p)
+         integer, intent(in) :: idx(:, :), p
+         integer :: j, k, nv
+         nv = 2**size(idx, 1)
+         call check(error, size(idx, 2), (p + 1)**size(idx, 1), 'node count')
+         if (allocated(error)) return
+         call check(error, all(idx >= 0 .and. idx <= p), 'indices in 0..p')
+         if (allocated(error)) return
+         do j = 1, size(idx, 2)
+            do k = 1, j - 1
+               call check(error, any(idx(:, j) /= idx(:, k)), 'no two nodes alike')
+               if (allocated(error)) return
+            end do
+            call check(error, (j <= nv) .eqv. all(idx(:, j) == 0 .or. idx(:, j) == p), 'vertices first')
+            if (allocated(error)) return
+         end do
+      end subroutine check_table
+   end subroutine test_lagrange_tables
+
+   !> Kronecker property n_i(x_j) = delta_ij at the nodes (exact: the basis takes the
+   !> values 0 and 1 there in floating point), and partition of unity at points inside
+   !> and outside the element to a few ulps; for every table, degree 1 and 2.
+   subroutine test_lagrange_kronecker(error)
+      type(error_type), allocatable, intent(out) :: error
+      call check_element(vtk_line2, 1)
+      if (allocated(error)) return
+      call check_element(vtk_line3, 2)
+      if (allocated(error)) return
+      call check_element(vtk_quad4, 1)
+      if (allocated(error)) return
+      call check_element(vtk_quad9, 2)
+      if (allocated(error)) return
+      call check_element(vtk_hex8, 1)
+      if (allocated(error)) return
+      call check_element(vtk_hex27, 2)
+   contains
+      subroutine check_element(idx, p)
+         integer, intent(in) :: idx(:, :), p
+         real(wp) :: n(size(idx, 2)), xi(size(idx, 1)), delta(size(idx, 2))
+         real(wp), parameter :: pts(3, 4) = reshape([0.3_wp, 0.71_wp, 0.05_wp, -0.4_wp, 1.3_wp, 0.5_wp, &
+            & 1.0_wp/3.0_wp, 0.9_wp, 2.0_wp, 0.123_wp, -1.0_wp, 0.77_wp], [3, 4])
+         integer :: j, q
+         do j = 1, size(idx, 2)
+            xi = real(idx(:, j), wp)/real(p, wp)
+            call tensor_shape(idx, p, xi, n)
+            delta = 0.0_wp
+            delta(j) = 1.0_wp
+            call check(error, all(n == delta), 'n_i(x_j) = delta_ij')
+            if (allocated(error)) return
+         end do
+         do q = 1, size(pts, 2)
+            call tensor_shape(idx, p, pts(1:size(idx, 1), q), n)
+            ! The terms reach |n| < 20 at these points; their sum rounds to 1 within 64 eps.
+            call check(error, sum(n), 1.0_wp, thr=64*epsilon(1.0_wp), rel=.false.)
+            if (allocated(error)) return
+         end do
+      end subroutine check_element
+   end subroutine test_lagrange_kronecker
+
+   !> The derivatives against central differences: the basis is of degree <= 2 in each
+   !> variable, so the central difference has no truncation error and differs only by
+   !> rounding, below 16 eps / h with h = 2**-10 (values up to ~4 in magnitude here).
+   subroutine test_lagrange_derivative(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), parameter :: h = 2.0_wp**(-10)
+      real(wp) :: l(0:2), dl(0:2), lp(0:2), lm(0:2)
+      integer :: p
+      real(wp) :: t
+      do p = 1, 2
+         t = 0.37_wp
+         call lagrange_1d(p, t, l, dl)
+         call lagrange_1d(p, t + h, lp)
+         call lagrange_1d(p, t - h, lm)
+         call check(error, maxval(abs((lp - lm)/(2*h) - dl)) <= 16*epsilon(1.0_wp)/h, '1D derivative')
+         if (allocated(error)) return
+      end do
+      call check_element(vtk_line3, 2)
+      if (allocated(error)) return
+      call check_element(vtk_quad4, 1)
+      if (allocated(error)) return
+      call check_element(vtk_quad9, 2)
+      if (allocated(error)) return
+      call check_element(vtk_hex8, 1)
+      if (allocated(error)) return
+      call check_element(vtk_hex27, 2)
+   contains
+      subroutine check_element(idx, p)
+         integer, intent(in) :: idx(:, :), p
+         real(wp) :: n(size(idx, 2)), np(size(idx, 2)), nm(size(idx, 2)), d(size(idx, 1), size(idx, 2))
+         real(wp) :: xi(size(idx, 1)), e(size(idx, 1))
+         real(wp), parameter :: x0(3) = [0.31_wp, 1.2_wp, -0.15_wp]
+         integer :: k, rdim
+         rdim = size(idx, 1)
+         xi = x0(1:rdim)
+         call tensor_shape(idx, p, xi, n, d)
+         do k = 1, rdim
+            e = 0.0_wp
+            e(k) = h
+            call tensor_shape(idx, p, xi + e, np)
+            call tensor_shape(idx, p, xi - e, nm)
+            call check(error, maxval(abs((np - nm)/(2*h) - d(k, :))) <= 16*epsilon(1.0_wp)/h, &
+               & 'd n / d xi by central differences')
+            if (allocated(error)) return
+         end do
+      end subroutine check_element
+   end subroutine test_lagrange_derivative
 
    subroutine test_strings(error)
       type(error_type), allocatable, intent(out) :: error

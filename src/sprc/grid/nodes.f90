@@ -1,15 +1,7 @@
 !> Nodes of the Q1 / Q2 Lagrange elements on the active leaves of a grid.
 !>
 !> Elements are the grid's leaves in its (Morton) order: element e is leaf e.
-!> Local node order is VTK's, so output needs no permutation:
-!> - quad4 (VTK_QUAD):      (0,0) (1,0) (1,1) (0,1)
-!> - quad9 (VTK_BIQUADRATIC_QUAD): corners as quad4, then edge midpoints of
-!>   y=0, x=1, y=1, x=0, then the centre
-!> - hex8 (VTK_HEXAHEDRON): bottom face z=0 as quad4, then top face z=1
-!> - hex27 (VTK_TRIQUADRATIC_HEXAHEDRON): 8 corners as hex8; edge midpoints of
-!>   the bottom face (as quad9's 4..7), of the top face, then the vertical edges
-!>   above corners 0..3; face centres x=0, x=1, y=0, y=1, z=0, z=1; the centre.
-!> `element_node_index` gives these as Lagrange indices (0..degree per axis).
+!> Local node order is VTK's (`sprc_core_lagrange`), so output needs no permutation.
 !>
 !> Nodes live on an integer lattice of resolution `lattice_level` = finest leaf
 !> level + 1 (so Q2 midpoints of the finest leaves are lattice points) and are
@@ -22,6 +14,7 @@ module sprc_grid_nodes
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_alloc, only: check_allocation
    use sprc_core_hash, only: hash_int
+   use sprc_core_lagrange, only: element_node_index, tensor_shape
    use sprc_grid_tree, only: grid_type
    implicit none
    private
@@ -59,66 +52,13 @@ contains
       nodes_per_element = (degree + 1)**dim
    end function nodes_per_element
 
-   !> Lagrange indices (dim, (degree+1)**dim) of the local nodes in VTK order: node j
-   !> sits at reference position index(:, j) / degree in [0, 1]^dim.
-   pure function element_node_index(dim, degree) result(idx)
-      integer, intent(in) :: dim, degree
-      integer :: idx(dim, (degree + 1)**dim)
-      integer, parameter :: quad4(2, 4) = reshape([0, 0, 1, 0, 1, 1, 0, 1], [2, 4])
-      integer, parameter :: quad9(2, 9) = reshape([0, 0, 2, 0, 2, 2, 0, 2, 1, 0, 2, 1, 1, 2, 0, 1, 1, 1], [2, 9])
-      integer, parameter :: hex8(3, 8) = reshape([0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, &
-         & 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1], [3, 8])
-      integer, parameter :: hex27(3, 27) = reshape([ &
-         & 0, 0, 0, 2, 0, 0, 2, 2, 0, 0, 2, 0, 0, 0, 2, 2, 0, 2, 2, 2, 2, 0, 2, 2, &
-         & 1, 0, 0, 2, 1, 0, 1, 2, 0, 0, 1, 0, &
-         & 1, 0, 2, 2, 1, 2, 1, 2, 2, 0, 1, 2, &
-         & 0, 0, 1, 2, 0, 1, 2, 2, 1, 0, 2, 1, &
-         & 0, 1, 1, 2, 1, 1, 1, 0, 1, 1, 2, 1, 1, 1, 0, 1, 1, 2, &
-         & 1, 1, 1], [3, 27])
-
-      if (dim == 2 .and. degree == 1) then
-         idx = quad4
-      else if (dim == 2) then
-         idx = quad9
-      else if (degree == 1) then
-         idx = hex8
-      else
-         idx = hex27
-      end if
-   end function element_node_index
-
    !> Values of the Q`degree` shape functions (VTK order) at reference point xi in [0, 1]^dim.
    pure subroutine element_shape(dim, degree, xi, shape)
       integer, intent(in) :: dim, degree
       real(wp), intent(in) :: xi(:)
       real(wp), intent(out) :: shape(:)
-      real(wp) :: l1d(0:2, 3)
-      integer :: idx(dim, (degree + 1)**dim)
-      integer :: j, k
-
-      do k = 1, dim
-         call lagrange_1d(degree, xi(k), l1d(:, k))
-      end do
-      idx = element_node_index(dim, degree)
-      do j = 1, size(idx, 2)
-         shape(j) = 1.0_wp
-         do k = 1, dim
-            shape(j) = shape(j)*l1d(idx(k, j), k)
-         end do
-      end do
+      call tensor_shape(element_node_index(dim, degree), degree, xi, shape)
    end subroutine element_shape
-
-   !> 1D Lagrange basis of degree 1 or 2 on equispaced nodes of [0, 1].
-   pure subroutine lagrange_1d(degree, t, l)
-      integer, intent(in) :: degree
-      real(wp), intent(in) :: t
-      real(wp), intent(out) :: l(0:2)
-      if (degree == 1) then
-         l = [1.0_wp - t, t, 0.0_wp]
-      else
-         l = [(2.0_wp*t - 1.0_wp)*(t - 1.0_wp), 4.0_wp*t*(1.0_wp - t), t*(2.0_wp*t - 1.0_wp)]
-      end if
-   end subroutine lagrange_1d
 
    !> Number the Q`degree` nodes of the active leaves of `grid`.
    subroutine nodes_build(self, grid, degree, error)
