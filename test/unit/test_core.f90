@@ -12,6 +12,7 @@ module sprc_test_core
       & dgemm, dsyrk, dsysv, lapack_info_error
    use sprc_core_lagrange, only: lagrange_1d, tensor_shape, element_node_index, vtk_line2, vtk_line3, &
       & vtk_quad4, vtk_quad9, vtk_hex8, vtk_hex27
+   use sprc_core_hash, only: key_table_type, hash_int
    use sprc_testsuite, only: unittest_type, new_unittest, check
    implicit none
    private
@@ -41,6 +42,7 @@ contains
          new_unittest('lagrange_vtk_tables', test_lagrange_tables), &
          new_unittest('lagrange_kronecker_unity', test_lagrange_kronecker), &
          new_unittest('lagrange_derivative_fd', test_lagrange_derivative), &
+         new_unittest('key_table_structured_keys', test_key_table), &
          new_unittest('boundary_kinds', test_boundary_kinds) &
          ]
    end subroutine collect_core
@@ -379,6 +381,63 @@ contains
          end do
       end subroutine check_element
    end subroutine test_lagrange_derivative
+
+   !> The hash table on adversarial keys: lattice points that are multiples of 2**18
+   !> (all low bits zero), keys differing only in their highest bits, negative keys,
+   !> each inserted twice (ties). Every key keeps the number of its first insertion, a
+   !> repeat adds nothing, absent keys are not found, and no probe run is long: at load
+   !> alpha <= 1/2 linear probing's longest run over n keys is about
+   !> ln(n)/(alpha - 1 - ln alpha) = ln(n)/0.193, 50 for n = 3*4096, so 128 fails only for a hash that lets
+   !> structured keys collide (the slot from the low bits alone puts them all in slot 0).
+   subroutine test_key_table(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(key_table_type) :: t
+      integer, parameter :: m = 4096
+      integer :: i, k, number, key(3), run, longest
+      integer(i8) :: s
+      logical :: added
+
+      call t%init(3, 16, 'test', error)
+      if (allocated(error)) return
+      do k = 1, 2
+         do i = 1, 3*m
+            key = adversarial(i)
+            call t%insert(key, number, added, error)
+            if (allocated(error)) return
+            call check(error, number == i .and. (added .eqv. k == 1), 'first-insertion numbering, ties added once')
+            if (allocated(error)) return
+         end do
+      end do
+      call check(error, t%n, 3*m, 'keys stored')
+      if (allocated(error)) return
+      call check(error, t%find([1, 2, 3]) == 0 .and. t%find([0, 0, 0]) == 0 .and. &
+         & t%find([-2**30, 0, 0]) == 0, 'absent keys')
+      if (allocated(error)) return
+      longest = 0
+      do i = 1, t%n
+         s = iand(hash_int(t%keys(:, i)), t%mask)
+         run = 0
+         do while (t%slot(s) /= i)
+            s = iand(s + 1_i8, t%mask)
+            run = run + 1
+         end do
+         longest = max(longest, run)
+      end do
+      call check(error, longest <= 128, 'longest probe run '//itoa(longest)//' for structured keys')
+   contains
+      pure function adversarial(i) result(g)
+         integer, intent(in) :: i
+         integer :: g(3)
+         select case ((i - 1)/m)
+         case (0)   ! dyadic lattice points: multiples of 2**18
+            g = [mod(i, 2)*2**18, (i/2)*2**18, 0]
+         case (1)   ! only the high bits vary
+            g = [ishft(mod(i, 128), 24), ishft(i/128, 24), 7]
+         case default   ! negative, and equal but for the sign
+            g = [-i, i, -huge(1)]
+         end select
+      end function adversarial
+   end subroutine test_key_table
 
    subroutine test_strings(error)
       type(error_type), allocatable, intent(out) :: error
