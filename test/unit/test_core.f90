@@ -13,6 +13,7 @@ module sprc_test_core
    use sprc_core_lagrange, only: lagrange_1d, tensor_shape, element_node_index, vtk_line2, vtk_line3, &
       & vtk_quad4, vtk_quad9, vtk_hex8, vtk_hex27
    use sprc_core_hash, only: key_table_type, hash_int
+   use sprc_core_sort, only: sort_order, sort, sort_pairs
    use sprc_testsuite, only: unittest_type, new_unittest, check
    implicit none
    private
@@ -43,6 +44,7 @@ contains
          new_unittest('lagrange_kronecker_unity', test_lagrange_kronecker), &
          new_unittest('lagrange_derivative_fd', test_lagrange_derivative), &
          new_unittest('key_table_structured_keys', test_key_table), &
+         new_unittest('sort_stable_against_counting', test_sort), &
          new_unittest('boundary_kinds', test_boundary_kinds) &
          ]
    end subroutine collect_core
@@ -438,6 +440,71 @@ contains
          end select
       end function adversarial
    end subroutine test_key_table
+
+   !> The sorts against an independent O(n**2) reference: in a stable ascending sort,
+   !> element i goes to 1 + #{j: v(j) < v(i)} + #{j < i: v(j) == v(i)}. Keys with many
+   !> ties, negative values, -0 and +0 (equal under <), huge and subnormal reals; sizes
+   !> around the insertion runs (16) and merge widths.
+   subroutine test_sort(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: sizes(8) = [0, 1, 2, 15, 16, 17, 33, 1000]
+      integer :: c, n, i
+      real(wp), allocatable :: r(:), rv(:)
+      integer, allocatable :: k(:), kv(:), order(:), work(:), expect(:)
+      integer(i8), allocatable :: k8(:)
+      real(wp), parameter :: special(6) = [-0.0_wp, 0.0_wp, huge(1.0_wp), -huge(1.0_wp), tiny(1.0_wp)/8, -1.5_wp]
+
+      do c = 1, size(sizes)
+         n = sizes(c)
+         allocate (r(n), k(n), k8(n), order(n), work(n), expect(n))
+         do i = 1, n
+            k(i) = mod(7919*i, 23) - 11
+            r(i) = real(k(i), wp)/4.0_wp
+            if (mod(i, 5) == 0) r(i) = special(1 + mod(i/5, size(special)))
+            k8(i) = int(k(i), i8)*2_i8**40 + mod(i, 3)
+         end do
+         call sort_order(r, order, work)
+         expect = stable_positions(r)
+         call check(error, all(expect(order) == [(i, i=1, n)]), 'real sort_order, n = '//itoa(n))
+         if (allocated(error)) return
+         call sort_order(k, order, work)
+         expect = stable_positions(real(k, wp))
+         call check(error, all(expect(order) == [(i, i=1, n)]), 'integer sort_order')
+         if (allocated(error)) return
+         call sort_order(k8, order, work)
+         expect = stable_positions(real(k8, wp))
+         call check(error, all(expect(order) == [(i, i=1, n)]), 'integer(i8) sort_order')
+         if (allocated(error)) return
+         ! In place: the same values as the permuted input, bit for bit (-0 and +0 in input order).
+         call sort_order(r, order, work)
+         rv = r
+         call sort(rv)
+         call check(error, all(transfer(rv, 1_i8, n) == transfer(r(order), 1_i8, n)), 'real sort in place')
+         if (allocated(error)) return
+         kv = k
+         call sort(kv)
+         call sort_order(k, order, work)
+         call check(error, all(kv == k(order)), 'integer sort in place')
+         if (allocated(error)) return
+         kv = [(n + 1 - i, i=1, n)]*3
+         rv = real(kv, wp) + 0.5_wp
+         call sort_pairs(kv, rv)
+         call check(error, all(kv == [(3*i, i=1, n)]) .and. all(rv == real(kv, wp) + 0.5_wp), 'sort_pairs carries values')
+         if (allocated(error)) return
+         deallocate (r, k, k8, order, work, expect)
+      end do
+   contains
+      pure function stable_positions(v) result(pos)
+         real(wp), intent(in) :: v(:)
+         integer :: pos(size(v)), i, j
+         do i = 1, size(v)
+            pos(i) = 1
+            do j = 1, size(v)
+               if (v(j) < v(i) .or. (j < i .and. v(j) == v(i))) pos(i) = pos(i) + 1
+            end do
+         end do
+      end function stable_positions
+   end subroutine test_sort
 
    subroutine test_strings(error)
       type(error_type), allocatable, intent(out) :: error

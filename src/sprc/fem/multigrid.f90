@@ -29,7 +29,7 @@ module sprc_fem_multigrid
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_alloc, only: check_allocation
    use sprc_core_hash, only: key_table_type
-   use sprc_fem_sparse, only: sort_row
+   use sprc_core_sort, only: sort_pairs
    use sprc_recovery_dense, only: qr_pivoted, apply_q, solve_upper
    implicit none
    private
@@ -207,7 +207,7 @@ contains
          call move_alloc(col_new, col)
          call move_alloc(val_new, val)
       end if
-      call sort_row(cols, vals)
+      call sort_pairs(cols, vals)
       col(q + 1:q + m) = cols
       val(q + 1:q + m) = vals
       q = q + m

@@ -38,6 +38,7 @@ module sprc_grid_tree
    use sprc_geometry_region, only: region_type, cell_outside, cell_inside, cell_cut
    use sprc_grid_morton, only: morton_encode
    use sprc_core_hash, only: key_table_type
+   use sprc_core_sort, only: sort_order
    implicit none
    private
 
@@ -642,7 +643,7 @@ contains
       type(builder_type), intent(inout) :: b
       type(error_type), allocatable, intent(out) :: error
       integer(i8), allocatable :: keys(:)
-      integer, allocatable :: idx(:), perm(:)
+      integer, allocatable :: idx(:), perm(:), work(:)
       integer :: n, i, j, d, stat
 
       deallocate (b%cells%keys, b%cells%value, b%cells%slot)
@@ -658,8 +659,10 @@ contains
          idx(j) = i
          keys(j) = morton_encode(ishft(b%crd(1:d, i), grid_max_level - b%lev(i)))
       end do
-      call radix_sort(keys, perm, error)
+      allocate (perm(n), work(n), stat=stat)
+      call check_allocation(stat, 'grid build', 'the sort permutation of the leaves', n, 8, error)
       if (allocated(error)) return
+      call sort_order(keys, perm, work)
       allocate (grid%leaf_level(n), grid%leaf_coord(d, n), grid%leaf_class(n), grid%leaf_key(n), stat=stat)
       call check_allocation(stat, 'grid build', 'the leaves of the grid', n, 4*(d + 2) + 8, error)
       if (allocated(error)) return
@@ -679,47 +682,6 @@ contains
          end if
       end do
    end subroutine finalize
-
-   !> Ascending permutation of non-negative keys: LSD radix sort, 16-bit digits.
-   subroutine radix_sort(keys, perm, error)
-      integer(i8), intent(in) :: keys(:)
-      integer, allocatable, intent(out) :: perm(:)
-      type(error_type), allocatable, intent(out) :: error
-      integer, allocatable :: tmp(:), cnt(:)
-      integer :: n, i, pass, digit, npass, stat
-      integer(i8) :: kmax
-
-      n = size(keys)
-      allocate (perm(n), tmp(n), cnt(0:65536), stat=stat)
-      call check_allocation(stat, 'grid build', 'the sort permutation of the leaves', n, 8, error)
-      if (allocated(error)) return
-      do i = 1, n
-         perm(i) = i
-      end do
-      kmax = 0_i8
-      if (n > 0) kmax = maxval(keys)
-      npass = 0
-      do while (kmax > 0_i8)
-         npass = npass + 1
-         kmax = ishft(kmax, -16)
-      end do
-      do pass = 0, npass - 1
-         cnt = 0
-         do i = 1, n
-            digit = int(iand(ishft(keys(perm(i)), -16*pass), 65535_i8))
-            cnt(digit + 1) = cnt(digit + 1) + 1
-         end do
-         do i = 1, 65536
-            cnt(i) = cnt(i) + cnt(i - 1)
-         end do
-         do i = 1, n
-            digit = int(iand(ishft(keys(perm(i)), -16*pass), 65535_i8))
-            cnt(digit) = cnt(digit) + 1
-            tmp(cnt(digit)) = perm(i)
-         end do
-         perm(1:n) = tmp(1:n)
-      end do
-   end subroutine radix_sort
 
    ! ---------------------------------------------------------------- cell hash
 
