@@ -20,13 +20,18 @@ module sprc_core_lagrange
    public :: lagrange_1d, tensor_shape, element_node_index
    public :: vtk_line2, vtk_line3, vtk_quad4, vtk_quad9, vtk_hex8, vtk_hex27
 
-   !> Lagrange indices (dim, nodes) of VTK's local nodes (module notes).
+   !> Lagrange indices (dim, nodes) of VTK's line2 (module notes).
    integer, parameter :: vtk_line2(1, 2) = reshape([0, 1], [1, 2])
+   !> Lagrange indices of VTK's line3 (VTK_QUADRATIC_EDGE).
    integer, parameter :: vtk_line3(1, 3) = reshape([0, 2, 1], [1, 3])
+   !> Lagrange indices of VTK's quad4.
    integer, parameter :: vtk_quad4(2, 4) = reshape([0, 0, 1, 0, 1, 1, 0, 1], [2, 4])
+   !> Lagrange indices of VTK's quad9.
    integer, parameter :: vtk_quad9(2, 9) = reshape([0, 0, 2, 0, 2, 2, 0, 2, 1, 0, 2, 1, 1, 2, 0, 1, 1, 1], [2, 9])
+   !> Lagrange indices of VTK's hex8.
    integer, parameter :: vtk_hex8(3, 8) = reshape([0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, &
       & 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1], [3, 8])
+   !> Lagrange indices of VTK's hex27.
    integer, parameter :: vtk_hex27(3, 27) = reshape([ &
       & 0, 0, 0, 2, 0, 0, 2, 2, 0, 0, 2, 0, 0, 0, 2, 2, 0, 2, 2, 2, 2, 0, 2, 2, &
       & 1, 0, 0, 2, 1, 0, 1, 2, 0, 0, 1, 0, &

@@ -1,4 +1,4 @@
-!> Sorting: one stable merge sort behind every sort of the library.
+!> The one stable merge sort behind every sort of the library.
 !>
 !> Every key type is mapped to 64-bit integers in the same order (reals through
 !> their IEEE bits, -0 counted as +0 as `<` does), and one routine sorts a
