@@ -1,152 +1,42 @@
-!> The coupled FE solve of one contact pair: both bodies' reduced systems in
-!> one block system plus the contact terms on the slave surface points
-!> (thesis eqs. 2-5, Tur et al. 2015; doc/theory.md, section 6; doc/scene.md
-!> `&contact`).
+!> The coupled FE solve of one contact pair: both bodies' reduced systems in one
+!> block system plus the contact terms on the slave surface points. The maths and
+!> the reasons for each choice are in doc/theory.md, section 6 (Tur et al. 2015;
+!> the scene keys in doc/scene.md, `&contact`).
 !>
-!> Formulation: the stabilized multiplier of thesis eq. 5 (with the sign
-!> erratum), gamma = kappa E_s/h, p_N the slave's FE traction (Nitsche-type)
-!> or, with `recovered`, its recovered traction of the previous solution.
-!> The multiplier is P0 on contact cells (slave aggregates sharing a parent
-!> cell, spanning at least two master cells where those are larger): P0 on
-!> the slave cells is not inf-sup stable against the trace (the pressure
-!> alternates from cell to cell), and a constraint per quadrature point
-!> over-constrains the interface. It is eliminated cell by cell,
-!> lambda_c = pbar + gamma gbar; the cell's block is the second variation of
-!> W_c [pbar.gbar + gamma/2 |gbar|^2] - 1/(2 gamma) sum_i w_i |p_N,i - pbar|^2.
-!> The system is SPD when gamma exceeds the slave traction's trace-inverse
-!> bound; `default_kappa` (sprc_study_spec) is the centre in decades of the
-!> plateau where err_fe and p_max do not depend on kappa.
-!>
-!> Discrete multiplier space: lambda constant on each contact cell c (P0): the
-!> slave points with a master point whose slave aggregates (cell
-!> aggregation's roots) share a parent cell (`macro_cells`: two cells along a
-!> 2D surface, up to four on a 3D one), a sliver of surface joined to the
-!> nearest full contact cell (`group_cells`), measure W_c. P0 on the slave
-!> cells themselves is not inf-sup stable against the continuous trace of
-!> the displacements: a pressure alternating from cell to cell is orthogonal
-!> to every interior trace function, and the multiplier showed it (a shrink
-!> fit's pressure oscillating around the ring at every level and kappa, a 3D
-!> Hertz peak far too high); P0 on the parent cells is the stable
-!> macro-element pair. The same holds against the master's trace, which the
-!> constraint moves alone when the slave is much the stiffer: where the
-!> master's cells are larger than the slave's, a contact cell is the ancestor
-!> spanning at least two master cells (a shaft slave on a grid half the size
-!> of a soft hub's pressure alternated by 5 % from cell to cell). The price:
-!> the open/closed boundary is resolved to a contact cell, two slave cells
-!> (or two master cells). A contact cell turns at most a quarter turn (its
-!> normals within 45 degrees of its mean normal; else its roots go one
-!> ancestor level down, to single roots at the least): on a coarse grid the
-!> ancestor of a ring's cells can be the whole ring, whose mean gap holds
-!> neither a translation nor the rotation (`turns_too_far`). The multiplier is
-!> eliminated cell by cell: stationarity in lambda_c gives
-!>   lambda_c = pbar + gamma gbar,
-!> with pbar, gbar the means over the cell's points of p_N and g, and the
-!> cell's contribution to the energy becomes
-!>   W_c [pbar.gbar + gamma/2 |gbar|^2] - 1/(2 gamma) sum_i w_i |p_N,i - pbar|^2.
-!> Its second variation is the cell's block of the system (symmetric); the
-!> first two terms are the symmetric Nitsche terms of sprc_fem_problem's
-!> Dirichlet conditions with the mean gap as the constraint, the last one
-!> the stabilization's variance term. One constraint per contact cell and direction
-!> matches the displacement space: enforcing g = 0 at every quadrature point
-!> instead (multipliers eliminated point by point) over-constrains the
-!> interface: the pressure oscillates between points and falsely opens
-!> points of a closed interface, the more so the larger kappa. On open cells
-!> lambda = 0 and nothing is added. The pressure reported per point (`p_fe`)
-!> is that of its cell, p = -n_i.lambda_c (0 open); `ts_fe` the magnitude of
-!> the tangential part of lambda_c (0 frictionless).
-!>
-!> Constant in the surface's frame, not in Cartesian components. The
-!> frictionless multiplier is a scalar: its traction lambda_c n_i turns with
-!> the surface. The vector multiplier of stick and Coulomb is constant in the
-!> same sense: at point i it is R_i lambda_c, R_i the least rotation carrying
-!> the cell's mean normal nbar to the point's normal n_i (`frame_rotation`),
-!> so lambda_c.nbar is the pressure and its part normal to nbar the shear,
-!> each constant over the cell as the frictionless pressure is. Every point
-!> operator (gap, traction, the recovered traction p*) enters the cell's
-!> means rotated back by R_i^T, and the formulation below is unchanged. A
-!> Cartesian constant instead cannot carry a uniform pressure on a curved
-!> surface: the traction p n_i of a cell of angle h/R has a tangential part
-!> varying by p h/R across the cell, which the constant misses; the
-!> interface then carries a spurious shear of size p h/R, harmless at Q1
-!> (O(h) like the discretization) but a consistency error of order h^(3/2)
-!> in energy at Q2 (a shrink fit with stick converged at rate 1.5 with the
-!> estimate seeing half the error, where frictionless converged at 2).
-!>
-!> kappa. gamma = kappa E_s/h (SCENE.md: effective stiffness kappa E/h), with
-!> E_s the slave body's Young's modulus and h the smallest edge of the slave
-!> cell (of its aggregate's root). The block system is SPD when gamma exceeds
-!> the trace-inverse bound of the slave traction, C_I dmax/h (the bound of the
-!> Dirichlet Nitsche terms, sprc_fem_problem: about (p+1)^2 times a geometric
-!> factor, cell aggregation keeping it independent of the cut; dmax = 1.35 E
-!> for nu = 0.3 in plane strain), with a margin for the variance term (at
-!> most C_I/kappa times the energy). Sweeps (shrink fit Q1 and Q2, Hertz;
-!> figures in the commits that set the default) found err_fe and p_max flat
-!> from kappa = 100 to 1e6 and moving below it, where coercivity is lost; the
-!> default `default_kappa` = 1e4 (sprc_study_spec) is the centre of that
-!> plateau in decades.
-!>
-!> Points. The slave surface's cut-cell quadrature points with their exact
-!> normals and initial gaps (sprc_contact_surface), cut at the master grid's
-!> planes. The slave traction and displacement at a point are the slave
-!> cell's polynomial there; the master displacement the master host cell's
-!> polynomial at the master point; both reduced through the bodies'
-!> constraints (hanging nodes, aggregation, strong symmetry), like every
-!> element matrix.
-!>
-!> Active set (primal-dual / semi-smooth Newton), per contact cell. First
-!> active set: the cells with a point with g0 <= h, h the smallest edge of
-!> the slave root cell of the cell's first point (one slave cell: touching
-!> and near surfaces, every cell of a fit with or without interference);
-!> this holds a load-controlled body from the start. Each iteration assembles and
-!> factorizes the block system once (CHOLMOD; UMFPACK if CHOLMOD finds it not
-!> positive definite), solves, and takes as the next set the cells with
-!> nbar.lambda_c < 0 (nbar the cell's mean normal). The iteration ends when
-!> the set repeats; after `max_iterations` it is stat_not_converged with the
-!> count of the points whose cells still switched. Before each factorization
-!> the rigid-body modes of both bodies are checked on the block system: a
-!> body that the closed cells and its own conditions leave free is an error
-!> naming the body (stat_singular).
-!>
-!> Friction: 'frictionless' and 'stick' (the closed zone tied: the vector
-!> gap) are symmetric. With stick and Coulomb the cell's normal nbar is the
-!> mean of the bisectors n_s - n_m of the two surfaces' normals (the contact
-!> plane, the same whichever body is the slave), and the initial vector gap
-!> of a point is g0 (n_s.n_m) n_m, its distance to the master's tangent plane
-!> along the master normal: the surfaces close along the common normal. Along
-!> the slave normal instead, a curved slave (a roller, n_s tilted by x/R from
-!> the flat master's normal) got a spurious tangential gap g0 x/R and a
-!> tangential traction p x/R from the normal load alone, O(a/R) but
-!> tangential tractions up to mu p at the contact edges, absent from the
-!> half-space theory (Cattaneo-Mindlin). 'coulomb': the vector multiplier of
-!> a cell less its slip s_c (history), lambda_c = tbar + gamma (gbar - s_c),
-!> split along nbar into lambda_n and lambda_t; a closed cell sticks (the
-!> stick terms with the gap shifted by s_c) while |lambda_t| <= mu
-!> (-lambda_n), else it slips along tau = lambda_t/|lambda_t| with the
-!> friction traction lambda_t = -mu lambda_n tau. A slipping cell's terms are
-!> the second variation of the cell energy with that lambda_t held:
-!>   W [lambda.gbar - 1/(2 gamma) |lambda - pbar|^2] - variance,
-!> the normal terms, the friction work and its stabilization (lambda_t -
-!> tt)/gamma . dtt (tt = tau.tbar u; without it the FE tangential traction
-!> of a slipping cell was free and the trial lambda_t jumped between the
-!> states), whose linearization -mu W (gt + tt/gamma)(nbar^T (tbar + gamma
-!> gbar)) makes the system unsymmetric (UMFPACK). The load path comes in
-!> increments (`&bc stage` and `&contact steps`, the caller's `loads`); in
-!> each the states and slip directions are iterated until they repeat
-!> (directions within `direction_tol`), then the slips are updated: a
-!> slipping cell's so that its trial traction is the friction traction, an
-!> open cell's to its current tangential position. A slipping cell whose
-!> trial turns against its slip direction sticks (`coulomb_states`): the
-!> trial is continuous in the friction traction, which cannot go from mu p
-!> tau to -mu p tau without crossing the stick range; sending it to the
-!> opposite slip instead made edge cells of small pressure flip between the
-!> two directions for ever (a roller under a normal then a tangential load).
-!> The rigid-mode check uses the system without the friction terms.
-!>
-!> Recovered stabilization (`stabilization = 'recovered'`): the cell's block
-!> is the penalty W gamma G^T G alone and p* moves to the load, SPD for every
-!> gamma > 0 and consistent when the recovery is exact; frictionless and
-!> stick only. With a `contact_factor_type` the CHOLMOD factor is reused
-!> while the active set repeats (one back substitution per update).
+!> - Multiplier: stabilized (gamma = kappa E_s/h, h the smallest edge of the slave
+!>   point's aggregate root), with p_N the slave's FE traction (Nitsche-type) or,
+!>   with `recovered`, its recovered traction of the previous solution.
+!> - Multiplier space: P0 on contact cells (`macro_cells`, `group_cells`): slave
+!>   aggregates sharing a parent cell, spanning at least two master cells where
+!>   those are larger, turning at most a quarter turn (`turns_too_far`). P0 on the
+!>   slave cells is not inf-sup stable against the trace, and a constraint per
+!>   point over-constrains the interface. The multiplier is eliminated cell by cell,
+!>   lambda_c = pbar + gamma gbar; the cell's block is the second variation of
+!>   W_c [pbar.gbar + gamma/2 |gbar|^2] - 1/(2 gamma) sum_i w_i |p_N,i - pbar|^2,
+!>   SPD when gamma exceeds the trace-inverse bound (`default_kappa` in
+!>   sprc_study_spec is the centre of the plateau where the results do not depend
+!>   on kappa).
+!> - Frame: lambda_c is constant in the surface's frame; at point i it acts as
+!>   R_i lambda_c, R_i the least rotation from the cell's mean normal to n_i
+!>   (`frame_rotation`), so that a uniform pressure on a curved surface is in the
+!>   space (a Cartesian constant costs Q2 its order).
+!> - Points: the slave's cut-cell surface points cut at the master grid's planes;
+!>   traction and displacements are the host cells' polynomials, reduced through
+!>   each body's constraints like every element matrix.
+!> - Active set: primal-dual per contact cell, starting from the cells with a point
+!>   with g0 <= h; one factorization per iteration (CHOLMOD, UMFPACK if not
+!>   positive definite); the next set is the cells with nbar.lambda_c < 0; it ends
+!>   when the set repeats, else stat_not_converged. A body that the closed cells
+!>   and its own conditions leave free is stat_singular, naming it.
+!> - Friction: with stick and Coulomb the cell normal is the mean bisector of the
+!>   two normals and the initial vector gap g0 (n_s.n_m) n_m (a curved slave gets
+!>   no spurious shear). Coulomb is path dependent: the loads come in increments,
+!>   states and slip directions iterate until they repeat, a slipping cell whose
+!>   trial turns against its slip sticks (the trial cannot jump from mu p tau to
+!>   -mu p tau), and the slipping linearization is unsymmetric (UMFPACK).
+!> - Recovered stabilization: the cell's block is the penalty W gamma G^T G and p*
+!>   moves to the load (SPD for every gamma > 0); frictionless and stick only; with
+!>   a `contact_factor_type` the factor is reused while the active set repeats.
 module sprc_contact_solve
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_not_converged, stat_singular, &

@@ -25,11 +25,11 @@
 !> are symmetric positive definite whenever A is. Coarsening stops at
 !> `coarse_nodes` nodes or when a level no longer shrinks.
 module sprc_fem_multigrid
-   use sprc_core_kinds, only: wp, i8
+   use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_alloc, only: check_allocation
-   use sprc_grid_nodes, only: lattice_slot
-   use sprc_fem_sparse, only: sort_row
+   use sprc_core_hash, only: key_table_type
+   use sprc_core_sort, only: sort_pairs
    use sprc_recovery_dense, only: qr_pivoted, apply_q, solve_upper
    implicit none
    private
@@ -53,14 +53,6 @@ module sprc_fem_multigrid
    !> ends the hierarchy (the coarsening no longer pays).
    real(wp), parameter :: min_shrink = 0.8_wp
    character(len=*), parameter :: who = 'multigrid hierarchy'
-
-   !> Points of a lattice (coordinates `at(3, n)`, 0 beyond dim) found by
-   !> open addressing: `table` holds point numbers (0: empty), at most half full.
-   type :: point_set_type
-      integer, allocatable :: at(:, :), table(:)
-      integer :: n = 0
-      integer(i8) :: mask = 0
-   end type point_set_type
 
 contains
 
@@ -104,8 +96,9 @@ contains
    subroutine check_lattice(lattice, step, error)
       integer, intent(in) :: lattice(:, :), step
       type(error_type), allocatable, intent(out) :: error
-      type(point_set_type) :: points
+      type(key_table_type) :: points
       integer :: d, j, other
+      logical :: added
       character(len=160) :: buf
 
       d = size(lattice, 1)
@@ -118,11 +111,12 @@ contains
             & 'multiple of the node step)', stat_invalid_input)
          return
       end if
-      call new_point_set(points, size(lattice, 2), error)
+      call points%init(d, size(lattice, 2), who, error)
       if (allocated(error)) return
       do j = 1, size(lattice, 2)
-         call add_point(points, lattice(:, j), other)
-         if (other /= 0) then
+         call points%insert(lattice(:, j), other, added, error)
+         if (allocated(error)) return
+         if (.not. added) then
             write (buf, '(a,": nodes ",i0," and ",i0," (0-based) share a lattice point")') who, other - 1, j - 1
             call fatal_error(error, trim(buf), stat_invalid_input)
             return
@@ -130,74 +124,17 @@ contains
       end do
    end subroutine check_lattice
 
-   !> An empty set for up to n points.
-   subroutine new_point_set(set, n, error)
-      type(point_set_type), intent(out) :: set
-      integer, intent(in) :: n
-      type(error_type), allocatable, intent(out) :: error
-      integer :: cap, stat
-      cap = 16
-      do while (cap < 2*n)
-         cap = 2*cap
-      end do
-      allocate (set%at(3, n), set%table(0:cap - 1), stat=stat)
-      call check_allocation(stat, who, 'a lattice point set', cap + 3*n, 4, error)
-      if (allocated(error)) return
-      set%table = 0
-      set%mask = int(cap, i8) - 1_i8
-   end subroutine new_point_set
-
-   !> Add the point g as number set%n + 1; `other` is the number of the point
-   !> already there (then nothing is added), 0 if none.
-   subroutine add_point(set, g, other)
-      type(point_set_type), intent(inout) :: set
-      integer, intent(in) :: g(:)
-      integer, intent(out) :: other
-      integer(i8) :: slot
-      call locate(set, g, slot, other)
-      if (other /= 0) return
-      set%n = set%n + 1
-      set%at(:, set%n) = 0
-      set%at(1:size(g), set%n) = g
-      set%table(slot) = set%n
-   end subroutine add_point
-
-   !> Number of the point g in the set, 0 if absent.
-   pure integer function find_point(set, g) result(found)
-      type(point_set_type), intent(in) :: set
-      integer, intent(in) :: g(:)
-      integer(i8) :: slot
-      call locate(set, g, slot, found)
-   end function find_point
-
-   !> The slot of the point g: its number `found` there, or 0 and the empty slot it would take.
-   pure subroutine locate(set, g, slot, found)
-      type(point_set_type), intent(in) :: set
-      integer, intent(in) :: g(:)
-      integer(i8), intent(out) :: slot
-      integer, intent(out) :: found
-      integer :: p(3)
-      p = 0
-      p(1:size(g)) = g
-      slot = lattice_slot(p, set%mask)
-      do while (set%table(slot) /= 0)
-         found = set%table(slot)
-         if (all(set%at(:, found) == p)) return
-         slot = iand(slot + 1_i8, set%mask)
-      end do
-      found = 0
-   end subroutine locate
-
    !> One coarsening (module notes) of the nodes `lattice(dim, n)` to the
    !> lattice of spacing `s`: the prolongation and the coarse nodes.
    subroutine coarsen(lattice, s, p, error)
       integer, intent(in) :: lattice(:, :), s
       type(prolongation_type), intent(out) :: p
       type(error_type), allocatable, intent(out) :: error
-      type(point_set_type) :: c_points
+      type(key_table_type) :: c_points
       integer, allocatable :: coarse_of(:), col(:)
       real(wp), allocatable :: val(:)
-      integer :: d, n, j, stat, nc, q, m, other, cols(4**size(lattice, 1))
+      integer :: d, n, j, stat, nc, q, m, cols(4**size(lattice, 1))
+      logical :: added
       real(wp) :: vals(4**size(lattice, 1))
 
       d = size(lattice, 1)
@@ -205,14 +142,14 @@ contains
       allocate (coarse_of(n), p%rowptr(n + 1), col(2*n), val(2*n), stat=stat)
       call check_allocation(stat, who, 'a prolongation', n, 24, error)
       if (allocated(error)) return
-      call new_point_set(c_points, n, error)
+      call c_points%init(d, n, who, error)
       if (allocated(error)) return
       ! C-points on the coarse lattice, numbered in node order
       coarse_of = 0
       do j = 1, n
          if (all(mod(lattice(:, j), s) == 0)) then
-            call add_point(c_points, lattice(:, j)/s, other)
-            coarse_of(j) = c_points%n
+            call c_points%insert(lattice(:, j)/s, coarse_of(j), added, error)
+            if (allocated(error)) return
          end if
       end do
       ! rows: injection at C-points; F-points get weights, or are C-points of their own
@@ -270,7 +207,7 @@ contains
          call move_alloc(col_new, col)
          call move_alloc(val_new, val)
       end if
-      call sort_row(cols, vals)
+      call sort_pairs(cols, vals)
       col(q + 1:q + m) = cols
       val(q + 1:q + m) = vals
       q = q + m
@@ -286,7 +223,7 @@ contains
    !> -1 .. 2): few weights, so the coarse matrices stay sparse.
    subroutine f_point_weights(q, s, c_points, cols, vals, m)
       integer, intent(in) :: q(:), s
-      type(point_set_type), intent(in) :: c_points
+      type(key_table_type), intent(in) :: c_points
       integer, intent(out) :: cols(:)
       real(wp), intent(out) :: vals(:)
       integer, intent(out) :: m
@@ -303,7 +240,7 @@ contains
       rank = -1
       do k = 0, 2**d - 1
          off = [(mod(k/2**(i - 1), 2), i = 1, d)]
-         c = find_point(c_points, base + off)
+         c = c_points%find(base + off)
          if (c == 0) then
             if (linear_weight(t, off) /= 0.0_wp) complete = .false.
             cycle
@@ -328,7 +265,7 @@ contains
             off = [(mod(k/4**(i - 1), 4) - 1, i = 1, d)]
             corner = all(off == 0 .or. off == 1)
             if (corner) cycle
-            c = find_point(c_points, base + off)
+            c = c_points%find(base + off)
             if (c == 0) cycle
             n_near = n_near + 1
             order(n_near) = c

@@ -31,7 +31,8 @@ module sprc_fem_petsc
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_unsupported
    use sprc_core_blas_threads, only: blas_serial_begin, blas_serial_end
    use sprc_core_alloc, only: check_allocation
-   use sprc_fem_sparse, only: csr_type, sort_row
+   use sprc_fem_sparse, only: csr_type
+   use sprc_core_sort, only: sort_pairs
    use sprc_fem_linear_solver, only: linear_solver_type, backend_error, message_length, set_solve_ranks, solve_ranks
    use sprc_fem_multigrid, only: prolongation_type, lattice_hierarchy
    implicit none
@@ -435,7 +436,7 @@ contains
             val(k) = a%val(q)
          end do
          associate (r0 => rowptr(p - p0 + 1))
-            if (any(col(r0 + 2:k) <= col(r0 + 1:k - 1))) call sort_row(col(r0 + 1:k), val(r0 + 1:k))
+            if (any(col(r0 + 2:k) <= col(r0 + 1:k - 1))) call sort_pairs(col(r0 + 1:k), val(r0 + 1:k))
          end associate
       end do
       rowptr(p1 - p0 + 2) = int(k, c_int32_t)
