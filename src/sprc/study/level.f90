@@ -389,11 +389,11 @@ contains
             & gamma=study%gamma, dilatation=study%dilatation)
       end if
       if (allocated(error)) return
+      bl%problem%solver = solver
       if (in_contact) then
          call bl%problem%assemble(error)
          return
       end if
-      bl%problem%solver = solver
       if (present(start)) allocate (bl%problem%start, source=start)
       call solve_level(study%partition, bl%problem, error)
       if (allocated(error)) return
@@ -533,6 +533,7 @@ contains
          k = merge(s, m, b == 1)
          bodies(k)%problem%rcond = sol%rcond
          bodies(k)%problem%solver_name = sol%solver_name
+         bodies(k)%problem%solver_iterations = merge(sol%solver_iterations, 0, b == 1)
       end do
       call contact_result(surface, sol, spec, study%bodies(s)%units, result, error)
       if (allocated(error)) return
