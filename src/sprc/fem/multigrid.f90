@@ -480,8 +480,8 @@ contains
    !> The hierarchy of two node sets numbered one after the other (`a`'s
    !> `na` fine nodes first, then `b`'s `nb`): level l's prolongation is
    !> diag(a(l), b(l)), with the identity for a set whose hierarchy has ended
-   !> (module notes). The coarse lattices are not kept (they belong to
-   !> different lattices).
+   !> (module notes); one identity level when neither coarsens. The coarse
+   !> lattices are not kept (they belong to different lattices).
    subroutine stack_hierarchies(a, na, b, nb, p, error)
       type(prolongation_type), intent(in) :: a(:), b(:)
       integer, intent(in) :: na, nb
@@ -515,6 +515,13 @@ contains
       end do
       if (l <= size(p)) call fatal_error(error, who//': a level of the stacked hierarchies does not start from '// &
          & 'the nodes of the level before', stat_invalid_input)
+      if (size(p) > 0 .or. allocated(error)) return
+      ! Neither coarsens (both small): one identity level, so that the coarse
+      ! solve is the whole system, exact, rather than no hierarchy (GAMG,
+      ! whose aggregates lock under the coupling as unkept nodes do).
+      deallocate (p)
+      allocate (p(1))
+      call identity(na + nb, p(1))
    end subroutine stack_hierarchies
 
    !> The identity prolongation of n nodes.
