@@ -1423,9 +1423,8 @@ contains
    !> report's pressures (p_max, each point's p) are pointwise tractions, which
    !> the energy norm bounds only through an inverse estimate: a traction
    !> error in one cell of size h is at most C (L/h)^(d/2) times the relative
-   !> energy error (the cell's share of the energy). With the single body's
-   !> bound the compound sphere's p_max moved by 2e-6 relative at level 4.
-   !> Not below 1e-12, the round-off of the solve.
+   !> energy error (the cell's share of the energy). Not below 1e-12, the
+   !> round-off of the solve.
    pure real(wp) function contact_tolerance(h_over_l, degree, dim) result(tau)
       real(wp), intent(in) :: h_over_l
       integer, intent(in) :: degree, dim

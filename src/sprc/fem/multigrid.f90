@@ -38,8 +38,7 @@
 !> every kept node off the lattice. The coupling, a penalty on the relative
 !> displacement of the two bodies' surfaces, would otherwise lock the
 !> coarse spaces, whose interpolated surfaces do not match (each body's own
-!> grid): the Hertz sphere's CG needed about a hundred iterations per solve
-!> at 2.6e3 unknowns, the estimate of cond(BA) near the penalty's factor.
+!> grid): CG's iterations then grow with the penalty factor.
 !> Coarsening stops by the count of the nodes not kept.
 module sprc_fem_multigrid
    use sprc_core_kinds, only: wp, i8
