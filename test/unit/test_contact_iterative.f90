@@ -30,6 +30,7 @@ module sprc_test_contact_iterative
    use sprc_core_text, only: real_text, itoa
    use sprc_io_namelist, only: read_text_file
    use sprc_study_level, only: level_type
+   use sprc_fem_linear_solver, only: use_iterative, solver_auto, solver_direct
    use sprc_study_row, only: report_row_type, is_empty
    use sprc_test_study, only: run_text
    use sprc_testsuite, only: unittest_type, new_unittest, check, replaced
@@ -62,6 +63,7 @@ contains
          new_unittest('cattaneo_mindlin_coulomb', test_cattaneo), &
          new_unittest('patch_3d_coulomb_slip', test_patch_3d_slip), &
          new_unittest('patch_2d_recovered', test_recovered), &
+         new_unittest('auto_rule_for_pairs', test_auto_rule), &
          new_unittest('coupled_memory_estimate', test_coupled_memory), &
          new_unittest('coupled_level_refused_before_build', test_coupled_refused) &
          ]
@@ -173,6 +175,18 @@ contains
       call same_as_direct(replaced(text, "friction='frictionless'", "friction='frictionless' "// &
          & "stabilization='recovered'"), 4, 'cg+gmg', error)
    end subroutine test_recovered
+
+   !> 'auto' for a contact pair's coupled system: iterative from 60,000
+   !> unknowns in 3D Q1 (one body: 25,000), never in 2D or for Q2 unless the
+   !> direct solve does not fit; 'direct' stays direct.
+   subroutine test_auto_rule(error)
+      type(error_type), allocatable, intent(out) :: error
+      call check(error, use_iterative(solver_auto, 3, 1, 30000) .and. .not. use_iterative(solver_auto, 3, 1, 30000, &
+         & coupled=.true.) .and. use_iterative(solver_auto, 3, 1, 60000, coupled=.true.) .and. .not. &
+         & use_iterative(solver_auto, 2, 1, 10**8, coupled=.true.) .and. .not. use_iterative(solver_auto, 3, 2, 10**8, &
+         & coupled=.true.) .and. use_iterative(solver_auto, 3, 2, 100, direct_fits=.false., coupled=.true.) .and. &
+         & .not. use_iterative(solver_direct, 3, 1, 10**8, coupled=.true.), 'the coupled thresholds')
+   end subroutine test_auto_rule
 
    !> The memory estimate of a contact pair (sprc_study_budget's
    !> `coupled_memory`; Hertz sphere, level 5): the dofs of both bodies in

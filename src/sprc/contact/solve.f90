@@ -150,7 +150,7 @@
 !>
 !> Iterative solves (`block_solver_type`): when the bodies' `solver` asks for
 !> it (`use_iterative` on the block system's unknowns: 'iterative', or 'auto'
-!> from `auto_iterative_min_dofs`), the block system goes to PETSc
+!> from `auto_coupled_min_dofs`), the block system goes to PETSc
 !> (`sprc_fem_petsc`): CG where it is symmetric (frictionless, stick, the
 !> stick-only systems of Coulomb; GMRES if CG meets an indefinite one, the
 !> counterpart of the UMFPACK fallback), GMRES where slipping cells make it
@@ -1389,7 +1389,7 @@ contains
       if (bs%ready) return
       choice = slave%solver
       if (master%solver == solver_iterative) choice = solver_iterative
-      bs%iterative = use_iterative(choice, slave%dim, slave%degree, slave%n_dofs() + master%n_dofs())
+      bs%iterative = use_iterative(choice, slave%dim, slave%degree, slave%n_dofs() + master%n_dofs(), coupled=.true.)
       bs%ready = .true.
       if (.not. bs%iterative) return
       call start_petsc(error)

@@ -108,12 +108,14 @@ contains
    !> Peak bytes of a level of `dofs` unknowns in one system plus `extra`
    !> bytes, by the solver 'auto' (or the scene) takes for it (module notes);
    !> `direct_fits` as for `level_memory`.
-   subroutine solve_bytes(scene, dofs, extra, bytes, available, direct_fits)
+   subroutine solve_bytes(scene, dofs, extra, bytes, available, direct_fits, coupled)
       type(scene_type), intent(in) :: scene
       real(wp), intent(in) :: dofs, extra
       real(wp), intent(out) :: bytes
       integer(i8), intent(in), optional :: available
       logical, intent(out), optional :: direct_fits
+      !> Bodies in contact, one system ('auto''s coupled threshold).
+      logical, intent(in), optional :: coupled
       real(wp) :: direct_bytes
       integer :: n
       logical :: fits
@@ -123,7 +125,7 @@ contains
       if (present(available)) fits = available < 0 .or. direct_bytes <= real(available, wp)
       n = int(min(dofs, real(huge(n), wp)))
       bytes = direct_bytes
-      if (use_iterative(scene_choice(scene), scene%dim, scene%order, n, direct_fits=fits)) &
+      if (use_iterative(scene_choice(scene), scene%dim, scene%order, n, direct_fits=fits, coupled=coupled)) &
          & bytes = base_bytes + dofs*per_dof(scene%dim, scene%order, dofs, .true.) + extra
       if (present(direct_fits)) direct_fits = fits
    end subroutine solve_bytes
@@ -197,7 +199,7 @@ contains
          if (any(slaves == members(k))) extra = extra + aux_bytes(scene, cut)
       end do
       dofs = real(scene%dim*scene%order**scene%dim, wp)*cells
-      call solve_bytes(scene, dofs, extra, bytes, available, direct_fits)
+      call solve_bytes(scene, dofs, extra, bytes, available, direct_fits, coupled=.true.)
    end subroutine coupled_memory
 
    !> Estimated bytes per dof of a level of `dofs` unknowns in dimension `d`
