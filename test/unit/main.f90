@@ -32,6 +32,7 @@ program sprc_unit_tests
    use sprc_test_contact_output, only: collect_contact_output
    use sprc_test_contact_fe, only: collect_contact_fe
    use sprc_test_contact_friction, only: collect_contact_friction
+   use sprc_test_contact_iterative, only: collect_contact_iterative
    use sprc_test_petsc, only: collect_petsc
    use sprc_test_contact_recovery, only: collect_contact_recovery
    use sprc_test_partition, only: collect_partition
@@ -71,6 +72,7 @@ program sprc_unit_tests
       new_testsuite('contact_output', collect_contact_output), &
       new_testsuite('contact_fe', collect_contact_fe), &
       new_testsuite('contact_friction', collect_contact_friction), &
+      new_testsuite('contact_iterative', collect_contact_iterative), &
       new_testsuite('petsc', collect_petsc), &
       new_testsuite('contact_recovery', collect_contact_recovery), &
       new_testsuite('partition', collect_partition), &

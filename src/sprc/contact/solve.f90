@@ -37,17 +37,31 @@
 !> - Recovered stabilization: the cell's block is the penalty W gamma G^T G and p*
 !>   moves to the load (SPD for every gamma > 0); frictionless and stick only; with
 !>   a `contact_factor_type` the factor is reused while the active set repeats.
+!> - Iterative solves (`block_solver_type`, 'iterative' or 'auto' from
+!>   `auto_coupled_min_dofs`): PETSc CG where the block system is symmetric
+!>   (GMRES if CG meets an indefinite one, and where slipping cells make it
+!>   unsymmetric), preconditioned by both bodies' geometric multigrid
+!>   hierarchies stacked block-diagonally with the contact nodes kept on every
+!>   level (`stack_hierarchies`), built once per solve; the coarse levels see the
+!>   contact terms through Galerkin products of each new fine matrix (a body held
+!>   only by the contact has no usable hierarchy of its own). Each iteration
+!>   starts from the previous solution; the stopping test is the single body's
+!>   energy bound tightened for pointwise values (`contact_tolerance`).
 module sprc_contact_solve
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_not_converged, stat_singular, &
-      & stat_unsupported
+      & stat_unsupported, stat_not_positive_definite
    use sprc_core_text, only: itoa
    use sprc_core_alloc, only: check_allocation
    use sprc_core_hash, only: hash_int
    use sprc_core_timer, only: timer_type
    use sprc_fem_sparse, only: coo_type, csr_type
    use sprc_fem_element, only: shape_functions, strain_matrix, traction_matrix, displacement_matrix
-   use sprc_fem_problem, only: elasticity_problem_type, free_motions, motion_names, solve_spd_or_lu
+   use sprc_fem_problem, only: elasticity_problem_type, free_motions, motion_names, solve_spd_or_lu, &
+      & master_hierarchy
+   use sprc_fem_linear_solver, only: use_iterative, solver_iterative
+   use sprc_fem_petsc, only: petsc_solver_type, iteration_tolerance, start_petsc
+   use sprc_fem_multigrid, only: prolongation_type, stack_hierarchies
    use sprc_fem_umfpack, only: umfpack_solver_type
    use sprc_fem_cholmod, only: cholmod_solver_type
    use sprc_contact_surface, only: contact_surface_type
@@ -119,12 +133,22 @@ module sprc_contact_solve
       real(wp), allocatable :: ns(:, :), ts(:, :), nm(:, :), tm(:, :)
    end type local_type
 
+   !> The linear solver of the block system (module notes): direct, or
+   !> Krylov + the bodies' stacked multigrid hierarchy, set up once by
+   !> `block_solver_setup`.
+   type :: block_solver_type
+      logical :: ready = .false., iterative = .false.
+      type(petsc_solver_type) :: krylov
+   end type block_solver_type
+
    !> The CHOLMOD factor of a recovered-stabilization block system and the
    !> contact cells' active set it was built for (module notes), kept by the
-   !> caller between updates of the stabilization traction.
+   !> caller between updates of the stabilization traction; or the
+   !> iterative solver set up for that system.
    type :: contact_factor_type
       private
       type(cholmod_solver_type) :: chol
+      type(block_solver_type) :: bs
       logical, allocatable :: closed(:)
    contains
       !> `destroy()`: release the factor (harmless when repeated).
@@ -146,9 +170,12 @@ module sprc_contact_solve
       !> nbar.lambda_c of every contact cell: negative where the cell carries
       !> compression when closed.
       real(wp), allocatable :: lambda_n(:)
-      !> Reciprocal condition estimate of the last block system and the solver used.
+      !> Reciprocal condition estimate of the last block system (-1 when an
+      !> iterative solve made none) and the solver used.
       real(wp) :: rcond = -1.0_wp
       character(len=:), allocatable :: solver_name
+      !> Krylov iterations of all block solves (0 for direct solves).
+      integer :: solver_iterations = 0
       !> Seconds of the contact operators and active-set evaluation, and of the
       !> block assemblies and solves.
       real(wp) :: t_contact = 0.0_wp, t_solve = 0.0_wp
@@ -193,7 +220,7 @@ contains
       real(wp), intent(in), optional :: recovered(:, :)
       !> With `recovered`: the factor of the previous solve (module notes),
       !> updated.
-      type(contact_factor_type), intent(inout), optional :: factor
+      type(contact_factor_type), intent(inout), optional, target :: factor
       type(point_operators_type) :: ops
       type(cell_operators_type), allocatable :: cells(:)
       type(csr_type) :: k
@@ -202,6 +229,8 @@ contains
       logical, allocatable :: closed(:), next(:)
       integer, allocatable :: state(:)
       real(wp), allocatable :: slip(:, :), tau(:, :), pstar(:, :)
+      type(block_solver_type), target :: own
+      type(block_solver_type), pointer :: bs
       integer :: it, maxit, n, c, switched, stat
       logical :: kept
 
@@ -228,16 +257,19 @@ contains
          if (allocated(error)) return
       end if
       kept = present(factor) .and. present(recovered)
+      bs => own
       if (kept) then
          if (allocated(factor%closed)) then
             if (size(factor%closed) == size(closed)) closed = factor%closed
          end if
+         bs => factor%bs
       end if
       call timer%stop()
       sol%t_contact = timer%elapsed
       n = slave%n_dofs() + master%n_dofs()
-      allocate (x(n), stat=stat)
+      allocate (x(n), source=0.0_wp, stat=stat)
       call check_allocation(stat, 'contact solve', 'the solution of both bodies', n, 8, error)
+      if (.not. allocated(error)) call block_solver_setup(slave, master, ops, bs, error)
       if (allocated(error)) return
       if (friction == friction_coulomb) then
          if (.not. present(mu)) then
@@ -245,11 +277,11 @@ contains
             return
          end if
          if (present(loads)) then
-            call solve_coulomb(slave, master, ops, cells, closed, mu, loads, names, maxit, x, sol, state, tau, slip, &
-               & error, progress)
+            call solve_coulomb(slave, master, ops, cells, closed, mu, loads, names, maxit, bs, x, sol, state, tau, &
+               & slip, error, progress)
          else
             call solve_coulomb(slave, master, ops, cells, closed, mu, reshape([slave%f, master%f], [n, 1]), names, &
-               & maxit, x, sol, state, tau, slip, error, progress)
+               & maxit, bs, x, sol, state, tau, slip, error, progress)
          end if
          if (allocated(error)) return
          call point_gaps(surface, ops, ops%ncell, x, sol, error)
@@ -269,7 +301,7 @@ contains
          end if
          if (.not. (allocated(error) .or. kept)) &
             & call check_held(slave, master, k, names, closed_points(ops, closed), it, error)
-         if (.not. (allocated(error) .or. kept)) call solve_block(k, f, x, sol, error)
+         if (.not. (allocated(error) .or. kept)) call solve_block(bs, k, f, x, sol, error)
          call timer%stop()
          sol%t_solve = sol%t_solve + timer%elapsed
          if (allocated(error)) return
@@ -826,12 +858,22 @@ contains
       if (same) then
          call block_load(slave, master, ops, cells, closed, f, pstar)
       else
-         call factor%destroy()
+         call factor%chol%destroy()
+         if (allocated(factor%closed)) deallocate (factor%closed)
          call block_system(slave, master, ops, cells, closed, k, f, error, pstar)
          if (.not. allocated(error)) call check_held(slave, master, k, names, closed_points(ops, closed), it, error)
-         if (.not. allocated(error)) call factor%chol%factorize(k, error)
+         if (allocated(error)) return
+         if (factor%bs%iterative) then
+            call krylov_setup(factor%bs%krylov, k, .true., error)
+         else
+            call factor%chol%factorize(k, error)
+         end if
          if (allocated(error)) return
          factor%closed = closed
+      end if
+      if (factor%bs%iterative) then
+         call krylov_solve(factor%bs%krylov, f, x, sol, error)
+         return
       end if
       sol%solver_name = 'cholmod'
       sol%rcond = factor%chol%rcond_estimate
@@ -843,6 +885,8 @@ contains
    subroutine factor_destroy(self)
       class(contact_factor_type), intent(inout) :: self
       call self%chol%destroy()
+      call self%bs%krylov%destroy()
+      self%bs%ready = .false.
       if (allocated(self%closed)) deallocate (self%closed)
    end subroutine factor_destroy
 
@@ -892,8 +936,8 @@ contains
    !> an iteration on the cells' states (open, stick, slip) and slip
    !> directions, solved with UMFPACK (the slip terms are unsymmetric); the
    !> slip of each cell is history.
-   subroutine solve_coulomb(slave, master, ops, cells, closed, mu, loads, names, maxit, x, sol, state, tau, slip, error, &
-         & progress)
+   subroutine solve_coulomb(slave, master, ops, cells, closed, mu, loads, names, maxit, bs, x, sol, state, tau, slip, &
+         & error, progress)
       type(elasticity_problem_type), intent(in) :: slave, master
       type(point_operators_type), intent(in) :: ops
       type(cell_operators_type), intent(in) :: cells(:)
@@ -901,6 +945,7 @@ contains
       real(wp), intent(in) :: mu, loads(:, :)
       character(len=*), intent(in) :: names(2)
       integer, intent(in) :: maxit
+      type(block_solver_type), intent(inout) :: bs
       real(wp), intent(inout) :: x(:)
       type(contact_solution_type), intent(inout) :: sol
       !> Final state of each cell, its slip direction (slipping cells) and its slip (history).
@@ -935,7 +980,13 @@ contains
                & sol%iterations, error)
             if (.not. allocated(error) .and. any(state == contact_slip)) &
                & call coulomb_system(slave, master, ops, cells, state, tau, slip, mu, loads(:, n), k, f, error)
-            if (.not. allocated(error)) call solve_unsymmetric(k, f, x, sol, error)
+            if (.not. allocated(error)) then
+               if (bs%iterative) then
+                  call iterative_block(bs%krylov, k, f, .not. any(state == contact_slip), x, sol, error)
+               else
+                  call solve_unsymmetric(k, f, x, sol, error)
+               end if
+            end if
             call timer%stop()
             sol%t_solve = sol%t_solve + timer%elapsed
             if (allocated(error)) return
@@ -1183,16 +1234,144 @@ contains
          & 'only by contact has lost it, or its conditions leave it free', stat_singular)
    end subroutine check_held
 
-   subroutine solve_block(k, f, x, sol, error)
+   !> Solve the symmetric block system: directly (CHOLMOD, UMFPACK if not
+   !> SPD) or iteratively (`iterative_block`), as `bs` was set up.
+   subroutine solve_block(bs, k, f, x, sol, error)
+      type(block_solver_type), intent(inout) :: bs
       type(csr_type), intent(in) :: k
       real(wp), intent(in) :: f(:)
       real(wp), intent(inout) :: x(:)
       type(contact_solution_type), intent(inout) :: sol
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: note
+      if (bs%iterative) then
+         call iterative_block(bs%krylov, k, f, .true., x, sol, error)
+         return
+      end if
       call solve_spd_or_lu(k, f, x, sol%rcond, sol%solver_name, note, error)
       if (allocated(error)) error%message = 'contact solve'//error%message
    end subroutine solve_block
+
+   !> Decide between the direct and the iterative solver (module notes) and,
+   !> for the iterative one, set up the block layout of both bodies and their
+   !> stacked multigrid hierarchy; nothing happens when `bs` is ready.
+   subroutine block_solver_setup(slave, master, ops, bs, error)
+      type(elasticity_problem_type), intent(in) :: slave, master
+      type(point_operators_type), intent(in) :: ops
+      type(block_solver_type), intent(inout) :: bs
+      type(error_type), allocatable, intent(out) :: error
+      type(prolongation_type), allocatable :: ps(:), pm(:), p(:)
+      integer, allocatable :: dof(:, :)
+      logical, allocatable :: touched(:)
+      integer :: ns, choice
+      logical :: found_s, found_m
+
+      if (bs%ready) return
+      choice = slave%solver
+      if (master%solver == solver_iterative) choice = solver_iterative
+      bs%iterative = use_iterative(choice, slave%dim, slave%degree, slave%n_dofs() + master%n_dofs(), coupled=.true.)
+      bs%ready = .true.
+      if (.not. bs%iterative) return
+      call start_petsc(error)
+      if (allocated(error)) return
+      ns = slave%n_dofs()
+      associate (cs => slave%constraints, cm => master%constraints)
+         dof = reshape([cs%dof, merge(cm%dof + ns, 0, cm%dof > 0)], [slave%dim, cs%n_masters + cm%n_masters])
+         call bs%krylov%set_blocks(dof, reshape([slave%mesh%nodes%x(:, cs%master_node), &
+            & master%mesh%nodes%x(:, cm%master_node)], shape(dof)), error)
+         if (allocated(error)) return
+         ! the masters a contact point's operators act on are kept on every level (sprc_fem_multigrid)
+         allocate (touched(0:slave%n_dofs() + master%n_dofs()), source=.false.)
+         touched(ops%dofs) = .true.
+         call master_hierarchy(slave, ps, found_s, error, keep=kept_masters(touched, dof(:, :cs%n_masters)))
+         if (.not. allocated(error)) call master_hierarchy(master, pm, found_m, error, &
+            & keep=kept_masters(touched, dof(:, cs%n_masters + 1:)))
+         if (allocated(error)) return
+         if (found_s .and. found_m) then
+            call stack_hierarchies(ps, cs%n_masters, pm, cm%n_masters, p, error)
+            if (.not. allocated(error)) call bs%krylov%set_hierarchy(p, error)
+            if (allocated(error)) return
+         end if
+      end associate
+      bs%krylov%tolerance = contact_tolerance(0.5_wp**max(slave%mesh%grid%max_level, master%mesh%grid%max_level), &
+         & slave%degree, slave%dim)
+   end subroutine block_solver_setup
+
+   !> The Krylov stopping tolerance of the block system (a relative energy
+   !> bound): the single body's `iteration_tolerance` 1e-7 (h/L)^p (h the
+   !> finer grid's finest cell, L its box) times (h/L)^(d/2). A contact
+   !> report's pressures (p_max, each point's p) are pointwise tractions, which
+   !> the energy norm bounds only through an inverse estimate: a traction
+   !> error in one cell of size h is at most C (L/h)^(d/2) times the relative
+   !> energy error (the cell's share of the energy). Not below 1e-12, the
+   !> round-off of the solve.
+   pure real(wp) function contact_tolerance(h_over_l, degree, dim) result(tau)
+      real(wp), intent(in) :: h_over_l
+      integer, intent(in) :: degree, dim
+      tau = max(iteration_tolerance(h_over_l, degree)*h_over_l**(0.5_wp*dim), 1.0e-12_wp)
+   end function contact_tolerance
+
+   !> The blocks (masters) of `dof` with a component in `touched` (0: none).
+   pure function kept_masters(touched, dof) result(keep)
+      logical, intent(in) :: touched(0:)
+      integer, intent(in) :: dof(:, :)
+      logical :: keep(size(dof, 2))
+      integer :: m
+      keep = [(any(touched(dof(:, m))), m = 1, size(dof, 2))]
+   end function kept_masters
+
+   !> Set up the Krylov solver on k (CG when `symmetric`, else GMRES).
+   subroutine krylov_setup(krylov, k, symmetric, error)
+      type(petsc_solver_type), intent(inout) :: krylov
+      type(csr_type), intent(in) :: k
+      logical, intent(in) :: symmetric
+      type(error_type), allocatable, intent(out) :: error
+      krylov%symmetric = symmetric
+      call krylov%factorize(k, error)
+      if (allocated(error)) error%message = 'contact solve (iterative setup): '//error%message
+   end subroutine krylov_setup
+
+   !> Solve with the set-up Krylov solver from x (the previous solution).
+   subroutine krylov_solve(krylov, f, x, sol, error)
+      type(petsc_solver_type), intent(inout) :: krylov
+      real(wp), intent(in) :: f(:)
+      real(wp), intent(inout) :: x(:)
+      type(contact_solution_type), intent(inout) :: sol
+      type(error_type), allocatable, intent(out) :: error
+      integer :: before
+
+      before = krylov%iterations
+      krylov%guess = x
+      call krylov%solve(f, x, error)
+      sol%solver_iterations = sol%solver_iterations + krylov%iterations - before
+      sol%solver_name = merge('cg+   ', 'gmres+', krylov%symmetric)
+      sol%solver_name = trim(sol%solver_name)//trim(merge('gmg ', 'gamg', krylov%multigrid))
+      sol%rcond = -1.0_wp
+      if (allocated(error)) error%message = 'contact solve (iterative): '//error%message
+   end subroutine krylov_solve
+
+   !> One block system through the Krylov solver (CG when `symmetric`, else
+   !> GMRES; GMRES too when CG finds the system indefinite), from x.
+   subroutine iterative_block(krylov, k, f, symmetric, x, sol, error)
+      type(petsc_solver_type), intent(inout) :: krylov
+      type(csr_type), intent(in) :: k
+      real(wp), intent(in) :: f(:)
+      logical, intent(in) :: symmetric
+      real(wp), intent(inout) :: x(:)
+      type(contact_solution_type), intent(inout) :: sol
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: x0(:)
+
+      x0 = x
+      call krylov_setup(krylov, k, symmetric, error)
+      if (.not. allocated(error)) call krylov_solve(krylov, f, x, sol, error)
+      if (.not. allocated(error) .or. .not. symmetric) return
+      if (error%stat /= stat_not_positive_definite) return
+      deallocate (error)
+      x = x0
+      call krylov_setup(krylov, k, .false., error)
+      if (.not. allocated(error)) call krylov_solve(krylov, f, x, sol, error)
+   end subroutine iterative_block
 
    !> The outputs allocated and reset (every point open); the linearized
    !> normal gap of every point with a master point (huge elsewhere).
