@@ -54,6 +54,9 @@ module sprc_grid_patches
    use sprc_grid_contact, only: grid_contact_type, contact_patch_solve
    use sprc_grid_recovered_field, only: recovered_field_type, method_spr, method_sprc, build_field
    use sprc_grid_share, only: share_type, share_range, gather_patches
+   use sprc_exact_corner, only: corner_type
+   use sprc_grid_singular, only: corner_site_type, singular_fit_type, find_corners, fit_corner, enrich_cells, &
+      & inner_cells
    implicit none
    private
 
@@ -96,6 +99,10 @@ module sprc_grid_patches
       real(wp), pointer :: elem_lo(:, :) => null(), elem_hi(:, :) => null()
       class(exact_solution_type), pointer :: exact => null()
       type(grid_contact_type), pointer :: contact => null()
+      !> Singular fields of re-entrant corners and the corner each node's patch leaves
+      !> out (0: none), sprc_grid_singular; unassociated without corners.
+      type(singular_fit_type), pointer :: corners(:) => null()
+      integer, pointer :: node_corner(:) => null()
       integer :: nstress = 0
       logical :: sprc = .false.
    contains
@@ -132,6 +139,7 @@ contains
       class(share_type), intent(in), optional :: share
       type(grid_source_type) :: src
       type(patch_loop_type) :: opt
+      integer, allocatable, target :: node_corner(:)
       logical, allocatable :: skip(:)
       integer, allocatable :: first(:)
       integer :: rounds_limit, ip, e, n, stat, lo, hi
@@ -182,6 +190,13 @@ contains
       end if
       src%nstress = field%nstress
       src%sprc = method == method_sprc
+      if (grid%dim == 2 .and. .not. present(contact)) then
+         call singular_corners(src, degree, field, node_corner)
+         if (allocated(field%singular)) then
+            src%corners => field%singular
+            src%node_corner => node_corner
+         end if
+      end if
       opt = patch_loop_type(dim=grid%dim, degree=degree, rounds_limit=rounds_limit, sprc=src%sprc)
       ! Over all nodes, hanging ones included: the capacity (and with it the bits) of before.
       opt%cap = patch_capacity(src, grid%dim, degree, nodes%node_element_ptr, nodes%node_element, &
@@ -377,7 +392,132 @@ contains
             end do
          end do
       end associate
+      if (associated(self%node_corner)) then
+         if (self%node_corner(node) /= 0) call leave_out_singular(self%corners(abs(self%node_corner(node))), &
+            & self%node_corner(node) < 0, patch)
+      end if
    end subroutine grid_fill
+
+   !> The patch's data less the singular field S of `corner`: sigma_h - S at the volume
+   !> points, t - S n at the traction points (sprc_grid_singular).
+   pure subroutine leave_out_singular(fit, inner, patch)
+      type(singular_fit_type), intent(in) :: fit
+      logical, intent(in) :: inner
+      type(patch_type), intent(inout) :: patch
+      real(wp) :: s(3)
+      integer :: k
+
+      do k = 1, patch%npoints
+         if (inner) then
+            call fit%smooth_stress(patch%x(1:2, k), patch%stress(1:3, k))
+         else
+            call fit%corner%stress(patch%x(1:2, k), s)
+            patch%stress(1:3, k) = patch%stress(1:3, k) - s
+         end if
+      end do
+      do k = 1, patch%nbpoints
+         if (patch%bkind(k) /= boundary_traction) cycle
+         call fit%corner%stress(patch%bx(1:2, k), s)
+         patch%btraction(1, k) = patch%btraction(1, k) - (s(1)*patch%bn(1, k) + s(3)*patch%bn(2, k))
+         patch%btraction(2, k) = patch%btraction(2, k) - (s(3)*patch%bn(1, k) + s(2)*patch%bn(2, k))
+      end do
+   end subroutine leave_out_singular
+
+   !> The re-entrant corners of a 2D input, their fitted singular fields (field%singular,
+   !> left unallocated without any) and the corner of each node's patch (node_corner;
+   !> field%patch_corner per patch): sprc_grid_singular's module notes.
+   subroutine singular_corners(src, degree, field, node_corner)
+      type(grid_source_type), intent(in) :: src
+      integer, intent(in) :: degree
+      type(recovered_field_type), intent(inout) :: field
+      integer, allocatable, intent(out) :: node_corner(:)
+      type(corner_site_type), allocatable :: sites(:)
+      type(singular_fit_type), allocatable :: fitted(:)
+      type(singular_fit_type) :: corner
+      logical, allocatable :: free(:), symmetry(:)
+      real(wp) :: t(3), width, dist, lo(2), hi(2)
+      integer :: k, kind, c, n, i, e
+      logical :: ok, inner, sym, global
+
+      associate (input => src%input, nodes => src%nodes)
+         allocate (free(size(input%bw)))
+         do k = 1, size(input%bw)
+            call point_kind(src, k, kind, t)
+            free(k) = kind == boundary_traction .and. all(t(1:2) == 0.0_wp)
+         end do
+         call find_corners(input%bx, input%bn, input%belem_ptr, free, field%elem_lo, field%elem_hi, sites)
+         allocate (fitted(0))
+         do c = 1, size(sites)
+            call fit_corner(sites(c), input%analysis, input%young, input%poisson, input%x, input%w, input%stress, &
+               & input%elem_ptr, field%elem_lo, field%elem_hi, degree, corner, ok)
+            if (ok) fitted = [fitted, corner]
+         end do
+         if (size(fitted) == 0) return
+         ! elements with symmetry points: their patches keep the whole field
+         allocate (symmetry(nodes%n_elements))
+         do e = 1, nodes%n_elements
+            symmetry(e) = .false.
+            do k = input%belem_ptr(e), input%belem_ptr(e + 1) - 1
+               call point_kind(src, k, kind, t)
+               symmetry(e) = symmetry(e) .or. kind == boundary_symmetry
+            end do
+         end do
+         allocate (node_corner(nodes%n_nodes))
+         node_corner = 0
+         global = size(fitted) == 1
+         if (global) global = in_wedge(fitted(1)%corner, input%x)
+         do n = 1, nodes%n_nodes
+            if (field%patch_of_node(n) == 0) cycle
+            width = 0.0_wp
+            sym = .false.
+            do i = nodes%node_element_ptr(n), nodes%node_element_ptr(n + 1) - 1
+               e = nodes%node_element(i)
+               sym = sym .or. symmetry(e)
+               width = max(width, maxval(field%elem_hi(:, e) - field%elem_lo(:, e)))
+            end do
+            if (sym) cycle
+            do c = 1, size(fitted)
+               dist = norm2(nodes%x(:, n) - fitted(c)%corner%point)
+               if (dist < enrich_cells*width .or. global) then
+                  inner = .false.
+                  do i = nodes%node_element_ptr(n), nodes%node_element_ptr(n + 1) - 1
+                     e = nodes%node_element(i)
+                     lo = field%elem_lo(:, e)
+                     hi = field%elem_hi(:, e)
+                     inner = inner .or. norm2(max(lo - fitted(c)%corner%point, 0.0_wp, fitted(c)%corner%point - hi)) &
+                        & < inner_cells*maxval(hi - lo)
+                  end do
+                  node_corner(n) = merge(-c, c, inner)
+                  exit
+               end if
+            end do
+         end do
+         if (.not. any(node_corner /= 0)) return
+         call move_alloc(fitted, field%singular)
+         field%patch_corner = abs(node_corner(field%patch_node))
+      end associate
+   end subroutine singular_corners
+
+   !> Whether every point x(:, k) lies in the material wedge of `corner` (polar angle
+   !> from the bisector at most half the opening, up to round-off), where its field is
+   !> continuous.
+   pure logical function in_wedge(corner, x) result(inside)
+      type(corner_type), intent(in) :: corner
+      real(wp), intent(in) :: x(:, :)
+      real(wp) :: half, d(2), t
+      integer :: k
+
+      half = 0.5_wp*corner%angle*acos(-1.0_wp)/180.0_wp
+      inside = .true.
+      do k = 1, size(x, 2)
+         d = x(1:2, k) - corner%point
+         t = atan2(corner%direction(1)*d(2) - corner%direction(2)*d(1), dot_product(corner%direction, d))
+         if (abs(t) > half + sqrt(epsilon(1.0_wp))) then
+            inside = .false.
+            return
+         end if
+      end do
+   end function in_wedge
 
    !> Recovery boundary kind (0: not constrained) and prescribed traction of input boundary
    !> point k: contact or free on the contact shape (module notes), else `boundary_data`.
