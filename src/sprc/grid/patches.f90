@@ -103,6 +103,9 @@ module sprc_grid_patches
       !> out (0: none), sprc_grid_singular; unassociated without corners.
       type(singular_fit_type), pointer :: corners(:) => null()
       integer, pointer :: node_corner(:) => null()
+      !> Each corner's stress S at the volume points (3, npts, corner) and its
+      !> traction S n at the boundary points (2, nb, corner), evaluated once.
+      real(wp), pointer :: corner_stress(:, :, :) => null(), corner_traction(:, :, :) => null()
       integer :: nstress = 0
       logical :: sprc = .false.
    contains
@@ -140,6 +143,7 @@ contains
       type(grid_source_type) :: src
       type(patch_loop_type) :: opt
       integer, allocatable, target :: node_corner(:)
+      real(wp), allocatable, target :: corner_stress(:, :, :), corner_traction(:, :, :)
       logical, allocatable :: skip(:)
       integer, allocatable :: first(:)
       integer :: rounds_limit, ip, e, n, stat, lo, hi
@@ -193,8 +197,11 @@ contains
       if (grid%dim == 2 .and. .not. present(contact)) then
          call singular_corners(src, degree, field, node_corner)
          if (allocated(field%singular)) then
+            call corner_values(input, field%singular, corner_stress, corner_traction)
             src%corners => field%singular
             src%node_corner => node_corner
+            src%corner_stress => corner_stress
+            src%corner_traction => corner_traction
          end if
       end if
       opt = patch_loop_type(dim=grid%dim, degree=degree, rounds_limit=rounds_limit, sprc=src%sprc)
@@ -393,35 +400,69 @@ contains
          end do
       end associate
       if (associated(self%node_corner)) then
-         if (self%node_corner(node) /= 0) call leave_out_singular(self%corners(abs(self%node_corner(node))), &
+         if (self%node_corner(node) /= 0) call leave_out_singular(self, elements, abs(self%node_corner(node)), &
             & self%node_corner(node) < 0, patch)
       end if
    end subroutine grid_fill
 
-   !> The patch's data less the singular field S of `corner`: sigma_h - S at the volume
-   !> points, t - S n at the traction points (sprc_grid_singular).
-   pure subroutine leave_out_singular(fit, inner, patch)
-      type(singular_fit_type), intent(in) :: fit
+   !> The patch's data less the singular field S of corner c: sigma_h - S at the volume
+   !> points (the fit's smooth part for an `inner` patch), t - S n at the traction points
+   !> (sprc_grid_singular). The points in `grid_fill`'s order.
+   pure subroutine leave_out_singular(self, elements, c, inner, patch)
+      class(grid_source_type), intent(in) :: self
+      integer, intent(in) :: elements(:), c
       logical, intent(in) :: inner
       type(patch_type), intent(inout) :: patch
-      real(wp) :: s(3)
-      integer :: k
+      real(wp) :: t(3)
+      integer :: i, e, k, j, jb, kind
 
-      do k = 1, patch%npoints
-         if (inner) then
-            call fit%smooth_stress(patch%x(1:2, k), patch%stress(1:3, k))
-         else
-            call fit%corner%stress(patch%x(1:2, k), s)
-            patch%stress(1:3, k) = patch%stress(1:3, k) - s
-         end if
-      end do
-      do k = 1, patch%nbpoints
-         if (patch%bkind(k) /= boundary_traction) cycle
-         call fit%corner%stress(patch%bx(1:2, k), s)
-         patch%btraction(1, k) = patch%btraction(1, k) - (s(1)*patch%bn(1, k) + s(3)*patch%bn(2, k))
-         patch%btraction(2, k) = patch%btraction(2, k) - (s(3)*patch%bn(1, k) + s(2)*patch%bn(2, k))
+      j = 0
+      jb = 0
+      do i = 1, size(elements)
+         e = elements(i)
+         do k = self%input%elem_ptr(e), self%input%elem_ptr(e + 1) - 1
+            j = j + 1
+            if (inner) then
+               call self%corners(c)%smooth_stress(patch%x(1:2, j), patch%stress(1:3, j))
+            else
+               patch%stress(1:3, j) = patch%stress(1:3, j) - self%corner_stress(:, k, c)
+            end if
+         end do
+         if (.not. self%sprc) cycle
+         do k = self%input%belem_ptr(e), self%input%belem_ptr(e + 1) - 1
+            call point_kind(self, k, kind, t)
+            if (kind == 0) cycle
+            jb = jb + 1
+            if (patch%bkind(jb) == boundary_traction) &
+               & patch%btraction(1:2, jb) = patch%btraction(1:2, jb) - self%corner_traction(:, k, c)
+         end do
       end do
    end subroutine leave_out_singular
+
+   !> Each corner's stress at the input's volume points and traction at its boundary points.
+   subroutine corner_values(input, fits, stress, traction)
+      type(recovery_input_type), intent(in) :: input
+      type(singular_fit_type), intent(in) :: fits(:)
+      real(wp), allocatable, intent(out) :: stress(:, :, :), traction(:, :, :)
+      real(wp) :: s(3)
+      integer :: c, k
+
+      allocate (stress(3, size(input%w), size(fits)), traction(2, size(input%bw), size(fits)))
+      do c = 1, size(fits)
+         !$omp parallel do schedule(static)
+         do k = 1, size(input%w)
+            call fits(c)%corner%stress(input%x(1:2, k), stress(:, k, c))
+         end do
+         !$omp end parallel do
+         !$omp parallel do schedule(static) private(s)
+         do k = 1, size(input%bw)
+            call fits(c)%corner%stress(input%bx(1:2, k), s)
+            traction(1, k, c) = s(1)*input%bn(1, k) + s(3)*input%bn(2, k)
+            traction(2, k, c) = s(3)*input%bn(1, k) + s(2)*input%bn(2, k)
+         end do
+         !$omp end parallel do
+      end do
+   end subroutine corner_values
 
    !> The re-entrant corners of a 2D input, their fitted singular fields (field%singular,
    !> left unallocated without any) and the corner of each node's patch (node_corner;
