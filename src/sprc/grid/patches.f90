@@ -358,7 +358,8 @@ contains
       integer, intent(in) :: node, elements(:)
       type(patch_type), intent(inout) :: patch
       real(wp) :: x0(3), h, t(3)
-      integer :: d, i, e, k, np, nb, kind, ns
+      integer :: d, i, e, k, np, nb, kind, ns, c
+      logical :: inner
 
       associate (input => self%input, elem_lo => self%elem_lo, elem_hi => self%elem_hi)
          d = self%nodes%dim
@@ -377,6 +378,11 @@ contains
          call patch_reset(patch, d, input%analysis, input%young, input%poisson, x0(1:d), h)
          call patch_reserve(patch, np, nb)
          patch%body_force(1:d) = input%body_force(1:d)
+         ! the corner whose singular field the patch leaves out (sprc_grid_singular)
+         c = 0
+         if (associated(self%node_corner)) c = abs(self%node_corner(node))
+         inner = .false.
+         if (c > 0) inner = self%node_corner(node) < 0
          do i = 1, size(elements)
             e = elements(i)
             do k = input%elem_ptr(e), input%elem_ptr(e + 1) - 1
@@ -384,6 +390,11 @@ contains
                patch%x(1:d, patch%npoints) = input%x(:, k)
                patch%w(patch%npoints) = input%w(k)
                patch%stress(1:ns, patch%npoints) = input%stress(:, k)
+               if (inner) then
+                  call self%corners(c)%smooth_stress(input%x(:, k), patch%stress(1:3, patch%npoints))
+               else if (c > 0) then
+                  patch%stress(1:3, patch%npoints) = input%stress(:, k) - self%corner_stress(:, k, c)
+               end if
             end do
             if (.not. self%sprc) cycle
             do k = input%belem_ptr(e), input%belem_ptr(e + 1) - 1
@@ -396,48 +407,12 @@ contains
                patch%bkind(patch%nbpoints) = kind
                patch%bpiece(patch%nbpoints) = input%bshape(k)
                patch%btraction(1:d, patch%nbpoints) = t(1:d)
+               if (c > 0 .and. kind == boundary_traction) &
+                  & patch%btraction(1:2, patch%nbpoints) = t(1:2) - self%corner_traction(:, k, c)
             end do
          end do
       end associate
-      if (associated(self%node_corner)) then
-         if (self%node_corner(node) /= 0) call leave_out_singular(self, elements, abs(self%node_corner(node)), &
-            & self%node_corner(node) < 0, patch)
-      end if
    end subroutine grid_fill
-
-   !> The patch's data less the singular field S of corner c: sigma_h - S at the volume
-   !> points (the fit's smooth part for an `inner` patch), t - S n at the traction points
-   !> (sprc_grid_singular). The points in `grid_fill`'s order.
-   pure subroutine leave_out_singular(self, elements, c, inner, patch)
-      class(grid_source_type), intent(in) :: self
-      integer, intent(in) :: elements(:), c
-      logical, intent(in) :: inner
-      type(patch_type), intent(inout) :: patch
-      real(wp) :: t(3)
-      integer :: i, e, k, j, jb, kind
-
-      j = 0
-      jb = 0
-      do i = 1, size(elements)
-         e = elements(i)
-         do k = self%input%elem_ptr(e), self%input%elem_ptr(e + 1) - 1
-            j = j + 1
-            if (inner) then
-               call self%corners(c)%smooth_stress(patch%x(1:2, j), patch%stress(1:3, j))
-            else
-               patch%stress(1:3, j) = patch%stress(1:3, j) - self%corner_stress(:, k, c)
-            end if
-         end do
-         if (.not. self%sprc) cycle
-         do k = self%input%belem_ptr(e), self%input%belem_ptr(e + 1) - 1
-            call point_kind(self, k, kind, t)
-            if (kind == 0) cycle
-            jb = jb + 1
-            if (patch%bkind(jb) == boundary_traction) &
-               & patch%btraction(1:2, jb) = patch%btraction(1:2, jb) - self%corner_traction(:, k, c)
-         end do
-      end do
-   end subroutine leave_out_singular
 
    !> Each corner's stress at the input's volume points and traction at its boundary points.
    subroutine corner_values(input, fits, stress, traction)
@@ -475,16 +450,17 @@ contains
       type(corner_site_type), allocatable :: sites(:)
       type(singular_fit_type), allocatable :: fitted(:)
       type(singular_fit_type) :: corner
-      logical, allocatable :: free(:), symmetry(:)
+      logical, allocatable :: free(:), symmetry(:), bsym(:)
       real(wp) :: t(3), width, dist, lo(2), hi(2)
       integer :: k, kind, c, n, i, e
       logical :: ok, inner, sym, global
 
       associate (input => src%input, nodes => src%nodes)
-         allocate (free(size(input%bw)))
+         allocate (free(size(input%bw)), bsym(size(input%bw)))
          do k = 1, size(input%bw)
             call point_kind(src, k, kind, t)
             free(k) = kind == boundary_traction .and. all(t(1:2) == 0.0_wp)
+            bsym(k) = kind == boundary_symmetry
          end do
          call find_corners(input%bx, input%bn, input%belem_ptr, free, field%elem_lo, field%elem_hi, sites)
          allocate (fitted(0))
@@ -497,11 +473,7 @@ contains
          ! elements with symmetry points: their patches keep the whole field
          allocate (symmetry(nodes%n_elements))
          do e = 1, nodes%n_elements
-            symmetry(e) = .false.
-            do k = input%belem_ptr(e), input%belem_ptr(e + 1) - 1
-               call point_kind(src, k, kind, t)
-               symmetry(e) = symmetry(e) .or. kind == boundary_symmetry
-            end do
+            symmetry(e) = any(bsym(input%belem_ptr(e):input%belem_ptr(e + 1) - 1))
          end do
          allocate (node_corner(nodes%n_nodes))
          node_corner = 0
