@@ -55,14 +55,14 @@
 module sprc_grid_singular
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type
-   use sprc_core_material, only: plane_stress, plane_strain
+   use sprc_core_material, only: plane_stress, plane_strain, compliance_matrix
    use sprc_core_lapack, only: dsyev
    use sprc_core_poly, only: poly_basis_type, new_poly_basis
    use sprc_exact_corner, only: corner_type, new_corner
    implicit none
    private
 
-   public :: corner_site_type, singular_fit_type, find_corners, fit_corner, compliance_2d
+   public :: corner_site_type, singular_fit_type, find_corners, fit_corner
    public :: straight_tol, fit_cells, enrich_cells, inner_cells
 
    !> Relative tolerance of "straight face" and "apex in the element" (module notes).
@@ -181,26 +181,6 @@ contains
       found = .true.
    end subroutine element_corner
 
-   !> Compliance D^-1 (3 x 3, engineering shear) of plane stress or plane strain.
-   pure function compliance_2d(analysis, young, poisson) result(c)
-      integer, intent(in) :: analysis
-      real(wp), intent(in) :: young, poisson
-      real(wp) :: c(3, 3), e, nu
-
-      e = young
-      nu = poisson
-      if (analysis == plane_strain) then
-         e = young/(1.0_wp - poisson**2)
-         nu = poisson/(1.0_wp - poisson)
-      end if
-      c = 0.0_wp
-      c(1, 1) = 1.0_wp/e
-      c(2, 2) = 1.0_wp/e
-      c(1, 2) = -nu/e
-      c(2, 1) = -nu/e
-      c(3, 3) = 2.0_wp*(1.0_wp + nu)/e
-   end function compliance_2d
-
    !> The singular field of `site` with amplitudes fitted to the FE stress
    !> (module notes). `x`, `w`, `stress` the volume points, weights and FE
    !> stresses, `elem_ptr` the points of each element; `degree` the polynomial
@@ -228,8 +208,8 @@ contains
       if (.not. allocated(error)) call new_corner(fit%corner, site%point, site%direction, site%angle, 1.0_wp, 0.0_wp, &
          & young, poisson, analysis, error)
       if (.not. allocated(error)) call new_poly_basis(fit%basis, 2, degree, error)
+      if (.not. allocated(error)) call compliance_matrix(analysis, young, poisson, c, error)
       if (allocated(error)) return
-      c = compliance_2d(analysis, young, poisson)
       nt = fit%basis%nterms
       nu = 2 + 3*nt
       allocate (m(nu, nu), r(nu), b(3, nu), cb(3, nu), ev(nu), work(max(1, 3*nu)), z(nu))
