@@ -23,6 +23,7 @@ program sprc_unit_tests
    use sprc_test_output, only: collect_output
    use sprc_test_fem, only: collect_fem
    use sprc_test_patches, only: collect_patches
+   use sprc_test_singular, only: collect_singular
    use sprc_test_mesh_recovery, only: collect_mesh_recovery
    use sprc_test_contact_mesh, only: collect_contact_mesh
    use sprc_test_stiff, only: collect_stiff
@@ -61,6 +62,7 @@ program sprc_unit_tests
       new_testsuite('recovery', collect_recovery), &
       new_testsuite('report', collect_report), &
       new_testsuite('patches', collect_patches), &
+      new_testsuite('singular', collect_singular), &
       new_testsuite('output', collect_output), &
       new_testsuite('fem', collect_fem), &
       new_testsuite('mesh_recovery', collect_mesh_recovery), &
