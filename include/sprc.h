@@ -358,6 +358,93 @@ void sprc_eval_recovery(sprc_error error, sprc_recovery recovery, int npts, cons
 /* Free *recovery and set it to NULL. */
 void sprc_delete_recovery(sprc_recovery *recovery);
 
+/* ---------------------------------------- contact recovery on your meshes */
+
+/* SPR-C recovery of bodies in contact (the seed's eqs. 103-138) on your own
+ * meshes: collect the bodies and the contact pairs in an sprc_contact_input,
+ * recover, then read each body as an sprc_recovery and each pair's contact
+ * tractions at its slave facets' quadrature points. Both sides of a pair get
+ * contact-aware patches (each is body (1) of its own patches, the other
+ * body's integration and boundary points in the prism Omega_aux over the
+ * patch's contact facets), as in sprc's own pipeline. Several pairs and
+ * bodies per call; a patch whose contact points belong to two pairs is an
+ * error (give the pairs' facets apart). SPRC_METHOD_SPR ignores contact. */
+
+/* Contact laws of a contact facet: open (a free surface), frictionless,
+ * Coulomb slip (|t_t| = mu p, against the slip direction), stick. */
+#define SPRC_CONTACT_OPEN 0
+#define SPRC_CONTACT_FRICTIONLESS 1
+#define SPRC_CONTACT_SLIP 2
+#define SPRC_CONTACT_STICK 3
+
+typedef struct _sprc_contact_input *sprc_contact_input;
+typedef struct _sprc_contact_recovery *sprc_contact_recovery;
+
+/* A new, empty input; NULL on error. */
+sprc_contact_input sprc_new_contact_input(sprc_error error);
+
+/* Add a body: the arguments of sprc_recover_reference (without method).
+ * The real arrays (nodes, gauss_points, gauss_weights, gauss_stress,
+ * body_force, facet_traction, gauss_xi) are used in place: keep them valid
+ * until sprc_recover_contact returns. The index arrays are checked and
+ * copied now. Returns the body's index (0-based), -1 on error (messages
+ * name bodies[i]). The facets here are the body's other boundaries; its
+ * contact facets come with the pairs. */
+int sprc_contact_add_body(sprc_error error, sprc_contact_input input, int dim, int analysis, int nnode,
+                          const double *nodes, int element_type, int nen, int nelem, const int *connectivity,
+                          int ngp, const double *gauss_points, const double *gauss_weights,
+                          const double *gauss_stress, double young, double poisson, const double *body_force,
+                          int nfacet, int facet_nnode, const int *facet_nodes, const int *facet_kind,
+                          const double *facet_traction, const double *gauss_xi, int reference);
+
+/* Add a contact pair of two bodies added (0-based slave, master):
+ *   slave_facets  [nslave][facet_nnode]   0-based nodes of the slave body;
+ *                                         sides of its elements, any order
+ *   slave_law     [nslave]                SPRC_CONTACT_* per facet
+ *   slave_slip    [nslave][dim] or NULL   the slave's slip direction relative
+ *                                         to the master (needed on slip facets)
+ *   master_*      the same for the master body (its slip relative to the slave)
+ *   mu            Coulomb coefficient, finite and >= 0 (read by slip facets)
+ *   pressure      [nslave * points per facet] or NULL: your FE contact
+ *                 pressure at the slave points (kept for reporting)
+ * The slip and pressure arrays are used in place (as a body's). Returns the
+ * pair's index (0-based), -1 on error (messages name pairs[k]). */
+int sprc_contact_add_pair(sprc_error error, sprc_contact_input input, int slave, int master, int nslave,
+                          const int *slave_facets, const int *slave_law, const double *slave_slip, int nmaster,
+                          const int *master_facets, const int *master_law, const double *master_slip, double mu,
+                          const double *pressure);
+
+/* Recover (SPRC_METHOD_SPRC or SPRC_METHOD_SPR, patch degree 'auto'); a new
+ * contact recovery or NULL with the error set. Messages name the entries as
+ * C does: bodies[i]: gauss_weights[e][q], pairs[k].slave_facets[f][a], ... */
+sprc_contact_recovery sprc_recover_contact(sprc_error error, sprc_contact_input input, int method);
+
+/* Body `body` (0-based) as a new sprc_recovery (a copy; read it with the
+ * sprc_get_recovery_* calls, free it with sprc_delete_recovery); NULL on
+ * error. */
+sprc_recovery sprc_get_contact_body(sprc_error error, sprc_contact_recovery recovery, int body);
+
+/* The number of contact points of pair `pair` (the quadrature points of its
+ * slave facets, in facet order); -1 on error. */
+int sprc_get_contact_points(sprc_error error, sprc_contact_recovery recovery, int pair);
+
+/* Pair `pair`'s values at its npoints points (npoints must equal
+ * sprc_get_contact_points); any array may be NULL:
+ *   points, normals (the slave's outward unit normal n)      [npoints][dim]
+ *   weights (surface measure)                                [npoints]
+ *   pressure = -n.sigma*_slave.n, pressure_master = -n.sigma*_master.n  [npoints]
+ *   traction_tangential (slave), traction_tangential_master  [npoints][dim]
+ *   jump = (sigma*_slave - sigma*_master) n (action-reaction) [npoints][dim]
+ * The master's field is taken in its element holding the point, or in the
+ * nearest one when the meshes of a curved surface do not match. */
+void sprc_get_contact_pair(sprc_error error, sprc_contact_recovery recovery, int pair, int npoints, double *points,
+                           double *weights, double *normals, double *pressure, double *pressure_master,
+                           double *traction_tangential, double *traction_tangential_master, double *jump);
+
+/* Free *input (not your arrays) / *recovery and set it to NULL. */
+void sprc_delete_contact_input(sprc_contact_input *input);
+void sprc_delete_contact_recovery(sprc_contact_recovery *recovery);
+
 #ifdef __cplusplus
 }
 #endif

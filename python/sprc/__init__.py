@@ -21,8 +21,10 @@ import math
 from . import library
 from .library import SprcError
 from .recovery import Recovery, recover
+from .contact_recovery import ContactPair, ContactRecovery, recover_contact
 
 __all__ = ["__version__", "SprcError", "get_version", "run_scene", "run", "Study", "Level", "recover", "Recovery",
+           "recover_contact", "ContactRecovery", "ContactPair",
            "INTEGER_COLUMNS"]
 
 __version__ = "0.1.0"

@@ -237,3 +237,25 @@ def get_study_field(study, row, grid, field):
         values = np.empty((rows, cols), dtype=np.float64)
         _get_study_field(study, row, grid.encode(), field.encode(), values.ctypes.data_as(_c_double_p), rows * cols)
     return values[:, 0].copy() if cols == 1 else values
+
+new_contact_input = error_check(_prototype("sprc_new_contact_input", _handle, _handle))
+contact_add_body = error_check(_prototype("sprc_contact_add_body", ctypes.c_int, _handle, _handle,
+                                          ctypes.c_int, ctypes.c_int, ctypes.c_int, _c_double_p,   # dim ... nodes
+                                          ctypes.c_int, ctypes.c_int, ctypes.c_int, _c_int_p,      # connectivity
+                                          ctypes.c_int, _c_double_p, _c_double_p, _c_double_p,     # points
+                                          ctypes.c_double, ctypes.c_double, _c_double_p,           # material, force
+                                          ctypes.c_int, ctypes.c_int, _c_int_p, _c_int_p, _c_double_p,  # facets
+                                          _c_double_p, ctypes.c_int))                              # gauss_xi
+contact_add_pair = error_check(_prototype("sprc_contact_add_pair", ctypes.c_int, _handle, _handle,
+                                          ctypes.c_int, ctypes.c_int,                              # slave, master
+                                          ctypes.c_int, _c_int_p, _c_int_p, _c_double_p,           # slave side
+                                          ctypes.c_int, _c_int_p, _c_int_p, _c_double_p,           # master side
+                                          ctypes.c_double, _c_double_p))                           # mu, pressure
+recover_contact = error_check(_prototype("sprc_recover_contact", _handle, _handle, _handle, ctypes.c_int))
+get_contact_body = error_check(_prototype("sprc_get_contact_body", _handle, _handle, _handle, ctypes.c_int))
+get_contact_points = error_check(_prototype("sprc_get_contact_points", ctypes.c_int, _handle, _handle,
+                                            ctypes.c_int))
+get_contact_pair = error_check(_prototype("sprc_get_contact_pair", None, _handle, _handle, ctypes.c_int,
+                                          ctypes.c_int, *([_c_double_p] * 8)))
+delete_contact_input = _prototype("sprc_delete_contact_input", None, ctypes.POINTER(_handle))
+delete_contact_recovery = _prototype("sprc_delete_contact_recovery", None, ctypes.POINTER(_handle))

@@ -87,6 +87,7 @@ typedef int ScatterMode;
 typedef const char *MatType;
 typedef const char *KSPType;
 typedef const char *PCType;
+typedef const char *MatSolverType;
 #define SPRC_DEFINE_CONSTANT(name, value) enum { name = (value) };
 SPRC_PETSC_CONSTANTS(SPRC_DEFINE_CONSTANT)
 #endif
@@ -159,6 +160,8 @@ extern PetscErrorCode PCMGSetGalerkin(PC, PCMGGalerkinType);
 extern PetscErrorCode PCMGSetInterpolation(PC, PetscInt, Mat);
 extern PetscErrorCode PCMGGetSmoother(PC, PetscInt, KSP *);
 extern PetscErrorCode KSPChebyshevSetEigenvalues(KSP, PetscReal, PetscReal);
+extern PetscErrorCode PCMGGetCoarseSolve(PC, KSP *);
+extern PetscErrorCode PCFactorSetMatSolverType(PC, MatSolverType);
 
 /* The soname of Debian's PETSc 3.18 (real scalars, 32-bit indices). */
 #define SPRC_PETSC_LIBRARY "libpetsc_real.so.3.18"
@@ -175,7 +178,7 @@ extern PetscErrorCode KSPChebyshevSetEigenvalues(KSP, PetscReal, PetscReal);
     X(KSPGetConvergedReasonString) X(MatMPIAIJSetPreallocationCSR) X(VecCreateMPI) X(VecScatterCreateToAll)   \
     X(VecScatterBegin) X(VecScatterEnd) X(VecScatterDestroy) X(MPI_Comm_rank) X(MPI_Comm_size) X(PetscFinalize)   \
     X(MPI_Allreduce) X(MatSeqAIJSetPreallocationCSR) X(PCMGSetLevels) X(PCMGSetGalerkin) X(PCMGSetInterpolation)   \
-    X(PCMGGetSmoother) X(KSPChebyshevSetEigenvalues)
+    X(PCMGGetSmoother) X(KSPChebyshevSetEigenvalues) X(PCMGGetCoarseSolve) X(PCFactorSetMatSolverType)
 
 /* One pointer per function, set by load_petsc; from here on every call of
  * such a function goes through its pointer. */
@@ -241,6 +244,8 @@ static void *p_mpi_int, *p_op_min; /* Open MPI's MPI_INT and MPI_MIN */
 #define PCMGSetInterpolation (*p_PCMGSetInterpolation)
 #define PCMGGetSmoother (*p_PCMGGetSmoother)
 #define KSPChebyshevSetEigenvalues (*p_KSPChebyshevSetEigenvalues)
+#define PCMGGetCoarseSolve (*p_PCMGGetCoarseSolve)
+#define PCFactorSetMatSolverType (*p_PCFactorSetMatSolverType)
 #undef PETSC_COMM_SELF
 #define PETSC_COMM_SELF ((MPI_Comm)(void *)p_comm_self)
 #define SPRC_COMM_WORLD ((MPI_Comm)(void *)p_comm_world)
@@ -524,6 +529,18 @@ static int build_multigrid(PC pc, PetscInt n, PetscInt dim, const sprc_petsc_lev
         col += nnz;
         val += nnz;
         rows = cols;
+    }
+    {
+        /* The coarsest level by MUMPS's LU (PETSc's own by default): with the
+         * contact nodes kept on every level (sprc_fem_multigrid) it holds the
+         * whole contact surface, a 2D-like graph whose factor MUMPS builds
+         * faster than PETSc's own LU. */
+        KSP coarse;
+        PC lu;
+        TRY(PCMGGetCoarseSolve(pc, &coarse));
+        TRY(KSPGetPC(coarse, &lu));
+        TRY(PCSetType(lu, "lu"));
+        TRY(PCFactorSetMatSolverType(lu, "mumps"));
     }
     return set_smoothers(pc, levels, msg, len);
 }

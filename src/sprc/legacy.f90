@@ -15,12 +15,16 @@
 !> length; blank on success).
 module sprc_legacy
    use sprc_core_kinds, only: wp
-   use sprc_core_error, only: error_type, stat_success
+   use sprc_core_error, only: error_type, stat_success, fatal_error
+   use sprc_core_error, only: stat_invalid_input
+   use sprc_core_text, only: itoa
    use sprc_recovery_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval
+   use sprc_contact_mesh_recovery, only: contact_body_type, contact_pair_type, mesh_contact_recovery_type, &
+      & recover_contact_on_mesh
    implicit none
    private
 
-   public :: sprc_recover_mesh
+   public :: sprc_recover_mesh, sprc_recover_contact_mesh
 
 contains
 
@@ -78,5 +82,101 @@ contains
       glerr = result%err
       eta = result%eta
    end subroutine sprc_recover_mesh
+
+   !> Recover two bodies in contact, each on its own mesh (sprc_contact_mesh_recovery): body 1
+   !> the slave, body 2 the master of one pair; no other boundary facets (the modern API,
+   !> `recover_contact_on_mesh`, takes them, and several bodies and pairs).
+   !>
+   !> Inputs: ndim, nstr, analysis, method (as sprc_recover_mesh); per body b = 1, 2: nnodeb,
+   !> coordsb(ndim, nnodeb), etypeb, nenb, nelemb, connb(nenb, nelemb) (1-based), ngpb,
+   !> gpb(ndim, ngpb, nelemb), gwb(ngpb, nelemb), gsb(nstr, ngpb, nelemb), youngb, poissonb;
+   !> its contact facets: nfnb nodes per facet, ncfb facets, cfacb(nfnb, ncfb) (1-based,
+   !> element sides), claw b(ncfb) the law per facet (0 open, 1 frictionless, 2 slip, 3
+   !> stick), cslipb(ndim, ncfb) its slip direction relative to the other body (read on slip
+   !> facets); mu the friction coefficient; mpts the room for contact points.
+   !> Outputs: nodalb(nstr, nnodeb), elerrb(nelemb), glerrb, etab per body; npts the contact
+   !> points (the quadrature points of body 1's contact facets, facet by facet: nq ncf1, nq =
+   !> 2 on lines, 3 on line3 / tri3 faces, 4 on quad4 faces, 9 on quad9 faces), xc(ndim, npts)
+   !> their coordinates, pc(npts) and pcm(npts) the recovered pressure of body 1 and of body
+   !> 2 (-n.sigma*.n, n body 1's outward normal), jc(ndim, npts) the traction jump
+   !> (sigma*_1 - sigma*_2) n; stat, errmsg. mpts < npts is an error (stat 1) that names npts.
+   subroutine sprc_recover_contact_mesh(ndim, nstr, analysis, method, &
+         & nnode1, coords1, etype1, nen1, nelem1, conn1, ngp1, gp1, gw1, gs1, young1, poisson1, &
+         & nnode2, coords2, etype2, nen2, nelem2, conn2, ngp2, gp2, gw2, gs2, young2, poisson2, &
+         & nfn1, ncf1, cfac1, claw1, cslip1, nfn2, ncf2, cfac2, claw2, cslip2, mu, mpts, &
+         & nodal1, elerr1, glerr1, eta1, nodal2, elerr2, glerr2, eta2, npts, xc, pc, pcm, jc, stat, errmsg)
+      integer, intent(in) :: ndim, nstr, analysis, method, nnode1, etype1, nen1, nelem1, ngp1, nnode2, etype2, &
+         & nen2, nelem2, ngp2, nfn1, ncf1, nfn2, ncf2, mpts
+      double precision, intent(in), target :: coords1(ndim, nnode1), gp1(ndim, ngp1, nelem1), gw1(ngp1, nelem1), &
+         & gs1(nstr, ngp1, nelem1), coords2(ndim, nnode2), gp2(ndim, ngp2, nelem2), gw2(ngp2, nelem2), &
+         & gs2(nstr, ngp2, nelem2), cslip1(ndim, ncf1), cslip2(ndim, ncf2)
+      integer, intent(in), target :: conn1(nen1, nelem1), conn2(nen2, nelem2), cfac1(nfn1, ncf1), claw1(ncf1), &
+         & cfac2(nfn2, ncf2), claw2(ncf2)
+      double precision, intent(in) :: young1, poisson1, young2, poisson2, mu
+      double precision, intent(out) :: nodal1(nstr, nnode1), elerr1(nelem1), glerr1, eta1, nodal2(nstr, nnode2), &
+         & elerr2(nelem2), glerr2, eta2, xc(ndim, mpts), pc(mpts), pcm(mpts), jc(ndim, mpts)
+      integer, intent(out) :: npts, stat
+      character(len=*), intent(out) :: errmsg
+      type(contact_body_type) :: bodies(2)
+      type(contact_pair_type) :: pairs(1)
+      type(mesh_contact_recovery_type) :: res
+      type(error_type), allocatable :: error
+
+      nodal1 = 0.0d0
+      elerr1 = 0.0d0
+      nodal2 = 0.0d0
+      elerr2 = 0.0d0
+      glerr1 = 0.0d0
+      eta1 = 0.0d0
+      glerr2 = 0.0d0
+      eta2 = 0.0d0
+      xc = 0.0d0
+      pc = 0.0d0
+      pcm = 0.0d0
+      jc = 0.0d0
+      npts = 0
+      stat = stat_success
+      errmsg = ''
+      ! The arrays are double precision = real(wp) (sprc_core_kinds): used in place.
+      bodies(1) = contact_body_type(dim=ndim, analysis=analysis, element_type=etype1, young=young1, &
+         & poisson=poisson1, nodes=coords1, connectivity=conn1, gp=gp1, gw=gw1, gs=gs1)
+      bodies(2) = contact_body_type(dim=ndim, analysis=analysis, element_type=etype2, young=young2, &
+         & poisson=poisson2, nodes=coords2, connectivity=conn2, gp=gp2, gw=gw2, gs=gs2)
+      pairs(1)%slave = 1
+      pairs(1)%master = 2
+      pairs(1)%slave_facets => cfac1
+      pairs(1)%master_facets => cfac2
+      pairs(1)%slave_law => claw1
+      pairs(1)%master_law => claw2
+      pairs(1)%slave_slip => cslip1
+      pairs(1)%master_slip => cslip2
+      pairs(1)%mu = mu
+      call recover_contact_on_mesh(bodies, pairs, method, res, error)
+      if (.not. allocated(error)) then
+         if (res%pairs(1)%npoints > mpts) call fatal_error(error, 'sprc_recover_contact_mesh: mpts = '//itoa(mpts)// &
+            & ' but the contact facets have '//itoa(res%pairs(1)%npoints)//' points (npts)', stat_invalid_input)
+      end if
+      if (allocated(error)) then
+         stat = error%stat
+         errmsg = error%message
+         if (allocated(res%pairs)) npts = res%pairs(1)%npoints
+         return
+      end if
+      nodal1 = res%bodies(1)%nodal
+      elerr1 = res%bodies(1)%elem_err
+      glerr1 = res%bodies(1)%err
+      eta1 = res%bodies(1)%eta
+      nodal2 = res%bodies(2)%nodal
+      elerr2 = res%bodies(2)%elem_err
+      glerr2 = res%bodies(2)%err
+      eta2 = res%bodies(2)%eta
+      associate (p => res%pairs(1))
+         npts = p%npoints
+         xc(:, 1:npts) = p%x
+         pc(1:npts) = p%pressure
+         pcm(1:npts) = p%pressure_master
+         jc(:, 1:npts) = p%jump
+      end associate
+   end subroutine sprc_recover_contact_mesh
 
 end module sprc_legacy

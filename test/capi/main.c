@@ -40,6 +40,7 @@ static int has_error(sprc_error err, const char *text) {
   if (sprc_check_error(err) != 1) return 0;
   sprc_get_error(err, buf, &size);
   sprc_clear_error(err);
+  if (strstr(buf, text) == NULL) printf("     (the message was: %s)\n", buf);
   return strstr(buf, text) != NULL;
 }
 
@@ -1077,6 +1078,200 @@ static void test_study_bad_requests(void) {
   PASS();
 }
 
+/* Two bodies in contact: the quad mesh of the unit square (slave, field 2: a
+ * uniform compression, sigma_xy = 0) and the same mesh moved up by 1 (master);
+ * the slave's top side against the master's bottom side. */
+typedef struct {
+  quad_mesh a, b;
+  int top[M][2], bottom[M][2], law[M], slip_law[M];
+  double slip[M][2];
+} contact_case;
+
+static void build_contact_case(contact_case *c) {
+  int i, e, q;
+  build_quad_mesh(&c->a, 2);
+  build_quad_mesh(&c->b, 2);
+  for (i = 0; i < NNODE; i++) c->b.nodes[i][1] += 1.0;
+  for (e = 0; e < NELEM; e++)
+    for (q = 0; q < NGP; q++) c->b.gp[e][q][1] += 1.0;
+  for (i = 0; i < M; i++) {
+    c->top[i][0] = i + (M + 1) * M;
+    c->top[i][1] = i + 1 + (M + 1) * M;
+    c->bottom[i][0] = i + 1;
+    c->bottom[i][1] = i;
+    c->law[i] = SPRC_CONTACT_FRICTIONLESS;
+    c->slip_law[i] = SPRC_CONTACT_SLIP;
+    c->slip[i][0] = 1.0;
+    c->slip[i][1] = 0.0;
+  }
+}
+
+static int add_quad_body(sprc_error err, sprc_contact_input in, const quad_mesh *m) {
+  return sprc_contact_add_body(err, in, 2, SPRC_PLANE_STRESS, NNODE, &m->nodes[0][0], SPRC_QUAD4, 4, NELEM,
+                               &m->conn[0][0], NGP, &m->gp[0][0][0], &m->gw[0][0], &m->gs[0][0][0], 1000.0, 0.3,
+                               NULL, 0, 2, NULL, NULL, NULL, NULL, SPRC_REFERENCE_UNIT);
+}
+
+/* A frictionless pair: the recovered pressure is the exact 3 on both sides,
+ * the jump zero, the bodies readable as recoveries. */
+static void test_contact_recovery(void) {
+  const char *name = "contact_recovery";
+  static contact_case c;
+  double x[2 * M][2], p[2 * M], pm[2 * M], jump[2 * M][2], nodal[NNODE][3], dev = 0.0;
+  int i, k;
+  sprc_error err = sprc_new_error();
+  sprc_contact_input in = sprc_new_contact_input(err);
+  sprc_contact_recovery rec;
+  sprc_recovery body;
+  build_contact_case(&c);
+  CHECK(add_quad_body(err, in, &c.a) == 0, "first body is not 0");
+  CHECK(add_quad_body(err, in, &c.b) == 1, "second body is not 1");
+  CHECK(sprc_contact_add_pair(err, in, 0, 1, M, &c.top[0][0], c.law, NULL, M, &c.bottom[0][0], c.law, NULL, 0.0,
+                              NULL) == 0, "pair is not 0");
+  rec = sprc_recover_contact(err, in, SPRC_METHOD_SPRC);
+  CHECK(rec != NULL && sprc_check_error(err) == 0, "sprc_recover_contact failed");
+  CHECK(sprc_get_contact_points(err, rec, 0) == 2 * M, "not 2 points per facet");
+  sprc_get_contact_pair(err, rec, 0, 2 * M, &x[0][0], NULL, NULL, p, pm, NULL, NULL, &jump[0][0]);
+  CHECK(sprc_check_error(err) == 0, "sprc_get_contact_pair failed");
+  for (i = 0; i < 2 * M; i++) {
+    dev = fmax(dev, fmax(fabs(p[i] - 3.0), fabs(pm[i] - 3.0)));
+    dev = fmax(dev, fmax(fabs(jump[i][0]), fabs(jump[i][1])));
+    CHECK(fabs(x[i][1] - 1.0) < 1e-14, "a contact point is not on y = 1");
+  }
+  CHECK(dev < 1e-12, "pressure or jump off the exact values");
+  for (k = 0; k < 2; k++) {
+    body = sprc_get_contact_body(err, rec, k);
+    CHECK(body != NULL, "sprc_get_contact_body failed");
+    sprc_get_recovery_nodal_stress(err, body, &nodal[0][0], NNODE);
+    for (i = 0; i < NNODE; i++) dev = fmax(dev, fabs(nodal[i][1] + 3.0) + fabs(nodal[i][2]));
+    sprc_delete_recovery(&body);
+  }
+  CHECK(dev < 1e-12, "a body's nodal stress is off the exact field");
+  sprc_delete_contact_recovery(&rec);
+  sprc_delete_contact_input(&in);
+  CHECK(in == NULL && rec == NULL, "delete did not clear the handles");
+  sprc_delete_contact_input(NULL);
+  sprc_delete_contact_recovery(NULL);
+  sprc_delete_error(&err);
+  PASS();
+}
+
+/* Malformed contact calls, one at a time: each a clean error naming it. */
+static void test_contact_bad_input(void) {
+  const char *name = "contact_bad_input";
+  static contact_case c;
+  static quad_mesh nan_mesh;
+  int inner[1][2] = {{1, 1 + (M + 1)}}, diag[1][2] = {{0, M + 2}}, far[1][2] = {{0, 1000000}}, bad_law[M];
+  double nan_slip[M][2], x[2 * M][2];
+  sprc_error err = sprc_new_error();
+  sprc_contact_input in = sprc_new_contact_input(err);
+  sprc_contact_recovery rec;
+  int i;
+  build_contact_case(&c);
+  nan_mesh = c.b;
+  nan_mesh.gs[2][1][0] = NAN;
+  for (i = 0; i < M; i++) {
+    bad_law[i] = 7;
+    nan_slip[i][0] = NAN;
+    nan_slip[i][1] = 0.0;
+  }
+#define CONTACT_FAILS(call, text)                                                              \
+  do {                                                                                         \
+    (void)(call);                                                                              \
+    CHECK(sprc_get_error_status(err) == SPRC_STAT_INVALID_INPUT, "not invalid input: " text); \
+    CHECK(has_error(err, text), "no error saying: " text);                                     \
+  } while (0)
+  CONTACT_FAILS(sprc_contact_add_body(err, NULL, 2, 1, NNODE, &c.a.nodes[0][0], 9, 4, NELEM, &c.a.conn[0][0], NGP,
+                                      &c.a.gp[0][0][0], &c.a.gw[0][0], &c.a.gs[0][0][0], 1e3, 0.3, NULL, 0, 2, NULL,
+                                      NULL, NULL, NULL, 0),
+                "contact input handle is NULL");
+  CONTACT_FAILS(sprc_contact_add_body(err, in, 4, 1, NNODE, &c.a.nodes[0][0], 9, 4, NELEM, &c.a.conn[0][0], NGP,
+                                      &c.a.gp[0][0][0], &c.a.gw[0][0], &c.a.gs[0][0][0], 1e3, 0.3, NULL, 0, 2, NULL,
+                                      NULL, NULL, NULL, 0),
+                "bodies[0]: dim = 4");
+  CONTACT_FAILS(sprc_contact_add_body(err, in, 2, 1, NNODE, NULL, 9, 4, NELEM, &c.a.conn[0][0], NGP,
+                                      &c.a.gp[0][0][0], &c.a.gw[0][0], &c.a.gs[0][0][0], 1e3, 0.3, NULL, 0, 2, NULL,
+                                      NULL, NULL, NULL, 0),
+                "nodes is NULL");
+  CONTACT_FAILS(sprc_contact_add_body(err, in, 2, 1, NNODE - 5, &c.a.nodes[0][0], 9, 4, NELEM, &c.a.conn[0][0], NGP,
+                                      &c.a.gp[0][0][0], &c.a.gw[0][0], &c.a.gs[0][0][0], 1e3, 0.3, NULL, 0, 2, NULL,
+                                      NULL, NULL, NULL, 0),
+                "connectivity[");
+  CONTACT_FAILS(sprc_contact_add_body(err, in, 2, 1, NNODE, &c.a.nodes[0][0], 9, 4, NELEM, &c.a.conn[0][0], NGP,
+                                      &c.a.gp[0][0][0], &c.a.gw[0][0], &c.a.gs[0][0][0], 1e3, 0.3, NULL, 0, 2, NULL,
+                                      NULL, NULL, NULL, 5),
+                "reference = 5");
+  CHECK(add_quad_body(err, in, &c.a) == 0, "first body is not 0");
+  CHECK(add_quad_body(err, in, &nan_mesh) == 1, "second body is not 1");
+  CHECK(add_quad_body(err, in, &c.b) == 2, "third body is not 2");
+  CONTACT_FAILS(sprc_contact_add_pair(err, in, 5, 1, M, &c.top[0][0], c.law, NULL, M, &c.bottom[0][0], c.law, NULL,
+                                      0.0, NULL),
+                "pairs[0].slave = 5");
+  CONTACT_FAILS(sprc_contact_add_pair(err, in, 0, 2, M, &c.top[0][0], c.law, NULL, M, &c.bottom[0][0], c.law, NULL,
+                                      -0.5, NULL),
+                "pairs[0].mu must be finite and >= 0");
+  CONTACT_FAILS(sprc_contact_add_pair(err, in, 0, 2, M, &c.top[0][0], c.law, NULL, M, &c.bottom[0][0], c.law, NULL,
+                                      NAN, NULL),
+                "pairs[0].mu must be finite");
+  CONTACT_FAILS(sprc_contact_add_pair(err, in, 0, 2, M, &c.top[0][0], c.law, NULL, 0, &c.bottom[0][0], c.law, NULL,
+                                      0.0, NULL),
+                "contact facets on both sides");
+  CONTACT_FAILS(sprc_contact_add_pair(err, in, 0, 2, M, NULL, c.law, NULL, M, &c.bottom[0][0], c.law, NULL, 0.0,
+                                      NULL),
+                "slave_facets or slave_law is NULL");
+  CONTACT_FAILS(sprc_contact_add_pair(err, in, 0, 2, 1, &far[0][0], c.law, NULL, M, &c.bottom[0][0], c.law, NULL,
+                                      0.0, NULL),
+                "pairs[0].slave_facets[0][1] = 1000000");
+  /* Errors found when recovering: one pair at a time in a fresh input. */
+#define PAIR_FAILS(slave, master, ns, sf, sl, ss, nm, mf, ml, ms, mu, text)                               \
+  do {                                                                                                     \
+    sprc_contact_input in2 = sprc_new_contact_input(err);                                                  \
+    add_quad_body(err, in2, &c.a);                                                                         \
+    add_quad_body(err, in2, &c.b);                                                                         \
+    if ((master) == 2) add_quad_body(err, in2, &nan_mesh);                                                 \
+    if (sprc_contact_add_pair(err, in2, slave, master, ns, sf, sl, ss, nm, mf, ml, ms, mu, NULL) == 0) { \
+      rec = sprc_recover_contact(err, in2, SPRC_METHOD_SPRC);                                              \
+      CHECK(rec == NULL, "a recovery came back: " text);                                                   \
+    }                                                                                                      \
+    sprc_delete_contact_input(&in2);                                                                       \
+    CHECK(sprc_get_error_status(err) == SPRC_STAT_INVALID_INPUT, "not invalid input: " text);             \
+    CHECK(has_error(err, text), "no error saying: " text);                                                 \
+  } while (0)
+  PAIR_FAILS(0, 0, M, &c.top[0][0], c.law, NULL, M, &c.top[0][0], c.law, NULL, 0.0, "a pair needs two bodies");
+  PAIR_FAILS(0, 1, M, &c.top[0][0], bad_law, NULL, M, &c.bottom[0][0], c.law, NULL, 0.0,
+             "pairs[0].slave_law[0] = 7");
+  PAIR_FAILS(0, 1, M, &c.top[0][0], c.slip_law, NULL, M, &c.bottom[0][0], c.law, NULL, 0.3, "slave_slip");
+  PAIR_FAILS(0, 1, M, &c.top[0][0], c.slip_law, &nan_slip[0][0], M, &c.bottom[0][0], c.law, NULL, 0.3,
+             "pairs[0].slave_slip is not finite");
+  PAIR_FAILS(0, 1, 1, &inner[0][0], c.law, NULL, M, &c.bottom[0][0], c.law, NULL, 0.0, "not a boundary facet");
+  PAIR_FAILS(0, 1, 1, &diag[0][0], c.law, NULL, M, &c.bottom[0][0], c.law, NULL, 0.0, "not a side of any element");
+  PAIR_FAILS(0, 1, M, &c.top[0][0], c.law, NULL, 1, &far[0][0], c.law, NULL, 0.0,
+             "pairs[0].master_facets[0][1] = 1000000 is not a node in 0..24 of bodies[1]");
+  /* A facet of the wrong body: the slave's top side given as the master's (nodes of the master's top). */
+  PAIR_FAILS(0, 1, M, &c.top[0][0], c.law, NULL, M, &c.top[0][0], c.law, NULL, 0.0, "do not face each other");
+  PAIR_FAILS(0, 2, M, &c.top[0][0], c.law, NULL, M, &c.bottom[0][0], c.law, NULL, 0.0, "bodies[2]");
+  {
+    sprc_contact_input in3 = sprc_new_contact_input(err);
+    add_quad_body(err, in3, &c.a);
+    add_quad_body(err, in3, &c.b);
+    sprc_contact_add_pair(err, in3, 0, 1, M, &c.top[0][0], c.law, NULL, M, &c.bottom[0][0], c.law, NULL, 0.0, NULL);
+    CONTACT_FAILS(sprc_recover_contact(err, in3, 9), "method = 9");
+    rec = sprc_recover_contact(err, in3, SPRC_METHOD_SPRC);
+    CHECK(rec != NULL, "the good input failed");
+    CONTACT_FAILS(sprc_get_contact_pair(err, rec, 0, 3, &x[0][0], NULL, NULL, NULL, NULL, NULL, NULL, NULL),
+                  "npoints = 3");
+    CONTACT_FAILS(sprc_get_contact_pair(err, rec, 4, 2 * M, &x[0][0], NULL, NULL, NULL, NULL, NULL, NULL, NULL),
+                  "pair = 4");
+    CONTACT_FAILS(sprc_get_contact_body(err, rec, 2), "body = 2");
+    CONTACT_FAILS(sprc_get_contact_points(err, NULL, 0), "contact recovery handle is NULL");
+    sprc_delete_contact_recovery(&rec);
+    sprc_delete_contact_input(&in3);
+  }
+  sprc_delete_contact_input(&in);
+  sprc_delete_error(&err);
+  PASS();
+}
+
 int main(int argc, char **argv) {
   /* `fpm test -- SUITE` passes the unit tests' suite name to every test
      program: take argv[1] as the root only if it holds example/scenes. */
@@ -1103,6 +1298,8 @@ int main(int argc, char **argv) {
   test_recovery_facets();
   test_recovery_pressure_facets();
   test_recovery_given_xi();
+  test_contact_recovery();
+  test_contact_bad_input();
   test_study_bad_requests();
   test_study_fields_2d();
   test_study_fields_3d();

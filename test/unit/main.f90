@@ -24,7 +24,9 @@ program sprc_unit_tests
    use sprc_test_output, only: collect_output
    use sprc_test_fem, only: collect_fem
    use sprc_test_patches, only: collect_patches
+   use sprc_test_singular, only: collect_singular
    use sprc_test_mesh_recovery, only: collect_mesh_recovery
+   use sprc_test_contact_mesh, only: collect_contact_mesh
    use sprc_test_stiff, only: collect_stiff
    use sprc_test_study, only: collect_study
    use sprc_test_adaptive, only: collect_adaptive
@@ -33,6 +35,7 @@ program sprc_unit_tests
    use sprc_test_contact_fe, only: collect_contact_fe
    use sprc_test_contact_assembly, only: collect_contact_assembly
    use sprc_test_contact_friction, only: collect_contact_friction
+   use sprc_test_contact_iterative, only: collect_contact_iterative
    use sprc_test_petsc, only: collect_petsc
    use sprc_test_contact_recovery, only: collect_contact_recovery
    use sprc_test_partition, only: collect_partition
@@ -62,9 +65,11 @@ program sprc_unit_tests
       new_testsuite('recovery', collect_recovery), &
       new_testsuite('report', collect_report), &
       new_testsuite('patches', collect_patches), &
+      new_testsuite('singular', collect_singular), &
       new_testsuite('output', collect_output), &
       new_testsuite('fem', collect_fem), &
       new_testsuite('mesh_recovery', collect_mesh_recovery), &
+      new_testsuite('contact_mesh', collect_contact_mesh), &
       new_testsuite('stiff', collect_stiff), &
       new_testsuite('study', collect_study), &
       new_testsuite('adaptive', collect_adaptive), &
@@ -73,6 +78,7 @@ program sprc_unit_tests
       new_testsuite('contact_fe', collect_contact_fe), &
       new_testsuite('contact_assembly', collect_contact_assembly), &
       new_testsuite('contact_friction', collect_contact_friction), &
+      new_testsuite('contact_iterative', collect_contact_iterative), &
       new_testsuite('petsc', collect_petsc), &
       new_testsuite('contact_recovery', collect_contact_recovery), &
       new_testsuite('partition', collect_partition), &

@@ -5,11 +5,15 @@ module sprc_test_core
    use sprc_core_error, only: error_type, fatal_error, stat_name, stat_invalid_input, &
       & stat_singular, stat_not_positive_definite
    use sprc_core_timer, only: timer_type, wall_time
-   use sprc_core_text, only: fixed_text, itoa, rtoa
+   use sprc_core_text, only: fixed_text, itoa, rtoa, lower, xml_escape
    use sprc_core_boundary, only: bc_none, bc_traction, bc_symmetry, bc_free, bc_pressure, bc_contact, bc_kind_name, &
       & bc_kind_from_name
    use sprc_core_lapack, only: dgesv, dgecon, dgetrf, dlange, dpotrf, dpotrs, dgeqp3, dgesvd, &
       & dgemm, dsyrk, dsysv, lapack_info_error
+   use sprc_core_lagrange, only: lagrange_1d, tensor_shape, element_node_index, vtk_line2, vtk_line3, &
+      & vtk_quad4, vtk_quad9, vtk_hex8, vtk_hex27
+   use sprc_core_hash, only: key_table_type, hash_int
+   use sprc_core_sort, only: sort_order, sort, sort_pairs
    use sprc_testsuite, only: unittest_type, new_unittest, check
    implicit none
    private
@@ -35,6 +39,12 @@ contains
          new_unittest('dsysv_indefinite', test_dsysv), &
          new_unittest('lapack_info_translation', test_info_translation), &
          new_unittest('strings', test_strings), &
+         new_unittest('lower_and_xml_escape', test_lower_escape), &
+         new_unittest('lagrange_vtk_tables', test_lagrange_tables), &
+         new_unittest('lagrange_kronecker_unity', test_lagrange_kronecker), &
+         new_unittest('lagrange_derivative_fd', test_lagrange_derivative), &
+         new_unittest('key_table_structured_keys', test_key_table), &
+         new_unittest('sort_stable_against_counting', test_sort), &
          new_unittest('boundary_kinds', test_boundary_kinds) &
          ]
    end subroutine collect_core
@@ -227,6 +237,275 @@ contains
    end subroutine test_info_translation
 
    !> Integers and reals as text, checked against literal strings.
+   !> lower touches A-Z only; xml_escape writes all five XML entities (the apostrophe
+   !> too, so the text may sit in single-quoted attributes) and leaves the rest alone.
+   subroutine test_lower_escape(error)
+      type(error_type), allocatable, intent(out) :: error
+      call check(error, lower('Kind = "Hertz_3D" @[Z]`{'), 'kind = "hertz_3d" @[z]`{', 'lower')
+      if (allocated(error)) return
+      call check(error, len(lower('AB  ')), 4, 'lower keeps the length')
+      if (allocated(error)) return
+      call check(error, xml_escape('a<b & "c" > it''s'), 'a&lt;b &amp; &quot;c&quot; &gt; it&apos;s', 'xml_escape')
+      if (allocated(error)) return
+      call check(error, xml_escape('&amp;'), '&amp;amp;', 'xml_escape escapes an entity once more')
+      if (allocated(error)) return
+      call check(error, len(xml_escape('')), 0, 'xml_escape of nothing')
+   end subroutine test_lower_escape
+
+   !> Each VTK table is a permutation of the Lagrange indices {0..p}^dim with the
+   !> vertices first, and a few nodes sit where VTK puts them (by hand from the
+   !> VTK file-format figures).
+   subroutine test_lagrange_tables(error)
+      type(error_type), allocatable, intent(out) :: error
+      call check_table(vtk_line2, 1)
+      if (allocated(error)) return
+      call check_table(vtk_line3, 2)
+      if (allocated(error)) return
+      call check_table(vtk_quad4, 1)
+      if (allocated(error)) return
+      call check_table(vtk_quad9, 2)
+      if (allocated(error)) return
+      call check_table(vtk_hex8, 1)
+      if (allocated(error)) return
+      call check_table(vtk_hex27, 2)
+      if (allocated(error)) return
+      call check(error, all(vtk_quad9(:, 6) == [2, 1]) .and. all(vtk_quad9(:, 9) == [1, 1]) .and. &
+         & all(vtk_hex27(:, 17) == [0, 0, 1]) .and. all(vtk_hex27(:, 18) == [2, 0, 1]) .and. &
+         & all(vtk_hex27(:, 21) == [0, 1, 1]) .and. all(vtk_hex27(:, 23) == [1, 0, 1]) .and. &
+         & all(vtk_hex27(:, 25) == [1, 1, 0]), 'quad9 and hex27 edge and face nodes where VTK puts them')
+      if (allocated(error)) return
+      call check(error, all(element_node_index(2, 2) == vtk_quad9) .and. all(element_node_index(3, 1) == vtk_hex8), &
+         & 'element_node_index picks the table')
+   contains
+      subroutine check_table(idx, p)
+         integer, intent(in) :: idx(:, :), p
+         integer :: j, k, nv
+         nv = 2**size(idx, 1)
+         call check(error, size(idx, 2), (p + 1)**size(idx, 1), 'node count')
+         if (allocated(error)) return
+         call check(error, all(idx >= 0 .and. idx <= p), 'indices in 0..p')
+         if (allocated(error)) return
+         do j = 1, size(idx, 2)
+            do k = 1, j - 1
+               call check(error, any(idx(:, j) /= idx(:, k)), 'no two nodes alike')
+               if (allocated(error)) return
+            end do
+            call check(error, (j <= nv) .eqv. all(idx(:, j) == 0 .or. idx(:, j) == p), 'vertices first')
+            if (allocated(error)) return
+         end do
+      end subroutine check_table
+   end subroutine test_lagrange_tables
+
+   !> Kronecker property n_i(x_j) = delta_ij at the nodes (exact: the basis takes the
+   !> values 0 and 1 there in floating point), and partition of unity at points inside
+   !> and outside the element to a few ulps; for every table, degree 1 and 2.
+   subroutine test_lagrange_kronecker(error)
+      type(error_type), allocatable, intent(out) :: error
+      call check_element(vtk_line2, 1)
+      if (allocated(error)) return
+      call check_element(vtk_line3, 2)
+      if (allocated(error)) return
+      call check_element(vtk_quad4, 1)
+      if (allocated(error)) return
+      call check_element(vtk_quad9, 2)
+      if (allocated(error)) return
+      call check_element(vtk_hex8, 1)
+      if (allocated(error)) return
+      call check_element(vtk_hex27, 2)
+   contains
+      subroutine check_element(idx, p)
+         integer, intent(in) :: idx(:, :), p
+         real(wp) :: n(size(idx, 2)), xi(size(idx, 1)), delta(size(idx, 2))
+         real(wp), parameter :: pts(3, 4) = reshape([0.3_wp, 0.71_wp, 0.05_wp, -0.4_wp, 1.3_wp, 0.5_wp, &
+            & 1.0_wp/3.0_wp, 0.9_wp, 2.0_wp, 0.123_wp, -1.0_wp, 0.77_wp], [3, 4])
+         integer :: j, q
+         do j = 1, size(idx, 2)
+            xi = real(idx(:, j), wp)/real(p, wp)
+            call tensor_shape(idx, p, xi, n)
+            delta = 0.0_wp
+            delta(j) = 1.0_wp
+            call check(error, all(n == delta), 'n_i(x_j) = delta_ij')
+            if (allocated(error)) return
+         end do
+         do q = 1, size(pts, 2)
+            call tensor_shape(idx, p, pts(1:size(idx, 1), q), n)
+            ! The terms reach |n| < 20 at these points; their sum rounds to 1 within 64 eps.
+            call check(error, sum(n), 1.0_wp, thr=64*epsilon(1.0_wp), rel=.false.)
+            if (allocated(error)) return
+         end do
+      end subroutine check_element
+   end subroutine test_lagrange_kronecker
+
+   !> The derivatives against central differences: the basis is of degree <= 2 in each
+   !> variable, so the central difference has no truncation error and differs only by
+   !> rounding, below 16 eps / h with h = 2**-10 (values up to ~4 in magnitude here).
+   subroutine test_lagrange_derivative(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), parameter :: h = 2.0_wp**(-10)
+      real(wp) :: l(0:2), dl(0:2), lp(0:2), lm(0:2)
+      integer :: p
+      real(wp) :: t
+      do p = 1, 2
+         t = 0.37_wp
+         call lagrange_1d(p, t, l, dl)
+         call lagrange_1d(p, t + h, lp)
+         call lagrange_1d(p, t - h, lm)
+         call check(error, maxval(abs((lp - lm)/(2*h) - dl)) <= 16*epsilon(1.0_wp)/h, '1D derivative')
+         if (allocated(error)) return
+      end do
+      call check_element(vtk_line3, 2)
+      if (allocated(error)) return
+      call check_element(vtk_quad4, 1)
+      if (allocated(error)) return
+      call check_element(vtk_quad9, 2)
+      if (allocated(error)) return
+      call check_element(vtk_hex8, 1)
+      if (allocated(error)) return
+      call check_element(vtk_hex27, 2)
+   contains
+      subroutine check_element(idx, p)
+         integer, intent(in) :: idx(:, :), p
+         real(wp) :: n(size(idx, 2)), np(size(idx, 2)), nm(size(idx, 2)), d(size(idx, 1), size(idx, 2))
+         real(wp) :: xi(size(idx, 1)), e(size(idx, 1))
+         real(wp), parameter :: x0(3) = [0.31_wp, 1.2_wp, -0.15_wp]
+         integer :: k, rdim
+         rdim = size(idx, 1)
+         xi = x0(1:rdim)
+         call tensor_shape(idx, p, xi, n, d)
+         do k = 1, rdim
+            e = 0.0_wp
+            e(k) = h
+            call tensor_shape(idx, p, xi + e, np)
+            call tensor_shape(idx, p, xi - e, nm)
+            call check(error, maxval(abs((np - nm)/(2*h) - d(k, :))) <= 16*epsilon(1.0_wp)/h, &
+               & 'd n / d xi by central differences')
+            if (allocated(error)) return
+         end do
+      end subroutine check_element
+   end subroutine test_lagrange_derivative
+
+   !> The hash table on adversarial keys: lattice points that are multiples of 2**18
+   !> (all low bits zero), keys differing only in their highest bits, negative keys,
+   !> each inserted twice (ties). Every key keeps the number of its first insertion, a
+   !> repeat adds nothing, absent keys are not found, and no probe run is long: at load
+   !> alpha <= 1/2 linear probing's longest run over n keys is about
+   !> ln(n)/(alpha - 1 - ln alpha) = ln(n)/0.193, 50 for n = 3*4096, so 128 fails only for a hash that lets
+   !> structured keys collide (the slot from the low bits alone puts them all in slot 0).
+   subroutine test_key_table(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(key_table_type) :: t
+      integer, parameter :: m = 4096
+      integer :: i, k, number, key(3), run, longest
+      integer(i8) :: s
+      logical :: added
+
+      call t%init(3, 16, 'test', error)
+      if (allocated(error)) return
+      do k = 1, 2
+         do i = 1, 3*m
+            key = adversarial(i)
+            call t%insert(key, number, added, error)
+            if (allocated(error)) return
+            call check(error, number == i .and. (added .eqv. k == 1), 'first-insertion numbering, ties added once')
+            if (allocated(error)) return
+         end do
+      end do
+      call check(error, t%n, 3*m, 'keys stored')
+      if (allocated(error)) return
+      call check(error, t%find([1, 2, 3]) == 0 .and. t%find([0, 0, 0]) == 0 .and. &
+         & t%find([-2**30, 0, 0]) == 0, 'absent keys')
+      if (allocated(error)) return
+      longest = 0
+      do i = 1, t%n
+         s = iand(hash_int(t%keys(:, i)), t%mask)
+         run = 0
+         do while (t%slot(s) /= i)
+            s = iand(s + 1_i8, t%mask)
+            run = run + 1
+         end do
+         longest = max(longest, run)
+      end do
+      call check(error, longest <= 128, 'longest probe run '//itoa(longest)//' for structured keys')
+   contains
+      pure function adversarial(i) result(g)
+         integer, intent(in) :: i
+         integer :: g(3)
+         select case ((i - 1)/m)
+         case (0)   ! dyadic lattice points: multiples of 2**18
+            g = [mod(i, 2)*2**18, (i/2)*2**18, 0]
+         case (1)   ! only the high bits vary
+            g = [ishft(mod(i, 128), 24), ishft(i/128, 24), 7]
+         case default   ! negative, and equal but for the sign
+            g = [-i, i, -huge(1)]
+         end select
+      end function adversarial
+   end subroutine test_key_table
+
+   !> The sorts against an independent O(n**2) reference: in a stable ascending sort,
+   !> element i goes to 1 + #{j: v(j) < v(i)} + #{j < i: v(j) == v(i)}. Keys with many
+   !> ties, negative values, -0 and +0 (equal under <), huge and subnormal reals; sizes
+   !> around the insertion runs (16) and merge widths.
+   subroutine test_sort(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: sizes(8) = [0, 1, 2, 15, 16, 17, 33, 1000]
+      integer :: c, n, i
+      real(wp), allocatable :: r(:), rv(:)
+      integer, allocatable :: k(:), kv(:), order(:), work(:), expect(:)
+      integer(i8), allocatable :: k8(:)
+      real(wp), parameter :: special(6) = [-0.0_wp, 0.0_wp, huge(1.0_wp), -huge(1.0_wp), tiny(1.0_wp)/8, -1.5_wp]
+
+      do c = 1, size(sizes)
+         n = sizes(c)
+         allocate (r(n), k(n), k8(n), order(n), work(n), expect(n))
+         do i = 1, n
+            k(i) = mod(7919*i, 23) - 11
+            r(i) = real(k(i), wp)/4.0_wp
+            if (mod(i, 5) == 0) r(i) = special(1 + mod(i/5, size(special)))
+            k8(i) = int(k(i), i8)*2_i8**40 + mod(i, 3)
+         end do
+         call sort_order(r, order, work)
+         expect = stable_positions(r)
+         call check(error, all(expect(order) == [(i, i=1, n)]), 'real sort_order, n = '//itoa(n))
+         if (allocated(error)) return
+         call sort_order(k, order, work)
+         expect = stable_positions(real(k, wp))
+         call check(error, all(expect(order) == [(i, i=1, n)]), 'integer sort_order')
+         if (allocated(error)) return
+         call sort_order(k8, order, work)
+         expect = stable_positions(real(k8, wp))
+         call check(error, all(expect(order) == [(i, i=1, n)]), 'integer(i8) sort_order')
+         if (allocated(error)) return
+         ! In place: the same values as the permuted input, bit for bit (-0 and +0 in input order).
+         call sort_order(r, order, work)
+         rv = r
+         call sort(rv)
+         call check(error, all(transfer(rv, 1_i8, n) == transfer(r(order), 1_i8, n)), 'real sort in place')
+         if (allocated(error)) return
+         kv = k
+         call sort(kv)
+         call sort_order(k, order, work)
+         call check(error, all(kv == k(order)), 'integer sort in place')
+         if (allocated(error)) return
+         kv = [(n + 1 - i, i=1, n)]*3
+         rv = real(kv, wp) + 0.5_wp
+         call sort_pairs(kv, rv)
+         call check(error, all(kv == [(3*i, i=1, n)]) .and. all(rv == real(kv, wp) + 0.5_wp), 'sort_pairs carries values')
+         if (allocated(error)) return
+         deallocate (r, k, k8, order, work, expect)
+      end do
+   contains
+      pure function stable_positions(v) result(pos)
+         real(wp), intent(in) :: v(:)
+         integer :: pos(size(v)), i, j
+         do i = 1, size(v)
+            pos(i) = 1
+            do j = 1, size(v)
+               if (v(j) < v(i) .or. (j < i .and. v(j) == v(i))) pos(i) = pos(i) + 1
+            end do
+         end do
+      end function stable_positions
+   end subroutine test_sort
+
    subroutine test_strings(error)
       type(error_type), allocatable, intent(out) :: error
       call check(error, itoa(0)//' '//itoa(-12)//' '//itoa(huge(1_i4))//' '//itoa(-huge(1_i8)), &

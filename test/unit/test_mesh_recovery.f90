@@ -34,7 +34,7 @@ module sprc_test_mesh_recovery
    implicit none
    private
 
-   public :: collect_mesh_recovery
+   public :: collect_mesh_recovery, case_type, build_case, node_id
 
    !> Round-off tier of values that pass through the patch solves (QR, KKT by dsysv), relative
    !> to the stress scale: sqrt(eps). The solves are backward stable, but the conditioning of a

@@ -8,6 +8,7 @@ module sprc_test_output
       & h5dget_space_f, h5sget_simple_extent_ndims_f, h5sget_simple_extent_dims_f, h5sclose_f, &
       & h5fget_obj_count_f, h5eset_auto_f, H5F_ACC_RDONLY_F, H5F_OBJ_ALL_F, H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, &
       & h5aopen_f, h5aclose_f, h5aget_type_f, h5aread_f, h5tget_size_f, h5tclose_f
+   use sprc_core_text, only: itoa
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: stat_io, stat_invalid_input
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type
@@ -944,13 +945,5 @@ contains
          pos = pos + k
       end do
    end function count_sub
-
-   pure function itoa(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=16) :: buf
-      write (buf, '(i0)') i
-      s = trim(buf)
-   end function itoa
 
 end module sprc_test_output

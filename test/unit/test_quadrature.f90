@@ -60,6 +60,7 @@ contains
          new_unittest('divergence_theorem', test_divergence), &
          new_unittest('normals_and_shape_index', test_normals), &
          new_unittest('faces_on_grid_planes', test_grid_faces), &
+         & new_unittest('shared_faces_inside', test_shared_faces), &
          new_unittest('planes_off_grid_through_centres', test_planes_off_grid), &
          new_unittest('degenerate_tiny_cut', test_tiny_cut), &
          new_unittest('degenerate_nodes_and_tangency', test_nodes_tangency), &
@@ -600,6 +601,60 @@ contains
       if (allocated(error)) return
       call check(error, sums%flux, 0.0_wp, tol2d, 'closed boundary')
    end subroutine test_grid_faces
+
+   !> Two boxes of a union sharing a face on a grid plane: the shared face is
+   !> inside the body (no boundary), the step where their heights differ (off
+   !> the grid lines) is boundary, counted once; 2D and 3D. Exact measures:
+   !> the sums are of a few exact products, so the tolerance is ulps.
+   subroutine test_shared_faces(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: body
+      type(grid_sums_type) :: sums
+      integer :: dim
+
+      do dim = 2, 3
+         call two_boxes(body, dim, error)
+         if (allocated(error)) return
+         call integrate_grid(body, 3, 2, sums, error)
+         if (allocated(error)) return
+         if (dim == 2) then
+            call check(error, sums%m(1), 0.125_wp, 1.0e-15_wp, 'union area')
+            if (allocated(error)) return
+            call check(error, sums%m(2), 1.7_wp, 1.0e-14_wp, 'union perimeter, shared edge inside')
+         else
+            call check(error, sums%m(1), 0.0625_wp, 1.0e-15_wp, 'union volume')
+            if (allocated(error)) return
+            call check(error, sums%m(2), 1.1_wp, 1.0e-14_wp, 'union area, shared face inside')
+         end if
+         if (allocated(error)) return
+         call check(error, sums%flux, 0.0_wp, 1.0e-14_wp, 'closed boundary')
+         if (allocated(error)) return
+      end do
+   end subroutine test_shared_faces
+
+   !> [0.25, 0.5] x [0.25, 0.6] (x [0.25, 0.75]) added to [0.5, 0.75] x [0.25, 0.4] (x [0.25, 0.75]).
+   subroutine two_boxes(body, dim, error)
+      type(body_type), intent(out) :: body
+      integer, intent(in) :: dim
+      type(error_type), allocatable, intent(out) :: error
+      type(shape_type) :: s
+      real(wp) :: lo(3), hi(3)
+
+      call new_body(body, 'union')
+      lo = [0.25_wp, 0.25_wp, 0.25_wp]
+      hi = [0.5_wp, 0.6_wp, 0.75_wp]
+      if (dim == 3) hi = [0.5_wp, 0.75_wp, 0.6_wp]
+      call new_box(s, 'left', lo(1:dim), hi(1:dim), error)
+      if (allocated(error)) return
+      call body%add_shape(csg_add, s, error)
+      if (allocated(error)) return
+      lo(1) = 0.5_wp
+      hi(1) = 0.75_wp
+      hi(dim) = 0.4_wp
+      call new_box(s, 'right', lo(1:dim), hi(1:dim), error)
+      if (allocated(error)) return
+      call body%add_shape(csg_add, s, error)
+   end subroutine two_boxes
 
    !> A cut of 1e-12 of the cell size: a rectangle whose top lies 1e-12 h above
    !> a grid line, and a disk reaching 1e-12 h past a grid line.

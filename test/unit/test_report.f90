@@ -2,6 +2,7 @@
 !> layout, SVG plot. Also holds the small XML well-formedness checker that
 !> the output tests reuse for the XDMF file. Files go to build/.
 module sprc_test_report
+   use sprc_core_text, only: lower, itoa
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: stat_io, stat_invalid_input
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type
@@ -1178,23 +1179,5 @@ contains
          pos = pos + k
       end do
    end function count_sub
-
-   pure function lower(s) result(t)
-      character(len=*), intent(in) :: s
-      character(len=len(s)) :: t
-      integer :: i
-      t = s
-      do i = 1, len(s)
-         if (s(i:i) >= 'A' .and. s(i:i) <= 'Z') t(i:i) = achar(iachar(s(i:i)) + 32)
-      end do
-   end function lower
-
-   pure function itoa(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=16) :: buf
-      write (buf, '(i0)') i
-      s = trim(buf)
-   end function itoa
 
 end module sprc_test_report

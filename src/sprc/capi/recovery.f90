@@ -24,7 +24,8 @@ module sprc_capi_recovery
    implicit none
    private
 
-   public :: capi_recovery_type
+   public :: capi_recovery_type, mesh_sizes_type, check_sizes, check_pointers, one_based, method_mask, flag_p, &
+      & flag_p_plus_1
    public :: sprc_recover, sprc_recover_xi, sprc_recover_reference, sprc_get_recovery_nodal_stress, &
       & sprc_get_recovery_element_error, &
       & sprc_get_recovery_global_error, sprc_get_recovery_eta, sprc_eval_recovery, sprc_delete_recovery

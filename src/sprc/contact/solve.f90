@@ -1,171 +1,76 @@
-!> The coupled FE solve of one contact pair: both bodies' reduced systems in
-!> one block system plus the contact terms on the slave surface points
-!> (thesis eqs. 2-5, Tur et al. 2015; doc/theory.md, section 6; doc/scene.md
-!> `&contact`).
+!> The coupled FE solve of one contact pair: both bodies' reduced systems in one
+!> block system plus the contact terms on the slave surface points. The maths and
+!> the reasons for each choice are in doc/theory.md, section 6 (Tur et al. 2015;
+!> the scene keys in doc/scene.md, `&contact`).
 !>
-!> Formulation: the stabilized multiplier of thesis eq. 5 (with the sign
-!> erratum), gamma = kappa E_s/h, p_N the slave's FE traction (Nitsche-type)
-!> or, with `recovered`, its recovered traction of the previous solution.
-!> The multiplier is P0 on contact cells (slave aggregates sharing a parent
-!> cell, spanning at least two master cells where those are larger): P0 on
-!> the slave cells is not inf-sup stable against the trace (the pressure
-!> alternates from cell to cell), and a constraint per quadrature point
-!> over-constrains the interface. It is eliminated cell by cell,
-!> lambda_c = pbar + gamma gbar; the cell's block is the second variation of
-!> W_c [pbar.gbar + gamma/2 |gbar|^2] - 1/(2 gamma) sum_i w_i |p_N,i - pbar|^2.
-!> The system is SPD when gamma exceeds the slave traction's trace-inverse
-!> bound; `default_kappa` (sprc_study_spec) is the centre in decades of the
-!> plateau where err_fe and p_max do not depend on kappa.
-!>
-!> Discrete multiplier space: lambda constant on each contact cell c (P0): the
-!> slave points with a master point whose slave aggregates (cell
-!> aggregation's roots) share a parent cell (`macro_cells`: two cells along a
-!> 2D surface, up to four on a 3D one), a sliver of surface joined to the
-!> nearest full contact cell (`group_cells`), measure W_c. P0 on the slave
-!> cells themselves is not inf-sup stable against the continuous trace of
-!> the displacements: a pressure alternating from cell to cell is orthogonal
-!> to every interior trace function, and the multiplier showed it (a shrink
-!> fit's pressure oscillating around the ring at every level and kappa, a 3D
-!> Hertz peak far too high); P0 on the parent cells is the stable
-!> macro-element pair. The same holds against the master's trace, which the
-!> constraint moves alone when the slave is much the stiffer: where the
-!> master's cells are larger than the slave's, a contact cell is the ancestor
-!> spanning at least two master cells (a shaft slave on a grid half the size
-!> of a soft hub's pressure alternated by 5 % from cell to cell). The price:
-!> the open/closed boundary is resolved to a contact cell, two slave cells
-!> (or two master cells). A contact cell turns at most a quarter turn (its
-!> normals within 45 degrees of its mean normal; else its roots go one
-!> ancestor level down, to single roots at the least): on a coarse grid the
-!> ancestor of a ring's cells can be the whole ring, whose mean gap holds
-!> neither a translation nor the rotation (`turns_too_far`). The multiplier is
-!> eliminated cell by cell: stationarity in lambda_c gives
-!>   lambda_c = pbar + gamma gbar,
-!> with pbar, gbar the means over the cell's points of p_N and g, and the
-!> cell's contribution to the energy becomes
-!>   W_c [pbar.gbar + gamma/2 |gbar|^2] - 1/(2 gamma) sum_i w_i |p_N,i - pbar|^2.
-!> Its second variation is the cell's block of the system (symmetric); the
-!> first two terms are the symmetric Nitsche terms of sprc_fem_problem's
-!> Dirichlet conditions with the mean gap as the constraint, the last one
-!> the stabilization's variance term. One constraint per contact cell and direction
-!> matches the displacement space: enforcing g = 0 at every quadrature point
-!> instead (multipliers eliminated point by point) over-constrains the
-!> interface: the pressure oscillates between points and falsely opens
-!> points of a closed interface, the more so the larger kappa. On open cells
-!> lambda = 0 and nothing is added. The pressure reported per point (`p_fe`)
-!> is that of its cell, p = -n_i.lambda_c (0 open); `ts_fe` the magnitude of
-!> the tangential part of lambda_c (0 frictionless).
-!>
-!> Constant in the surface's frame, not in Cartesian components. The
-!> frictionless multiplier is a scalar: its traction lambda_c n_i turns with
-!> the surface. The vector multiplier of stick and Coulomb is constant in the
-!> same sense: at point i it is R_i lambda_c, R_i the least rotation carrying
-!> the cell's mean normal nbar to the point's normal n_i (`frame_rotation`),
-!> so lambda_c.nbar is the pressure and its part normal to nbar the shear,
-!> each constant over the cell as the frictionless pressure is. Every point
-!> operator (gap, traction, the recovered traction p*) enters the cell's
-!> means rotated back by R_i^T, and the formulation below is unchanged. A
-!> Cartesian constant instead cannot carry a uniform pressure on a curved
-!> surface: the traction p n_i of a cell of angle h/R has a tangential part
-!> varying by p h/R across the cell, which the constant misses; the
-!> interface then carries a spurious shear of size p h/R, harmless at Q1
-!> (O(h) like the discretization) but a consistency error of order h^(3/2)
-!> in energy at Q2 (a shrink fit with stick converged at rate 1.5 with the
-!> estimate seeing half the error, where frictionless converged at 2).
-!>
-!> kappa. gamma = kappa E_s/h (SCENE.md: effective stiffness kappa E/h), with
-!> E_s the slave body's Young's modulus and h the smallest edge of the slave
-!> cell (of its aggregate's root). The block system is SPD when gamma exceeds
-!> the trace-inverse bound of the slave traction, C_I dmax/h (the bound of the
-!> Dirichlet Nitsche terms, sprc_fem_problem: about (p+1)^2 times a geometric
-!> factor, cell aggregation keeping it independent of the cut; dmax = 1.35 E
-!> for nu = 0.3 in plane strain), with a margin for the variance term (at
-!> most C_I/kappa times the energy). Sweeps (shrink fit Q1 and Q2, Hertz;
-!> figures in the commits that set the default) found err_fe and p_max flat
-!> from kappa = 100 to 1e6 and moving below it, where coercivity is lost; the
-!> default `default_kappa` = 1e4 (sprc_study_spec) is the centre of that
-!> plateau in decades.
-!>
-!> Points. The slave surface's cut-cell quadrature points with their exact
-!> normals and initial gaps (sprc_contact_surface), cut at the master grid's
-!> planes. The slave traction and displacement at a point are the slave
-!> cell's polynomial there; the master displacement the master host cell's
-!> polynomial at the master point; both reduced through the bodies'
-!> constraints (hanging nodes, aggregation, strong symmetry), like every
-!> element matrix.
-!>
-!> Active set (primal-dual / semi-smooth Newton), per contact cell. First
-!> active set: the cells with a point with g0 <= h, h the smallest edge of
-!> the slave root cell of the cell's first point (one slave cell: touching
-!> and near surfaces, every cell of a fit with or without interference);
-!> this holds a load-controlled body from the start. Each iteration assembles and
-!> factorizes the block system once (CHOLMOD; UMFPACK if CHOLMOD finds it not
-!> positive definite), solves, and takes as the next set the cells with
-!> nbar.lambda_c < 0 (nbar the cell's mean normal). The iteration ends when
-!> the set repeats; after `max_iterations` it is stat_not_converged with the
-!> count of the points whose cells still switched. Before each factorization
-!> the rigid-body modes of both bodies are checked on the block system: a
-!> body that the closed cells and its own conditions leave free is an error
-!> naming the body (stat_singular).
-!>
-!> Friction: 'frictionless' and 'stick' (the closed zone tied: the vector
-!> gap) are symmetric. With stick and Coulomb the cell's normal nbar is the
-!> mean of the bisectors n_s - n_m of the two surfaces' normals (the contact
-!> plane, the same whichever body is the slave), and the initial vector gap
-!> of a point is g0 (n_s.n_m) n_m, its distance to the master's tangent plane
-!> along the master normal: the surfaces close along the common normal. Along
-!> the slave normal instead, a curved slave (a roller, n_s tilted by x/R from
-!> the flat master's normal) got a spurious tangential gap g0 x/R and a
-!> tangential traction p x/R from the normal load alone, O(a/R) but
-!> tangential tractions up to mu p at the contact edges, absent from the
-!> half-space theory (Cattaneo-Mindlin). 'coulomb': the vector multiplier of
-!> a cell less its slip s_c (history), lambda_c = tbar + gamma (gbar - s_c),
-!> split along nbar into lambda_n and lambda_t; a closed cell sticks (the
-!> stick terms with the gap shifted by s_c) while |lambda_t| <= mu
-!> (-lambda_n), else it slips along tau = lambda_t/|lambda_t| with the
-!> friction traction lambda_t = -mu lambda_n tau. A slipping cell's terms are
-!> the second variation of the cell energy with that lambda_t held:
-!>   W [lambda.gbar - 1/(2 gamma) |lambda - pbar|^2] - variance,
-!> the normal terms, the friction work and its stabilization (lambda_t -
-!> tt)/gamma . dtt (tt = tau.tbar u; without it the FE tangential traction
-!> of a slipping cell was free and the trial lambda_t jumped between the
-!> states), whose linearization -mu W (gt + tt/gamma)(nbar^T (tbar + gamma
-!> gbar)) makes the system unsymmetric (UMFPACK). The load path comes in
-!> increments (`&bc stage` and `&contact steps`, the caller's `loads`); in
-!> each the states and slip directions are iterated until they repeat
-!> (directions within `direction_tol`), then the slips are updated: a
-!> slipping cell's so that its trial traction is the friction traction, an
-!> open cell's to its current tangential position. A slipping cell whose
-!> trial turns against its slip direction sticks (`coulomb_states`): the
-!> trial is continuous in the friction traction, which cannot go from mu p
-!> tau to -mu p tau without crossing the stick range; sending it to the
-!> opposite slip instead made edge cells of small pressure flip between the
-!> two directions for ever (a roller under a normal then a tangential load).
-!> The rigid-mode check uses the system without the friction terms.
-!>
-!> Recovered stabilization (`stabilization = 'recovered'`): the cell's block
-!> is the penalty W gamma G^T G alone and p* moves to the load, SPD for every
-!> gamma > 0 and consistent when the recovery is exact; frictionless and
-!> stick only. With a `contact_factor_type` the CHOLMOD factor is reused
-!> while the active set repeats (one back substitution per update).
+!> - Multiplier: stabilized (gamma = kappa E_s/h, h the smallest edge of the slave
+!>   point's aggregate root), with p_N the slave's FE traction (Nitsche-type) or,
+!>   with `recovered`, its recovered traction of the previous solution.
+!> - Multiplier space: P0 on contact cells (`macro_cells`, `group_cells`): slave
+!>   aggregates sharing a parent cell, spanning at least two master cells where
+!>   those are larger, turning at most a quarter turn (`turns_too_far`). P0 on the
+!>   slave cells is not inf-sup stable against the trace, and a constraint per
+!>   point over-constrains the interface. The multiplier is eliminated cell by cell,
+!>   lambda_c = pbar + gamma gbar; the cell's block is the second variation of
+!>   W_c [pbar.gbar + gamma/2 |gbar|^2] - 1/(2 gamma) sum_i w_i |p_N,i - pbar|^2,
+!>   SPD when gamma exceeds the trace-inverse bound (`default_kappa` in
+!>   sprc_study_spec is the centre of the plateau where the results do not depend
+!>   on kappa).
+!> - Frame: lambda_c is constant in the surface's frame; at point i it acts as
+!>   R_i lambda_c, R_i the least rotation from the cell's mean normal to n_i
+!>   (`frame_rotation`), so that a uniform pressure on a curved surface is in the
+!>   space (a Cartesian constant costs Q2 its order).
+!> - Points: the slave's cut-cell surface points cut at the master grid's planes;
+!>   traction and displacements are the host cells' polynomials, reduced through
+!>   each body's constraints like every element matrix.
+!> - Active set: primal-dual per contact cell, starting from the cells with a point
+!>   with g0 <= h; one factorization per iteration (CHOLMOD, UMFPACK if not
+!>   positive definite); the next set is the cells with nbar.lambda_c < 0; it ends
+!>   when the set repeats, else stat_not_converged. A body that the closed cells
+!>   and its own conditions leave free is stat_singular, naming it.
+!> - Friction: with stick and Coulomb the cell normal is the mean bisector of the
+!>   two normals and the initial vector gap g0 (n_s.n_m) n_m (a curved slave gets
+!>   no spurious shear). Coulomb is path dependent: the loads come in increments,
+!>   states and slip directions iterate until they repeat, a slipping cell whose
+!>   trial turns against its slip sticks (the trial cannot jump from mu p tau to
+!>   -mu p tau), and the slipping linearization is unsymmetric (UMFPACK).
+!> - Recovered stabilization: the cell's block is the penalty W gamma G^T G and p*
+!>   moves to the load (SPD for every gamma > 0); frictionless and stick only; with
+!>   a `contact_factor_type` the factor is reused while the active set repeats.
+!> - Iterative solves (`block_solver_type`, 'iterative' or 'auto' from
+!>   `auto_coupled_min_dofs`): PETSc CG where the block system is symmetric
+!>   (GMRES if CG meets an indefinite one, and where slipping cells make it
+!>   unsymmetric), preconditioned by both bodies' geometric multigrid
+!>   hierarchies stacked block-diagonally with the contact nodes kept on every
+!>   level (`stack_hierarchies`), built once per solve; the coarse levels see the
+!>   contact terms through Galerkin products of each new fine matrix (a body held
+!>   only by the contact has no usable hierarchy of its own). Each iteration
+!>   starts from the previous solution; the stopping test is the single body's
+!>   energy bound tightened for pointwise values (`contact_tolerance`).
 !>
 !> Assemblies (`solve_contact_assembly`): several bodies and the pairs between
 !> them, one block system with every body's reduced system on the diagonal
 !> (offsets in body order) and the cells of every pair, built as a pair's
 !> alone (`point_operators` with the bodies' offsets); one active set over
-!> all cells, the rigid-mode check over every body. Frictionless and stick
-!> with the FE stabilization stress: Coulomb's load path and the recovered
-!> stabilization stay per pair (`solve_contact_pair`).
+!> all cells, the rigid-mode check over every body, a direct solve
+!> (`solve_block` with an unset block solver). Frictionless and stick with the
+!> FE stabilization stress: Coulomb's load path, the recovered stabilization
+!> and the iterative solvers stay per pair (`solve_contact_pair`).
 module sprc_contact_solve
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_not_converged, stat_singular, &
-      & stat_unsupported
+      & stat_unsupported, stat_not_positive_definite
    use sprc_core_text, only: itoa
    use sprc_core_alloc, only: check_allocation
    use sprc_core_hash, only: hash_int
    use sprc_core_timer, only: timer_type
    use sprc_fem_sparse, only: coo_type, csr_type
    use sprc_fem_element, only: shape_functions, strain_matrix, traction_matrix, displacement_matrix
-   use sprc_fem_problem, only: elasticity_problem_type, free_motions, motion_names, solve_spd_or_lu
+   use sprc_fem_problem, only: elasticity_problem_type, free_motions, motion_names, solve_spd_or_lu, &
+      & master_hierarchy
+   use sprc_fem_linear_solver, only: use_iterative, solver_iterative
+   use sprc_fem_petsc, only: petsc_solver_type, iteration_tolerance, start_petsc
+   use sprc_fem_multigrid, only: prolongation_type, stack_hierarchies
    use sprc_fem_umfpack, only: umfpack_solver_type
    use sprc_fem_cholmod, only: cholmod_solver_type
    use sprc_contact_surface, only: contact_surface_type
@@ -238,12 +143,22 @@ module sprc_contact_solve
       real(wp), allocatable :: ns(:, :), ts(:, :), nm(:, :), tm(:, :)
    end type local_type
 
+   !> The linear solver of the block system (module notes): direct, or
+   !> Krylov + the bodies' stacked multigrid hierarchy, set up once by
+   !> `block_solver_setup`.
+   type :: block_solver_type
+      logical :: ready = .false., iterative = .false.
+      type(petsc_solver_type) :: krylov
+   end type block_solver_type
+
    !> The CHOLMOD factor of a recovered-stabilization block system and the
    !> contact cells' active set it was built for (module notes), kept by the
-   !> caller between updates of the stabilization traction.
+   !> caller between updates of the stabilization traction; or the
+   !> iterative solver set up for that system.
    type :: contact_factor_type
       private
       type(cholmod_solver_type) :: chol
+      type(block_solver_type) :: bs
       logical, allocatable :: closed(:)
    contains
       !> `destroy()`: release the factor (harmless when repeated).
@@ -265,9 +180,12 @@ module sprc_contact_solve
       !> nbar.lambda_c of every contact cell: negative where the cell carries
       !> compression when closed.
       real(wp), allocatable :: lambda_n(:)
-      !> Reciprocal condition estimate of the last block system and the solver used.
+      !> Reciprocal condition estimate of the last block system (-1 when an
+      !> iterative solve made none) and the solver used.
       real(wp) :: rcond = -1.0_wp
       character(len=:), allocatable :: solver_name
+      !> Krylov iterations of all block solves (0 for direct solves).
+      integer :: solver_iterations = 0
       !> Seconds of the contact operators and active-set evaluation, and of the
       !> block assemblies and solves.
       real(wp) :: t_contact = 0.0_wp, t_solve = 0.0_wp
@@ -339,7 +257,7 @@ contains
       real(wp), intent(in), optional :: recovered(:, :)
       !> With `recovered`: the factor of the previous solve (module notes),
       !> updated.
-      type(contact_factor_type), intent(inout), optional :: factor
+      type(contact_factor_type), intent(inout), optional, target :: factor
       type(point_operators_type) :: ops
       type(cell_operators_type), allocatable :: cells(:)
       type(csr_type) :: k
@@ -348,6 +266,8 @@ contains
       logical, allocatable :: closed(:), next(:)
       integer, allocatable :: state(:)
       real(wp), allocatable :: slip(:, :), tau(:, :), pstar(:, :)
+      type(block_solver_type), target :: own
+      type(block_solver_type), pointer :: bs
       integer :: it, maxit, n, c, switched, stat
       logical :: kept
 
@@ -374,16 +294,19 @@ contains
          if (allocated(error)) return
       end if
       kept = present(factor) .and. present(recovered)
+      bs => own
       if (kept) then
          if (allocated(factor%closed)) then
             if (size(factor%closed) == size(closed)) closed = factor%closed
          end if
+         bs => factor%bs
       end if
       call timer%stop()
       sol%t_contact = timer%elapsed
       n = slave%n_dofs() + master%n_dofs()
-      allocate (x(n), stat=stat)
+      allocate (x(n), source=0.0_wp, stat=stat)
       call check_allocation(stat, 'contact solve', 'the solution of both bodies', n, 8, error)
+      if (.not. allocated(error)) call block_solver_setup(slave, master, ops, bs, error)
       if (allocated(error)) return
       if (friction == friction_coulomb) then
          if (.not. present(mu)) then
@@ -391,11 +314,11 @@ contains
             return
          end if
          if (present(loads)) then
-            call solve_coulomb(slave, master, ops, cells, closed, mu, loads, names, maxit, x, sol, state, tau, slip, &
-               & error, progress)
+            call solve_coulomb(slave, master, ops, cells, closed, mu, loads, names, maxit, bs, x, sol, state, tau, &
+               & slip, error, progress)
          else
             call solve_coulomb(slave, master, ops, cells, closed, mu, reshape([slave%f, master%f], [n, 1]), names, &
-               & maxit, x, sol, state, tau, slip, error, progress)
+               & maxit, bs, x, sol, state, tau, slip, error, progress)
          end if
          if (allocated(error)) return
          call point_gaps(surface, ops, ops%ncell, x, sol, error)
@@ -415,7 +338,7 @@ contains
          end if
          if (.not. (allocated(error) .or. kept)) &
             & call check_held(slave, master, k, names, closed_points(ops, closed), it, error)
-         if (.not. (allocated(error) .or. kept)) call solve_block(k, f, x, sol, error)
+         if (.not. (allocated(error) .or. kept)) call solve_block(bs, k, f, x, sol, error)
          call timer%stop()
          sol%t_solve = sol%t_solve + timer%elapsed
          if (allocated(error)) return
@@ -977,12 +900,22 @@ contains
       if (same) then
          call block_load(slave, master, ops, cells, closed, f, pstar)
       else
-         call factor%destroy()
+         call factor%chol%destroy()
+         if (allocated(factor%closed)) deallocate (factor%closed)
          call block_system(slave, master, ops, cells, closed, k, f, error, pstar)
          if (.not. allocated(error)) call check_held(slave, master, k, names, closed_points(ops, closed), it, error)
-         if (.not. allocated(error)) call factor%chol%factorize(k, error)
+         if (allocated(error)) return
+         if (factor%bs%iterative) then
+            call krylov_setup(factor%bs%krylov, k, .true., error)
+         else
+            call factor%chol%factorize(k, error)
+         end if
          if (allocated(error)) return
          factor%closed = closed
+      end if
+      if (factor%bs%iterative) then
+         call krylov_solve(factor%bs%krylov, f, x, sol, error)
+         return
       end if
       sol%solver_name = 'cholmod'
       sol%rcond = factor%chol%rcond_estimate
@@ -994,6 +927,8 @@ contains
    subroutine factor_destroy(self)
       class(contact_factor_type), intent(inout) :: self
       call self%chol%destroy()
+      call self%bs%krylov%destroy()
+      self%bs%ready = .false.
       if (allocated(self%closed)) deallocate (self%closed)
    end subroutine factor_destroy
 
@@ -1043,8 +978,8 @@ contains
    !> an iteration on the cells' states (open, stick, slip) and slip
    !> directions, solved with UMFPACK (the slip terms are unsymmetric); the
    !> slip of each cell is history.
-   subroutine solve_coulomb(slave, master, ops, cells, closed, mu, loads, names, maxit, x, sol, state, tau, slip, error, &
-         & progress)
+   subroutine solve_coulomb(slave, master, ops, cells, closed, mu, loads, names, maxit, bs, x, sol, state, tau, slip, &
+         & error, progress)
       type(elasticity_problem_type), intent(in) :: slave, master
       type(point_operators_type), intent(in) :: ops
       type(cell_operators_type), intent(in) :: cells(:)
@@ -1052,6 +987,7 @@ contains
       real(wp), intent(in) :: mu, loads(:, :)
       character(len=*), intent(in) :: names(2)
       integer, intent(in) :: maxit
+      type(block_solver_type), intent(inout) :: bs
       real(wp), intent(inout) :: x(:)
       type(contact_solution_type), intent(inout) :: sol
       !> Final state of each cell, its slip direction (slipping cells) and its slip (history).
@@ -1086,7 +1022,13 @@ contains
                & sol%iterations, error)
             if (.not. allocated(error) .and. any(state == contact_slip)) &
                & call coulomb_system(slave, master, ops, cells, state, tau, slip, mu, loads(:, n), k, f, error)
-            if (.not. allocated(error)) call solve_unsymmetric(k, f, x, sol, error)
+            if (.not. allocated(error)) then
+               if (bs%iterative) then
+                  call iterative_block(bs%krylov, k, f, .not. any(state == contact_slip), x, sol, error)
+               else
+                  call solve_unsymmetric(k, f, x, sol, error)
+               end if
+            end if
             call timer%stop()
             sol%t_solve = sol%t_solve + timer%elapsed
             if (allocated(error)) return
@@ -1334,16 +1276,144 @@ contains
          & 'only by contact has lost it, or its conditions leave it free', stat_singular)
    end subroutine check_held
 
-   subroutine solve_block(k, f, x, sol, error)
+   !> Solve the symmetric block system: directly (CHOLMOD, UMFPACK if not
+   !> SPD) or iteratively (`iterative_block`), as `bs` was set up.
+   subroutine solve_block(bs, k, f, x, sol, error)
+      type(block_solver_type), intent(inout) :: bs
       type(csr_type), intent(in) :: k
       real(wp), intent(in) :: f(:)
       real(wp), intent(inout) :: x(:)
       type(contact_solution_type), intent(inout) :: sol
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: note
+      if (bs%iterative) then
+         call iterative_block(bs%krylov, k, f, .true., x, sol, error)
+         return
+      end if
       call solve_spd_or_lu(k, f, x, sol%rcond, sol%solver_name, note, error)
       if (allocated(error)) error%message = 'contact solve'//error%message
    end subroutine solve_block
+
+   !> Decide between the direct and the iterative solver (module notes) and,
+   !> for the iterative one, set up the block layout of both bodies and their
+   !> stacked multigrid hierarchy; nothing happens when `bs` is ready.
+   subroutine block_solver_setup(slave, master, ops, bs, error)
+      type(elasticity_problem_type), intent(in) :: slave, master
+      type(point_operators_type), intent(in) :: ops
+      type(block_solver_type), intent(inout) :: bs
+      type(error_type), allocatable, intent(out) :: error
+      type(prolongation_type), allocatable :: ps(:), pm(:), p(:)
+      integer, allocatable :: dof(:, :)
+      logical, allocatable :: touched(:)
+      integer :: ns, choice
+      logical :: found_s, found_m
+
+      if (bs%ready) return
+      choice = slave%solver
+      if (master%solver == solver_iterative) choice = solver_iterative
+      bs%iterative = use_iterative(choice, slave%dim, slave%degree, slave%n_dofs() + master%n_dofs(), coupled=.true.)
+      bs%ready = .true.
+      if (.not. bs%iterative) return
+      call start_petsc(error)
+      if (allocated(error)) return
+      ns = slave%n_dofs()
+      associate (cs => slave%constraints, cm => master%constraints)
+         dof = reshape([cs%dof, merge(cm%dof + ns, 0, cm%dof > 0)], [slave%dim, cs%n_masters + cm%n_masters])
+         call bs%krylov%set_blocks(dof, reshape([slave%mesh%nodes%x(:, cs%master_node), &
+            & master%mesh%nodes%x(:, cm%master_node)], shape(dof)), error)
+         if (allocated(error)) return
+         ! the masters a contact point's operators act on are kept on every level (sprc_fem_multigrid)
+         allocate (touched(0:slave%n_dofs() + master%n_dofs()), source=.false.)
+         touched(ops%dofs) = .true.
+         call master_hierarchy(slave, ps, found_s, error, keep=kept_masters(touched, dof(:, :cs%n_masters)))
+         if (.not. allocated(error)) call master_hierarchy(master, pm, found_m, error, &
+            & keep=kept_masters(touched, dof(:, cs%n_masters + 1:)))
+         if (allocated(error)) return
+         if (found_s .and. found_m) then
+            call stack_hierarchies(ps, cs%n_masters, pm, cm%n_masters, p, error)
+            if (.not. allocated(error)) call bs%krylov%set_hierarchy(p, error)
+            if (allocated(error)) return
+         end if
+      end associate
+      bs%krylov%tolerance = contact_tolerance(0.5_wp**max(slave%mesh%grid%max_level, master%mesh%grid%max_level), &
+         & slave%degree, slave%dim)
+   end subroutine block_solver_setup
+
+   !> The Krylov stopping tolerance of the block system (a relative energy
+   !> bound): the single body's `iteration_tolerance` 1e-7 (h/L)^p (h the
+   !> finer grid's finest cell, L its box) times (h/L)^(d/2). A contact
+   !> report's pressures (p_max, each point's p) are pointwise tractions, which
+   !> the energy norm bounds only through an inverse estimate: a traction
+   !> error in one cell of size h is at most C (L/h)^(d/2) times the relative
+   !> energy error (the cell's share of the energy). Not below 1e-12, the
+   !> round-off of the solve.
+   pure real(wp) function contact_tolerance(h_over_l, degree, dim) result(tau)
+      real(wp), intent(in) :: h_over_l
+      integer, intent(in) :: degree, dim
+      tau = max(iteration_tolerance(h_over_l, degree)*h_over_l**(0.5_wp*dim), 1.0e-12_wp)
+   end function contact_tolerance
+
+   !> The blocks (masters) of `dof` with a component in `touched` (0: none).
+   pure function kept_masters(touched, dof) result(keep)
+      logical, intent(in) :: touched(0:)
+      integer, intent(in) :: dof(:, :)
+      logical :: keep(size(dof, 2))
+      integer :: m
+      keep = [(any(touched(dof(:, m))), m = 1, size(dof, 2))]
+   end function kept_masters
+
+   !> Set up the Krylov solver on k (CG when `symmetric`, else GMRES).
+   subroutine krylov_setup(krylov, k, symmetric, error)
+      type(petsc_solver_type), intent(inout) :: krylov
+      type(csr_type), intent(in) :: k
+      logical, intent(in) :: symmetric
+      type(error_type), allocatable, intent(out) :: error
+      krylov%symmetric = symmetric
+      call krylov%factorize(k, error)
+      if (allocated(error)) error%message = 'contact solve (iterative setup): '//error%message
+   end subroutine krylov_setup
+
+   !> Solve with the set-up Krylov solver from x (the previous solution).
+   subroutine krylov_solve(krylov, f, x, sol, error)
+      type(petsc_solver_type), intent(inout) :: krylov
+      real(wp), intent(in) :: f(:)
+      real(wp), intent(inout) :: x(:)
+      type(contact_solution_type), intent(inout) :: sol
+      type(error_type), allocatable, intent(out) :: error
+      integer :: before
+
+      before = krylov%iterations
+      krylov%guess = x
+      call krylov%solve(f, x, error)
+      sol%solver_iterations = sol%solver_iterations + krylov%iterations - before
+      sol%solver_name = merge('cg+   ', 'gmres+', krylov%symmetric)
+      sol%solver_name = trim(sol%solver_name)//trim(merge('gmg ', 'gamg', krylov%multigrid))
+      sol%rcond = -1.0_wp
+      if (allocated(error)) error%message = 'contact solve (iterative): '//error%message
+   end subroutine krylov_solve
+
+   !> One block system through the Krylov solver (CG when `symmetric`, else
+   !> GMRES; GMRES too when CG finds the system indefinite), from x.
+   subroutine iterative_block(krylov, k, f, symmetric, x, sol, error)
+      type(petsc_solver_type), intent(inout) :: krylov
+      type(csr_type), intent(in) :: k
+      real(wp), intent(in) :: f(:)
+      logical, intent(in) :: symmetric
+      real(wp), intent(inout) :: x(:)
+      type(contact_solution_type), intent(inout) :: sol
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: x0(:)
+
+      x0 = x
+      call krylov_setup(krylov, k, symmetric, error)
+      if (.not. allocated(error)) call krylov_solve(krylov, f, x, sol, error)
+      if (.not. allocated(error) .or. .not. symmetric) return
+      if (error%stat /= stat_not_positive_definite) return
+      deallocate (error)
+      x = x0
+      call krylov_setup(krylov, k, .false., error)
+      if (.not. allocated(error)) call krylov_solve(krylov, f, x, sol, error)
+   end subroutine iterative_block
 
    !> The outputs allocated and reset (every point open); the linearized
    !> normal gap of every point with a master point (huge elsewhere).
@@ -1504,6 +1574,8 @@ contains
       procedure(contact_progress), optional :: progress
       type(pair_work_type), allocatable :: work(:)
       type(contact_solution_type) :: solved
+      !> Unset: a direct solve (module notes).
+      type(block_solver_type) :: bs
       type(csr_type) :: k
       type(timer_type) :: timer
       real(wp), allocatable :: f(:), x(:)
@@ -1540,7 +1612,7 @@ contains
          call assembly_system(bodies, offset, work, k, f, error)
          if (.not. allocated(error)) call check_held_bodies(bodies, k, &
             & sum([(closed_points(work(p)%ops, work(p)%closed), p=1, size(pairs))]), it, error)
-         if (.not. allocated(error)) call solve_block(k, f, x, solved, error)
+         if (.not. allocated(error)) call solve_block(bs, k, f, x, solved, error)
          call timer%stop()
          solved%t_solve = solved%t_solve + timer%elapsed
          if (allocated(error)) return

@@ -1,12 +1,13 @@
-!> Text of numbers for messages and files: one implementation for every layer
-!> (integers, reals in a given edit descriptor, shortest round-trip reals, fixed notation).
+!> Text for messages and files: one implementation for every layer (integers, reals
+!> in a given edit descriptor, shortest round-trip reals, fixed notation, lower case,
+!> XML escapes).
 module sprc_core_text
    use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_is_finite
    use sprc_core_kinds, only: wp, i4, i8
    implicit none
    private
 
-   public :: fixed_text, itoa, rtoa, real_text, byte_text
+   public :: fixed_text, itoa, rtoa, real_text, byte_text, lower, xml_escape
 
    !> An integer in its shortest decimal form (`i0`); with `digits`, padded
    !> with leading zeros to at least that many digits (`itoa(4, 2)` = '04',
@@ -151,5 +152,35 @@ contains
          end if
       end if
    end function real_text
+
+   !> text with the ASCII capitals A-Z in lower case (names are compared case-blind).
+   pure function lower(text) result(low)
+      character(len=*), intent(in) :: text
+      character(len=len(text)) :: low
+      integer :: i
+      low = text
+      do i = 1, len(text)
+         if (text(i:i) >= 'A' .and. text(i:i) <= 'Z') low(i:i) = achar(iachar(text(i:i)) + 32)
+      end do
+   end function lower
+
+   !> s with the five XML special characters as entities, so that it is safe both as
+   !> character data and inside an attribute in either kind of quotes.
+   pure function xml_escape(s) result(t)
+      character(len=*), intent(in) :: s
+      character(len=:), allocatable :: t
+      integer :: i
+      t = ''
+      do i = 1, len(s)
+         select case (s(i:i))
+         case ('&'); t = t//'&amp;'
+         case ('<'); t = t//'&lt;'
+         case ('>'); t = t//'&gt;'
+         case ('"'); t = t//'&quot;'
+         case ("'"); t = t//'&apos;'
+         case default; t = t//s(i:i)
+         end select
+      end do
+   end function xml_escape
 
 end module sprc_core_text

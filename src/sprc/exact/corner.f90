@@ -269,19 +269,21 @@ contains
       real(wp), intent(in) :: x(:)
       real(wp), intent(out) :: v(:)
       real(wp) :: r, t, l, sum_, s_local(3)
-      complex(wp) :: a, c, z1, z3, diff
+      complex(wp) :: a, c, z1, z3, diff, e2
       integer :: k
 
       call local_polar(self, x, r, t)
       sum_ = 0.0_wp
       diff = (0.0_wp, 0.0_wp)
+      ! e^(-2it), so that one power and one sine/cosine pair serve both terms
+      e2 = cmplx(cos(2.0_wp*t), -sin(2.0_wp*t), wp)
       do k = 1, 2
          if (self%amplitude(k) == 0.0_wp) cycle
          call potentials(self, k, a, c)
          l = self%lambda(k)
          ! z^(l-1) and conj(z) z^(l-2) = r^(l-1) e^(i(l-3)t).
          z1 = r**(l - 1.0_wp)*cmplx(cos((l - 1.0_wp)*t), sin((l - 1.0_wp)*t), wp)
-         z3 = r**(l - 1.0_wp)*cmplx(cos((l - 3.0_wp)*t), sin((l - 3.0_wp)*t), wp)
+         z3 = z1*e2
          sum_ = sum_ + 4.0_wp*real(a*l*z1, wp)
          diff = diff + 2.0_wp*(a*l*(l - 1.0_wp)*z3 + c*l*z1)
       end do

@@ -29,7 +29,7 @@ module sprc_fem_constraints
    use sprc_grid_tree, only: grid_type
    use sprc_grid_nodes, only: grid_nodes_type, element_shape
    use sprc_grid_hanging, only: hanging_type
-   use sprc_fem_sparse, only: sort_row
+   use sprc_core_sort, only: sort_pairs
    implicit none
    private
 
@@ -256,7 +256,7 @@ contains
          real(wp), allocatable, intent(inout) :: vals(:)
          integer, intent(inout) :: count
          integer :: a
-         call sort_row(row_col(1:nrow), acc(1:nrow))
+         call sort_pairs(row_col(1:nrow), acc(1:nrow))
          do a = 1, nrow
             marker(row_col(a)) = 0
          end do

@@ -4,8 +4,7 @@
 !> so the Jacobian is the constant diagonal diag(hi - lo): gradients are the
 !> reference gradients divided by the edge lengths, with no inversion. Shape
 !> functions are tensor products of 1D Lagrange polynomials on equispaced
-!> nodes, and the local node order is `sprc_grid_nodes`' VTK order
-!> (`element_node_index`). Points outside the box are allowed: the element's
+!> nodes, and the local node order is VTK's (`sprc_core_lagrange`). Points outside the box are allowed: the element's
 !> polynomial is then extrapolated (what cell aggregation needs).
 !>
 !> Local dofs are node-major: dof (j - 1) dim + c is component c of node j.
@@ -16,7 +15,7 @@
 !> sized by the element, so it may be called from OpenMP threads.
 module sprc_fem_element
    use sprc_core_kinds, only: wp
-   use sprc_grid_nodes, only: element_node_index
+   use sprc_core_lagrange, only: lagrange_1d, element_node_index
    implicit none
    private
 
@@ -51,20 +50,6 @@ contains
          end do
       end do
    end subroutine shape_functions
-
-   !> 1D Lagrange basis of degree 1 or 2 on the equispaced nodes of [0, 1] and its derivative.
-   pure subroutine lagrange_1d(degree, t, l, dl)
-      integer, intent(in) :: degree
-      real(wp), intent(in) :: t
-      real(wp), intent(out) :: l(0:2), dl(0:2)
-      if (degree == 1) then
-         l = [1.0_wp - t, t, 0.0_wp]
-         dl = [-1.0_wp, 1.0_wp, 0.0_wp]
-      else
-         l = [(2.0_wp*t - 1.0_wp)*(t - 1.0_wp), 4.0_wp*t*(1.0_wp - t), t*(2.0_wp*t - 1.0_wp)]
-         dl = [4.0_wp*t - 3.0_wp, 4.0_wp - 8.0_wp*t, 4.0_wp*t - 1.0_wp]
-      end if
-   end subroutine lagrange_1d
 
    !> Strain-displacement matrix b(nstress, dim*nen): eps = b u_e.
    pure subroutine strain_matrix(dim, dndx, b)

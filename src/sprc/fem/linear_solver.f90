@@ -41,6 +41,14 @@ module sprc_fem_linear_solver
    !> there); so does Q2 in 3D, where GAMG needs ~200 iterations.
    integer, parameter :: auto_never = huge(1)
    integer, parameter :: auto_min_dofs(2:3, 1:2) = reshape([auto_never, 25000, auto_never, auto_never], [2, 2])
+   !> The same for the coupled system of bodies in contact (sprc_contact_solve,
+   !> both bodies' unknowns): its iterative solve sets up the multigrid once
+   !> per active-set iteration with the contact surface on the coarsest
+   !> level, and its tolerance is tighter (pointwise pressures), so the
+   !> crossover lies higher (doc/benchmarks.md: the Hertz sphere, direct
+   !> faster at 17.5k unknowns, iterative at 128k).
+   integer, parameter :: auto_coupled_min_dofs(2:3, 1:2) = reshape([auto_never, 60000, auto_never, auto_never], &
+      & [2, 2])
 
    !> MPI ranks the iterative solves are distributed over (`mpirun -n R`,
    !> sprc_fem_petsc's `start_ranks`); 1 in a serial run. With several ranks
@@ -342,15 +350,22 @@ contains
    !> `solve_ranks` ranks). 'auto' follows `auto_min_dofs`, and also goes
    !> iterative when `direct_fits` is false: a direct solve of the system
    !> would not fit in the memory available (sprc_study_budget).
-   pure logical function use_iterative(choice, dim, degree, n, direct_fits)
+   pure logical function use_iterative(choice, dim, degree, n, direct_fits, coupled)
       integer, intent(in) :: choice, dim, degree, n
       logical, intent(in), optional :: direct_fits
+      !> The coupled system of bodies in contact (`auto_coupled_min_dofs`).
+      logical, intent(in), optional :: coupled
       logical :: fits
+      integer :: min_dofs
 
       fits = .true.
       if (present(direct_fits)) fits = direct_fits
+      min_dofs = auto_iterative_min_dofs(dim, degree)
+      if (present(coupled)) then
+         if (coupled .and. min_dofs /= auto_never) min_dofs = auto_coupled_min_dofs(dim, degree)
+      end if
       use_iterative = choice == solver_iterative .or. (choice == solver_auto .and. &
-         & (solve_ranks > 1 .or. .not. fits .or. n >= auto_iterative_min_dofs(dim, degree)))
+         & (solve_ranks > 1 .or. .not. fits .or. n >= min_dofs))
    end function use_iterative
 
    !> 'auto''s threshold for `dim` and `degree` (`auto_min_dofs`; `auto_never`

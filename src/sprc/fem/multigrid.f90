@@ -24,17 +24,33 @@
 !> C-points' rows are the identity): the Galerkin coarse matrices P^T A P
 !> are symmetric positive definite whenever A is. Coarsening stops at
 !> `coarse_nodes` nodes or when a level no longer shrinks.
+!>
+!> Several bodies in one system (a contact pair: `stack_hierarchies`): each
+!> body's nodes are coarsened on its own lattice and the prolongation of a
+!> level is block diagonal, the bodies' nodes in their order on every level;
+!> a body whose hierarchy is shorter keeps its coarsest nodes (identity) on
+!> the remaining levels. The coupling terms are then seen by the coarse
+!> levels through the Galerkin products of the coupled fine matrix.
+!> Kept nodes (`keep`: those a coupling term of large weight acts on, the
+!> contact surface's) are C-points of their own on every level, and no
+!> F-point takes a weight from them unless they lie on the coarse lattice:
+!> a coarse function is then either a kept node's fine one or zero at
+!> every kept node off the lattice. The coupling, a penalty on the relative
+!> displacement of the two bodies' surfaces, would otherwise lock the
+!> coarse spaces, whose interpolated surfaces do not match (each body's own
+!> grid): CG's iterations then grow with the penalty factor.
+!> Coarsening stops by the count of the nodes not kept.
 module sprc_fem_multigrid
-   use sprc_core_kinds, only: wp, i8
+   use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_alloc, only: check_allocation
-   use sprc_grid_nodes, only: lattice_slot
-   use sprc_fem_sparse, only: sort_row
+   use sprc_core_hash, only: key_table_type
+   use sprc_core_sort, only: sort_pairs
    use sprc_recovery_dense, only: qr_pivoted, apply_q, solve_upper
    implicit none
    private
 
-   public :: prolongation_type, lattice_hierarchy, coarsen
+   public :: prolongation_type, lattice_hierarchy, coarsen, stack_hierarchies
 
    !> A scalar prolongation from `n_coarse` coarse nodes to `n_fine` fine ones
    !> in 1-based CSR (columns ascending in each row), and the coarse nodes'
@@ -44,6 +60,8 @@ module sprc_fem_multigrid
       integer, allocatable :: rowptr(:), col(:)
       real(wp), allocatable :: val(:)
       integer, allocatable :: lattice(:, :)
+      !> The coarse nodes that are kept (module notes); not allocated: none.
+      logical, allocatable :: keep(:)
    end type prolongation_type
 
    !> Stop coarsening at this many nodes or fewer (a coarse problem that a
@@ -54,28 +72,23 @@ module sprc_fem_multigrid
    real(wp), parameter :: min_shrink = 0.8_wp
    character(len=*), parameter :: who = 'multigrid hierarchy'
 
-   !> Points of a lattice (coordinates `at(3, n)`, 0 beyond dim) found by
-   !> open addressing: `table` holds point numbers (0: empty), at most half full.
-   type :: point_set_type
-      integer, allocatable :: at(:, :), table(:)
-      integer :: n = 0
-      integer(i8) :: mask = 0
-   end type point_set_type
-
 contains
 
    !> The prolongations `p(1)` (finest to first coarse level), `p(2)`, ... of
    !> the nodes at the lattice coordinates `lattice(dim, n)` (non-negative,
    !> multiples of `step`, no two alike) whose node step is `step`. `p` is
    !> empty when the nodes do not coarsen (at most `coarse` of them;
-   !> `coarse` defaults to `coarse_nodes`).
-   subroutine lattice_hierarchy(lattice, step, p, error, coarse)
+   !> `coarse` defaults to `coarse_nodes`). `keep`: the nodes kept on every
+   !> level (module notes); they do not count towards `coarse`.
+   subroutine lattice_hierarchy(lattice, step, p, error, coarse, keep)
       integer, intent(in) :: lattice(:, :), step
       type(prolongation_type), allocatable, intent(out) :: p(:)
       type(error_type), allocatable, intent(out) :: error
       integer, intent(in), optional :: coarse
+      logical, intent(in), optional :: keep(:)
       type(prolongation_type) :: next
-      integer :: s, smallest
+      logical, allocatable :: kept(:)
+      integer :: s, smallest, n_free
 
       smallest = coarse_nodes
       if (present(coarse)) smallest = coarse
@@ -83,18 +96,30 @@ contains
       allocate (p(0))
       call check_lattice(lattice, step, error)
       if (allocated(error)) return
-      if (size(lattice, 2) <= smallest) return
+      if (present(keep)) then
+         if (size(keep) /= size(lattice, 2)) then
+            call fatal_error(error, who//': the kept nodes are not given for each node', stat_invalid_input)
+            return
+         end if
+         kept = keep
+      else
+         allocate (kept(size(lattice, 2)), source=.false.)
+      end if
+      n_free = count(.not. kept)
+      if (n_free <= smallest) return
       s = 2*step
       do
          if (size(p) == 0) then
-            call coarsen(lattice, s, next, error)
+            call coarsen(lattice, s, next, error, kept)
          else
-            call coarsen(p(size(p))%lattice, s, next, error)
+            call coarsen(p(size(p))%lattice, s, next, error, kept)
          end if
          if (allocated(error)) return
-         if (real(next%n_coarse, wp) > min_shrink*real(next%n_fine, wp)) exit
+         if (real(next%n_coarse - count(next%keep), wp) > min_shrink*real(n_free, wp)) exit
+         kept = next%keep
+         n_free = next%n_coarse - count(kept)
          p = [p, next]
-         if (next%n_coarse <= smallest .or. s >= 2**22) exit
+         if (n_free <= smallest .or. s >= 2**22) exit
          s = 2*s
       end do
    end subroutine lattice_hierarchy
@@ -104,8 +129,9 @@ contains
    subroutine check_lattice(lattice, step, error)
       integer, intent(in) :: lattice(:, :), step
       type(error_type), allocatable, intent(out) :: error
-      type(point_set_type) :: points
+      type(key_table_type) :: points
       integer :: d, j, other
+      logical :: added
       character(len=160) :: buf
 
       d = size(lattice, 1)
@@ -118,11 +144,12 @@ contains
             & 'multiple of the node step)', stat_invalid_input)
          return
       end if
-      call new_point_set(points, size(lattice, 2), error)
+      call points%init(d, size(lattice, 2), who, error)
       if (allocated(error)) return
       do j = 1, size(lattice, 2)
-         call add_point(points, lattice(:, j), other)
-         if (other /= 0) then
+         call points%insert(lattice(:, j), other, added, error)
+         if (allocated(error)) return
+         if (.not. added) then
             write (buf, '(a,": nodes ",i0," and ",i0," (0-based) share a lattice point")') who, other - 1, j - 1
             call fatal_error(error, trim(buf), stat_invalid_input)
             return
@@ -130,74 +157,19 @@ contains
       end do
    end subroutine check_lattice
 
-   !> An empty set for up to n points.
-   subroutine new_point_set(set, n, error)
-      type(point_set_type), intent(out) :: set
-      integer, intent(in) :: n
-      type(error_type), allocatable, intent(out) :: error
-      integer :: cap, stat
-      cap = 16
-      do while (cap < 2*n)
-         cap = 2*cap
-      end do
-      allocate (set%at(3, n), set%table(0:cap - 1), stat=stat)
-      call check_allocation(stat, who, 'a lattice point set', cap + 3*n, 4, error)
-      if (allocated(error)) return
-      set%table = 0
-      set%mask = int(cap, i8) - 1_i8
-   end subroutine new_point_set
-
-   !> Add the point g as number set%n + 1; `other` is the number of the point
-   !> already there (then nothing is added), 0 if none.
-   subroutine add_point(set, g, other)
-      type(point_set_type), intent(inout) :: set
-      integer, intent(in) :: g(:)
-      integer, intent(out) :: other
-      integer(i8) :: slot
-      call locate(set, g, slot, other)
-      if (other /= 0) return
-      set%n = set%n + 1
-      set%at(:, set%n) = 0
-      set%at(1:size(g), set%n) = g
-      set%table(slot) = set%n
-   end subroutine add_point
-
-   !> Number of the point g in the set, 0 if absent.
-   pure integer function find_point(set, g) result(found)
-      type(point_set_type), intent(in) :: set
-      integer, intent(in) :: g(:)
-      integer(i8) :: slot
-      call locate(set, g, slot, found)
-   end function find_point
-
-   !> The slot of the point g: its number `found` there, or 0 and the empty slot it would take.
-   pure subroutine locate(set, g, slot, found)
-      type(point_set_type), intent(in) :: set
-      integer, intent(in) :: g(:)
-      integer(i8), intent(out) :: slot
-      integer, intent(out) :: found
-      integer :: p(3)
-      p = 0
-      p(1:size(g)) = g
-      slot = lattice_slot(p, set%mask)
-      do while (set%table(slot) /= 0)
-         found = set%table(slot)
-         if (all(set%at(:, found) == p)) return
-         slot = iand(slot + 1_i8, set%mask)
-      end do
-      found = 0
-   end subroutine locate
-
    !> One coarsening (module notes) of the nodes `lattice(dim, n)` to the
-   !> lattice of spacing `s`: the prolongation and the coarse nodes.
-   subroutine coarsen(lattice, s, p, error)
+   !> lattice of spacing `s`: the prolongation and the coarse nodes; `keep`
+   !> the nodes kept (C-points of their own), `p%keep` the coarse ones.
+   subroutine coarsen(lattice, s, p, error, keep)
       integer, intent(in) :: lattice(:, :), s
       type(prolongation_type), intent(out) :: p
       type(error_type), allocatable, intent(out) :: error
-      type(point_set_type) :: c_points
+      logical, intent(in), optional :: keep(:)
+      type(key_table_type) :: c_points
       integer, allocatable :: coarse_of(:), col(:)
       real(wp), allocatable :: val(:)
-      integer :: d, n, j, stat, nc, q, m, other, cols(4**size(lattice, 1))
+      integer :: d, n, j, stat, nc, q, m, cols(4**size(lattice, 1))
+      logical :: added
       real(wp) :: vals(4**size(lattice, 1))
 
       d = size(lattice, 1)
@@ -205,14 +177,14 @@ contains
       allocate (coarse_of(n), p%rowptr(n + 1), col(2*n), val(2*n), stat=stat)
       call check_allocation(stat, who, 'a prolongation', n, 24, error)
       if (allocated(error)) return
-      call new_point_set(c_points, n, error)
+      call c_points%init(d, n, who, error)
       if (allocated(error)) return
       ! C-points on the coarse lattice, numbered in node order
       coarse_of = 0
       do j = 1, n
          if (all(mod(lattice(:, j), s) == 0)) then
-            call add_point(c_points, lattice(:, j)/s, other)
-            coarse_of(j) = c_points%n
+            call c_points%insert(lattice(:, j)/s, coarse_of(j), added, error)
+            if (allocated(error)) return
          end if
       end do
       ! rows: injection at C-points; F-points get weights, or are C-points of their own
@@ -221,7 +193,8 @@ contains
       do j = 1, n
          p%rowptr(j) = q + 1
          if (coarse_of(j) == 0) then
-            call f_point_weights(lattice(:, j), s, c_points, cols, vals, m)
+            m = 0
+            if (.not. kept(j)) call f_point_weights(lattice(:, j), s, c_points, cols, vals, m)
             if (m == 0) then
                nc = nc + 1
                coarse_of(j) = nc
@@ -240,12 +213,21 @@ contains
       p%n_coarse = nc
       p%col = col(1:q)
       p%val = val(1:q)
-      allocate (p%lattice(d, nc), stat=stat)
-      call check_allocation(stat, who, 'the coarse nodes', nc, 4*d, error)
+      allocate (p%lattice(d, nc), p%keep(nc), stat=stat)
+      call check_allocation(stat, who, 'the coarse nodes', nc, 4*d + 4, error)
       if (allocated(error)) return
+      p%keep = .false.
       do j = 1, n
-         if (coarse_of(j) /= 0) p%lattice(:, coarse_of(j)) = lattice(:, j)
+         if (coarse_of(j) == 0) cycle
+         p%lattice(:, coarse_of(j)) = lattice(:, j)
+         p%keep(coarse_of(j)) = kept(j)
       end do
+   contains
+      pure logical function kept(j)
+         integer, intent(in) :: j
+         kept = .false.
+         if (present(keep)) kept = keep(j)
+      end function kept
    end subroutine coarsen
 
    !> Append a row (sorted by column) after position q of the growing arrays col, val.
@@ -270,7 +252,7 @@ contains
          call move_alloc(col_new, col)
          call move_alloc(val_new, val)
       end if
-      call sort_row(cols, vals)
+      call sort_pairs(cols, vals)
       col(q + 1:q + m) = cols
       val(q + 1:q + m) = vals
       q = q + m
@@ -286,7 +268,7 @@ contains
    !> -1 .. 2): few weights, so the coarse matrices stay sparse.
    subroutine f_point_weights(q, s, c_points, cols, vals, m)
       integer, intent(in) :: q(:), s
-      type(point_set_type), intent(in) :: c_points
+      type(key_table_type), intent(in) :: c_points
       integer, intent(out) :: cols(:)
       real(wp), intent(out) :: vals(:)
       integer, intent(out) :: m
@@ -303,7 +285,7 @@ contains
       rank = -1
       do k = 0, 2**d - 1
          off = [(mod(k/2**(i - 1), 2), i = 1, d)]
-         c = find_point(c_points, base + off)
+         c = c_points%find(base + off)
          if (c == 0) then
             if (linear_weight(t, off) /= 0.0_wp) complete = .false.
             cycle
@@ -328,7 +310,7 @@ contains
             off = [(mod(k/4**(i - 1), 4) - 1, i = 1, d)]
             corner = all(off == 0 .or. off == 1)
             if (corner) cycle
-            c = find_point(c_points, base + off)
+            c = c_points%find(base + off)
             if (c == 0) cycle
             n_near = n_near + 1
             order(n_near) = c
@@ -430,5 +412,83 @@ contains
       call apply_q(m, n, at, tau, 1, y)
       w = w0 + y(:, 1)
    end subroutine closest_linear_weights
+
+   !> The hierarchy of two node sets numbered one after the other (`a`'s
+   !> `na` fine nodes first, then `b`'s `nb`): level l's prolongation is
+   !> diag(a(l), b(l)), with the identity for a set whose hierarchy has ended
+   !> (module notes); one identity level when neither coarsens. The coarse
+   !> lattices are not kept (they belong to different lattices).
+   subroutine stack_hierarchies(a, na, b, nb, p, error)
+      type(prolongation_type), intent(in) :: a(:), b(:)
+      integer, intent(in) :: na, nb
+      type(prolongation_type), allocatable, intent(out) :: p(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(prolongation_type) :: ia, ib
+      integer :: l, ma, mb, stat
+
+      allocate (p(max(size(a), size(b))), stat=stat)
+      call check_allocation(stat, who, 'the stacked levels', size(p), 64, error)
+      if (allocated(error)) return
+      ma = na
+      mb = nb
+      do l = 1, size(p)
+         if (l <= size(a)) then
+            if (a(l)%n_fine /= ma) exit
+            ia = a(l)
+         else
+            call identity(ma, ia)
+         end if
+         if (l <= size(b)) then
+            if (b(l)%n_fine /= mb) exit
+            ib = b(l)
+         else
+            call identity(mb, ib)
+         end if
+         call diagonal_pair(ia, ib, p(l), error)
+         if (allocated(error)) return
+         ma = ia%n_coarse
+         mb = ib%n_coarse
+      end do
+      if (l <= size(p)) call fatal_error(error, who//': a level of the stacked hierarchies does not start from '// &
+         & 'the nodes of the level before', stat_invalid_input)
+      if (size(p) > 0 .or. allocated(error)) return
+      ! Neither coarsens (both small): one identity level, so that the coarse
+      ! solve is the whole system, exact, rather than no hierarchy (GAMG,
+      ! whose aggregates lock under the coupling as unkept nodes do).
+      deallocate (p)
+      allocate (p(1))
+      call identity(na + nb, p(1))
+   end subroutine stack_hierarchies
+
+   !> The identity prolongation of n nodes.
+   pure subroutine identity(n, p)
+      integer, intent(in) :: n
+      type(prolongation_type), intent(out) :: p
+      integer :: j
+      p%n_fine = n
+      p%n_coarse = n
+      p%rowptr = [(j, j = 1, n + 1)]
+      p%col = [(j, j = 1, n)]
+      p%val = [(1.0_wp, j = 1, n)]
+   end subroutine identity
+
+   !> diag(a, b): b's rows and columns after a's.
+   subroutine diagonal_pair(a, b, p, error)
+      type(prolongation_type), intent(in) :: a, b
+      type(prolongation_type), intent(out) :: p
+      type(error_type), allocatable, intent(out) :: error
+      integer :: nnz_a, stat
+
+      nnz_a = a%rowptr(a%n_fine + 1) - 1
+      p%n_fine = a%n_fine + b%n_fine
+      p%n_coarse = a%n_coarse + b%n_coarse
+      allocate (p%rowptr(p%n_fine + 1), stat=stat)
+      call check_allocation(stat, who, 'a stacked prolongation', p%n_fine, 4, error)
+      if (allocated(error)) return
+      p%rowptr(1:a%n_fine) = a%rowptr(1:a%n_fine)
+      p%rowptr(a%n_fine + 1:) = b%rowptr + nnz_a
+      p%col = [a%col(1:nnz_a), b%col(1:b%rowptr(b%n_fine + 1) - 1) + a%n_coarse]
+      p%val = [a%val(1:nnz_a), b%val(1:b%rowptr(b%n_fine + 1) - 1)]
+   end subroutine diagonal_pair
 
 end module sprc_fem_multigrid

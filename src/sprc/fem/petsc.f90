@@ -31,7 +31,8 @@ module sprc_fem_petsc
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_unsupported
    use sprc_core_blas_threads, only: blas_serial_begin, blas_serial_end
    use sprc_core_alloc, only: check_allocation
-   use sprc_fem_sparse, only: csr_type, sort_row
+   use sprc_fem_sparse, only: csr_type
+   use sprc_core_sort, only: sort_pairs
    use sprc_fem_linear_solver, only: linear_solver_type, backend_error, message_length, set_solve_ranks, solve_ranks
    use sprc_fem_multigrid, only: prolongation_type, lattice_hierarchy
    implicit none
@@ -54,6 +55,9 @@ module sprc_fem_petsc
       !> node step (`set_lattice`): geometric multigrid when allocated.
       integer, allocatable :: lattice(:, :)
       integer :: step = 0
+      !> Prolongations given by the caller (`set_hierarchy`): built once,
+      !> used by every `factorize` until the next `set_blocks`.
+      type(prolongation_type), allocatable :: hierarchy(:)
       !> True when the last `factorize` set up geometric multigrid (false: GAMG).
       logical, public :: multigrid = .false.
       !> The blocked matrix in 0-based CSR (`padded_csr`), this rank's rows
@@ -78,6 +82,7 @@ module sprc_fem_petsc
    contains
       procedure :: set_blocks
       procedure :: set_lattice
+      procedure :: set_hierarchy
       procedure :: factorize_backend => petsc_factorize
       procedure :: solve_backend => petsc_solve
       procedure :: destroy_backend => petsc_destroy
@@ -256,6 +261,7 @@ contains
       end if
       self%coords = reshape(x, [self%n_padded])
       if (allocated(self%lattice)) deallocate (self%lattice)
+      if (allocated(self%hierarchy)) deallocate (self%hierarchy)
    end subroutine set_blocks
 
    !> Geometric multigrid (`sprc_fem_multigrid`) instead of GAMG, after
@@ -277,6 +283,31 @@ contains
       self%lattice = lattice
       self%step = step
    end subroutine set_lattice
+
+   !> Geometric multigrid on prolongations the caller built (after
+   !> `set_blocks`; `p(1)%n_fine` is the number of blocks), kept for every
+   !> later `factorize`: the hierarchy of several bodies in one system
+   !> (`stack_hierarchies`), built once and used for each of the systems
+   !> that differ in their coupling terms only. A distributed solve keeps GAMG.
+   subroutine set_hierarchy(self, p, error)
+      class(petsc_solver_type), intent(inout) :: self
+      type(prolongation_type), intent(in) :: p(:)
+      type(error_type), allocatable, intent(out) :: error
+
+      if (allocated(self%hierarchy)) deallocate (self%hierarchy)
+      if (self%dim == 0) then
+         call fatal_error(error, 'iterative solver: set_blocks must come before set_hierarchy', stat_invalid_input)
+         return
+      end if
+      if (size(p) > 0) then
+         if (p(1)%n_fine*self%dim /= self%n_padded) then
+            call fatal_error(error, 'iterative solver: the finest prolongation does not map to the blocks of '// &
+               & 'set_blocks', stat_invalid_input)
+            return
+         end if
+      end if
+      self%hierarchy = p
+   end subroutine set_hierarchy
 
    subroutine petsc_factorize(self, a, error)
       class(petsc_solver_type), intent(inout) :: self
@@ -302,8 +333,12 @@ contains
       end if
       call padded_csr(self, a, self%rowptr, self%col, self%val, error)
       if (allocated(error)) return
-      if (allocated(self%lattice) .and. solve_ranks == 1) then
-         call lattice_hierarchy(self%lattice, self%step, p, error)
+      if ((allocated(self%lattice) .or. allocated(self%hierarchy)) .and. solve_ranks == 1) then
+         if (allocated(self%hierarchy)) then
+            p = self%hierarchy
+         else
+            call lattice_hierarchy(self%lattice, self%step, p, error)
+         end if
          if (allocated(error)) return
          call blocked_levels(p, self%dim, n_coarse, rowptr, col, val, error)
          if (allocated(error)) return
@@ -435,7 +470,7 @@ contains
             val(k) = a%val(q)
          end do
          associate (r0 => rowptr(p - p0 + 1))
-            if (any(col(r0 + 2:k) <= col(r0 + 1:k - 1))) call sort_row(col(r0 + 1:k), val(r0 + 1:k))
+            if (any(col(r0 + 2:k) <= col(r0 + 1:k - 1))) call sort_pairs(col(r0 + 1:k), val(r0 + 1:k))
          end associate
       end do
       rowptr(p1 - p0 + 2) = int(k, c_int32_t)

@@ -65,6 +65,7 @@ module sprc_fem_problem
    use sprc_fem_umfpack, only: umfpack_solver_type
    use sprc_fem_linear_solver, only: linear_solver_type, solver_auto, use_iterative
    use sprc_fem_petsc, only: petsc_solver_type, iteration_tolerance, start_petsc
+   use sprc_fem_multigrid, only: prolongation_type, lattice_hierarchy
    use sprc_fem_nested, only: fe_displacement_type
    use sprc_fem_element, only: shape_functions, strain_matrix, traction_matrix, displacement_matrix, &
       & add_stiffness, mirror_upper, element_stress, element_strain
@@ -77,7 +78,7 @@ module sprc_fem_problem
    private
 
    public :: elasticity_problem_type, default_gamma, rigid_tol, solve_on_grid, gamma_range, gamma_note
-   public :: free_motions, motion_names, solve_spd_or_lu
+   public :: free_motions, motion_names, solve_spd_or_lu, master_hierarchy, lattice_step
 
    !> A rigid-body mode whose normalised energy (module notes of `check_rigid_modes`)
    !> is below this is free. Free modes give round-off, ~1e-15; the weakest
@@ -1214,7 +1215,7 @@ contains
       ! nodes without lattice coordinates (none are built so): GAMG
       associate (nodes => self%mesh%nodes)
          if (allocated(nodes%lattice)) call krylov%set_lattice(nodes%lattice(:, self%constraints%master_node), &
-            & 2**(nodes%lattice_level - self%mesh%grid%max_level)/self%degree, error)
+            & lattice_step(self), error)
       end associate
       if (allocated(error)) return
       if (allocated(self%start)) then
@@ -1241,6 +1242,30 @@ contains
       self%solver_iterations = self%solver_iterations + krylov%iterations
       if (allocated(error)) error%message = 'elasticity solve (GMRES fallback): '//error%message
    end subroutine iterative_solve
+
+   !> The lattice step between neighbouring nodes of the finest elements
+   !> (`sprc_fem_petsc`'s `set_lattice`).
+   pure integer function lattice_step(self) result(step)
+      type(elasticity_problem_type), intent(in) :: self
+      step = 2**(self%mesh%nodes%lattice_level - self%mesh%grid%max_level)/self%degree
+   end function lattice_step
+
+   !> The geometric multigrid hierarchy of this body's reduced unknowns (its
+   !> master nodes on the node lattice, `lattice_hierarchy`); `found` is false
+   !> when the nodes have no lattice coordinates. `keep(m)`: master m is
+   !> kept on every level (`lattice_hierarchy`).
+   subroutine master_hierarchy(self, p, found, error, keep)
+      type(elasticity_problem_type), intent(in) :: self
+      type(prolongation_type), allocatable, intent(out) :: p(:)
+      logical, intent(out) :: found
+      type(error_type), allocatable, intent(out) :: error
+      logical, intent(in), optional :: keep(:)
+
+      found = allocated(self%mesh%nodes%lattice)
+      if (.not. found) return
+      call lattice_hierarchy(self%mesh%nodes%lattice(:, self%constraints%master_node), lattice_step(self), p, error, &
+         & keep=keep)
+   end subroutine master_hierarchy
 
    !> 'gmg' (geometric multigrid on the node lattice) or 'gamg'.
    pure function preconditioner_name(krylov) result(name)

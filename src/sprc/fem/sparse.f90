@@ -18,12 +18,13 @@
 module sprc_fem_sparse
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use sprc_core_kinds, only: wp, i8
+   use sprc_core_sort, only: sort_pairs
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_alloc, only: check_allocation
    implicit none
    private
 
-   public :: coo_type, csr_type, block_list_type, csr_validate, sort_row
+   public :: coo_type, csr_type, block_list_type, csr_validate
 
    !> Capacity of a `coo_type` whose first `add` finds no storage.
    integer(i8), parameter :: min_capacity = 64
@@ -416,80 +417,9 @@ contains
                a%val(q) = tval(p)
             end if
          end do
-         call sort_row(a%col(a%rowptr(i):q), a%val(a%rowptr(i):q))
+         call sort_pairs(a%col(a%rowptr(i):q), a%val(a%rowptr(i):q))
       end do
    end subroutine merge_band
-
-   !> Sort distinct columns ascending, carrying the values: insertion sort for
-   !> the short rows of finite elements, heap sort beyond.
-   subroutine sort_row(col, val)
-      integer, intent(inout) :: col(:)
-      real(wp), intent(inout) :: val(:)
-      integer, parameter :: short = 32
-      integer :: m, k, c
-      real(wp) :: v
-
-      if (size(col) > short) then
-         call heap_sort(col, val)
-         return
-      end if
-      do k = 2, size(col)
-         c = col(k)
-         v = val(k)
-         m = k - 1
-         do while (m >= 1)
-            if (col(m) <= c) exit
-            col(m + 1) = col(m)
-            val(m + 1) = val(m)
-            m = m - 1
-         end do
-         col(m + 1) = c
-         val(m + 1) = v
-      end do
-   end subroutine sort_row
-
-   subroutine heap_sort(col, val)
-      integer, intent(inout) :: col(:)
-      real(wp), intent(inout) :: val(:)
-      integer :: n, k
-
-      n = size(col)
-      do k = n/2, 1, -1
-         call sift_down(col, val, k, n)
-      end do
-      do k = n, 2, -1
-         call swap(col, val, 1, k)
-         call sift_down(col, val, 1, k - 1)
-      end do
-   end subroutine heap_sort
-
-   subroutine sift_down(col, val, first, last)
-      integer, intent(inout) :: col(:)
-      real(wp), intent(inout) :: val(:)
-      integer, intent(in) :: first, last
-      integer :: root, child
-
-      root = first
-      do while (2*root <= last)
-         child = 2*root
-         if (child < last) then
-            if (col(child + 1) > col(child)) child = child + 1
-         end if
-         if (col(root) >= col(child)) return
-         call swap(col, val, root, child)
-         root = child
-      end do
-   end subroutine sift_down
-
-   subroutine swap(col, val, i, j)
-      integer, intent(inout) :: col(:)
-      real(wp), intent(inout) :: val(:)
-      integer, intent(in) :: i, j
-      integer :: c
-      real(wp) :: v
-      c = col(i); col(i) = col(j); col(j) = c
-      v = val(i); val(i) = val(j); val(j) = v
-   end subroutine swap
 
    !> Room for blocks of sizes m(1..nblocks) on an n x n matrix (their dofs,
    !> values and vectors uninitialised).
@@ -649,7 +579,7 @@ contains
                v0 = v0 + m
             end do
          end do
-         call sort_row(a%col(a%rowptr(i):q), a%val(a%rowptr(i):q))
+         call sort_pairs(a%col(a%rowptr(i):q), a%val(a%rowptr(i):q))
       end do
       !$omp end do
       !$omp end parallel

@@ -28,6 +28,7 @@
 module sprc_geometry_shape
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use sprc_core_kinds, only: wp
+   use sprc_core_sort, only: sort
    use sprc_core_text, only: itoa, rtoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    implicit none
@@ -641,7 +642,7 @@ contains
          breaks(nbreak + 1:nbreak + 2) = [tfirst(i), tlast(i)]
          nbreak = nbreak + 2
       end do
-      call insertion_sort(breaks(1:nbreak))
+      call sort(breaks(1:nbreak))
       ! sentinels: the first and last pieces are unbounded
       breaks(0) = -huge(1.0_wp)
       breaks(nbreak + 1) = huge(1.0_wp)
@@ -689,22 +690,6 @@ contains
       real(wp), intent(in) :: q(3), lo(3), hi(3)
       length = norm2(max(lo - q, 0.0_wp, q - hi))
    end function gap_length
-
-   pure subroutine insertion_sort(v)
-      real(wp), intent(inout) :: v(:)
-      real(wp) :: key
-      integer :: i, j
-      do i = 2, size(v)
-         key = v(i)
-         j = i - 1
-         do while (j >= 1)
-            if (v(j) <= key) exit
-            v(j + 1) = v(j)
-            j = j - 1
-         end do
-         v(j + 1) = key
-      end do
-   end subroutine insertion_sort
 
    ! ------------------------------------------------------------ validation
 

@@ -1,15 +1,7 @@
 !> Nodes of the Q1 / Q2 Lagrange elements on the active leaves of a grid.
 !>
 !> Elements are the grid's leaves in its (Morton) order: element e is leaf e.
-!> Local node order is VTK's, so output needs no permutation:
-!> - quad4 (VTK_QUAD):      (0,0) (1,0) (1,1) (0,1)
-!> - quad9 (VTK_BIQUADRATIC_QUAD): corners as quad4, then edge midpoints of
-!>   y=0, x=1, y=1, x=0, then the centre
-!> - hex8 (VTK_HEXAHEDRON): bottom face z=0 as quad4, then top face z=1
-!> - hex27 (VTK_TRIQUADRATIC_HEXAHEDRON): 8 corners as hex8; edge midpoints of
-!>   the bottom face (as quad9's 4..7), of the top face, then the vertical edges
-!>   above corners 0..3; face centres x=0, x=1, y=0, y=1, z=0, z=1; the centre.
-!> `element_node_index` gives these as Lagrange indices (0..degree per axis).
+!> Local node order is VTK's (`sprc_core_lagrange`), so output needs no permutation.
 !>
 !> Nodes live on an integer lattice of resolution `lattice_level` = finest leaf
 !> level + 1 (so Q2 midpoints of the finest leaves are lattice points) and are
@@ -21,12 +13,13 @@ module sprc_grid_nodes
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_alloc, only: check_allocation
-   use sprc_core_hash, only: hash_int
+   use sprc_core_hash, only: key_table_type
+   use sprc_core_lagrange, only: element_node_index, tensor_shape
    use sprc_grid_tree, only: grid_type
    implicit none
    private
 
-   public :: grid_nodes_type, element_node_index, element_shape, nodes_per_element, lattice_slot
+   public :: grid_nodes_type, element_node_index, element_shape, nodes_per_element
 
    !> The routine named in messages.
    character(len=*), parameter :: who = 'grid nodes'
@@ -59,66 +52,13 @@ contains
       nodes_per_element = (degree + 1)**dim
    end function nodes_per_element
 
-   !> Lagrange indices (dim, (degree+1)**dim) of the local nodes in VTK order: node j
-   !> sits at reference position index(:, j) / degree in [0, 1]^dim.
-   pure function element_node_index(dim, degree) result(idx)
-      integer, intent(in) :: dim, degree
-      integer :: idx(dim, (degree + 1)**dim)
-      integer, parameter :: quad4(2, 4) = reshape([0, 0, 1, 0, 1, 1, 0, 1], [2, 4])
-      integer, parameter :: quad9(2, 9) = reshape([0, 0, 2, 0, 2, 2, 0, 2, 1, 0, 2, 1, 1, 2, 0, 1, 1, 1], [2, 9])
-      integer, parameter :: hex8(3, 8) = reshape([0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, &
-         & 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1], [3, 8])
-      integer, parameter :: hex27(3, 27) = reshape([ &
-         & 0, 0, 0, 2, 0, 0, 2, 2, 0, 0, 2, 0, 0, 0, 2, 2, 0, 2, 2, 2, 2, 0, 2, 2, &
-         & 1, 0, 0, 2, 1, 0, 1, 2, 0, 0, 1, 0, &
-         & 1, 0, 2, 2, 1, 2, 1, 2, 2, 0, 1, 2, &
-         & 0, 0, 1, 2, 0, 1, 2, 2, 1, 0, 2, 1, &
-         & 0, 1, 1, 2, 1, 1, 1, 0, 1, 1, 2, 1, 1, 1, 0, 1, 1, 2, &
-         & 1, 1, 1], [3, 27])
-
-      if (dim == 2 .and. degree == 1) then
-         idx = quad4
-      else if (dim == 2) then
-         idx = quad9
-      else if (degree == 1) then
-         idx = hex8
-      else
-         idx = hex27
-      end if
-   end function element_node_index
-
    !> Values of the Q`degree` shape functions (VTK order) at reference point xi in [0, 1]^dim.
    pure subroutine element_shape(dim, degree, xi, shape)
       integer, intent(in) :: dim, degree
       real(wp), intent(in) :: xi(:)
       real(wp), intent(out) :: shape(:)
-      real(wp) :: l1d(0:2, 3)
-      integer :: idx(dim, (degree + 1)**dim)
-      integer :: j, k
-
-      do k = 1, dim
-         call lagrange_1d(degree, xi(k), l1d(:, k))
-      end do
-      idx = element_node_index(dim, degree)
-      do j = 1, size(idx, 2)
-         shape(j) = 1.0_wp
-         do k = 1, dim
-            shape(j) = shape(j)*l1d(idx(k, j), k)
-         end do
-      end do
+      call tensor_shape(element_node_index(dim, degree), degree, xi, shape)
    end subroutine element_shape
-
-   !> 1D Lagrange basis of degree 1 or 2 on equispaced nodes of [0, 1].
-   pure subroutine lagrange_1d(degree, t, l)
-      integer, intent(in) :: degree
-      real(wp), intent(in) :: t
-      real(wp), intent(out) :: l(0:2)
-      if (degree == 1) then
-         l = [1.0_wp - t, t, 0.0_wp]
-      else
-         l = [(2.0_wp*t - 1.0_wp)*(t - 1.0_wp), 4.0_wp*t*(1.0_wp - t), t*(2.0_wp*t - 1.0_wp)]
-      end if
-   end subroutine lagrange_1d
 
    !> Number the Q`degree` nodes of the active leaves of `grid`.
    subroutine nodes_build(self, grid, degree, error)
@@ -126,8 +66,10 @@ contains
       type(grid_type), intent(in) :: grid
       integer, intent(in) :: degree
       type(error_type), allocatable, intent(out) :: error
-      integer, allocatable :: idx(:, :), table(:), lattice(:, :)
-      integer :: d, nen, e, j, size_e, step, g(3), node, cap, estimate, stat
+      integer, allocatable :: idx(:, :)
+      type(key_table_type) :: table
+      integer :: d, nen, e, j, size_e, step, estimate, stat
+      logical :: added
       real(wp) :: h
 
       if (degree /= 1 .and. degree /= 2) then
@@ -147,39 +89,26 @@ contains
       self%n_elements = grid%n_leaves
       self%lattice_level = grid%max_level + 1
 
-      ! Each element adds about degree**dim nodes of its own; the lattice grows if that is short.
+      ! Each element adds about degree**dim nodes of its own; the table grows if that is short.
       estimate = grid%n_leaves*degree**d + 64
-      cap = 16
-      do while (cap < 2*estimate)
-         cap = 2*cap
-      end do
-      allocate (table(0:cap - 1), stat=stat)
-      call check_allocation(stat, who, 'the node hash table', cap, 4, error)
-      if (allocated(error)) return
-      allocate (self%lattice(d, estimate), stat=stat)
-      call check_allocation(stat, who, 'the node lattice points', estimate, 4*d, error)
+      call table%init(d, estimate, who, error)
       if (allocated(error)) return
       allocate (self%connectivity(nen, grid%n_leaves), stat=stat)
       call check_allocation(stat, who, 'the element connectivity', grid%n_leaves, 4*nen, error)
       if (allocated(error)) return
-      table = 0
-      g = 0
       do e = 1, grid%n_leaves
          size_e = 2**(self%lattice_level - grid%leaf_level(e))
          step = size_e/degree
          do j = 1, nen
-            g(1:d) = grid%leaf_coord(:, e)*size_e + idx(:, j)*step
-            call find_or_add(self, table, g, node, error)
+            call table%insert(grid%leaf_coord(:, e)*size_e + idx(:, j)*step, self%connectivity(j, e), added, error)
             if (allocated(error)) return
-            self%connectivity(j, e) = node
          end do
       end do
-      deallocate (table)
-      allocate (lattice(d, self%n_nodes), stat=stat)
+      self%n_nodes = table%n
+      allocate (self%lattice(d, self%n_nodes), stat=stat)
       call check_allocation(stat, who, 'the node lattice points', self%n_nodes, 4*d, error)
       if (allocated(error)) return
-      lattice(:, :) = self%lattice(:, 1:self%n_nodes)
-      call move_alloc(lattice, self%lattice)
+      self%lattice(:, :) = table%keys(:, 1:self%n_nodes)
 
       h = grid%box_size*2.0_wp**(-self%lattice_level)
       allocate (self%x(d, self%n_nodes), stat=stat)
@@ -218,75 +147,6 @@ contains
       copy%nodes_per_element = self%nodes_per_element
       copy%lattice_level = self%lattice_level
    end subroutine nodes_copy
-
-   !> Node at lattice point g, added if new. `table` holds node numbers (0: empty)
-   !> and is kept at most half full.
-   subroutine find_or_add(self, table, g, node, error)
-      type(grid_nodes_type), intent(inout) :: self
-      integer, allocatable, intent(inout) :: table(:)
-      integer, intent(in) :: g(3)
-      integer, intent(out) :: node
-      type(error_type), allocatable, intent(out) :: error
-      integer(i8) :: s, mask
-      integer, allocatable :: tmp(:, :)
-      integer :: stat
-
-      mask = int(size(table), i8) - 1_i8
-      s = lattice_slot(g, mask)
-      do while (table(s) /= 0)
-         if (all(self%lattice(:, table(s)) == g(1:self%dim))) then
-            node = table(s)
-            return
-         end if
-         s = iand(s + 1_i8, mask)
-      end do
-      self%n_nodes = self%n_nodes + 1
-      node = self%n_nodes
-      if (node > size(self%lattice, 2)) then
-         allocate (tmp(self%dim, 2*size(self%lattice, 2)), stat=stat)
-         call check_allocation(stat, who, 'the node lattice points', 2*size(self%lattice, 2), &
-            & 4*self%dim, error)
-         if (allocated(error)) return
-         tmp(:, 1:node - 1) = self%lattice(:, 1:node - 1)
-         call move_alloc(tmp, self%lattice)
-      end if
-      self%lattice(:, node) = g(1:self%dim)
-      table(s) = node
-      if (2*self%n_nodes > size(table)) call rehash(self, table, error)
-   end subroutine find_or_add
-
-   subroutine rehash(self, table, error)
-      type(grid_nodes_type), intent(in) :: self
-      integer, allocatable, intent(inout) :: table(:)
-      type(error_type), allocatable, intent(out) :: error
-      integer(i8) :: s, mask
-      integer :: i, g(3), size_old, stat
-      size_old = size(table)
-      deallocate (table)
-      allocate (table(0:2*size_old - 1), stat=stat)
-      call check_allocation(stat, who, 'the node hash table', 2*size_old, 4, error)
-      if (allocated(error)) return
-      table = 0
-      mask = int(size(table), i8) - 1_i8
-      g = 0
-      do i = 1, self%n_nodes
-         g(1:self%dim) = self%lattice(:, i)
-         s = lattice_slot(g, mask)
-         do while (table(s) /= 0)
-            s = iand(s + 1_i8, mask)
-         end do
-         table(s) = i
-      end do
-   end subroutine rehash
-
-   !> Slot of the lattice point g (0 beyond dim) in a hash table of mask + 1 slots (a power of 2).
-   !> Lattice coordinates are multiples of powers of two: every bit must reach the slot
-   !> (sprc_core_hash).
-   pure integer(i8) function lattice_slot(g, mask)
-      integer, intent(in) :: g(3)
-      integer(i8), intent(in) :: mask
-      lattice_slot = iand(hash_int(g), mask)
-   end function lattice_slot
 
    !> Node -> elements adjacency (CSR), elements ascending.
    subroutine node_elements(self, error)

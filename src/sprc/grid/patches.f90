@@ -60,6 +60,9 @@ module sprc_grid_patches
    use sprc_grid_contact, only: grid_contact_type, contact_patch_solve
    use sprc_grid_recovered_field, only: recovered_field_type, method_spr, method_sprc, build_field
    use sprc_grid_share, only: share_type, share_range, gather_patches
+   use sprc_exact_corner, only: corner_type
+   use sprc_grid_singular, only: corner_site_type, singular_fit_type, find_corners, fit_corner, enrich_cells, &
+      & inner_cells
    implicit none
    private
 
@@ -102,6 +105,13 @@ module sprc_grid_patches
       real(wp), pointer :: elem_lo(:, :) => null(), elem_hi(:, :) => null()
       class(exact_solution_type), pointer :: exact => null()
       type(grid_contact_type), pointer :: contacts(:) => null()
+      !> Singular fields of re-entrant corners and the corner each node's patch leaves
+      !> out (0: none), sprc_grid_singular; unassociated without corners.
+      type(singular_fit_type), pointer :: corners(:) => null()
+      integer, pointer :: node_corner(:) => null()
+      !> Each corner's stress S at the volume points (3, npts, corner) and its
+      !> traction S n at the boundary points (2, nb, corner), evaluated once.
+      real(wp), pointer :: corner_stress(:, :, :) => null(), corner_traction(:, :, :) => null()
       integer :: nstress = 0
       logical :: sprc = .false.
    contains
@@ -138,6 +148,8 @@ contains
       class(share_type), intent(in), optional :: share
       type(grid_source_type) :: src
       type(patch_loop_type) :: opt
+      integer, allocatable, target :: node_corner(:)
+      real(wp), allocatable, target :: corner_stress(:, :, :), corner_traction(:, :, :)
       logical, allocatable :: skip(:)
       integer, allocatable :: first(:)
       integer :: rounds_limit, ip, e, n, stat, lo, hi
@@ -191,6 +203,16 @@ contains
       end if
       src%nstress = field%nstress
       src%sprc = method == method_sprc
+      if (grid%dim == 2 .and. .not. present(contacts)) then
+         call singular_corners(src, degree, field, node_corner)
+         if (allocated(field%singular)) then
+            call corner_values(input, field%singular, corner_stress, corner_traction)
+            src%corners => field%singular
+            src%node_corner => node_corner
+            src%corner_stress => corner_stress
+            src%corner_traction => corner_traction
+         end if
+      end if
       opt = patch_loop_type(dim=grid%dim, degree=degree, rounds_limit=rounds_limit, sprc=src%sprc)
       ! Over all nodes, hanging ones included: the capacity (and with it the bits) of before.
       opt%cap = patch_capacity(src, grid%dim, degree, nodes%node_element_ptr, nodes%node_element, &
@@ -345,7 +367,8 @@ contains
       integer, intent(in) :: node, elements(:)
       type(patch_type), intent(inout) :: patch
       real(wp) :: x0(3), h, t(3)
-      integer :: d, i, e, k, np, nb, kind, ns
+      integer :: d, i, e, k, np, nb, kind, ns, c
+      logical :: inner
 
       associate (input => self%input, elem_lo => self%elem_lo, elem_hi => self%elem_hi)
          d = self%nodes%dim
@@ -364,6 +387,11 @@ contains
          call patch_reset(patch, d, input%analysis, input%young, input%poisson, x0(1:d), h)
          call patch_reserve(patch, np, nb)
          patch%body_force(1:d) = input%body_force(1:d)
+         ! the corner whose singular field the patch leaves out (sprc_grid_singular)
+         c = 0
+         if (associated(self%node_corner)) c = abs(self%node_corner(node))
+         inner = .false.
+         if (c > 0) inner = self%node_corner(node) < 0
          do i = 1, size(elements)
             e = elements(i)
             do k = input%elem_ptr(e), input%elem_ptr(e + 1) - 1
@@ -371,6 +399,11 @@ contains
                patch%x(1:d, patch%npoints) = input%x(:, k)
                patch%w(patch%npoints) = input%w(k)
                patch%stress(1:ns, patch%npoints) = input%stress(:, k)
+               if (inner) then
+                  call self%corners(c)%smooth_stress(input%x(:, k), patch%stress(1:3, patch%npoints))
+               else if (c > 0) then
+                  patch%stress(1:3, patch%npoints) = input%stress(:, k) - self%corner_stress(:, k, c)
+               end if
             end do
             if (.not. self%sprc) cycle
             do k = input%belem_ptr(e), input%belem_ptr(e + 1) - 1
@@ -383,10 +416,130 @@ contains
                patch%bkind(patch%nbpoints) = kind
                patch%bpiece(patch%nbpoints) = input%bshape(k)
                patch%btraction(1:d, patch%nbpoints) = t(1:d)
+               if (c > 0 .and. kind == boundary_traction) &
+                  & patch%btraction(1:2, patch%nbpoints) = t(1:2) - self%corner_traction(:, k, c)
             end do
          end do
       end associate
    end subroutine grid_fill
+
+   !> Each corner's stress at the input's volume points and traction at its boundary points.
+   subroutine corner_values(input, fits, stress, traction)
+      type(recovery_input_type), intent(in) :: input
+      type(singular_fit_type), intent(in) :: fits(:)
+      real(wp), allocatable, intent(out) :: stress(:, :, :), traction(:, :, :)
+      real(wp) :: s(3)
+      integer :: c, k
+
+      allocate (stress(3, size(input%w), size(fits)), traction(2, size(input%bw), size(fits)))
+      do c = 1, size(fits)
+         !$omp parallel do schedule(static)
+         do k = 1, size(input%w)
+            call fits(c)%corner%stress(input%x(1:2, k), stress(:, k, c))
+         end do
+         !$omp end parallel do
+         !$omp parallel do schedule(static) private(s)
+         do k = 1, size(input%bw)
+            call fits(c)%corner%stress(input%bx(1:2, k), s)
+            traction(1, k, c) = s(1)*input%bn(1, k) + s(3)*input%bn(2, k)
+            traction(2, k, c) = s(3)*input%bn(1, k) + s(2)*input%bn(2, k)
+         end do
+         !$omp end parallel do
+      end do
+   end subroutine corner_values
+
+   !> The re-entrant corners of a 2D input, their fitted singular fields (field%singular,
+   !> left unallocated without any) and the corner of each node's patch (node_corner;
+   !> field%patch_corner per patch): sprc_grid_singular's module notes.
+   subroutine singular_corners(src, degree, field, node_corner)
+      type(grid_source_type), intent(in) :: src
+      integer, intent(in) :: degree
+      type(recovered_field_type), intent(inout) :: field
+      integer, allocatable, intent(out) :: node_corner(:)
+      type(corner_site_type), allocatable :: sites(:)
+      type(singular_fit_type), allocatable :: fitted(:)
+      type(singular_fit_type) :: corner
+      logical, allocatable :: free(:), symmetry(:), bsym(:)
+      real(wp) :: t(3), width, dist, lo(2), hi(2)
+      integer :: k, kind, c, n, i, e
+      logical :: ok, inner, sym, global
+
+      associate (input => src%input, nodes => src%nodes)
+         allocate (free(size(input%bw)), bsym(size(input%bw)))
+         do k = 1, size(input%bw)
+            call point_kind(src, k, kind, t)
+            free(k) = kind == boundary_traction .and. all(t(1:2) == 0.0_wp)
+            bsym(k) = kind == boundary_symmetry
+         end do
+         call find_corners(input%bx, input%bn, input%belem_ptr, free, field%elem_lo, field%elem_hi, sites)
+         allocate (fitted(0))
+         do c = 1, size(sites)
+            call fit_corner(sites(c), input%analysis, input%young, input%poisson, input%x, input%w, input%stress, &
+               & input%elem_ptr, field%elem_lo, field%elem_hi, degree, corner, ok)
+            if (ok) fitted = [fitted, corner]
+         end do
+         if (size(fitted) == 0) return
+         ! elements with symmetry points: their patches keep the whole field
+         allocate (symmetry(nodes%n_elements))
+         do e = 1, nodes%n_elements
+            symmetry(e) = any(bsym(input%belem_ptr(e):input%belem_ptr(e + 1) - 1))
+         end do
+         allocate (node_corner(nodes%n_nodes))
+         node_corner = 0
+         global = size(fitted) == 1
+         if (global) global = in_wedge(fitted(1)%corner, input%x)
+         do n = 1, nodes%n_nodes
+            if (field%patch_of_node(n) == 0) cycle
+            width = 0.0_wp
+            sym = .false.
+            do i = nodes%node_element_ptr(n), nodes%node_element_ptr(n + 1) - 1
+               e = nodes%node_element(i)
+               sym = sym .or. symmetry(e)
+               width = max(width, maxval(field%elem_hi(:, e) - field%elem_lo(:, e)))
+            end do
+            if (sym) cycle
+            do c = 1, size(fitted)
+               dist = norm2(nodes%x(:, n) - fitted(c)%corner%point)
+               if (dist < enrich_cells*width .or. global) then
+                  inner = .false.
+                  do i = nodes%node_element_ptr(n), nodes%node_element_ptr(n + 1) - 1
+                     e = nodes%node_element(i)
+                     lo = field%elem_lo(:, e)
+                     hi = field%elem_hi(:, e)
+                     inner = inner .or. norm2(max(lo - fitted(c)%corner%point, 0.0_wp, fitted(c)%corner%point - hi)) &
+                        & < inner_cells*maxval(hi - lo)
+                  end do
+                  node_corner(n) = merge(-c, c, inner)
+                  exit
+               end if
+            end do
+         end do
+         if (.not. any(node_corner /= 0)) return
+         call move_alloc(fitted, field%singular)
+         field%patch_corner = abs(node_corner(field%patch_node))
+      end associate
+   end subroutine singular_corners
+
+   !> Whether every point x(:, k) lies in the material wedge of `corner` (polar angle
+   !> from the bisector at most half the opening, up to round-off), where its field is
+   !> continuous.
+   pure logical function in_wedge(corner, x) result(inside)
+      type(corner_type), intent(in) :: corner
+      real(wp), intent(in) :: x(:, :)
+      real(wp) :: half, d(2), t
+      integer :: k
+
+      half = 0.5_wp*corner%angle*acos(-1.0_wp)/180.0_wp
+      inside = .true.
+      do k = 1, size(x, 2)
+         d = x(1:2, k) - corner%point
+         t = atan2(corner%direction(1)*d(2) - corner%direction(2)*d(1), dot_product(corner%direction, d))
+         if (abs(t) > half + sqrt(epsilon(1.0_wp))) then
+            inside = .false.
+            return
+         end if
+      end do
+   end function in_wedge
 
    !> Recovery boundary kind (0: not constrained) and prescribed traction of input boundary
    !> point k: contact or free on the contact shape (module notes), else `boundary_data`.

@@ -442,7 +442,7 @@ contains
       type(context_type) :: ctx
       real(wp) :: flo(3), fhi(3), ylo(3), yhi(3), xf, side
       integer :: m, iside, s, i, dim
-      logical :: free(3), on, inside_on_cell_side
+      logical :: free(3), on, inside_on_cell_side, on_i, dummy
 
       dim = quad%dim
       ! the shapes' classes on a face in rule%shapes (the reduction below only grows it)
@@ -467,9 +467,13 @@ contains
                call body%shape_classes(flo(1:dim), fhi(1:dim), rule%shapes(1:body%nshape))
                rule%np = 0
                do i = 1, body%nshape
-                  if (i == s) then
-                     if (body%shapes(s)%kind == shape_box) &
-                        & call add_shape_quadrics(body, s, ctx, flo(1:dim), fhi(1:dim), rule)
+                  ! a box face on this plane bounds the face part (its own, or
+                  ! another shape's one-sided value): its edges split the face
+                  on_i = .false.
+                  if (i /= s) call on_face_plane(body, i, m, side, xf, flo(1:dim), fhi(1:dim), on_i, dummy)
+                  if (i == s .or. on_i) then
+                     if (body%shapes(i)%kind == shape_box) &
+                        & call add_shape_quadrics(body, i, ctx, flo(1:dim), fhi(1:dim), rule)
                   else if (rule%shapes(i) == cell_cut) then
                      call add_shape_quadrics(body, i, ctx, flo(1:dim), fhi(1:dim), rule)
                   end if
@@ -527,46 +531,24 @@ contains
    end subroutine on_face_plane
 
    !> Body membership just on one side of the face plane at x (on the plane).
+   !> Every shape whose surface lies on this plane takes its one-sided value,
+   !> not only the face's own shape: where two shapes meet on the plane (two
+   !> boxes of a union sharing a face) the face is inside the body, no boundary.
    pure logical function face_member(ctx, body, x, cell_side) result(inside)
       type(context_type), intent(in) :: ctx
       class(body_type), intent(in) :: body
       real(wp), intent(in) :: x(:)
       logical, intent(in) :: cell_side
-      real(wp) :: v, xm(3)
-      integer :: s, m, d
-
-      s = ctx%face_shape
-      m = ctx%face_dim
-      if (cell_side .eqv. ctx%cell_side_inside) then
-         ! on the shape's inner side of the plane
-         if (body%shapes(s)%kind == shape_box) then
-            ! the other faces decide: phi with x_m moved to the box's mid-plane
-            d = size(x)
-            xm(1:d) = x
-            xm(m) = 0.5_wp*(body%shapes(s)%lower(m) + body%shapes(s)%upper(m))
-            v = body%shapes(s)%phi(xm(1:d))
-         else
-            v = -1.0_wp
-         end if
-      else
-         v = 1.0_wp
-      end if
-      inside = csg_phi(body, x, s, v) < 0.0_wp
-   end function face_member
-
-   !> The body's level set at x with shape s's value replaced by v.
-   pure real(wp) function csg_phi(body, x, s, v) result(f)
-      class(body_type), intent(in) :: body
-      real(wp), intent(in) :: x(:), v
-      integer, intent(in) :: s
-      real(wp) :: g
+      real(wp) :: toward, f, g
       integer :: k
 
+      ! the cell lies on the side opposite to the face's outward direction
+      toward = merge(-ctx%face_side, ctx%face_side, cell_side)
       do k = 1, body%nshape
-         if (k == s) then
-            g = v
+         if (k == ctx%face_shape) then
+            g = plane_value(body, k, ctx%face_dim, x, cell_side .eqv. ctx%cell_side_inside)
          else
-            g = body%shapes(k)%phi(x)
+            g = one_sided_phi(body, k, ctx%face_dim, x, toward)
          end if
          if (k == 1) then
             f = g
@@ -578,7 +560,113 @@ contains
             f = max(f, -g)
          end if
       end do
-   end function csg_phi
+      inside = f < 0.0_wp
+   end function face_member
+
+   !> Shape k's level set at x just off the plane x_m = x(m) towards the sign of
+   !> `toward`: its one-sided value if its surface lies on that plane, else phi(x).
+   pure real(wp) function one_sided_phi(body, k, m, x, toward) result(g)
+      class(body_type), intent(in) :: body
+      integer, intent(in) :: k, m
+      real(wp), intent(in) :: x(:), toward
+      logical :: on
+      real(wp) :: inner_sign
+
+      call plane_relation(body, k, m, x, on, inner_sign)
+      if (on) then
+         g = plane_value(body, k, m, x, inner_sign*toward > 0.0_wp)
+      else
+         g = body%shapes(k)%phi(x)
+      end if
+   end function one_sided_phi
+
+   !> Whether shape k's surface lies on the plane x_m = x(m) (a halfspace with
+   !> normal +-e_m or a box face, within the snapping tolerance), and on which
+   !> side its inside lies (inner_sign +1: towards +x_m).
+   pure subroutine plane_relation(body, k, m, x, on, inner_sign)
+      class(body_type), intent(in) :: body
+      integer, intent(in) :: k, m
+      real(wp), intent(in) :: x(:)
+      logical, intent(out) :: on
+      real(wp), intent(out) :: inner_sign
+      real(wp) :: tol
+      integer :: i
+
+      on = .false.
+      inner_sign = 0.0_wp
+      tol = snap_tolerance(body%shapes(k), x, x)
+      associate (sh => body%shapes(k))
+         select case (sh%kind)
+         case (shape_halfspace)
+            do i = 1, body%dim
+               if (i /= m .and. sh%normal(i) /= 0.0_wp) return
+            end do
+            on = abs(sh%point(m) - x(m)) <= tol
+            inner_sign = -sign(1.0_wp, sh%normal(m))
+         case (shape_box)
+            if (abs(sh%upper(m) - x(m)) <= tol) then
+               on = .true.
+               inner_sign = -1.0_wp
+            else if (abs(sh%lower(m) - x(m)) <= tol) then
+               on = .true.
+               inner_sign = 1.0_wp
+            end if
+         end select
+      end associate
+   end subroutine plane_relation
+
+   !> A point on the face plane belongs to the face shape's surface: within
+   !> its face (a box's face rectangle) and not taken by another shape whose
+   !> surface lies on the same plane there. doc/scene.md `&bc`: a box face
+   !> takes it from a half-space; between shapes of one kind the later one in
+   !> file order takes it, as off grid planes.
+   pure logical function own_face(ctx, body, x) result(own)
+      type(context_type), intent(in) :: ctx
+      class(body_type), intent(in) :: body
+      real(wp), intent(in) :: x(:)
+      logical :: on, wins
+      real(wp) :: inner_sign
+      integer :: k, m, s
+
+      m = ctx%face_dim
+      s = ctx%face_shape
+      own = plane_value(body, s, m, x, .true.) < 0.0_wp
+      do k = 1, body%nshape
+         if (.not. own) return
+         if (k == s) cycle
+         if (body%shapes(k)%kind == body%shapes(s)%kind) then
+            wins = k > s
+         else
+            wins = body%shapes(k)%kind == shape_box
+         end if
+         if (.not. wins) cycle
+         call plane_relation(body, k, m, x, on, inner_sign)
+         if (on) own = .not. plane_value(body, k, m, x, .true.) < 0.0_wp
+      end do
+   end function own_face
+
+   !> Value of shape k (its surface on the plane x_m = x(m)) just off the plane:
+   !> outside (+1) on its outer side; on its inner side -1 for a halfspace, and
+   !> for a box phi with x_m moved to the box's mid-plane (its other faces decide).
+   pure real(wp) function plane_value(body, k, m, x, inner) result(g)
+      class(body_type), intent(in) :: body
+      integer, intent(in) :: k, m
+      real(wp), intent(in) :: x(:)
+      logical, intent(in) :: inner
+      real(wp) :: xm(3)
+      integer :: d
+
+      if (.not. inner) then
+         g = 1.0_wp
+      else if (body%shapes(k)%kind == shape_box) then
+         d = size(x)
+         xm(1:d) = x
+         xm(m) = 0.5_wp*(body%shapes(k)%lower(m) + body%shapes(k)%upper(m))
+         g = body%shapes(k)%phi(xm(1:d))
+      else
+         g = -1.0_wp
+      end if
+   end function plane_value
 
    ! ------------------------------------------------------------ dimension reduction
 
@@ -968,7 +1056,8 @@ contains
       if (ctx%face_shape == 0) then
          inside = body%phi(x(1:d)) < 0.0_wp
       else
-         inside = face_member(ctx, body, x(1:d), .true.)
+         inside = own_face(ctx, body, x(1:d))
+         if (inside) inside = face_member(ctx, body, x(1:d), .true.)
          if (inside) inside = .not. face_member(ctx, body, x(1:d), .false.)
       end if
    end function member

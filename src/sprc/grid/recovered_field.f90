@@ -39,6 +39,7 @@ module sprc_grid_recovered_field
    use sprc_grid_hanging, only: hanging_type
    use sprc_recovery_patch, only: recovered_patch_type
    use sprc_recovery_estimate, only: eval_recovered
+   use sprc_grid_singular, only: singular_fit_type
    implicit none
    private
 
@@ -82,6 +83,11 @@ module sprc_grid_recovered_field
       real(wp), allocatable :: corner_coef(:)
       !> Nodal values of eq. 101 (nstress, n_nodes) and the method's field at the nodes.
       real(wp), allocatable :: nodal_interp(:, :), nodal(:, :)
+      !> Singular fields of re-entrant corners (sprc_grid_singular), with fitted amplitudes,
+      !> and per patch the corner whose field its polynomial leaves out (0: none). The
+      !> field adds each corner's stress with the union weights of its patches.
+      type(singular_fit_type), allocatable :: singular(:)
+      integer, allocatable :: patch_corner(:)
       !> Seconds: patch recoveries (t_recovery) and building this field's data (t_field).
       real(wp) :: t_recovery = 0.0_wp, t_field = 0.0_wp
    end type recovered_field_type
@@ -150,7 +156,35 @@ contains
       else
          call union_at(field, elem, x, sigma)
       end if
+      if (allocated(field%singular)) call add_singular(field, elem, x, sigma)
    end subroutine field_eval_unchecked
+
+   !> sigma += sum over the corners c of w_c(x) S_c(x), w_c the Q1 union weight of the
+   !> patches that left corner c's field out (module sprc_grid_singular).
+   pure subroutine add_singular(field, e, x, sigma)
+      type(recovered_field_type), intent(in) :: field
+      integer, intent(in) :: e
+      real(wp), intent(in) :: x(:)
+      real(wp), intent(inout) :: sigma(:)
+      real(wp) :: xi(3), shp(8), weight(size(field%singular)), s(3)
+      integer :: j, k, s0, c
+
+      call reference_point(field, e, x, xi)
+      call element_shape(field%dim, 1, xi, shp)
+      weight = 0.0_wp
+      do j = 1, field%nvertex
+         s0 = (e - 1)*field%nvertex + j
+         do k = field%corner_ptr(s0), field%corner_ptr(s0 + 1) - 1
+            c = field%patch_corner(field%corner_patch(k))
+            if (c > 0) weight(c) = weight(c) + shp(j)*field%corner_coef(k)
+         end do
+      end do
+      do c = 1, size(weight)
+         if (weight(c) == 0.0_wp) cycle
+         call field%singular(c)%corner%stress(x(1:2), s)
+         sigma(1:3) = sigma(1:3) + weight(c)*s
+      end do
+   end subroutine add_singular
 
    !> Reference coordinates xi in [0, 1]^dim of x in the box of element e.
    pure subroutine reference_point(field, e, x, xi)
@@ -378,6 +412,10 @@ contains
                & hanging%t_val(k)*field%nodal_interp(:, hanging%free_node(hanging%t_col(k)))
          end do
          if (field%method == method_spr) field%nodal(:, n) = field%nodal_interp(:, n)
+      end do
+      if (.not. allocated(field%singular)) return
+      do n = 1, field%n_nodes
+         call add_singular(field, nodes%node_element(nodes%node_element_ptr(n)), field%node_x(:, n), field%nodal(:, n))
       end do
    end subroutine nodal_values
 

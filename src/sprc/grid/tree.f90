@@ -37,7 +37,8 @@ module sprc_grid_tree
    use sprc_core_text, only: itoa
    use sprc_geometry_region, only: region_type, cell_outside, cell_inside, cell_cut
    use sprc_grid_morton, only: morton_encode
-   use sprc_core_hash, only: hash_seed, hash_i8
+   use sprc_core_hash, only: key_table_type
+   use sprc_core_sort, only: sort_order
    implicit none
    private
 
@@ -96,9 +97,8 @@ module sprc_grid_tree
       logical :: bad_class = .false.
       integer, allocatable :: lev(:), crd(:, :), cls(:)
       logical, allocatable :: alive(:)
-      integer(i8), allocatable :: hkey(:)
-      integer, allocatable :: hval(:)
-      integer :: hcount = 0
+      !> Every stored cell by its key [level, coord(1:dim)], with the value above.
+      type(key_table_type) :: cells
       integer(i8) :: n_outside(0:grid_max_level) = 0_i8
       !> Set when an array could not grow: the build stops and returns it.
       type(error_type), allocatable :: error
@@ -441,9 +441,7 @@ contains
       type(builder_type), intent(inout) :: b
       integer, parameter :: cap0 = 1024
       allocate (b%lev(cap0), b%crd(3, cap0), b%cls(cap0), b%alive(cap0))
-      allocate (b%hkey(0:2*cap0 - 1), b%hval(0:2*cap0 - 1))
-      b%hkey = 0_i8
-      b%hval = 0
+      call b%cells%init(b%dim + 1, cap0, 'grid build', b%error)
    end subroutine builder_init
 
    integer function classify(b, region, level, coord) result(cls)
@@ -488,7 +486,7 @@ contains
          split = level < b%level .or. (cls == cell_cut .and. level < b%top)
       end if
       if (split) then
-         call hash_put(b, cell_key(b%dim, level, coord), -1)
+         call hash_put(b, level, coord, -1)
          do k = 0, 2**b%dim - 1
             child = 2*coord + child_offset(k)
             if (b%dim == 2) child(3) = 0
@@ -534,7 +532,7 @@ contains
       b%crd(:, b%n) = coord
       b%cls(b%n) = cls
       b%alive(b%n) = .true.
-      call hash_put(b, cell_key(b%dim, level, coord), b%n)
+      call hash_put(b, level, coord, b%n)
    end subroutine add_leaf
 
    subroutine grow_leaves(b)
@@ -568,7 +566,7 @@ contains
       cls = b%cls(i)
       b%alive(i) = .false.
       b%n_splits = b%n_splits + 1
-      call hash_put(b, cell_key(b%dim, level, coord), -1)
+      call hash_put(b, level, coord, -1)
       do k = 0, 2**b%dim - 1
          child = 2*coord + child_offset(k)
          if (b%dim == 2) child(3) = 0
@@ -623,10 +621,10 @@ contains
       integer, intent(in) :: level, coord(3)
       integer :: m, v
 
-      if (hash_get(b, cell_key(b%dim, level, coord)) /= 0) return
+      if (hash_get(b, level, coord) /= 0) return
       v = 0
       do m = level - 1, 0, -1
-         v = hash_get(b, cell_key(b%dim, m, ishft(coord, -(level - m))))
+         v = hash_get(b, m, ishft(coord, -(level - m)))
          if (v /= 0) exit
       end do
       if (v <= 0) return
@@ -634,7 +632,7 @@ contains
          call split_leaf(b, region, v)
          m = m + 1
          if (m == level) exit
-         v = hash_get(b, cell_key(b%dim, m, ishft(coord, -(level - m))))
+         v = hash_get(b, m, ishft(coord, -(level - m)))
          if (v <= 0) exit
       end do
    end subroutine ensure_cell
@@ -645,10 +643,10 @@ contains
       type(builder_type), intent(inout) :: b
       type(error_type), allocatable, intent(out) :: error
       integer(i8), allocatable :: keys(:)
-      integer, allocatable :: idx(:), perm(:)
+      integer, allocatable :: idx(:), perm(:), work(:)
       integer :: n, i, j, d, stat
 
-      deallocate (b%hkey, b%hval)
+      deallocate (b%cells%keys, b%cells%value, b%cells%slot)
       d = b%dim
       n = count(b%alive(1:b%n))
       allocate (keys(n), idx(n), stat=stat)
@@ -661,8 +659,10 @@ contains
          idx(j) = i
          keys(j) = morton_encode(ishft(b%crd(1:d, i), grid_max_level - b%lev(i)))
       end do
-      call radix_sort(keys, perm, error)
+      allocate (perm(n), work(n), stat=stat)
+      call check_allocation(stat, 'grid build', 'the sort permutation of the leaves', n, 8, error)
       if (allocated(error)) return
+      call sort_order(keys, perm, work)
       allocate (grid%leaf_level(n), grid%leaf_coord(d, n), grid%leaf_class(n), grid%leaf_key(n), stat=stat)
       call check_allocation(stat, 'grid build', 'the leaves of the grid', n, 4*(d + 2) + 8, error)
       if (allocated(error)) return
@@ -683,47 +683,6 @@ contains
       end do
    end subroutine finalize
 
-   !> Ascending permutation of non-negative keys: LSD radix sort, 16-bit digits.
-   subroutine radix_sort(keys, perm, error)
-      integer(i8), intent(in) :: keys(:)
-      integer, allocatable, intent(out) :: perm(:)
-      type(error_type), allocatable, intent(out) :: error
-      integer, allocatable :: tmp(:), cnt(:)
-      integer :: n, i, pass, digit, npass, stat
-      integer(i8) :: kmax
-
-      n = size(keys)
-      allocate (perm(n), tmp(n), cnt(0:65536), stat=stat)
-      call check_allocation(stat, 'grid build', 'the sort permutation of the leaves', n, 8, error)
-      if (allocated(error)) return
-      do i = 1, n
-         perm(i) = i
-      end do
-      kmax = 0_i8
-      if (n > 0) kmax = maxval(keys)
-      npass = 0
-      do while (kmax > 0_i8)
-         npass = npass + 1
-         kmax = ishft(kmax, -16)
-      end do
-      do pass = 0, npass - 1
-         cnt = 0
-         do i = 1, n
-            digit = int(iand(ishft(keys(perm(i)), -16*pass), 65535_i8))
-            cnt(digit + 1) = cnt(digit + 1) + 1
-         end do
-         do i = 1, 65536
-            cnt(i) = cnt(i) + cnt(i - 1)
-         end do
-         do i = 1, n
-            digit = int(iand(ishft(keys(perm(i)), -16*pass), 65535_i8))
-            cnt(digit) = cnt(digit) + 1
-            tmp(cnt(digit)) = perm(i)
-         end do
-         perm(1:n) = tmp(1:n)
-      end do
-   end subroutine radix_sort
-
    ! ---------------------------------------------------------------- cell hash
 
    !> Key of a cell unique over all levels: its Morton key with a marker bit above it.
@@ -732,76 +691,26 @@ contains
       cell_key = ior(morton_encode(coord(1:dim)), ishft(1_i8, dim*level))
    end function cell_key
 
-   pure integer(i8) function hash_slot(key, mask)
-      integer(i8), intent(in) :: key, mask
-      ! Morton keys of one level differ in a few bits: every bit must reach the slot.
-      hash_slot = iand(hash_i8(hash_seed, key), mask)
-   end function hash_slot
-
-   integer function hash_get(b, key) result(val)
+   !> The value of the cell (level, coord): 0 if it was never stored.
+   integer function hash_get(b, level, coord) result(val)
       type(builder_type), intent(in) :: b
-      integer(i8), intent(in) :: key
-      integer(i8) :: s, mask
-      mask = int(size(b%hkey), i8) - 1_i8
-      s = hash_slot(key, mask)
+      integer, intent(in) :: level, coord(3)
+      integer :: n
       val = 0
-      do while (b%hkey(s) /= 0_i8)
-         if (b%hkey(s) == key) then
-            val = b%hval(s)
-            return
-         end if
-         s = iand(s + 1_i8, mask)
-      end do
+      n = b%cells%find([level, coord(1:b%dim)])
+      if (n > 0) val = b%cells%value(n)
    end function hash_get
 
-   subroutine hash_put(b, key, val)
+   !> Store the cell (level, coord) with the value val (see builder_type).
+   subroutine hash_put(b, level, coord, val)
       type(builder_type), intent(inout) :: b
-      integer(i8), intent(in) :: key
-      integer, intent(in) :: val
-      integer(i8) :: s, mask
-      if (2*(b%hcount + 1) > size(b%hkey)) call hash_grow(b)
+      integer, intent(in) :: level, coord(3), val
+      integer :: n
+      logical :: added
       if (allocated(b%error)) return
-      mask = int(size(b%hkey), i8) - 1_i8
-      s = hash_slot(key, mask)
-      do while (b%hkey(s) /= 0_i8)
-         if (b%hkey(s) == key) then
-            b%hval(s) = val
-            return
-         end if
-         s = iand(s + 1_i8, mask)
-      end do
-      b%hkey(s) = key
-      b%hval(s) = val
-      b%hcount = b%hcount + 1
+      call b%cells%insert([level, coord(1:b%dim)], n, added, b%error)
+      if (allocated(b%error)) return
+      b%cells%value(n) = val
    end subroutine hash_put
-
-   subroutine hash_grow(b)
-      type(builder_type), intent(inout) :: b
-      integer(i8), allocatable :: okey(:)
-      integer, allocatable :: oval(:)
-      integer(i8) :: i, s, mask
-      integer :: stat
-      call move_alloc(b%hkey, okey)
-      call move_alloc(b%hval, oval)
-      allocate (b%hkey(0:2*size(okey) - 1), b%hval(0:2*size(okey) - 1), stat=stat)
-      call check_allocation(stat, 'grid build', 'the cell hash table', 2*size(okey), 12, b%error)
-      if (allocated(b%error)) then
-         call move_alloc(okey, b%hkey)
-         call move_alloc(oval, b%hval)
-         return
-      end if
-      b%hkey = 0_i8
-      b%hval = 0
-      mask = int(size(b%hkey), i8) - 1_i8
-      do i = 0, size(okey, kind=i8) - 1_i8
-         if (okey(i) == 0_i8) cycle
-         s = hash_slot(okey(i), mask)
-         do while (b%hkey(s) /= 0_i8)
-            s = iand(s + 1_i8, mask)
-         end do
-         b%hkey(s) = okey(i)
-         b%hval(s) = oval(i)
-      end do
-   end subroutine hash_grow
 
 end module sprc_grid_tree

@@ -20,7 +20,7 @@
 module sprc_io_namelist
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use sprc_core_kinds, only: wp, i8
-   use sprc_core_text, only: itoa
+   use sprc_core_text, only: itoa, lower
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_io
    use sprc_core_alloc, only: check_allocation
    implicit none
@@ -1020,15 +1020,5 @@ contains
       character(len=1), intent(in) :: c
       is_digit = c >= '0' .and. c <= '9'
    end function is_digit
-
-   pure function lower(text) result(low)
-      character(len=*), intent(in) :: text
-      character(len=len(text)) :: low
-      integer :: i
-      low = text
-      do i = 1, len(text)
-         if (text(i:i) >= 'A' .and. text(i:i) <= 'Z') low(i:i) = achar(iachar(text(i:i)) + 32)
-      end do
-   end function lower
 
 end module sprc_io_namelist

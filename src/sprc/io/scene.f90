@@ -9,7 +9,7 @@ module sprc_io_scene
    use sprc_fem_dilatation, only: projected_poisson
    use sprc_fem_linear_solver, only: solver_names, auto_iterative_min_dofs, auto_never
    use sprc_fem_problem, only: default_gamma, gamma_note
-   use sprc_core_text, only: itoa, real_text
+   use sprc_core_text, only: itoa, real_text, lower
    use sprc_core_error, only: error_type, fatal_error
    use sprc_exact_corner, only: corner_eigenvalues
    use sprc_study_spec, only: scene_type, body_spec_type, shape_spec_type, bc_spec_type, exact_spec_type, &
@@ -1822,16 +1822,6 @@ contains
          text = join(text, "'"//word//"'")
       end do
    end function quoted_list
-
-   pure function lower(text) result(low)
-      character(len=*), intent(in) :: text
-      character(len=len(text)) :: low
-      integer :: i
-      low = text
-      do i = 1, len(text)
-         if (text(i:i) >= 'A' .and. text(i:i) <= 'Z') low(i:i) = achar(iachar(text(i:i)) + 32)
-      end do
-   end function lower
 
    function int_list(values) result(text)
       integer, intent(in) :: values(:)

@@ -32,7 +32,7 @@
 module sprc_io_svg
    use sprc_core_kinds, only: wp, i8
    use sprc_core_sort, only: sort_order
-   use sprc_core_text, only: fixed_text
+   use sprc_core_text, only: fixed_text, xml_escape
    use sprc_core_alloc, only: check_allocation
    use sprc_core_error, only: error_type, fatal_error, stat_io
    use sprc_io_report, only: report_row_type, report_column, is_empty, report_empty
@@ -290,10 +290,10 @@ contains
          '<svg xmlns="http://www.w3.org/2000/svg" version="1.1" width="'//num(page_width)//'" height="'// &
          num(page_height)//'" viewBox="0 0 '//num(page_width)//' '//num(page_height)//'">'//nl// &
          '<!-- '//comment//' -->'//nl//extra// &
-         '<title>'//escape(title)//'</title>'//nl// &
+         '<title>'//xml_escape(title)//'</title>'//nl// &
          '<rect x="0" y="0" width="'//num(page_width)//'" height="'//num(page_height)//'" fill="white"/>'//nl// &
          '<g font-family="sans-serif" font-size="12" fill="black">'//nl// &
-         '<text x="'//num(page_width/2)//'" y="30" font-size="18" text-anchor="middle">'//escape(title)// &
+         '<text x="'//num(page_width/2)//'" y="30" font-size="18" text-anchor="middle">'//xml_escape(title)// &
          '</text>'//nl
    end function page_open
 
@@ -979,14 +979,14 @@ contains
       character(len=:), allocatable :: text
       if (style%colour == 'none') then
          text = '<text class="legend '//style%name//'" x="'//num(x)//'" y="'//num(y + 4)//'">'// &
-            & escape(legend_label(style))//'</text>'//nl
+            & xml_escape(legend_label(style))//'</text>'//nl
          return
       end if
       text = '<line x1="'//num(x)//'" y1="'//num(y)//'" x2="'//num(x + 36)//'" y2="'//num(y)// &
          '" stroke="'//style%colour//'"'//style%stroke//'/>'//nl// &
          marker(style, x + 18, y, 'legend')// &
          '<text class="legend '//style%name//'" x="'//num(x + 44)//'" y="'//num(y + 4)//'">'// &
-         & escape(legend_label(style))//'</text>'//nl
+         & xml_escape(legend_label(style))//'</text>'//nl
    end function legend_entry
 
    !> `a` if `condition`, else `b`.
@@ -1016,23 +1016,5 @@ contains
       write (buf, '(i0)') nint(v)
       s = trim(buf)
    end function inum
-
-   !> Text with the XML special characters escaped.
-   pure function escape(s) result(t)
-      character(len=*), intent(in) :: s
-      character(len=:), allocatable :: t
-      integer :: i
-      t = ''
-      do i = 1, len(s)
-         select case (s(i:i))
-         case ('&'); t = t//'&amp;'
-         case ('<'); t = t//'&lt;'
-         case ('>'); t = t//'&gt;'
-         case ('"'); t = t//'&quot;'
-         case ("'"); t = t//'&apos;'
-         case default; t = t//s(i:i)
-         end select
-      end do
-   end function escape
 
 end module sprc_io_svg

@@ -37,7 +37,7 @@
 !> (Gmsh and others order the 27-node face centres differently; XDMF does not fix it.)
 module sprc_io_xdmf
    use sprc_core_error, only: error_type, fatal_error, stat_io, stat_invalid_input
-   use sprc_core_text, only: itoa
+   use sprc_core_text, only: itoa, xml_escape
    implicit none
    private
 
@@ -248,12 +248,12 @@ contains
          g = minloc(grids%level, dim=1, mask=.not. done)
          level = grids(g)%level
          if (count(grids%level == level) == 1 .and. .not. named(grids(g))) then
-            text = text//grid_text(escape(h5_name), grids(g), .true.)
+            text = text//grid_text(xml_escape(h5_name), grids(g), .true.)
          else
             text = text//'   <Grid Name="level_'//itoa(level, 2)//'" GridType="Collection" '// &
                'CollectionType="Spatial">'//nl//'    <Time Value="'//itoa(level)//'"/>'//nl
             do g = 1, size(grids)
-               if (grids(g)%level == level) text = text//grid_text(escape(h5_name), grids(g), .false.)
+               if (grids(g)%level == level) text = text//grid_text(xml_escape(h5_name), grids(g), .false.)
             end do
             text = text//'   </Grid>'//nl
          end if
@@ -339,7 +339,7 @@ contains
       character(len=:), allocatable :: text
       text = ''
       if (.not. allocated(field%units)) return
-      if (len(field%units) > 0) text = '     <Information Name="units" Value="'//escape(field%units)//'"/>'//nl
+      if (len(field%units) > 0) text = '     <Information Name="units" Value="'//xml_escape(field%units)//'"/>'//nl
    end function information
 
    !> XDMF needs the nodes per element of a Polyvertex topology (the other types fix it).
@@ -388,23 +388,5 @@ contains
       character(len=:), allocatable :: base
       base = path(index(path, '/', back=.true.) + 1:)
    end function basename
-
-   pure function escape(s) result(t)
-      character(len=*), intent(in) :: s
-      character(len=:), allocatable :: t
-      integer :: i
-      t = ''
-      do i = 1, len(s)
-         select case (s(i:i))
-         case ('&'); t = t//'&amp;'
-         case ('<'); t = t//'&lt;'
-         case ('>'); t = t//'&gt;'
-         case ('"'); t = t//'&quot;'
-         case default; t = t//s(i:i)
-         end select
-      end do
-   end function escape
-
-
 
 end module sprc_io_xdmf

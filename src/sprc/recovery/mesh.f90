@@ -31,17 +31,28 @@
 !> `mesh_recovery_eval` takes each point's element if given, else the lowest-index element
 !> holding it, searched through bins (sprc_recovery_mesh_bins) from 4 points on.
 !>
+!> Contact (`contact_facets`, SPR-C only; the two-body entry sprc_contact_mesh_recovery):
+!> contact facets are element sides as the boundary facets, each with a law (0 open:
+!> a free surface; contact_law_frictionless, _slip, _stick), a slip direction and the
+!> index of its pair. A patch holding a point of a closed contact facet is solved by the
+!> caller's `mesh_contact_solver_type` (the coupled solve with the other body, contact
+!> wins), whose points must all belong to one pair (else an error naming the node).
+!> `mesh_facet_points` gives the quadrature points of a facet list as the recovery
+!> builds them (owner element, outward normal).
+!>
 !> Parallelism and determinism: the patch loop is sprc_recovery_patch_loop's (shared with
 !> the grid); the bits do not depend on the thread count.
 module sprc_recovery_mesh
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular, &
       & stat_not_converged, stat_out_of_memory
-   use sprc_core_material, only: voigt_size, compliance_matrix
+   use sprc_core_material, only: voigt_size, compliance_matrix, plane_stress, solid
    use sprc_core_timer, only: wall_time
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reset, patch_reserve, &
-      & boundary_traction, boundary_symmetry
-   use sprc_recovery_patch_loop, only: patch_source_type, patch_loop_type, run_patch_loop, patch_capacity, auto_degree
+      & boundary_traction, boundary_symmetry, boundary_contact
+   use sprc_recovery_workspace, only: recovery_workspace_type
+   use sprc_recovery_patch_loop, only: patch_source_type, patch_loop_type, run_patch_loop, patch_capacity, auto_degree, &
+      & recover_patch_default
    use sprc_recovery_estimate, only: eval_recovered_points, energy_norms, scaled_norm, relative_error
    use sprc_recovery_mesh_element, only: elem_tri3, elem_quad4, elem_tet4, elem_hex8, elem_quad9, elem_hex27, &
       & element_dim, element_nodes, element_vertices, element_degree, element_facet_nodes, element_shape, &
@@ -62,6 +73,7 @@ module sprc_recovery_mesh
    public :: mesh_method_spr, mesh_method_sprc, facet_traction, facet_symmetry, facet_free, facet_pressure
    public :: mesh_reference_unit, mesh_reference_symmetric
    public :: elem_tri3, elem_quad4, elem_tet4, elem_hex8, elem_quad9, elem_hex27
+   public :: mesh_contact_solver_type, mesh_facet_points, mesh_recovery_eval_near
 
    !> Default limit of expansion rounds per patch.
    integer, parameter :: mesh_default_max_rounds = 3
@@ -104,11 +116,34 @@ module sprc_recovery_mesh
          & t_nodal = 0.0_wp, t_estimate = 0.0_wp
    end type mesh_recovery_type
 
-   !> Mesh data of one recovery: node -> element CSR and boundary points per element (CSR).
+   !> The solver of a body's contact patches (module notes): `solve` recovers a filled patch
+   !> holding contact points of pair `pair`, law(j) and slip(1:dim, j) per boundary point j
+   !> (read where patch%bkind(j) = boundary_contact). Called from several threads at once.
+   type, abstract :: mesh_contact_solver_type
+   contains
+      procedure(contact_solve_interface), deferred :: solve
+   end type mesh_contact_solver_type
+
+   abstract interface
+      subroutine contact_solve_interface(self, pair, patch, law, slip, degree, ws, rec, error)
+         import :: mesh_contact_solver_type, patch_type, recovery_workspace_type, recovered_patch_type, &
+            & error_type, wp
+         class(mesh_contact_solver_type), intent(in) :: self
+         integer, intent(in) :: pair, law(:), degree
+         type(patch_type), intent(in) :: patch
+         real(wp), intent(in) :: slip(:, :)
+         type(recovery_workspace_type), intent(inout) :: ws
+         type(recovered_patch_type), intent(out) :: rec
+         type(error_type), allocatable, intent(out) :: error
+      end subroutine contact_solve_interface
+   end interface
+
+   !> Mesh data of one recovery: node -> element CSR and boundary points per element (CSR),
+   !> with the contact law, pair and slip direction of each (law 0: not a contact point).
    type :: topology_type
       integer, allocatable :: ne_ptr(:), ne_list(:)
-      integer, allocatable :: bptr(:), bkind(:), bpiece(:)
-      real(wp), allocatable :: bx(:, :), bw(:), bn(:, :), bt(:, :)
+      integer, allocatable :: bptr(:), bkind(:), bpiece(:), blaw(:), bpair(:)
+      real(wp), allocatable :: bx(:, :), bw(:), bn(:, :), bt(:, :), bslip(:, :)
       real(wp) :: body_force(3) = 0.0_wp
    end type topology_type
 
@@ -134,9 +169,12 @@ module sprc_recovery_mesh
          & gs(:, :, :) => null()
       integer, pointer, contiguous :: connectivity(:, :) => null()
       type(topology_type), pointer :: topo => null()
+      class(mesh_contact_solver_type), pointer :: contact => null()
+      logical :: c_indices = .false.
    contains
       procedure :: fill => mesh_fill
       procedure :: points_of => mesh_points_of
+      procedure :: recover => mesh_recover
    end type mesh_source_type
 
 contains
@@ -147,7 +185,7 @@ contains
    !> `max_rounds` expansions (stat_singular, naming the node).
    subroutine recover_on_mesh(dim, analysis, nodes, element_type, connectivity, gp, gw, gs, young, poisson, method, &
          & result, error, body_force, facet_nodes, facet_kind, facet_traction, degree, max_rounds, c_indices, &
-         & gauss_xi, reference)
+         & gauss_xi, reference, contact_facets, contact_law, contact_slip, contact_pair, contact_solver)
       integer, intent(in) :: dim, analysis
       !> Node coordinates (dim, nnode).
       real(wp), intent(in) :: nodes(:, :)
@@ -179,6 +217,14 @@ contains
       !> [0, 1]^dim) or mesh_reference_symmetric ([-1, 1]^dim); simplices are the unit simplex
       !> in both.
       integer, intent(in), optional :: reference
+      !> Contact facets (nfn, ncontact), element sides as facet_nodes; per facet the law (0
+      !> open, contact_law_frictionless, _slip, _stick), the slip direction (dim, ncontact;
+      !> read for slip) and the pair (>= 1, passed to the solver); the solver of the contact
+      !> patches (module notes). All or none; validated by the caller (the contact entry)
+      !> except for being element sides.
+      integer, intent(in), optional :: contact_facets(:, :), contact_law(:), contact_pair(:)
+      real(wp), intent(in), optional :: contact_slip(:, :)
+      class(mesh_contact_solver_type), intent(in), optional, target :: contact_solver
       type(topology_type), target :: topo
       type(rule_type) :: rule
       real(wp), allocatable :: xi(:, :, :)
@@ -222,6 +268,10 @@ contains
       if (present(body_force)) topo%body_force(1:dim) = body_force
       call boundary_points(result, topo, error, facet_nodes, facet_kind, facet_traction)
       if (allocated(error)) return
+      if (present(contact_facets)) then
+         call add_contact_points(result, topo, contact_facets, contact_law, contact_slip, contact_pair, error)
+         if (allocated(error)) return
+      end if
       t(2) = wall_time()
       ! The caller's reference coordinates are used in place (checked, not copied), or on
       ! [-1, 1]^dim mapped onto the element library's [0, 1]^dim once.
@@ -240,7 +290,11 @@ contains
       end if
       if (allocated(error)) return
       t(3) = wall_time()
-      call recover_patches(result, topo, gp, gw, gs, rounds, error)
+      if (present(contact_solver)) then
+         call recover_patches(result, topo, gp, gw, gs, rounds, error, contact_solver)
+      else
+         call recover_patches(result, topo, gp, gw, gs, rounds, error)
+      end if
       if (allocated(error)) return
       t(4) = wall_time()
       call nodal_values(result, topo, error)
@@ -604,7 +658,7 @@ contains
       integer, intent(in), optional :: facet_nodes(:, :), facet_kind(:)
       real(wp), intent(in), optional :: facet_traction_value(:, :)
       integer, allocatable :: owner(:), fill(:), ordered(:, :)
-      real(wp) :: xq(3, max_facet_points), wq(max_facet_points), nq(3, max_facet_points), c(3)
+      real(wp) :: xq(3, max_facet_points), wq(max_facet_points), nq(3, max_facet_points)
       integer :: nf, nfn, f, e, q, nq_f, k, d, st
 
       d = r%dim
@@ -617,7 +671,7 @@ contains
       if (allocated(error)) return
       fill = 0
       do f = 1, nf
-         call facet_owner(r, topo, facet_nodes(:, f), f, owner(f), ordered(:, f), error)
+         call facet_owner(r, topo, facet_nodes(:, f), f, owner(f), ordered(:, f), error, 'facet_nodes')
          if (allocated(error)) return
          fill(owner(f)) = fill(owner(f)) + 1
       end do
@@ -629,26 +683,24 @@ contains
       k = topo%bptr(r%nelem + 1) - 1
       if (nf == 0) k = 0
       r%n_boundary_points = k
-      allocate (topo%bx(d, k), topo%bw(k), topo%bn(d, k), topo%bt(d, k), topo%bkind(k), topo%bpiece(k), stat=st)
-      call check_allocation(st, 'recover_on_mesh', 'the boundary points', k, 24*d + 16, error)
+      allocate (topo%bx(d, k), topo%bw(k), topo%bn(d, k), topo%bt(d, k), topo%bkind(k), topo%bpiece(k), &
+         & topo%blaw(k), topo%bpair(k), topo%bslip(d, k), stat=st)
+      call check_allocation(st, 'recover_on_mesh', 'the boundary points', k, 32*d + 24, error)
       if (allocated(error)) return
+      topo%blaw = 0
+      topo%bpair = 0
+      topo%bslip = 0.0_wp
       fill = 0
       do f = 1, nf
          e = owner(f)
-         call facet_points(d, nfn, r%x(:, ordered(:, f)), nq_f, xq, wq, nq)
-         if (.not. all(wq(1:nq_f) > 0.0_wp)) then
-            call fatal_error(error, 'recover_on_mesh: facet '//index_name(r%c_indices, f)// &
-               & ' is degenerate (zero length or area)', stat_invalid_input)
-            return
-         end if
-         c(1:d) = sum(r%x(:, r%connectivity(1:r%nvertex, e)), dim=2)/real(r%nvertex, wp)
+         call facet_quadrature(r, e, ordered(:, f), f, 'facet', nq_f, xq, wq, nq, error)
+         if (allocated(error)) return
          do q = 1, nq_f
             k = topo%bptr(e) + fill(e)
             fill(e) = fill(e) + 1
             topo%bx(:, k) = xq(1:d, q)
             topo%bw(k) = wq(q)
             topo%bn(:, k) = nq(1:d, q)
-            if (dot_product(xq(1:d, q) - c(1:d), nq(1:d, q)) < 0.0_wp) topo%bn(:, k) = -nq(1:d, q)
             topo%bt(:, k) = 0.0_wp
             select case (facet_kind(f))
             case (facet_traction)
@@ -671,13 +723,175 @@ contains
       end do
    end subroutine boundary_points
 
+   !> The quadrature points of facet f (nodes `ordered`, a side of element e): coordinates,
+   !> weights, normals pointing away from e's vertex centroid. `what` names the facet in
+   !> the error of a degenerate one.
+   subroutine facet_quadrature(r, e, ordered, f, what, nq_f, xq, wq, nq, error)
+      type(mesh_recovery_type), intent(in) :: r
+      integer, intent(in) :: e, ordered(:), f
+      character(len=*), intent(in) :: what
+      integer, intent(out) :: nq_f
+      real(wp), intent(out) :: xq(:, :), wq(:), nq(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: c(3)
+      integer :: d, q
+
+      d = r%dim
+      call facet_points(d, size(ordered), r%x(:, ordered), nq_f, xq, wq, nq)
+      if (.not. all(wq(1:nq_f) > 0.0_wp)) then
+         call fatal_error(error, 'recover_on_mesh: '//what//' '//index_name(r%c_indices, f)// &
+            & ' is degenerate (zero length or area)', stat_invalid_input)
+         return
+      end if
+      c(1:d) = sum(r%x(:, r%connectivity(1:r%nvertex, e)), dim=2)/real(r%nvertex, wp)
+      do q = 1, nq_f
+         if (dot_product(xq(1:d, q) - c(1:d), nq(1:d, q)) < 0.0_wp) nq(1:d, q) = -nq(1:d, q)
+      end do
+   end subroutine facet_quadrature
+
+   !> Append the quadrature points of the contact facets to the boundary points (CSR per
+   !> element, after the facets' own): kind boundary_contact where the law is closed, a free
+   !> surface (zero traction, piece 1) where it is open (module notes).
+   subroutine add_contact_points(r, topo, cfacets, claw, cslip, cpair, error)
+      type(mesh_recovery_type), intent(inout) :: r
+      type(topology_type), intent(inout) :: topo
+      integer, intent(in) :: cfacets(:, :), claw(:), cpair(:)
+      real(wp), intent(in) :: cslip(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      integer, allocatable :: owner(:), ordered(:, :), cnt(:), ptr(:), perm(:)
+      real(wp) :: xq(3, max_facet_points), wq(max_facet_points), nq(3, max_facet_points)
+      integer :: nc, f, e, q, nq_f, k, j, d, nb, st
+      type(topology_type) :: old
+
+      d = r%dim
+      nc = size(cfacets, 2)
+      allocate (owner(nc), ordered(size(cfacets, 1), nc), cnt(r%nelem), ptr(r%nelem + 1), stat=st)
+      call check_allocation(st, 'recover_on_mesh', 'the contact facet owners', nc + r%nelem, 8, error)
+      if (allocated(error)) return
+      cnt = 0
+      do f = 1, nc
+         call facet_owner(r, topo, cfacets(:, f), f, owner(f), ordered(:, f), error, 'contact_facets')
+         if (allocated(error)) return
+         cnt(owner(f)) = cnt(owner(f)) + 1
+      end do
+      nq_f = facet_npoints(size(cfacets, 1))
+      ! New CSR: each element's old points, then its contact points (in facet order).
+      ptr(1) = 1
+      do e = 1, r%nelem
+         ptr(e + 1) = ptr(e) + (topo%bptr(e + 1) - topo%bptr(e)) + nq_f*cnt(e)
+      end do
+      nb = ptr(r%nelem + 1) - 1
+      call move_alloc(topo%bptr, old%bptr)
+      call move_alloc(topo%bx, old%bx)
+      call move_alloc(topo%bw, old%bw)
+      call move_alloc(topo%bn, old%bn)
+      call move_alloc(topo%bt, old%bt)
+      call move_alloc(topo%bkind, old%bkind)
+      call move_alloc(topo%bpiece, old%bpiece)
+      call move_alloc(topo%blaw, old%blaw)
+      call move_alloc(topo%bpair, old%bpair)
+      call move_alloc(topo%bslip, old%bslip)
+      allocate (topo%bx(d, nb), topo%bw(nb), topo%bn(d, nb), topo%bt(d, nb), topo%bkind(nb), topo%bpiece(nb), &
+         & topo%blaw(nb), topo%bpair(nb), topo%bslip(d, nb), perm(r%nelem), stat=st)
+      call check_allocation(st, 'recover_on_mesh', 'the boundary and contact points', nb, 32*d + 24, error)
+      if (allocated(error)) return
+      do e = 1, r%nelem
+         k = ptr(e)
+         do j = old%bptr(e), old%bptr(e + 1) - 1
+            topo%bx(:, k) = old%bx(:, j)
+            topo%bw(k) = old%bw(j)
+            topo%bn(:, k) = old%bn(:, j)
+            topo%bt(:, k) = old%bt(:, j)
+            topo%bkind(k) = old%bkind(j)
+            topo%bpiece(k) = old%bpiece(j)
+            topo%blaw(k) = 0
+            topo%bpair(k) = 0
+            topo%bslip(:, k) = 0.0_wp
+            k = k + 1
+         end do
+         perm(e) = k
+      end do
+      call move_alloc(ptr, topo%bptr)
+      do f = 1, nc
+         e = owner(f)
+         call facet_quadrature(r, e, ordered(:, f), f, 'contact facet', nq_f, xq, wq, nq, error)
+         if (allocated(error)) return
+         do q = 1, nq_f
+            k = perm(e)
+            perm(e) = k + 1
+            topo%bx(:, k) = xq(1:d, q)
+            topo%bw(k) = wq(q)
+            topo%bn(:, k) = nq(1:d, q)
+            topo%bt(:, k) = 0.0_wp
+            topo%blaw(k) = claw(f)
+            topo%bpair(k) = cpair(f)
+            topo%bslip(:, k) = cslip(1:d, f)
+            topo%bpiece(k) = 1
+            topo%bkind(k) = merge(boundary_contact, boundary_traction, claw(f) /= 0)
+         end do
+      end do
+      r%n_boundary_points = nb
+   end subroutine add_contact_points
+
+   !> The quadrature points of the facets facet_nodes(:, f) (nfn, nfacet; element sides, any
+   !> node order) of a caller's mesh as the recovery builds them: x(dim, nq nfacet), weights
+   !> w, outward normals n, the owner element and facet of each point (`fname` names the
+   !> array in messages). Errors as recover_on_mesh's for facets and the mesh.
+   subroutine mesh_facet_points(dim, nodes, element_type, connectivity, facet_nodes, c_indices, fname, x, w, n, &
+         & owner_elem, facet_of, error)
+      integer, intent(in) :: dim, element_type
+      real(wp), intent(in) :: nodes(:, :)
+      integer, intent(in) :: connectivity(:, :), facet_nodes(:, :)
+      logical, intent(in) :: c_indices
+      character(len=*), intent(in) :: fname
+      real(wp), allocatable, intent(out) :: x(:, :), w(:), n(:, :)
+      integer, allocatable, intent(out) :: owner_elem(:), facet_of(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(mesh_recovery_type) :: r
+      type(topology_type) :: topo
+      real(wp) :: xq(3, max_facet_points), wq(max_facet_points), nq(3, max_facet_points)
+      integer :: ordered(size(facet_nodes, 1)), f, e, nq_f, k, nf, st
+
+      call init_result(r, dim, solid_or_plane(dim), element_type, mesh_method_spr, 1, 1.0_wp, 0.0_wp, nodes, &
+         & connectivity, error)
+      if (allocated(error)) return
+      r%c_indices = c_indices
+      call node_elements(r, topo, error)
+      if (allocated(error)) return
+      nf = size(facet_nodes, 2)
+      nq_f = facet_npoints(size(facet_nodes, 1))
+      allocate (x(dim, nq_f*nf), w(nq_f*nf), n(dim, nq_f*nf), owner_elem(nq_f*nf), facet_of(nq_f*nf), stat=st)
+      call check_allocation(st, 'recover_on_mesh', 'the facet points', nq_f*nf, 16*dim + 16, error)
+      if (allocated(error)) return
+      k = 0
+      do f = 1, nf
+         call facet_owner(r, topo, facet_nodes(:, f), f, e, ordered, error, fname)
+         if (allocated(error)) return
+         call facet_quadrature(r, e, ordered, f, fname, nq_f, xq, wq, nq, error)
+         if (allocated(error)) return
+         x(:, k + 1:k + nq_f) = xq(1:dim, 1:nq_f)
+         w(k + 1:k + nq_f) = wq(1:nq_f)
+         n(:, k + 1:k + nq_f) = nq(1:dim, 1:nq_f)
+         owner_elem(k + 1:k + nq_f) = e
+         facet_of(k + 1:k + nq_f) = f
+         k = k + nq_f
+      end do
+   contains
+      pure integer function solid_or_plane(d)
+         integer, intent(in) :: d
+         solid_or_plane = merge(solid, plane_stress, d == 3)
+      end function solid_or_plane
+   end subroutine mesh_facet_points
+
    !> The one element that has the facet as a side (face), its nodes in any order
    !> (element_facet_order), and the facet's nodes in an order that parametrises it.
    !> Candidates are the elements of the facet's first node (node -> element CSR): O(valence).
-   subroutine facet_owner(r, topo, fnodes, f, owner, ordered, error)
+   subroutine facet_owner(r, topo, fnodes, f, owner, ordered, error, fname)
       type(mesh_recovery_type), intent(in) :: r
       type(topology_type), intent(in) :: topo
       integer, intent(in) :: fnodes(:), f
+      !> The caller's array of the facet (facet_nodes, contact_facets), for messages.
+      character(len=*), intent(in) :: fname
       integer, intent(out) :: owner, ordered(:)
       type(error_type), allocatable, intent(out) :: error
       integer :: k, e, a, b, n, holder, loc(max_element_nodes), perm(max_element_nodes)
@@ -689,7 +903,7 @@ contains
       do a = 2, n
          do b = 1, a - 1
             if (fnodes(a) /= fnodes(b)) cycle
-            call fatal_error(error, 'recover_on_mesh: facet '//index_name(r%c_indices, f)//' is degenerate: '// &
+            call fatal_error(error, 'recover_on_mesh: '//word()//' '//index_name(r%c_indices, f)//' is degenerate: '// &
                & facet_name()//' repeats node '//index_name(r%c_indices, fnodes(a)), stat_invalid_input)
             return
          end do
@@ -705,7 +919,7 @@ contains
          call element_facet_order(r%element_type, loc(1:n), perm(1:n), side)
          if (.not. side) cycle
          if (owner /= 0) then
-            call fatal_error(error, 'recover_on_mesh: facet '//index_name(r%c_indices, f)//' is shared by elements '// &
+            call fatal_error(error, 'recover_on_mesh: '//word()//' '//index_name(r%c_indices, f)//' is shared by elements '// &
                & index_name(r%c_indices, owner)//' and '//index_name(r%c_indices, e)//': not a boundary facet ('// &
                & facet_name()//')', stat_invalid_input)
             return
@@ -715,31 +929,37 @@ contains
       end do
       if (owner /= 0) return
       if (holder /= 0) then
-         call fatal_error(error, 'recover_on_mesh: facet '//index_name(r%c_indices, f)//' is not a side of any '// &
+         call fatal_error(error, 'recover_on_mesh: '//word()//' '//index_name(r%c_indices, f)//' is not a side of any '// &
             & 'element: '//facet_name()//' are nodes of element '//index_name(r%c_indices, holder)//' but not one of its '// &
             & trim(merge('sides', 'faces', r%dim == 2))//' (a boundary facet is an element side, its nodes in any '// &
             & 'order)', stat_invalid_input)
       else
-         call fatal_error(error, 'recover_on_mesh: facet '//index_name(r%c_indices, f)//' is not a side of any '// &
+         call fatal_error(error, 'recover_on_mesh: '//word()//' '//index_name(r%c_indices, f)//' is not a side of any '// &
             & 'element: '//facet_name()//' are not the nodes of one element', stat_invalid_input)
       end if
    contains
       !> The facet as the caller wrote it (only for messages: facets are many).
       pure function facet_name() result(s)
          character(len=:), allocatable :: s
-         s = entry_name(r%c_indices, 'facet_nodes', 'facet_nodes', [0, f])//' = ('// &
-            & ivec_str(r%c_indices, fnodes)//')'
+         s = entry_name(r%c_indices, fname, fname, [0, f])//' = ('//ivec_str(r%c_indices, fnodes)//')'
       end function facet_name
+      !> 'facet' or 'contact facet'.
+      pure function word() result(s)
+         character(len=:), allocatable :: s
+         s = 'facet'
+         if (fname /= 'facet_nodes') s = 'contact facet'
+      end function word
    end subroutine facet_owner
 
    !> The shared patch loop (sprc_recovery_patch_loop) over the vertex nodes; a failing
    !> patch is named by its node.
-   subroutine recover_patches(r, topo, gp, gw, gs, rounds, error)
+   subroutine recover_patches(r, topo, gp, gw, gs, rounds, error, contact)
       type(mesh_recovery_type), intent(inout), target :: r
       type(topology_type), intent(in), target :: topo
       real(wp), intent(in), target, contiguous :: gp(:, :, :), gw(:, :), gs(:, :, :)
       integer, intent(in) :: rounds
       type(error_type), allocatable, intent(out) :: error
+      class(mesh_contact_solver_type), intent(in), optional, target :: contact
       type(mesh_source_type) :: src
       type(patch_loop_type) :: opt
       integer :: ip, n, st
@@ -757,6 +977,8 @@ contains
       src%gp => gp
       src%gw => gw
       src%gs => gs
+      if (present(contact)) src%contact => contact
+      src%c_indices = r%c_indices
       opt = patch_loop_type(dim=r%dim, degree=r%degree, rounds_limit=rounds, sprc=src%sprc)
       opt%cap = patch_capacity(src, r%dim, r%degree, topo%ne_ptr, topo%ne_list, r%patch_node)
       allocate (r%recs(r%n_patches), r%patch_rounds(r%n_patches), r%patch_elements(r%n_patches), stat=st)
@@ -781,6 +1003,48 @@ contains
       if (r%n_patches > 0) r%max_rounds_used = maxval(r%patch_rounds)
       r%n_tolerance_bites = count(r%recs%tolerance_bites)
    end subroutine recover_patches
+
+   !> Solve a filled patch: by the contact solver if it holds a contact point (module
+   !> notes), else the default. law / slip / pair of its boundary points in mesh_fill's order.
+   subroutine mesh_recover(self, node, elements, patch, degree, sprc, ws, rec, error)
+      class(mesh_source_type), intent(in) :: self
+      integer, intent(in) :: node, elements(:), degree
+      type(patch_type), intent(in) :: patch
+      logical, intent(in) :: sprc
+      type(recovery_workspace_type), intent(inout) :: ws
+      type(recovered_patch_type), intent(out) :: rec
+      type(error_type), allocatable, intent(out) :: error
+      integer, allocatable :: law(:)
+      real(wp), allocatable :: slip(:, :)
+      integer :: i, j, k, pair
+
+      if (sprc .and. associated(self%contact) .and. patch%nbpoints > 0) then
+         if (any(patch%bkind(1:patch%nbpoints) == boundary_contact)) then
+            allocate (law(patch%nbpoints), slip(self%dim, patch%nbpoints))
+            j = 0
+            pair = 0
+            do i = 1, size(elements)
+               do k = self%topo%bptr(elements(i)), self%topo%bptr(elements(i) + 1) - 1
+                  j = j + 1
+                  law(j) = self%topo%blaw(k)
+                  slip(:, j) = self%topo%bslip(:, k)
+                  if (self%topo%bkind(k) /= boundary_contact) cycle
+                  if (pair /= 0 .and. self%topo%bpair(k) /= pair) then
+                     call fatal_error(error, 'the patch holds contact points of pairs '// &
+                        & index_name(self%c_indices, pair)//' and '//index_name(self%c_indices, self%topo%bpair(k))// &
+                        & ': a contact patch couples one other body (give the pairs'' facets apart)', &
+                        & stat_invalid_input)
+                     return
+                  end if
+                  pair = self%topo%bpair(k)
+               end do
+            end do
+            call self%contact%solve(pair, patch, law, slip, degree, ws, rec, error)
+            return
+         end if
+      end if
+      call recover_patch_default(self, node, elements, patch, degree, sprc, ws, rec, error)
+   end subroutine mesh_recover
 
    !> [volume points, boundary points] the elements add to a patch.
    pure function mesh_points_of(self, elements) result(counts)
@@ -1109,6 +1373,71 @@ contains
          s = entry_name(result%c_indices, 'x', 'points', [0, i])
       end function point
    end subroutine mesh_recovery_eval
+
+   !> The recovered field sigma(nstress, npts) at points x(dim, npts) on or near the mesh (a
+   !> contact surface of another body whose facets do not match this mesh's): each point in
+   !> the element holding it, else in the element among the candidates of its bin (bins padded
+   !> by `pad` times each element's extent) whose reference point is nearest its reference
+   !> cell (the field extended past the element; a point off the mesh by a gap of the order of
+   !> the discretisation of a curved surface). Errors (stat_invalid_input): shapes, a
+   !> non-finite point, a point near no element.
+   subroutine mesh_recovery_eval_near(result, x, sigma, pad, error)
+      type(mesh_recovery_type), intent(in) :: result
+      real(wp), intent(in) :: x(:, :), pad
+      real(wp), intent(out) :: sigma(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      type(element_bins_type) :: bins
+      real(wp) :: xi(3), best_xi(3), dist, best
+      integer :: i, k, e, b
+      logical :: ok
+
+      if (.not. allocated(result%nodal) .or. size(x, 1) /= result%dim .or. size(sigma, 1) /= result%nstress .or. &
+         & size(sigma, 2) /= size(x, 2)) then
+         call fatal_error(error, 'mesh_recovery_eval_near: the result is not built or the shapes disagree', &
+            & stat_invalid_input)
+         return
+      end if
+      call build_element_bins(result%box_lo, result%box_hi, pad, bins, error)
+      if (allocated(error)) return
+      do i = 1, size(x, 2)
+         if (.not. all(abs(x(:, i)) <= huge(1.0_wp))) then
+            call fatal_error(error, 'mesh_recovery_eval_near: point '//itoa(i)//' is not finite', stat_invalid_input)
+            return
+         end if
+         b = bin_of_point(bins, x(:, i))
+         best = huge(1.0_wp)
+         e = 0
+         do k = bins%ptr(b), bins%ptr(b + 1) - 1
+            call element_inverse_map(result%element_type, result%x(:, result%connectivity(:, bins%list(k))), &
+               & x(:, i), xi(1:result%dim), ok)
+            if (.not. ok) cycle
+            dist = outside(xi(1:result%dim))
+            if (dist < best) then
+               best = dist
+               e = bins%list(k)
+               best_xi = xi
+            end if
+            if (best <= inside_tol) exit
+         end do
+         if (e == 0) then
+            call fatal_error(error, 'mesh_recovery_eval_near: point '//index_name(result%c_indices, i)//' = '// &
+               & vec_str(x(:, i))//' is near no element', stat_invalid_input)
+            return
+         end if
+         call field_at(result, e, best_xi(1:result%dim), x(:, i), sigma(:, i))
+      end do
+   contains
+      !> How far xi lies outside the reference cell (0 inside).
+      pure real(wp) function outside(xi)
+         real(wp), intent(in) :: xi(:)
+         outside = max(0.0_wp, maxval(-xi))
+         if (element_simplex(result%element_type)) then
+            outside = max(outside, sum(xi) - 1.0_wp)
+         else
+            outside = max(outside, maxval(xi - 1.0_wp))
+         end if
+      end function outside
+   end subroutine mesh_recovery_eval_near
 
    !> True (and the reference coordinates) if x lies in element e.
    logical function in_element(r, e, x, xi)

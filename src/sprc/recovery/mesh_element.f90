@@ -3,16 +3,8 @@
 !> inverse, and facet quadrature (points, weight*|J|, unit normal).
 !>
 !> Element type codes are the VTK cell type ids (part of the C API; never renumber),
-!> and local node order is VTK's:
-!> - tri3  (VTK_TRIANGLE = 5): (0,0) (1,0) (0,1) on the unit triangle;
-!> - quad4 (VTK_QUAD = 9): (0,0) (1,0) (1,1) (0,1) on [0,1]^2;
-!> - tet4  (VTK_TETRA = 10): (0,0,0) (1,0,0) (0,1,0) (0,0,1) on the unit tetrahedron;
-!> - hex8  (VTK_HEXAHEDRON = 12): bottom face z=0 as quad4, then the top face z=1;
-!> - quad9 (VTK_BIQUADRATIC_QUAD = 28): corners as quad4, edge midpoints of y=0, x=1, y=1,
-!>   x=0, then the centre;
-!> - hex27 (VTK_TRIQUADRATIC_HEXAHEDRON = 29): corners as hex8; edge midpoints of the bottom
-!>   face (as quad9's 4..7), of the top face, then of the vertical edges above corners 0..3;
-!>   face centres x=0, x=1, y=0, y=1, z=0, z=1; the centre.
+!> and local node order is VTK's (`sprc_core_lagrange`; tri3 (0,0) (1,0) (0,1) and tet4 (0,0,0)
+!> (1,0,0) (0,1,0) (0,0,1) on the unit simplex).
 !> The vertices are the first 2^dim (dim+1 for simplices) nodes; the vertex partition of
 !> unity (for the polynomial union, thesis eq. 102) is the linear element on them (quad4 for
 !> quad9, hex8 for hex27).
@@ -26,6 +18,8 @@
 module sprc_recovery_mesh_element
    use sprc_core_kinds, only: wp
    use sprc_core_gauss, only: gauss_legendre_nodes
+   use sprc_core_lagrange, only: tensor_shape, idx1 => vtk_line2, idx1q => vtk_line3, quad4 => vtk_quad4, &
+      & quad9 => vtk_quad9, hex8 => vtk_hex8, hex27 => vtk_hex27
    implicit none
    private
 
@@ -42,20 +36,6 @@ module sprc_recovery_mesh_element
    integer, parameter :: elem_quad9 = 28, elem_hex27 = 29
    !> Largest node counts of an element and of a facet, largest facet quadrature.
    integer, parameter :: max_element_nodes = 27, max_facet_nodes = 9, max_facet_points = 9
-
-   integer, parameter :: idx1(1, 2) = reshape([0, 1], [1, 2])
-   integer, parameter :: idx1q(1, 3) = reshape([0, 2, 1], [1, 3])
-   integer, parameter :: quad4(2, 4) = reshape([0, 0, 1, 0, 1, 1, 0, 1], [2, 4])
-   integer, parameter :: quad9(2, 9) = reshape([0, 0, 2, 0, 2, 2, 0, 2, 1, 0, 2, 1, 1, 2, 0, 1, 1, 1], [2, 9])
-   integer, parameter :: hex8(3, 8) = reshape([0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, &
-      & 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1], [3, 8])
-   integer, parameter :: hex27(3, 27) = reshape([ &
-      & 0, 0, 0, 2, 0, 0, 2, 2, 0, 0, 2, 0, 0, 0, 2, 2, 0, 2, 2, 2, 2, 0, 2, 2, &
-      & 1, 0, 0, 2, 1, 0, 1, 2, 0, 0, 1, 0, &
-      & 1, 0, 2, 2, 1, 2, 1, 2, 2, 0, 1, 2, &
-      & 0, 0, 1, 2, 0, 1, 2, 2, 1, 0, 2, 1, &
-      & 0, 1, 1, 2, 1, 1, 1, 0, 1, 1, 2, 1, 1, 1, 0, 1, 1, 2, &
-      & 1, 1, 1], [3, 27])
 
 contains
 
@@ -456,69 +436,6 @@ contains
          d(k, k + 1) = 1.0_wp
       end do
    end subroutine simplex_shape
-
-   !> Tensor Lagrange shape functions of degree deg on [0,1]^rdim, node j at idx(:, j)/deg,
-   !> and their derivatives d if wanted. Products written out per dimension (no temporaries:
-   !> this runs per point).
-   pure subroutine tensor_shape(idx, deg, xi, n, d)
-      integer, intent(in) :: idx(:, :), deg
-      real(wp), intent(in) :: xi(:)
-      real(wp), intent(out) :: n(:)
-      real(wp), intent(out), optional :: d(:, :)
-      real(wp) :: l(0:2, 3), dl(0:2, 3)
-      integer :: j, k, rdim
-
-      rdim = size(idx, 1)
-      do k = 1, rdim
-         call lagrange_1d(deg, xi(k), l(:, k), dl(:, k))
-      end do
-      select case (rdim)
-      case (1)
-         do j = 1, size(idx, 2)
-            n(j) = l(idx(1, j), 1)
-         end do
-      case (2)
-         do j = 1, size(idx, 2)
-            n(j) = l(idx(1, j), 1)*l(idx(2, j), 2)
-         end do
-      case default
-         do j = 1, size(idx, 2)
-            n(j) = l(idx(1, j), 1)*l(idx(2, j), 2)*l(idx(3, j), 3)
-         end do
-      end select
-      if (.not. present(d)) return
-      select case (rdim)
-      case (1)
-         do j = 1, size(idx, 2)
-            d(1, j) = dl(idx(1, j), 1)
-         end do
-      case (2)
-         do j = 1, size(idx, 2)
-            d(1, j) = dl(idx(1, j), 1)*l(idx(2, j), 2)
-            d(2, j) = l(idx(1, j), 1)*dl(idx(2, j), 2)
-         end do
-      case default
-         do j = 1, size(idx, 2)
-            d(1, j) = dl(idx(1, j), 1)*l(idx(2, j), 2)*l(idx(3, j), 3)
-            d(2, j) = l(idx(1, j), 1)*dl(idx(2, j), 2)*l(idx(3, j), 3)
-            d(3, j) = l(idx(1, j), 1)*l(idx(2, j), 2)*dl(idx(3, j), 3)
-         end do
-      end select
-   end subroutine tensor_shape
-
-   !> 1D Lagrange basis of degree 1 or 2 on equispaced nodes of [0, 1], with derivatives.
-   pure subroutine lagrange_1d(deg, t, l, dl)
-      integer, intent(in) :: deg
-      real(wp), intent(in) :: t
-      real(wp), intent(out) :: l(0:2), dl(0:2)
-      if (deg == 1) then
-         l = [1.0_wp - t, t, 0.0_wp]
-         dl = [-1.0_wp, 1.0_wp, 0.0_wp]
-      else
-         l = [(2.0_wp*t - 1.0_wp)*(t - 1.0_wp), 4.0_wp*t*(1.0_wp - t), t*(2.0_wp*t - 1.0_wp)]
-         dl = [4.0_wp*t - 3.0_wp, 4.0_wp - 8.0_wp*t, 4.0_wp*t - 1.0_wp]
-      end if
-   end subroutine lagrange_1d
 
    !> Inverse of a 2x2 or 3x3 matrix by its adjugate, and the determinant (inv undefined if 0).
    pure subroutine small_inverse(d, a, inv, det)

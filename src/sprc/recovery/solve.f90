@@ -36,6 +36,7 @@
 !> no OpenBLAS lock and no dependence on its thread count.
 module sprc_recovery_solve
    use sprc_core_kinds, only: wp
+   use sprc_core_sort, only: sort
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular
    use sprc_recovery_dense, only: qr_pivoted, apply_qt, apply_q, solve_upper
    use sprc_core_material, only: compliance_matrix
@@ -716,7 +717,7 @@ contains
       end do
       call pivoted_rank(ws, n, m, rec, r, error)
       if (allocated(error)) return
-      call sort_int(ws%jpvt(1:r))
+      call sort(ws%jpvt(1:r))
       do k = 1, r
          i = ws%jpvt(k)
          ws%c(mc + k, 1:n) = ws%blk(i, 1:n)
@@ -743,7 +744,7 @@ contains
       call pivoted_rank(ws, n, mc, rec, r, error)
       if (allocated(error)) return
       if (r == mc) return
-      call sort_int(ws%jpvt(1:r))
+      call sort(ws%jpvt(1:r))
       do k = 1, r
          i = ws%jpvt(k)
          ws%c(k, 1:n) = ws%c(i, 1:n)
@@ -766,21 +767,6 @@ contains
       r = diag_rank(ws%cq, min(n, m))
       if (r < min(n, m) .and. r > 0) call note_dropped(rec, abs(ws%cq(r + 1, r + 1))/abs(ws%cq(1, 1)))
    end subroutine pivoted_rank
-
-   pure subroutine sort_int(a)
-      integer, intent(inout) :: a(:)
-      integer :: i, j, v
-      do i = 2, size(a)
-         v = a(i)
-         j = i - 1
-         do while (j >= 1)
-            if (a(j) <= v) exit
-            a(j + 1) = a(j)
-            j = j - 1
-         end do
-         a(j + 1) = v
-      end do
-   end subroutine sort_int
 
    !> rec%coef allocated (nterms, nstress), its entries left to the caller (least_squares
    !> sets every one): storage of the patch's own size, so that a mesh of many patches

@@ -25,6 +25,19 @@
 !> passed the check hung in OpenBLAS's retry loop of blas_memory_alloc.
 !> Buffers already taken
 !> (blas_reserve_buffers) are in the virtual size and do not count again.
+!>
+!> Bodies in contact (`check_coupled_memory`) are solved in one block system
+!> of all their unknowns: the estimate is that of one level with the sum of
+!> their dofs (a direct factor fills with the whole system's size, so the
+!> pair costs more than its bodies apart), plus the contact recovery's
+!> Omega_aux data: each slave surface cell's SPR-C patches sample the other
+!> body in a prism about three cells deep (sprc_recovery_contact_aux), each
+!> of the 2^(d-1) patches at a surface cell its own, with dim + 6 reals
+!> (point and stress) per sampling point at (order + 1)^dim points a cell:
+!> 3 * 2^(d-1) (order + 1)^d (d + 6) * 8 bytes per slave cut cell, times 2
+!> for the patch matrices built from them (`aux_bytes`). 'auto' sends the
+!> coupled system to the iterative solver when its direct estimate does not
+!> fit, as for one body.
 module sprc_study_budget
    !$ use omp_lib, only: omp_get_max_threads
    use sprc_core_kinds, only: wp, i8
@@ -39,7 +52,7 @@ module sprc_study_budget
    implicit none
    private
 
-   public :: level_memory, check_level_memory
+   public :: level_memory, check_level_memory, check_coupled_memory, coupled_memory
 
    real(wp), parameter :: base_bytes = 32.0e6_wp, per_dof_2d = 2.5e3_wp, per_dof_3d = 1.0e4_wp, &
       & dofs_3d = 3.0e4_wp, q2_factor_3d = 1.75_wp, per_dof_3d_iterative = 8.0e3_wp
@@ -67,11 +80,8 @@ contains
       integer(i8), intent(in), optional :: available
       logical, intent(out), optional :: direct_fits
       real(wp), intent(in), optional :: known_dofs
-      type(grid_type) :: grid
-      integer :: d, coarse, up, n
-      real(wp) :: active, cut, box_size, direct_bytes
-      real(wp), allocatable :: box_min(:)
-      logical :: fits
+      integer :: d
+      real(wp) :: cut
 
       cells = 0.0_wp
       dofs = 0.0_wp
@@ -82,14 +92,8 @@ contains
          dofs = known_dofs
          cells = dofs/real(d*scene%order**d, wp)
       else
-         coarse = min(level, merge(6, 4, d == 2))
-         call body_box(scene, body, box_min, box_size)
-         call grid%build(body, d, box_min, box_size, coarse, 0, error)
+         call level_cells(scene, body, level, cells, cut, error)
          if (allocated(error)) return
-         active = real(sum(grid%n_inside) + sum(grid%n_cut), wp)
-         cut = real(sum(grid%n_cut), wp)
-         up = level - coarse
-         cells = active*2.0_wp**(d*up) + cut*2.0_wp**((d - 1)*up)*(2.0_wp**(d*scene%refine_boundary) - 1.0_wp)
          dofs = real(d*scene%order**d, wp)*cells
       end if
       if (present(grid_only)) then
@@ -98,15 +102,105 @@ contains
             return
          end if
       end if
-      direct_bytes = base_bytes + dofs*per_dof(d, scene%order, dofs, .false.)
+      call solve_bytes(scene, dofs, 0.0_wp, bytes, available, direct_fits)
+   end subroutine level_memory
+
+   !> Peak bytes of a level of `dofs` unknowns in one system plus `extra`
+   !> bytes, by the solver 'auto' (or the scene) takes for it (module notes);
+   !> `direct_fits` as for `level_memory`.
+   subroutine solve_bytes(scene, dofs, extra, bytes, available, direct_fits, coupled)
+      type(scene_type), intent(in) :: scene
+      real(wp), intent(in) :: dofs, extra
+      real(wp), intent(out) :: bytes
+      integer(i8), intent(in), optional :: available
+      logical, intent(out), optional :: direct_fits
+      !> Bodies in contact, one system ('auto''s coupled threshold).
+      logical, intent(in), optional :: coupled
+      real(wp) :: direct_bytes
+      integer :: n
+      logical :: fits
+
+      direct_bytes = base_bytes + dofs*per_dof(scene%dim, scene%order, dofs, .false.) + extra
       fits = .true.
       if (present(available)) fits = available < 0 .or. direct_bytes <= real(available, wp)
       n = int(min(dofs, real(huge(n), wp)))
       bytes = direct_bytes
-      if (use_iterative(scene_choice(scene), d, scene%order, n, direct_fits=fits)) &
-         & bytes = base_bytes + dofs*per_dof(d, scene%order, dofs, .true.)
+      if (use_iterative(scene_choice(scene), scene%dim, scene%order, n, direct_fits=fits, coupled=coupled)) &
+         & bytes = base_bytes + dofs*per_dof(scene%dim, scene%order, dofs, .true.) + extra
       if (present(direct_fits)) direct_fits = fits
-   end subroutine level_memory
+   end subroutine solve_bytes
+
+   !> Upper estimate of the cells and cut cells of `body` at `level` (module notes).
+   subroutine level_cells(scene, body, level, cells, cut_cells, error)
+      type(scene_type), intent(in) :: scene
+      type(body_type), intent(in) :: body
+      integer, intent(in) :: level
+      real(wp), intent(out) :: cells, cut_cells
+      type(error_type), allocatable, intent(out) :: error
+      type(grid_type) :: grid
+      integer :: d, coarse, up
+      real(wp) :: active, cut, box_size
+      real(wp), allocatable :: box_min(:)
+
+      cells = 0.0_wp
+      cut_cells = 0.0_wp
+      d = scene%dim
+      coarse = min(level, merge(6, 4, d == 2))
+      call body_box(scene, body, box_min, box_size)
+      call grid%build(body, d, box_min, box_size, coarse, 0, error)
+      if (allocated(error)) return
+      active = real(sum(grid%n_inside) + sum(grid%n_cut), wp)
+      cut = real(sum(grid%n_cut), wp)
+      up = level - coarse
+      cut_cells = cut*2.0_wp**((d - 1)*up)*2.0_wp**((d - 1)*scene%refine_boundary)
+      cells = active*2.0_wp**(d*up) + cut*2.0_wp**((d - 1)*up)*(2.0_wp**(d*scene%refine_boundary) - 1.0_wp)
+   end subroutine level_cells
+
+   !> Omega_aux bytes of `cut_cells` slave surface cells (module notes).
+   pure real(wp) function aux_bytes(scene, cut_cells)
+      type(scene_type), intent(in) :: scene
+      real(wp), intent(in) :: cut_cells
+      integer :: d
+      d = scene%dim
+      aux_bytes = 2.0_wp*3.0_wp*2.0_wp**(d - 1)*real((scene%order + 1)**d*(d + 6), wp)*8.0_wp*cut_cells
+   end function aux_bytes
+
+   !> Estimated cells, dofs and peak bytes of `level` for the bodies
+   !> `bodies(members)` solved in one block system, `slaves` those of them
+   !> whose contact surfaces carry slave points (module notes); `available`,
+   !> `direct_fits` and `known_dofs` (per member) as for `level_memory`.
+   subroutine coupled_memory(scene, bodies, members, slaves, level, cells, dofs, bytes, error, available, &
+      & direct_fits, known_dofs)
+      type(scene_type), intent(in) :: scene
+      type(body_type), intent(in) :: bodies(:)
+      integer, intent(in) :: members(:), slaves(:), level
+      real(wp), intent(out) :: cells, dofs, bytes
+      type(error_type), allocatable, intent(out) :: error
+      integer(i8), intent(in), optional :: available
+      logical, intent(out), optional :: direct_fits
+      real(wp), intent(in), optional :: known_dofs(:)
+      real(wp) :: c, cut, extra
+      integer :: k
+
+      cells = 0.0_wp
+      dofs = 0.0_wp
+      bytes = 0.0_wp
+      extra = 0.0_wp
+      do k = 1, size(members)
+         if (present(known_dofs)) then
+            c = known_dofs(k)/real(scene%dim*scene%order**scene%dim, wp)
+            ! a surface of an adapted mesh: that of a uniform grid of c cells, an upper estimate
+            cut = 2.0_wp*real(scene%dim, wp)*c**(real(scene%dim - 1, wp)/real(scene%dim, wp))
+         else
+            call level_cells(scene, bodies(members(k)), level, c, cut, error)
+            if (allocated(error)) return
+         end if
+         cells = cells + c
+         if (any(slaves == members(k))) extra = extra + aux_bytes(scene, cut)
+      end do
+      dofs = real(scene%dim*scene%order**scene%dim, wp)*cells
+      call solve_bytes(scene, dofs, extra, bytes, available, direct_fits, coupled=.true.)
+   end subroutine coupled_memory
 
    !> Estimated bytes per dof of a level of `dofs` unknowns in dimension `d`
    !> with elements of degree `order`, solved iteratively or not (module notes).
@@ -153,20 +247,12 @@ contains
       integer(i8) :: avail, usable
       character(len=:), allocatable :: source
       character(len=256) :: buf
-      integer :: threads
       logical :: wanted, direct_fits
 
       if (present(solver)) solver = scene_choice(scene)
       call memory_check_wanted(wanted, error)
       if (allocated(error) .or. .not. wanted) return
-      call available_memory(avail, source)
-      threads = 1
-      !$ threads = omp_get_max_threads()
-      reserve = 0.0_wp
-      if (source == 'ulimit -v') reserve = real(max(0, threads + 1 - blas_reserved_threads()), wp)* &
-         & real(blas_buffer_bytes, wp)
-      usable = avail
-      if (avail >= 0) usable = max(0_i8, avail - int(reserve, i8))
+      call usable_memory(avail, usable, reserve, source)
       call level_memory(scene, body, level, cells, dofs, bytes, error, grid_only, usable, direct_fits, known_dofs)
       if (allocated(error)) return
       bytes = bytes + reserve
@@ -181,6 +267,63 @@ contains
          & byte_text(real(avail, wp)), source
       call fatal_error(error, trim(buf), stat_out_of_memory)
    end subroutine check_level_memory
+
+   !> `check_level_memory` for the bodies `bodies(members)` solved in one
+   !> block system (`coupled_memory`): stat_out_of_memory, before any of
+   !> them is built, when their estimate exceeds the memory available;
+   !> `solver` becomes `solver_iterative` where 'auto' found that a direct
+   !> solve of the coupled system would not fit.
+   subroutine check_coupled_memory(scene, bodies, members, slaves, level, error, solver, known_dofs)
+      type(scene_type), intent(in) :: scene
+      type(body_type), intent(in) :: bodies(:)
+      integer, intent(in) :: members(:), slaves(:), level
+      type(error_type), allocatable, intent(out) :: error
+      integer, intent(out), optional :: solver
+      real(wp), intent(in), optional :: known_dofs(:)
+      real(wp) :: cells, dofs, bytes, reserve
+      integer(i8) :: avail, usable
+      character(len=:), allocatable :: source
+      character(len=320) :: buf
+      logical :: wanted, direct_fits
+
+      if (present(solver)) solver = scene_choice(scene)
+      call memory_check_wanted(wanted, error)
+      if (allocated(error) .or. .not. wanted) return
+      call usable_memory(avail, usable, reserve, source)
+      call coupled_memory(scene, bodies, members, slaves, level, cells, dofs, bytes, error, usable, direct_fits, &
+         & known_dofs)
+      if (allocated(error)) return
+      bytes = bytes + reserve
+      if (avail < 0 .or. bytes <= real(avail, wp)) then
+         if (present(solver) .and. .not. direct_fits) then
+            if (solver == solver_auto) solver = solver_iterative
+         end if
+         return
+      end if
+      write (buf, '("the bodies in contact (solved together) need about ",a," of memory (an estimate for ",es7.1, &
+         & " cells, ",es7.1," dofs in one system, with the contact recovery''s data), but ",a," is available (",a, &
+         & "); use a lower level")') byte_text(bytes), cells, dofs, byte_text(real(avail, wp)), source
+      call fatal_error(error, trim(buf), stat_out_of_memory)
+   end subroutine check_coupled_memory
+
+   !> The memory available (`avail`, -1 unknown, and what bounds it), less
+   !> the BLAS buffers still to be reserved under an address-space limit
+   !> (`reserve`; module notes): `usable`.
+   subroutine usable_memory(avail, usable, reserve, source)
+      integer(i8), intent(out) :: avail, usable
+      real(wp), intent(out) :: reserve
+      character(len=:), allocatable, intent(out) :: source
+      integer :: threads
+
+      call available_memory(avail, source)
+      threads = 1
+      !$ threads = omp_get_max_threads()
+      reserve = 0.0_wp
+      if (source == 'ulimit -v') reserve = real(max(0, threads + 1 - blas_reserved_threads()), wp)* &
+         & real(blas_buffer_bytes, wp)
+      usable = avail
+      if (avail >= 0) usable = max(0_i8, avail - int(reserve, i8))
+   end subroutine usable_memory
 
    !> False when the environment variable SPRC_MEMORY_CHECK is 'off': the estimate
    !> above is then skipped (it is an upper estimate; a user who knows a level fits,

@@ -60,7 +60,7 @@ module sprc_study_level
    use sprc_study_spec, only: scene_type, contact_spec_type, recovery_degree, contact_unsupported, contact_components
    use sprc_study_model, only: build_bodies, build_exact, body_conditions, analysis_kind, analysis_units_type, &
       & analysis_units, in_units
-   use sprc_study_budget, only: check_level_memory
+   use sprc_study_budget, only: check_level_memory, check_coupled_memory
    use sprc_study_partition, only: partition_type, start_partition, integrate_level, solve_level
    use sprc_grid_share, only: share_type
    use sprc_study_row, only: report_row_type
@@ -268,13 +268,15 @@ contains
       type(mesh_source_type), intent(in), optional :: source(:)
       type(cut_quadrature_type) :: quad
       real(wp) :: t_start, t_contact
-      integer, allocatable :: comp(:), ks(:)
+      integer, allocatable :: comp(:), ks(:), pair_solver(:)
       integer :: b, k, c, ncomp
 
       t_start = wall_time()
       result%level = level
       result%done = study%run
       call new_cut_quadrature(quad, study%dim, study%points, error)
+      if (allocated(error)) return
+      call check_pairs_memory(study, level, pair_solver, error, source)
       if (allocated(error)) return
       allocate (result%bodies(size(study%bodies)))
       do b = 1, size(study%bodies)
@@ -292,6 +294,10 @@ contains
             if (size(study%bodies) > 1) error%message = 'body '''//study%bodies(b)%name//''': '//error%message
             return
          end if
+      end do
+      ! the solver each pair's memory estimate chose (check_pairs_memory)
+      do b = 1, size(study%bodies)
+         if (pair_solver(b) /= 0) result%bodies(b)%problem%solver = pair_solver(b)
       end do
       t_contact = 0.0_wp
       if (size(study%scene%contacts) > 0) allocate (result%contacts(size(study%scene%contacts)), &
@@ -417,11 +423,11 @@ contains
             & gamma=study%gamma, dilatation=study%dilatation)
       end if
       if (allocated(error)) return
+      bl%problem%solver = solver
       if (in_contact) then
          call bl%problem%assemble(error)
          return
       end if
-      bl%problem%solver = solver
       if (present(start)) allocate (bl%problem%start, source=start)
       call solve_level(study%partition, bl%problem, error)
       if (allocated(error)) return
@@ -485,6 +491,37 @@ contains
          if (allocated(error)) return
       end do
    end subroutine recover_body
+
+   !> The memory estimate of each contact pair's bodies solved together
+   !> (sprc_study_budget's `check_coupled_memory`), before any body is built:
+   !> a pair that does not fit is refused. `solver(b)`: the solver of body b's
+   !> pair (0 for a body in no pair), iterative where 'auto' found that the
+   !> pair's direct solve would not fit.
+   subroutine check_pairs_memory(study, level, solver, error, source)
+      type(study_type), intent(in) :: study
+      integer, intent(in) :: level
+      integer, allocatable, intent(out) :: solver(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(mesh_source_type), intent(in), optional :: source(:)
+      integer :: k, choice, members(2)
+
+      allocate (solver(size(study%bodies)), source=0)
+      do k = 1, size(study%scene%contacts)
+         members = [study%scene%contacts(k)%slave_index, study%scene%contacts(k)%master_index]
+         if (present(source)) then
+            call check_coupled_memory(study%scene, study%bodies%geometry, members, members(1:1), level, error, &
+               & choice, [source(members(1))%dofs, source(members(2))%dofs])
+         else
+            call check_coupled_memory(study%scene, study%bodies%geometry, members, members(1:1), level, error, choice)
+         end if
+         if (allocated(error)) then
+            error%message = "&contact '"//study%scene%contacts(k)%slave//"' on '"//study%scene%contacts(k)%master// &
+               & "': "//error%message
+            return
+         end if
+         solver(members) = choice
+      end do
+   end subroutine check_pairs_memory
 
    !> Whether body b belongs to a `&contact` pair.
    pure logical function in_contact(study, b)
@@ -550,6 +587,7 @@ contains
          k = merge(s, m, b == 1)
          bodies(k)%problem%rcond = sol%rcond
          bodies(k)%problem%solver_name = sol%solver_name
+         bodies(k)%problem%solver_iterations = merge(sol%solver_iterations, 0, b == 1)
       end do
       call contact_result(surface, sol, spec, study%bodies(s)%units, result, error)
       if (allocated(error)) return
