@@ -10,6 +10,7 @@ program sprc_unit_tests
    use sprc_test_exact, only: collect_exact
    use sprc_test_exact_contact, only: collect_exact_contact
    use sprc_test_exact_corner, only: collect_exact_corner
+   use sprc_test_exact_layered, only: collect_exact_layered
    use sprc_test_contact_surface, only: collect_contact_surface
    use sprc_test_namelist, only: collect_namelist
    use sprc_test_scene, only: collect_scene
@@ -32,6 +33,7 @@ program sprc_unit_tests
    use sprc_test_contact_model, only: collect_contact_model
    use sprc_test_contact_output, only: collect_contact_output
    use sprc_test_contact_fe, only: collect_contact_fe
+   use sprc_test_contact_assembly, only: collect_contact_assembly
    use sprc_test_contact_friction, only: collect_contact_friction
    use sprc_test_contact_iterative, only: collect_contact_iterative
    use sprc_test_petsc, only: collect_petsc
@@ -51,6 +53,7 @@ program sprc_unit_tests
       new_testsuite('exact', collect_exact), &
       new_testsuite('exact_contact', collect_exact_contact), &
       new_testsuite('exact_corner', collect_exact_corner), &
+      new_testsuite('exact_layered', collect_exact_layered), &
       new_testsuite('contact_surface', collect_contact_surface), &
       new_testsuite('namelist', collect_namelist), &
       new_testsuite('scene', collect_scene), &
@@ -73,6 +76,7 @@ program sprc_unit_tests
       new_testsuite('contact_model', collect_contact_model), &
       new_testsuite('contact_output', collect_contact_output), &
       new_testsuite('contact_fe', collect_contact_fe), &
+      new_testsuite('contact_assembly', collect_contact_assembly), &
       new_testsuite('contact_friction', collect_contact_friction), &
       new_testsuite('contact_iterative', collect_contact_iterative), &
       new_testsuite('petsc', collect_petsc), &

@@ -44,9 +44,9 @@ contains
    subroutine test_csv_read_back(error)
       type(error_type), allocatable, intent(out) :: error
       character(len=*), parameter :: path = dir//'test_contact.csv'
-      ! SCENE.md's columns, then the trailing signed tangential traction (an extension).
+      ! SCENE.md's columns, then the trailing signed tangential traction and the pair (extensions).
       character(len=*), parameter :: contract = 'level,x,y,z,weight,gap,state,p_fe,p_spr,p_sprc,p_exact,ts_fe,ts_sprc,'// &
-         & 'tx_fe,ty_fe,tz_fe'
+         & 'tx_fe,ty_fe,tz_fe,pair'
       type(contact_level_type) :: levels(2)
       character(len=:), allocatable :: text
       character(len=400) :: lines(10)
@@ -76,6 +76,8 @@ contains
                row = row + 1
                call check_line(trim(lines(row)), levels(l)%level, levels(l)%contacts(k), i, error)
                if (allocated(error)) return
+               call check(error, cell_of(trim(lines(row)), 17), itoa(k), 'line '//itoa(row)//': pair')
+               if (allocated(error)) return
             end do
          end do
       end do
@@ -92,7 +94,7 @@ contains
       integer :: j
 
       where = 'line of level '//itoa(level)//' point '//itoa(i)//': '
-      call check(error, count_sub(line, ','), 15, where//'16 cells')
+      call check(error, count_sub(line, ','), 16, where//'17 cells')
       if (allocated(error)) return
       call check(error, cell_of(line, 1), itoa(level), where//'level')
       if (allocated(error)) return

@@ -17,7 +17,7 @@ module sprc_test_scene
    character(len=*), parameter :: nl = new_line('a')
    character(len=*), parameter :: bad_dir = 'test/data/scenes/bad/'
    !> Minimum number of malformed scene files the suite must hold.
-   integer, parameter :: min_bad_files = 127
+   integer, parameter :: min_bad_files = 146
 
    !> A small valid 2D scene; tests edit it with `replaced`.
    character(len=*), parameter :: minimal = &

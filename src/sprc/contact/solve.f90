@@ -47,6 +47,15 @@
 !>   only by the contact has no usable hierarchy of its own). Each iteration
 !>   starts from the previous solution; the stopping test is the single body's
 !>   energy bound tightened for pointwise values (`contact_tolerance`).
+!>
+!> Assemblies (`solve_contact_assembly`): several bodies and the pairs between
+!> them, one block system with every body's reduced system on the diagonal
+!> (offsets in body order) and the cells of every pair, built as a pair's
+!> alone (`point_operators` with the bodies' offsets); one active set over
+!> all cells, the rigid-mode check over every body, a direct solve
+!> (`solve_block` with an unset block solver). Frictionless and stick with the
+!> FE stabilization stress: Coulomb's load path, the recovered stabilization
+!> and the iterative solvers stay per pair (`solve_contact_pair`).
 module sprc_contact_solve
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_not_converged, stat_singular, &
@@ -70,6 +79,7 @@ module sprc_contact_solve
    private
 
    public :: contact_solution_type, solve_contact_pair, friction_kind, contact_progress, contact_factor_type
+   public :: contact_body_type, contact_pair_type, solve_contact_assembly
    public :: friction_frictionless, friction_stick, friction_coulomb, default_max_iterations
 
    abstract interface
@@ -180,6 +190,33 @@ module sprc_contact_solve
       !> block assemblies and solves.
       real(wp) :: t_contact = 0.0_wp, t_solve = 0.0_wp
    end type contact_solution_type
+
+   !> A body of an assembly (`solve_contact_assembly`): its assembled problem and its name.
+   type :: contact_body_type
+      type(elasticity_problem_type), pointer :: problem => null()
+      character(len=:), allocatable :: name
+   end type contact_body_type
+
+   !> A pair of an assembly: slave and master (indices into the assembly's
+   !> bodies), the slave surface with its initial gaps to the master, the
+   !> friction law (frictionless or stick) and kappa.
+   type :: contact_pair_type
+      integer :: slave = 0, master = 0, friction = friction_frictionless
+      real(wp) :: kappa = 0.0_wp
+      type(contact_surface_type) :: surface
+   end type contact_pair_type
+
+   !> A matrix of a list of matrices (one body's rigid modes).
+   type :: dense_block_type
+      real(wp), allocatable :: a(:, :)
+   end type dense_block_type
+
+   !> A pair's operators, contact cells and active set during an assembly's solve.
+   type :: pair_work_type
+      type(point_operators_type) :: ops
+      type(cell_operators_type), allocatable :: cells(:)
+      logical, allocatable :: closed(:)
+   end type pair_work_type
 
 contains
 
@@ -375,16 +412,21 @@ contains
    end subroutine check_pair
 
    !> Gap and traction operators of every point with a master point.
-   subroutine point_operators(slave, master, surface, kappa, ops, error)
+   !> `offsets`: the slave's and the master's first dof less one in the
+   !> system's numbering (default 0 and the slave's dofs: the pair's block system).
+   subroutine point_operators(slave, master, surface, kappa, ops, error, offsets)
       type(elasticity_problem_type), intent(in) :: slave, master
       type(contact_surface_type), intent(in) :: surface
       real(wp), intent(in) :: kappa
       type(point_operators_type), intent(out) :: ops
       type(error_type), allocatable, intent(out) :: error
+      integer, intent(in), optional :: offsets(2)
       type(local_type), allocatable :: loc(:)
-      integer :: i, q0, q1, d, c, stat
+      integer :: i, q0, q1, d, c, stat, off(2)
 
       d = surface%dim
+      off = [0, slave%n_dofs()]
+      if (present(offsets)) off = offsets
       call group_cells(surface, slave, master, ops, error)
       if (allocated(error)) return
       allocate (loc(surface%npoint), ops%ptr(surface%npoint + 1), ops%gamma(ops%ncell), stat=stat)
@@ -414,12 +456,12 @@ contains
          associate (p => loc(i))
             q0 = ops%ptr(i)
             q1 = q0 + p%ms - 1
-            ops%dofs(q0:q1) = p%ds(1:p%ms)
+            ops%dofs(q0:q1) = off(1) + p%ds(1:p%ms)
             ops%gop(:, q0:q1) = -p%ns
             ops%top(:, q0:q1) = p%ts
             q0 = q1 + 1
             q1 = ops%ptr(i + 1) - 1
-            ops%dofs(q0:q1) = slave%n_dofs() + p%dm(1:p%mm)
+            ops%dofs(q0:q1) = off(2) + p%dm(1:p%mm)
             ops%gop(:, q0:q1) = p%nm
             ops%top(:, q0:q1) = 0.0_wp
          end associate
@@ -1510,5 +1552,256 @@ contains
          pstar(:, c) = pstar(:, c)/cells(c)%measure
       end do
    end subroutine cell_tractions
+
+   !> Solve an assembly: several bodies and the pairs between them (a
+   !> connected component of the contact graph) in one block system, every
+   !> body's reduced system on the diagonal and every pair's contact cells
+   !> (module notes, frictionless or stick, the FE stabilization stress), one
+   !> active-set iteration over the cells of all pairs: each iteration
+   !> assembles, checks the rigid modes of every body and solves the one
+   !> system, then every pair's cells take their next state; it ends when no
+   !> cell of any pair switches. A pair's cells, first active set and
+   !> operators are those `solve_contact_pair` gives it alone. On success
+   !> every problem holds its solution and sols(k) is pair k's; the iteration
+   !> count, condition estimate, solver and times are the assembly's, the
+   !> same in every sols(k).
+   subroutine solve_contact_assembly(bodies, pairs, sols, error, max_iterations, progress)
+      type(contact_body_type), intent(in) :: bodies(:)
+      type(contact_pair_type), intent(in) :: pairs(:)
+      type(contact_solution_type), allocatable, intent(out) :: sols(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer, intent(in), optional :: max_iterations
+      procedure(contact_progress), optional :: progress
+      type(pair_work_type), allocatable :: work(:)
+      type(contact_solution_type) :: solved
+      !> Unset: a direct solve (module notes).
+      type(block_solver_type) :: bs
+      type(csr_type) :: k
+      type(timer_type) :: timer
+      real(wp), allocatable :: f(:), x(:)
+      integer, allocatable :: offset(:)
+      integer :: it, maxit, p, c, switched, b, stat
+      logical, allocatable :: next(:)
+
+      maxit = default_max_iterations
+      if (present(max_iterations)) maxit = max_iterations
+      allocate (sols(size(pairs)), work(size(pairs)), offset(size(bodies) + 1), stat=stat)
+      call check_allocation(stat, 'contact assembly', 'the pairs', size(pairs), 64, error)
+      if (allocated(error)) return
+      offset(1) = 0
+      do b = 1, size(bodies)
+         offset(b + 1) = offset(b) + bodies(b)%problem%n_dofs()
+      end do
+      call timer%start()
+      do p = 1, size(pairs)
+         call pair_work(bodies, pairs(p), offset, work(p), error)
+         if (allocated(error)) then
+            error%message = pair_name(bodies, pairs(p))//': '//error%message
+            return
+         end if
+      end do
+      call timer%stop()
+      solved%t_contact = timer%elapsed
+      allocate (x(offset(size(bodies) + 1)), stat=stat)
+      call check_allocation(stat, 'contact assembly', 'the solution of every body', size(x), 8, error)
+      if (allocated(error)) return
+      do it = 1, maxit
+         solved%iterations = it
+         call timer%reset()
+         call timer%start()
+         call assembly_system(bodies, offset, work, k, f, error)
+         if (.not. allocated(error)) call check_held_bodies(bodies, k, &
+            & sum([(closed_points(work(p)%ops, work(p)%closed), p=1, size(pairs))]), it, error)
+         if (.not. allocated(error)) call solve_block(bs, k, f, x, solved, error)
+         call timer%stop()
+         solved%t_solve = solved%t_solve + timer%elapsed
+         if (allocated(error)) return
+         call timer%reset()
+         call timer%start()
+         switched = 0
+         do p = 1, size(pairs)
+            associate (w => work(p))
+               call evaluate(pairs(p)%surface, w%ops, w%cells, w%closed, x, sols(p), error)
+               if (allocated(error)) return
+               next = sols(p)%lambda_n < 0.0_wp
+               do c = 1, w%ops%ncell
+                  if (next(c) .neqv. w%closed(c)) switched = switched + w%ops%cell_ptr(c + 1) - w%ops%cell_ptr(c)
+               end do
+               w%closed = next
+            end associate
+         end do
+         call timer%stop()
+         solved%t_contact = solved%t_contact + timer%elapsed
+         if (present(progress)) call progress(1, 1, it, switched)
+         if (switched == 0) exit
+         if (it == maxit) then
+            call fatal_error(error, 'contact assembly of bodies '//body_list(bodies)// &
+               & ': the active set did not settle in '//itoa(maxit)//' iterations; '//itoa(switched)// &
+               & ' points still switched in the last one', stat_not_converged)
+            return
+         end if
+      end do
+      do b = 1, size(bodies)
+         call bodies(b)%problem%set_solution(x(offset(b) + 1:offset(b + 1)), error)
+         if (allocated(error)) return
+      end do
+      do p = 1, size(pairs)
+         sols(p)%iterations = solved%iterations
+         sols(p)%rcond = solved%rcond
+         sols(p)%solver_name = solved%solver_name
+         sols(p)%t_solve = solved%t_solve
+         sols(p)%t_contact = solved%t_contact
+      end do
+   end subroutine solve_contact_assembly
+
+   !> A pair's operators in the assembly's numbering, its cells and first
+   !> active set (as `solve_contact_pair`'s).
+   subroutine pair_work(bodies, pair, offset, work, error)
+      type(contact_body_type), intent(in) :: bodies(:)
+      type(contact_pair_type), intent(in) :: pair
+      integer, intent(in) :: offset(:)
+      type(pair_work_type), intent(out) :: work
+      type(error_type), allocatable, intent(out) :: error
+      integer :: c, stat
+
+      if (pair%friction /= friction_frictionless .and. pair%friction /= friction_stick) then
+         call fatal_error(error, 'contact assembly: friction '//itoa(pair%friction)//' is not frictionless or '// &
+            & 'stick', stat_unsupported)
+         return
+      end if
+      associate (slave => bodies(pair%slave)%problem, master => bodies(pair%master)%problem)
+         call check_pair(slave, master, pair%surface, pair%friction, pair%kappa, error)
+         if (.not. allocated(error)) call point_operators(slave, master, pair%surface, pair%kappa, work%ops, error, &
+            & [offset(pair%slave), offset(pair%master)])
+         if (allocated(error)) return
+         allocate (work%cells(work%ops%ncell), work%closed(work%ops%ncell), stat=stat)
+         call check_allocation(stat, 'contact solve', 'the contact cells', work%ops%ncell, 2, error)
+         if (allocated(error)) return
+         do c = 1, work%ops%ncell
+            call cell_operators(pair%surface, work%ops, c, pair%friction, work%cells(c), error)
+            if (allocated(error)) return
+            work%closed(c) = any(pair%surface%g0(work%ops%cell_point(work%ops%cell_ptr(c):work%ops%cell_ptr(c + 1) &
+               & - 1)) <= cell_size(slave, slave%root(pair%surface%slave_cell(work%ops%cell_point( &
+               & work%ops%cell_ptr(c))))))
+         end do
+      end associate
+   end subroutine pair_work
+
+   !> The assembly's block system (every body's K on the diagonal, the closed
+   !> cells' blocks of every pair) and its load.
+   subroutine assembly_system(bodies, offset, work, k, f, error)
+      type(contact_body_type), intent(in) :: bodies(:)
+      integer, intent(in) :: offset(:)
+      type(pair_work_type), intent(in) :: work(:)
+      type(csr_type), intent(out) :: k
+      real(wp), allocatable, intent(out) :: f(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(coo_type) :: coo
+      real(wp), allocatable :: kc(:, :)
+      integer(i8) :: capacity
+      integer :: b, p, c, n
+
+      n = offset(size(bodies) + 1)
+      capacity = 0
+      do b = 1, size(bodies)
+         capacity = capacity + bodies(b)%problem%k%nnz()
+      end do
+      do p = 1, size(work)
+         do c = 1, size(work(p)%cells)
+            if (work(p)%closed(c)) capacity = capacity + int(work(p)%cells(c)%nu, i8)**2
+         end do
+      end do
+      call coo%init(n, n, error, capacity=capacity)
+      if (allocated(error)) return
+      allocate (f(n))
+      do b = 1, size(bodies)
+         call add_csr(coo, bodies(b)%problem%k, offset(b), error)
+         if (allocated(error)) return
+         f(offset(b) + 1:offset(b + 1)) = bodies(b)%problem%f
+      end do
+      do p = 1, size(work)
+         do c = 1, size(work(p)%cells)
+            if (.not. work(p)%closed(c)) cycle
+            associate (cell => work(p)%cells(c), gamma => work(p)%ops%gamma(c))
+               call tied_block(cell, gamma, kc)
+               call coo%add(cell%dofs, kc, error)
+               if (allocated(error)) return
+               f(cell%dofs) = f(cell%dofs) - cell%measure*matmul(cell%g0bar, cell%tbar + gamma*cell%gbar)
+            end associate
+         end do
+      end do
+      call coo%to_csr(k, error)
+   end subroutine assembly_system
+
+   !> Every rigid-body mode of every body of an assembly must be resisted by
+   !> its block system; the free ones are an error naming their bodies.
+   subroutine check_held_bodies(bodies, k, nclosed, iteration, error)
+      type(contact_body_type), intent(in) :: bodies(:)
+      type(csr_type), intent(in) :: k
+      integer, intent(in) :: nclosed, iteration
+      type(error_type), allocatable, intent(out) :: error
+      type(dense_block_type), allocatable :: modes(:)
+      real(wp), allocatable :: r(:, :), vec(:, :)
+      logical, allocatable :: involved(:)
+      integer :: nfree, j, b, row, col, nm, stat
+      character(len=:), allocatable :: what
+
+      allocate (modes(size(bodies)), stat=stat)
+      call check_allocation(stat, 'contact rigid-mode check', 'the bodies'' modes', size(bodies), 64, error)
+      if (allocated(error)) return
+      do b = 1, size(bodies)
+         call bodies(b)%problem%rigid_modes(modes(b)%a, error)
+         if (allocated(error)) return
+      end do
+      nm = size(modes(1)%a, 2)
+      allocate (r(k%nrows, nm*size(bodies)), source=0.0_wp, stat=stat)
+      call check_allocation(stat, 'contact rigid-mode check', 'the rigid-body motions of every body', &
+         & int(k%nrows, i8)*nm*size(bodies), 8, error)
+      if (allocated(error)) return
+      row = 0
+      do b = 1, size(bodies)
+         col = (b - 1)*nm
+         r(row + 1:row + size(modes(b)%a, 1), col + 1:col + nm) = modes(b)%a
+         row = row + size(modes(b)%a, 1)
+      end do
+      call free_motions(k, r, vec, nfree, error)
+      if (allocated(error) .or. nfree == 0) return
+      allocate (involved(nm*size(bodies)), source=.false.)
+      do j = 1, nfree
+         involved = involved .or. abs(vec(:, j)) >= 0.2_wp*maxval(abs(vec(:, j)))
+      end do
+      what = ''
+      do b = 1, size(bodies)
+         associate (flags => involved((b - 1)*nm + 1:b*nm))
+            if (.not. any(flags)) cycle
+            if (len(what) > 0) what = what//'; '
+            what = what//"body '"//bodies(b)%name//"' is not held: "//motion_names(bodies(1)%problem%dim, flags)// &
+               & ' free'
+         end associate
+      end do
+      call fatal_error(error, what//' (contact assembly of bodies '//body_list(bodies)//', active-set iteration '// &
+         & itoa(iteration)//', '//itoa(nclosed)//' closed points): a body held only by contact has lost it, or '// &
+         & 'its conditions leave it free', stat_singular)
+   end subroutine check_held_bodies
+
+   !> 'a', 'b', 'c': the assembly's body names for messages.
+   function body_list(bodies) result(text)
+      type(contact_body_type), intent(in) :: bodies(:)
+      character(len=:), allocatable :: text
+      integer :: b
+      text = ''
+      do b = 1, size(bodies)
+         if (b > 1) text = text//', '
+         text = text//"'"//bodies(b)%name//"'"
+      end do
+   end function body_list
+
+   !> "contact 'slave' on 'master'" of a pair, for messages.
+   function pair_name(bodies, pair) result(text)
+      type(contact_body_type), intent(in) :: bodies(:)
+      type(contact_pair_type), intent(in) :: pair
+      character(len=:), allocatable :: text
+      text = "contact '"//bodies(pair%slave)%name//"' on '"//bodies(pair%master)%name//"'"
+   end function pair_name
 
 end module sprc_contact_solve

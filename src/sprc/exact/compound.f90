@@ -45,7 +45,7 @@ module sprc_exact_compound
    implicit none
    private
 
-   public :: compound_type, new_compound_cylinder, new_compound_sphere
+   public :: compound_type, new_compound_cylinder, new_compound_sphere, make_shell, radial_displacement
 
    !> Two concentric shells in frictionless contact at r = r_contact.
    type :: compound_type

@@ -32,7 +32,13 @@
 !> on the contact shape are contact points where their law is closed and free-surface
 !> (zero-traction) points where it is open; a patch holding a contact point is solved by
 !> the coupled contact solve (contact wins, the thesis), expanded like any other patch when it
-!> lacks rank.
+!> lacks rank. A body of several pairs has one description per pair (`contacts`): a
+!> boundary point is a contact point of the first description (pair order) whose shape it
+!> lies on and that closes it, a free-surface point if its shape is a contact shape that
+!> none closes. A patch holding contact points of several pairs is solved with the pair
+!> holding most of them (the first on a tie), with the other pairs' contact points left
+!> out of the patch: each coupled solve has one other body (its Omega_aux), and a point
+!> of another pair is neither free nor in contact with that body.
 module sprc_grid_patches
    use sprc_core_kinds, only: wp
    use sprc_core_text, only: itoa, rtoa
@@ -98,7 +104,7 @@ module sprc_grid_patches
       type(grid_nodes_type), pointer :: nodes => null()
       real(wp), pointer :: elem_lo(:, :) => null(), elem_hi(:, :) => null()
       class(exact_solution_type), pointer :: exact => null()
-      type(grid_contact_type), pointer :: contact => null()
+      type(grid_contact_type), pointer :: contacts(:) => null()
       !> Singular fields of re-entrant corners and the corner each node's patch leaves
       !> out (0: none), sprc_grid_singular; unassociated without corners.
       type(singular_fit_type), pointer :: corners(:) => null()
@@ -122,11 +128,11 @@ contains
    !> the FE degree p or p+1). `exact` is needed for bc_exact_traction shapes. Errors:
    !> invalid input (stat_invalid_input, naming the field and index), a patch still rank
    !> deficient after `max_rounds` expansions (stat_singular, naming the node). With
-   !> `contact` (SPR-C only; ignored by SPR), the body's contact surface (module notes).
+   !> `contacts` (SPR-C only; ignored by SPR), the body's contact surfaces, one per pair (module notes).
    !> With `share` (a level shared out among ranks, `sprc_grid_share`) each rank
    !> recovers its range of patches and the records are gathered: the same field
    !> on every rank as one process recovers.
-   subroutine recover_grid(input, grid, nodes, hanging, method, degree, field, error, exact, max_rounds, contact, &
+   subroutine recover_grid(input, grid, nodes, hanging, method, degree, field, error, exact, max_rounds, contacts, &
          & share)
       type(recovery_input_type), intent(in), target :: input
       type(grid_type), intent(in) :: grid
@@ -138,7 +144,7 @@ contains
       class(exact_solution_type), intent(in), optional, target :: exact
       !> Expansion rounds allowed per patch (>= 0; default `default_max_rounds`).
       integer, intent(in), optional :: max_rounds
-      type(grid_contact_type), intent(in), optional, target :: contact
+      type(grid_contact_type), intent(in), optional, target :: contacts(:)
       class(share_type), intent(in), optional :: share
       type(grid_source_type) :: src
       type(patch_loop_type) :: opt
@@ -184,17 +190,20 @@ contains
       src%elem_lo => field%elem_lo
       src%elem_hi => field%elem_hi
       if (present(exact)) src%exact => exact
-      if (present(contact)) then
-         if (size(contact%law) /= size(input%bw) .or. size(contact%slip, 1) < grid%dim) then
-            call fatal_error(error, 'recover_grid: the contact description has '//itoa(size(contact%law))// &
-               & ' boundary points, the input '//itoa(size(input%bw)), stat_invalid_input)
-            return
-         end if
-         src%contact => contact
+      if (present(contacts)) then
+         do n = 1, size(contacts)
+            if (size(contacts(n)%law) /= size(input%bw) .or. size(contacts(n)%slip, 1) < grid%dim) then
+               call fatal_error(error, 'recover_grid: contact description '//itoa(n)//' has '// &
+                  & itoa(size(contacts(n)%law))//' boundary points, the input '//itoa(size(input%bw)), &
+                  & stat_invalid_input)
+               return
+            end if
+         end do
+         src%contacts => contacts
       end if
       src%nstress = field%nstress
       src%sprc = method == method_sprc
-      if (grid%dim == 2 .and. .not. present(contact)) then
+      if (grid%dim == 2 .and. .not. present(contacts)) then
          call singular_corners(src, degree, field, node_corner)
          if (allocated(field%singular)) then
             call corner_values(input, field%singular, corner_stress, corner_traction)
@@ -542,10 +551,10 @@ contains
       integer :: d
 
       d = self%nodes%dim
-      if (associated(self%contact)) then
-         if (self%input%bshape(k) == self%contact%shape) then
+      if (associated(self%contacts)) then
+         if (any(self%contacts%shape == self%input%bshape(k))) then
             t = 0.0_wp
-            kind = merge(boundary_contact, boundary_traction, self%contact%law(k) /= 0)
+            kind = merge(boundary_contact, boundary_traction, contact_of(self, k) > 0)
             return
          end if
       end if
@@ -566,15 +575,16 @@ contains
       type(recovery_workspace_type), intent(inout) :: ws
       type(recovered_patch_type), intent(out) :: rec
       type(error_type), allocatable, intent(out) :: error
-      integer, allocatable :: law(:)
+      integer, allocatable :: law(:), owner(:)
       real(wp), allocatable :: slip(:, :)
+      type(patch_type) :: own
       real(wp) :: t(3)
-      integer :: i, j, k, kind, d
+      integer :: i, j, k, kind, d, win
 
       d = self%nodes%dim
-      if (sprc .and. associated(self%contact) .and. patch%nbpoints > 0) then
+      if (sprc .and. associated(self%contacts) .and. patch%nbpoints > 0) then
          if (any(patch%bkind(1:patch%nbpoints) == boundary_contact)) then
-            allocate (law(patch%nbpoints), slip(d, patch%nbpoints))
+            allocate (law(patch%nbpoints), slip(d, patch%nbpoints), owner(patch%nbpoints))
             j = 0
             do i = 1, size(elements)
                do k = self%input%belem_ptr(elements(i)), self%input%belem_ptr(elements(i) + 1) - 1
@@ -583,17 +593,67 @@ contains
                   j = j + 1
                   law(j) = 0
                   slip(:, j) = 0.0_wp
+                  owner(j) = 0
                   if (kind /= boundary_contact) cycle
-                  law(j) = self%contact%law(k)
-                  slip(:, j) = self%contact%slip(1:d, k)
+                  owner(j) = contact_of(self, k)
+                  law(j) = self%contacts(owner(j))%law(k)
+                  slip(:, j) = self%contacts(owner(j))%slip(1:d, k)
                end do
             end do
-            call contact_patch_solve(self%contact, patch, law, slip, degree, ws, rec, error)
+            win = 1
+            do i = 2, size(self%contacts)
+               if (count(owner == i) > count(owner == win)) win = i
+            end do
+            if (all(owner == 0 .or. owner == win)) then
+               call contact_patch_solve(self%contacts(win), patch, law, slip, degree, ws, rec, error)
+            else
+               call one_pair_patch(patch, owner, win, law, slip, own)
+               call contact_patch_solve(self%contacts(win), own, law, slip, degree, ws, rec, error)
+            end if
             return
          end if
       end if
       call recover_patch_default(self, node, elements, patch, degree, sprc, ws, rec, error)
    end subroutine grid_recover
+
+   !> The contact description (index into `contacts`) that closes boundary point k: the
+   !> first whose shape k lies on with a closed law; 0 if none (module notes).
+   pure integer function contact_of(self, k)
+      class(grid_source_type), intent(in) :: self
+      integer, intent(in) :: k
+      do contact_of = 1, size(self%contacts)
+         if (self%contacts(contact_of)%shape /= self%input%bshape(k)) cycle
+         if (self%contacts(contact_of)%law(k) /= 0) return
+      end do
+      contact_of = 0
+   end function contact_of
+
+   !> `patch` without the contact points of pairs other than `win` (owner(j) the pair of
+   !> boundary point j, 0 for a point that is not a contact point); law and slip compacted alike.
+   pure subroutine one_pair_patch(patch, owner, win, law, slip, own)
+      type(patch_type), intent(in) :: patch
+      integer, intent(in) :: owner(:), win
+      integer, intent(inout) :: law(:)
+      real(wp), intent(inout) :: slip(:, :)
+      type(patch_type), intent(out) :: own
+      integer :: j, m
+
+      own = patch
+      m = 0
+      do j = 1, patch%nbpoints
+         if (owner(j) /= 0 .and. owner(j) /= win) cycle
+         m = m + 1
+         own%bx(:, m) = patch%bx(:, j)
+         own%bw(m) = patch%bw(j)
+         own%bn(:, m) = patch%bn(:, j)
+         own%bkind(m) = patch%bkind(j)
+         own%bpiece(m) = patch%bpiece(j)
+         own%btraction(:, m) = patch%btraction(:, j)
+         law(m) = law(j)
+         slip(:, m) = slip(:, j)
+      end do
+      own%nbpoints = m
+   end subroutine one_pair_patch
 
    !> The recovery boundary points of `input` (kinds and tractions as the patches take them,
    !> bc_none left out) other than those on shape `skip_shape`, in the boundary arrays of

@@ -3,6 +3,7 @@
 !> `level,x,y,z,weight,gap,state,p_fe,p_spr,p_sprc,p_exact,ts_fe,ts_sprc`,
 !> then (trailing) `tx_fe,ty_fe,tz_fe`, the FE
 !> tangential traction on the slave body as a vector (`tz_fe` empty in 2D),
+!> and `pair`, the point's `&contact` pair (1-based, scene order),
 !> reals as in the report CSV (read back bit for bit), `z` empty in
 !> 2D, `state` open / stick / slip, an empty value (not computed) an empty
 !> cell. The pairs of a level follow each other in `&contact` order.
@@ -17,9 +18,9 @@ module sprc_io_contact
 
    public :: contact_level_type, contact_csv_header, write_contact_csv
 
-   !> The CSV header: doc/scene.md's columns, then the signed tangential traction.
+   !> The CSV header: doc/scene.md's columns, then the signed tangential traction and the pair.
    character(len=*), parameter :: contact_csv_header = 'level,x,y,z,weight,gap,state,p_fe,p_spr,p_sprc,p_exact,'// &
-      & 'ts_fe,ts_sprc,tx_fe,ty_fe,tz_fe'
+      & 'ts_fe,ts_sprc,tx_fe,ty_fe,tz_fe,pair'
 
    !> The contact results of one level of a study.
    type :: contact_level_type
@@ -49,7 +50,8 @@ contains
          do k = 1, size(levels(l)%contacts)
             do i = 1, levels(l)%contacts(k)%npoint
                if (stat /= 0) exit
-               write (unit, '(a)', iostat=stat, iomsg=msg) point_line(levels(l)%level, levels(l)%contacts(k), i)
+               write (unit, '(a)', iostat=stat, iomsg=msg) point_line(levels(l)%level, levels(l)%contacts(k), i)// &
+                  & ','//itoa(k)
             end do
          end do
       end do

@@ -10,10 +10,11 @@ module sprc_io_scene
    use sprc_fem_linear_solver, only: solver_names, auto_iterative_min_dofs, auto_never
    use sprc_fem_problem, only: default_gamma, gamma_note
    use sprc_core_text, only: itoa, real_text, lower
-   use sprc_core_error, only: error_type, fatal_error, stat_unsupported
+   use sprc_core_error, only: error_type, fatal_error
    use sprc_exact_corner, only: corner_eigenvalues
    use sprc_study_spec, only: scene_type, body_spec_type, shape_spec_type, bc_spec_type, exact_spec_type, &
-      & contact_spec_type, recovery_degree, default_stabilization, contact_unsupported, default_max_level
+      & contact_spec_type, recovery_degree, default_stabilization, contact_unsupported, default_max_level, &
+      & contact_components
    use sprc_grid_tree, only: grid_max_level
    use sprc_io_namelist, only: nml_group_type, parse_namelist, read_text_file, nml_get, nml_get_array, &
       & nml_has, nml_check_consumed, nml_field_error, nml_group_error, nml_item_text
@@ -33,7 +34,7 @@ module sprc_io_scene
    character(len=*), parameter :: bc_fields = 'value vector'
    character(len=*), parameter :: bc_keys = 'on type stage '//bc_fields
    character(len=*), parameter :: exact_fields = 'center r_in r_out p_in p_out radius s_inf stress r_contact '// &
-      & 'inner outer interference point normal load direction angle mode1 mode2'
+      & 'inner outer interference point normal load direction angle mode1 mode2 radii bodies'
    character(len=*), parameter :: exact_keys = 'kind '//exact_fields
    character(len=*), parameter :: contact_keys = 'slave master slave_surface master_surface friction mu kappa '// &
       & 'steps stabilization'
@@ -50,7 +51,7 @@ module sprc_io_scene
    character(len=*), parameter :: bc_types = 'free pressure traction displacement symmetry exact_traction '// &
       & 'exact_displacement'
    character(len=*), parameter :: exact_kinds = 'lame_cylinder lame_sphere kirsch uniform compound_cylinder '// &
-      & 'compound_sphere hertz_cylinder hertz_sphere corner'
+      & 'compound_sphere layered_cylinder layered_sphere hertz_cylinder hertz_sphere corner'
    character(len=*), parameter :: frictions = 'frictionless coulomb stick'
    character(len=*), parameter :: stabilizations = 'fe recovered'
 
@@ -68,8 +69,7 @@ module sprc_io_scene
 contains
 
    !> Read and validate a scene file. A missing or unreadable file is
-   !> `stat_io`; a bad scene `stat_invalid_input`; a request this version
-   !> cannot take (a second &contact pair) `stat_unsupported`.
+   !> `stat_io`; a bad scene `stat_invalid_input`.
    subroutine read_scene(path, scene, error)
       !> Path of the scene file; messages name it.
       character(len=*), intent(in) :: path
@@ -445,8 +445,10 @@ contains
    pure integer function kind_dim(kind)
       character(len=*), intent(in) :: kind
       select case (kind)
-      case ('disk', 'ellipse', 'lame_cylinder', 'kirsch', 'compound_cylinder', 'hertz_cylinder', 'corner'); kind_dim = 2
-      case ('sphere', 'ellipsoid', 'cylinder', 'lame_sphere', 'compound_sphere', 'hertz_sphere'); kind_dim = 3
+      case ('disk', 'ellipse', 'lame_cylinder', 'kirsch', 'compound_cylinder', 'layered_cylinder', 'hertz_cylinder', &
+         & 'corner'); kind_dim = 2
+      case ('sphere', 'ellipsoid', 'cylinder', 'lame_sphere', 'compound_sphere', 'layered_sphere', 'hertz_sphere')
+         kind_dim = 3
       case default; kind_dim = 0
       end select
    end function kind_dim
@@ -607,6 +609,8 @@ contains
             call get_vector(g, 'stress', 3*(scene%dim - 1), .true., exact%stress, error)
          case ('compound_cylinder', 'compound_sphere')
             call read_compound(g, scene, exact, error)
+         case ('layered_cylinder', 'layered_sphere')
+            call read_layered(g, scene, exact, error)
          case ('hertz_cylinder', 'hertz_sphere')
             call read_hertz(g, scene, exact, error)
          case ('corner')
@@ -772,9 +776,110 @@ contains
       end if
       call nml_get(g, 'interference', exact%interference, found, error)
       if (allocated(error)) return
-      if (exact%interference < 0.0_wp) call nml_field_error(g, 'interference', &
-         & 'must be >= 0 (the radial overlap of the rings; a clearance has no closed-form solution here)', error)
+      if (exact%interference < 0.0_wp) then
+         call nml_field_error(g, 'interference', &
+            & 'must be >= 0 (the radial overlap of the rings; a clearance has no closed-form solution here)', error)
+      else if (.not. exact%interference < exact%r_out - exact%r_contact) then
+         call nml_field_error(g, 'interference', 'must be less than r_out - r_contact (the outer ring''s width)', error)
+      end if
+      exact%ring_shifts = [exact%interference]
    end subroutine read_compound
+
+   !> n concentric rings: radii (n + 1, increasing), the ring bodies (n different
+   !> bodies, blank- or comma-separated, inside out), the n - 1 interferences
+   !> (default 0), p_in, p_out (default 0); the &contact between neighbouring
+   !> rings is checked with the pairs.
+   subroutine read_layered(g, scene, exact, error)
+      type(nml_group_type), intent(inout) :: g
+      type(scene_type), intent(in) :: scene
+      type(exact_spec_type), intent(inout) :: exact
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: names, word
+      integer :: n, i, pos, b
+      logical :: found
+
+      call check_fields(g, exact_fields, 'center radii bodies p_in', 'interference p_out', "kind = '"//exact%kind//"'", &
+         & error)
+      if (allocated(error)) return
+      call get_vector(g, 'center', scene%dim, .true., exact%center, error)
+      if (allocated(error)) return
+      call nml_get_array(g, 'radii', exact%radii, 3, 64, found, error)
+      if (allocated(error)) return
+      if (.not. found) then
+         call nml_field_error(g, 'radii', 'required (n + 1 radii of n >= 2 rings, inside out)', error)
+         return
+      end if
+      n = size(exact%radii) - 1
+      if (.not. (exact%radii(1) > 0.0_wp)) then
+         call nml_field_error(g, 'radii', 'the first radius must be > 0', error)
+         return
+      end if
+      do i = 2, n + 1
+         if (.not. (exact%radii(i) > exact%radii(i - 1))) then
+            call nml_field_error(g, 'radii', 'must increase (radius '//itoa(i)//' does not exceed radius '// &
+               & itoa(i - 1)//')', error)
+            return
+         end if
+      end do
+      names = ''
+      call nml_get(g, 'bodies', names, found, error)
+      if (allocated(error)) return
+      if (.not. found) then
+         call nml_field_error(g, 'bodies', 'required (the '//itoa(n)//' ring bodies, inside out)', error)
+         return
+      end if
+      names = translate_commas(names)
+      allocate (exact%ring_index(0))
+      exact%ring_names = ''
+      pos = 1
+      do
+         call next_word(names, pos, word)
+         if (len(word) == 0) exit
+         b = body_index(scene, word)
+         if (b == 0) then
+            call nml_field_error(g, 'bodies', "'"//word//"' is not a body; bodies: "//body_names(scene), error)
+            return
+         end if
+         if (any(exact%ring_index == b)) then
+            call nml_field_error(g, 'bodies', "names body '"//word//"' twice: each ring is its own body", error)
+            return
+         end if
+         exact%ring_index = [exact%ring_index, b]
+         exact%ring_names = join(exact%ring_names, word)
+      end do
+      if (size(exact%ring_index) /= n) then
+         call nml_field_error(g, 'bodies', 'names '//itoa(size(exact%ring_index))//' bodies; radii give '// &
+            & itoa(n)//' rings', error)
+         return
+      end if
+      allocate (exact%interferences(n - 1), source=0.0_wp)
+      call nml_get_array(g, 'interference', exact%interferences, n - 1, n - 1, found, error)
+      if (allocated(error)) return
+      if (.not. found) exact%interferences = [(0.0_wp, i=1, n - 1)]
+      if (any(exact%interferences < 0.0_wp)) then
+         call nml_field_error(g, 'interference', 'must be >= 0 (the radial overlaps of neighbouring rings)', error)
+         return
+      end if
+      if (.not. all(exact%interferences < exact%radii(3:) - exact%radii(2:n))) then
+         call nml_field_error(g, 'interference', 'each must be less than the width of the ring outside it', error)
+         return
+      end if
+      exact%ring_shifts = exact%interferences
+      call nml_get(g, 'p_in', exact%p_in, found, error)
+      if (allocated(error)) return
+      call nml_get(g, 'p_out', exact%p_out, found, error)
+   end subroutine read_layered
+
+   !> `text` with its commas made blanks (a list of names either way).
+   pure function translate_commas(text) result(out)
+      character(len=*), intent(in) :: text
+      character(len=len(text)) :: out
+      integer :: i
+      out = text
+      do i = 1, len(out)
+         if (out(i:i) == ',') out(i:i) = ' '
+      end do
+   end function translate_commas
 
    subroutine read_hertz(g, scene, exact, error)
       type(nml_group_type), intent(inout) :: g
@@ -837,12 +942,6 @@ contains
       do ig = 1, size(groups)
          if (groups(ig)%name /= 'contact') cycle
          n = n + 1
-         if (n > 1) then
-            call nml_group_error(groups(ig), 'a second &contact group (the first is on line '// &
-               & itoa(groups(first_group(groups, 'contact'))%line)//'): this version takes one contact pair', &
-               & error, stat_unsupported)
-            return
-         end if
          associate (g => groups(ig), c => scene%contacts(n))
             call check_keys(g, contact_keys, error)
             if (allocated(error)) return
@@ -891,11 +990,47 @@ contains
             call get_choice(g, 'stabilization', stabilizations, .false., c%stabilization, error)
             if (allocated(error)) return
             call nml_check_consumed(g, error)
+            if (.not. allocated(error)) call check_pair_unique(g, scene%contacts(1:n), error)
             if (allocated(error)) return
          end associate
       end do
       call check_exact_pair(groups, scene, error)
    end subroutine read_contacts
+
+   !> Pair `pairs(n)` against the pairs before it (doc/scene.md `&contact`):
+   !> two bodies touch through one pair (either way round), a slave surface
+   !> belongs to one pair (its points have one master), and a surface is not
+   !> the slave of one pair and the master of another. A master surface may
+   !> serve several pairs (a rail under two rollers).
+   subroutine check_pair_unique(g, pairs, error)
+      type(nml_group_type), intent(in) :: g
+      type(contact_spec_type), intent(in) :: pairs(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: k, n
+
+      n = size(pairs)
+      associate (c => pairs(n))
+         do k = 1, n - 1
+            associate (o => pairs(k))
+               if ((o%slave_index == c%slave_index .and. o%master_index == c%master_index) .or. &
+                  & (o%slave_index == c%master_index .and. o%master_index == c%slave_index)) then
+                  call nml_field_error(g, 'master', "bodies '"//c%slave//"' and '"//c%master//"' are already "// &
+                     & 'a pair (&contact '//itoa(k)//'): two bodies touch through one pair', error)
+               else if (o%slave_surface_index == c%slave_surface_index) then
+                  call nml_field_error(g, 'slave_surface', 'is already the slave surface of &contact '//itoa(k)// &
+                     & ': a slave point has one master', error)
+               else if (o%master_surface_index == c%slave_surface_index) then
+                  call nml_field_error(g, 'slave_surface', 'is the master surface of &contact '//itoa(k)// &
+                     & ': a surface is the slave or the master of its pairs, not both', error)
+               else if (o%slave_surface_index == c%master_surface_index) then
+                  call nml_field_error(g, 'master_surface', 'is the slave surface of &contact '//itoa(k)// &
+                     & ': a surface is the slave or the master of its pairs, not both', error)
+               end if
+            end associate
+            if (allocated(error)) return
+         end do
+      end associate
+   end subroutine check_pair_unique
 
    !> A compound exact solution needs a &contact between its inner and outer
    !> bodies, a Hertz one a &contact at all: without it their fields do not hold.
@@ -920,9 +1055,25 @@ contains
             ig = first_group(groups, 'exact')
             call nml_field_error(groups(ig), 'outer', "no &contact between bodies '"//e%inner//"' and '"// &
                & e%outer//"': kind = '"//e%kind//"' is the solution of their shrink fit", error)
+         else if (index(e%kind, 'layered_') == 1) then
+            do i = 1, size(e%ring_index) - 1
+               if (any((scene%contacts%slave_index == e%ring_index(i) .and. &
+                  & scene%contacts%master_index == e%ring_index(i + 1)) .or. &
+                  & (scene%contacts%slave_index == e%ring_index(i + 1) .and. &
+                  & scene%contacts%master_index == e%ring_index(i)))) cycle
+               ig = first_group(groups, 'exact')
+               call nml_field_error(groups(ig), 'bodies', "no &contact between neighbouring rings '"// &
+                  & scene%bodies(e%ring_index(i))%name//"' and '"//scene%bodies(e%ring_index(i + 1))%name// &
+                  & "': kind = '"//e%kind//"' is the solution of their fit", error)
+               return
+            end do
          else if (index(e%kind, 'hertz_') == 1 .and. size(scene%contacts) == 0) then
             ig = first_group(groups, 'exact')
             call nml_field_error(groups(ig), 'kind', 'needs a &contact (it is the pressure of a contact)', error)
+         else if (index(e%kind, 'hertz_') == 1 .and. size(scene%contacts) > 1) then
+            ig = first_group(groups, 'exact')
+            call nml_field_error(groups(ig), 'kind', 'is the pressure of one contact at one point; the scene has '// &
+               & itoa(size(scene%contacts))//' &contact pairs', error)
          end if
       end associate
    end subroutine check_exact_pair
@@ -1218,8 +1369,13 @@ contains
          text = text//'exact solution: none'//nl
       end if
       do i = 1, size(scene%contacts)
-         text = text//'contact: '//contact_line(scene%contacts(i))//nl
+         if (size(scene%contacts) == 1) then
+            text = text//'contact: '//contact_line(scene%contacts(i))//nl
+         else
+            text = text//'contact '//itoa(i)//': '//contact_line(scene%contacts(i))//nl
+         end if
       end do
+      if (size(scene%contacts) > 0) text = text//component_lines(scene)
       text = text//switches(scene)
       text = text//adapt_text(scene)
       if (len(contact_unsupported(scene)) > 0) then
@@ -1490,6 +1646,10 @@ contains
             & ', r_contact = '//real_text(exact%r_contact)//', r_out = '//real_text(exact%r_out)// &
             & ', p_in = '//real_text(exact%p_in)//", inner = '"//exact%inner//"', outer = '"//exact%outer// &
             & "', interference = "//real_text(exact%interference)
+      case ('layered_cylinder', 'layered_sphere')
+         text = text//', center = '//real_list(exact%center)//', radii = '//real_list(exact%radii)// &
+            & ", bodies = '"//exact%ring_names//"', interference = "//real_list(exact%interferences)// &
+            & ', p_in = '//real_text(exact%p_in)//', p_out = '//real_text(exact%p_out)
       case ('corner')
          text = text//', point = '//real_list(exact%point)//', direction = '//real_list(exact%direction)// &
             & ', angle = '//real_text(exact%angle)//', mode1 = '//real_text(exact%mode1)//', mode2 = '// &
@@ -1527,6 +1687,37 @@ contains
       text = text//', steps = '//itoa(c%steps)//', stabilization = '//c%stabilization
    end function contact_line
 
+   !> One line per component of the contact graph (the bodies solved together,
+   !> their pairs), then the bodies without contact (each its own problem).
+   function component_lines(scene) result(text)
+      type(scene_type), intent(in) :: scene
+      character(len=:), allocatable :: text
+      character(len=*), parameter :: nl = new_line('a')
+      character(len=:), allocatable :: names, pairs
+      integer, allocatable :: comp(:)
+      integer :: c, n, b, k
+
+      call contact_components(scene, comp, n)
+      text = ''
+      do c = 1, n
+         names = ''
+         do b = 1, size(scene%bodies)
+            if (comp(b) == c) names = join(names, "'"//scene%bodies(b)%name//"'")
+         end do
+         pairs = ''
+         do k = 1, size(scene%contacts)
+            if (comp(scene%contacts(k)%slave_index) == c) pairs = join(pairs, itoa(k))
+         end do
+         text = text//'contact component '//itoa(c)//': bodies '//names//' (pairs '//pairs// &
+            & '): one coupled system, one active set'//nl
+      end do
+      names = ''
+      do b = 1, size(scene%bodies)
+         if (comp(b) == 0) names = join(names, "'"//scene%bodies(b)%name//"'")
+      end do
+      if (len(names) > 0) text = text//'bodies without contact (each its own problem): '//names//nl
+   end function component_lines
+
    !> The contact part of 'what a scene switches on' (doc/scene.md).
    function contact_switches(scene) result(text)
       type(scene_type), intent(in) :: scene
@@ -1541,11 +1732,18 @@ contains
       stages = 1
       if (size(scene%bcs) > 0) stages = max(1, maxval(scene%bcs%stage))
       associate (c => scene%contacts(1))
-         text = "  contact: on (slave '"//c%slave//"' on master '"//c%master//"', friction "//c%friction
+         if (size(scene%contacts) > 1) then
+            text = '  contact: on ('//itoa(size(scene%contacts))//' pairs, first: slave '''//c%slave// &
+               & ''' on master '''//c%master//''', friction '//c%friction
+         else
+            text = "  contact: on (slave '"//c%slave//"' on master '"//c%master//"', friction "//c%friction
+         end if
          if (len(contact_unsupported(scene)) > 0) then
             text = text//'; NOT IMPLEMENTED in this version: sprc run refuses the scene)'//nl
          else
-            text = text//'; coupled solve of both bodies, active-set iteration)'//nl
+            text = text//'; coupled solve of '// &
+               & trim(merge('both bodies          ', 'the bodies in contact', size(scene%contacts) == 1))// &
+               & ', active-set iteration)'//nl
          end if
          text = text//'  contact stabilization stress: '//c%stabilization//nl
          if (c%friction == 'coulomb') then

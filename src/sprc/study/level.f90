@@ -9,12 +9,18 @@
 !> ```
 !> Bodies without `&contact` between them are independent problems: each
 !> body's results are exactly those of a scene holding that body alone.
-!> The two bodies of a `&contact` pair are solved together
-!> (sprc_contact_solve: one block system, active-set iteration) in one unit
-!> system (the slave body's modulus unit, the larger strain unit of the two),
-!> and their contact result (`contacts`) comes in scene units. This version
-!> runs one pair; more pairs (and the recovered stabilization with Coulomb
-!> friction) are refused (stat_unsupported) before any computation. With
+!> The bodies joined by `&contact` pairs (a component of the contact graph,
+!> `contact_components`) are solved together (sprc_contact_solve: one block
+!> system, one active-set iteration over the cells of all its pairs) in one
+!> unit system (the modulus unit of the slave of the component's first pair,
+!> the largest strain unit of its bodies), and every pair's contact result
+!> (`contacts`) comes in scene units. A component of one pair is
+!> `solve_contact_pair`'s (every friction law and stabilization); one of
+!> several pairs `solve_contact_assembly`'s (frictionless or stick, FE
+!> stabilization; the rest is refused, stat_unsupported, before any
+!> computation). A body of several pairs recovers with one contact
+!> description per pair (sprc_grid_patches: what a patch touching two
+!> pairs takes). With
 !> `stabilization = 'recovered'` the pair is solved with a zero
 !> stabilization traction first (penalty), then re-solved with the slave
 !> body's coupled SPR-C traction of the previous solution until it settles
@@ -51,7 +57,7 @@ module sprc_study_level
    use sprc_fem_nested, only: fe_displacement_type
    use sprc_fem_recovery_input, only: fe_recovery_input
    use sprc_fem_dilatation, only: dilatation_choice
-   use sprc_study_spec, only: scene_type, contact_spec_type, recovery_degree, contact_unsupported
+   use sprc_study_spec, only: scene_type, contact_spec_type, recovery_degree, contact_unsupported, contact_components
    use sprc_study_model, only: build_bodies, build_exact, body_conditions, analysis_kind, analysis_units_type, &
       & analysis_units, in_units
    use sprc_study_budget, only: check_level_memory, check_coupled_memory
@@ -63,7 +69,8 @@ module sprc_study_level
       & contact_slip
    use sprc_contact_surface, only: contact_surface_type, slave_surface_points, initial_gaps
    use sprc_contact_solve, only: contact_solution_type, solve_contact_pair, friction_kind, friction_coulomb, &
-      & friction_frictionless, contact_progress, default_max_iterations, contact_factor_type
+      & friction_frictionless, contact_progress, default_max_iterations, contact_factor_type, contact_body_type, &
+      & contact_pair_type, solve_contact_assembly
    use sprc_fem_element, only: traction_matrix
    use sprc_core_text, only: itoa, real_text
    implicit none
@@ -218,22 +225,29 @@ contains
       call blas_reserve_buffers(error)
    end subroutine prepare_study
 
-   !> Bodies in contact share one unit system: the slave body's modulus unit
-   !> and the larger of the two strain units expressed in it (powers of two,
-   !> so exact). Other bodies keep their own units.
+   !> The bodies of a component of the contact graph share one unit system:
+   !> the modulus unit of the slave of the component's first pair and the
+   !> largest of the bodies' strain units expressed in it (powers of two, so
+   !> exact; for one pair the slave's modulus unit and the larger strain unit
+   !> of the two). Other bodies keep their own units.
    subroutine shared_units(scene, bodies)
       type(scene_type), intent(in) :: scene
       type(study_body_type), intent(inout) :: bodies(:)
       type(analysis_units_type) :: u
-      integer :: k, s, m
+      integer, allocatable :: comp(:)
+      integer :: c, k, b, n
 
-      do k = 1, size(scene%contacts)
-         s = scene%contacts(k)%slave_index
-         m = scene%contacts(k)%master_index
-         u%modulus = bodies(s)%units%modulus
-         u%strain = max(bodies(s)%units%strain, bodies(m)%units%strain*(bodies(m)%units%modulus/u%modulus))
-         bodies(s)%units = u
-         bodies(m)%units = u
+      call contact_components(scene, comp, n)
+      do c = 1, n
+         k = findloc(comp(scene%contacts%slave_index), c, 1)
+         u%modulus = bodies(scene%contacts(k)%slave_index)%units%modulus
+         u%strain = 0.0_wp
+         do b = 1, size(bodies)
+            if (comp(b) == c) u%strain = max(u%strain, bodies(b)%units%strain*(bodies(b)%units%modulus/u%modulus))
+         end do
+         do b = 1, size(bodies)
+            if (comp(b) == c) bodies(b)%units = u
+         end do
       end do
    end subroutine shared_units
 
@@ -244,7 +258,7 @@ contains
    subroutine run_level(study, level, result, error, progress, start, source)
       type(study_type), intent(in) :: study
       integer, intent(in) :: level
-      type(level_type), intent(out) :: result
+      type(level_type), intent(out), target :: result
       type(error_type), allocatable, intent(out) :: error
       !> Told after each contact iteration (sprc_contact_solve's `contact_progress`).
       procedure(contact_progress), optional :: progress
@@ -254,8 +268,8 @@ contains
       type(mesh_source_type), intent(in), optional :: source(:)
       type(cut_quadrature_type) :: quad
       real(wp) :: t_start, t_contact
-      integer, allocatable :: pair_solver(:)
-      integer :: b, k
+      integer, allocatable :: comp(:), ks(:), pair_solver(:)
+      integer :: b, k, c, ncomp
 
       t_start = wall_time()
       result%level = level
@@ -288,16 +302,29 @@ contains
       t_contact = 0.0_wp
       if (size(study%scene%contacts) > 0) allocate (result%contacts(size(study%scene%contacts)), &
          & result%traction_jump(3, size(study%scene%contacts)))
-      do k = 1, size(study%scene%contacts)
-         call run_contact(study, study%scene%contacts(k), result%bodies, result%contacts(k), t_contact, error, &
-            & result%traction_jump(:, k), progress)
+      call contact_components(study%scene, comp, ncomp)
+      do c = 1, ncomp
+         ks = pack([(k, k=1, size(study%scene%contacts))], comp(study%scene%contacts%slave_index) == c)
+         if (size(ks) == 1) then
+            k = ks(1)
+            call run_contact(study, study%scene%contacts(k), result%bodies, result%contacts(k), t_contact, error, &
+               & result%traction_jump(:, k), progress)
+         else
+            call run_assembly(study, ks, pack([(b, b=1, size(study%bodies))], comp == c), result%bodies, &
+               & result%contacts, t_contact, error, result%traction_jump, progress)
+         end if
          if (allocated(error)) return
       end do
       call sum_row(study, result, result%row)
       if (present(source)) call finest_cells(study, result)
       if (allocated(result%contacts)) then
          result%row%has_contact = .true.
-         result%row%contact_iterations = sum(result%contacts%iterations)
+         ! An assembly's pairs share its iterations: counted once per component.
+         result%row%contact_iterations = 0
+         do c = 1, ncomp
+            k = findloc(comp(study%scene%contacts%slave_index), c, 1)
+            result%row%contact_iterations = result%row%contact_iterations + result%contacts(k)%iterations
+         end do
          result%row%t_contact = t_contact
          call fill_contact_exact(study%scene, result%contacts, error)
          if (allocated(error)) return
@@ -447,20 +474,20 @@ contains
       if (part%shared() .and. size(study%scene%contacts) == 0) share => part
    end function level_share
 
-   !> The recoveries and estimates of a body from its recovery input; `contact` is its
-   !> contact surface (SPR-C's coupled contact patches, sprc_grid_contact).
-   subroutine recover_body(study, sb, bl, input, error, contact)
+   !> The recoveries and estimates of a body from its recovery input; `contacts` are its
+   !> contact surfaces, one per pair (SPR-C's coupled contact patches, sprc_grid_contact).
+   subroutine recover_body(study, sb, bl, input, error, contacts)
       type(study_type), intent(in) :: study
       type(study_body_type), intent(in) :: sb
       type(body_level_type), intent(inout) :: bl
       type(recovery_input_type), intent(in) :: input
       type(error_type), allocatable, intent(out) :: error
-      type(grid_contact_type), intent(in), optional :: contact
+      type(grid_contact_type), intent(in), optional :: contacts(:)
       integer :: m
 
       do m = 1, 2
          if (.not. study%run(m)) cycle
-         call recover_and_estimate(study, sb, input, bl, m, study%degree(m), error, contact)
+         call recover_and_estimate(study, sb, input, bl, m, study%degree(m), error, contacts)
          if (allocated(error)) return
       end do
    end subroutine recover_body
@@ -531,20 +558,9 @@ contains
       s = spec%slave_index
       m = spec%master_index
       call timer%start()
-      associate (slave => bodies(s)%problem%mesh, master => bodies(m)%problem%mesh)
-         call slave_surface_points(surface, slave%grid, slave%body, slave%quad, &
-            & study%scene%shapes(spec%slave_surface_index)%body_shape, error, split_grid=master%grid)
-         if (.not. allocated(error)) call initial_gaps(surface, master%body, &
-            & study%scene%shapes(spec%master_surface_index)%body_shape, master%grid, &
-            & max(study%bodies(s)%box_size, study%bodies(m)%box_size), error)
-      end associate
+      call pair_surface(study, spec, bodies, surface, error)
       call timer%stop()
-      if (allocated(error)) then
-         error%message = "&contact '"//spec%slave//"' on '"//spec%master//"': "//error%message
-         return
-      end if
-      ! The gaps are displacements: into the pair's units.
-      where (surface%has_master) surface%g0 = surface%g0/study%bodies(s)%units%strain
+      if (allocated(error)) return
       if (friction_kind(spec%friction) == friction_coulomb) then
          call load_path(study, spec, bodies(s)%problem, bodies(m)%problem, loads, error)
          if (allocated(error)) return
@@ -585,6 +601,157 @@ contains
       if (allocated(error)) return
       t_contact = t_contact + timer%elapsed + sol%t_contact
    end subroutine run_contact
+
+   !> A pair's slave points with their initial gaps to the master
+   !> (sprc_contact_surface), the gaps in the pair's units.
+   subroutine pair_surface(study, spec, bodies, surface, error)
+      type(study_type), intent(in) :: study
+      type(contact_spec_type), intent(in) :: spec
+      type(body_level_type), intent(in) :: bodies(:)
+      type(contact_surface_type), intent(out) :: surface
+      type(error_type), allocatable, intent(out) :: error
+      integer :: s, m
+
+      s = spec%slave_index
+      m = spec%master_index
+      associate (slave => bodies(s)%problem%mesh, master => bodies(m)%problem%mesh)
+         call slave_surface_points(surface, slave%grid, slave%body, slave%quad, &
+            & study%scene%shapes(spec%slave_surface_index)%body_shape, error, split_grid=master%grid)
+         if (.not. allocated(error)) call initial_gaps(surface, master%body, &
+            & study%scene%shapes(spec%master_surface_index)%body_shape, master%grid, &
+            & max(study%bodies(s)%box_size, study%bodies(m)%box_size), error)
+      end associate
+      if (allocated(error)) then
+         error%message = "&contact '"//spec%slave//"' on '"//spec%master//"': "//error%message
+         return
+      end if
+      ! The gaps are displacements: into the pair's units.
+      where (surface%has_master) surface%g0 = surface%g0/study%bodies(s)%units%strain
+   end subroutine pair_surface
+
+   !> A component of several pairs at this level (`ks` its pairs in scene
+   !> order, `members` its bodies ascending): every pair's slave points and
+   !> gaps, one coupled solve of all the members (solve_contact_assembly),
+   !> then every member's errors and recoveries, with one contact description
+   !> per pair it belongs to (`finish_assembly`); each pair's contact result
+   !> in scene units and its traction jump. The block solves count in the
+   !> first member's t_solve; points, gaps and contact terms add to `t_contact`.
+   subroutine run_assembly(study, ks, members, bodies, results, t_contact, error, jumps, progress)
+      type(study_type), intent(in) :: study
+      integer, intent(in) :: ks(:), members(:)
+      type(body_level_type), intent(inout), target :: bodies(:)
+      type(contact_result_type), intent(inout) :: results(:)
+      real(wp), intent(inout) :: t_contact
+      type(error_type), allocatable, intent(out) :: error
+      !> Every pair's `traction_jump` (FE, SPR, SPR-C), columns in scene order.
+      real(wp), intent(inout) :: jumps(:, :)
+      procedure(contact_progress), optional :: progress
+      type(contact_body_type), allocatable :: cb(:)
+      type(contact_pair_type), allocatable :: pairs(:)
+      type(contact_solution_type), allocatable :: sols(:)
+      type(timer_type) :: timer
+      integer :: j, p, stat
+
+      allocate (cb(size(members)), pairs(size(ks)), stat=stat)
+      call check_allocation(stat, 'contact assembly', 'its bodies and pairs', size(ks) + size(members), 64, error)
+      if (allocated(error)) return
+      do j = 1, size(members)
+         cb(j)%problem => bodies(members(j))%problem
+         cb(j)%name = study%bodies(members(j))%name
+      end do
+      call timer%start()
+      do p = 1, size(ks)
+         associate (spec => study%scene%contacts(ks(p)))
+            pairs(p)%slave = findloc(members, spec%slave_index, 1)
+            pairs(p)%master = findloc(members, spec%master_index, 1)
+            pairs(p)%friction = friction_kind(spec%friction)
+            pairs(p)%kappa = spec%kappa
+            call pair_surface(study, spec, bodies, pairs(p)%surface, error)
+         end associate
+         if (allocated(error)) return
+      end do
+      call timer%stop()
+      call solve_contact_assembly(cb, pairs, sols, error, progress=progress)
+      if (allocated(error)) return
+      do j = 1, size(members)
+         bodies(members(j))%problem%t_solve = merge(sols(1)%t_solve, 0.0_wp, j == 1)
+         bodies(members(j))%problem%rcond = sols(1)%rcond
+         bodies(members(j))%problem%solver_name = sols(1)%solver_name
+      end do
+      do p = 1, size(ks)
+         associate (spec => study%scene%contacts(ks(p)))
+            call contact_result(pairs(p)%surface, sols(p), spec, study%bodies(spec%slave_index)%units, &
+               & results(ks(p)), error)
+         end associate
+         if (allocated(error)) return
+      end do
+      call finish_assembly(study, ks, members, pairs, results, bodies, error)
+      if (allocated(error)) return
+      do p = 1, size(ks)
+         associate (spec => study%scene%contacts(ks(p)))
+            call recovered_tractions(pairs(p)%surface, bodies(spec%slave_index), study%run, &
+               & study%bodies(spec%slave_index)%units, results(ks(p)), error)
+            if (.not. allocated(error)) call traction_jump(pairs(p)%surface, results(ks(p)), &
+               & bodies(spec%slave_index), bodies(spec%master_index), study%run, jumps(:, ks(p)), error)
+         end associate
+         if (allocated(error)) return
+      end do
+      t_contact = t_contact + timer%elapsed + sols(1)%t_contact
+   end subroutine run_assembly
+
+   !> After an assembly's FE solve: every member's exact error, recoveries and
+   !> estimates, SPR-C with one contact description per pair the member
+   !> belongs to (`pair_contact`, the pair's other body as body (2));
+   !> sprc_grid_patches says what a patch touching two pairs takes.
+   subroutine finish_assembly(study, ks, members, pairs, results, bodies, error)
+      type(study_type), intent(in) :: study
+      integer, intent(in) :: ks(:), members(:)
+      type(contact_pair_type), intent(in) :: pairs(:)
+      type(contact_result_type), intent(in) :: results(:)
+      type(body_level_type), intent(inout) :: bodies(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(recovery_input_type), allocatable :: inputs(:)
+      type(grid_contact_type), allocatable :: contacts(:)
+      integer :: j, b, p, n, side, other
+
+      allocate (inputs(size(members)))
+      do j = 1, size(members)
+         b = members(j)
+         call exact_error(study, study%bodies(b), bodies(b), error)
+         if (.not. allocated(error) .and. any(study%run)) call fe_recovery_input(bodies(b)%problem, inputs(j), error)
+         if (allocated(error)) then
+            error%message = 'body '''//study%bodies(b)%name//''': '//error%message
+            return
+         end if
+      end do
+      if (.not. any(study%run)) return
+      do j = 1, size(members)
+         b = members(j)
+         allocate (contacts(count(pairs%slave == j) + count(pairs%master == j)))
+         n = 0
+         do p = 1, size(ks)
+            if (pairs(p)%slave == j) then
+               side = 1
+               other = pairs(p)%master
+            else if (pairs(p)%master == j) then
+               side = 2
+               other = pairs(p)%slave
+            else
+               cycle
+            end if
+            n = n + 1
+            call pair_contact(study, study%scene%contacts(ks(p)), pairs(p)%surface, results(ks(p)), side, inputs(j), &
+               & bodies(b)%problem%mesh%nodes, inputs(other), contacts(n), error)
+            if (allocated(error)) exit
+         end do
+         if (.not. allocated(error)) call recover_body(study, study%bodies(b), bodies(b), inputs(j), error, contacts)
+         if (allocated(error)) then
+            error%message = 'body '''//study%bodies(b)%name//''': '//error%message
+            return
+         end if
+         deallocate (contacts)
+      end do
+   end subroutine finish_assembly
 
    !> Tur's recovered stabilization (sprc_contact_solve notes): the pair
    !> solved with a zero stabilization traction first (the penalty method,
@@ -694,7 +861,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(recovery_input_type) :: inputs(2)
       type(contact_result_type) :: result
-      type(grid_contact_type) :: contact
+      type(grid_contact_type) :: contact(1)
       type(recovered_field_type) :: field
       real(wp) :: sigma(6), tn(3, 6)
       integer :: i, d, s, stat
@@ -705,11 +872,11 @@ contains
       if (.not. allocated(error)) call fe_recovery_input(bodies(s)%problem, inputs(1), error)
       if (.not. allocated(error)) call fe_recovery_input(bodies(spec%master_index)%problem, inputs(2), error)
       if (.not. allocated(error)) call pair_contact(study, spec, surface, result, 1, inputs(1), &
-         & bodies(s)%problem%mesh%nodes, inputs(2), contact, error)
+         & bodies(s)%problem%mesh%nodes, inputs(2), contact(1), error)
       if (allocated(error)) return
       associate (mesh => bodies(s)%problem%mesh)
          call recover_grid(inputs(1), mesh%grid, mesh%nodes, mesh%hanging, method_sprc, study%degree(2), field, &
-            & error, contact=contact)
+            & error, contacts=contact)
       end associate
       if (allocated(error)) return
       allocate (pstar(d, surface%npoint), source=0.0_wp, stat=stat)
@@ -752,7 +919,7 @@ contains
          call pair_contact(study, spec, surface, result, b, inputs(b), &
             & bodies(k(b))%problem%mesh%nodes, inputs(3 - b), contacts(b), error)
          if (.not. allocated(error)) &
-            & call recover_body(study, study%bodies(k(b)), bodies(k(b)), inputs(b), error, contacts(b))
+            & call recover_body(study, study%bodies(k(b)), bodies(k(b)), inputs(b), error, contacts(b:b))
          if (allocated(error)) then
             error%message = 'body '''//study%bodies(k(b))%name//''': '//error%message
             return
@@ -1026,15 +1193,15 @@ contains
    end subroutine traction_jump
 
    !> Recovery and estimate with one method (1 SPR, 2 SPR-C) at the patch degree `degree`.
-   !> With `contact`, SPR-C's contact patches (sprc_grid_contact).
-   subroutine recover_and_estimate(study, sb, input, bl, m, degree, error, contact)
+   !> With `contacts` (one per pair of the body), SPR-C's contact patches (sprc_grid_contact).
+   subroutine recover_and_estimate(study, sb, input, bl, m, degree, error, contacts)
       type(study_type), intent(in) :: study
       type(study_body_type), intent(in) :: sb
       type(recovery_input_type), intent(in) :: input
       type(body_level_type), intent(inout) :: bl
       integer, intent(in) :: m, degree
       type(error_type), allocatable, intent(out) :: error
-      type(grid_contact_type), intent(in), optional :: contact
+      type(grid_contact_type), intent(in), optional :: contacts(:)
       type(partition_type), target :: part
       integer :: method
 
@@ -1042,12 +1209,12 @@ contains
       part = study%partition
       if (allocated(sb%exact)) then
          call recover_grid(input, bl%problem%mesh%grid, bl%problem%mesh%nodes, bl%problem%mesh%hanging, method, &
-            & degree, bl%field(m), error, exact=sb%exact, contact=contact, share=level_share(study, part))
+            & degree, bl%field(m), error, exact=sb%exact, contacts=contacts, share=level_share(study, part))
          if (allocated(error)) return
          call estimate_error(input, bl%field(m), bl%est(m), error, exact=sb%exact, share=level_share(study, part))
       else
          call recover_grid(input, bl%problem%mesh%grid, bl%problem%mesh%nodes, bl%problem%mesh%hanging, method, &
-            & degree, bl%field(m), error, contact=contact, share=level_share(study, part))
+            & degree, bl%field(m), error, contacts=contacts, share=level_share(study, part))
          if (allocated(error)) return
          call estimate_error(input, bl%field(m), bl%est(m), error, share=level_share(study, part))
       end if

@@ -17,12 +17,12 @@ module sprc_study_model
    use sprc_exact_lame, only: lame_cylinder_type, lame_sphere_type, new_lame_cylinder, new_lame_sphere
    use sprc_exact_kirsch, only: kirsch_type, new_kirsch
    use sprc_exact_uniform, only: uniform_type, new_uniform
-   use sprc_exact_compound, only: compound_type, new_compound_cylinder, new_compound_sphere
+   use sprc_exact_layered, only: layered_type, new_layered
    use sprc_exact_pressure, only: exact_pressure_type, field_pressure_type, new_field_pressure
    use sprc_exact_hertz, only: hertz_type, new_hertz_cylinder, new_hertz_sphere
    use sprc_exact_corner, only: corner_type, new_corner
    use sprc_core_text, only: itoa, real_text
-   use sprc_study_spec, only: scene_type, shape_spec_type, kappa_note
+   use sprc_study_spec, only: scene_type, shape_spec_type, kappa_note, exact_spec_type, contact_spec_type
    use sprc_fem_bc, only: fe_bc_type, new_fe_bc, bc_kind_from_name
    use sprc_fem_problem, only: gamma_note
    implicit none
@@ -144,6 +144,7 @@ contains
       scaled%exact%s_inf = stress1(scene%exact%s_inf)
       scaled%exact%load = stress1(scene%exact%load)
       scaled%exact%interference = scene%exact%interference/units%strain
+      if (allocated(scene%exact%interferences)) scaled%exact%interferences = scene%exact%interferences/units%strain
       if (allocated(scene%exact%stress)) scaled%exact%stress = stress(scene%exact%stress)
    contains
       pure function stress(v) result(w)
@@ -550,6 +551,8 @@ contains
             end select
          case ('compound_cylinder', 'compound_sphere')
             call build_compound_ring(scene, b, exact, error)
+         case ('layered_cylinder', 'layered_sphere')
+            call build_layered_ring(scene, b, exact, error)
          case ('corner')
             allocate (corner_type :: exact)
             select type (exact)
@@ -569,39 +572,63 @@ contains
    end subroutine build_exact
 
    !> Body b's ring of the scene's compound solution, with the materials of the
-   !> bodies `inner` and `outer` (not allocated for another body).
+   !> bodies `inner` and `outer` (not allocated for another body): the two-ring
+   !> layered solution on the real radii (sprc_exact_layered), the inner ring
+   !> out to r_contact + interference where the scene puts its surface, so
+   !> that the reference carries no delta/r error (with no interference it is
+   !> sprc_exact_compound's closed form).
    subroutine build_compound_ring(scene, b, exact, error)
       type(scene_type), intent(in) :: scene
       integer, intent(in) :: b
       class(exact_solution_type), allocatable, intent(out) :: exact
       type(error_type), allocatable, intent(out) :: error
-      type(compound_type) :: compound
+      type(layered_type) :: layered
 
       if (b /= scene%exact%inner_index .and. b /= scene%exact%outer_index) return
       associate (spec => scene%exact, inner => scene%bodies(scene%exact%inner_index), &
          & outer => scene%bodies(scene%exact%outer_index))
-         if (spec%kind == 'compound_cylinder') then
-            call new_compound_cylinder(compound, spec%center, spec%r_in, spec%r_contact, spec%r_out, spec%p_in, &
-               & spec%interference, inner%young, inner%poisson, outer%young, outer%poisson, analysis_kind(scene), &
-               & error)
-         else
-            call new_compound_sphere(compound, spec%center, spec%r_in, spec%r_contact, spec%r_out, spec%p_in, &
-               & spec%interference, inner%young, inner%poisson, outer%young, outer%poisson, error)
-         end if
+         call new_layered(layered, scene%dim, analysis_kind(scene), spec%center, [spec%r_in, spec%r_contact, &
+            & spec%r_out], [spec%interference], spec%p_in, 0.0_wp, [inner%young, outer%young], &
+            & [inner%poisson, outer%poisson], error, shifts=spec%ring_shifts)
       end associate
       if (allocated(error)) return
       if (b == scene%exact%inner_index) then
-         call move_alloc(compound%inner, exact)
+         call move_alloc(layered%rings(1)%field, exact)
       else
-         call move_alloc(compound%outer, exact)
+         call move_alloc(layered%rings(2)%field, exact)
       end if
    end subroutine build_compound_ring
+
+   !> Body b's ring of the scene's layered solution, with every ring body's
+   !> material (not allocated for a body that is not a ring).
+   subroutine build_layered_ring(scene, b, exact, error)
+      type(scene_type), intent(in) :: scene
+      integer, intent(in) :: b
+      class(exact_solution_type), allocatable, intent(out) :: exact
+      type(error_type), allocatable, intent(out) :: error
+      type(layered_type) :: layered
+      real(wp), allocatable :: young(:), poisson(:)
+      integer :: i, j
+
+      i = findloc(scene%exact%ring_index, b, 1)
+      if (i == 0) return
+      allocate (young(size(scene%exact%ring_index)), poisson(size(scene%exact%ring_index)))
+      do j = 1, size(young)
+         young(j) = scene%bodies(scene%exact%ring_index(j))%young
+         poisson(j) = scene%bodies(scene%exact%ring_index(j))%poisson
+      end do
+      associate (spec => scene%exact)
+         call new_layered(layered, scene%dim, analysis_kind(scene), spec%center, spec%radii, spec%interferences, &
+            & spec%p_in, spec%p_out, young, poisson, error, shifts=spec%ring_shifts)
+      end associate
+      if (.not. allocated(error)) call move_alloc(layered%rings(i)%field, exact)
+   end subroutine build_layered_ring
 
    !> The exact contact pressure on the slave surface of `&contact` pair `k`,
    !> in the units of `scene` (the scene's own for a contact result): hertz_*
    !> from the closed form with E* of the pair's two bodies; every other kind
-   !> from the slave body's exact field (p = -n.sigma.n; compound_* on the
-   !> interface r = r_contact, where their closed form puts both surfaces). Not allocated
+   !> from the slave body's exact field (p = -n.sigma.n; compound_* and
+   !> layered_* on the slave's real surface, where its ring ends). Not allocated
    !> without `&exact` or when the slave body has no exact field (a compound
    !> scene's third body).
    subroutine build_exact_pressure(scene, k, pressure, error)
@@ -630,7 +657,12 @@ contains
             call build_exact(scene, scene%contacts(k)%slave_index, field, error)
             if (allocated(error) .or. .not. allocated(field)) return
             if (spec%kind == 'compound_cylinder' .or. spec%kind == 'compound_sphere') then
-               call new_field_pressure(from_field, field, spec%center, spec%r_contact)
+               ! On the slave's real surface: the inner ring's ends an interference out.
+               call new_field_pressure(from_field, field, spec%center, spec%r_contact + &
+                  & merge(spec%ring_shifts(1), 0.0_wp, scene%contacts(k)%slave_index == spec%inner_index))
+            else if (spec%kind == 'layered_cylinder' .or. spec%kind == 'layered_sphere') then
+               ! On the slave's real surface, where its ring of the closed form ends.
+               call new_field_pressure(from_field, field, spec%center, interface_radius(spec, scene%contacts(k)))
             else
                call new_field_pressure(from_field, field)
             end if
@@ -640,5 +672,19 @@ contains
       end associate
       if (allocated(error)) error%message = '&exact: '//error%message
    end subroutine build_exact_pressure
+
+   !> The radius of the slave surface of `pair` in the layered solution on
+   !> real radii (sprc_exact_layered): between rings i and i + 1, the inner
+   !> ring's r_i + delta_i when it is the slave, the outer ring's bore r_i
+   !> when that is.
+   pure real(wp) function interface_radius(spec, pair) result(r)
+      type(exact_spec_type), intent(in) :: spec
+      type(contact_spec_type), intent(in) :: pair
+      integer :: i, j
+      i = findloc(spec%ring_index, pair%slave_index, 1)
+      j = findloc(spec%ring_index, pair%master_index, 1)
+      r = spec%radii(max(1, min(i, j) + 1))
+      if (i < j .and. i >= 1 .and. i <= size(spec%ring_shifts)) r = r + spec%ring_shifts(i)
+   end function interface_radius
 
 end module sprc_study_model

@@ -5,14 +5,14 @@
 !> reads and validates scene files into them; the study layer runs them.
 module sprc_study_spec
    use sprc_core_kinds, only: wp
-   use sprc_core_text, only: real_text
+   use sprc_core_text, only: real_text, itoa
    use sprc_recovery_patch_loop, only: auto_degree
    implicit none
    private
 
    public :: scene_type, body_spec_type, shape_spec_type, bc_spec_type, exact_spec_type, contact_spec_type
    public :: adapt_spec_type, default_max_level
-   public :: recovery_degree, contact_unsupported
+   public :: recovery_degree, contact_unsupported, contact_components
    public :: default_kappa, default_stabilization, kappa_range, kappa_note
 
    !> Default of `&contact kappa`, the dimensionless factor of the contact
@@ -108,7 +108,8 @@ module sprc_study_spec
       !> Whether the scene has an `&exact` group.
       logical :: present = .false.
       !> 'lame_cylinder' | 'lame_sphere' | 'kirsch' | 'uniform' | 'compound_cylinder' |
-      !> 'compound_sphere' | 'hertz_cylinder' | 'hertz_sphere' | 'corner'.
+      !> 'compound_sphere' | 'layered_cylinder' | 'layered_sphere' | 'hertz_cylinder' | 'hertz_sphere' |
+      !> 'corner'.
       character(len=:), allocatable :: kind
       !> Centre, `dim` values.
       real(wp), allocatable :: center(:)
@@ -123,6 +124,14 @@ module sprc_study_spec
       !> Compound: the inner and outer bodies and their indices in `scene%bodies`.
       character(len=:), allocatable :: inner, outer
       integer :: inner_index = 0, outer_index = 0
+      !> For layered_*, the radii r_0 < ... < r_n (n + 1 values, inside out), the n ring bodies
+      !> inside out (names and indices in `scene%bodies`) and the n - 1 radial interferences.
+      real(wp), allocatable :: radii(:), interferences(:)
+      !> For layered_* and compound_*, the interferences as lengths (the inner rings' outer
+      !> surfaces lie that far out; not scaled with the analysis units, as lengths are not).
+      real(wp), allocatable :: ring_shifts(:)
+      character(len=:), allocatable :: ring_names
+      integer, allocatable :: ring_index(:)
       !> Hertz: first-contact point and the unit normal of the contact plane, `dim` values.
       real(wp), allocatable :: point(:), normal(:)
       !> Hertz: the whole contact force (per unit thickness in 2D), > 0.
@@ -261,23 +270,70 @@ contains
       if (scene%recovery_degree == 'p+1') recovery_degree = scene%order + 1
    end function recovery_degree
 
-   !> What of the scene's `&contact` this version's contact FE does not run,
-   !> as a sentence ('' when it runs the scene): one pair; the recovered
-   !> stabilization with frictionless or stick contact (sprc_contact_solve).
+   !> Pairs of a component with more than one pair are solved together
+   !> (`contact_components`); this version runs such a component with
+   !> friction 'frictionless' or 'stick' and the FE stabilization stress only
+   !> (Coulomb's load path and the recovered stabilization's fixed point are
+   !> per pair). Empty when the scene can run.
    pure function contact_unsupported(scene) result(why)
       type(scene_type), intent(in) :: scene
       character(len=:), allocatable :: why
-      character(len=12) :: buf
+      integer, allocatable :: comp(:)
+      integer :: k, n
 
       why = ''
       if (.not. allocated(scene%contacts)) return
       if (size(scene%contacts) == 0) return
-      if (size(scene%contacts) > 1) then
-         write (buf, '(i0)') size(scene%contacts)
-         why = '&contact: '//trim(buf)//' contact pairs; this version runs one pair per scene'
-      else if (scene%contacts(1)%stabilization == 'recovered' .and. scene%contacts(1)%friction == 'coulomb') then
-         why = "&contact: stabilization = 'recovered' with friction = 'coulomb' is not in this version (use 'fe')"
-      end if
+      call contact_components(scene, comp, n)
+      do k = 1, size(scene%contacts)
+         associate (c => scene%contacts(k))
+            if (c%stabilization == 'recovered' .and. c%friction == 'coulomb') then
+               why = "&contact: stabilization = 'recovered' with friction = 'coulomb' is not in this version (use 'fe')"
+            else if (count(comp(scene%contacts%slave_index) == comp(c%slave_index)) > 1 .and. &
+               & (c%stabilization == 'recovered' .or. c%friction == 'coulomb')) then
+               why = '&contact '//itoa(k)//": friction = '"//c%friction//"', stabilization = '"//c%stabilization// &
+                  & "' in an assembly of several pairs: this version solves several pairs together with "// &
+                  & "friction 'frictionless' or 'stick' and stabilization 'fe' only"
+            end if
+         end associate
+         if (len(why) > 0) return
+      end do
    end function contact_unsupported
+
+   !> The components of the contact graph (bodies joined by `&contact` pairs):
+   !> comp(b) in 1..n for a body in contact, numbered in the order of their
+   !> first body; 0 for a body without contact (its own problem).
+   pure subroutine contact_components(scene, comp, n)
+      type(scene_type), intent(in) :: scene
+      integer, allocatable, intent(out) :: comp(:)
+      integer, intent(out) :: n
+      integer :: b, k, root(size(scene%bodies)), a, c
+
+      root = [(b, b=1, size(scene%bodies))]
+      do k = 1, size(scene%contacts)
+         a = find(scene%contacts(k)%slave_index)
+         c = find(scene%contacts(k)%master_index)
+         root(max(a, c)) = min(a, c)
+      end do
+      allocate (comp(size(scene%bodies)), source=0)
+      n = 0
+      do b = 1, size(scene%bodies)
+         if (.not. (any(scene%contacts%slave_index == b) .or. any(scene%contacts%master_index == b))) cycle
+         a = find(b)
+         if (comp(a) == 0) then
+            n = n + 1
+            comp(a) = n
+         end if
+         comp(b) = comp(a)
+      end do
+   contains
+      pure integer function find(b0)
+         integer, intent(in) :: b0
+         find = b0
+         do while (root(find) /= find)
+            find = root(find)
+         end do
+      end function find
+   end subroutine contact_components
 
 end module sprc_study_spec
