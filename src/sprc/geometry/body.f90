@@ -22,7 +22,7 @@ module sprc_geometry_body
    use sprc_core_text, only: fixed_text, itoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_geometry_region, only: region_type, cell_outside, cell_inside, cell_cut
-   use sprc_geometry_shape, only: shape_type, shape_kind_name
+   use sprc_geometry_shape, only: shape_type, shape_kind_name, shape_facets
    implicit none
    private
 
@@ -208,6 +208,10 @@ contains
       integer :: k
 
       do k = 1, self%nshape
+         if (self%shapes(k)%kind == shape_facets) then
+            classes(k) = self%shapes(k)%facet_class(lo, hi)
+            cycle
+         end if
          call self%shapes(k)%phi_range(lo, hi, fmin, fmax)
          tol = snap_tolerance(self%shapes(k), lo, hi)
          classes(k) = class_of_range(fmin, fmax, tol)
