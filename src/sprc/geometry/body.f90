@@ -67,6 +67,7 @@ module sprc_geometry_body
       procedure :: phi => body_phi
       procedure :: classify_box
       procedure :: shape_classes
+      procedure :: class_with
       procedure :: active_shapes
       procedure :: is_boundary_on
       procedure :: surface_at
@@ -239,6 +240,14 @@ contains
       call self%shape_classes(lo, hi, many)
       cls = evaluate(self%ops, many)
    end function classify_box
+
+   !> Class of the body from the shapes' classes (`shape_classes`) with shape
+   !> i's class replaced by ci.
+   pure integer function class_with(self, classes, i, ci) result(cls)
+      class(body_type), intent(in) :: self
+      integer, intent(in) :: classes(:), i, ci
+      cls = evaluate_with(self%ops, classes(1:self%nshape), i, ci)
+   end function class_with
 
    !> Shapes whose surface may pass through the box [lo, hi] and matters
    !> there: the shape is cut by the box and the body's class is not decided

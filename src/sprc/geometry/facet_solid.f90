@@ -515,7 +515,8 @@ contains
    end function snap_area
 
    !> Facet f clipped to the closed box [lo, hi]: vertices poly(:, 1:nv)
-   !> (a polygon in 3D, a segment nv = 2 in 2D; nv = 0 if empty).
+   !> (a polygon in 3D, a segment nv = 2 in 2D; nv = 0 if it degenerates to
+   !> fewer than dim vertices).
    pure subroutine clip_to_box(self, f, lo, hi, poly, nv)
       type(facet_solid_type), intent(in) :: self
       integer, intent(in) :: f
@@ -537,7 +538,10 @@ contains
             else
                call clip_axis(self%dim, work, nv, m, hi(m), 1.0_wp, poly)
             end if
-            if (nv == 0) return
+            if (nv < self%dim) then
+               nv = 0
+               return
+            end if
          end do
       end do
    end subroutine clip_to_box

@@ -36,7 +36,8 @@ module sprc_grid_quadrature
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_out_of_memory
    use sprc_core_gauss, only: max_gauss_points, gauss_legendre_nodes
    use sprc_geometry_region, only: cell_outside, cell_inside, cell_cut
-   use sprc_geometry_shape, only: shape_halfspace, shape_box
+   use sprc_geometry_shape, only: shape_halfspace, shape_box, shape_facets
+   use sprc_grid_facet_rule, only: facet_rule_type, facet_cell_rule, facet_face_rule
    use sprc_geometry_body, only: body_type, csg_add, csg_intersect, snap_tolerance
    use sprc_grid_quadric, only: ncoef, max_shape_quadrics, quadric_range, derivative_range, &
       & quadric_gradient, depends_on, restrict, line_coefficients, quadratic_roots, shape_quadrics, crossing
@@ -95,6 +96,8 @@ module sprc_grid_quadrature
       logical, allocatable, private :: require(:)
       !> An array could not grow (out of memory): the rule is incomplete.
       logical, private :: failed = .false.
+      !> Work and points of the faceted-solid rule.
+      type(facet_rule_type), private :: facets
    end type cell_rule_type
 
    !> Default strength of a height direction (module notes, `min_ratio`).
@@ -386,6 +389,11 @@ contains
       call reserve_work(rule, body%nshape)
       if (rule%failed) return
       call body%active_shapes(lo, hi, rule%shapes(1:body%nshape), n)
+      if (any(body%shapes(rule%shapes(1:n))%kind == shape_facets)) then
+         call facet_cut(quad, body, lo, hi, rule, rule%shapes(1:n))
+         call add_face_parts(quad, body, lo, hi, rule)
+         return
+      end if
       do i = 1, n
          call add_shape_quadrics(body, rule%shapes(i), ctx, lo, hi, rule)
       end do
@@ -399,6 +407,65 @@ contains
       rule%np = 0
       call add_face_parts(quad, body, lo, hi, rule)
    end subroutine cut_rule
+
+   !> Cut rule of a cell whose active shapes (`active`) include a faceted
+   !> solid: the exact polyhedral rule (sprc_grid_facet_rule) when it is the
+   !> only one; otherwise the documented approximation of `mixed_cut`.
+   pure subroutine facet_cut(quad, body, lo, hi, rule, active)
+      type(cut_quadrature_type), intent(in) :: quad
+      class(body_type), intent(in) :: body
+      real(wp), intent(in) :: lo(:), hi(:)
+      type(cell_rule_type), intent(inout) :: rule
+      integer, intent(in) :: active(:)
+      integer :: classes(body%nshape), s, i
+      logical :: member_in, member_out
+
+      if (size(active) /= 1) then
+         rule%nunresolved = rule%nunresolved + 1
+         return
+      end if
+      s = active(1)
+      call body%shape_classes(lo, hi, classes)
+      member_in = body%class_with(classes, s, cell_inside) == cell_inside
+      member_out = body%class_with(classes, s, cell_outside) == cell_inside
+      call facet_cell_rule(rule%facets, body%shapes(s)%solid, lo, hi, quad%q, member_in, member_out)
+      rule%nsplit = rule%nsplit + rule%facets%nsplit
+      do i = 1, rule%facets%nvol
+         call push_volume(rule, rule%facets%vol_x(:, i), rule%facets%vol_w(i))
+      end do
+      call push_facet_surface(rule, s)
+   end subroutine facet_cut
+
+   !> Append the facet rule's surface points as points of shape s.
+   pure subroutine push_facet_surface(rule, s)
+      type(cell_rule_type), intent(inout) :: rule
+      integer, intent(in) :: s
+      integer :: i
+      do i = 1, rule%facets%nsurf
+         call push_surface(rule, rule%facets%surf_x(:, i), rule%facets%surf_w(i), rule%facets%surf_n(:, i), s)
+      end do
+   end subroutine push_facet_surface
+
+   !> Facet fragments in the face planes of the cell where it is on the body side.
+   pure subroutine add_facet_face_parts(quad, body, lo, hi, rule)
+      type(cut_quadrature_type), intent(in) :: quad
+      class(body_type), intent(in) :: body
+      real(wp), intent(in) :: lo(:), hi(:)
+      type(cell_rule_type), intent(inout) :: rule
+      integer :: classes(body%nshape), s
+      logical :: member_in, member_out
+
+      if (.not. any(body%shapes%kind == shape_facets)) return
+      call body%shape_classes(lo, hi, classes)
+      do s = 1, body%nshape
+         if (body%shapes(s)%kind /= shape_facets) cycle
+         member_in = body%class_with(classes, s, cell_inside) == cell_inside
+         member_out = body%class_with(classes, s, cell_outside) == cell_inside
+         if (member_in .eqv. member_out) cycle
+         call facet_face_rule(rule%facets, body%shapes(s)%solid, lo, hi, quad%q, member_in, member_out)
+         call push_facet_surface(rule, s)
+      end do
+   end subroutine add_facet_face_parts
 
    pure subroutine new_context(ctx, dim, lo, hi)
       type(context_type), intent(out) :: ctx
@@ -445,6 +512,7 @@ contains
       logical :: free(3), on, inside_on_cell_side
 
       dim = quad%dim
+      call add_facet_face_parts(quad, body, lo, hi, rule)
       ! the shapes' classes on a face in rule%shapes (the reduction below only grows it)
       call reserve_work(rule, body%nshape)
       if (rule%failed) return
