@@ -422,6 +422,24 @@ contains
             & 'facet bar 3D Q'//achar(48 + deg), error)
          if (allocated(error)) return
       end do
+      ! the ends (local x faces of facets_box) as named groups: the displacement on
+      ! one end, traction on the rest of the bar (the shape's condition)
+      set%group(9:10) = 1
+      set%group(11:12) = 2
+      set%group_name = [character(len=64) :: 'left', 'right']
+      call new_facet_shape(s(1), 'bar', set, error)
+      if (allocated(error)) return
+      call make_body(body, s, [csg_add], error)
+      if (allocated(error)) return
+      call check(error, body%surface_index('left') == 2 .and. body%surface_index('right') == 3 .and. &
+         & body%surface_name(3) == 'right' .and. body%surface_shape(3) == 1 .and. body%nsurface() == 3, &
+         & 'surface ids of the groups')
+      if (allocated(error)) return
+      do deg = 1, 2
+         call run_patch(body, [new_fe_bc(1, bc_exact_traction), new_fe_bc(body%surface_index('left'), &
+            & bc_exact_displacement)], field, deg, 3, 0, 'facet bar with named ends 3D Q'//achar(48 + deg), error)
+         if (allocated(error)) return
+      end do
       call new_poly_field(field, plane_strain, [0.01_wp, -0.02_wp], &
          & reshape([0.003_wp, -0.001_wp, 0.002_wp, 0.004_wp], [2, 2]), error=error)
       if (allocated(error)) return

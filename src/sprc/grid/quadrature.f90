@@ -75,7 +75,8 @@ module sprc_grid_quadrature
       integer :: nvol = 0
       real(wp), allocatable :: vol_x(:, :), vol_w(:)
       !> Surface points: coordinates, weights (surface measure), unit outward
-      !> normals (3, :), and the body's shape index of the surface.
+      !> normals (3, :), and the body's surface id (sprc_geometry_body notes:
+      !> the shape index, or a faceted shape's group).
       integer :: nsurf = 0
       real(wp), allocatable :: surf_x(:, :), surf_w(:), surf_n(:, :)
       integer, allocatable :: surf_shape(:)
@@ -433,16 +434,20 @@ contains
       do i = 1, rule%facets%nvol
          call push_volume(rule, rule%facets%vol_x(:, i), rule%facets%vol_w(i))
       end do
-      call push_facet_surface(rule, s)
+      call push_facet_surface(body, rule, s)
    end subroutine facet_cut
 
-   !> Append the facet rule's surface points as points of shape s.
-   pure subroutine push_facet_surface(rule, s)
+   !> Append the facet rule's surface points of shape s with their surface ids.
+   pure subroutine push_facet_surface(body, rule, s)
+      class(body_type), intent(in) :: body
       type(cell_rule_type), intent(inout) :: rule
       integer, intent(in) :: s
-      integer :: i
+      integer :: i, g, id
       do i = 1, rule%facets%nsurf
-         call push_surface(rule, rule%facets%surf_x(:, i), rule%facets%surf_w(i), rule%facets%surf_n(:, i), s)
+         g = 0
+         if (allocated(body%shapes(s)%solid%set%group)) g = body%shapes(s)%solid%set%group(rule%facets%surf_facet(i))
+         id = body%group_surface(s, g)
+         call push_surface(rule, rule%facets%surf_x(:, i), rule%facets%surf_w(i), rule%facets%surf_n(:, i), id)
       end do
    end subroutine push_facet_surface
 
@@ -463,7 +468,7 @@ contains
          member_out = body%class_with(classes, s, cell_outside) == cell_inside
          if (member_in .eqv. member_out) cycle
          call facet_face_rule(rule%facets, body%shapes(s)%solid, lo, hi, quad%q, member_in, member_out)
-         call push_facet_surface(rule, s)
+         call push_facet_surface(body, rule, s)
       end do
    end subroutine add_facet_face_parts
 
