@@ -20,7 +20,7 @@ module sprc_test_facets
    use sprc_core_kinds, only: wp
    use sprc_geometry_region, only: cell_outside, cell_inside, cell_cut
    use sprc_geometry_facets, only: facet_set_type
-   use sprc_geometry_shape, only: shape_type, new_facet_shape, new_box
+   use sprc_geometry_shape, only: shape_type, new_facet_shape, new_box, new_cylinder, new_disk
    use sprc_geometry_body, only: body_type, new_body, csg_add, csg_subtract
    use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature, cell_rule_type, cell_rule, &
       & default_points
@@ -36,7 +36,7 @@ module sprc_test_facets
    !> Grid sums: measure, boundary measure, sum w x.n, |sum w n|, smallest weight.
    type :: sums_type
       real(wp) :: vol = 0.0_wp, area = 0.0_wp, div = 0.0_wp, flux(3) = 0.0_wp, wmin = huge(1.0_wp)
-      integer :: ncut = 0
+      integer :: ncut = 0, nunresolved = 0
    end type sums_type
 
 contains
@@ -50,6 +50,7 @@ contains
          new_unittest('torus', test_torus), &
          new_unittest('cavity', test_cavity), &
          new_unittest('polygons_2d', test_polygons), &
+         new_unittest('mixed_csg', test_mixed), &
          new_unittest('classification', test_classification), &
          new_unittest('shape_errors', test_shape_errors) &
          ]
@@ -162,6 +163,75 @@ contains
          & 0.0_wp, 0.5_wp, -0.5_wp, 0.5_wp], [2, 6]))
       call check_measures(set, 4, -1.0_wp, 2.0_wp, 'L on nodes', error)
    end subroutine test_polygons
+
+   !> A faceted box minus an exact cylinder (3D) or disk (2D) against the same
+   !> body built from a primitive box. Faces on grid planes (the plate of a
+   !> Kirsch scene): no cell is cut by both kinds, so the measures agree to
+   !> 1e-10. Faces off the grid: cells on the curves where the bore meets the
+   !> faces are halved (`mixed_box`) and the boxes left unresolved are
+   !> bounded: each changes the volume by at most its own, a^dim, and the
+   !> boundary measure by at most 3 a^(dim-1) (two surface pieces, each at
+   !> most sqrt(2) a^(dim-1) for a plane or a nearly flat piece of a cylinder).
+   subroutine test_mixed(error)
+      type(error_type), allocatable, intent(out) :: error
+      call mixed_case(3, [0.5_wp, 0.5_wp, 0.25_wp], 3, error)
+      if (allocated(error)) return
+      call mixed_case(3, [0.53_wp, 0.47_wp, 0.29_wp], 3, error)
+      if (allocated(error)) return
+      call mixed_case(2, [0.5_wp, 0.75_wp, 0.0_wp], 4, error)
+      if (allocated(error)) return
+      call mixed_case(2, [0.53_wp, 0.71_wp, 0.0_wp], 4, error)
+   end subroutine test_mixed
+
+   subroutine mixed_case(dim, half, level, error)
+      integer, intent(in) :: dim, level
+      real(wp), intent(in) :: half(3)
+      type(error_type), allocatable, intent(out) :: error
+      type(facet_set_type) :: set
+      type(shape_type) :: box, bore
+      type(body_type) :: exact_body, mixed_body
+      type(sums_type) :: ref, got
+      real(wp) :: a, p(2, 4), tol_v, tol_s
+      character(len=:), allocatable :: name
+      integer :: i
+
+      name = 'mixed '//achar(48 + dim)//'D'
+      if (dim == 3) then
+         call facets_box(set, [0.0_wp, 0.0_wp, 0.0_wp], half, [0.0_wp, 0.0_wp, 0.0_wp])
+         call new_box(box, 'plate', -half, half, error)
+         if (allocated(error)) return
+         call new_cylinder(bore, 'bore', [0.03_wp, -0.02_wp, 0.0_wp], [0.0_wp, 0.0_wp, 1.0_wp], 0.2_wp, error)
+      else
+         p = reshape([-half(1), -half(2), half(1), -half(2), half(1), half(2), -half(1), half(2)], [2, 4])
+         call facets_polygon(set, p)
+         call new_box(box, 'plate', -half(1:2), half(1:2), error)
+         if (allocated(error)) return
+         call new_disk(bore, 'bore', [0.03_wp, -0.02_wp], 0.2_wp, error)
+      end if
+      if (allocated(error)) return
+      call new_body(exact_body, 'exact')
+      call exact_body%add_shape(csg_add, box, error)
+      if (.not. allocated(error)) call exact_body%add_shape(csg_subtract, bore, error)
+      if (allocated(error)) return
+      call make_body(set, mixed_body, error)
+      if (.not. allocated(error)) call mixed_body%add_shape(csg_subtract, bore, error)
+      if (allocated(error)) return
+      call grid_sums(exact_body, dim, level, -1.0_wp, 2.0_wp, ref, error)
+      if (allocated(error)) return
+      call grid_sums(mixed_body, dim, level, -1.0_wp, 2.0_wp, got, error)
+      if (allocated(error)) return
+      a = 2.0_wp/2**level/2**merge(4, 8, dim == 3)
+      tol_v = tol_rel*ref%vol + got%nunresolved*a**dim
+      tol_s = tol_rel*ref%area + got%nunresolved*3*a**(dim - 1)
+      call check(error, got%vol, ref%vol, tol_v, name//' volume')
+      if (allocated(error)) return
+      call check(error, got%area, ref%area, tol_s, name//' boundary measure')
+      if (allocated(error)) return
+      call check(error, got%wmin > 0.0_wp, name//': non-positive weight')
+      if (allocated(error)) return
+      i = count([half(1:dim)*2**level/2.0_wp - nint(half(1:dim)*2**level/2.0_wp) /= 0.0_wp])
+      if (i == 0) call check(error, got%nunresolved, 0, name//' with faces on grid planes: unresolved boxes')
+   end subroutine mixed_case
 
    !> Classes of boxes against a unit cube [0, 1]^3 given as facets: inside,
    !> outside, cut, and the tie rules (a facet on a box face, a box touching the
@@ -285,6 +355,7 @@ contains
                call cell_rule(quad, body, lo(1:dim), hi(1:dim), rule, error)
                if (allocated(error)) return
                if (rule%cls == cell_cut) sums%ncut = sums%ncut + 1
+               sums%nunresolved = sums%nunresolved + rule%nunresolved
                sums%vol = sums%vol + sum(rule%vol_w(1:rule%nvol))
                do q = 1, rule%nsurf
                   sums%area = sums%area + rule%surf_w(q)

@@ -32,7 +32,7 @@ module sprc_geometry_facet_solid
 
    public :: facet_solid_type, new_facet_solid
    public :: solid_query_box, solid_nearest, solid_inside, solid_box_class
-   public :: clip_to_box, polygon_measure, facet_points, snap_area, snap_length, on_face_plane
+   public :: clip_to_box, polygon_measure, facet_points, snap_area, snap_length, on_face_plane, face_cover
 
    !> Facets per leaf of the hierarchy.
    integer, parameter :: leaf_size = 4
@@ -650,6 +650,51 @@ contains
       m = 0
       side = 0
    end subroutine on_face_plane
+
+   !> Does the solid's surface cover the whole face x_m = (lo_m or hi_m by side
+   !> -1 / +1) of the box [lo, hi]? +1: covered by fragments in that plane whose
+   !> solid lies on the box side, -1: on the other side, 0: not covered (no
+   !> fragment, a partial cover, or both orientations). Covered: the fragments'
+   !> measures sum to the face's within 64 eps relative (they do not overlap on
+   !> a valid surface).
+   pure integer function face_cover(self, lo, hi, m, side) result(cover)
+      type(facet_solid_type), intent(in) :: self
+      real(wp), intent(in) :: lo(:), hi(:)
+      integer, intent(in) :: m, side
+      real(wp) :: flo(3), fhi(3), poly(3, max_clip_vertices), total, face, h
+      integer, allocatable :: list(:)
+      integer :: i, n, nv, mm, ss, d
+      logical :: inward, outward
+
+      d = self%dim
+      flo(1:d) = lo(1:d)
+      fhi(1:d) = hi(1:d)
+      if (side < 0) fhi(m) = lo(m)
+      if (side > 0) flo(m) = hi(m)
+      face = product(fhi(1:d) - flo(1:d), mask=[(i /= m, i=1, d)])
+      h = maxval(hi(1:d) - lo(1:d))
+      call solid_query_box(self, flo(1:d), fhi(1:d), list, n)
+      total = 0.0_wp
+      inward = .false.
+      outward = .false.
+      do i = 1, n
+         call clip_to_box(self, list(i), lo, hi, poly, nv)
+         if (nv < d) cycle
+         if (polygon_measure(d, poly, nv) <= snap_area(d, h)) cycle
+         call on_face_plane(self, poly, nv, flo(1:d), fhi(1:d), mm, ss)
+         if (mm /= m) cycle
+         total = total + polygon_measure(d, poly, nv)
+         if (self%normal(m, list(i))*side > 0.0_wp) then
+            inward = .true.
+         else
+            outward = .true.
+         end if
+      end do
+      cover = 0
+      if (inward .eqv. outward) return
+      if (abs(total - face) > 64.0_wp*epsilon(1.0_wp)*face) return
+      cover = merge(1, -1, inward)
+   end function face_cover
 
    !> Class of the box [lo, hi] (module notes).
    pure integer function solid_box_class(self, lo, hi) result(cls)

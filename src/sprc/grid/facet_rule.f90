@@ -121,22 +121,24 @@ contains
    end subroutine facet_cell_rule
 
    !> Surface points of the fragments of `solid` lying in the face planes of the
-   !> cell [lo, hi] where this cell is on the body side (module notes):
-   !> member_in / member_out as in `facet_cell_rule`.
-   pure subroutine facet_face_rule(rule, solid, lo, hi, q, member_in, member_out)
+   !> cell [lo, hi], with the facet's outward normal and surf_facet = f where the
+   !> solid's inside lies on the cell side of the plane, -f where it lies on
+   !> the other side (the caller decides by CSG membership which it keeps).
+   !> Faces marked in skip(side, m) (1 lower, 2 upper) are left out, and with the
+   !> box [skip_lo, skip_hi], fragments in its face planes.
+   pure subroutine facet_face_rule(rule, solid, lo, hi, q, skip, skip_lo, skip_hi)
       type(facet_rule_type), intent(inout) :: rule
       type(facet_solid_type), intent(in) :: solid
       real(wp), intent(in) :: lo(:), hi(:)
       integer, intent(in) :: q
-      logical, intent(in) :: member_in, member_out
-      real(wp) :: poly(3, max_clip_vertices), h, sgn
-      integer :: i, n, nv, m, side, f, d
-      logical :: cell_in, here, there
+      logical, intent(in) :: skip(:, :)
+      real(wp), intent(in), optional :: skip_lo(:), skip_hi(:)
+      real(wp) :: poly(3, max_clip_vertices), h
+      integer :: i, n, nv, m, side, f, d, m2, side2
 
       call prepare(rule, solid%dim, q)
       d = solid%dim
       h = maxval(hi(1:d) - lo(1:d))
-      sgn = merge(1.0_wp, -1.0_wp, member_in)
       call solid_query_box(solid, lo, hi, rule%cand, n)
       do i = 1, n
          f = rule%cand(i)
@@ -145,11 +147,13 @@ contains
          if (polygon_measure(d, poly, nv) <= snap_area(d, h)) cycle
          call on_face_plane(solid, poly, nv, lo, hi, m, side)
          if (m == 0) cycle
+         if (skip((side + 3)/2, m)) cycle
+         if (present(skip_lo)) then
+            call on_face_plane(solid, poly, nv, skip_lo, skip_hi, m2, side2)
+            if (m2 > 0) cycle
+         end if
          ! the cell lies on the solid's inside iff the outward normal leaves the cell
-         cell_in = solid%normal(m, f)*side > 0.0_wp
-         here = merge(member_in, member_out, cell_in)
-         there = merge(member_in, member_out, .not. cell_in)
-         if (here .and. .not. there) call fragment_surface(rule, d, poly, nv, sgn*solid%normal(:, f), f)
+         call fragment_surface(rule, d, poly, nv, solid%normal(:, f), merge(f, -f, solid%normal(m, f)*side > 0.0_wp))
       end do
    end subroutine facet_face_rule
 
