@@ -2,19 +2,23 @@
 !> exact for the polyhedron (polygon in 2D): the volume rule integrates over
 !> cell ∩ solid, the surface rule over the facets clipped to the cell.
 !>
-!> Volume: the cell is split into simplices (6 tetrahedra / 2 triangles) and
-!> partitioned by a binary space partition whose splitting planes are the
-!> planes of the facet fragments (facets clipped to the cell) that cross the
-!> current region. A fragment is used once: the region on its back side is
-!> inside the solid next to it, the front side outside. When no fragment is
-!> left in a region, the region is inside or outside as the side of the last
-!> plane says (solid-leaf BSP: the last fragment lies on the region's
-!> boundary and no facet crosses the region). A plane that does not cross the
-!> region (the fragment lies on its boundary) only sets that class. The
-!> simplices of inside regions get a collapsed (Duffy) product Gauss rule of
-!> qs = q + 1 points per direction: positive weights, exact for polynomials
-!> of total degree 2 qs - 3 = 2 q - 1 on a tetrahedron and 2 qs - 2 on a
-!> triangle, i.e. every total degree the tensor rule of q points integrates.
+!> Volume: the cell is partitioned by a binary space partition whose
+!> splitting planes are the planes of the facet fragments (facets clipped to
+!> the cell) that cross the current region. Regions are convex polytopes kept
+!> as their face loops (a polygon in 2D), clipped by each plane (Sutherland-
+!> Hodgman on every face, the new face from the points on the plane ordered
+!> by angle), so a region's size grows only with the planes that bound it. A
+!> fragment is used once: the region on its back side is inside the solid
+!> next to it, the front side outside. When no fragment is left in a region,
+!> the region is inside or outside as the side of the last plane says
+!> (solid-leaf BSP: the last fragment lies on the region's boundary and no
+!> facet crosses the region). A plane that does not cross the region (the
+!> fragment lies on its boundary) only sets that class. Inside regions are
+!> split into simplices (a fan from one vertex over the fanned faces) that
+!> get a collapsed (Duffy) product Gauss rule of qs = q + 1 points per
+!> direction: positive weights, exact for polynomials of total degree
+!> 2 qs - 3 = 2 q - 1 on a tetrahedron and 2 qs - 2 on a triangle, i.e. every
+!> total degree the tensor rule of q points integrates.
 !>
 !> Surface: each fragment crossing the cell (not in a face plane of the cell)
 !> is fanned into triangles (a segment in 2D) with the qs-point rule; its
@@ -23,8 +27,9 @@
 !> the cell on the body side, as for the primitives.
 !>
 !> Round-off: plane sides within the solid's snapping length count as on the
-!> plane; fragments and simplices of measure below the snapping measure
-!> (16 eps h^(dim-1), 16 eps h^dim) are dropped.
+!> plane; fragments, faces and simplices of measure below the snapping
+!> measure (16 eps h^(dim-1), 16 eps h^dim) are dropped, and points of a
+!> region within 4 snapping lengths are merged.
 module sprc_grid_facet_rule
    use sprc_core_kinds, only: wp
    use sprc_core_gauss, only: max_gauss_points, gauss_legendre_nodes
@@ -47,11 +52,11 @@ module sprc_grid_facet_rule
       !> Planes that split a region (statistics).
       integer :: nsplit = 0
       integer, allocatable, private :: cand(:)
-      !> Simplex pool (3, 4, :) and fragment pool: vertices (3, :), per fragment
-      !> its first vertex, vertex count and facet.
-      real(wp), allocatable, private :: simp(:, :, :), fv(:, :)
+      !> Polygon pool of the fragments and the regions' faces: vertices (3, :), per
+      !> polygon its first vertex, vertex count and facet (0 for a region's face).
+      real(wp), allocatable, private :: fv(:, :)
       integer, allocatable, private :: fstart(:), fcount(:), ffacet(:)
-      integer, private :: nsimp = 0, nfv = 0, nfrag = 0
+      integer, private :: nfv = 0, nfrag = 0
       !> Reference rules: simplex (dim, nref) with weights, triangle and segment.
       integer, private :: dim = 0, qs = 0
       real(wp), allocatable, private :: ref_x(:, :), ref_w(:), tri_x(:, :), tri_w(:), seg_x(:), seg_w(:)
@@ -60,6 +65,8 @@ module sprc_grid_facet_rule
    !> What the BSP needs besides the pools.
    type :: context_type
       real(wp) :: tol = 0.0_wp, min_vol = 0.0_wp, min_frag = 0.0_wp
+      !> Points of a region closer than this are one.
+      real(wp) :: merge = 0.0_wp
       logical :: member_in = .true., member_out = .false.
    end type context_type
 
@@ -87,6 +94,7 @@ contains
          ctx%tol = snap_length(solid, max(maxval(abs(lo(1:d))), maxval(abs(hi(1:d)))))
          ctx%min_frag = snap_area(d, h)
          ctx%min_vol = 16.0_wp*epsilon(1.0_wp)*h**d
+         ctx%merge = 4.0_wp*ctx%tol
          ctx%member_in = member_in
          ctx%member_out = member_out
          sgn = merge(1.0_wp, -1.0_wp, member_in)
@@ -105,17 +113,18 @@ contains
             if (member_in .neqv. member_out) call fragment_surface(rule, d, poly, nv, sgn*solid%normal(:, f), f)
             call push_fragment(rule, poly(:, 1:nv), f)
          end do
-         call box_simplices(rule, d, lo, hi)
-         if (rule%nfrag == 0) then
+         n = rule%nfrag
+         call box_region(rule, d, lo, hi)
+         if (n == 0) then
             if (face_class < 0) then
                x = 0.0_wp
                x(1:d) = 0.5_wp*(lo(1:d) + hi(1:d))
                call solid_inside(solid, x, inside, on)
                face_class = merge(1, 0, inside)
             end if
-            call leaf(rule, ctx, 1, rule%nsimp, face_class == 1)
+            call leaf(rule, ctx, n + 1, rule%nfrag, face_class == 1)
          else
-            call partition(rule, solid, ctx, 1, rule%nsimp, 1, rule%nfrag, face_class == 1)
+            call partition(rule, solid, ctx, n + 1, rule%nfrag, 1, n, face_class == 1)
          end if
       end associate d_block
    end subroutine facet_cell_rule
@@ -165,12 +174,11 @@ contains
       rule%nvol = 0
       rule%nsurf = 0
       rule%nsplit = 0
-      rule%nsimp = 0
       rule%nfv = 0
       rule%nfrag = 0
       if (.not. allocated(rule%vol_x)) then
          allocate (rule%vol_x(3, 256), rule%vol_w(256), rule%surf_x(3, 64), rule%surf_w(64), rule%surf_n(3, 64), &
-            & rule%surf_facet(64), rule%cand(64), rule%simp(3, 4, 64), rule%fv(3, 256), rule%fstart(64), &
+            & rule%surf_facet(64), rule%cand(64), rule%fv(3, 256), rule%fstart(64), &
             & rule%fcount(64), rule%ffacet(64))
       end if
       if (rule%dim /= dim .or. rule%qs /= min(q + 1, max_gauss_points)) call reference_rules(rule, dim, q)
@@ -221,187 +229,208 @@ contains
       end do
    end subroutine reference_rules
 
-   !> The cell as simplices: 6 tetrahedra around the diagonal lo-hi (3D), 2 triangles (2D).
-   pure subroutine box_simplices(rule, d, lo, hi)
+   !> The cell as a region: its 6 faces (3D) or itself (2D).
+   pure subroutine box_region(rule, d, lo, hi)
       type(facet_rule_type), intent(inout) :: rule
       integer, intent(in) :: d
       real(wp), intent(in) :: lo(:), hi(:)
-      integer, parameter :: perm(3, 6) = reshape([1, 2, 3, 1, 3, 2, 2, 1, 3, 2, 3, 1, 3, 1, 2, 3, 2, 1], [3, 6])
-      real(wp) :: v(3, 4)
-      integer :: p, i
+      real(wp) :: v(3, 4), c(3, 8)
+      integer, parameter :: quads(4, 6) = reshape([1, 3, 4, 2, 5, 6, 8, 7, 1, 2, 6, 5, 3, 7, 8, 4, 1, 5, 7, 3, &
+         & 2, 4, 8, 6], [4, 6])
+      integer :: i, f
 
       v = 0.0_wp
       if (d == 2) then
          v(1:2, 1) = lo(1:2)
-         v(1:2, 3) = hi(1:2)
          v(1:2, 2) = [hi(1), lo(2)]
-         call push_simplex(rule, v)
-         v(1:2, 2) = [lo(1), hi(2)]
-         call push_simplex(rule, v)
+         v(1:2, 3) = hi(1:2)
+         v(1:2, 4) = [lo(1), hi(2)]
+         call push_fragment(rule, v, 0)
          return
       end if
-      do p = 1, 6
-         v(:, 1) = lo(1:3)
-         do i = 1, 3
-            v(:, i + 1) = v(:, i)
-            v(perm(i, p), i + 1) = hi(perm(i, p))
-         end do
-         call push_simplex(rule, v)
+      do i = 1, 8
+         c(:, i) = merge(hi(1:3), lo(1:3), [btest(i - 1, 0), btest(i - 1, 1), btest(i - 1, 2)])
       end do
-   end subroutine box_simplices
+      do f = 1, 6
+         call push_fragment(rule, c(:, quads(:, f)), 0)
+      end do
+   end subroutine box_region
 
    ! ------------------------------------------------------------ partition
 
-   !> Partition the region of simplices s0 .. s1 with fragments k0 .. k1; `inside`:
+   !> Partition the region of faces r0 .. r1 with fragments k0 .. k1; `inside`:
    !> the class the last plane gave it.
-   pure recursive subroutine partition(rule, solid, ctx, s0, s1, k0, k1, inside)
+   pure recursive subroutine partition(rule, solid, ctx, r0, r1, k0, k1, inside)
       type(facet_rule_type), intent(inout) :: rule
       type(facet_solid_type), intent(in) :: solid
       type(context_type), intent(in) :: ctx
-      integer, intent(in) :: s0, s1, k0, k1
+      integer, intent(in) :: r0, r1, k0, k1
       logical, intent(in) :: inside
       real(wp) :: n(3), p0(3), smin, smax
-      integer :: top_s, top_f, top_v, b0, b1, f0, f1, g, j, side
+      integer :: top_f, top_v, b0, b1, f0, f1, g, j, side
 
       if (k0 > k1) then
-         call leaf(rule, ctx, s0, s1, inside)
+         call leaf(rule, ctx, r0, r1, inside)
          return
       end if
       g = rule%ffacet(k0)
       n = solid%normal(:, g)
       p0 = solid%set%vert(:, solid%set%facet(1, g))
-      call side_range(rule, solid%dim, s0, s1, n, p0, smin, smax)
+      call side_range(rule, r0, r1, n, p0, smin, smax)
       if (.not. (smin < -ctx%tol .and. smax > ctx%tol)) then
          ! the fragment lies on the region's boundary: it only tells the class
-         call partition(rule, solid, ctx, s0, s1, k0 + 1, k1, smax <= ctx%tol)
+         call partition(rule, solid, ctx, r0, r1, k0 + 1, k1, smax <= ctx%tol)
          return
       end if
       rule%nsplit = rule%nsplit + 1
-      top_s = rule%nsimp
       top_f = rule%nfrag
       top_v = rule%nfv
       do side = -1, 1, 2
-         b0 = rule%nsimp + 1
-         do j = s0, s1
-            call split_simplex(rule, ctx, solid%dim, j, n, p0, real(side, wp))
-         end do
-         b1 = rule%nsimp
+         b0 = rule%nfrag + 1
+         call clip_region(rule, ctx, solid%dim, r0, r1, n, p0, real(side, wp))
+         b1 = rule%nfrag
          f0 = rule%nfrag + 1
          do j = k0 + 1, k1
             call split_fragment(rule, ctx, solid%dim, j, n, p0, real(side, wp))
          end do
          f1 = rule%nfrag
-         call partition(rule, solid, ctx, b0, b1, f0, f1, side < 0)
-         rule%nsimp = b0 - 1
-         rule%nfrag = f0 - 1
+         if (b1 >= b0) call partition(rule, solid, ctx, b0, b1, f0, f1, side < 0)
+         rule%nfrag = top_f
          rule%nfv = top_v
       end do
-      rule%nsimp = top_s
-      rule%nfrag = top_f
-      rule%nfv = top_v
    end subroutine partition
 
-   pure subroutine side_range(rule, d, s0, s1, n, p0, smin, smax)
+   pure subroutine side_range(rule, r0, r1, n, p0, smin, smax)
       type(facet_rule_type), intent(in) :: rule
-      integer, intent(in) :: d, s0, s1
+      integer, intent(in) :: r0, r1
       real(wp), intent(in) :: n(3), p0(3)
       real(wp), intent(out) :: smin, smax
       real(wp) :: s
-      integer :: j, i
+      integer :: i
       smin = huge(1.0_wp)
       smax = -huge(1.0_wp)
-      do j = s0, s1
-         do i = 1, d + 1
-            s = dot_product(rule%simp(:, i, j) - p0, n)
-            smin = min(smin, s)
-            smax = max(smax, s)
-         end do
+      do i = rule%fstart(r0), rule%fstart(r1) + rule%fcount(r1) - 1
+         s = dot_product(rule%fv(:, i) - p0, n)
+         smin = min(smin, s)
+         smax = max(smax, s)
       end do
    end subroutine side_range
 
-   !> The part of simplex j on `side` of the plane (-1: back, s <= 0; +1: front; s the
-   !> signed distance to the plane),
-   !> pushed as simplices (module notes: a kept vertex set of 1, 2 or 3 vertices
-   !> gives a simplex, a wedge or a prism).
-   pure subroutine split_simplex(rule, ctx, d, j, n, p0, side)
+   !> The part of the region r0 .. r1 on `side` of the plane (-1: back, s <= 0; +1:
+   !> front; s the signed distance), pushed as faces: each face clipped, and in 3D
+   !> the new face on the plane from the points of the clipped faces on it.
+   pure subroutine clip_region(rule, ctx, d, r0, r1, n, p0, side)
       type(facet_rule_type), intent(inout) :: rule
       type(context_type), intent(in) :: ctx
-      integer, intent(in) :: d, j
+      integer, intent(in) :: d, r0, r1
       real(wp), intent(in) :: n(3), p0(3), side
-      real(wp) :: v(3, 4), s(4), a(3, 4), x(3, 4, 3), t(3, 4)
-      integer :: i, k, o, nk, no, ik(4), io(4)
+      real(wp), allocatable :: cap(:, :), v(:, :), out(:, :), s(:)
+      real(wp) :: x(3)
+      integer :: j, i, k, nv, nout, ncap
 
-      v = rule%simp(:, :, j)
-      nk = 0
-      no = 0
-      do i = 1, d + 1
-         s(i) = -side*dot_product(v(:, i) - p0, n)
-         if (abs(s(i)) <= ctx%tol) s(i) = 0.0_wp
-         if (s(i) > 0.0_wp) then
-            no = no + 1
-            io(no) = i
-         else
-            nk = nk + 1
-            ik(nk) = i
+      allocate (cap(3, 16), v(3, 16), out(3, 17), s(16))
+      ncap = 0
+      do j = r0, r1
+         nv = rule%fcount(j)
+         if (nv + 1 > size(out, 2)) then
+            deallocate (v, out, s)
+            allocate (v(3, 2*nv), out(3, 2*nv + 1), s(2*nv))
          end if
-      end do
-      if (no == 0) then
-         call keep(rule, ctx, d, v)
-         return
-      end if
-      if (all(s(ik(1:nk)) >= 0.0_wp)) return
-      ! a(:, k): kept vertex k; x(:, k, o): where edge (kept k, other o) meets the plane
-      do k = 1, nk
-         a(:, k) = v(:, ik(k))
-         do o = 1, no
-            if (s(ik(k)) < 0.0_wp) then
-               x(:, k, o) = v(:, ik(k)) + (s(ik(k))/(s(ik(k)) - s(io(o))))*(v(:, io(o)) - v(:, ik(k)))
-            else
-               x(:, k, o) = a(:, k)
+         v(:, 1:nv) = rule%fv(:, rule%fstart(j):rule%fstart(j) + nv - 1)
+         do i = 1, nv
+            s(i) = -side*dot_product(v(:, i) - p0, n)
+            if (abs(s(i)) <= ctx%tol) s(i) = 0.0_wp
+         end do
+         nout = 0
+         do i = 1, nv
+            k = mod(i, nv) + 1
+            if (s(i) <= 0.0_wp) then
+               call add_point(out, nout, v(:, i), ctx%merge)
+               if (s(i) >= 0.0_wp) call add_cap(cap, ncap, v(:, i), ctx%merge)
+            end if
+            if ((s(i) < 0.0_wp .and. s(k) > 0.0_wp) .or. (s(i) > 0.0_wp .and. s(k) < 0.0_wp)) then
+               x = v(:, i) + (s(i)/(s(i) - s(k)))*(v(:, k) - v(:, i))
+               call add_point(out, nout, x, ctx%merge)
+               call add_cap(cap, ncap, x, ctx%merge)
             end if
          end do
-      end do
-      t = 0.0_wp
-      select case (nk)
-      case (1)
-         t(:, 1) = a(:, 1)
-         t(:, 2:no + 1) = x(:, 1, 1:no)
-         call keep(rule, ctx, d, t)
-      case (2)
-         if (d == 2) then
-            call keep(rule, ctx, d, reshape([a(:, 1), a(:, 2), x(:, 2, 1), t(:, 4)], [3, 4]))
-            call keep(rule, ctx, d, reshape([a(:, 1), x(:, 2, 1), x(:, 1, 1), t(:, 4)], [3, 4]))
-         else
-            call prism(rule, ctx, d, reshape([a(:, 1), x(:, 1, 1), x(:, 1, 2), a(:, 2), x(:, 2, 1), x(:, 2, 2)], &
-               & [3, 6]))
+         if (nout > 1) then
+            if (norm2(out(:, nout) - out(:, 1)) <= ctx%merge) nout = nout - 1
          end if
-      case (3)
-         call prism(rule, ctx, d, reshape([a(:, 1), a(:, 2), a(:, 3), x(:, 1, 1), x(:, 2, 1), x(:, 3, 1)], [3, 6]))
-      end select
-   end subroutine split_simplex
+         if (nout < 3) cycle
+         if (d == 3 .and. polygon_measure(3, out, nout) <= ctx%min_frag) cycle
+         call push_fragment(rule, out(:, 1:nout), 0)
+      end do
+      if (d == 2 .or. ncap < 3) return
+      call order_by_angle(cap(:, 1:ncap), n)
+      if (polygon_measure(3, cap, ncap) > ctx%min_frag) call push_fragment(rule, cap(:, 1:ncap), 0)
+   end subroutine clip_region
 
-   !> Push simplex w unless it is a sliver below the snapping measure.
-   pure subroutine keep(rule, ctx, d, w)
-      type(facet_rule_type), intent(inout) :: rule
-      type(context_type), intent(in) :: ctx
-      integer, intent(in) :: d
-      real(wp), intent(in) :: w(3, 4)
-      if (simplex_measure(d, w) > ctx%min_vol) call push_simplex(rule, w)
-   end subroutine keep
+   !> Append x to the points of the new face unless one lies within `merge` of it
+   !> (the same point reached from two faces, or a vertex on the plane).
+   pure subroutine add_cap(cap, ncap, x, merge)
+      real(wp), allocatable, intent(inout) :: cap(:, :)
+      integer, intent(inout) :: ncap
+      real(wp), intent(in) :: x(3), merge
+      real(wp), allocatable :: t(:, :)
+      integer :: i
+      do i = 1, ncap
+         if (norm2(cap(:, i) - x) <= merge) return
+      end do
+      if (ncap == size(cap, 2)) then
+         allocate (t(3, 2*ncap))
+         t(:, 1:ncap) = cap
+         call move_alloc(t, cap)
+      end if
+      ncap = ncap + 1
+      cap(:, ncap) = x
+   end subroutine add_cap
 
-   !> Prism with bottom (a0, a1, a2) = v(:, 1:3), top (b0, b1, b2) = v(:, 4:6), edges
-   !> ai-bi (the faces planar): the three tetrahedra of the staircase split.
-   pure subroutine prism(rule, ctx, d, v)
-      type(facet_rule_type), intent(inout) :: rule
-      type(context_type), intent(in) :: ctx
-      integer, intent(in) :: d
-      real(wp), intent(in) :: v(3, 6)
-      call keep(rule, ctx, d, v(:, [1, 2, 3, 6]))
-      call keep(rule, ctx, d, v(:, [1, 2, 5, 6]))
-      call keep(rule, ctx, d, v(:, [1, 4, 5, 6]))
-   end subroutine prism
+   !> Append x to a clipped face loop unless it repeats the previous point within `merge`.
+   pure subroutine add_point(out, nout, x, merge)
+      real(wp), intent(inout) :: out(:, :)
+      integer, intent(inout) :: nout
+      real(wp), intent(in) :: x(3), merge
+      if (nout > 0) then
+         if (norm2(out(:, nout) - x) <= merge) return
+      end if
+      nout = nout + 1
+      out(:, nout) = x
+   end subroutine add_point
 
-   !> The part of fragment j on `side` of the plane (as `split_simplex`), pushed if it has measure and is not in the plane.
+   !> Order the points p (a convex set in a plane of normal n, duplicates allowed)
+   !> by angle around their centroid (insertion sort: a face has few points).
+   pure subroutine order_by_angle(p, n)
+      real(wp), intent(inout) :: p(:, :)
+      real(wp), intent(in) :: n(3)
+      real(wp) :: c(3), u(3), w(3), ang(size(p, 2)), key, kp(3)
+      integer :: i, j
+
+      c = sum(p, dim=2)/size(p, 2)
+      u = 0.0_wp
+      u(minloc(abs(n), 1)) = 1.0_wp
+      u = u - dot_product(u, n)*n
+      u = u/norm2(u)
+      w = [n(2)*u(3) - n(3)*u(2), n(3)*u(1) - n(1)*u(3), n(1)*u(2) - n(2)*u(1)]
+      do i = 1, size(p, 2)
+         ang(i) = atan2(dot_product(p(:, i) - c, w), dot_product(p(:, i) - c, u))
+      end do
+      do i = 2, size(p, 2)
+         key = ang(i)
+         kp = p(:, i)
+         j = i - 1
+         do while (j >= 1)
+            if (ang(j) <= key) exit
+            ang(j + 1) = ang(j)
+            p(:, j + 1) = p(:, j)
+            j = j - 1
+         end do
+         ang(j + 1) = key
+         p(:, j + 1) = kp
+      end do
+   end subroutine order_by_angle
+
+   !> The part of fragment j on `side` of the plane (as `clip_region`), pushed if it has measure and is not in the plane.
    pure subroutine split_fragment(rule, ctx, d, j, n, p0, side)
       type(facet_rule_type), intent(inout) :: rule
       type(context_type), intent(in) :: ctx
@@ -444,30 +473,56 @@ contains
       call push_fragment(rule, out(:, 1:nout), rule%ffacet(j))
    end subroutine split_fragment
 
-   !> A region of one class: its simplices' rules if it is in the body.
-   pure subroutine leaf(rule, ctx, s0, s1, inside)
+   !> A region of one class (faces r0 .. r1): if it is in the body, the rules of
+   !> its simplices (3D: a fan from the first vertex over the fanned faces; 2D:
+   !> the fanned polygon).
+   pure subroutine leaf(rule, ctx, r0, r1, inside)
       type(facet_rule_type), intent(inout) :: rule
       type(context_type), intent(in) :: ctx
-      integer, intent(in) :: s0, s1
       logical, intent(in) :: inside
-      real(wp) :: v(3, 4), e(3, 3), det, x(3)
-      integer :: j, i, d
+      integer, intent(in) :: r0, r1
+      real(wp) :: v(3, 4)
+      integer :: j, i, first
 
       if (.not. merge(ctx%member_in, ctx%member_out, inside)) return
-      d = rule%dim
-      do j = s0, s1
-         v = rule%simp(:, :, j)
-         e = 0.0_wp
-         do i = 1, d
-            e(:, i) = v(:, i + 1) - v(:, 1)
-         end do
-         det = simplex_measure(d, v)*merge(2.0_wp, 6.0_wp, d == 2)
-         do i = 1, size(rule%ref_w)
-            x = v(:, 1) + matmul(e, rule%ref_x(:, i))
-            call push_volume(rule, x, det*rule%ref_w(i))
+      v = 0.0_wp
+      v(:, 1) = rule%fv(:, rule%fstart(r0))
+      do j = r0, r1
+         first = rule%fstart(j)
+         do i = 1, rule%fcount(j) - 2
+            if (rule%dim == 2) then
+               v(:, 2) = rule%fv(:, first + i)
+               v(:, 3) = rule%fv(:, first + i + 1)
+            else
+               v(:, 2) = rule%fv(:, first)
+               v(:, 3) = rule%fv(:, first + i)
+               v(:, 4) = rule%fv(:, first + i + 1)
+            end if
+            call simplex_points(rule, ctx, v)
          end do
       end do
    end subroutine leaf
+
+   !> Collapsed Gauss points of simplex v unless it is a sliver below the snapping measure.
+   pure subroutine simplex_points(rule, ctx, v)
+      type(facet_rule_type), intent(inout) :: rule
+      type(context_type), intent(in) :: ctx
+      real(wp), intent(in) :: v(3, 4)
+      real(wp) :: e(3, 3), det, m
+      integer :: i, d
+
+      d = rule%dim
+      m = simplex_measure(d, v)
+      if (m <= ctx%min_vol) return
+      e = 0.0_wp
+      do i = 1, d
+         e(:, i) = v(:, i + 1) - v(:, 1)
+      end do
+      det = m*merge(2.0_wp, 6.0_wp, d == 2)
+      do i = 1, size(rule%ref_w)
+         call push_volume(rule, v(:, 1) + matmul(e, rule%ref_x(:, i)), det*rule%ref_w(i))
+      end do
+   end subroutine simplex_points
 
    !> Surface points of the fragment poly(:, 1:nv) with outward normal n.
    pure subroutine fragment_surface(rule, d, poly, nv, n, f)
@@ -511,19 +566,6 @@ contains
    end function simplex_measure
 
    ! ------------------------------------------------------------ growing arrays
-
-   pure subroutine push_simplex(rule, v)
-      type(facet_rule_type), intent(inout) :: rule
-      real(wp), intent(in) :: v(3, 4)
-      real(wp), allocatable :: t(:, :, :)
-      if (rule%nsimp == size(rule%simp, 3)) then
-         allocate (t(3, 4, 2*rule%nsimp))
-         t(:, :, 1:rule%nsimp) = rule%simp
-         call move_alloc(t, rule%simp)
-      end if
-      rule%nsimp = rule%nsimp + 1
-      rule%simp(:, :, rule%nsimp) = v
-   end subroutine push_simplex
 
    pure subroutine push_fragment(rule, v, f)
       type(facet_rule_type), intent(inout) :: rule
