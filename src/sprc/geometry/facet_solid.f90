@@ -51,8 +51,8 @@ module sprc_geometry_facet_solid
       real(wp), allocatable :: normal(:, :)
       !> Measure (area, length) of each facet.
       real(wp), allocatable :: measure(:)
-      !> Hierarchy: number of nodes, node boxes (3, nnode), first facet and
-      !> count in `order` (count > 0: leaf), right child (left child = node + 1).
+      !> The hierarchy (number of nodes, node boxes (3, nnode), first facet and
+      !> count in `order` (count > 0: leaf), right child; left child = node + 1).
       integer :: nnode = 0
       real(wp), allocatable :: lo(:, :), hi(:, :)
       integer, allocatable :: first(:), count(:), right(:)

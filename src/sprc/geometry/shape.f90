@@ -97,7 +97,7 @@ module sprc_geometry_shape
       real(wp) :: axis(3) = 0.0_wp
       !> Magnitude of the parameters (a length), for round-off tolerances.
       real(wp) :: scale = 0.0_wp
-      !> Facets: the faceted solid with its hierarchy.
+      !> The faceted solid with its hierarchy (kind facets).
       type(facet_solid_type), allocatable :: solid
    contains
       procedure :: phi => shape_phi

@@ -57,7 +57,7 @@ module sprc_grid_facet_rule
       real(wp), allocatable, private :: fv(:, :)
       integer, allocatable, private :: fstart(:), fcount(:), ffacet(:)
       integer, private :: nfv = 0, nfrag = 0
-      !> Reference rules: simplex (dim, nref) with weights, triangle and segment.
+      !> The reference rules of the simplex (dim, nref) with weights, the triangle and the segment.
       integer, private :: dim = 0, qs = 0
       real(wp), allocatable, private :: ref_x(:, :), ref_w(:), tri_x(:, :), tri_w(:), seg_x(:), seg_w(:)
    end type facet_rule_type
