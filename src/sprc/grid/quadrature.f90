@@ -38,7 +38,7 @@ module sprc_grid_quadrature
    use sprc_geometry_region, only: cell_outside, cell_inside, cell_cut
    use sprc_geometry_shape, only: shape_halfspace, shape_box, shape_facets
    use sprc_grid_facet_rule, only: facet_rule_type, facet_cell_rule, facet_face_rule
-   use sprc_geometry_facet_solid, only: face_cover, solid_nearest
+   use sprc_geometry_facet_solid, only: facet_solid_type, face_cover, solid_nearest, solid_query_box
    use sprc_geometry_body, only: body_type, csg_add, csg_intersect, snap_tolerance
    use sprc_grid_quadric, only: ncoef, max_shape_quadrics, quadric_range, derivative_range, &
       & quadric_gradient, depends_on, restrict, line_coefficients, quadratic_roots, shape_quadrics, crossing
@@ -101,6 +101,9 @@ module sprc_grid_quadrature
       !> Work and points of the faceted-solid rule.
       type(facet_rule_type), private :: facets
    end type cell_rule_type
+
+   !> Facets a box may meet before `mixed_box` halves it.
+   integer, parameter :: max_box_facets = 32
 
    !> Default strength of a height direction (module notes, `min_ratio`).
    real(wp), parameter :: default_min_ratio = 3.0_wp
@@ -425,7 +428,10 @@ contains
 
    !> Rule of the box [lo, hi] inside the cell [clo, chi] when a faceted solid is
    !> among its active shapes. One active shape, faceted: the exact polyhedral
-   !> rule (sprc_grid_facet_rule). Only primitives: dimension reduction. A
+   !> rule (sprc_grid_facet_rule), after halving the box while it meets more
+   !> than `max_box_facets` facets (up to `mixed_depth` levels: the partition's
+   !> depth and size grow with the facets of a box). Only primitives:
+   !> dimension reduction. A
    !> faceted solid with other active shapes (a CSG edge between a faceted and
    !> another surface): the box is halved, up to `mixed_depth` levels; at that
    !> depth the box counts in `nunresolved` and gets its tensor rule with
@@ -455,10 +461,11 @@ contains
          return
       end if
       if (n == 1) then
-         call facet_box(quad, body, lo, hi, rule, active(1))
-         return
-      end if
-      if (depth >= mixed_depth(d)) then
+         if (depth >= mixed_depth(d) .or. box_facets(body%shapes(active(1))%solid, lo, hi) <= max_box_facets) then
+            call facet_box(quad, body, lo, hi, rule, active(1))
+            return
+         end if
+      else if (depth >= mixed_depth(d)) then
          rule%nunresolved = rule%nunresolved + 1
          call member_tensor(quad, body, lo, hi, rule)
          return
@@ -473,6 +480,14 @@ contains
          call mixed_box(quad, body, clo, chi, slo, shi, depth + 1, rule)
       end do
    end subroutine mixed_box
+
+   !> Facets whose boxes meet the box [lo, hi].
+   pure integer function box_facets(solid, lo, hi) result(n)
+      type(facet_solid_type), intent(in) :: solid
+      real(wp), intent(in) :: lo(:), hi(:)
+      integer, allocatable :: list(:)
+      call solid_query_box(solid, lo, hi, list, n)
+   end function box_facets
 
    !> Halvings of a cell cut by a faceted and another surface (`mixed_box`).
    pure integer function mixed_depth(dim)
