@@ -27,7 +27,7 @@ all: build
 help:
 	@echo "make run     install what is missing, build (release) and run the driver on its default scene"
 	@echo "make test    install what is missing and run the whole test suite"
-	@echo "make bench   benchmarks (sparse direct solvers, grid build, recovery on a caller's mesh)"
+	@echo "make bench   benchmarks (sparse direct solvers, grid build, faceted solids, recovery on a caller's mesh)"
 	@echo "make fuzz    5000 seeded mutants of the example scenes through sprc check and run (FUZZ_COUNT, FUZZ_SEED)"
 	@echo "make doc     the API reference and doc/ pages (FORD) in build/doc/index.html"
 	@echo "make build   build the release profile"
@@ -62,6 +62,7 @@ fuzz: deps
 bench: deps
 	@tools/bench-sparse
 	$(FPM) run --profile release --example bench_grid
+	$(FPM) run --profile release --example bench_facets
 	$(FPM) run --profile release --example bench_mesh_recovery
 
 # fpm names its build directories by hashes: remove every archive, build the

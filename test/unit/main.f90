@@ -19,6 +19,7 @@ program sprc_unit_tests
    use sprc_test_adapt, only: collect_adapt
    use sprc_test_model, only: collect_model
    use sprc_test_quadrature, only: collect_quadrature
+   use sprc_test_facets, only: collect_facets
    use sprc_test_recovery, only: collect_recovery
    use sprc_test_report, only: collect_report
    use sprc_test_output, only: collect_output
@@ -62,6 +63,7 @@ program sprc_unit_tests
       new_testsuite('adapt', collect_adapt), &
       new_testsuite('model', collect_model), &
       new_testsuite('quadrature', collect_quadrature), &
+      new_testsuite('facets', collect_facets), &
       new_testsuite('recovery', collect_recovery), &
       new_testsuite('report', collect_report), &
       new_testsuite('patches', collect_patches), &

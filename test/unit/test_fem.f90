@@ -30,6 +30,9 @@ module sprc_test_fem
    use sprc_grid_patches, only: recovery_input_type, rec_none => bc_none, rec_traction => bc_traction, &
       & rec_pressure => bc_pressure, rec_symmetry => bc_symmetry
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type
+   use sprc_geometry_facets, only: facet_set_type
+   use sprc_geometry_shape, only: new_facet_shape
+   use sprc_test_facets, only: facets_box, facets_polygon
    implicit none
    private
 
@@ -80,6 +83,7 @@ contains
          new_unittest('shape_functions', test_shape_functions), &
          new_unittest('patch_linear_2d', test_patch_2d), &
          new_unittest('patch_linear_3d', test_patch_3d), &
+         new_unittest('patch_facets', test_patch_facets), &
          new_unittest('patch_strong_symmetry', test_patch_strong_symmetry), &
          new_unittest('patch_weak_symmetry', test_patch_weak_symmetry), &
          new_unittest('quadratic_q2', test_quadratic_q2), &
@@ -390,6 +394,81 @@ contains
          if (allocated(error)) return
       end do
    end subroutine test_patch_3d
+
+   !> Patch test on faceted solids, Q1 and Q2: a bar rotated off the grid axes
+   !> given as 12 triangles (3D) and as a polygon (2D, plus a non-convex one);
+   !> the uniform-strain field imposed on the whole surface (Nitsche), so the
+   !> volume rule, the surface rule and its normals must all be consistent
+   !> for the FE solution to be the field to round-off (`solve_tolerance`).
+   subroutine test_patch_facets(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(facet_set_type) :: set
+      type(shape_type) :: s(1)
+      type(body_type) :: body
+      type(poly_field_type) :: field
+      real(wp) :: p(2, 6), a
+      integer :: deg, i
+
+      call new_poly_field(field, solid, [0.01_wp, -0.02_wp, 0.005_wp], reshape([0.003_wp, -0.001_wp, 0.002_wp, &
+         & 0.004_wp, 0.001_wp, -0.002_wp, 0.0015_wp, 0.0005_wp, -0.003_wp], [3, 3]), error=error)
+      if (allocated(error)) return
+      call facets_box(set, [0.03_wp, -0.02_wp, 0.01_wp], [0.8_wp, 0.25_wp, 0.3_wp], [0.2_wp, 0.35_wp, 0.4_wp])
+      call new_facet_shape(s(1), 'bar', set, error)
+      if (allocated(error)) return
+      call make_body(body, s, [csg_add], error)
+      if (allocated(error)) return
+      do deg = 1, 2
+         call run_patch(body, [new_fe_bc(1, bc_exact_displacement)], field, deg, 3, 0, &
+            & 'facet bar 3D Q'//achar(48 + deg), error)
+         if (allocated(error)) return
+      end do
+      ! the ends (local x faces of facets_box) as named groups: the displacement on
+      ! one end, traction on the rest of the bar (the shape's condition)
+      set%group(9:10) = 1
+      set%group(11:12) = 2
+      set%group_name = [character(len=64) :: 'left', 'right']
+      call new_facet_shape(s(1), 'bar', set, error)
+      if (allocated(error)) return
+      call make_body(body, s, [csg_add], error)
+      if (allocated(error)) return
+      call check(error, body%surface_index('left') == 2 .and. body%surface_index('right') == 3 .and. &
+         & body%surface_name(3) == 'right' .and. body%surface_shape(3) == 1 .and. body%nsurface() == 3, &
+         & 'surface ids of the groups')
+      if (allocated(error)) return
+      do deg = 1, 2
+         call run_patch(body, [new_fe_bc(1, bc_exact_traction), new_fe_bc(body%surface_index('left'), &
+            & bc_exact_displacement)], field, deg, 3, 0, 'facet bar with named ends 3D Q'//achar(48 + deg), error)
+         if (allocated(error)) return
+      end do
+      call new_poly_field(field, plane_strain, [0.01_wp, -0.02_wp], &
+         & reshape([0.003_wp, -0.001_wp, 0.002_wp, 0.004_wp], [2, 2]), error=error)
+      if (allocated(error)) return
+      do i = 1, 4
+         a = 0.4_wp + (i - 1)*acos(-1.0_wp)/2
+         p(:, i) = merge(0.85_wp, 0.3_wp, mod(i, 2) == 1)*[cos(a), sin(a)]
+      end do
+      call facets_polygon(set, p(:, 1:4))
+      call new_facet_shape(s(1), 'bar', set, error)
+      if (allocated(error)) return
+      call make_body(body, s, [csg_add], error)
+      if (allocated(error)) return
+      do deg = 1, 2
+         call run_patch(body, [new_fe_bc(1, bc_exact_displacement)], field, deg, 4, 1, &
+            & 'facet bar 2D Q'//achar(48 + deg), error)
+         if (allocated(error)) return
+      end do
+      call facets_polygon(set, reshape([-0.7_wp, -0.6_wp, 0.65_wp, -0.55_wp, 0.6_wp, 0.03_wp, 0.02_wp, 0.05_wp, &
+         & 0.01_wp, 0.7_wp, -0.68_wp, 0.66_wp], [2, 6]))
+      call new_facet_shape(s(1), 'L', set, error)
+      if (allocated(error)) return
+      call make_body(body, s, [csg_add], error)
+      if (allocated(error)) return
+      do deg = 1, 2
+         call run_patch(body, [new_fe_bc(1, bc_exact_displacement)], field, deg, 4, 1, &
+            & 'facet L 2D Q'//achar(48 + deg), error)
+         if (allocated(error)) return
+      end do
+   end subroutine test_patch_facets
 
    !> Strong symmetry: quarter (2D) / octant (3D) of the polygonal body with
    !> symmetry planes x = 0, y = 0 (, z = 0) on grid planes, all else

@@ -152,7 +152,7 @@ contains
          call grid%leaf_box(leaf, lo(1:d), hi(1:d))
          call leaf_rule(grid%leaf_class(leaf) == cell_inside, lo(1:d), hi(1:d), rule, error)
          if (allocated(error)) return
-         if (count(rule%surf_shape(1:rule%nsurf) == shape) == 0) cycle
+         if (.not. any(on_shape(rule%surf_shape(1:rule%nsurf)))) cycle
          if (.not. present(split_grid)) then
             call collect(leaf, rule)
             cycle
@@ -202,12 +202,18 @@ contains
          if (allocated(error)) error%message = 'contact surface, leaf '//itoa(leaf)//': '//error%message
       end subroutine leaf_rule
 
+      !> Is surface id on the contact shape (the shape or one of its faceted groups)?
+      elemental logical function on_shape(id)
+         integer, intent(in) :: id
+         on_shape = body%surface_shape(id) == shape
+      end function on_shape
+
       subroutine collect(leaf, rule)
          integer, intent(in) :: leaf
          type(cell_rule_type), intent(in) :: rule
          integer :: q
          do q = 1, rule%nsurf
-            if (rule%surf_shape(q) /= shape) cycle
+            if (.not. on_shape(rule%surf_shape(q))) cycle
             if (n == size(w)) call grow(x, w, nrm, cell, error)
             if (allocated(error)) return
             n = n + 1

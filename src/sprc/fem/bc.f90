@@ -28,7 +28,8 @@ module sprc_fem_bc
 
    !> One boundary condition on the surface of shape `shape` of the body.
    type :: fe_bc_type
-      !> Index of the shape in the body (1..nshape).
+      !> Surface of the body: a shape index (1..nshape) or a faceted group's
+      !> surface id (sprc_geometry_body notes).
       integer :: shape = 0
       !> One of the kinds of `sprc_core_boundary` an FE condition can have:
       !> free, pressure, traction, displacement, symmetry, exact_traction, exact_displacement.
@@ -57,8 +58,8 @@ contains
       end if
    end function new_fe_bc
 
-   !> Validate conditions for a body of `nshape` shapes in dimension `dim`:
-   !> shape index in range and not repeated, known kind, finite data, vector of
+   !> Validate conditions for a body of `nshape` surfaces (its shapes, then its
+   !> faceted groups: sprc_geometry_body notes) in dimension `dim`: surface index in range and not repeated, known kind, finite data, vector of
    !> size dim where needed, an exact solution (`have_exact`) for exact_* kinds.
    pure subroutine check_bcs(bcs, nshape, dim, have_exact, error)
       type(fe_bc_type), intent(in) :: bcs(:)

@@ -100,7 +100,8 @@ module sprc_fem_problem
       type(cut_mesh_type), allocatable :: mesh
       type(fe_bc_type), allocatable :: bcs(:)
       class(exact_solution_type), allocatable :: exact
-      !> Condition index of each shape (0: free surface); shape symmetry imposed strongly.
+      !> Condition index of each surface id (0: free surface; sprc_geometry_body notes);
+      !> symmetry imposed strongly.
       integer, allocatable :: bc_of_shape(:)
       logical, allocatable :: strong_shape(:)
       !> Aggregation root of each element (root(e) = e: well posed).
@@ -272,7 +273,7 @@ contains
       call check_inputs(mesh%body, mesh%grid, mesh%nodes, mesh%hanging, mesh%quad, allocated(mesh%vol_ptr), analysis, &
          & body_force, error)
       if (allocated(error)) return
-      call check_bcs(bcs, mesh%body%nshape, mesh%grid%dim, present(exact), error)
+      call check_bcs(bcs, mesh%body%nsurface(), mesh%grid%dim, present(exact), error)
       if (allocated(error)) return
       if (present(exact)) then
          call check_exact(exact, analysis, young, poisson, error)
@@ -406,25 +407,34 @@ contains
       end if
    end subroutine check_exact
 
-   !> Condition of each shape, and the strong symmetry planes: a symmetry
-   !> halfspace with an axis normal that no cell straddles.
+   !> Condition of each surface (sprc_geometry_body notes), and the strong
+   !> symmetry planes: a symmetry halfspace with an axis normal that no cell
+   !> straddles.
    subroutine classify_bcs(self, plane_axis, plane_coord)
       type(elasticity_problem_type), intent(inout) :: self
       integer, allocatable, intent(out) :: plane_axis(:)
       real(wp), allocatable, intent(out) :: plane_coord(:)
-      integer :: i, s, a, e, d
+      integer :: i, s, a, e, d, nsurf
       real(wp) :: p, tol, lo(3), hi(3)
       logical :: straddled
 
       d = self%dim
-      allocate (self%bc_of_shape(self%mesh%body%nshape), self%strong_shape(self%mesh%body%nshape), plane_axis(0), &
-         & plane_coord(0))
+      nsurf = self%mesh%body%nsurface()
+      allocate (self%bc_of_shape(nsurf), self%strong_shape(nsurf), plane_axis(0), plane_coord(0))
       self%bc_of_shape = 0
       self%strong_shape = .false.
       tol = plane_tol(self%mesh%grid)
       do i = 1, size(self%bcs)
          s = self%bcs(i)%shape
          self%bc_of_shape(s) = i
+      end do
+      ! a faceted group without its own condition has its shape's
+      do s = self%mesh%body%nshape + 1, nsurf
+         if (self%bc_of_shape(s) == 0) self%bc_of_shape(s) = self%bc_of_shape(self%mesh%body%surface_shape(s))
+      end do
+      do i = 1, size(self%bcs)
+         s = self%bcs(i)%shape
+         if (s > self%mesh%body%nshape) cycle
          if (self%bcs(i)%kind /= bc_symmetry .or. self%mesh%body%shapes(s)%kind /= shape_halfspace) cycle
          a = maxloc(abs(self%mesh%body%shapes(s)%normal(1:d)), 1)
          if (abs(abs(self%mesh%body%shapes(s)%normal(a)) - 1.0_wp) > 1.0e-12_wp) cycle

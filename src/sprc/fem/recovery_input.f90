@@ -67,7 +67,7 @@ contains
       call boundary_kinds(problem, input)
    end subroutine fe_recovery_input
 
-   !> Recovery kind and data of each shape from the problem's conditions.
+   !> Recovery kind and data of each surface from the problem's conditions.
    subroutine boundary_kinds(problem, input)
       type(elasticity_problem_type), intent(in) :: problem
       type(recovery_input_type), intent(inout) :: input
@@ -79,8 +79,10 @@ contains
       input%bc_kind = bc_traction
       input%bc_traction = 0.0_wp
       input%bc_pressure = 0.0_wp
-      do i = 1, size(problem%bcs)
-         s = problem%bcs(i)%shape
+      ! per surface through bc_of_shape: a faceted group inherits its shape's condition
+      do s = 1, nshape
+         i = problem%bc_of_shape(s)
+         if (i == 0) cycle
          input%bc_kind(s) = problem%bcs(i)%kind
          select case (problem%bcs(i)%kind)
          case (bc_free)

@@ -7,6 +7,14 @@
 !> outside, cut) is sound, and a shape's influence on the result can be tested
 !> by setting it to inside and to outside in turn (`active_shapes`).
 !>
+!> Surfaces: boundary conditions and contact name surfaces. Surface ids
+!> 1..nshape are the shapes (the whole surface of each); then come the named
+!> facet groups of the faceted shapes, shape by shape, group by group
+!> (`surface_index`, `surface_shape`, `group_surface`). A quadrature point on
+!> a facet of a group carries the group's id; a condition on the whole shape
+!> applies to its groups unless they have their own (sprc_fem_problem). A
+!> body without faceted groups has exactly the shape ids.
+!>
 !> Round-off and snapping: a shape's class of a box comes from its certified
 !> range [fmin, fmax] of phi with a snapping tolerance
 !> tol = snap_ulps * epsilon * (largest |coordinate| of the box + shape%scale),
@@ -22,7 +30,7 @@ module sprc_geometry_body
    use sprc_core_text, only: fixed_text, itoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_geometry_region, only: region_type, cell_outside, cell_inside, cell_cut
-   use sprc_geometry_shape, only: shape_type, shape_kind_name
+   use sprc_geometry_shape, only: shape_type, shape_kind_name, shape_facets
    implicit none
    private
 
@@ -67,10 +75,16 @@ module sprc_geometry_body
       procedure :: phi => body_phi
       procedure :: classify_box
       procedure :: shape_classes
+      procedure :: class_with
       procedure :: active_shapes
       procedure :: is_boundary_on
       procedure :: surface_at
       procedure :: outward_normal
+      procedure :: nsurface
+      procedure :: surface_index
+      procedure :: surface_shape
+      procedure :: surface_name
+      procedure :: group_surface
    end type body_type
 
 contains
@@ -168,6 +182,91 @@ contains
       idx = 0
    end function shape_index
 
+   !> Number of surfaces (module notes).
+   pure integer function nsurface(self) result(n)
+      class(body_type), intent(in) :: self
+      integer :: k
+      n = self%nshape
+      do k = 1, self%nshape
+         n = n + ngroup(self%shapes(k))
+      end do
+   end function nsurface
+
+   !> Id of the surface named `name`: a shape's name first, then a facet group's
+   !> (the first in surface order); 0 if none.
+   pure integer function surface_index(self, name) result(id)
+      class(body_type), intent(in) :: self
+      character(len=*), intent(in) :: name
+      integer :: k, g
+      id = self%shape_index(name)
+      if (id > 0 .or. len_trim(name) == 0) return
+      do k = 1, self%nshape
+         do g = 1, ngroup(self%shapes(k))
+            if (trim(self%shapes(k)%solid%set%group_name(g)) /= trim(name)) cycle
+            id = self%group_surface(k, g)
+            return
+         end do
+      end do
+   end function surface_index
+
+   !> Shape of surface `id` (0 for an id out of range).
+   pure integer function surface_shape(self, id) result(s)
+      class(body_type), intent(in) :: self
+      integer, intent(in) :: id
+      integer :: first
+      s = 0
+      if (id < 1) return
+      if (id <= self%nshape) then
+         s = id
+         return
+      end if
+      first = self%nshape
+      do s = 1, self%nshape
+         if (id <= first + ngroup(self%shapes(s))) return
+         first = first + ngroup(self%shapes(s))
+      end do
+      s = 0
+   end function surface_shape
+
+   !> Name of surface `id` ('' out of range).
+   pure function surface_name(self, id) result(name)
+      class(body_type), intent(in) :: self
+      integer, intent(in) :: id
+      character(len=:), allocatable :: name
+      integer :: s
+      name = ''
+      s = self%surface_shape(id)
+      if (s == 0) return
+      if (id == s) then
+         name = shape_name(self%shapes(s))
+      else
+         name = trim(self%shapes(s)%solid%set%group_name(id - self%group_surface(s, 1) + 1))
+      end if
+   end function surface_name
+
+   !> Id of group g (1-based, of the facet set) of shape s; s itself for g = 0.
+   pure integer function group_surface(self, s, g) result(id)
+      class(body_type), intent(in) :: self
+      integer, intent(in) :: s, g
+      integer :: k
+      id = s
+      if (g <= 0) return
+      id = self%nshape
+      do k = 1, s - 1
+         id = id + ngroup(self%shapes(k))
+      end do
+      id = id + g
+   end function group_surface
+
+   !> Named groups of a faceted shape (0 for the other kinds).
+   pure integer function ngroup(shape)
+      type(shape_type), intent(in) :: shape
+      ngroup = 0
+      if (shape%kind /= shape_facets) return
+      if (.not. allocated(shape%solid)) return
+      if (allocated(shape%solid%set%group_name)) ngroup = size(shape%solid%set%group_name)
+   end function ngroup
+
    !> Level set of the body at x: union min, intersect max, subtract max(a, -b).
    !> An empty body is outside everywhere (huge).
    pure real(wp) function body_phi(self, x) result(f)
@@ -208,6 +307,10 @@ contains
       integer :: k
 
       do k = 1, self%nshape
+         if (self%shapes(k)%kind == shape_facets) then
+            classes(k) = self%shapes(k)%facet_class(lo, hi)
+            cycle
+         end if
          call self%shapes(k)%phi_range(lo, hi, fmin, fmax)
          tol = snap_tolerance(self%shapes(k), lo, hi)
          classes(k) = class_of_range(fmin, fmax, tol)
@@ -235,6 +338,14 @@ contains
       call self%shape_classes(lo, hi, many)
       cls = evaluate(self%ops, many)
    end function classify_box
+
+   !> Class of the body from the shapes' classes (`shape_classes`) with shape
+   !> i's class replaced by ci.
+   pure integer function class_with(self, classes, i, ci) result(cls)
+      class(body_type), intent(in) :: self
+      integer, intent(in) :: classes(:), i, ci
+      cls = evaluate_with(self%ops, classes(1:self%nshape), i, ci)
+   end function class_with
 
    !> Shapes whose surface may pass through the box [lo, hi] and matters
    !> there: the shape is cut by the box and the body's class is not decided

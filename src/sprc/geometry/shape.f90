@@ -20,6 +20,15 @@
 !> each bound is phi evaluated at a point of the box where the extremum is
 !> attained, found from the shape's analytic structure, never by sampling.
 !>
+!> - facets: a closed faceted surface (sprc_geometry_facet_solid): the signed
+!>   distance to the nearest facet, negative inside (inside test by ray
+!>   parity through the facet hierarchy).
+!>
+!> For facets `phi_range` is the Lipschitz enclosure phi(centre) -+ half the
+!> box diagonal, made sign-definite for a box no facet cuts (the facet
+!> solid's classification): certified, not attained. Cells are classified by
+!> the facet solid directly (`facet_class`), not from this range.
+!>
 !> `gradient_range` gives a certified enclosure of one component of the
 !> gradient over a box (what a height-direction test needs): exact for the
 !> disk/sphere, ellipse/ellipsoid, halfspace and axis-parallel cylinder; a
@@ -31,12 +40,17 @@ module sprc_geometry_shape
    use sprc_core_sort, only: sort
    use sprc_core_text, only: itoa, rtoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
+   use sprc_geometry_region, only: cell_inside, cell_outside
+   use sprc_geometry_facets, only: facet_set_type
+   use sprc_geometry_facet_solid, only: facet_solid_type, new_facet_solid, solid_nearest, solid_inside, &
+      & solid_box_class
    implicit none
    private
 
    public :: shape_type
    public :: shape_disk, shape_sphere, shape_ellipse, shape_ellipsoid, shape_box, shape_halfspace, shape_cylinder
    public :: new_disk, new_sphere, new_ellipse, new_ellipsoid, new_box, new_halfspace, new_cylinder
+   public :: shape_facets, new_facet_shape
    public :: shape_kind_name, shape_kind_from_name
 
    !> Shape kinds (values are stable: scene and C API may store them): disk (2D).
@@ -53,9 +67,11 @@ module sprc_geometry_shape
    integer, parameter :: shape_halfspace = 6
    !> Infinite cylinder (3D).
    integer, parameter :: shape_cylinder = 7
+   !> Closed faceted surface (2D polygon, 3D triangles).
+   integer, parameter :: shape_facets = 8
 
-   character(len=*), parameter :: kind_names(7) = [character(len=9) :: &
-      & 'disk', 'sphere', 'ellipse', 'ellipsoid', 'box', 'halfspace', 'cylinder']
+   character(len=*), parameter :: kind_names(8) = [character(len=9) :: &
+      & 'disk', 'sphere', 'ellipse', 'ellipsoid', 'box', 'halfspace', 'cylinder', 'facets']
 
    !> One implicit primitive. Only the parameters of its kind are meaningful;
    !> vectors hold `dim` used entries (the rest are zero).
@@ -82,12 +98,15 @@ module sprc_geometry_shape
       real(wp) :: axis(3) = 0.0_wp
       !> Magnitude of the parameters (a length), for round-off tolerances.
       real(wp) :: scale = 0.0_wp
+      !> The faceted solid with its hierarchy (kind facets).
+      type(facet_solid_type), allocatable :: solid
    contains
       procedure :: phi => shape_phi
       procedure :: gradient => shape_gradient
       procedure :: phi_range => shape_phi_range
       procedure :: gradient_range => shape_gradient_range
       procedure :: bounds => shape_bounds
+      procedure :: facet_class
    end type shape_type
 
 contains
@@ -278,6 +297,61 @@ contains
       self%scale = maxval(abs(point)) + radius
    end subroutine build_cylinder
 
+   !> A closed faceted solid (kind shape_facets) of the dimension of the facet
+   !> set. The surface must be closed and oriented outwards (the readers
+   !> validate it); checked here: dimension 2 or 3, at least dim + 1 facets,
+   !> vertex indices in range.
+   subroutine new_facet_shape(self, name, facets, error)
+      type(shape_type), intent(out) :: self
+      character(len=*), intent(in) :: name
+      type(facet_set_type), intent(in) :: facets
+      type(error_type), allocatable, intent(out) :: error
+
+      call start(self, shape_facets, facets%dim, name)
+      call check_dim_2_or_3(self, 'facets%dim', error)
+      if (.not. allocated(error)) call check_facet_set(self, facets, error)
+      if (allocated(error)) then
+         self%kind = 0
+         return
+      end if
+      allocate (self%solid)
+      call new_facet_solid(self%solid, facets)
+      self%scale = self%solid%scale
+   end subroutine new_facet_shape
+
+   subroutine check_facet_set(self, facets, error)
+      type(shape_type), intent(in) :: self
+      type(facet_set_type), intent(in) :: facets
+      type(error_type), allocatable, intent(out) :: error
+      integer :: d
+
+      d = facets%dim
+      if (facets%nfacet < d + 1 .or. .not. allocated(facets%facet) .or. .not. allocated(facets%vert)) then
+         call fatal_error(error, prefix(self)//itoa(facets%nfacet)//' facets; a closed surface needs at least '// &
+            & itoa(d + 1), stat_invalid_input)
+         return
+      end if
+      if (size(facets%facet, 1) /= d .or. size(facets%facet, 2) < facets%nfacet .or. &
+         & size(facets%vert, 2) < facets%nvert) then
+         call fatal_error(error, prefix(self)//'facet array shape does not match dim and nfacet', stat_invalid_input)
+         return
+      end if
+      if (any(facets%facet(:, 1:facets%nfacet) < 1) .or. any(facets%facet(:, 1:facets%nfacet) > facets%nvert)) then
+         call fatal_error(error, prefix(self)//'a facet vertex index is outside 1..'//itoa(facets%nvert), &
+            & stat_invalid_input)
+         return
+      end if
+      call check_finite(self, 'vert', reshape(facets%vert(:, 1:facets%nvert), [3*facets%nvert]), error)
+   end subroutine check_facet_set
+
+   !> Class (cell_inside / cell_outside / cell_cut) of the box [lo, hi] for a
+   !> facet shape (sprc_geometry_facet_solid notes).
+   pure integer function facet_class(self, lo, hi) result(cls)
+      class(shape_type), intent(in) :: self
+      real(wp), intent(in) :: lo(:), hi(:)
+      cls = solid_box_class(self%solid, lo, hi)
+   end function facet_class
+
    !> Name of a kind ('disk', ...); '' for an unknown kind.
    pure function shape_kind_name(kind) result(name)
       integer, intent(in) :: kind
@@ -337,6 +411,9 @@ contains
             lo(k) = self%point(k) - self%radius
             hi(k) = self%point(k) + self%radius
          end do
+      case (shape_facets)
+         lo(1:d) = self%solid%lo(1:d, 1)
+         hi(1:d) = self%solid%hi(1:d, 1)
       case default
          ! A shape never constructed is empty.
          lo(1:d) = huge(1.0_wp)
@@ -362,6 +439,8 @@ contains
          f = dot_product(x(1:d) - self%point(1:d), self%normal(1:d))
       case (shape_cylinder)
          f = norm2(perpendicular(self%axis, x(1:3) - self%point)) - self%radius
+      case (shape_facets)
+         f = facet_phi(self, x)
       case default
          ! A shape never constructed is empty: outside everywhere.
          f = huge(1.0_wp)
@@ -421,8 +500,36 @@ contains
             v = perpendicular(self%axis, v)
             g = v/norm2(v)
          end if
+      case (shape_facets)
+         g(1:d) = facet_gradient(self, x)
       end select
    end function shape_gradient
+
+   !> Signed distance to the faceted surface (0 on it within the snapping length).
+   pure real(wp) function facet_phi(self, x) result(f)
+      type(shape_type), intent(in) :: self
+      real(wp), intent(in) :: x(:)
+      integer :: g
+      logical :: inside, on
+
+      call solid_nearest(self%solid, x, g, f)
+      call solid_inside(self%solid, x, inside, on)
+      if (on) f = 0.0_wp
+      if (inside) f = -f
+   end function facet_phi
+
+   !> Gradient for facets: the outward normal of the nearest facet (the
+   !> gradient of the signed distance wherever the nearest point is inside a
+   !> facet; a unit direction of the same side elsewhere).
+   pure function facet_gradient(self, x) result(g)
+      type(shape_type), intent(in) :: self
+      real(wp), intent(in) :: x(:)
+      real(wp) :: g(self%dim), f
+      integer :: k
+
+      call solid_nearest(self%solid, x, k, f)
+      g = self%solid%normal(1:self%dim, k)
+   end function facet_gradient
 
    !> Certified enclosure [fmin, fmax] of phi over the box [lo, hi] (size dim,
    !> lo <= hi). Exact for every kind (see the module notes):
@@ -465,6 +572,8 @@ contains
          tmax(1:d) = self%normal(1:d)*(hi(1:d) - self%point(1:d))
          fmin = sum(min(tmin(1:d), tmax(1:d)))
          fmax = sum(max(tmin(1:d), tmax(1:d)))
+      case (shape_facets)
+         call facet_phi_range(self, lo, hi, fmin, fmax)
       case (shape_cylinder)
          fmin = line_box_distance(self%point, self%axis, lo(1:3), hi(1:3)) - self%radius
          fmax = -huge(1.0_wp)
@@ -479,6 +588,27 @@ contains
          fmax = huge(1.0_wp)
       end select
    end subroutine shape_phi_range
+
+   !> Lipschitz enclosure of the signed distance over a box, sign-definite if no facet cuts it.
+   pure subroutine facet_phi_range(self, lo, hi, fmin, fmax)
+      type(shape_type), intent(in) :: self
+      real(wp), intent(in) :: lo(:), hi(:)
+      real(wp), intent(out) :: fmin, fmax
+      real(wp) :: f, r
+      integer :: d
+
+      d = self%dim
+      f = facet_phi(self, 0.5_wp*(lo(1:d) + hi(1:d)))
+      r = 0.5_wp*norm2(hi(1:d) - lo(1:d))
+      fmin = f - r
+      fmax = f + r
+      select case (self%facet_class(lo, hi))
+      case (cell_inside)
+         fmax = min(fmax, 0.0_wp)
+      case (cell_outside)
+         fmin = max(fmin, 0.0_wp)
+      end select
+   end subroutine facet_phi_range
 
    !> Certified enclosure [gmin, gmax] of the k-th gradient component over the
    !> box [lo, hi] (size dim, lo <= hi, 1 <= k <= dim); see the module notes.
@@ -557,6 +687,9 @@ contains
          s = 0.5_wp*(self%lower(k) + self%upper(k))
          gmin = merge(-1.0_wp, 0.0_wp, lo(k) < s)
          gmax = merge(1.0_wp, 0.0_wp, hi(k) > s)
+      case (shape_facets)
+         gmin = -1.0_wp
+         gmax = 1.0_wp
       case default
          gmin = 0.0_wp
          gmax = 0.0_wp

@@ -36,7 +36,9 @@ module sprc_grid_quadrature
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_out_of_memory
    use sprc_core_gauss, only: max_gauss_points, gauss_legendre_nodes
    use sprc_geometry_region, only: cell_outside, cell_inside, cell_cut
-   use sprc_geometry_shape, only: shape_halfspace, shape_box
+   use sprc_geometry_shape, only: shape_halfspace, shape_box, shape_facets
+   use sprc_grid_facet_rule, only: facet_rule_type, facet_cell_rule, facet_face_rule
+   use sprc_geometry_facet_solid, only: facet_solid_type, face_cover, solid_nearest, solid_query_box
    use sprc_geometry_body, only: body_type, csg_add, csg_intersect, snap_tolerance
    use sprc_grid_quadric, only: ncoef, max_shape_quadrics, quadric_range, derivative_range, &
       & quadric_gradient, depends_on, restrict, line_coefficients, quadratic_roots, shape_quadrics, crossing
@@ -74,7 +76,8 @@ module sprc_grid_quadrature
       integer :: nvol = 0
       real(wp), allocatable :: vol_x(:, :), vol_w(:)
       !> Surface points: coordinates, weights (surface measure), unit outward
-      !> normals (3, :), and the body's shape index of the surface.
+      !> normals (3, :), and the body's surface id (sprc_geometry_body notes:
+      !> the shape index, or a faceted shape's group).
       integer :: nsurf = 0
       real(wp), allocatable :: surf_x(:, :), surf_w(:), surf_n(:, :)
       integer, allocatable :: surf_shape(:)
@@ -95,7 +98,12 @@ module sprc_grid_quadrature
       logical, allocatable, private :: require(:)
       !> An array could not grow (out of memory): the rule is incomplete.
       logical, private :: failed = .false.
+      !> Work and points of the faceted-solid rule.
+      type(facet_rule_type), private :: facets
    end type cell_rule_type
+
+   !> Facets a box may meet before `mixed_box` halves it.
+   integer, parameter :: max_box_facets = 32
 
    !> Default strength of a height direction (module notes, `min_ratio`).
    real(wp), parameter :: default_min_ratio = 3.0_wp
@@ -376,18 +384,37 @@ contains
       class(body_type), intent(in) :: body
       real(wp), intent(in) :: lo(:), hi(:)
       type(cell_rule_type), intent(inout) :: rule
+      integer :: n, active(body%nshape)
+
+      call body%active_shapes(lo, hi, active, n)
+      if (any(body%shapes(active(1:n))%kind == shape_facets)) then
+         call mixed_box(quad, body, lo, hi, lo, hi, 0, rule)
+      else
+         call saye_rule(quad, body, lo, hi, rule, active(1:n))
+      end if
+      call add_face_parts(quad, body, lo, hi, rule)
+   end subroutine cut_rule
+
+   !> Volume and surface rule of the box [lo, hi] by dimension reduction on the
+   !> quadrics of the shapes `active` (no boundary parts on its faces).
+   pure subroutine saye_rule(quad, body, lo, hi, rule, active)
+      type(cut_quadrature_type), intent(in) :: quad
+      class(body_type), intent(in) :: body
+      real(wp), intent(in) :: lo(:), hi(:)
+      type(cell_rule_type), intent(inout) :: rule
+      integer, intent(in) :: active(:)
       type(context_type) :: ctx
       real(wp) :: ylo(3), yhi(3)
-      integer :: n, i, dim
+      integer :: i, dim
       logical :: free(3)
 
       dim = quad%dim
       call new_context(ctx, dim, lo, hi)
       call reserve_work(rule, body%nshape)
       if (rule%failed) return
-      call body%active_shapes(lo, hi, rule%shapes(1:body%nshape), n)
-      do i = 1, n
-         call add_shape_quadrics(body, rule%shapes(i), ctx, lo, hi, rule)
+      rule%np = 0
+      do i = 1, size(active)
+         call add_shape_quadrics(body, active(i), ctx, lo, hi, rule)
       end do
       ylo = 0.0_wp
       yhi = 0.0_wp
@@ -397,8 +424,170 @@ contains
       free(1:dim) = .true.
       call reduce(ctx, quad, body, rule, ylo, yhi, free, 1, rule%np, .true., 0, 0)
       rule%np = 0
-      call add_face_parts(quad, body, lo, hi, rule)
-   end subroutine cut_rule
+   end subroutine saye_rule
+
+   !> Rule of the box [lo, hi] inside the cell [clo, chi] when a faceted solid is
+   !> among its active shapes. One active shape, faceted: the exact polyhedral
+   !> rule (sprc_grid_facet_rule), after halving the box while it meets more
+   !> than `max_box_facets` facets (up to `mixed_depth` levels: the partition's
+   !> depth and size grow with the facets of a box). Only primitives:
+   !> dimension reduction. A
+   !> faceted solid with other active shapes (a CSG edge between a faceted and
+   !> another surface): the box is halved, up to `mixed_depth` levels; at that
+   !> depth the box counts in `nunresolved` and gets its tensor rule with
+   !> membership at each point (body%phi) and no surface points: the error is
+   !> bounded by the measure and boundary measure of such boxes. Facet
+   !> fragments on the faces of sub-boxes inside the cell enter the surface
+   !> rule once, from the sub-box on the body side; those on the cell's faces
+   !> are the cell's `add_face_parts`.
+   pure recursive subroutine mixed_box(quad, body, clo, chi, lo, hi, depth, rule)
+      type(cut_quadrature_type), intent(in) :: quad
+      class(body_type), intent(in) :: body
+      real(wp), intent(in) :: clo(:), chi(:), lo(:), hi(:)
+      integer, intent(in) :: depth
+      type(cell_rule_type), intent(inout) :: rule
+      real(wp) :: slo(size(lo)), shi(size(lo)), mid(size(lo))
+      integer :: active(body%nshape), n, child, k, d
+
+      d = size(lo)
+      call body%active_shapes(lo, hi, active, n)
+      if (depth > 0) call add_facet_face_parts(quad, body, lo, hi, rule, clo, chi)
+      if (n == 0) then
+         if (body%classify_box(lo, hi) == cell_inside) call tensor_volume(quad, lo, hi, rule)
+         return
+      end if
+      if (.not. any(body%shapes(active(1:n))%kind == shape_facets)) then
+         call saye_rule(quad, body, lo, hi, rule, active(1:n))
+         return
+      end if
+      if (n == 1) then
+         if (depth >= mixed_depth(d) .or. box_facets(body%shapes(active(1))%solid, lo, hi) <= max_box_facets) then
+            call facet_box(quad, body, lo, hi, rule, active(1))
+            return
+         end if
+      else if (depth >= mixed_depth(d)) then
+         rule%nunresolved = rule%nunresolved + 1
+         call member_tensor(quad, body, lo, hi, rule)
+         return
+      end if
+      rule%nsplit = rule%nsplit + 1
+      mid = 0.5_wp*(lo + hi)
+      do child = 0, 2**d - 1
+         do k = 1, d
+            slo(k) = merge(mid(k), lo(k), btest(child, k - 1))
+            shi(k) = merge(hi(k), mid(k), btest(child, k - 1))
+         end do
+         call mixed_box(quad, body, clo, chi, slo, shi, depth + 1, rule)
+      end do
+   end subroutine mixed_box
+
+   !> Facets whose boxes meet the box [lo, hi].
+   pure integer function box_facets(solid, lo, hi) result(n)
+      type(facet_solid_type), intent(in) :: solid
+      real(wp), intent(in) :: lo(:), hi(:)
+      integer, allocatable :: list(:)
+      call solid_query_box(solid, lo, hi, list, n)
+   end function box_facets
+
+   !> Halvings of a cell cut by a faceted and another surface (`mixed_box`).
+   pure integer function mixed_depth(dim)
+      integer, intent(in) :: dim
+      mixed_depth = merge(8, 4, dim == 2)
+   end function mixed_depth
+
+   !> Tensor rule of the box keeping the points inside the body (phi < 0).
+   pure subroutine member_tensor(quad, body, lo, hi, rule)
+      type(cut_quadrature_type), intent(in) :: quad
+      class(body_type), intent(in) :: body
+      real(wp), intent(in) :: lo(:), hi(:)
+      type(cell_rule_type), intent(inout) :: rule
+      real(wp) :: x(3), w
+      integer :: ipt
+      do ipt = 1, quad%q**quad%dim
+         call tensor_point(quad, lo, hi, ipt, x, w)
+         if (body%phi(x(1:quad%dim)) < 0.0_wp) call push_volume(rule, x, w)
+      end do
+   end subroutine member_tensor
+
+   !> The exact polyhedral rule of the box [lo, hi] where the faceted shape s is
+   !> the only active shape.
+   pure subroutine facet_box(quad, body, lo, hi, rule, s)
+      type(cut_quadrature_type), intent(in) :: quad
+      class(body_type), intent(in) :: body
+      real(wp), intent(in) :: lo(:), hi(:)
+      type(cell_rule_type), intent(inout) :: rule
+      integer, intent(in) :: s
+      integer :: classes(body%nshape), i
+      logical :: member_in, member_out
+
+      call body%shape_classes(lo, hi, classes)
+      member_in = body%class_with(classes, s, cell_inside) == cell_inside
+      member_out = body%class_with(classes, s, cell_outside) == cell_inside
+      call facet_cell_rule(rule%facets, body%shapes(s)%solid, lo, hi, quad%q, member_in, member_out)
+      rule%nsplit = rule%nsplit + rule%facets%nsplit
+      do i = 1, rule%facets%nvol
+         call push_volume(rule, rule%facets%vol_x(:, i), rule%facets%vol_w(i))
+      end do
+      call push_facet_surface(body, rule, s)
+   end subroutine facet_box
+
+   !> Append the facet rule's surface points of shape s with their surface ids.
+   pure subroutine push_facet_surface(body, rule, s)
+      class(body_type), intent(in) :: body
+      type(cell_rule_type), intent(inout) :: rule
+      integer, intent(in) :: s
+      integer :: i, g, id
+      do i = 1, rule%facets%nsurf
+         g = 0
+         if (allocated(body%shapes(s)%solid%set%group)) g = body%shapes(s)%solid%set%group(rule%facets%surf_facet(i))
+         id = body%group_surface(s, g)
+         call push_surface(rule, rule%facets%surf_x(:, i), rule%facets%surf_w(i), rule%facets%surf_n(:, i), id)
+      end do
+   end subroutine push_facet_surface
+
+   !> Facet fragments in the face planes of the box [lo, hi] where it is on the
+   !> body side: a point is kept where the body's membership just on the box
+   !> side (the faceted shape's value replaced by inside or outside as its
+   !> fragment says) is in and just across is out, as `face_member` does for
+   !> the primitives; exact where no other surface crosses the fragment,
+   !> point-sampled where one does. Faces the facets cover whole are left to
+   !> the primitives' face rule (`on_face_plane`, exact with the other
+   !> shapes' quadrics). With the cell [clo, chi] (a sub-box of it), fragments
+   !> on the cell's own faces are left out (the cell adds them).
+   pure subroutine add_facet_face_parts(quad, body, lo, hi, rule, clo, chi)
+      type(cut_quadrature_type), intent(in) :: quad
+      class(body_type), intent(in) :: body
+      real(wp), intent(in) :: lo(:), hi(:)
+      type(cell_rule_type), intent(inout) :: rule
+      real(wp), intent(in), optional :: clo(:), chi(:)
+      real(wp) :: v, x(3)
+      integer :: s, i, d, g, f, m, iside
+      logical :: here, there, covered(2, 3)
+
+      if (.not. any(body%shapes%kind == shape_facets)) return
+      d = quad%dim
+      do s = 1, body%nshape
+         if (body%shapes(s)%kind /= shape_facets) cycle
+         do m = 1, d
+            do iside = 1, 2
+               covered(iside, m) = face_cover(body%shapes(s)%solid, lo, hi, m, 2*iside - 3) /= 0
+            end do
+         end do
+         call facet_face_rule(rule%facets, body%shapes(s)%solid, lo, hi, quad%q, covered(:, 1:d), clo, chi)
+         do i = 1, rule%facets%nsurf
+            f = rule%facets%surf_facet(i)
+            v = merge(-1.0_wp, 1.0_wp, f > 0)
+            x = rule%facets%surf_x(:, i)
+            here = csg_phi(body, x(1:d), s, v) < 0.0_wp
+            there = csg_phi(body, x(1:d), s, -v) < 0.0_wp
+            if (.not. here .or. there) cycle
+            g = 0
+            if (allocated(body%shapes(s)%solid%set%group)) g = body%shapes(s)%solid%set%group(abs(f))
+            call push_surface(rule, x, rule%facets%surf_w(i), sign(1.0_wp, -v)*rule%facets%surf_n(:, i), &
+               & body%group_surface(s, g))
+         end do
+      end do
+   end subroutine add_facet_face_parts
 
    pure subroutine new_context(ctx, dim, lo, hi)
       type(context_type), intent(out) :: ctx
@@ -445,6 +634,7 @@ contains
       logical :: free(3), on, inside_on_cell_side, on_i, dummy
 
       dim = quad%dim
+      call add_facet_face_parts(quad, body, lo, hi, rule)
       ! the shapes' classes on a face in rule%shapes (the reduction below only grows it)
       call reserve_work(rule, body%nshape)
       if (rule%failed) return
@@ -474,6 +664,9 @@ contains
                   if (i == s .or. on_i) then
                      if (body%shapes(i)%kind == shape_box) &
                         & call add_shape_quadrics(body, i, ctx, flo(1:dim), fhi(1:dim), rule)
+                  else if (rule%shapes(i) == cell_cut .and. body%shapes(i)%kind == shape_facets) then
+                     ! another faceted surface crossing the face: membership by point
+                     rule%nunresolved = rule%nunresolved + 1
                   else if (rule%shapes(i) == cell_cut) then
                      call add_shape_quadrics(body, i, ctx, flo(1:dim), fhi(1:dim), rule)
                   end if
@@ -497,7 +690,9 @@ contains
 
    !> True if shape s's surface lies on the plane x_m = xf (the cell face
    !> [flo, fhi] on `side`): a halfspace with normal +-e_m, or a box face,
-   !> within the snapping tolerance. inside_on_cell_side: the shape's inside
+   !> within the snapping tolerance, or facets covering the whole face with
+   !> one orientation (`face_cover`; a partly covered face is left to
+   !> `add_facet_face_parts`). inside_on_cell_side: the shape's inside
    !> lies on the cell side of the plane.
    pure subroutine on_face_plane(body, s, m, side, xf, flo, fhi, on, inside_on_cell_side)
       class(body_type), intent(in) :: body
@@ -505,13 +700,17 @@ contains
       real(wp), intent(in) :: side, xf, flo(:), fhi(:)
       logical, intent(out) :: on, inside_on_cell_side
       real(wp) :: tol
-      integer :: i
+      integer :: i, cover
 
       on = .false.
       inside_on_cell_side = .false.
       tol = snap_tolerance(body%shapes(s), flo, fhi)
       associate (sh => body%shapes(s))
          select case (sh%kind)
+         case (shape_facets)
+            cover = face_cover(sh%solid, flo, fhi, m, nint(side))
+            on = cover /= 0
+            inside_on_cell_side = cover > 0
          case (shape_halfspace)
             do i = 1, body%dim
                if (i /= m .and. sh%normal(i) /= 0.0_wp) return
@@ -667,6 +866,32 @@ contains
          g = -1.0_wp
       end if
    end function plane_value
+
+   !> The body's level set at x with shape s's value replaced by v.
+   pure real(wp) function csg_phi(body, x, s, v) result(f)
+      class(body_type), intent(in) :: body
+      real(wp), intent(in) :: x(:), v
+      integer, intent(in) :: s
+      real(wp) :: g
+      integer :: k
+
+      do k = 1, body%nshape
+         if (k == s) then
+            g = v
+         else
+            g = body%shapes(k)%phi(x)
+         end if
+         if (k == 1) then
+            f = g
+         else if (body%ops(k) == csg_add) then
+            f = min(f, g)
+         else if (body%ops(k) == csg_intersect) then
+            f = max(f, g)
+         else
+            f = max(f, -g)
+         end if
+      end do
+   end function csg_phi
 
    ! ------------------------------------------------------------ dimension reduction
 
@@ -952,7 +1177,7 @@ contains
             w = w*(hi(d) - lo(d))*quad%weight(idx)
          end do
          if (top) then
-            call emit_volume(ctx, rule, y, w, free)
+            call emit_volume(ctx, body, rule, y, w, free)
          else
             call push_point(rule, y, w)
          end if
@@ -1034,7 +1259,7 @@ contains
                ym = y
                ym(k) = t(j) + len*quad%node(g)
                if (top) then
-                  call emit_volume(ctx, rule, ym, wb*len*quad%weight(g), free)
+                  call emit_volume(ctx, body, rule, ym, wb*len*quad%weight(g), free)
                else
                   call push_point(rule, ym, wb*len*quad%weight(g))
                end if
@@ -1064,8 +1289,9 @@ contains
 
    !> A top-level volume point (y-measure weight w): a volume point of the
    !> cell, or in face mode a surface point on the face.
-   pure subroutine emit_volume(ctx, rule, y, w, free)
+   pure subroutine emit_volume(ctx, body, rule, y, w, free)
       type(context_type), intent(in) :: ctx
+      class(body_type), intent(in) :: body
       type(cell_rule_type), intent(inout) :: rule
       real(wp), intent(in) :: y(3), w
       logical, intent(in) :: free(3)
@@ -1078,9 +1304,23 @@ contains
       else
          n = 0.0_wp
          n(ctx%face_dim) = ctx%face_side
-         call push_surface(rule, x, w*product(ctx%half, mask=free), n, ctx%face_shape)
+         call push_surface(rule, x, w*product(ctx%half, mask=free), n, face_surface(ctx, body, x))
       end if
    end subroutine emit_volume
+
+   !> Surface id of a face point: the face's shape, or for facets the group of the nearest facet.
+   pure integer function face_surface(ctx, body, x) result(id)
+      type(context_type), intent(in) :: ctx
+      class(body_type), intent(in) :: body
+      real(wp), intent(in) :: x(3)
+      real(wp) :: dist
+      integer :: f
+      id = ctx%face_shape
+      if (body%shapes(id)%kind /= shape_facets) return
+      if (.not. allocated(body%shapes(id)%solid%set%group)) return
+      call solid_nearest(body%shapes(id)%solid, x(1:ctx%dim), f, dist)
+      id = body%group_surface(id, body%shapes(id)%solid%set%group(f))
+   end function face_surface
 
    !> A surface point at y on shape s seen along y_k, base weight wb (y measure).
    pure subroutine emit_surface(ctx, body, rule, y, wb, k, free, s)

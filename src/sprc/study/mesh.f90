@@ -169,7 +169,7 @@ contains
          call neumaier_add(vol, rule%vol_w(1:rule%nvol))
          call neumaier_add(surf, rule%surf_w(1:rule%nsurf))
          do q = 1, rule%nsurf
-            s = rule%surf_shape(q)
+            s = body%surface_shape(rule%surf_shape(q))
             if (s >= 1 .and. s <= body%nshape) call neumaier_add(shape_acc(:, s), rule%surf_w(q:q))
          end do
       end do
