@@ -15,7 +15,10 @@
 !> A closed surface oriented inwards (negative volume) is flipped and a note
 !> says so. Vertices are first merged exactly by coordinates (a lexicographic
 !> sort, three stable passes), edges matched by a sort on their vertex pairs:
-!> O(n log n) throughout.
+!> O(n log n) throughout. In 2D segments must not cross or touch except at
+!> the vertex two neighbours share: segments are binned on a grid of about n
+!> cells over the box and only segments of one cell are compared (linear for
+!> segments of comparable length; a few long segments cost their cell count).
 !>
 !> Orientation is checked per edge, so it is consistent within each connected
 !> piece; a piece given with the opposite sign to the whole (a cavity written
@@ -60,6 +63,7 @@ contains
       call check_degenerate(set, error)
       if (allocated(error)) return
       call check_edges(set, error)
+      if (set%dim == 2 .and. .not. allocated(error)) call check_crossings(set, error)
       if (allocated(error)) return
       call facet_measures(set, volume, area, scale)
       if (.not. abs(volume) > sqrt(epsilon(1.0_wp))*scale) then
@@ -198,7 +202,7 @@ contains
       do i = 1, set%nvert
          if (i == 1) then
             n = 1
-         else if (any(set%vert(:, order(i)) /= set%vert(:, order(i - 1)))) then
+         else if (any(abs(set%vert(:, order(i)) - set%vert(:, order(i - 1))) > 0.0_wp)) then
             n = n + 1
          end if
          id(order(i)) = n
@@ -207,7 +211,7 @@ contains
       merged(:, id) = set%vert
       call move_alloc(merged, set%vert)
       set%nvert = n
-      set%facet = id(set%facet)
+      set%facet = reshape(id(reshape(set%facet, [size(set%facet)])), shape(set%facet))
    end subroutine merge_vertices
 
    !> Order of the columns of `x` sorted by rows 1..dim (row 1 first): stable
@@ -372,6 +376,130 @@ contains
       end do
       text = text//')'
    end function point_text
+
+   !> No two segments cross, touch or overlap, except neighbours at their
+   !> shared vertex.
+   subroutine check_crossings(set, error)
+      type(facet_set_type), intent(in) :: set
+      type(error_type), allocatable, intent(out) :: error
+      integer, allocatable :: start(:), member(:)
+      integer :: nb, b, i, j, si, sj
+      real(wp) :: lo(3), hi(3)
+
+      call facet_bounds(set, lo, hi)
+      nb = max(1, int(sqrt(real(set%nfacet, wp))))
+      call bin_segments(set, lo, hi, nb, start, member)
+      do b = 1, nb*nb
+         do i = start(b), start(b + 1) - 1
+            do j = i + 1, start(b + 1) - 1
+               si = min(member(i), member(j))
+               sj = max(member(i), member(j))
+               if (.not. segments_meet(set, si, sj)) cycle
+               call fatal_error(error, facet_where(set, si)//'the polygon crosses itself: it meets segment '// &
+                  & itoa(set%file_index(sj))//' (from '//point_text(set, set%facet(1, sj))//' to '// &
+                  & point_text(set, set%facet(2, sj))//')', stat_invalid_input)
+               return
+            end do
+         end do
+      end do
+   end subroutine check_crossings
+
+   !> Segments of each of nb x nb bins over the box [lo, hi]: those of bin b are
+   !> member(start(b):start(b+1)-1), in increasing order.
+   subroutine bin_segments(set, lo, hi, nb, start, member)
+      type(facet_set_type), intent(in) :: set
+      real(wp), intent(in) :: lo(3), hi(3)
+      integer, intent(in) :: nb
+      integer, allocatable, intent(out) :: start(:), member(:)
+      integer :: k, pass, ix, iy, r(2, 2)
+
+      allocate (start(nb*nb + 1), source=0)
+      allocate (member(0))
+      do pass = 1, 2
+         do k = 1, set%nfacet
+            r = bin_range(set, k, lo, hi, nb)
+            do iy = r(1, 2), r(2, 2)
+               do ix = r(1, 1), r(2, 1)
+                  if (pass == 1) then
+                     start(ix + nb*(iy - 1) + 1) = start(ix + nb*(iy - 1) + 1) + 1
+                  else
+                     member(start(ix + nb*(iy - 1))) = k
+                     start(ix + nb*(iy - 1)) = start(ix + nb*(iy - 1)) + 1
+                  end if
+               end do
+            end do
+         end do
+         if (pass == 1) then
+            start(1) = 1
+            do k = 2, nb*nb + 1
+               start(k) = start(k) + start(k - 1)
+            end do
+            deallocate (member)
+            allocate (member(start(nb*nb + 1) - 1))
+         end if
+      end do
+      ! The second pass moved each start to the next bin's: shift back.
+      start(2:nb*nb + 1) = start(1:nb*nb)
+      start(1) = 1
+   end subroutine bin_segments
+
+   !> Bins (first and last in x, in y) the box of segment k overlaps.
+   pure function bin_range(set, k, lo, hi, nb) result(r)
+      type(facet_set_type), intent(in) :: set
+      integer, intent(in) :: k, nb
+      real(wp), intent(in) :: lo(3), hi(3)
+      integer :: r(2, 2), i
+      real(wp) :: a, b, w
+      do i = 1, 2
+         a = min(set%vert(i, set%facet(1, k)), set%vert(i, set%facet(2, k)))
+         b = max(set%vert(i, set%facet(1, k)), set%vert(i, set%facet(2, k)))
+         w = max(hi(i) - lo(i), tiny(1.0_wp))
+         r(1, i) = min(nb, max(1, 1 + int((a - lo(i))/w*nb)))
+         r(2, i) = min(nb, max(1, 1 + int((b - lo(i))/w*nb)))
+      end do
+   end function bin_range
+
+   !> Whether segments i and j meet anywhere but at a vertex they share.
+   pure logical function segments_meet(set, i, j) result(meet)
+      type(facet_set_type), intent(in) :: set
+      integer, intent(in) :: i, j
+      real(wp) :: p(2), q(2), r(2), s(2)
+      integer :: shared
+
+      p = set%vert(1:2, set%facet(1, i))
+      q = set%vert(1:2, set%facet(2, i))
+      r = set%vert(1:2, set%facet(1, j))
+      s = set%vert(1:2, set%facet(2, j))
+      shared = count([set%facet(1, i) == set%facet(1, j), set%facet(1, i) == set%facet(2, j), &
+         & set%facet(2, i) == set%facet(1, j), set%facet(2, i) == set%facet(2, j)])
+      if (shared > 0) then
+         ! Neighbours meet elsewhere only when they fold back along one line.
+         meet = abs(orient(p, q, r)) <= 0.0_wp .and. abs(orient(p, q, s)) <= 0.0_wp .and. &
+            & dot_product(q - p, s - r) < 0.0_wp .and. (set%facet(2, i) == set%facet(1, j) .or. &
+            & set%facet(1, i) == set%facet(2, j))
+         return
+      end if
+      meet = straddles(p, q, r, s) .and. straddles(r, s, p, q)
+   end function segments_meet
+
+   !> Whether r and s lie on different sides of line pq or on it within pq's span.
+   pure logical function straddles(p, q, r, s)
+      real(wp), intent(in) :: p(2), q(2), r(2), s(2)
+      real(wp) :: o1, o2
+      o1 = orient(p, q, r)
+      o2 = orient(p, q, s)
+      if (abs(o1) <= 0.0_wp .and. abs(o2) <= 0.0_wp) then
+         straddles = max(dot_product(r - p, q - p), dot_product(s - p, q - p)) >= 0.0_wp .and. &
+            & min(dot_product(r - p, q - p), dot_product(s - p, q - p)) <= dot_product(q - p, q - p)
+      else
+         straddles = .not. (o1*o2 > 0.0_wp)
+      end if
+   end function straddles
+
+   pure real(wp) function orient(p, q, r)
+      real(wp), intent(in) :: p(2), q(2), r(2)
+      orient = (q(1) - p(1))*(r(2) - p(2)) - (q(2) - p(2))*(r(1) - p(1))
+   end function orient
 
    subroutine flip(set)
       type(facet_set_type), intent(inout) :: set

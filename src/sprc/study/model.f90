@@ -172,6 +172,11 @@ contains
       integer :: i
 
       text = ''
+      do i = 1, size(scene%shapes)
+         if (.not. allocated(scene%shapes(i)%note)) cycle
+         if (len(scene%shapes(i)%note) > 0) text = text//"warning: shape '"//scene%shapes(i)%name//"': "// &
+            & scene%shapes(i)%note//new_line('a')
+      end do
       load = 0.0_wp
       do i = 1, size(scene%bodies)
          if (allocated(scene%bodies(i)%body_force)) load = max(load, maxval([0.0_wp, abs(scene%bodies(i)%body_force)]))
@@ -443,6 +448,12 @@ contains
       case ('box'); call new_box(shape, spec%name, spec%lower, spec%upper, error)
       case ('halfspace'); call new_halfspace(shape, spec%name, spec%point, spec%normal, error)
       case ('cylinder'); call new_cylinder(shape, spec%name, spec%point, spec%axis, spec%radius, error)
+      case ('stl', 'obj', 'polygon')
+         ! >>> CONNECT new_facet_shape HERE: replace the two lines below by
+         !     call new_facet_shape(shape, spec%name, spec%facets, error)
+         !     (spec%facets is read, placed, validated and oriented outwards).
+         call fatal_error(error, "shape '"//spec%name//"': kind = '"//spec%kind// &
+            & "': the faceted shape is read and checked, but not yet built into a body", stat_unsupported)
       case default
          call fatal_error(error, 'unknown shape kind '''//spec%kind//'''', stat_invalid_input)
       end select
