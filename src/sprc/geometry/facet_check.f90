@@ -196,7 +196,7 @@ contains
       real(wp), allocatable :: merged(:, :)
       integer :: i, n
 
-      call lexicographic_order(set%vert, set%dim, order)
+      call lexicographic_order(set%vert(:, 1:set%nvert), set%dim, order)
       allocate (id(set%nvert))
       n = 0
       do i = 1, set%nvert
@@ -208,7 +208,7 @@ contains
          id(order(i)) = n
       end do
       allocate (merged(3, n))
-      merged(:, id) = set%vert
+      merged(:, id) = set%vert(:, 1:set%nvert)
       call move_alloc(merged, set%vert)
       set%nvert = n
       set%facet = reshape(id(reshape(set%facet, [size(set%facet)])), shape(set%facet))

@@ -107,6 +107,7 @@ contains
          end select
       end do
       set%group_name = set%group_name(1:ng)
+      set%vert = set%vert(:, 1:set%nvert)
    end subroutine read_statements
 
    !> One `f` statement: its vertex indices resolved against the `nvert`

@@ -453,6 +453,8 @@ contains
       type(scene_type), intent(in) :: scene
       type(shape_spec_type), intent(inout) :: shape
       type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: why
+      integer :: stat
       logical :: found
 
       if (shape%kind == 'polygon') then
@@ -474,8 +476,10 @@ contains
       if (allocated(error)) return
       if (.not. allocated(shape%translate)) allocate (shape%translate(scene%dim), source=0.0_wp)
       call load_facets(scene%source, shape, error)
-      if (allocated(error)) call nml_field_error(g, trim(merge('file  ', 'points', nml_has(g, 'file'))), &
-         & error%message, error, error%stat)
+      if (.not. allocated(error)) return
+      why = error%message
+      stat = error%stat
+      call nml_field_error(g, trim(merge('file  ', 'points', nml_has(g, 'file'))), why, error, stat)
    end subroutine read_facet_fields
 
    !> Dimension of a shape kind; 0 for kinds valid in 2D and 3D.
@@ -498,7 +502,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer :: ig, n
       integer, allocatable :: line_of(:)
-      character(len=:), allocatable :: fields
+      character(len=:), allocatable :: fields, why
       logical :: found
 
       allocate (scene%bcs(count_groups(groups, 'bc')))
@@ -515,9 +519,11 @@ contains
             bc%shape_index = shape_index(scene, bc%on)
             if (bc%shape_index == 0) then
                call group_surface(scene%shapes, bc%on, bc%shape_index, bc%group, error)
-               if (allocated(error)) call nml_field_error(g, 'on', error%message//'; surfaces: '// &
-                  & shape_names(scene), error)
-               if (allocated(error)) return
+               if (allocated(error)) then
+                  why = error%message
+                  call nml_field_error(g, 'on', why//'; surfaces: '//shape_names(scene), error)
+                  return
+               end if
             end if
             line_of(n) = g%line
             call get_choice(g, 'type', bc_types, .true., bc%type, error)
@@ -1516,6 +1522,10 @@ contains
       if (allocated(shape%upper)) text = text//', upper = '//real_list(shape%upper)
       if (allocated(shape%normal)) text = text//', normal = '//real_list(shape%normal)
       if (allocated(shape%axis)) text = text//', axis = '//real_list(shape%axis)
+      if (allocated(shape%file)) text = text//", file = '"//shape%file//"'"
+      if (allocated(shape%points)) text = text//', points = '//real_list(shape%points)
+      if (allocated(shape%translate)) text = text//', scale = '//real_text(shape%scale)//', translate = '// &
+         & real_list(shape%translate)
       select case (shape%kind)
       case ('disk', 'sphere', 'cylinder'); text = text//', radius = '//real_text(shape%radius)
       end select

@@ -82,8 +82,12 @@ contains
             group = g
          end do
       end do
-      if (shape == 0) call fatal_error(error, 'no &shape and no group (solid, g, o, edge name) of a geometry file '// &
-         & 'has this name')
+      if (shape /= 0) return
+      if (any([(facet_kind(shapes(k)%kind), k=1, size(shapes))])) then
+         call fatal_error(error, 'no &shape has this name, nor a group (solid, g, o, edge name) of a geometry file')
+      else
+         call fatal_error(error, 'no &shape has this name')
+      end if
    end subroutine group_surface
 
    !> Lines of `sprc check` for a faceted shape: facets, box, measures, named

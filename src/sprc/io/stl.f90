@@ -162,8 +162,12 @@ contains
          end if
       end do
       if (state /= 0) then
-         call fatal_error(error, "'"//path//"': truncated: the file ends inside "//trim(merge('facet '//itoa(nf), &
-            & 'a solid        ', state >= 2))//' (no endsolid)', stat_invalid_input)
+         if (state >= 2) then
+            call fatal_error(error, "'"//path//"': truncated: the file ends inside facet "//itoa(nf), stat_invalid_input)
+         else
+            call fatal_error(error, "'"//path//"': truncated: the file ends inside a solid (no endsolid)", &
+               & stat_invalid_input)
+         end if
          return
       end if
       set%nvert = nv
