@@ -38,6 +38,9 @@ module sprc_geometry_facet_check
    !> Multiple of the rounding bound of a cross product below which a facet is
    !> refused as degenerate (see the module notes).
    real(wp), parameter :: degenerate_factor = 4.0_wp
+   !> Largest coordinate magnitude accepted: cubes of coordinates (volume
+   !> terms) stay far from overflow.
+   real(wp), parameter :: max_coordinate = 1.0e100_wp
 
    !> Edge problems, by the order in which they are reported for one edge.
    integer, parameter :: edge_ok = 0, edge_open = 1, edge_nonmanifold = 2, edge_orientation = 3
@@ -166,15 +169,23 @@ contains
       c = [a(2)*b(3) - a(3)*b(2), a(3)*b(1) - a(1)*b(3), a(1)*b(2) - a(2)*b(1)]
    end function cross
 
+   !> Every coordinate finite and below `max_coordinate` in magnitude.
    subroutine check_finite(set, error)
       type(facet_set_type), intent(in) :: set
       type(error_type), allocatable, intent(out) :: error
       integer :: k, j
       do k = 1, set%nfacet
          do j = 1, set%dim
-            if (all(ieee_is_finite(set%vert(:, set%facet(j, k))))) cycle
-            call fatal_error(error, facet_where(set, k)//'a coordinate is NaN or infinite', stat_invalid_input)
-            return
+            associate (x => set%vert(:, set%facet(j, k)))
+               if (.not. all(ieee_is_finite(x))) then
+                  call fatal_error(error, facet_where(set, k)//'a coordinate is NaN or infinite', stat_invalid_input)
+               else if (maxval(abs(x)) > max_coordinate) then
+                  call fatal_error(error, facet_where(set, k)//'a coordinate of magnitude '// &
+                     & real_text(maxval(abs(x)))//' exceeds '//real_text(max_coordinate)// &
+                     & ' (volumes would overflow)', stat_invalid_input)
+               end if
+            end associate
+            if (allocated(error)) return
          end do
       end do
    end subroutine check_finite
