@@ -424,6 +424,18 @@ contains
             return
          end if
       end do
+      ! >>> CONNECT group surfaces HERE: a &bc on a group of a geometry file
+      !     (bc%group > 0: an STL solid, OBJ group or polygon edge name) must
+      !     load only that group's facets; until the surface rule carries the
+      !     group of each facet it is refused rather than applied to the whole
+      !     surface of the shape.
+      do s = 1, size(scene%bcs)
+         if (scene%bcs(s)%group == 0) cycle
+         call fatal_error(error, "&bc on '"//scene%bcs(s)%on//"': a group of the geometry file of shape '"// &
+            & scene%shapes(scene%bcs(s)%shape_index)%name//"' is read and checked, but conditions on it are "// &
+            & 'not yet applied', stat_unsupported)
+         return
+      end do
       do b = 1, size(bodies)
          if (allocated(scene%bodies(b)%box_min)) then
             call check_body_in_box(bodies(b), scene%bodies(b)%box_min, scene%bodies(b)%box_size, error, &
