@@ -117,7 +117,8 @@ contains
          if (all(lo(1:d) >= box_min(1:d)) .and. all(hi(1:d) <= box_min(1:d) + box_size)) then
             text = text//'yes'//nl
          else
-            text = text//'NO (box '//point(box_min(1:d))//' .. '//point(box_min(1:d) + box_size)//')'//nl
+            text = text//'no: it reaches beyond the box '//point(box_min(1:d))//' .. '// &
+               & point(box_min(1:d) + box_size)//"; the body's other shapes must cut it to the box"//nl
          end if
       end associate
    end function facet_summary
