@@ -179,6 +179,7 @@ contains
       character(len=:), allocatable, intent(out) :: note
       real(wp), intent(out) :: volume, area
       type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: why
       if (index(path, '.obj') > 0) then
          call read_obj(path, set, error)
       else
@@ -186,7 +187,8 @@ contains
       end if
       if (.not. allocated(error)) call check_facets(set, note, error)
       if (allocated(error)) then
-         call test_failed(error, 'unexpected error: '//error%message)
+         why = error%message
+         call test_failed(error, 'unexpected error: '//why)
          return
       end if
       call facet_measures(set, volume, area)

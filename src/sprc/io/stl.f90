@@ -25,6 +25,12 @@ module sprc_io_stl
    !> Fewest bytes of one ASCII facet ("facet normal 0 0 0", "outer loop",
    !> three "vertex 0 0 0", "endloop", "endfacet"): bounds the facet count.
    integer, parameter :: ascii_facet_bytes = 80
+   !> Bytes no ASCII STL holds: the controls but tab, line feed, vertical tab,
+   !> form feed and carriage return.
+   character(len=*), parameter :: control_bytes = achar(0)//achar(1)//achar(2)//achar(3)//achar(4)//achar(5)// &
+      & achar(6)//achar(7)//achar(8)//achar(14)//achar(15)//achar(16)//achar(17)//achar(18)//achar(19)// &
+      & achar(20)//achar(21)//achar(22)//achar(23)//achar(24)//achar(25)//achar(26)//achar(27)//achar(28)// &
+      & achar(29)//achar(30)//achar(31)//achar(127)
 
 contains
 
@@ -53,6 +59,12 @@ contains
       else if (starts_solid(head)) then
          call check_facet_memory(path, size, size/ascii_facet_bytes + 1, error)
          if (.not. allocated(error)) call read_ascii(path, size, set, error)
+         if (allocated(error)) then
+            if (error%stat == -1) call fatal_error(error, "'"//path//"': starts with ""solid"" but has bytes no "// &
+               & 'ASCII STL has, and as a binary STL its size does not match: the header says '//itoa(count)// &
+               & ' facets (84 + 50*'//itoa(count)//' = '//itoa(84 + 50*count)//' bytes), the file has '// &
+               & itoa(size)//' bytes (truncated or padded)', stat_invalid_input)
+         end if
       else if (size < 84) then
          call fatal_error(error, "'"//path//"': truncated: "//itoa(size)//' bytes, shorter than the 84-byte header '// &
             & 'of a binary STL, and not ASCII (it does not start with "solid")', stat_invalid_input)
@@ -142,6 +154,11 @@ contains
 
       call read_bytes(path, 1_i8, size, text, error)
       if (allocated(error)) return
+      ! Control bytes (other than tab, line and page ends) mark a binary file.
+      if (scan(text, control_bytes) > 0) then
+         call fatal_error(error, 'binary', -1)
+         return
+      end if
       allocate (vert(3, 0), grp(1, 0), names(0))
       pos = 1
       line = 0
