@@ -33,7 +33,7 @@ module sprc_geometry_facet_check
    implicit none
    private
 
-   public :: check_facets, facet_measures, facet_bounds, merge_vertices, group_measure
+   public :: check_facets, facet_measures, facet_bounds, merge_vertices, group_measure, cross
 
    !> Multiple of the rounding bound of a cross product below which a facet is
    !> refused as degenerate (see the module notes).
@@ -163,6 +163,7 @@ contains
       end if
    end function facet_size
 
+   !> The vector product a x b.
    pure function cross(a, b) result(c)
       real(wp), intent(in) :: a(3), b(3)
       real(wp) :: c(3)

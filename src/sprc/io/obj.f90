@@ -14,6 +14,7 @@ module sprc_io_obj
    use sprc_core_error, only: error_type, fatal_error
    use sprc_core_text, only: itoa
    use sprc_geometry_facets, only: facet_set_type
+   use sprc_geometry_facet_check, only: cross
    use sprc_io_facet_file, only: file_size, check_facet_memory, read_bytes, next_line, next_word, to_real, grow, &
       & group_of
    implicit none
@@ -232,11 +233,5 @@ contains
          end if
       end do
    end subroutine check_planar_convex
-
-   pure function cross(a, b) result(c)
-      real(wp), intent(in) :: a(3), b(3)
-      real(wp) :: c(3)
-      c = [a(2)*b(3) - a(3)*b(2), a(3)*b(1) - a(1)*b(3), a(1)*b(2) - a(2)*b(1)]
-   end function cross
 
 end module sprc_io_obj
