@@ -25,7 +25,8 @@
 !> outwards) is not detected: that needs an inside test of one piece in another.
 module sprc_geometry_facet_check
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-   use sprc_core_kinds, only: wp
+   use sprc_core_kinds, only: wp, i8
+   use sprc_core_alloc, only: check_allocation
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_sort, only: sort_order
    use sprc_core_text, only: itoa, real_text
@@ -62,8 +63,8 @@ contains
       end if
       call check_finite(set, error)
       if (allocated(error)) return
-      call merge_vertices(set)
-      call check_degenerate(set, error)
+      call merge_vertices(set, error)
+      if (.not. allocated(error)) call check_degenerate(set, error)
       if (allocated(error)) return
       call check_edges(set, error)
       if (set%dim == 2 .and. .not. allocated(error)) call check_crossings(set, error)
@@ -202,14 +203,17 @@ contains
 
    !> Merge vertices of equal coordinates (exactly; -0 equals 0) and renumber
    !> the facets; vertices no facet uses are kept.
-   subroutine merge_vertices(set)
+   subroutine merge_vertices(set, error)
       type(facet_set_type), intent(inout) :: set
+      type(error_type), allocatable, intent(out) :: error
       integer, allocatable :: order(:), id(:)
       real(wp), allocatable :: merged(:, :)
-      integer :: i, n
+      integer :: i, n, stat
 
       call lexicographic_order(set%vert(:, 1:set%nvert), set%dim, order)
-      allocate (id(set%nvert))
+      allocate (id(set%nvert), stat=stat)
+      call check_allocation(stat, 'facet vertex merge', 'vertex numbers', int(set%nvert, i8), 4, error)
+      if (allocated(error)) return
       n = 0
       do i = 1, set%nvert
          if (i == 1) then
@@ -219,7 +223,9 @@ contains
          end if
          id(order(i)) = n
       end do
-      allocate (merged(3, n))
+      allocate (merged(3, n), stat=stat)
+      call check_allocation(stat, 'facet vertex merge', 'merged vertices', 3_i8*n, 8, error)
+      if (allocated(error)) return
       merged(:, id) = set%vert(:, 1:set%nvert)
       call move_alloc(merged, set%vert)
       set%nvert = n
@@ -278,7 +284,8 @@ contains
       integer, allocatable :: key(:, :), owner(:), dir(:), order(:)
       integer :: first, last, worst_kind, worst_facet, worst_run, problem
 
-      call facet_edges(set, key, owner, dir)
+      call facet_edges(set, key, owner, dir, error)
+      if (allocated(error)) return
       call lexicographic_order(real(key, wp), 2, order)
       worst_kind = edge_ok
       worst_facet = huge(1)
@@ -311,12 +318,15 @@ contains
 
    !> The edges of all facets: `key(:, e)` the sorted vertex pair (2D: the
    !> vertex and 0), `owner(e)` its facet, `dir(e)` +1 or -1 by direction.
-   subroutine facet_edges(set, key, owner, dir)
+   subroutine facet_edges(set, key, owner, dir, error)
       type(facet_set_type), intent(in) :: set
       integer, allocatable, intent(out) :: key(:, :), owner(:), dir(:)
-      integer :: k, j, e, a, b
+      type(error_type), allocatable, intent(out) :: error
+      integer :: k, j, e, a, b, stat
 
-      allocate (key(2, set%dim*set%nfacet), owner(set%dim*set%nfacet), dir(set%dim*set%nfacet))
+      allocate (key(2, set%dim*set%nfacet), owner(set%dim*set%nfacet), dir(set%dim*set%nfacet), stat=stat)
+      call check_allocation(stat, 'facet edge matching', 'edges', int(set%dim, i8)*set%nfacet, 16, error)
+      if (allocated(error)) return
       e = 0
       do k = 1, set%nfacet
          do j = 1, set%dim

@@ -13,6 +13,7 @@ module sprc_io_obj
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error
    use sprc_core_text, only: itoa
+   use sprc_core_alloc, only: check_allocation
    use sprc_geometry_facets, only: facet_set_type
    use sprc_geometry_facet_check, only: cross
    use sprc_io_facet_file, only: file_size, check_facet_memory, read_bytes, next_line, next_word, to_real, grow, &
@@ -22,9 +23,11 @@ module sprc_io_obj
 
    public :: read_obj
 
-   !> Fewest bytes of a face or vertex statement ("f 1 2 3", "v 0 0 0" and
-   !> a line end): bounds the facet count.
-   integer, parameter :: obj_line_bytes = 8
+   !> Bytes of a short face or vertex statement ("f 11 12 13", "v 0 0.5 1"
+   !> and a line end): the facet count estimated from the file size (files of
+   !> one-digit indices hold up to twice as many; the bytes per facet of
+   !> `facet_bytes` are themselves an upper estimate).
+   integer, parameter :: obj_line_bytes = 16
 
    !> Faces as read: the vertex indices of all faces in one list.
    type :: face_list_type
@@ -164,10 +167,12 @@ contains
       type(face_list_type), intent(in) :: faces
       type(facet_set_type), intent(inout) :: set
       type(error_type), allocatable, intent(out) :: error
-      integer :: f, ntri, j, t
+      integer :: f, ntri, j, t, stat
 
       ntri = sum(faces%face(2, 1:faces%nface) - 2)
-      allocate (set%facet(3, ntri), set%group(ntri), set%file_index(ntri))
+      allocate (set%facet(3, ntri), set%group(ntri), set%file_index(ntri), stat=stat)
+      call check_allocation(stat, "read '"//path//"'", 'triangles', int(ntri, i8), 20, error)
+      if (allocated(error)) return
       t = 0
       do f = 1, faces%nface
          associate (ids => faces%index(1, faces%face(1, f):faces%face(1, f) + faces%face(2, f) - 1))
