@@ -517,6 +517,8 @@ contains
             call get_name(g, 'on', bc%on, error)
             if (allocated(error)) return
             bc%shape_index = shape_index(scene, bc%on)
+            call check_unambiguous(g, scene, bc%on, bc%shape_index, error)
+            if (allocated(error)) return
             if (bc%shape_index == 0) then
                call group_surface(scene%shapes, bc%on, bc%shape_index, bc%group, error)
                if (allocated(error)) then
@@ -559,6 +561,26 @@ contains
          end associate
       end do
    end subroutine read_bcs
+
+   !> A shape's name that is also a group of another shape's file could mean
+   !> either surface: refused. (A group named like its own shape is that
+   !> shape's whole surface when `on` names it.)
+   subroutine check_unambiguous(g, scene, name, k, error)
+      type(nml_group_type), intent(in) :: g
+      type(scene_type), intent(in) :: scene
+      character(len=*), intent(in) :: name
+      integer, intent(in) :: k
+      type(error_type), allocatable, intent(out) :: error
+      integer :: j
+      if (k == 0) return
+      do j = 1, size(scene%shapes)
+         if (j == k .or. .not. allocated(scene%shapes(j)%facets%group_name)) cycle
+         if (.not. any(scene%shapes(j)%facets%group_name == name)) cycle
+         call nml_field_error(g, 'on', "names shape '"//name//"' and a group of the file of shape '"// &
+            & scene%shapes(j)%name//"': rename one", error)
+         return
+      end do
+   end subroutine check_unambiguous
 
    !> The last of `bcs` against the earlier ones on its surface (their groups on
    !> lines `line_of`): a surface takes several &bc only as loads of one type
