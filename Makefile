@@ -28,7 +28,7 @@ help:
 	@echo "make run     install what is missing, build (release) and run the driver on its default scene"
 	@echo "make test    install what is missing and run the whole test suite"
 	@echo "make bench   benchmarks (sparse direct solvers, grid build, faceted solids, recovery on a caller's mesh)"
-	@echo "make fuzz    5000 seeded mutants of the example scenes through sprc check and run (FUZZ_COUNT, FUZZ_SEED)"
+	@echo "make fuzz    5000 seeded mutants of the example scenes (check, run) and of geometry files (check) (FUZZ_COUNT, FUZZ_SEED)"
 	@echo "make doc     the API reference and doc/ pages (FORD) in build/doc/index.html"
 	@echo "make build   build the release profile"
 	@echo "make lib     build/lib/libsprc.so and libsprc.a, Fortran modules in build/lib/mod"
@@ -58,6 +58,7 @@ FUZZ_SEED ?= 2
 fuzz: deps
 	$(FPM) build
 	@tools/fuzz-scenes --count $(FUZZ_COUNT) --seed $(FUZZ_SEED)
+	@tools/fuzz-facets --count $(FUZZ_COUNT) --seed $(FUZZ_SEED)
 
 bench: deps
 	@tools/bench-sparse

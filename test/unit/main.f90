@@ -14,6 +14,7 @@ program sprc_unit_tests
    use sprc_test_contact_surface, only: collect_contact_surface
    use sprc_test_namelist, only: collect_namelist
    use sprc_test_scene, only: collect_scene
+   use sprc_test_facet_files, only: collect_facet_files
    use sprc_test_geometry, only: collect_geometry
    use sprc_test_grid, only: collect_grid
    use sprc_test_adapt, only: collect_adapt
@@ -58,6 +59,7 @@ program sprc_unit_tests
       new_testsuite('contact_surface', collect_contact_surface), &
       new_testsuite('namelist', collect_namelist), &
       new_testsuite('scene', collect_scene), &
+      new_testsuite('facet_files', collect_facet_files), &
       new_testsuite('geometry', collect_geometry), &
       new_testsuite('grid', collect_grid), &
       new_testsuite('adapt', collect_adapt), &

@@ -16,6 +16,7 @@ module sprc_io_scene
       & contact_spec_type, recovery_degree, default_stabilization, contact_unsupported, default_max_level, &
       & contact_components
    use sprc_grid_tree, only: grid_max_level
+   use sprc_io_scene_facets, only: load_facets, facet_kind, facet_summary, group_surface
    use sprc_io_namelist, only: nml_group_type, parse_namelist, read_text_file, nml_get, nml_get_array, &
       & nml_has, nml_check_consumed, nml_field_error, nml_group_error, nml_item_text
    implicit none
@@ -29,7 +30,8 @@ module sprc_io_scene
    character(len=*), parameter :: scene_keys = 'title analysis order levels refine_boundary box_min box_size '// &
       & 'recovery recovery_degree output dilatation nitsche_gamma solver'
    character(len=*), parameter :: body_keys = 'name young poisson body_force box_min box_size'
-   character(len=*), parameter :: shape_fields = 'center radius semi_axes lower upper point normal axis'
+   character(len=*), parameter :: shape_fields = 'center radius semi_axes lower upper point normal axis '// &
+      & 'file scale translate points'
    character(len=*), parameter :: shape_keys = 'body op kind name '//shape_fields
    character(len=*), parameter :: bc_fields = 'value vector'
    character(len=*), parameter :: bc_keys = 'on type stage '//bc_fields
@@ -47,7 +49,7 @@ module sprc_io_scene
    character(len=*), parameter :: recovery_degrees = 'auto p p+1'
    character(len=*), parameter :: dilatations = 'auto full projected'
    character(len=*), parameter :: ops = 'add subtract intersect'
-   character(len=*), parameter :: shape_kinds = 'disk sphere ellipse ellipsoid box halfspace cylinder'
+   character(len=*), parameter :: shape_kinds = 'disk sphere ellipse ellipsoid box halfspace cylinder stl obj polygon'
    character(len=*), parameter :: bc_types = 'free pressure traction displacement symmetry exact_traction '// &
       & 'exact_displacement'
    character(len=*), parameter :: exact_kinds = 'lame_cylinder lame_sphere kirsch uniform compound_cylinder '// &
@@ -377,6 +379,7 @@ contains
                end if
             end do
             call read_shape_fields(g, scene%dim, shape, error)
+            if (.not. allocated(error) .and. facet_kind(shape%kind)) call read_facet_fields(g, scene, shape, error)
             if (allocated(error)) return
             call nml_check_consumed(g, error)
             if (allocated(error)) return
@@ -405,6 +408,7 @@ contains
       case ('ellipse', 'ellipsoid'); fields = 'center semi_axes'
       case ('box'); fields = 'lower upper'
       case ('halfspace'); fields = 'point normal'
+      case ('stl', 'obj', 'polygon'); return
       case default; fields = 'point axis radius'
       end select
       call check_fields(g, shape_fields, fields, '', "kind = '"//shape%kind//"'", error)
@@ -441,13 +445,51 @@ contains
       if (has_word(fields, 'axis')) call get_direction(g, 'axis', dim, shape%axis, error)
    end subroutine read_shape_fields
 
+   !> Fields of a faceted shape (stl, obj: `file`; polygon: `points` or
+   !> `file`; all: `scale`, `translate`), then its surface read, placed and
+   !> validated. A relative `file` is relative to the scene file's directory.
+   subroutine read_facet_fields(g, scene, shape, error)
+      type(nml_group_type), intent(inout) :: g
+      type(scene_type), intent(in) :: scene
+      type(shape_spec_type), intent(inout) :: shape
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: why
+      integer :: stat
+      logical :: found
+
+      if (shape%kind == 'polygon') then
+         call check_fields(g, shape_fields, '', 'points file scale translate', "kind = 'polygon'", error)
+         if (.not. allocated(error) .and. (nml_has(g, 'points') .eqv. nml_has(g, 'file'))) &
+            & call nml_group_error(g, "kind = 'polygon' takes either points = x1,y1, x2,y2, ... or file = '...'", error)
+      else
+         call check_fields(g, shape_fields, 'file', 'scale translate', "kind = '"//shape%kind//"'", error)
+      end if
+      if (allocated(error)) return
+      if (nml_has(g, 'file')) then
+         call nml_get(g, 'file', shape%file, found, error)
+         if (.not. allocated(error) .and. len_trim(shape%file) == 0) call nml_field_error(g, 'file', 'is empty', error)
+      end if
+      if (.not. allocated(error) .and. nml_has(g, 'points')) &
+         & call nml_get_array(g, 'points', shape%points, 2, huge(1), found, error)
+      if (.not. allocated(error)) call get_positive(g, 'scale', .false., shape%scale, error)
+      if (.not. allocated(error)) call get_vector(g, 'translate', scene%dim, .false., shape%translate, error)
+      if (allocated(error)) return
+      if (.not. allocated(shape%translate)) allocate (shape%translate(scene%dim), source=0.0_wp)
+      call load_facets(scene%source, shape, error)
+      if (.not. allocated(error)) return
+      why = error%message
+      stat = error%stat
+      call nml_field_error(g, trim(merge('file  ', 'points', nml_has(g, 'file'))), why, error, stat)
+   end subroutine read_facet_fields
+
    !> Dimension of a shape kind; 0 for kinds valid in 2D and 3D.
    pure integer function kind_dim(kind)
       character(len=*), intent(in) :: kind
       select case (kind)
       case ('disk', 'ellipse', 'lame_cylinder', 'kirsch', 'compound_cylinder', 'layered_cylinder', 'hertz_cylinder', &
-         & 'corner'); kind_dim = 2
-      case ('sphere', 'ellipsoid', 'cylinder', 'lame_sphere', 'compound_sphere', 'layered_sphere', 'hertz_sphere')
+         & 'corner', 'polygon'); kind_dim = 2
+      case ('sphere', 'ellipsoid', 'cylinder', 'lame_sphere', 'compound_sphere', 'layered_sphere', 'hertz_sphere', &
+         & 'stl', 'obj')
          kind_dim = 3
       case default; kind_dim = 0
       end select
@@ -461,7 +503,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer :: ig, n
       integer, allocatable :: line_of(:)
-      character(len=:), allocatable :: fields
+      character(len=:), allocatable :: fields, why
       logical :: found
 
       allocate (scene%bcs(count_groups(groups, 'bc')))
@@ -476,9 +518,15 @@ contains
             call get_name(g, 'on', bc%on, error)
             if (allocated(error)) return
             bc%shape_index = shape_index(scene, bc%on)
+            call check_unambiguous(g, scene, bc%on, bc%shape_index, error)
+            if (allocated(error)) return
             if (bc%shape_index == 0) then
-               call nml_field_error(g, 'on', 'no &shape has this name; surfaces: '//shape_names(scene), error)
-               return
+               call group_surface(scene%shapes, bc%on, bc%shape_index, bc%group, error)
+               if (allocated(error)) then
+                  why = error%message
+                  call nml_field_error(g, 'on', why//'; surfaces: '//shape_names(scene), error)
+                  return
+               end if
             end if
             line_of(n) = g%line
             call get_choice(g, 'type', bc_types, .true., bc%type, error)
@@ -515,6 +563,26 @@ contains
       end do
    end subroutine read_bcs
 
+   !> A shape's name that is also a group of another shape's file could mean
+   !> either surface: refused. (A group named like its own shape is that
+   !> shape's whole surface when `on` names it.)
+   subroutine check_unambiguous(g, scene, name, k, error)
+      type(nml_group_type), intent(in) :: g
+      type(scene_type), intent(in) :: scene
+      character(len=*), intent(in) :: name
+      integer, intent(in) :: k
+      type(error_type), allocatable, intent(out) :: error
+      integer :: j
+      if (k == 0) return
+      do j = 1, size(scene%shapes)
+         if (j == k .or. .not. allocated(scene%shapes(j)%facets%group_name)) cycle
+         if (.not. any(scene%shapes(j)%facets%group_name == name)) cycle
+         call nml_field_error(g, 'on', "names shape '"//name//"' and a group of the file of shape '"// &
+            & scene%shapes(j)%name//"': rename one", error)
+         return
+      end do
+   end subroutine check_unambiguous
+
    !> The last of `bcs` against the earlier ones on its surface (their groups on
    !> lines `line_of`): a surface takes several &bc only as loads of one type
    !> (pressure, traction or displacement), each in its own stage; their loads
@@ -529,6 +597,8 @@ contains
       n = size(bcs)
       do j = 1, n - 1
          if (bcs(j)%shape_index /= bcs(n)%shape_index) cycle
+         ! Two groups of one file are two surfaces; a group is part of the whole.
+         if (bcs(j)%group /= bcs(n)%group .and. bcs(j)%group > 0 .and. bcs(n)%group > 0) cycle
          if (bcs(j)%type /= bcs(n)%type .or. .not. any(bcs(n)%type == [character(len=12) :: 'pressure', &
             & 'traction', 'displacement'])) then
             call nml_field_error(g, 'on', "this surface already has a &bc of type = '"//bcs(j)%type// &
@@ -1309,15 +1379,20 @@ contains
       end do
    end function body_names
 
+   !> The surfaces `&bc on` may name: shapes, then the groups of faceted shapes.
    function shape_names(scene) result(text)
       type(scene_type), intent(in) :: scene
       character(len=:), allocatable :: text
-      integer :: k
+      integer :: k, i
       text = ''
       do k = 1, size(scene%shapes)
          if (.not. allocated(scene%shapes(k)%name)) cycle
          if (len(text) > 0) text = text//', '
          text = text//"'"//scene%shapes(k)%name//"'"
+         if (.not. allocated(scene%shapes(k)%facets%group_name)) cycle
+         do i = 1, size(scene%shapes(k)%facets%group_name)
+            text = text//", '"//trim(scene%shapes(k)%facets%group_name(i))//"'"
+         end do
       end do
    end function shape_names
 
@@ -1354,7 +1429,14 @@ contains
             text = text//nl
          end associate
          do j = 1, size(scene%shapes)
-            if (scene%shapes(j)%body_index == i) text = text//'  '//shape_line(scene%shapes(j))//nl
+            if (scene%shapes(j)%body_index /= i) cycle
+            text = text//'  '//shape_line(scene%shapes(j))//nl
+            if (.not. facet_kind(scene%shapes(j)%kind)) cycle
+            if (scene%bodies(i)%has_box) then
+               text = text//facet_summary(scene%shapes(j), scene%bodies(i)%box_min, scene%bodies(i)%box_size)
+            else
+               text = text//facet_summary(scene%shapes(j), scene%box_min, scene%box_size)
+            end if
          end do
       end do
       text = text//'boundary conditions:'//nl
@@ -1617,6 +1699,10 @@ contains
       if (allocated(shape%upper)) text = text//', upper = '//real_list(shape%upper)
       if (allocated(shape%normal)) text = text//', normal = '//real_list(shape%normal)
       if (allocated(shape%axis)) text = text//', axis = '//real_list(shape%axis)
+      if (allocated(shape%file)) text = text//", file = '"//shape%file//"'"
+      if (allocated(shape%points)) text = text//', points = '//real_list(shape%points)
+      if (allocated(shape%translate)) text = text//', scale = '//real_text(shape%scale)//', translate = '// &
+         & real_list(shape%translate)
       select case (shape%kind)
       case ('disk', 'sphere', 'cylinder'); text = text//', radius = '//real_text(shape%radius)
       end select

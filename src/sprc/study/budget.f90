@@ -52,7 +52,7 @@ module sprc_study_budget
    implicit none
    private
 
-   public :: level_memory, check_level_memory, check_coupled_memory, coupled_memory
+   public :: level_memory, check_level_memory, check_coupled_memory, coupled_memory, memory_check_wanted
 
    real(wp), parameter :: base_bytes = 32.0e6_wp, per_dof_2d = 2.5e3_wp, per_dof_3d = 1.0e4_wp, &
       & dofs_3d = 3.0e4_wp, q2_factor_3d = 1.75_wp, per_dof_3d_iterative = 8.0e3_wp

@@ -11,7 +11,7 @@ module sprc_study_model
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_unsupported
    use sprc_core_material, only: plane_stress, plane_strain, solid
    use sprc_geometry_shape, only: shape_type, new_disk, new_sphere, new_ellipse, &
-      & new_ellipsoid, new_box, new_halfspace, new_cylinder
+      & new_ellipsoid, new_box, new_halfspace, new_cylinder, new_facet_shape
    use sprc_geometry_body, only: body_type, new_body, csg_op_from_name, check_body_in_box
    use sprc_exact_solution, only: exact_solution_type
    use sprc_exact_lame, only: lame_cylinder_type, lame_sphere_type, new_lame_cylinder, new_lame_sphere
@@ -22,7 +22,7 @@ module sprc_study_model
    use sprc_exact_hertz, only: hertz_type, new_hertz_cylinder, new_hertz_sphere
    use sprc_exact_corner, only: corner_type, new_corner
    use sprc_core_text, only: itoa, real_text
-   use sprc_study_spec, only: scene_type, shape_spec_type, kappa_note, exact_spec_type, contact_spec_type
+   use sprc_study_spec, only: scene_type, shape_spec_type, bc_spec_type, kappa_note, exact_spec_type, contact_spec_type
    use sprc_fem_bc, only: fe_bc_type, new_fe_bc, bc_kind_from_name
    use sprc_fem_problem, only: gamma_note
    implicit none
@@ -173,6 +173,11 @@ contains
       integer :: i
 
       text = ''
+      do i = 1, size(scene%shapes)
+         if (.not. allocated(scene%shapes(i)%note)) cycle
+         if (len(scene%shapes(i)%note) > 0) text = text//"warning: shape '"//scene%shapes(i)%name//"': "// &
+            & scene%shapes(i)%note//new_line('a')
+      end do
       load = 0.0_wp
       do i = 1, size(scene%bodies)
          if (allocated(scene%bodies(i)%body_force)) load = max(load, maxval([0.0_wp, abs(scene%bodies(i)%body_force)]))
@@ -444,6 +449,8 @@ contains
       case ('box'); call new_box(shape, spec%name, spec%lower, spec%upper, error)
       case ('halfspace'); call new_halfspace(shape, spec%name, spec%point, spec%normal, error)
       case ('cylinder'); call new_cylinder(shape, spec%name, spec%point, spec%axis, spec%radius, error)
+      case ('stl', 'obj', 'polygon')
+         call new_facet_shape(shape, spec%name, spec%facets, error)
       case default
          call fatal_error(error, 'unknown shape kind '''//spec%kind//'''', stat_invalid_input)
       end select
@@ -468,8 +475,11 @@ contains
       last = huge(1)
       if (present(stage)) last = stage
       do i = 1, size(scene%bcs)
-         first(i) = scene%shapes(scene%bcs(i)%shape_index)%body_index == b .and. &
-            & .not. any(scene%bcs(1:i - 1)%shape_index == scene%bcs(i)%shape_index)
+         first(i) = scene%shapes(scene%bcs(i)%shape_index)%body_index == b
+         do j = 1, i - 1
+            if (bc_surface(scene, scene%bcs(j)) == bc_surface(scene, scene%bcs(i)) .and. &
+               & scene%shapes(scene%bcs(j)%shape_index)%body_index == b) first(i) = .false.
+         end do
       end do
       allocate (bcs(count(first)))
       n = 0
@@ -478,21 +488,41 @@ contains
          n = n + 1
          associate (bc => scene%bcs(i))
             if (allocated(bc%vector)) then
-               bcs(n) = new_fe_bc(scene%shapes(bc%shape_index)%body_shape, bc_kind_from_name(bc%type), 0.0_wp, &
-                  & 0.0_wp*bc%vector)
+               bcs(n) = new_fe_bc(bc_surface(scene, bc), bc_kind_from_name(bc%type), 0.0_wp, 0.0_wp*bc%vector)
             else
-               bcs(n) = new_fe_bc(scene%shapes(bc%shape_index)%body_shape, bc_kind_from_name(bc%type), 0.0_wp)
+               bcs(n) = new_fe_bc(bc_surface(scene, bc), bc_kind_from_name(bc%type), 0.0_wp)
             end if
          end associate
          do j = i, size(scene%bcs)
             associate (bc => scene%bcs(j))
-               if (bc%shape_index /= scene%bcs(i)%shape_index .or. bc%stage > last) cycle
+               if (bc_surface(scene, bc) /= bc_surface(scene, scene%bcs(i)) .or. bc%stage > last) cycle
+               if (scene%shapes(bc%shape_index)%body_index /= b) cycle
                bcs(n)%value = bcs(n)%value + bc%value
                if (allocated(bc%vector)) bcs(n)%vector = bcs(n)%vector + bc%vector
             end associate
          end do
       end do
    end subroutine body_conditions
+
+   !> The body's surface id a condition acts on (sprc_geometry_body, module
+   !> notes): its shape's index in the body, or for a group of a faceted shape
+   !> the id after the body's shapes and the groups of the shapes before it.
+   pure integer function bc_surface(scene, bc) result(id)
+      type(scene_type), intent(in) :: scene
+      type(bc_spec_type), intent(in) :: bc
+      integer :: k, body
+
+      id = scene%shapes(bc%shape_index)%body_shape
+      if (bc%group <= 0) return
+      body = scene%shapes(bc%shape_index)%body_index
+      id = count(scene%shapes%body_index == body)
+      do k = 1, size(scene%shapes)
+         if (scene%shapes(k)%body_index /= body) cycle
+         if (scene%shapes(k)%body_shape >= scene%shapes(bc%shape_index)%body_shape) cycle
+         if (allocated(scene%shapes(k)%facets%group_name)) id = id + size(scene%shapes(k)%facets%group_name)
+      end do
+      id = id + bc%group
+   end function bc_surface
 
    !> Whether the scene's exact solution has a stress field (every kind but
    !> hertz_*, which give the contact pressure only): the energy-norm error

@@ -7,6 +7,7 @@ module sprc_study_spec
    use sprc_core_kinds, only: wp
    use sprc_core_text, only: real_text, itoa
    use sprc_recovery_patch_loop, only: auto_degree
+   use sprc_geometry_facets, only: facet_set_type
    implicit none
    private
 
@@ -66,7 +67,8 @@ module sprc_study_spec
       integer :: body_shape = 0
       !> 'add' | 'subtract' | 'intersect'.
       character(len=:), allocatable :: op
-      !> 'disk' | 'sphere' | 'ellipse' | 'ellipsoid' | 'box' | 'halfspace' | 'cylinder'.
+      !> 'disk' | 'sphere' | 'ellipse' | 'ellipsoid' | 'box' | 'halfspace' | 'cylinder' |
+      !> 'stl' | 'obj' | 'polygon' (the faceted kinds).
       character(len=:), allocatable :: kind
       !> Unique non-empty name of the surface.
       character(len=:), allocatable :: name
@@ -84,6 +86,18 @@ module sprc_study_spec
       real(wp), allocatable :: normal(:)
       !> Unit axis direction (cylinder).
       real(wp), allocatable :: axis(:)
+      !> Geometry file (stl, obj, polygon) as the scene gives it.
+      character(len=:), allocatable :: file
+      !> Faceted kinds: x -> scale*x + translate applied to the file's vertices.
+      real(wp) :: scale = 1.0_wp
+      real(wp), allocatable :: translate(:)
+      !> Vertices x1, y1, x2, y2, ... (polygon without a file).
+      real(wp), allocatable :: points(:)
+      !> Faceted kinds: the validated closed surface, placed and oriented outwards;
+      !> its groups are surfaces of their own for `&bc on`.
+      type(facet_set_type) :: facets
+      !> '' or a note for the user from the validation (a surface flipped outwards).
+      character(len=:), allocatable :: note
    end type shape_spec_type
 
    !> A boundary condition on one shape surface.
@@ -92,6 +106,9 @@ module sprc_study_spec
       character(len=:), allocatable :: on
       !> Index of that shape in `scene%shapes`.
       integer :: shape_index = 0
+      !> A group of a faceted shape (index in its `facets%group_name`) when `on`
+      !> names one; 0 when `on` names the shape's whole surface.
+      integer :: group = 0
       !> 'free' | 'pressure' | 'traction' | 'displacement' | 'symmetry' |
       !> 'exact_traction' | 'exact_displacement'.
       character(len=:), allocatable :: type
