@@ -119,54 +119,60 @@ contains
    end subroutine test_shrink_fit_example
 
    !> For both rings, built in their own analysis units and converted back to
-   !> the scene's: sigma_rr(c) = -p_c with p_c = `reference`*`scale` (within
-   !> half a unit of its 7th digit), sigma_rr = -p_in at the bore, sigma_rr = 0
-   !> at r_out, u_o(c) - u_i(c) = delta; and the exact pressure of the pair at
-   !> the interface is p_c.
+   !> the scene's, on the real radii (doc/scene.md compound_cylinder: the inner
+   !> ring ends at its surface r_s = c + delta, the outer's bore at c):
+   !> sigma_rr(r_s) = -p_s on the inner ring, sigma_rr(c) = -p_m on the outer
+   !> with equal forces p_s r_s = p_m c, the gap closed (c + u_o(c) = r_s +
+   !> u_i(r_s)), sigma_rr = -p_in at the bore, 0 at r_out, and the exact pressure
+   !> of the pair on the slave's surface is p_s. p_s agrees with the nominal
+   !> closed form's p_c = `reference`*`scale` (by hand, at r_s = c) to first
+   !> order in delta/c: within 2 delta/c relative.
    subroutine check_compound(scene, reference, scale, error)
       type(scene_type), intent(in) :: scene
       real(wp), intent(in) :: reference, scale
       type(error_type), allocatable, intent(out) :: error
       class(exact_solution_type), allocatable :: inner, outer
       class(exact_pressure_type), allocatable :: pressure
-      real(wp) :: s_unit(2), u_unit(2), sigma(3), ui(2), uo(2), p_c, c, x(2)
+      real(wp) :: s_unit(2), u_unit(2), sigma(3), ui(2), uo(2), p_s, p_m, c, rs, xs(2), xm(2), x(2)
 
       c = scene%exact%r_contact
-      x = scene%exact%center + [c, 0.0_wp]
+      rs = c + scene%exact%interference
+      xs = scene%exact%center + [rs, 0.0_wp]
+      xm = scene%exact%center + [c, 0.0_wp]
       call body_exact(scene, scene%exact%inner_index, inner, s_unit(1), u_unit(1), error)
       if (allocated(error)) return
       call body_exact(scene, scene%exact%outer_index, outer, s_unit(2), u_unit(2), error)
       if (allocated(error)) return
-      call inner%stress(x, sigma)
-      p_c = -s_unit(1)*sigma(1)
-      call check(error, abs(p_c - reference*scale) <= 0.5e-10_wp*scale, 'interface pressure of the inner ring')
+      call inner%stress(xs, sigma)
+      p_s = -s_unit(1)*sigma(1)
+      call check(error, abs(p_s - reference*scale) <= 2.0_wp*scene%exact%interference/c*reference*scale, &
+         & 'interface pressure of the inner ring against the nominal closed form')
       if (allocated(error)) return
-      call outer%stress(x, sigma)
-      call check(error, -s_unit(2)*sigma(1), p_c, roundoff, 'interface pressure of the outer ring', rel=.true.)
+      call outer%stress(xm, sigma)
+      p_m = -s_unit(2)*sigma(1)
+      call check(error, p_m*c, p_s*rs, roundoff, 'equal forces on the two surfaces', rel=.true.)
       if (allocated(error)) return
       call inner%stress(scene%exact%center + [scene%exact%r_in, 0.0_wp], sigma)
-      call check(error, abs(s_unit(1)*sigma(1) + scene%exact%p_in) <= roundoff*p_c, 'p_in at the bore')
+      call check(error, abs(s_unit(1)*sigma(1) + scene%exact%p_in) <= roundoff*p_s, 'p_in at the bore')
       if (allocated(error)) return
       call outer%stress(scene%exact%center + [scene%exact%r_out, 0.0_wp], sigma)
-      call check(error, abs(s_unit(2)*sigma(1)) <= roundoff*p_c, 'free outer surface')
+      call check(error, abs(s_unit(2)*sigma(1)) <= roundoff*p_s, 'free outer surface')
       if (allocated(error)) return
-      call inner%displacement(x, ui)
-      call outer%displacement(x, uo)
+      call inner%displacement(xs, ui)
+      call outer%displacement(xm, uo)
       call check(error, u_unit(2)*uo(1) - u_unit(1)*ui(1), scene%exact%interference, roundoff, &
-         & 'u_o(c) - u_i(c) = interference', rel=.true.)
+         & 'u_o(c) - u_i(c + delta) = interference: the gap closed', rel=.true.)
       if (allocated(error)) return
       call build_exact_pressure(scene, 1, pressure, error)
       if (allocated(error)) return
       call check(error, allocated(pressure), 'exact pressure of the pair')
       if (allocated(error)) return
-      ! The slave (shaft = inner) normal at (c, 0) is +x.
-      call check(error, pressure%pressure(x, [1.0_wp, 0.0_wp]), p_c, roundoff, 'exact contact pressure', rel=.true.)
+      ! The slave (shaft = inner) normal at its surface point on the x axis is +x.
+      call check(error, pressure%pressure(xs, [1.0_wp, 0.0_wp]), p_s, roundoff, 'exact contact pressure', rel=.true.)
       if (allocated(error)) return
-      ! The slave points of an interference fit lie at r = c + delta, off the
-      ! closed form's interface; the pressure there is still p_c.
-      x = scene%exact%center + (c + 10.0_wp*scene%exact%interference)*[0.6_wp, 0.8_wp]
-      call check(error, pressure%pressure(x, [0.6_wp, 0.8_wp]), p_c, roundoff, &
-         & 'exact contact pressure at a slave point off the interface', rel=.true.)
+      x = scene%exact%center + rs*[0.6_wp, 0.8_wp]
+      call check(error, pressure%pressure(x, [0.6_wp, 0.8_wp]), p_s, roundoff, &
+         & 'exact contact pressure at another slave point', rel=.true.)
    end subroutine check_compound
 
    !> Issue 11's ring pair, one material (E, nu = 0.3), p_in = 0, in `analysis`.
@@ -414,7 +420,9 @@ contains
       if (allocated(error)) return
       call fill_contact_exact(scene, contacts, error)
       if (allocated(error)) return
-      call check(error, maxval(abs(contacts(1)%p_exact - 3.923350_wp)) <= 0.5e-6_wp, 'p_c at both points')
+      ! the nominal closed form's p_c by hand; the real radii move it by O(delta/c)
+      call check(error, maxval(abs(contacts(1)%p_exact - 3.923350_wp)) <= 2.0_wp*0.002_wp/20.0_wp*3.923350_wp, &
+         & 'p_c at both points')
       if (allocated(error)) return
       call read_scene('test/data/scenes/valid/contact_punch.nml', scene, error)
       if (allocated(error)) return
