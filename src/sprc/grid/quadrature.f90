@@ -699,8 +699,8 @@ contains
       integer, intent(in) :: s, m
       real(wp), intent(in) :: side, xf, flo(:), fhi(:)
       logical, intent(out) :: on, inside_on_cell_side
-      real(wp) :: tol
-      integer :: i, cover
+      real(wp) :: tol, inner_sign
+      integer :: cover
 
       on = .false.
       inside_on_cell_side = .false.
@@ -711,20 +711,9 @@ contains
             cover = face_cover(sh%solid, flo, fhi, m, nint(side))
             on = cover /= 0
             inside_on_cell_side = cover > 0
-         case (shape_halfspace)
-            do i = 1, body%dim
-               if (i /= m .and. sh%normal(i) /= 0.0_wp) return
-            end do
-            on = abs(sh%point(m) - xf) <= tol
-            inside_on_cell_side = sh%normal(m)*side > 0.0_wp
-         case (shape_box)
-            if (abs(sh%upper(m) - xf) <= tol) then
-               on = .true.
-               inside_on_cell_side = side > 0.0_wp
-            else if (abs(sh%lower(m) - xf) <= tol) then
-               on = .true.
-               inside_on_cell_side = side < 0.0_wp
-            end if
+         case (shape_halfspace, shape_box)
+            call plane_relation(body, s, m, xf, tol, on, inner_sign)
+            inside_on_cell_side = on .and. inner_sign*side < 0.0_wp
          end select
       end associate
    end subroutine on_face_plane
@@ -771,7 +760,7 @@ contains
       logical :: on
       real(wp) :: inner_sign
 
-      call plane_relation(body, k, m, x, on, inner_sign)
+      call plane_relation(body, k, m, x(m), snap_tolerance(body%shapes(k), x, x), on, inner_sign)
       if (on) then
          g = plane_value(body, k, m, x, inner_sign*toward > 0.0_wp)
       else
@@ -779,34 +768,32 @@ contains
       end if
    end function one_sided_phi
 
-   !> Whether shape k's surface lies on the plane x_m = x(m) (a halfspace with
-   !> normal +-e_m or a box face, within the snapping tolerance), and on which
-   !> side its inside lies (inner_sign +1: towards +x_m).
-   pure subroutine plane_relation(body, k, m, x, on, inner_sign)
+   !> Whether shape k's surface lies on the plane x_m = xm (a halfspace with
+   !> normal +-e_m or a box face, within `tol`), and on which side its inside
+   !> lies (inner_sign +1: towards +x_m).
+   pure subroutine plane_relation(body, k, m, xm, tol, on, inner_sign)
       class(body_type), intent(in) :: body
       integer, intent(in) :: k, m
-      real(wp), intent(in) :: x(:)
+      real(wp), intent(in) :: xm, tol
       logical, intent(out) :: on
       real(wp), intent(out) :: inner_sign
-      real(wp) :: tol
       integer :: i
 
       on = .false.
       inner_sign = 0.0_wp
-      tol = snap_tolerance(body%shapes(k), x, x)
       associate (sh => body%shapes(k))
          select case (sh%kind)
          case (shape_halfspace)
             do i = 1, body%dim
                if (i /= m .and. sh%normal(i) /= 0.0_wp) return
             end do
-            on = abs(sh%point(m) - x(m)) <= tol
+            on = abs(sh%point(m) - xm) <= tol
             inner_sign = -sign(1.0_wp, sh%normal(m))
          case (shape_box)
-            if (abs(sh%upper(m) - x(m)) <= tol) then
+            if (abs(sh%upper(m) - xm) <= tol) then
                on = .true.
                inner_sign = -1.0_wp
-            else if (abs(sh%lower(m) - x(m)) <= tol) then
+            else if (abs(sh%lower(m) - xm) <= tol) then
                on = .true.
                inner_sign = 1.0_wp
             end if
@@ -839,7 +826,7 @@ contains
             wins = body%shapes(k)%kind == shape_box
          end if
          if (.not. wins) cycle
-         call plane_relation(body, k, m, x, on, inner_sign)
+         call plane_relation(body, k, m, x(m), snap_tolerance(body%shapes(k), x, x), on, inner_sign)
          if (on) own = .not. plane_value(body, k, m, x, .true.) < 0.0_wp
       end do
    end function own_face
