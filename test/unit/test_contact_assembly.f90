@@ -1,6 +1,6 @@
 !> Tests of contact assemblies: several `&contact` pairs solved as one
 !> coupled system per component of the contact graph (sprc_study_level,
-!> sprc_contact_solve's solve_contact_assembly).
+!> sprc_contact_pair_solve's solve_contact_assembly).
 !>
 !> - A stack of three blocks of different materials on offset grids, the
 !>   middle one the slave of one pair and the master of the other, under a
@@ -11,7 +11,7 @@
 !>   too. The middle block (0.3 tall, cells 0.36 at level 2) has vertex
 !>   patches holding contact points of both pairs (10 at levels 2 and 3),
 !>   where one pair's coupled contact patch wins and the other's points are
-!>   left out (sprc_grid_patches): keeping them fails Q2 (the patch's
+!>   left out (sprc_estimate_patches): keeping them fails Q2 (the patch's
 !>   contact normals cancel), letting the pair with fewer points win fails
 !>   Q1.
 !> - Three concentric rings with two interference fits and a bore pressure

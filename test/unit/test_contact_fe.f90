@@ -1,4 +1,4 @@
-!> Tests of the contact FE (sprc_contact_solve through the study layer).
+!> Tests of the contact FE (sprc_contact_pair_solve through the study layer).
 !>
 !> Patch test (issue 11 acceptance): two blocks of different materials on
 !> non-matching, offset grids with a flat interface that cuts cells, uniform
@@ -444,7 +444,7 @@ contains
       ! error of the stresses (measured: 0.5 and 0.4 times it at the finest level).
       call check(error, perr(n) <= err(n), 'pressure error '//real_text(perr(n))//' > err_fe '//real_text(err(n)))
       if (allocated(error)) return
-      ! With a stable multiplier space (sprc_contact_solve: macro cells) the a
+      ! With a stable multiplier space (sprc_contact_pair_solve: macro cells) the a
       ! priori estimate h^(1/2) |lambda - lambda_h|_L2 <= C h^p gives a rate of
       ! at least 1/2 for the L2 pressure error; a checkerboard mode stalls it.
       rate = log(perr(n - 2)/perr(n))/log(real(2**(levels(n) - levels(n - 2)), wp))
@@ -683,7 +683,7 @@ contains
       s = trim(adjustl(buf))
    end function real_text
 
-   !> The patch tests with the recovered stabilization (sprc_contact_solve
+   !> The patch tests with the recovered stabilization (sprc_contact_pair_solve
    !> notes): the uniform state is its fixed point (the SPR-C traction of a
    !> uniform FE field is exact, so gbar = 0 and lambda = p*), reached from
    !> the penalty start. Tolerance: the solve's C eps/rcond plus the

@@ -1,4 +1,4 @@
-!> The friction laws against closed forms (sprc_contact_solve).
+!> The friction laws against closed forms (sprc_contact_pair_solve).
 !>
 !> A shrink fit (the compound cylinder in 2D, quarter model; the compound
 !> sphere in 3D, octant) is axisymmetric: the interface carries no shear, so
@@ -219,7 +219,7 @@ contains
    !> frictionless ring in a ring is free): the translation along x. Each
    !> holds from the first active set: the run succeeds in one active-set
    !> iteration with every slave point closed and the pressure compressive
-   !> everywhere. The cells' turn limit (sprc_contact_solve) makes it hold;
+   !> everywhere. The cells' turn limit (sprc_contact_pair_solve) makes it hold;
    !> before it, "body 'shaft' is not held".
    subroutine test_closed_fit_2d(error)
       type(error_type), allocatable, intent(out) :: error

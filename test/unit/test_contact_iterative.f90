@@ -1,4 +1,4 @@
-!> The iterative solve of contact pairs (sprc_contact_solve: CG or GMRES +
+!> The iterative solve of contact pairs (sprc_contact_pair_solve: CG or GMRES +
 !> the bodies' stacked multigrid hierarchies) against the direct one.
 !>
 !> Each case runs a scene with `solver = 'direct'` and `solver = 'iterative'`

@@ -1,4 +1,4 @@
-!> Tests of the SPR-C contact recovery on the caller's meshes (sprc_contact_mesh_recovery).
+!> Tests of the SPR-C contact recovery on the caller's meshes (sprc_contact_caller_mesh_recovery).
 !>
 !> Two bodies on non-matching meshes: the lattice cases of sprc_test_mesh_recovery (vertex
 !> perturbation, planar sides) with m and m + 1 cells per side, body 1 (slave) below the
@@ -26,10 +26,10 @@ module sprc_test_contact_mesh
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type
    use sprc_core_error, only: stat_invalid_input
    use sprc_core_text, only: rtoa
-   use sprc_recovery_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, mesh_method_sprc, &
+   use sprc_recovery_caller_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, mesh_method_sprc, &
       & elem_tri3, elem_quad4, elem_tet4, elem_hex8, elem_quad9, elem_hex27
    use sprc_recovery_operators, only: traction_operator
-   use sprc_contact_mesh_recovery, only: contact_body_type, contact_pair_type, mesh_contact_recovery_type, &
+   use sprc_contact_caller_mesh_recovery, only: contact_body_type, contact_pair_type, mesh_contact_recovery_type, &
       & recover_contact_on_mesh, contact_law_frictionless, contact_law_slip, contact_law_stick
    use sprc_test_mesh_recovery, only: case_type, build_case, node_id
    use sprc_legacy, only: sprc_recover_contact_mesh

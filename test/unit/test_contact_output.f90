@@ -8,7 +8,7 @@ module sprc_test_contact_output
    use sprc_core_error, only: stat_io
    use sprc_core_text, only: itoa
    use sprc_contact_result, only: contact_result_type, new_contact_result, contact_stick
-   use sprc_io_contact, only: contact_level_type, contact_csv_header, write_contact_csv
+   use sprc_io_contact_csv, only: contact_level_type, contact_csv_header, write_contact_csv
    use sprc_io_svg, only: write_contact_svg, contact_svg
    use sprc_study_row, only: is_empty
    use sprc_test_contact_model, only: contact_sample

@@ -13,7 +13,7 @@ module sprc_test_contact_recovery
    use sprc_recovery_contact_operators, only: contact_frame, contact_operator, contact_law_operator, &
       & contact_rows, contact_law_frictionless, contact_law_slip, contact_law_stick, contact_traction
    use sprc_recovery_contact_aux, only: aux_domain_type, new_aux_domain, aux_contains, aux_select
-   use sprc_recovery_contact_solve, only: recover_sprc_contact, recover_contact_patch
+   use sprc_recovery_contact_patch_solve, only: recover_sprc_contact, recover_contact_patch
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reset, patch_add_point, &
       & patch_add_boundary_point, boundary_contact, boundary_symmetry, boundary_none
    use sprc_recovery_workspace, only: recovery_workspace_type
@@ -24,10 +24,10 @@ module sprc_test_contact_recovery
    use sprc_study_level, only: study_type, level_type
    use sprc_test_study, only: run_text
    use sprc_contact_result, only: contact_open
-   use sprc_grid_recovered_field, only: recovered_field_type
+   use sprc_estimate_recovered_field, only: recovered_field_type
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type, replaced
-   use sprc_recovery_dense, only: qr_pivoted
-   use sprc_grid_contact, only: point_cells_type, new_point_cells, cells_box, cells_prism, aux_bounds
+   use sprc_core_dense, only: qr_pivoted
+   use sprc_estimate_contact_patches, only: point_cells_type, new_point_cells, cells_box, cells_prism, aux_bounds
    use sprc_exact_hertz, only: cattaneo_mindlin_traction
    implicit none
    private
@@ -535,7 +535,7 @@ contains
       end associate
    end subroutine test_study_patch_pressures
 
-   !> The coupled contact patches through the grid path (sprc_grid_patches, sprc_study_level):
+   !> The coupled contact patches through the grid path (sprc_estimate_patches, sprc_study_level):
    !> two blocks of different materials on non-matching offset grids whose flat interface
    !> cuts cells of both, carrying the uniform stress sigma_yy = -1 (frictionless: the
    !> materials may differ; stick: equal materials, or the lateral strains would differ).

@@ -525,8 +525,8 @@ contains
    !> layer's names for them are the same constants.
    subroutine test_boundary_kinds(error)
       use sprc_fem_bc, only: fe_traction => bc_traction, fe_free => bc_free
-      use sprc_grid_patches, only: grid_traction => bc_traction, grid_symmetry => bc_symmetry
-      use sprc_recovery_mesh, only: facet_traction, facet_symmetry, facet_free
+      use sprc_estimate_patches, only: grid_traction => bc_traction, grid_symmetry => bc_symmetry
+      use sprc_recovery_caller_mesh, only: facet_traction, facet_symmetry, facet_free
       use sprc_recovery_patch, only: boundary_traction, boundary_symmetry, boundary_contact, boundary_none
       use sprc_test_report, only: read_text_file
       type(error_type), allocatable, intent(out) :: error

@@ -26,8 +26,8 @@ module sprc_test_fem
    use sprc_fem_bc, only: fe_bc_type, new_fe_bc, bc_free, bc_pressure, bc_traction, bc_displacement, &
       & bc_symmetry, bc_exact_traction, bc_exact_displacement
    use sprc_fem_problem, only: elasticity_problem_type, solve_on_grid
-   use sprc_fem_recovery_input, only: fe_recovery_input
-   use sprc_grid_patches, only: recovery_input_type, rec_none => bc_none, rec_traction => bc_traction, &
+   use sprc_estimate_fe_input, only: fe_recovery_input
+   use sprc_estimate_patches, only: recovery_input_type, rec_none => bc_none, rec_traction => bc_traction, &
       & rec_pressure => bc_pressure, rec_symmetry => bc_symmetry
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type
    use sprc_geometry_facets, only: facet_set_type

@@ -1,4 +1,4 @@
-!> Tests of recovery on a caller's unstructured mesh (sprc_recovery_mesh) and of the legacy
+!> Tests of recovery on a caller's unstructured mesh (sprc_recovery_caller_mesh) and of the legacy
 !> wrapper (sprc_legacy).
 !>
 !> The meshes, their isoparametric maps and Gauss rules are built here from a lattice, not
@@ -20,14 +20,14 @@ module sprc_test_mesh_recovery
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type
    use sprc_core_error, only: stat_invalid_input, stat_singular
    use sprc_core_material, only: plane_stress, plane_strain, solid
-   use sprc_recovery_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, mesh_method_spr, &
+   use sprc_recovery_caller_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, mesh_method_spr, &
       & mesh_method_sprc, facet_traction, facet_symmetry, facet_free, facet_pressure, elem_tri3, elem_quad4, &
       & elem_tet4, elem_hex8, elem_quad9, elem_hex27, mesh_reference_symmetric
    use sprc_legacy, only: sprc_recover_mesh
-   use sprc_recovery_mesh_check, only: check_duplicate_nodes
+   use sprc_recovery_caller_mesh_check, only: check_duplicate_nodes
    use sprc_core_kinds, only: i8
    use sprc_core_text, only: rtoa
-   use sprc_recovery_mesh_element, only: facet_points, element_inverse_map, element_facet_order
+   use sprc_recovery_caller_mesh_element, only: facet_points, element_inverse_map, element_facet_order
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reset, patch_add_point
    use sprc_recovery_patch_loop, only: patch_source_type, patch_loop_type, run_patch_loop, patch_capacity
    !$ use omp_lib, only: omp_get_max_threads, omp_set_num_threads

@@ -1,5 +1,5 @@
 !> Tests of the grid producer of SPR / SPR-C patches and the recovered field
-!> (sprc_grid_patches, sprc_grid_recovered_field, sprc_grid_recovered_estimate).
+!> (sprc_estimate_patches, sprc_estimate_recovered_field, sprc_estimate_norms).
 !>
 !> Problems are real cut grids: a quarter annulus r in [5, 20] in the box [0, 25]^2 with
 !> symmetry halfspaces x >= 0, y >= 0, and a spherical-shell octant r in [0.3, 0.9] in
@@ -32,12 +32,12 @@ module sprc_test_patches
    use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature, cell_rule_type, cell_rule
    use sprc_exact_solution, only: exact_solution_type, init_exact_solution
    use sprc_exact_lame, only: lame_cylinder_type, new_lame_cylinder
-   use sprc_recovery_solve, only: recovery_rank_tol
-   use sprc_grid_patches, only: recovery_input_type, recover_grid, bc_none, bc_traction, bc_pressure, &
+   use sprc_recovery_patch_solve, only: recovery_rank_tol
+   use sprc_estimate_patches, only: recovery_input_type, recover_grid, bc_none, bc_traction, bc_pressure, &
       & bc_exact_traction, bc_symmetry
-   use sprc_grid_recovered_field, only: recovered_field_type, method_spr, method_sprc, interp_nodal, &
+   use sprc_estimate_recovered_field, only: recovered_field_type, method_spr, method_sprc, interp_nodal, &
       & interp_union, field_eval, field_union_weights
-   use sprc_grid_recovered_estimate, only: zz_estimate_type, estimate_error
+   use sprc_estimate_norms, only: zz_estimate_type, estimate_error
    use sprc_fem_bc, only: fe_bc_type, new_fe_bc, fe_pressure => bc_pressure, fe_symmetry => bc_symmetry
    use sprc_fem_problem, only: elasticity_problem_type, solve_on_grid
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type

@@ -33,11 +33,11 @@ module sprc_test_recovery
       & dominant_boundary_kind, kind_equilibrium, kind_compatibility, kind_traction, kind_symmetry
    use sprc_recovery_operators, only: incompatibility_operator
    use sprc_recovery_workspace, only: recovery_workspace_type, workspace_init, workspace_reserve
-   use sprc_recovery_solve, only: recover_spr, recover_sprc
+   use sprc_recovery_patch_solve, only: recover_spr, recover_sprc
    use sprc_recovery_flops, only: flops_gemm, flops_gemv, flops_syrk, flops_geqrf, flops_ormqr_left, flops_trtrs, &
       & flops_sysv, design_matrix_flops
    use sprc_recovery_estimate, only: eval_recovered, eval_union, zz_error_integral
-   use sprc_recovery_dense, only: qr_pivoted, apply_qt, apply_q, solve_upper
+   use sprc_core_dense, only: qr_pivoted, apply_qt, apply_q, solve_upper
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type
    implicit none
    private

@@ -1,4 +1,4 @@
-!> Tests of the singular split at re-entrant corners (sprc_grid_singular):
+!> Tests of the singular split at re-entrant corners (sprc_estimate_singular):
 !> corners found from boundary points against the geometry that made them
 !> (apex, opening, bisector of an L-shaped and a 225-degree notch, rotated and
 !> offset), no corner on convex corners, curved boundaries, loaded faces or a
@@ -8,7 +8,7 @@ module sprc_test_singular
    use sprc_core_kinds, only: wp
    use sprc_core_material, only: plane_strain, plane_stress
    use sprc_exact_corner, only: corner_type, new_corner
-   use sprc_grid_singular, only: corner_site_type, singular_fit_type, find_corners, fit_corner
+   use sprc_estimate_singular, only: corner_site_type, singular_fit_type, find_corners, fit_corner
    use sprc_testsuite, only: unittest_type, new_unittest, check, error_type
    implicit none
    private

@@ -1,12 +1,12 @@
 !> SPR-C recovery of bodies in contact on the caller's own meshes (thesis eqs. 103-138):
-!> each body as `recover_on_mesh` takes it (sprc_recovery_mesh) plus, per contact pair, the
+!> each body as `recover_on_mesh` takes it (sprc_recovery_caller_mesh) plus, per contact pair, the
 !> contact facets of both bodies with their law; out come each body's recovery and, at the
 !> slave facets' quadrature points, the recovered contact tractions of both bodies and
 !> their jump.
 !>
 !> The core is the grid pipeline's, not a copy: each body is recovered by recover_on_mesh
 !> with its contact facets as contact points, and a patch holding one is solved by
-!> `contact_patch_solve` (sprc_grid_contact) with the pair's other body as body (2): its
+!> `contact_patch_solve` (sprc_estimate_contact_patches) with the pair's other body as body (2): its
 !> integration points (weight*|J|, FE stresses) and its boundary points other than contact
 !> facets (traction, pressure, symmetry, free facets) inside the prism Omega_aux over the
 !> patch's contact points, found through the grid pipeline's point cells (a counting sort
@@ -35,7 +35,7 @@
 !>
 !> Errors name the argument as the caller wrote it (Fortran bodies(2)%..., or C / Python
 !> bodies[1], pairs[0].slave_facets[3] with c_indices).
-module sprc_contact_mesh_recovery
+module sprc_contact_caller_mesh_recovery
    use sprc_core_kinds, only: wp, i8
    use sprc_core_text, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
@@ -45,13 +45,13 @@ module sprc_contact_mesh_recovery
       & boundary_traction, boundary_symmetry
    use sprc_recovery_workspace, only: recovery_workspace_type
    use sprc_recovery_contact_operators, only: contact_law_frictionless, contact_law_slip, contact_law_stick
-   use sprc_recovery_mesh_element, only: element_facet_nodes, element_degree, element_name, facet_npoints
-   use sprc_recovery_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_contact_solver_type, mesh_facet_points, &
+   use sprc_recovery_caller_mesh_element, only: element_facet_nodes, element_degree, element_name, facet_npoints
+   use sprc_recovery_caller_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_contact_solver_type, mesh_facet_points, &
       & mesh_recovery_eval, mesh_recovery_eval_near, mesh_method_sprc, mesh_method_spr, mesh_reference_unit, &
       & facet_traction, facet_pressure, facet_symmetry, facet_free
    use sprc_recovery_patch_loop, only: auto_degree
-   use sprc_recovery_mesh_check, only: check_mesh_arrays, check_mesh_facets
-   use sprc_grid_contact, only: grid_contact_type, new_grid_contact, contact_patch_solve
+   use sprc_recovery_caller_mesh_check, only: check_mesh_arrays, check_mesh_facets
+   use sprc_estimate_contact_patches, only: grid_contact_type, new_grid_contact, contact_patch_solve
    implicit none
    private
 
@@ -711,4 +711,4 @@ contains
       end if
    end function pair_field
 
-end module sprc_contact_mesh_recovery
+end module sprc_contact_caller_mesh_recovery

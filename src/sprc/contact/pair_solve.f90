@@ -56,7 +56,7 @@
 !> (`solve_block` with an unset block solver). Frictionless and stick with the
 !> FE stabilization stress: Coulomb's load path, the recovered stabilization
 !> and the iterative solvers stay per pair (`solve_contact_pair`).
-module sprc_contact_solve
+module sprc_contact_pair_solve
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_not_converged, stat_singular, &
       & stat_unsupported, stat_not_positive_definite
@@ -1804,4 +1804,4 @@ contains
       text = "contact '"//bodies(pair%slave)%name//"' on '"//bodies(pair%master)%name//"'"
    end function pair_name
 
-end module sprc_contact_solve
+end module sprc_contact_pair_solve

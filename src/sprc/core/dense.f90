@@ -18,7 +18,7 @@
 !> pass patch-scaled rows of order one. |R_kk| is then
 !> non-increasing, so the rank decisions of the solves (|R_kk| > tol |R_11|) are those of
 !> dgeqp3.
-module sprc_recovery_dense
+module sprc_core_dense
    use sprc_core_kinds, only: wp
    implicit none
    private
@@ -258,4 +258,4 @@ contains
       ok = all(abs(b(1:k, 1:nrhs)) <= huge(1.0_wp))
    end subroutine solve_upper
 
-end module sprc_recovery_dense
+end module sprc_core_dense

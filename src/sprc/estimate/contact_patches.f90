@@ -2,9 +2,9 @@
 !> del SPR-C en contacto"): which boundary points are in contact and under which
 !> law, and the other body's FE stresses for the auxiliary domains Omega_aux.
 !>
-!> The grid producer (sprc_grid_patches) marks the body's boundary points on `shape` with a
+!> The grid producer (sprc_estimate_patches) marks the body's boundary points on `shape` with a
 !> closed law as contact points and solves every SPR-C patch holding one by the coupled
-!> contact solve (sprc_recovery_contact_solve, contact wins), with body (2) the other body;
+!> contact solve (sprc_recovery_contact_patch_solve, contact wins), with body (2) the other body;
 !> points of `shape` that are open are a free surface (zero traction). Both bodies of a pair
 !> get a description, each with the other as body (2): the master-side patches are the
 !> mirrored ones, so both recovered fields near the contact surface are contact-aware.
@@ -25,14 +25,14 @@
 !> (`contact_scratch_type`), allocated on its first contact patch.
 !>
 !> Small deformations: undeformed points and normals.
-module sprc_grid_contact
+module sprc_estimate_contact_patches
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_alloc, only: check_allocation
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reserve
    use sprc_recovery_workspace, only: recovery_workspace_type
    use sprc_recovery_contact_operators, only: contact_law_frictionless, contact_law_slip, contact_law_stick
-   use sprc_recovery_contact_solve, only: recover_contact_patch, aux_max_doublings, contact_points, aux_margin
+   use sprc_recovery_contact_patch_solve, only: recover_contact_patch, aux_max_doublings, contact_points, aux_margin
    use sprc_recovery_contact_aux, only: aux_domain_type, new_aux_domain, aux_contains
    implicit none
    private
@@ -341,7 +341,7 @@ contains
       end do
    end function box_in_prism
 
-   !> The coupled SPR-C solve of a patch holding contact points (sprc_recovery_contact_solve):
+   !> The coupled SPR-C solve of a patch holding contact points (sprc_recovery_contact_patch_solve):
    !> law(j), slip(1:dim, j) per boundary point j of `patch`, body (2) the other body's points
    !> (module notes). rec is the patch's recovered stress. The Omega_aux storage is the
    !> thread's (in `ws`, module notes).
@@ -449,4 +449,4 @@ contains
       bhi(1:d) = bhi(1:d) + pad
    end subroutine aux_bounds
 
-end module sprc_grid_contact
+end module sprc_estimate_contact_patches

@@ -1,5 +1,5 @@
 !> The FE → recovery adapter: the recovery's view of a solved FE problem on
-!> a cut grid (`recovery_input_type` of `sprc_grid_patches`).
+!> a cut grid (`recovery_input_type` of `sprc_estimate_patches`).
 !>
 !> - volume points of each element with w|J| and the FE stress there;
 !> - boundary points with w|J|, outward normals and the body's shape index;
@@ -9,12 +9,12 @@
 !>   traction needs the exact solution at recovery time, symmetry is a
 !>   symmetry plane, and Dirichlet surfaces (displacement, exact
 !>   displacement) carry no recovery constraint.
-module sprc_fem_recovery_input
+module sprc_estimate_fe_input
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_alloc, only: check_allocation
    use sprc_core_boundary, only: bc_none, bc_free, bc_pressure, bc_traction, bc_symmetry, bc_exact_traction
-   use sprc_grid_patches, only: recovery_input_type
+   use sprc_estimate_patches, only: recovery_input_type
    use sprc_fem_problem, only: elasticity_problem_type
    implicit none
    private
@@ -98,4 +98,4 @@ contains
       end do
    end subroutine boundary_kinds
 
-end module sprc_fem_recovery_input
+end module sprc_estimate_fe_input

@@ -20,15 +20,15 @@
 !> sigma* is the method's field (nodal for SPR, union for SPR-C) at the same points as
 !> sigma_h (`sigma_star`, kept for output). Per-element sums run in point order and the
 !> global sums in element order: the bits do not depend on the thread count.
-module sprc_grid_recovered_estimate
+module sprc_estimate_norms
    use sprc_core_kinds, only: wp, i8
    use sprc_core_alloc, only: check_allocation
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_timer, only: wall_time
    use sprc_exact_solution, only: exact_solution_type
    use sprc_recovery_estimate, only: zz_error_integral
-   use sprc_grid_recovered_field, only: recovered_field_type, field_eval_unchecked, interp_default
-   use sprc_grid_patches, only: recovery_input_type
+   use sprc_estimate_recovered_field, only: recovered_field_type, field_eval_unchecked, interp_default
+   use sprc_estimate_patches, only: recovery_input_type
    use sprc_grid_share, only: share_type, share_range
    implicit none
    private
@@ -274,4 +274,4 @@ contains
       end if
    end subroutine check_consistent
 
-end module sprc_grid_recovered_estimate
+end module sprc_estimate_norms

@@ -8,7 +8,7 @@
 !>
 !> Patches (`recover_grid`): one per free vertex node, i.e. per corner node of an active
 !> leaf that does not hang (for Q2 only corner nodes; mid-edge, face and centre nodes
-!> get their values from the vertex patches, see sprc_grid_recovered_field). Hanging
+!> get their values from the vertex patches, see sprc_estimate_recovered_field). Hanging
 !> vertices get no patch: their values follow from the constraints. Patch of node n:
 !> x0 = x_n; elements = the leaves whose closure holds n (node -> element CSR); h = the
 !> largest distance from x0 to a corner of those leaves; its points are the elements'
@@ -28,7 +28,7 @@
 !> sprc_recovery_patch_loop; this module supplies the grid's patches (`grid_source_type`)
 !> and names a failing patch by its node.
 !>
-!> Contact (SPR-C with a `grid_contact_type`, sprc_grid_contact): the body's boundary points
+!> Contact (SPR-C with a `grid_contact_type`, sprc_estimate_contact_patches): the body's boundary points
 !> on the contact shape are contact points where their law is closed and free-surface
 !> (zero-traction) points where it is open; a patch holding a contact point is solved by
 !> the coupled contact solve (contact wins, the thesis), expanded like any other patch when it
@@ -39,7 +39,7 @@
 !> holding most of them (the first on a tie), with the other pairs' contact points left
 !> out of the patch: each coupled solve has one other body (its Omega_aux), and a point
 !> of another pair is neither free nor in contact with that body.
-module sprc_grid_patches
+module sprc_estimate_patches
    use sprc_core_kinds, only: wp
    use sprc_core_text, only: itoa, rtoa
    use sprc_core_alloc, only: check_allocation
@@ -57,11 +57,11 @@ module sprc_grid_patches
    use sprc_recovery_workspace, only: recovery_workspace_type
    use sprc_recovery_patch_loop, only: patch_source_type, patch_loop_type, run_patch_loop, patch_capacity, &
       & recover_patch_default
-   use sprc_grid_contact, only: grid_contact_type, contact_patch_solve
-   use sprc_grid_recovered_field, only: recovered_field_type, method_spr, method_sprc, build_field
+   use sprc_estimate_contact_patches, only: grid_contact_type, contact_patch_solve
+   use sprc_estimate_recovered_field, only: recovered_field_type, method_spr, method_sprc, build_field
    use sprc_grid_share, only: share_type, share_range, gather_patches
    use sprc_exact_corner, only: corner_type
-   use sprc_grid_singular, only: corner_site_type, singular_fit_type, find_corners, fit_corner, enrich_cells, &
+   use sprc_estimate_singular, only: corner_site_type, singular_fit_type, find_corners, fit_corner, enrich_cells, &
       & inner_cells
    implicit none
    private
@@ -106,7 +106,7 @@ module sprc_grid_patches
       class(exact_solution_type), pointer :: exact => null()
       type(grid_contact_type), pointer :: contacts(:) => null()
       !> Singular fields of re-entrant corners and the corner each node's patch leaves
-      !> out (0: none), sprc_grid_singular; unassociated without corners.
+      !> out (0: none), sprc_estimate_singular; unassociated without corners.
       type(singular_fit_type), pointer :: corners(:) => null()
       integer, pointer :: node_corner(:) => null()
       !> Each corner's stress S at the volume points (3, npts, corner) and its
@@ -387,7 +387,7 @@ contains
          call patch_reset(patch, d, input%analysis, input%young, input%poisson, x0(1:d), h)
          call patch_reserve(patch, np, nb)
          patch%body_force(1:d) = input%body_force(1:d)
-         ! the corner whose singular field the patch leaves out (sprc_grid_singular)
+         ! the corner whose singular field the patch leaves out (sprc_estimate_singular)
          c = 0
          if (associated(self%node_corner)) c = abs(self%node_corner(node))
          inner = .false.
@@ -450,7 +450,7 @@ contains
 
    !> The re-entrant corners of a 2D input, their fitted singular fields (field%singular,
    !> left unallocated without any) and the corner of each node's patch (node_corner;
-   !> field%patch_corner per patch): sprc_grid_singular's module notes.
+   !> field%patch_corner per patch): sprc_estimate_singular's module notes.
    subroutine singular_corners(src, degree, field, node_corner)
       type(grid_source_type), intent(in) :: src
       integer, intent(in) :: degree
@@ -657,7 +657,7 @@ contains
 
    !> The recovery boundary points of `input` (kinds and tractions as the patches take them,
    !> bc_none left out) other than those on shape `skip_shape`, in the boundary arrays of
-   !> `points` (a contact's other body, sprc_grid_contact). `exact` as recover_grid's.
+   !> `points` (a contact's other body, sprc_estimate_contact_patches). `exact` as recover_grid's.
    subroutine boundary_points(input, dim, skip_shape, points, exact)
       type(recovery_input_type), intent(in) :: input
       integer, intent(in) :: dim, skip_shape
@@ -891,4 +891,4 @@ contains
       call fatal_error(error, 'recovery input: '//message, stat_invalid_input)
    end subroutine input_error
 
-end module sprc_grid_patches
+end module sprc_estimate_patches

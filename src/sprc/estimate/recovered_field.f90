@@ -1,5 +1,5 @@
 !> The recovered stress field on a Cartesian grid: the vertex-patch polynomials of
-!> SPR / SPR-C (filled by `sprc_grid_patches`) and their interpolation over the
+!> SPR / SPR-C (filled by `sprc_estimate_patches`) and their interpolation over the
 !> elements, evaluable at any point of any element without the grid objects.
 !>
 !> Two interpolations (thesis eqs. 101, 102):
@@ -30,7 +30,7 @@
 !> Nodal output `nodal`: the method's field at every node (incl. hanging and Q2
 !> nodes). SPR: `nodal_interp`. SPR-C: the union at the node in the node's first
 !> element (at a vertex with a patch this is the patch value itself).
-module sprc_grid_recovered_field
+module sprc_estimate_recovered_field
    use sprc_core_kinds, only: wp, i8
    use sprc_core_alloc, only: check_allocation
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_internal
@@ -39,7 +39,7 @@ module sprc_grid_recovered_field
    use sprc_grid_hanging, only: hanging_type
    use sprc_recovery_patch, only: recovered_patch_type
    use sprc_recovery_estimate, only: eval_recovered
-   use sprc_grid_singular, only: singular_fit_type
+   use sprc_estimate_singular, only: singular_fit_type
    implicit none
    private
 
@@ -83,7 +83,7 @@ module sprc_grid_recovered_field
       real(wp), allocatable :: corner_coef(:)
       !> Nodal values of eq. 101 (nstress, n_nodes) and the method's field at the nodes.
       real(wp), allocatable :: nodal_interp(:, :), nodal(:, :)
-      !> Singular fields of re-entrant corners (sprc_grid_singular), with fitted amplitudes,
+      !> Singular fields of re-entrant corners (sprc_estimate_singular), with fitted amplitudes,
       !> and per patch the corner whose field its polynomial leaves out (0: none). The
       !> field adds each corner's stress with the union weights of its patches.
       type(singular_fit_type), allocatable :: singular(:)
@@ -160,7 +160,7 @@ contains
    end subroutine field_eval_unchecked
 
    !> sigma += sum over the corners c of w_c(x) S_c(x), w_c the Q1 union weight of the
-   !> patches that left corner c's field out (module sprc_grid_singular).
+   !> patches that left corner c's field out (module sprc_estimate_singular).
    pure subroutine add_singular(field, e, x, sigma)
       type(recovered_field_type), intent(in) :: field
       integer, intent(in) :: e
@@ -419,4 +419,4 @@ contains
       end do
    end subroutine nodal_values
 
-end module sprc_grid_recovered_field
+end module sprc_estimate_recovered_field

@@ -41,7 +41,7 @@
 !>    is in equilibrium without body force, compatible, and free on the
 !>    corner's faces, so the smooth part meets the same constraints), and the
 !>    field adds S back with the union weights of those patches
-!>    (sprc_grid_recovered_field). A patch holding an element of the inner
+!>    (sprc_estimate_recovered_field). A patch holding an element of the inner
 !>    rings takes as its smooth data the fit's P c instead of its own polluted
 !>    sigma_h - S. Which patches: with a single corner whose material wedge
 !>    holds every volume point (its field is continuous over the body), all
@@ -52,7 +52,7 @@
 !>    of their own patch width from their nearest corner. Patches with
 !>    symmetry points keep the whole field (the symmetry constraint is on the
 !>    whole stress).
-module sprc_grid_singular
+module sprc_estimate_singular
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type
    use sprc_core_material, only: plane_stress, plane_strain, compliance_matrix
@@ -277,4 +277,4 @@ contains
       width = maxval(hi - lo)
    end subroutine box_distance
 
-end module sprc_grid_singular
+end module sprc_estimate_singular

@@ -46,7 +46,7 @@ module sprc_fem_multigrid
    use sprc_core_alloc, only: check_allocation
    use sprc_core_hash, only: key_table_type
    use sprc_core_sort, only: sort_pairs
-   use sprc_recovery_dense, only: qr_pivoted, apply_q, solve_upper
+   use sprc_core_dense, only: qr_pivoted, apply_q, solve_upper
    implicit none
    private
 
@@ -378,7 +378,7 @@ contains
    !> w = argmin |w - w0| subject to sum w = 1 and sum_k w_k x(:, k) = t: with
    !> A = [1; x] (d + 1 rows, m >= d + 1 columns), w = w0 + delta where delta is
    !> the least-norm solution of A delta = [1; t] - A w0, from the pivoted QR of
-   !> A^T (`sprc_recovery_dense`, the patch solves' kernel): A^T P = Q R gives
+   !> A^T (`sprc_core_dense`, the patch solves' kernel): A^T P = Q R gives
    !> R^T (Q^T delta)(1:d+1) = P^T ([1; t] - A w0) and the rest of Q^T delta = 0.
    !> `found` is false when A has not full row rank: |R_(d+1,d+1)| at most
    !> sqrt(eps) |R_11| (the offsets are small integers, so a rank-deficient A

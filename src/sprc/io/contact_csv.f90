@@ -7,7 +7,7 @@
 !> reals as in the report CSV (read back bit for bit), `z` empty in
 !> 2D, `state` open / stick / slip, an empty value (not computed) an empty
 !> cell. The pairs of a level follow each other in `&contact` order.
-module sprc_io_contact
+module sprc_io_contact_csv
    use sprc_core_kinds, only: wp
    use sprc_core_text, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_io
@@ -84,4 +84,4 @@ contains
          & csv_real(c%t_fe(1, i))//','//csv_real(c%t_fe(2, i))//','//tz
    end function point_line
 
-end module sprc_io_contact
+end module sprc_io_contact_csv

@@ -3,7 +3,7 @@
 !> mesh is plain arrays, the result one object (`mesh_recovery_type`, opaque to bindings).
 !>
 !> Input (`recover_on_mesh`, whose arguments say the shapes): one element type for the mesh
-!> (sprc_recovery_mesh_element: tri3, quad4, quad9, tet4, hex8, hex27; VTK codes and node
+!> (sprc_recovery_caller_mesh_element: tri3, quad4, quad9, tet4, hex8, hex27; VTK codes and node
 !> order), 1-based connectivity, per element the integration points, weights times |J| and
 !> FE stresses (Voigt), the material and method, optionally a body force and boundary
 !> facets. Every point must lie in its element (inverse isoparametric map, 1e-6 in reference
@@ -29,9 +29,9 @@
 !> and total ZZ errors and eta = err / sqrt(norm_h^2 + err^2), summed scaled by powers of
 !> two so any finite stresses give finite results (the plain formulas' bits otherwise).
 !> `mesh_recovery_eval` takes each point's element if given, else the lowest-index element
-!> holding it, searched through bins (sprc_recovery_mesh_bins) from 4 points on.
+!> holding it, searched through bins (sprc_recovery_caller_mesh_bins) from 4 points on.
 !>
-!> Contact (`contact_facets`, SPR-C only; the two-body entry sprc_contact_mesh_recovery):
+!> Contact (`contact_facets`, SPR-C only; the two-body entry sprc_contact_caller_mesh_recovery):
 !> contact facets are element sides as the boundary facets, each with a law (0 open:
 !> a free surface; contact_law_frictionless, _slip, _stick), a slip direction and the
 !> index of its pair. A patch holding a point of a closed contact facet is solved by the
@@ -42,7 +42,7 @@
 !>
 !> Parallelism and determinism: the patch loop is sprc_recovery_patch_loop's (shared with
 !> the grid); the bits do not depend on the thread count.
-module sprc_recovery_mesh
+module sprc_recovery_caller_mesh
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular, &
       & stat_not_converged, stat_out_of_memory
@@ -54,15 +54,15 @@ module sprc_recovery_mesh
    use sprc_recovery_patch_loop, only: patch_source_type, patch_loop_type, run_patch_loop, patch_capacity, auto_degree, &
       & recover_patch_default
    use sprc_recovery_estimate, only: eval_recovered_points, energy_norms, scaled_norm, relative_error
-   use sprc_recovery_mesh_element, only: elem_tri3, elem_quad4, elem_tet4, elem_hex8, elem_quad9, elem_hex27, &
+   use sprc_recovery_caller_mesh_element, only: elem_tri3, elem_quad4, elem_tet4, elem_hex8, elem_quad9, elem_hex27, &
       & element_dim, element_nodes, element_vertices, element_degree, element_facet_nodes, element_shape, &
       & element_facet_order, element_simplex, &
       & element_vertex_shape, element_node_xi, element_inside, element_inverse_map, element_name, &
       & facet_points, facet_npoints, max_facet_points, max_element_nodes
    use sprc_core_text, only: itoa
    use sprc_core_alloc, only: check_allocation
-   use sprc_recovery_mesh_bins, only: element_bins_type, build_element_bins, bin_of_point
-   use sprc_recovery_mesh_check, only: check_mesh_options, check_mesh_arrays, check_mesh_facets, &
+   use sprc_recovery_caller_mesh_bins, only: element_bins_type, build_element_bins, bin_of_point
+   use sprc_recovery_caller_mesh_check, only: check_mesh_options, check_mesh_arrays, check_mesh_facets, &
       & check_duplicate_nodes, check_duplicate_elements, vec_str, entry_name, index_name, &
       & mesh_reference_unit, mesh_reference_symmetric, reference_cell_name, &
       & mesh_method_spr, mesh_method_sprc, facet_traction, facet_symmetry, facet_free, facet_pressure
@@ -90,7 +90,7 @@ module sprc_recovery_mesh
       !> Nodes, elements, nodes and vertices per element.
       integer :: nnode = 0, nelem = 0, nen = 0, nvertex = 0
       real(wp) :: young = 0.0_wp, poisson = 0.0_wp
-      !> Messages name entries as C does (0-based, row-major; module sprc_recovery_mesh_check).
+      !> Messages name entries as C does (0-based, row-major; module sprc_recovery_caller_mesh_check).
       logical :: c_indices = .false.
       !> Copy of the mesh: nodes x(dim, nnode), connectivity(nen, nelem), element boxes.
       real(wp), allocatable :: x(:, :), box_lo(:, :), box_hi(:, :)
@@ -502,7 +502,7 @@ contains
    !> |x(gxi) - gp|_inf <= inside_tol h_e + (nen + 2) eps (|gp| + sum_a |N_a| |x_a|), with h_e
    !> the largest extent of the element's box (inside_tol in reference units, which the map
    !> stretches by about h_e) plus the round-off of evaluating the map (as in Newton's stopping
-   !> test, sprc_recovery_mesh_element). `rule`: the shape values of element 1's points, and
+   !> test, sprc_recovery_caller_mesh_element). `rule`: the shape values of element 1's points, and
    !> whether every element has the same points (then its shape values serve every element).
    !> OpenMP over elements; the first bad point (element order) is named.
    subroutine given_coordinates(r, gp, gxi, rule, error, reference, shown)
@@ -1453,7 +1453,7 @@ contains
    end function in_element
 
    !> The first element (lowest index) holding x, 0 if none: among the candidates of x's bin
-   !> if `bins` is given (the same element: sprc_recovery_mesh_bins), else among all.
+   !> if `bins` is given (the same element: sprc_recovery_caller_mesh_bins), else among all.
    integer function locate(r, x, xi, bins) result(found)
       type(mesh_recovery_type), intent(in) :: r
       real(wp), intent(in) :: x(:)
@@ -1496,4 +1496,4 @@ contains
       end do
    end function ivec_str
 
-end module sprc_recovery_mesh
+end module sprc_recovery_caller_mesh

@@ -8,7 +8,7 @@
 !> finds the lowest-index element holding x, as a scan of all elements does. About one bin
 !> per element (cubic bins over the boxes' bounding box): O(nelem) to build, O(1) bins per
 !> element of a mesh of comparable element sizes.
-module sprc_recovery_mesh_bins
+module sprc_recovery_caller_mesh_bins
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_out_of_memory
    implicit none
@@ -130,4 +130,4 @@ contains
       b = 1 + c(1) + bins%n(1)*(c(2) + bins%n(2)*c(3))
    end function bin_of_point
 
-end module sprc_recovery_mesh_bins
+end module sprc_recovery_caller_mesh_bins

@@ -1,4 +1,4 @@
-!> Validation of the input of recovery on a caller's mesh (`sprc_recovery_mesh`).
+!> Validation of the input of recovery on a caller's mesh (`sprc_recovery_caller_mesh`).
 !>
 !> Every check names the argument, the index and the value, so that a legacy caller can
 !> find the offending entry: options and codes first, then shapes, then values (finite
@@ -9,7 +9,7 @@
 !> Indices in messages follow the caller's language (`c_indices`): Fortran's 1-based,
 !> column-major `gw(3, 1)`, or for the C and Python entries 0-based, row-major
 !> `gauss_weights[0][2]` with the C argument names (module procedure `entry_name`).
-module sprc_recovery_mesh_check
+module sprc_recovery_caller_mesh_check
    use sprc_core_kinds, only: wp, i8
    use sprc_core_text, only: itoa, rtoa
    use sprc_core_alloc, only: check_allocation
@@ -18,7 +18,7 @@ module sprc_recovery_mesh_check
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_material, only: plane_stress, plane_strain, solid, voigt_size, check_material
    use sprc_core_poly, only: poly_max_degree
-   use sprc_recovery_mesh_element, only: element_known, element_dim, element_nodes, element_facet_nodes, &
+   use sprc_recovery_caller_mesh_element, only: element_known, element_dim, element_nodes, element_facet_nodes, &
       & element_name, elem_tri3, elem_quad4, elem_tet4, elem_hex8, elem_quad9, elem_hex27
    implicit none
    private
@@ -428,4 +428,4 @@ contains
       str = str//')'
    end function shape_str
 
-end module sprc_recovery_mesh_check
+end module sprc_recovery_caller_mesh_check

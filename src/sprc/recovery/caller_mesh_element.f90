@@ -15,7 +15,7 @@
 !> Gauss 2 (line2) or 3 (line3) points, the 3-point degree-2 rule on triangles, 2x2 (quad4)
 !> or 3x3 (quad9) Gauss. The normal returned here follows the facet's parametrisation
 !> ((dy, -dx) of the tangent in 2D, t1 x t2 in 3D); the producer orients it.
-module sprc_recovery_mesh_element
+module sprc_recovery_caller_mesh_element
    use sprc_core_kinds, only: wp
    use sprc_core_gauss, only: gauss_legendre_nodes
    use sprc_core_lagrange, only: tensor_shape, idx1 => vtk_line2, idx1q => vtk_line3, quad4 => vtk_quad4, &
@@ -463,4 +463,4 @@ contains
       end if
    end subroutine small_inverse
 
-end module sprc_recovery_mesh_element
+end module sprc_recovery_caller_mesh_element

@@ -2,7 +2,7 @@
 !> the fit of body (2)'s stresses on Omega_aux (sprc_recovery_contact_aux) recovered
 !> together, coupled by the contact law on the patch's contact points.
 !>
-!> Each body keeps its own SPR-C problem (sprc_constraints of sprc_recovery_solve: weighted
+!> Each body keeps its own SPR-C problem (sprc_constraints of sprc_recovery_patch_solve: weighted
 !> least squares of its sampling points, its equilibrium, compatibility and boundary rows
 !> C_b A_b = Lambda_b). The contact adds, in least-squares form (eqs. 129-133), the rows
 !> of Z(x_j) = [H(x_j) P(s1(x_j)), -H'_t(x_j) P(s2(x_j))] (sprc_recovery_contact_operators)
@@ -11,10 +11,10 @@
 !> Z^T Z A' = 0 becomes R Pi^T A' = 0, its leading rows with |R_kk| > traction_rank_tol
 !> |R_11| kept, at most the rank of the rows on a flat surface (`flat_traction_rank`: each
 !> of the dim residual components is a degree-p polynomial along it), degree p - 1 on a
-!> curved one - as the traction rows (sprc_recovery_solve, (c)). The two systems and the
+!> curved one - as the traction rows (sprc_recovery_patch_solve, (c)). The two systems and the
 !> contact rows form the one system of eq. 138 (with the erratum: the contact rows have
 !> two different column blocks). All rows are stacked, normalised and rank-selected once
-!> more (recovery_rank_tol), and the constrained minimum is computed as in sprc_recovery_solve
+!> more (recovery_rank_tol), and the constrained minimum is computed as in sprc_recovery_patch_solve
 !> by orthogonal transformations (no KKT matrix): with z_b = (I x R_b Pi_b^T) A_b the
 !> objective is |z1 - g1|^2 + |z2 - g2|^2 and the constraints W z = Lambda with
 !> W = C blockdiag(I x Pi_b R_b^-1); the pivoted QR of W^T gives the projection of g.
@@ -31,16 +31,16 @@
 !> the contact rows' in rec1, the stacked selection's in both.
 !>
 !> Storage: the coupled rows are allocated per call (a contact patch is one of few).
-module sprc_recovery_contact_solve
+module sprc_recovery_contact_patch_solve
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular
    use sprc_core_text, only: itoa
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, boundary_contact, patch_reset, patch_reserve
    use sprc_recovery_contact_aux, only: aux_domain_type, new_aux_domain, aux_contains
    use sprc_recovery_workspace, only: recovery_workspace_type
-   use sprc_recovery_solve, only: sprc_constraints, note_dropped, recovery_rank_tol, recovery_bite_ratio, traction_rank_tol, &
+   use sprc_recovery_patch_solve, only: sprc_constraints, note_dropped, recovery_rank_tol, recovery_bite_ratio, traction_rank_tol, &
       & flat_traction_rank
-   use sprc_recovery_dense, only: qr_pivoted, apply_qt, apply_q, solve_upper
+   use sprc_core_dense, only: qr_pivoted, apply_qt, apply_q, solve_upper
    use sprc_recovery_contact_operators, only: contact_frame, contact_operator, contact_law_operator, contact_rows, &
       & contact_law_slip, contact_law_name
    implicit none
@@ -338,7 +338,7 @@ contains
    !> returns the depth of the solve. patch2 is storage reused between calls.
    !> `max_doublings` (default aux_max_doublings) bounds the doublings. With `candidates`, only
    !> body (2)'s points j = candidates(i) are considered, in that order (a caller that has
-   !> culled them, sprc_grid_contact: no copy of the points).
+   !> culled them, sprc_estimate_contact_patches: no copy of the points).
    subroutine recover_contact_patch(patch1, degree, law, mu, slip, y2, w2, stress2, young2, poisson2, depth, &
       & ws1, ws2, patch2, rec1, rec2, error, body_force2, depth_used, max_doublings, boundary2, candidates)
       type(patch_type), intent(in) :: patch1
@@ -493,4 +493,4 @@ contains
       patch2%npoints = n
    end subroutine fill_aux_patch
 
-end module sprc_recovery_contact_solve
+end module sprc_recovery_contact_patch_solve

@@ -34,11 +34,11 @@
 !>
 !> Thread safety: no module state; one workspace per thread; no BLAS or LAPACK calls, so
 !> no OpenBLAS lock and no dependence on its thread count.
-module sprc_recovery_solve
+module sprc_recovery_patch_solve
    use sprc_core_kinds, only: wp
    use sprc_core_sort, only: sort
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular
-   use sprc_recovery_dense, only: qr_pivoted, apply_qt, apply_q, solve_upper
+   use sprc_core_dense, only: qr_pivoted, apply_qt, apply_q, solve_upper
    use sprc_core_material, only: compliance_matrix
    use sprc_core_poly, only: poly_max_degree
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, check_patch, dominant_boundary_kind, &
@@ -110,7 +110,7 @@ contains
    !> the weights ws%wn) and the rank-selected constraint rows ws%c(1:mc, 1:ws%n) A = ws%lam(1:mc)
    !> of the kinds switched on in `patch`. With contact_by_caller, contact boundary points are
    !> accepted and add no rows here (a patch with contact imposes contact only, as in the thesis): the
-   !> coupled contact solve (sprc_recovery_contact_solve) adds them. Errors as recover_sprc.
+   !> coupled contact solve (sprc_recovery_contact_patch_solve) adds them. Errors as recover_sprc.
    subroutine sprc_constraints(patch, degree, ws, rec, mc, contact_by_caller, error)
       type(patch_type), intent(in) :: patch
       integer, intent(in) :: degree
@@ -780,4 +780,4 @@ contains
       if (.not. allocated(rec%coef)) allocate (rec%coef(nt, ns))
    end subroutine coef_storage
 
-end module sprc_recovery_solve
+end module sprc_recovery_patch_solve

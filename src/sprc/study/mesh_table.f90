@@ -1,7 +1,7 @@
 !> The levels of a study and what `sprc mesh` computes over them (cells,
 !> measure and boundary measure of each body's grid), as rows of data; the
 !> driver or the C API format them (`sprc_io_report`).
-module sprc_study_mesh
+module sprc_study_mesh_table
    use sprc_core_kinds, only: wp, i8
    use sprc_core_text, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
@@ -330,4 +330,4 @@ contains
       end do
    end subroutine neumaier_add
 
-end module sprc_study_mesh
+end module sprc_study_mesh_table
