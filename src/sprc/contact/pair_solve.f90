@@ -8,54 +8,36 @@
 !>   with `recovered`, its recovered traction of the previous solution.
 !> - Multiplier space: P0 on contact cells (`macro_cells`, `group_cells`): slave
 !>   aggregates sharing a parent cell, spanning at least two master cells where
-!>   those are larger, turning at most a quarter turn (`turns_too_far`). P0 on the
-!>   slave cells is not inf-sup stable against the trace, and a constraint per
-!>   point over-constrains the interface. The multiplier is eliminated cell by cell,
-!>   lambda_c = pbar + gamma gbar; the cell's block is the second variation of
-!>   W_c [pbar.gbar + gamma/2 |gbar|^2] - 1/(2 gamma) sum_i w_i |p_N,i - pbar|^2,
-!>   SPD when gamma exceeds the trace-inverse bound (`default_kappa` in
-!>   sprc_study_spec is the centre of the plateau where the results do not depend
-!>   on kappa).
-!> - Frame: lambda_c is constant in the surface's frame; at point i it acts as
-!>   R_i lambda_c, R_i the least rotation from the cell's mean normal to n_i
-!>   (`frame_rotation`), so that a uniform pressure on a curved surface is in the
-!>   space (a Cartesian constant costs Q2 its order).
-!> - Points: the slave's cut-cell surface points cut at the master grid's planes;
-!>   traction and displacements are the host cells' polynomials, reduced through
-!>   each body's constraints like every element matrix.
-!> - Active set: primal-dual per contact cell, starting from the cells with a point
-!>   with g0 <= h; one factorization per iteration (CHOLMOD, UMFPACK if not
-!>   positive definite); the next set is the cells with nbar.lambda_c < 0; it ends
-!>   when the set repeats, else stat_not_converged. A body that the closed cells
-!>   and its own conditions leave free is stat_singular, naming it.
-!> - Friction: with stick and Coulomb the cell normal is the mean bisector of the
-!>   two normals and the initial vector gap g0 (n_s.n_m) n_m (a curved slave gets
-!>   no spurious shear). Coulomb is path dependent: the loads come in increments,
-!>   states and slip directions iterate until they repeat, a slipping cell whose
-!>   trial turns against its slip sticks (the trial cannot jump from mu p tau to
-!>   -mu p tau), and the slipping linearization is unsymmetric (UMFPACK).
+!>   those are larger, turning at most a quarter turn (`turns_too_far`); P0 on the
+!>   slave cells is not inf-sup stable against the trace. The multiplier is
+!>   eliminated cell by cell (lambda_c = pbar + gamma gbar; the block is SPD above
+!>   the trace-inverse bound, doc/theory.md section 6).
+!> - Frame: at point i lambda_c acts as R_i lambda_c, R_i the least rotation from the
+!>   cell's mean normal to n_i (`frame_rotation`): a uniform pressure on a curved
+!>   surface is in the space (a Cartesian constant costs Q2 its order).
+!> - Points: the slave's cut-cell surface points cut at the master grid's planes.
+!> - Active set: primal-dual per contact cell from the cells with g0 <= h, one
+!>   factorization per iteration, until the set repeats (else stat_not_converged); a
+!>   body the closed cells and its conditions leave free is stat_singular, named.
+!> - Friction: stick and Coulomb take the cell normal as the mean bisector of the
+!>   two normals (a curved slave gets no spurious shear). Coulomb is path dependent:
+!>   the loads come in increments, states and slip directions iterate until they
+!>   repeat, a slipping cell whose trial turns against its slip sticks, and the
+!>   slipping linearization is unsymmetric (UMFPACK).
 !> - Recovered stabilization: the cell's block is the penalty W gamma G^T G and p*
 !>   moves to the load (SPD for every gamma > 0); frictionless and stick only; with
 !>   a `contact_factor_type` the factor is reused while the active set repeats.
 !> - Iterative solves (`block_solver_type`, 'iterative' or 'auto' from
-!>   `auto_coupled_min_dofs`): PETSc CG where the block system is symmetric
-!>   (GMRES if CG meets an indefinite one, and where slipping cells make it
-!>   unsymmetric), preconditioned by both bodies' geometric multigrid
-!>   hierarchies stacked block-diagonally with the contact nodes kept on every
-!>   level (`stack_hierarchies`), built once per solve; the coarse levels see the
-!>   contact terms through Galerkin products of each new fine matrix (a body held
-!>   only by the contact has no usable hierarchy of its own). Each iteration
-!>   starts from the previous solution; the stopping test is the single body's
-!>   energy bound tightened for pointwise values (`contact_tolerance`).
+!>   `auto_coupled_min_dofs`): PETSc CG (GMRES where slipping cells make the system
+!>   unsymmetric or CG meets an indefinite one), preconditioned by both bodies'
+!>   multigrid hierarchies stacked block-diagonally (`stack_hierarchies`, contact
+!>   nodes kept on every level: a body held only by the contact has no usable
+!>   hierarchy of its own); stopping test `contact_tolerance`.
 !>
-!> Assemblies (`solve_contact_assembly`): several bodies and the pairs between
-!> them, one block system with every body's reduced system on the diagonal
-!> (offsets in body order) and the cells of every pair, built as a pair's
-!> alone (`point_operators` with the bodies' offsets); one active set over
-!> all cells, the rigid-mode check over every body, a direct solve
-!> (`solve_block` with an unset block solver). Frictionless and stick with the
-!> FE stabilization stress: Coulomb's load path, the recovered stabilization
-!> and the iterative solvers stay per pair (`solve_contact_pair`).
+!> Assemblies (`solve_contact_assembly`): several bodies and their pairs in one block
+!> system (bodies' reduced systems on the diagonal in body order, every pair's cells
+!> built as a pair's alone), one active set, a direct solve. Frictionless and stick
+!> with the FE stabilization only; the rest stays per pair (`solve_contact_pair`).
 module sprc_contact_pair_solve
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_not_converged, stat_singular, &

@@ -32,13 +32,11 @@
 !> on the contact shape are contact points where their law is closed and free-surface
 !> (zero-traction) points where it is open; a patch holding a contact point is solved by
 !> the coupled contact solve (contact wins, the thesis), expanded like any other patch when it
-!> lacks rank. A body of several pairs has one description per pair (`contacts`): a
-!> boundary point is a contact point of the first description (pair order) whose shape it
-!> lies on and that closes it, a free-surface point if its shape is a contact shape that
-!> none closes. A patch holding contact points of several pairs is solved with the pair
-!> holding most of them (the first on a tie), with the other pairs' contact points left
-!> out of the patch: each coupled solve has one other body (its Omega_aux), and a point
-!> of another pair is neither free nor in contact with that body.
+!> lacks rank. A body of several pairs has one description per pair (`contacts`): a point
+!> is a contact point of the first pair that closes it. A patch holding contact points of
+!> several pairs is solved with the pair holding most (the first on a tie), the others'
+!> points left out: a coupled solve has one other body, and their points are neither free
+!> nor in contact with it.
 module sprc_estimate_patches
    use sprc_core_kinds, only: wp
    use sprc_core_text, only: itoa, rtoa

@@ -1,57 +1,31 @@
 !> The singular part of the recovered field at re-entrant corners in 2D: the
 !> split of SPR-CX (Rodenas, Gonzalez-Estrada, Tarancon, Fuenmayor 2008,
 !> IJNME 76: sigma = sigma_smooth + sigma_singular, the smooth part recovered
-!> by the patches, the singular part added in closed form).
+!> by the patches, the singular part added in closed form). Near the apex the
+!> stress grows like r^(lambda - 1) (sprc_exact_corner), which no patch
+!> polynomial follows; the method and its reasons are in doc/theory.md,
+!> section 8a.
 !>
-!> Near the apex of a traction-free re-entrant corner the stress grows like
-!> r^(lambda - 1) (Williams' eigenfunctions, sprc_exact_corner): no patch
-!> polynomial follows it, and the recovered field there is about as poor as
-!> the FE stress, so the estimate falls short of the error (an effectivity
-!> near 1/2 in the apex elements, whatever the mesh, while the apex carries
-!> most of the error on every mesh of an adaptive run). Here:
-!>
-!> 1. `find_corners`: a corner is an element whose boundary points lie on two
-!>    straight faces (each face's points on one line, with one normal, to the
-!>    relative tolerance `straight_tol`) that meet inside the element's box at
-!>    a re-entrant angle (the points of each face on the outer side of the
-!>    other face's line), both faces traction free (recovery kind traction
-!>    with t = 0), the normals at least 30 degrees apart (material angle >=
-!>    210 degrees, lambda1 <= 0.75; the weaker kinks of a faceted curve are
-!>    left to the polynomials). The
-!>    apex is the two lines' intersection, the opening 180 degrees plus the
-!>    angle between the normals, the bisector -(n1 + n2)/|n1 + n2|. The same
-!>    apex found from two elements (on a shared edge) counts once. Corners on
-!>    curved faces, loaded faces or symmetry planes are not found (the
-!>    eigenfunctions are those of straight free faces).
-!> 2. `fit_corner`: the amplitudes (A1, A2) of the first two eigenfunctions
-!>    and a smooth part P c (a complete polynomial of the patch degree per
-!>    component, about the apex) by least squares of the FE stress in the
-!>    energy norm, sum over points w |J| (s_h - A1 S1 - A2 S2 - P c)^T D^-1
-!>    (...), over the elements between `inner_cells` and `fit_cells` of their
-!>    own width from the apex: some rings of elements on any grading, the same
-!>    in units of the local size on a uniform and on an adapted mesh. The
-!>    inner rings are left out: there the FE stress is polluted by the apex
-!>    (it falls short of the singularity it cannot follow) and would pull the
-!>    amplitudes down. The normal equations (columns scaled to unit diagonal)
-!>    are solved by eigen-decomposition, eigenvalues below n eps of the
-!>    largest dropped (the rank of the data decides). No data in the region
-!>    (a mesh too coarse for the apex to have rings) leaves the corner alone.
-!> 3. The patches take the singular part out of their data: sigma_h - S at
-!>    their volume points, t - S n at their traction points (S = A1 S1 + A2 S2
-!>    is in equilibrium without body force, compatible, and free on the
-!>    corner's faces, so the smooth part meets the same constraints), and the
-!>    field adds S back with the union weights of those patches
-!>    (sprc_estimate_recovered_field). A patch holding an element of the inner
-!>    rings takes as its smooth data the fit's P c instead of its own polluted
-!>    sigma_h - S. Which patches: with a single corner whose material wedge
-!>    holds every volume point (its field is continuous over the body), all
-!>    of them (the smooth part of a patch far from the apex absorbs what the
-!>    amplitudes miss, and no blend of enriched and plain patches is left for
-!>    the nodal SPR field, whose Q2 interpolation of a partial S would add an
-!>    error of its own); else those of the vertex nodes within `enrich_cells`
-!>    of their own patch width from their nearest corner. Patches with
-!>    symmetry points keep the whole field (the symmetry constraint is on the
-!>    whole stress).
+!> 1. `find_corners`: an element whose boundary points lie on two straight
+!>    traction-free faces (to the relative tolerance `straight_tol`) meeting
+!>    inside its box at a re-entrant angle, the normals at least 30 degrees
+!>    apart (lambda1 <= 0.75: the weaker kinks of a faceted curve are left to
+!>    the polynomials). The same apex found from two elements counts once;
+!>    curved, loaded or symmetry faces are not corners (the eigenfunctions are
+!>    those of straight free faces).
+!> 2. `fit_corner`: the amplitudes (A1, A2) and a smooth part P c by least
+!>    squares of the FE stress in the energy norm over the elements between
+!>    `inner_cells` and `fit_cells` of their own width from the apex (the inner
+!>    rings are polluted by the apex). The normal equations, columns scaled to
+!>    unit diagonal, are solved by eigen-decomposition, eigenvalues below
+!>    n eps of the largest dropped: the rank of the data decides.
+!> 3. The patches recover sigma_h - S and t - S n (S is in equilibrium,
+!>    compatible and free on the faces, so every constraint still holds) and the
+!>    field adds S back (sprc_estimate_recovered_field); a patch holding an inner
+!>    element takes the fit's P c as its data. All patches take part when one
+!>    corner's wedge holds the whole body, else those within `enrich_cells` of
+!>    their width from a corner; patches with symmetry points keep the whole
+!>    field (the symmetry constraint is on the whole stress).
 module sprc_estimate_singular
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type

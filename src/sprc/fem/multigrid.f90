@@ -31,15 +31,10 @@
 !> a body whose hierarchy is shorter keeps its coarsest nodes (identity) on
 !> the remaining levels. The coupling terms are then seen by the coarse
 !> levels through the Galerkin products of the coupled fine matrix.
-!> Kept nodes (`keep`: those a coupling term of large weight acts on, the
-!> contact surface's) are C-points of their own on every level, and no
-!> F-point takes a weight from them unless they lie on the coarse lattice:
-!> a coarse function is then either a kept node's fine one or zero at
-!> every kept node off the lattice. The coupling, a penalty on the relative
-!> displacement of the two bodies' surfaces, would otherwise lock the
-!> coarse spaces, whose interpolated surfaces do not match (each body's own
-!> grid): CG's iterations then grow with the penalty factor.
-!> Coarsening stops by the count of the nodes not kept.
+!> Kept nodes (`keep`, the contact surface's) are C-points on every level and
+!> lend no F-point a weight off the coarse lattice: the contact penalty would
+!> otherwise lock the coarse spaces, whose surfaces do not match, and CG's
+!> iterations grow with the penalty. Coarsening stops by the nodes not kept.
 module sprc_fem_multigrid
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input

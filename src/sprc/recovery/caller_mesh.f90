@@ -13,23 +13,19 @@
 !> nodes at one point and two elements on the same vertices are input errors.
 !>
 !> Facets: each a side of exactly one element, nodes in any order (else an error naming
-!> it); kinds traction, symmetry, free, pressure (turning with a curved facet's normal).
-!> Normals point away from the element's vertex centroid. Only surfaces given as facets are
-!> constrained; SPR validates and ignores them. Traction and free facets are boundary piece
-!> 1, symmetry facets piece 2: the core separates faces and planes by their normals.
+!> it); kinds traction, symmetry, free, pressure; normals point away from the element's
+!> vertex centroid. Only surfaces given as facets are constrained; SPR ignores them.
 !>
 !> Patches: one per vertex node, holding the elements that contain it; h = the largest
 !> distance from the node to a node of those elements; SPR-C adds the facets' points of
 !> those elements. A rank-deficient patch grows by rings up to `max_rounds` (default
 !> mesh_default_max_rounds), as on the grid. Degree 'auto' is `auto_degree`'s.
 !>
-!> Output: nodal values (a vertex node's patch polynomial at the node; a mid-side, face or
-!> centre node the union, eq. 102, in its first element; unused nodes zero); the field
-!> sigma*(x) (SPR: nodal interpolation, eq. 101; SPR-C: the union, eq. 102); the element
-!> and total ZZ errors and eta = err / sqrt(norm_h^2 + err^2), summed scaled by powers of
-!> two so any finite stresses give finite results (the plain formulas' bits otherwise).
-!> `mesh_recovery_eval` takes each point's element if given, else the lowest-index element
-!> holding it, searched through bins (sprc_recovery_caller_mesh_bins) from 4 points on.
+!> Output: nodal values (vertex nodes: the patch polynomial; other nodes the union, eq. 102,
+!> in their first element; unused nodes zero); the field sigma*(x) (SPR eq. 101, SPR-C eq.
+!> 102); element and total ZZ errors and eta, summed scaled by powers of two so any finite
+!> stresses give finite results. `mesh_recovery_eval` finds a point's element through bins
+!> (sprc_recovery_caller_mesh_bins) unless given: the lowest-index element holding it.
 !>
 !> Contact (`contact_facets`, SPR-C only; the two-body entry sprc_contact_caller_mesh_recovery):
 !> contact facets are element sides as the boundary facets, each with a law (0 open:
@@ -39,9 +35,7 @@
 !> wins), whose points must all belong to one pair (else an error naming the node).
 !> `mesh_facet_points` gives the quadrature points of a facet list as the recovery
 !> builds them (owner element, outward normal).
-!>
-!> Parallelism and determinism: the patch loop is sprc_recovery_patch_loop's (shared with
-!> the grid); the bits do not depend on the thread count.
+!> The patch loop is sprc_recovery_patch_loop's: the bits do not depend on the threads.
 module sprc_recovery_caller_mesh
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_singular, &
