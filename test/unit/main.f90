@@ -1,6 +1,8 @@
 !> Unit-test driver: `unit [SUITE [TEST]]` runs all suites, one suite, or one
 !> test; prints one line per test and `N passed, M failed` last; exits non-zero
-!> on any failure or an unknown selection.
+!> on any failure or an unknown selection. Suites are named LAYER/NAME after the
+!> layer they test (doc/architecture.md); SUITE is LAYER/NAME, NAME, or LAYER/
+!> for every suite of the layer.
 program sprc_unit_tests
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
    use sprc_testsuite, only: testsuite_type, new_testsuite, run_testsuite
@@ -95,7 +97,7 @@ program sprc_unit_tests
    nfail = 0
    nrun = 0
    do i = 1, size(suites)
-      if (len(suite_name) > 0 .and. suite_name /= suites(i)%name) cycle
+      if (.not. selected(suites(i)%name, suite_name)) cycle
       nrun = nrun + 1
       call run_testsuite(suites(i), test_name, output_unit, npass, nfail)
    end do
@@ -107,6 +109,16 @@ program sprc_unit_tests
    if (nfail > 0) error stop 1
 
 contains
+
+   !> Whether suite `name` (LAYER/SUITE) is selected by the first argument:
+   !> none, its full name, its SUITE part, or LAYER/ for all suites of a layer.
+   pure logical function selected(name, arg)
+      character(len=*), intent(in) :: name, arg
+      integer :: slash
+      slash = index(name, '/')
+      selected = len(arg) == 0 .or. arg == name .or. arg == name(slash + 1:)
+      if (len(arg) > 0 .and. slash > 0) selected = selected .or. arg == name(1:slash)
+   end function selected
 
    subroutine get_arg(i, arg)
       integer, intent(in) :: i
