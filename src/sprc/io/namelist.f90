@@ -21,8 +21,8 @@ module sprc_io_namelist
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use sprc_core_kinds, only: wp, i8
    use sprc_core_text, only: itoa, lower
-   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_io
-   use sprc_core_alloc, only: check_allocation
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
+   use sprc_io_file, only: file_size, read_bytes
    implicit none
    private
 
@@ -118,37 +118,16 @@ contains
       !> The file's bytes.
       character(len=:), allocatable, intent(out) :: text
       type(error_type), allocatable, intent(out) :: error
-      logical :: exists
-      integer :: unit, ios, stat
       integer(i8) :: size
-      character(len=256) :: msg
 
-      inquire (file=path, exist=exists)
-      if (.not. exists) then
-         call fatal_error(error, "cannot read '"//path//"': no such file", stat_io)
-         return
-      end if
-      open (newunit=unit, file=path, access='stream', form='unformatted', action='read', status='old', &
-         & iostat=ios, iomsg=msg)
-      if (ios /= 0) then
-         call fatal_error(error, "cannot open '"//path//"': "//trim(msg), stat_io)
-         return
-      end if
-      inquire (unit=unit, size=size)
-      if (size < 0_i8) then
-         call fatal_error(error, "cannot read '"//path//"': size unknown", stat_io)
-      else if (size > int(max_text_size, i8)) then
+      call file_size(path, size, error)
+      if (allocated(error)) return
+      if (size > int(max_text_size, i8)) then
          call fatal_error(error, "'"//path//"': "//itoa(int(size / 1024_i8))// &
             & ' KiB is too large for a text input file (limit '//itoa(max_text_size / 1024)//' KiB)')
-      else
-         allocate (character(len=int(size)) :: text, stat=stat)
-         call check_allocation(stat, 'read '''//path//'''', 'the text of the file', size, 1, error)
-         if (size > 0_i8 .and. .not. allocated(error)) then
-            read (unit, iostat=ios, iomsg=msg) text
-            if (ios /= 0) call fatal_error(error, "cannot read '"//path//"': "//trim(msg), stat_io)
-         end if
+         return
       end if
-      close (unit)
+      call read_bytes(path, 1_i8, size, text, error)
       if (allocated(error)) return
       call check_text(text, path, error)
    end subroutine read_text_file
