@@ -13,14 +13,14 @@ program sprc_main
    use sprc_study_model, only: build_bodies, scene_warnings
    use sprc_study_threads, only: level_threads, study_dofs, serial_dofs
    use sprc_geometry_body, only: body_type
-   use sprc_study_mesh, only: mesh_row_type, mesh_study, study_levels, check_surfaces
+   use sprc_study_mesh_table, only: mesh_row_type, mesh_study, study_levels, check_surfaces
    use sprc_study_level, only: study_type, prepare_study, run_level, level_type, hold_starts
    use sprc_study_adapt, only: adapt_run_type, start_adapt, adapt_step, adapt_warning, step_eta
    use sprc_fem_nested, only: fe_displacement_type
    use sprc_io_report, only: report_row_type, report_table, write_report_csv, format_mesh_row
    use sprc_io_fields, only: write_level_fields
    use sprc_io_svg, only: write_report_svg, write_contact_svg
-   use sprc_io_contact, only: contact_level_type, write_contact_csv
+   use sprc_io_contact_csv, only: contact_level_type, write_contact_csv
    use sprc_io_hdf5, only: h5_output_type
    use sprc_fem_petsc, only: start_ranks
    use sprc_study_partition, only: largest_over_ranks, fail_together

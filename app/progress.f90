@@ -1,5 +1,5 @@
 !> The driver's progress lines of the contact iterations on standard error
-!> (the library tells, through sprc_contact_solve's `contact_progress`).
+!> (the library tells, through sprc_contact_pair_solve's `contact_progress`).
 module sprc_app_progress
    use, intrinsic :: iso_fortran_env, only: error_unit
    use sprc_core_text, only: itoa

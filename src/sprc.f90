@@ -24,13 +24,13 @@ module sprc
    use sprc_geometry_body, only: geometry_body_type => body_type, new_body
    use sprc_io_scene, only: scene_type, read_scene, read_scene_text, scene_summary, default_scene_text
    use sprc_study_model, only: build_bodies, build_exact, body_conditions
-   use sprc_recovery_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, mesh_method_spr, &
+   use sprc_recovery_caller_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, mesh_method_spr, &
       & mesh_method_sprc, facet_traction, facet_symmetry, facet_free, facet_pressure, elem_tri3, elem_quad4, &
       & elem_tet4, elem_hex8, elem_quad9, elem_hex27, mesh_reference_unit, mesh_reference_symmetric
-   use sprc_contact_mesh_recovery, only: contact_body_type, contact_pair_type, mesh_contact_recovery_type, &
+   use sprc_contact_caller_mesh_recovery, only: contact_body_type, contact_pair_type, mesh_contact_recovery_type, &
       & contact_pair_recovery_type, recover_contact_on_mesh, contact_open, contact_law_frictionless, contact_law_slip, &
       & contact_law_stick
-   use sprc_study_mesh, only: mesh_row_type, mesh_study, study_levels
+   use sprc_study_mesh_table, only: mesh_row_type, mesh_study, study_levels
    use sprc_study_level, only: study_type, study_body_type, prepare_study, run_level, level_type, body_level_type
    use sprc_io_fields, only: write_level_fields
    use sprc_io_report, only: report_row_type, report_table, write_report_csv, read_report_csv, report_column, &

@@ -33,7 +33,7 @@ program bench_mesh_recovery
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type
    use sprc_core_material, only: plane_strain, solid
-   use sprc_recovery_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_method_spr, mesh_method_sprc, &
+   use sprc_recovery_caller_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_method_spr, mesh_method_sprc, &
       & facet_pressure, facet_symmetry, facet_free, elem_quad4, elem_hex8
    !$ use omp_lib, only: omp_set_num_threads, omp_get_max_threads
    implicit none

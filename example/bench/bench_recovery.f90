@@ -3,7 +3,7 @@
 !> each, jittered; half of the patches carry a traction boundary with (p+1)^(dim-1)
 !> points per boundary face). Prints per-thread rates, the rate of an OpenMP loop over
 !> all threads, and, from a separate single-thread run with ws%timing on: the share of time
-!> spent inside the dense kernels (sprc_recovery_dense and the Gram / equilibrium products,
+!> spent inside the dense kernels (sprc_core_dense and the Gram / equilibrium products,
 !> timed around each call), their mean nominal flops per patch (counted as the LAPACK/BLAS
 !> calls of the same operations, LAWN 41 leading terms, sprc_recovery_flops), the rate
 !> achieved inside them (those flops / the time inside), and the mean hand count
@@ -20,7 +20,7 @@ program bench_recovery
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reset, patch_add_point, &
       & patch_add_boundary_point, boundary_traction
    use sprc_recovery_workspace, only: recovery_workspace_type, workspace_init
-   use sprc_recovery_solve, only: recover_spr, recover_sprc
+   use sprc_recovery_patch_solve, only: recover_spr, recover_sprc
    !$ use omp_lib, only: omp_get_max_threads
    implicit none
 

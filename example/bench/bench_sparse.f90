@@ -113,7 +113,7 @@ contains
 
    !> Q1 elasticity on nel^dim elements of the unit square/cube, face x = 0
    !> clamped and eliminated, dofs node-major. Element stiffness as in
-   !> test/unit/test_sparse.f90 (the FE layer's element will replace both).
+   !> test/unit/fem_sparse.f90 (the FE layer's element will replace both).
    subroutine elasticity(dim, nel, a, error)
       integer, intent(in) :: dim, nel
       type(csr_type), intent(out) :: a

@@ -1,5 +1,5 @@
 !> Convergence and small-cut studies of the FE layer (the heavier companions
-!> of test/unit/test_fem.f90), printed as tables:
+!> of test/unit/fem.f90), printed as tables:
 !> - err_fe (energy norm, relative) against the level for the Lame cylinder
 !>   quarter (plane strain and plane stress, Q1 and Q2 levels 3..6), the
 !>   Kirsch quarter plate (plane stress, Q1 and Q2 3..7) and the Lame sphere

@@ -30,10 +30,10 @@ program recovery_study
       & fe_symmetry => bc_symmetry, fe_exact_traction => bc_exact_traction
    use sprc_fem_problem, only: elasticity_problem_type, solve_on_grid
    use sprc_grid_hanging, only: hanging_type
-   use sprc_grid_patches, only: recovery_input_type, recover_grid
-   use sprc_fem_recovery_input, only: fe_recovery_input
-   use sprc_grid_recovered_field, only: recovered_field_type, method_spr, method_sprc
-   use sprc_grid_recovered_estimate, only: zz_estimate_type, estimate_error
+   use sprc_estimate_patches, only: recovery_input_type, recover_grid
+   use sprc_estimate_fe_input, only: fe_recovery_input
+   use sprc_estimate_recovered_field, only: recovered_field_type, method_spr, method_sprc
+   use sprc_estimate_norms, only: zz_estimate_type, estimate_error
    use sprc_recovery_patch_loop, only: auto_degree
    implicit none
 

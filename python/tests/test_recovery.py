@@ -1,7 +1,7 @@
 """Tests of sprc.recover: recovery on a caller's mesh through the C API.
 
 The meshes, isoparametric maps and Gauss rules are built here in numpy (as
-test/unit/test_mesh_recovery.f90 builds them in Fortran), not with the
+test/unit/recovery_caller_mesh.f90 builds them in Fortran), not with the
 library: node (i, j, k) of a (q m + 1)^dim lattice on [0,1]^dim, vertex nodes
 (indices multiples of q) moved by a smooth perturbation of 0.2 cell in their
 interior components (sides stay planar), other nodes at the multilinear

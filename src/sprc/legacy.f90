@@ -3,7 +3,7 @@
 !>
 !> Integer codes (part of the C API; never renumber):
 !> - element type (VTK cell type ids): tri3 = 5, quad4 = 9, tet4 = 10, hex8 = 12,
-!>   quad9 = 28, hex27 = 29 (VTK node order, sprc_recovery_mesh_element);
+!>   quad9 = 28, hex27 = 29 (VTK node order, sprc_recovery_caller_mesh_element);
 !> - analysis: plane stress = 1, plane strain = 2, solid (3D) = 3;
 !> - method: SPR = 1, SPR-C = 2 (patch degree 'auto': SPR at the element degree p, SPR-C at
 !>   p + 1 for quad9 and hex27);
@@ -18,8 +18,8 @@ module sprc_legacy
    use sprc_core_error, only: error_type, stat_success, fatal_error
    use sprc_core_error, only: stat_invalid_input
    use sprc_core_text, only: itoa
-   use sprc_recovery_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval
-   use sprc_contact_mesh_recovery, only: contact_body_type, contact_pair_type, mesh_contact_recovery_type, &
+   use sprc_recovery_caller_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval
+   use sprc_contact_caller_mesh_recovery, only: contact_body_type, contact_pair_type, mesh_contact_recovery_type, &
       & recover_contact_on_mesh
    implicit none
    private
@@ -29,7 +29,7 @@ module sprc_legacy
 contains
 
    !> Recover the stresses of a caller's mesh, estimate the error and evaluate the recovered
-   !> field at points (sprc_recovery_mesh, recover_on_mesh and mesh_recovery_eval).
+   !> field at points (sprc_recovery_caller_mesh, recover_on_mesh and mesh_recovery_eval).
    !>
    !> Inputs: ndim (2 or 3); nnode, coords(ndim, nnode); etype; nen, nelem,
    !> conn(nen, nelem) (1-based); ngp, gp(ndim, ngp, nelem) physical integration points,
@@ -83,7 +83,7 @@ contains
       eta = result%eta
    end subroutine sprc_recover_mesh
 
-   !> Recover two bodies in contact, each on its own mesh (sprc_contact_mesh_recovery): body 1
+   !> Recover two bodies in contact, each on its own mesh (sprc_contact_caller_mesh_recovery): body 1
    !> the slave, body 2 the master of one pair; no other boundary facets (the modern API,
    !> `recover_contact_on_mesh`, takes them, and several bodies and pairs).
    !>

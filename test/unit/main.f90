@@ -1,6 +1,8 @@
 !> Unit-test driver: `unit [SUITE [TEST]]` runs all suites, one suite, or one
 !> test; prints one line per test and `N passed, M failed` last; exits non-zero
-!> on any failure or an unknown selection.
+!> on any failure or an unknown selection. Suites are named LAYER/NAME after the
+!> layer they test (doc/architecture.md); SUITE is LAYER/NAME, NAME, or LAYER/
+!> for every suite of the layer.
 program sprc_unit_tests
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
    use sprc_testsuite, only: testsuite_type, new_testsuite, run_testsuite
@@ -49,44 +51,44 @@ program sprc_unit_tests
    integer :: i, npass, nfail, nrun
 
    suites = [ &
-      new_testsuite('core', collect_core), &
-      new_testsuite('poly', collect_poly), &
-      new_testsuite('sparse', collect_sparse), &
-      new_testsuite('exact', collect_exact), &
-      new_testsuite('exact_contact', collect_exact_contact), &
-      new_testsuite('exact_corner', collect_exact_corner), &
-      new_testsuite('exact_layered', collect_exact_layered), &
-      new_testsuite('contact_surface', collect_contact_surface), &
-      new_testsuite('namelist', collect_namelist), &
-      new_testsuite('scene', collect_scene), &
-      new_testsuite('facet_files', collect_facet_files), &
-      new_testsuite('geometry', collect_geometry), &
-      new_testsuite('grid', collect_grid), &
-      new_testsuite('adapt', collect_adapt), &
-      new_testsuite('model', collect_model), &
-      new_testsuite('quadrature', collect_quadrature), &
-      new_testsuite('facets', collect_facets), &
-      new_testsuite('recovery', collect_recovery), &
-      new_testsuite('report', collect_report), &
-      new_testsuite('patches', collect_patches), &
-      new_testsuite('singular', collect_singular), &
-      new_testsuite('output', collect_output), &
-      new_testsuite('fem', collect_fem), &
-      new_testsuite('mesh_recovery', collect_mesh_recovery), &
-      new_testsuite('contact_mesh', collect_contact_mesh), &
-      new_testsuite('stiff', collect_stiff), &
-      new_testsuite('study', collect_study), &
-      new_testsuite('adaptive', collect_adaptive), &
-      new_testsuite('contact_model', collect_contact_model), &
-      new_testsuite('contact_output', collect_contact_output), &
-      new_testsuite('contact_fe', collect_contact_fe), &
-      new_testsuite('contact_assembly', collect_contact_assembly), &
-      new_testsuite('contact_friction', collect_contact_friction), &
-      new_testsuite('contact_iterative', collect_contact_iterative), &
-      new_testsuite('petsc', collect_petsc), &
-      new_testsuite('contact_recovery', collect_contact_recovery), &
-      new_testsuite('partition', collect_partition), &
-      new_testsuite('testsuite', collect_testsuite) &
+      new_testsuite('core/core', collect_core), &
+      new_testsuite('core/poly', collect_poly), &
+      new_testsuite('fem/sparse', collect_sparse), &
+      new_testsuite('exact/exact', collect_exact), &
+      new_testsuite('exact/exact_contact', collect_exact_contact), &
+      new_testsuite('exact/exact_corner', collect_exact_corner), &
+      new_testsuite('exact/exact_layered', collect_exact_layered), &
+      new_testsuite('contact/contact_surface', collect_contact_surface), &
+      new_testsuite('io/namelist', collect_namelist), &
+      new_testsuite('io/scene', collect_scene), &
+      new_testsuite('io/facet_files', collect_facet_files), &
+      new_testsuite('geometry/geometry', collect_geometry), &
+      new_testsuite('grid/grid', collect_grid), &
+      new_testsuite('grid/adapt', collect_adapt), &
+      new_testsuite('study/model', collect_model), &
+      new_testsuite('grid/quadrature', collect_quadrature), &
+      new_testsuite('geometry/facets', collect_facets), &
+      new_testsuite('recovery/recovery', collect_recovery), &
+      new_testsuite('io/report', collect_report), &
+      new_testsuite('estimate/patches', collect_patches), &
+      new_testsuite('estimate/singular', collect_singular), &
+      new_testsuite('io/output', collect_output), &
+      new_testsuite('fem/fem', collect_fem), &
+      new_testsuite('recovery/mesh_recovery', collect_mesh_recovery), &
+      new_testsuite('contact/contact_mesh', collect_contact_mesh), &
+      new_testsuite('fem/stiff', collect_stiff), &
+      new_testsuite('study/study', collect_study), &
+      new_testsuite('study/adaptive', collect_adaptive), &
+      new_testsuite('study/contact_model', collect_contact_model), &
+      new_testsuite('io/contact_output', collect_contact_output), &
+      new_testsuite('contact/contact_fe', collect_contact_fe), &
+      new_testsuite('contact/contact_assembly', collect_contact_assembly), &
+      new_testsuite('contact/contact_friction', collect_contact_friction), &
+      new_testsuite('contact/contact_iterative', collect_contact_iterative), &
+      new_testsuite('fem/petsc', collect_petsc), &
+      new_testsuite('recovery/contact_recovery', collect_contact_recovery), &
+      new_testsuite('study/partition', collect_partition), &
+      new_testsuite('harness/testsuite', collect_testsuite) &
       ]
 
    call get_arg(1, suite_name)
@@ -95,7 +97,7 @@ program sprc_unit_tests
    nfail = 0
    nrun = 0
    do i = 1, size(suites)
-      if (len(suite_name) > 0 .and. suite_name /= suites(i)%name) cycle
+      if (.not. selected(suites(i)%name, suite_name)) cycle
       nrun = nrun + 1
       call run_testsuite(suites(i), test_name, output_unit, npass, nfail)
    end do
@@ -107,6 +109,16 @@ program sprc_unit_tests
    if (nfail > 0) error stop 1
 
 contains
+
+   !> Whether suite `name` (LAYER/SUITE) is selected by the first argument:
+   !> none, its full name, its SUITE part, or LAYER/ for all suites of a layer.
+   pure logical function selected(name, arg)
+      character(len=*), intent(in) :: name, arg
+      integer :: slash
+      slash = index(name, '/')
+      selected = len(arg) == 0 .or. arg == name .or. arg == name(slash + 1:)
+      if (len(arg) > 0 .and. slash > 0) selected = selected .or. arg == name(1:slash)
+   end function selected
 
    subroutine get_arg(i, arg)
       integer, intent(in) :: i

@@ -160,19 +160,25 @@ contains
       integer, intent(inout) :: npass, nfail
       type(unittest_type), allocatable :: tests(:)
       character(len=:), allocatable :: failure
+      character(len=16) :: seconds
       integer :: i
+      integer(i8) :: start, finish, rate
 
       call suite%collect(tests)
       do i = 1, size(tests)
          if (len(selection) > 0 .and. selection /= tests(i)%name) cycle
+         call system_clock(start, rate)
          call run_one(tests(i), failure)
+         call system_clock(finish)
+         ! The wall time goes to the log (tools/run-tests sums it per layer), never into a verdict.
+         write (seconds, '(f10.2)') real(finish - start, wp)/real(max(rate, 1_i8), wp)
          if (allocated(failure)) then
             nfail = nfail + 1
             write (unit, '(a)') 'FAIL '//suite%name//'/'//tests(i)%name//': '//failure
             deallocate (failure)
          else
             npass = npass + 1
-            write (unit, '(a)') 'ok   '//suite%name//'/'//tests(i)%name
+            write (unit, '(a)') 'ok   '//suite%name//'/'//tests(i)%name//' ['//trim(adjustl(seconds))//' s]'
          end if
          flush (unit)
       end do

@@ -1,7 +1,7 @@
 !> C API, contact recovery on a caller's meshes: an `sprc_contact_input` collects bodies
 !> (`sprc_contact_add_body`, the arguments of sprc_recover_reference) and pairs
 !> (`sprc_contact_add_pair`), `sprc_recover_contact` runs recover_contact_on_mesh
-!> (sprc_contact_mesh_recovery) into an `sprc_contact_recovery`, whose bodies are read as
+!> (sprc_contact_caller_mesh_recovery) into an `sprc_contact_recovery`, whose bodies are read as
 !> ordinary recoveries (`sprc_get_contact_body`: a copy, an `sprc_recovery`) and whose pairs
 !> by `sprc_get_contact_pair`.
 !>
@@ -15,9 +15,9 @@ module sprc_capi_contact_recovery
    use sprc_core_text, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_out_of_memory
    use sprc_core_material, only: voigt_size
-   use sprc_recovery_mesh, only: mesh_method_spr, mesh_method_sprc, mesh_reference_unit, mesh_reference_symmetric
-   use sprc_recovery_mesh_element, only: element_facet_nodes, facet_npoints
-   use sprc_contact_mesh_recovery, only: contact_body_type, contact_pair_type, mesh_contact_recovery_type, &
+   use sprc_recovery_caller_mesh, only: mesh_method_spr, mesh_method_sprc, mesh_reference_unit, mesh_reference_symmetric
+   use sprc_recovery_caller_mesh_element, only: element_facet_nodes, facet_npoints
+   use sprc_contact_caller_mesh_recovery, only: contact_body_type, contact_pair_type, mesh_contact_recovery_type, &
       & recover_contact_on_mesh
    use sprc_capi_error, only: capi_error_type, get_capi_error, set_capi_error
    use sprc_capi_recovery, only: capi_recovery_type, mesh_sizes_type, check_sizes, check_pointers, one_based

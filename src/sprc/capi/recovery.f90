@@ -1,5 +1,5 @@
 !> C API, recovery on a caller's mesh: `sprc_recovery` holds the result of
-!> `recover_on_mesh` (sprc_recovery_mesh) for a mesh given as C arrays.
+!> `recover_on_mesh` (sprc_recovery_caller_mesh) for a mesh given as C arrays.
 !>
 !> C arrays in row-major order are the Fortran column-major arrays with the
 !> same memory (`nodes[nnode][dim]` is `nodes(dim, nnode)`), so the real
@@ -15,10 +15,10 @@ module sprc_capi_recovery
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_out_of_memory
    use sprc_core_alloc, only: check_allocation
    use sprc_core_material, only: voigt_size
-   use sprc_recovery_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, mesh_method_sprc, &
+   use sprc_recovery_caller_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, mesh_method_sprc, &
       & mesh_reference_unit, mesh_reference_symmetric
    use sprc_recovery_patch_loop, only: auto_degree
-   use sprc_recovery_mesh_element, only: element_known, element_nodes, element_facet_nodes, element_name, &
+   use sprc_recovery_caller_mesh_element, only: element_known, element_nodes, element_facet_nodes, element_name, &
       & element_degree
    use sprc_capi_error, only: capi_error_type, get_capi_error, set_capi_error
    implicit none

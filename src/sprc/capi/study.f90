@@ -11,7 +11,7 @@ module sprc_capi_study
    use sprc_core_text, only: itoa
    use sprc_io_scene, only: scene_type, read_scene
    use sprc_io_fields, only: level_fields_type, grid_fields_type, field_array_type, level_fields
-   use sprc_study_mesh, only: study_levels, check_surfaces
+   use sprc_study_mesh_table, only: study_levels, check_surfaces
    use sprc_geometry_body, only: body_type
    use sprc_study_level, only: study_type, prepare_study, run_level, level_type, hold_starts
    use sprc_study_threads, only: level_threads, serial_dofs

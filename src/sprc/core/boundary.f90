@@ -1,7 +1,7 @@
 !> The boundary kinds of sprc: one vocabulary for the scene's `&bc` types,
 !> the FE conditions (`sprc_fem_bc`), the recovery input on a grid
-!> (`sprc_grid_patches`), the facets of a caller's mesh
-!> (`sprc_recovery_mesh`) and the boundary points of a patch
+!> (`sprc_estimate_patches`), the facets of a caller's mesh
+!> (`sprc_recovery_caller_mesh`) and the boundary points of a patch
 !> (`sprc_recovery_patch`). Each layer accepts the kinds that mean something
 !> to it and says which in its checks.
 !>

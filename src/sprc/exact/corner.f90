@@ -2,72 +2,30 @@
 !> wedge of opening angle 180 < angle <= 360 degrees; 270 is the L-shaped
 !> domain, 360 a crack): the first symmetric (mode 1) and antisymmetric
 !> (mode 2) eigenfunctions of Williams (1952, J. Appl. Mech. 19), in the
-!> normalisation of Szabo & Babuska (Finite Element Analysis, 1991, the
-!> L-shaped domain) that Mitchell's adaptivity benchmarks also use
-!> (Mitchell 2013, "A collection of 2D elliptic problems for testing
-!> adaptive grid refinement algorithms"). Zero body force; plane stress or
-!> plane strain.
+!> normalisation of Szabo & Babuska (Finite Element Analysis, 1991) that
+!> Mitchell's adaptivity benchmarks (2013) also use. Zero body force; plane
+!> stress or plane strain.
 !>
 !> Local frame: origin at the apex `point`, x' along `direction` (the
 !> bisector of the material wedge), y' the bisector turned 90 degrees
 !> counterclockwise; polar angle t from x' in (-pi, pi], so the material is
-!> |t| <= beta with beta = alpha/2 (alpha the opening in radians) and its
-!> faces are t = +-beta. With the Kolosov-Muskhelishvili potentials
-!> (z = x' + i y' = r e^(it))
+!> |t| <= beta = alpha/2 and its faces are t = +-beta. The amplitudes
+!> A1 = `mode1`, A2 = `mode2` have units of stress times length^(1 - l); for
+!> a crack A = K/sqrt(2 pi) (K_I, K_II). The potentials, the stress and
+!> displacement formulas, the eigenvalue equations and the ratio Q are written
+!> out in doc/theory.md, section 10a ("The corner solution").
 !>
-!>   mode 1:  phi = A1 z^l1,     psi = A1 Q1 (l1 + 1) z^l1,
-!>   mode 2:  phi = -i A2 z^l2,  psi = -i A2 Q2 (l2 + 1) z^l2,
-!>
-!>   s_x'x' + s_y'y' = 4 Re phi',  s_y'y' - s_x'x' + 2 i s_x'y' = 2 (conj(z) phi'' + psi'),
-!>   2 G (u_x' + i u_y') = kappa phi - z conj(phi') - conj(psi),
-!>
-!> that is, for mode 1 (Szabo & Babuska's formulas),
-!>
-!>   s_x'x' = A1 l r^(l-1) ((2 - Q (l+1)) cos((l-1)t) - (l-1) cos((l-3)t)),
-!>   s_y'y' = A1 l r^(l-1) ((2 + Q (l+1)) cos((l-1)t) + (l-1) cos((l-3)t)),
-!>   s_x'y' = A1 l r^(l-1) ((l-1) sin((l-3)t) + Q (l+1) sin((l-1)t)),
-!>   u_x' = A1 r^l/(2G) ((kappa - Q (l+1)) cos(l t) - l cos((l-2)t)),
-!>   u_y' = A1 r^l/(2G) ((kappa + Q (l+1)) sin(l t) + l sin((l-2)t)),
-!>
-!> and for mode 2
-!>
-!>   u_x' = A2 r^l/(2G) ((kappa - Q (l+1)) sin(l t) - l sin((l-2)t)),
-!>   u_y' = -A2 r^l/(2G) ((kappa + Q (l+1)) cos(l t) + l cos((l-2)t)),
-!>
-!> with G = E/(2(1 + nu)), kappa = 3 - 4 nu (plane strain) or
-!> (3 - nu)/(1 + nu) (plane stress). The amplitudes A1 = `mode1`, A2 =
-!> `mode2` have units of stress times length^(1 - l). For a crack they are
-!> A = K/sqrt(2 pi) (K_I, K_II the stress intensity factors): ahead of the
-!> tip s_y'y' = A1/sqrt(r) and s_x'y' = A2/sqrt(r).
-!>
-!> Eigenvalues: the faces are free, phi + z conj(phi') + conj(psi) = 0 on
-!> t = +-beta, when l solves
-!>
-!>   mode 1:  sin(l alpha) + l sin(alpha) = 0,   mode 2:  sin(l alpha) - l sin(alpha) = 0,
-!>
-!> and then Q is the ratio the two real equations of that condition give
-!> (mode 1: Q = -cos((l-1)beta)/cos((l+1)beta) = -(l-1) sin((l-1)beta)/((l+1) sin((l+1)beta)),
-!> mode 2: Q = -sin((l-1)beta)/sin((l+1)beta) = -(l-1) cos((l-1)beta)/((l+1) cos((l+1)beta))),
-!> taken from the one with the larger denominator: at the crack
-!> (beta = pi, l = 1/2) one of each pair is 0/0 (Q1 = 1/3, Q2 = -1).
-!> l1 is the root in (1/2, pi/alpha], where the mode 1 function is concave,
-!> positive at 1/2 and negative at pi/alpha. l = 1 solves the mode 2
-!> equation for every alpha but is a rigid rotation (no stress); the first
-!> stressed mode 2 root is in (pi/alpha, 1) when alpha cos(alpha) > sin(alpha)
-!> (alpha above 257.45 degrees, where tan(alpha) = alpha) and in
-!> (1, 2 pi/alpha) below it, on either side of the minimum of the convex
-!> branch. Near 257.45 degrees l2 tends to 1 and the mode 2 field to that
-!> rotation: its stress vanishes with l2 - 1 (and l2 is a double root, found
-!> to about sqrt(eps)). Both roots are found by a safeguarded Newton
-!> iteration to round-off. L-shape: l1 = 0.5444837367825, l2 = 0.9085291898461,
-!> Q1 = 0.5430755788367, Q2 = -0.2189232362488; crack: l1 = l2 = 1/2.
+!> Both eigenvalues are found by a safeguarded Newton iteration to round-off,
+!> each in a bracket where its function is monotone (doc/theory.md); Q is taken
+!> from the face equation with the larger denominator, since at the crack one
+!> of each pair is 0/0. Near 257.45 degrees l2 is a double root, found to about
+!> sqrt(eps); its stress vanishes there with l2 - 1.
 !>
 !> The displacement has no rigid part beyond the one the formulas carry
 !> (u = 0 at the apex). The stress is infinite at the apex: points closer than
 !> the smallest normal number are evaluated at that distance, so every finite
-!> input gives finite output (stress up to ~1e154 times the amplitudes).
-!> Points outside the material wedge get the formulas' analytic continuation
-!> (the branch cut is the ray t = pi, opposite the bisector).
+!> input gives finite output. Points outside the material wedge get the
+!> formulas' analytic continuation (the branch cut is the ray t = pi).
 module sprc_exact_corner
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input

@@ -5,41 +5,22 @@
 !> (sprc_exact_lame); the compound cylinder and sphere (sprc_exact_compound)
 !> are the case n = 2.
 !>
-!> Ring i (1..n) occupies r_(i-1) <= r <= r_i (radii r_0 < ... < r_n, inside
-!> out), with pressure p_(i-1) on its inner and p_i on its outer surface:
-!> p_0 = p_in, p_n = p_out, and p_j (j = 1..n-1) the pressure of interface
-!> j at r_j, which makes the radial stress continuous there by
-!> construction. The radial displacement of ring i is linear in its two
-!> pressures, u_i(r) = alpha_i(r) p_(i-1) + beta_i(r) p_i, with alpha_i(r),
-!> beta_i(r) the displacements of the ring under a unit inner or outer
-!> pressure alone. Interface j is a fit with radial interference delta_j
-!> (the separation of the undeformed rings, both modelled at r_j): in contact
-!> the outer ring's displacement exceeds the inner one's by delta_j,
-!>   u_(j+1)(r_j) - u_j(r_j) = delta_j,
-!> that is, for j = 1..n-1 (the known p_0, p_n on the right),
-!>   -alpha_j(r_j) p_(j-1) + (alpha_(j+1)(r_j) - beta_j(r_j)) p_j + beta_(j+1)(r_j) p_(j+1) = delta_j,
-!> a tridiagonal system (solved densely: n is a handful). For n = 2 it is
-!> the compound formula p_c = (delta + u_i(c; p_in, 0))/(f_o + f_i) with
-!> f_o = alpha_2(c), f_i = -beta_1(c) (and p_out = 0).
+!> Ring i occupies r_(i-1) <= r <= r_i with pressure p_(i-1) inside and p_i
+!> outside (p_0 = p_in, p_n = p_out), so the radial stress is continuous by
+!> construction; the interface pressures p_1..p_(n-1) solve the tridiagonal
+!> system of the interferences (doc/theory.md, section 6a), solved densely
+!> since n is a handful.
 !>
-!> An interface carries no tension: an interface whose pressure comes out
-!> negative opens (p_j = 0, its equation dropped), and an open interface
-!> whose rings would separation, u_(j+1)(r_j) - u_j(r_j) < delta_j, closes;
-!> this active set is iterated until it repeats (at most 2 (n - 1) + 1 solves
-!> for the monotone cases; more is an error).
+!> An interface carries no tension: one whose pressure comes out negative
+!> opens (p_j = 0, its equation dropped), and an open one whose rings would
+!> overlap closes; this active set is iterated until it repeats (at most
+!> 2 (n - 1) + 1 solves for the monotone cases; more is an error).
 !>
-!> Real radii. A scene models interface j with the inner ring's outer
-!> surface at r_j + delta_j and the outer ring's bore at r_j (the shapes
-!> overlap by delta_j: the slave surface is where the mesh has it). The
-!> closed form on the nominal radii puts both at r_j, which bounds the FE
-!> error from below by about delta/r. With `shifts` = delta ring j ends at
-!> r_j + delta_j, and the interface conditions are the ones the contact
-!> formulation converges to: the gap along the radius closes,
-!>   u_(j+1)(r_j) - u_j(r_j + delta_j) = delta_j,
-!> and the two surfaces exchange equal forces (the multiplier acts on the
-!> slave surface and its reaction on the master), so the inner ring's outer
-!> pressure is p_j (r_j/(r_j + delta_j))^(dim - 1), p_j the bore pressure of
-!> ring j + 1. Only the radii and this ratio change in the system above.
+!> Real radii (`shifts`): a scene models interface j with the inner ring's
+!> outer surface at r_j + delta_j and the outer ring's bore at r_j; the closed
+!> form on the nominal radii would bound the FE error from below by about
+!> delta/r. With shifts the interface conditions are the ones the contact
+!> formulation converges to (doc/theory.md, section 6a).
 !>
 !> The result is one exact solution per ring (`rings(i)%field`), each with
 !> its own material, as the per-body error norms need.

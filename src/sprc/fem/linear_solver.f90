@@ -41,7 +41,7 @@ module sprc_fem_linear_solver
    !> there); so does Q2 in 3D, where GAMG needs ~200 iterations.
    integer, parameter :: auto_never = huge(1)
    integer, parameter :: auto_min_dofs(2:3, 1:2) = reshape([auto_never, 25000, auto_never, auto_never], [2, 2])
-   !> The same for the coupled system of bodies in contact (sprc_contact_solve,
+   !> The same for the coupled system of bodies in contact (sprc_contact_pair_solve,
    !> both bodies' unknowns): its iterative solve sets up the multigrid once
    !> per active-set iteration with the contact surface on the coarsest
    !> level, and its tolerance is tighter (pointwise pressures), so the

@@ -31,22 +31,17 @@
 !> a body whose hierarchy is shorter keeps its coarsest nodes (identity) on
 !> the remaining levels. The coupling terms are then seen by the coarse
 !> levels through the Galerkin products of the coupled fine matrix.
-!> Kept nodes (`keep`: those a coupling term of large weight acts on, the
-!> contact surface's) are C-points of their own on every level, and no
-!> F-point takes a weight from them unless they lie on the coarse lattice:
-!> a coarse function is then either a kept node's fine one or zero at
-!> every kept node off the lattice. The coupling, a penalty on the relative
-!> displacement of the two bodies' surfaces, would otherwise lock the
-!> coarse spaces, whose interpolated surfaces do not match (each body's own
-!> grid): CG's iterations then grow with the penalty factor.
-!> Coarsening stops by the count of the nodes not kept.
+!> Kept nodes (`keep`, the contact surface's) are C-points on every level and
+!> lend no F-point a weight off the coarse lattice: the contact penalty would
+!> otherwise lock the coarse spaces, whose surfaces do not match, and CG's
+!> iterations grow with the penalty. Coarsening stops by the nodes not kept.
 module sprc_fem_multigrid
    use sprc_core_kinds, only: wp
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
    use sprc_core_alloc, only: check_allocation
    use sprc_core_hash, only: key_table_type
    use sprc_core_sort, only: sort_pairs
-   use sprc_recovery_dense, only: qr_pivoted, apply_q, solve_upper
+   use sprc_core_dense, only: qr_pivoted, apply_q, solve_upper
    implicit none
    private
 
@@ -378,7 +373,7 @@ contains
    !> w = argmin |w - w0| subject to sum w = 1 and sum_k w_k x(:, k) = t: with
    !> A = [1; x] (d + 1 rows, m >= d + 1 columns), w = w0 + delta where delta is
    !> the least-norm solution of A delta = [1; t] - A w0, from the pivoted QR of
-   !> A^T (`sprc_recovery_dense`, the patch solves' kernel): A^T P = Q R gives
+   !> A^T (`sprc_core_dense`, the patch solves' kernel): A^T P = Q R gives
    !> R^T (Q^T delta)(1:d+1) = P^T ([1; t] - A w0) and the rest of Q^T delta = 0.
    !> `found` is false when A has not full row rank: |R_(d+1,d+1)| at most
    !> sqrt(eps) |R_11| (the offsets are small integers, so a rank-deficient A

@@ -1051,7 +1051,7 @@ contains
    !> (all of unit magnitude), taken to the reduced space by restrict_field
    !> (nodal values at the masters, zeroed components dropped). A failed
    !> allocation is returned in `error`; without `error` the run time stops
-   !> the program, as before `error` was added (contact/solve.f90 still calls it so).
+   !> the program, as before `error` was added (contact/pair_solve.f90 still calls it so).
    pure subroutine rigid_modes(self, r, error)
       class(elasticity_problem_type), intent(in) :: self
       real(wp), allocatable, intent(out) :: r(:, :)

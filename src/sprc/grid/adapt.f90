@@ -3,44 +3,24 @@
 !> Pure maths over element arrays; the caller concatenates all bodies.
 !>
 !> `optimal_levels`: the criterion of the minimum number of elements for a
-!> prescribed error, used with recovery estimators by Ródenas, Fuenmayor,
-!> Tarancón and Nadal. Let ‖e‖_K² = `err_sq(K)` be the squared energy-norm
-!> error estimate of element K of size h_K, degree p, dimension d. A priori
-!> ‖e‖_K² ∝ h_K^(2p+d) for the same local solution, so if the region of K is
-!> filled with elements of size h_K r_K (r_K^(-d) of them), each carries
-!> ‖e‖_K² r_K^(2p+d) and the region ‖e‖_K² r_K^(2p). The new mesh has
-!> N = Σ r_K^(-d) elements and squared error Σ ‖e‖_K² r_K^(2p); the target is
-!> E_t² = η_t² `norm_sq` (η = sqrt(Σ ‖e‖_K² / norm_sq), e.g. norm_sq =
-!> ‖σ_h‖² + ‖e‖²). Minimising N under Σ ‖e‖_K² r_K^(2p) = E_t² (Lagrange:
-!> d r_K^(-d-1) = 2pλ ‖e‖_K² r_K^(2p-1)) gives ‖e‖_K² r_K^(2p+d) = e_t², the
-!> same for all K: the error is equidistributed over the NEW elements. The
-!> constraint then gives e_t^(4p/(2p+d)) Σ_i ‖e‖_i^(2d/(2p+d)) = E_t², so
+!> prescribed error (Ródenas, Fuenmayor, Tarancón and Nadal), derived in
+!> doc/theory.md, section 10a: with ‖e‖_K² = `err_sq(K)` and the target
+!> E_t² = η_t² `norm_sq`, the size ratio
 !>
-!>     r_K = ‖e‖_K^(-2/(2p+d)) · [E_t² / Σ_i ‖e‖_i^(2d/(2p+d))]^(1/(2p)).
+!>     r_K = ‖e‖_K^(-2/(2p+d)) · [E_t² / Σ_i ‖e‖_i^(2d/(2p+d))]^(1/(2p))
 !>
-!> Evaluated in base-2 logarithms (no overflow for any finite input; an
-!> element with zero estimate has r_K = huge). Size h = box / 2^level, so the
-!> level change is x_K = -log2 r_K, made an integer (a change within sqrt(eps)
-!> of an integer counts as that integer, far above the rounding of the
-!> logarithms and far below any size that matters). A coarsening (x_K <= 0)
-!> is rounded up: a cell never becomes coarser than predicted. A refinement
-!> is rounded to the nearer error, not up: c levels leave the region of K
-!> the error ‖e‖_K² 2^(-2pc) against the wanted ‖e‖_K² 2^(-2p x_K), and
-!> between ⌊x_K⌋ and ⌈x_K⌉ the finer is nearer iff the fraction of x_K exceeds
-!>
-!>     θ_p = -log2((1 + 2^(-2p))/2) / (2p)      (0.339 for p = 1, 0.228 for p = 2),
-!>
-!> so the errors of the new mesh sum to the target to first order. Rounding
-!> every refinement up instead lands the step well below the target with up
-!> to (2^d - 1)/(d ln 2) times the predicted cells (2.2 in 2D, 3.4 in 3D).
-!> Whenever η > η_t some x_K > 0; if no x_K exceeds θ_p, the refinements are
-!> rounded up, so a step always refines something. The change is clamped to [-1, max_change]
-!> (`default_max_change` = 2): where the local rate is below p (re-entrant
-!> corners, contact edges) ‖e‖_K does not fall like h^(p+d/2), and a one-shot
-!> prediction subdivides the whole of K many levels deep where only the cells
-!> at the singular point need it; two levels per step and a new estimate grade
-!> the mesh instead. Coarsening one level per step keeps a poorly estimated
-!> element from losing several levels at once. Then into [0, max_level].
+!> equidistributes the error over the new elements. Evaluated in base-2
+!> logarithms (no overflow for any finite input; a zero estimate gives
+!> r_K = huge); the level change x_K = -log2 r_K counts as an integer within
+!> sqrt(eps) of one. A coarsening is rounded up (never coarser than predicted);
+!> a refinement to the nearer error, the finer level when the fraction of x_K
+!> exceeds θ_p = -log2((1 + 2^(-2p))/2) / (2p), so the new errors sum to the
+!> target to first order (rounding every refinement up overshoots the cells).
+!> If no x_K exceeds θ_p while η > η_t, the refinements are rounded up, so a
+!> step always refines something. The change is clamped to [-1, max_change]
+!> (`default_max_change` = 2: where the local rate is below p a one-shot
+!> prediction over-refines all of K; a few levels per step with a new estimate
+!> grade the mesh instead), then into [0, max_level].
 !>
 !> `fraction_levels`: Dörfler bulk marking, for comparison: refine by one
 !> level the smallest set of elements whose squared estimates sum to at least

@@ -21,8 +21,8 @@ module sprc_io_namelist
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use sprc_core_kinds, only: wp, i8
    use sprc_core_text, only: itoa, lower
-   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_io
-   use sprc_core_alloc, only: check_allocation
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
+   use sprc_io_file, only: file_size, read_bytes
    implicit none
    private
 
@@ -118,37 +118,16 @@ contains
       !> The file's bytes.
       character(len=:), allocatable, intent(out) :: text
       type(error_type), allocatable, intent(out) :: error
-      logical :: exists
-      integer :: unit, ios, stat
       integer(i8) :: size
-      character(len=256) :: msg
 
-      inquire (file=path, exist=exists)
-      if (.not. exists) then
-         call fatal_error(error, "cannot read '"//path//"': no such file", stat_io)
-         return
-      end if
-      open (newunit=unit, file=path, access='stream', form='unformatted', action='read', status='old', &
-         & iostat=ios, iomsg=msg)
-      if (ios /= 0) then
-         call fatal_error(error, "cannot open '"//path//"': "//trim(msg), stat_io)
-         return
-      end if
-      inquire (unit=unit, size=size)
-      if (size < 0_i8) then
-         call fatal_error(error, "cannot read '"//path//"': size unknown", stat_io)
-      else if (size > int(max_text_size, i8)) then
+      call file_size(path, size, error)
+      if (allocated(error)) return
+      if (size > int(max_text_size, i8)) then
          call fatal_error(error, "'"//path//"': "//itoa(int(size / 1024_i8))// &
             & ' KiB is too large for a text input file (limit '//itoa(max_text_size / 1024)//' KiB)')
-      else
-         allocate (character(len=int(size)) :: text, stat=stat)
-         call check_allocation(stat, 'read '''//path//'''', 'the text of the file', size, 1, error)
-         if (size > 0_i8 .and. .not. allocated(error)) then
-            read (unit, iostat=ios, iomsg=msg) text
-            if (ios /= 0) call fatal_error(error, "cannot read '"//path//"': "//trim(msg), stat_io)
-         end if
+         return
       end if
-      close (unit)
+      call read_bytes(path, 1_i8, size, text, error)
       if (allocated(error)) return
       call check_text(text, path, error)
    end subroutine read_text_file
@@ -739,6 +718,36 @@ contains
       end if
    end subroutine check_item
 
+   !> The one body of every getter: the index k of the item of `key`, checked to
+   !> hold `min_count` to `max_count` values of kind `wanted` (k = 0 when the key
+   !> is absent or the check fails; `found` says whether it is present).
+   subroutine get_item(group, key, wanted, min_count, max_count, k, found, error)
+      type(nml_group_type), intent(inout) :: group
+      character(len=*), intent(in) :: key
+      integer, intent(in) :: wanted, min_count, max_count
+      integer, intent(out) :: k
+      logical, intent(out) :: found
+      type(error_type), allocatable, intent(out) :: error
+      call lookup(group, key, k)
+      found = k > 0
+      if (.not. found) return
+      call check_item(group, k, wanted, min_count, max_count, error)
+      if (allocated(error)) k = 0
+   end subroutine get_item
+
+   !> Index into `item%values` of each scalar value, repeat counts expanded.
+   pure function expanded(item) result(map)
+      type(nml_item_type), intent(in) :: item
+      integer, allocatable :: map(:)
+      integer :: i, n
+      allocate (map(value_count(item)))
+      n = 0
+      do i = 1, size(item%values)
+         map(n + 1:n + item%values(i)%count) = i
+         n = n + item%values(i)%count
+      end do
+   end function expanded
+
    !> A real scalar; `value` is unchanged when the key is absent.
    subroutine get_real(group, key, value, found, error)
       type(nml_group_type), intent(inout) :: group
@@ -747,12 +756,8 @@ contains
       logical, intent(out) :: found
       type(error_type), allocatable, intent(out) :: error
       integer :: k
-      call lookup(group, key, k)
-      found = k > 0
-      if (.not. found) return
-      call check_item(group, k, nml_real, 1, 1, error)
-      if (allocated(error)) return
-      value = group%items(k)%values(1)%rval
+      call get_item(group, key, nml_real, 1, 1, k, found, error)
+      if (k > 0) value = group%items(k)%values(1)%rval
    end subroutine get_real
 
    !> An integer scalar; `value` is unchanged when the key is absent.
@@ -763,12 +768,8 @@ contains
       logical, intent(out) :: found
       type(error_type), allocatable, intent(out) :: error
       integer :: k
-      call lookup(group, key, k)
-      found = k > 0
-      if (.not. found) return
-      call check_item(group, k, nml_integer, 1, 1, error)
-      if (allocated(error)) return
-      value = group%items(k)%values(1)%ival
+      call get_item(group, key, nml_integer, 1, 1, k, found, error)
+      if (k > 0) value = group%items(k)%values(1)%ival
    end subroutine get_integer
 
    !> A string scalar; `value` is unchanged when the key is absent.
@@ -779,12 +780,8 @@ contains
       logical, intent(out) :: found
       type(error_type), allocatable, intent(out) :: error
       integer :: k
-      call lookup(group, key, k)
-      found = k > 0
-      if (.not. found) return
-      call check_item(group, k, nml_string, 1, 1, error)
-      if (allocated(error)) return
-      value = group%items(k)%values(1)%sval
+      call get_item(group, key, nml_string, 1, 1, k, found, error)
+      if (k > 0) value = group%items(k)%values(1)%sval
    end subroutine get_string
 
    !> A logical scalar; `value` is unchanged when the key is absent.
@@ -795,12 +792,8 @@ contains
       logical, intent(out) :: found
       type(error_type), allocatable, intent(out) :: error
       integer :: k
-      call lookup(group, key, k)
-      found = k > 0
-      if (.not. found) return
-      call check_item(group, k, nml_logical, 1, 1, error)
-      if (allocated(error)) return
-      value = group%items(k)%values(1)%lval
+      call get_item(group, key, nml_logical, 1, 1, k, found, error)
+      if (k > 0) value = group%items(k)%values(1)%lval
    end subroutine get_logical
 
    !> A real array of `min_count` to `max_count` values (equal for an exact
@@ -812,19 +805,9 @@ contains
       integer, intent(in) :: min_count, max_count
       logical, intent(out) :: found
       type(error_type), allocatable, intent(out) :: error
-      integer :: k, i, n
-      call lookup(group, key, k)
-      found = k > 0
-      if (.not. found) return
-      call check_item(group, k, nml_real, min_count, max_count, error)
-      if (allocated(error)) return
-      if (allocated(values)) deallocate (values)
-      allocate (values(value_count(group%items(k))))
-      n = 0
-      do i = 1, size(group%items(k)%values)
-         values(n + 1:n + group%items(k)%values(i)%count) = group%items(k)%values(i)%rval
-         n = n + group%items(k)%values(i)%count
-      end do
+      integer :: k
+      call get_item(group, key, nml_real, min_count, max_count, k, found, error)
+      if (k > 0) values = group%items(k)%values(expanded(group%items(k)))%rval
    end subroutine get_real_array
 
    !> An integer array of `min_count` to `max_count` values; `values` is
@@ -836,19 +819,9 @@ contains
       integer, intent(in) :: min_count, max_count
       logical, intent(out) :: found
       type(error_type), allocatable, intent(out) :: error
-      integer :: k, i, n
-      call lookup(group, key, k)
-      found = k > 0
-      if (.not. found) return
-      call check_item(group, k, nml_integer, min_count, max_count, error)
-      if (allocated(error)) return
-      if (allocated(values)) deallocate (values)
-      allocate (values(value_count(group%items(k))))
-      n = 0
-      do i = 1, size(group%items(k)%values)
-         values(n + 1:n + group%items(k)%values(i)%count) = group%items(k)%values(i)%ival
-         n = n + group%items(k)%values(i)%count
-      end do
+      integer :: k
+      call get_item(group, key, nml_integer, min_count, max_count, k, found, error)
+      if (k > 0) values = group%items(k)%values(expanded(group%items(k)))%ival
    end subroutine get_integer_array
 
    !> Fail on the first key no getter has read, naming it and the valid keys.

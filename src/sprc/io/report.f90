@@ -13,7 +13,7 @@ module sprc_io_report
    use sprc_core_text, only: fixed_text, itoa
    use sprc_core_error, only: error_type, fatal_error, stat_io, stat_invalid_input
    use sprc_study_row, only: report_row_type, report_empty, is_empty
-   use sprc_study_mesh, only: mesh_row_type
+   use sprc_study_mesh_table, only: mesh_row_type
    implicit none
    private
 

@@ -6,16 +6,13 @@
 module sprc_io_scene
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
    use sprc_core_kinds, only: wp, i8
-   use sprc_fem_dilatation, only: projected_poisson
-   use sprc_fem_linear_solver, only: solver_names, auto_iterative_min_dofs, auto_never
-   use sprc_fem_problem, only: default_gamma, gamma_note
    use sprc_core_text, only: itoa, real_text, lower
    use sprc_core_error, only: error_type, fatal_error
    use sprc_exact_corner, only: corner_eigenvalues
    use sprc_study_spec, only: scene_type, body_spec_type, shape_spec_type, bc_spec_type, exact_spec_type, &
       & contact_spec_type, recovery_degree, default_stabilization, contact_unsupported, default_max_level, &
-      & contact_components
-   use sprc_grid_tree, only: grid_max_level
+      & contact_components, projected_poisson, solver_names, auto_iterative_min_dofs, auto_never, default_gamma, &
+      & gamma_note, grid_max_level
    use sprc_io_scene_facets, only: load_facets, facet_kind, facet_summary, group_surface
    use sprc_io_namelist, only: nml_group_type, parse_namelist, read_text_file, nml_get, nml_get_array, &
       & nml_has, nml_check_consumed, nml_field_error, nml_group_error, nml_item_text

@@ -21,9 +21,8 @@
 !> to body (2) (the tangential part of u1 - u2). With t_n <= 0 in compression, eq. 114's
 !> t_s = mu t_n is the friction traction on body (1), of magnitude mu p (p = -t_n the
 !> contact pressure), opposed to its slip. (The contact FE's tau, the direction of the
-!> tangential traction on the slave, is -s.) For frictionless contact and stick the
-!> tangents are any orthonormal completion of n (`plane_tangents`): the residual's
-!> norm does not depend on it.
+!> tangential traction on the slave, is -s.) Frictionless and stick take any orthonormal
+!> completion of n (`plane_tangents`): the residual's norm does not depend on it.
 !>
 !> What the operator leaves free: body (2)'s tangential traction under frictionless and
 !> slip laws (only body (1)'s is constrained: t_s2 is the subject of body (2)'s own,
@@ -31,8 +30,7 @@
 !> across a contact surface.
 !>
 !> Small deformations: n, s and p are those of the undeformed slave surface (the
-!> thesis's deformed normals n^d coincide with them to first order in the displacement
-!> gradient, which linear elasticity neglects).
+!> thesis's deformed normals n^d agree to first order, which linear elasticity neglects).
 !>
 !> Coefficient rows (eqs. 128-132): with sigma(x) = P(s(x)) A, A stacked by component
 !> (nt coefficients per Voigt component), op sigma(x) = (op x p(s(x))) A, i.e. the row i

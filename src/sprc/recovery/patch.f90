@@ -83,7 +83,7 @@ module sprc_recovery_patch
       !> Boundary kind of point j (boundary_traction, boundary_symmetry, boundary_contact).
       integer, allocatable :: bkind(:)
       !> Boundary piece of point j (>= 1): the surface it lies on, e.g. the shape index. SPR-C
-      !> bounds the traction constraint rank per piece (sprc_recovery_solve).
+      !> bounds the traction constraint rank per piece (sprc_recovery_patch_solve).
       integer, allocatable :: bpiece(:)
       !> Prescribed traction vector t(1:dim, j) (traction points only; ignored otherwise).
       real(wp), allocatable :: btraction(:, :)

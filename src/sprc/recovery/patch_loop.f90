@@ -1,5 +1,5 @@
 !> The patch loop of SPR / SPR-C, shared by every producer of patches (the Cartesian grid,
-!> sprc_grid_patches; a caller's mesh, sprc_recovery_mesh). A producer may solve some patches
+!> sprc_estimate_patches; a caller's mesh, sprc_recovery_caller_mesh). A producer may solve some patches
 !> its own way (`recover`: the grid's contact patches) or skip them (`skip`). Thesis eqs. 8-11,
 !> 19-24, 99-100; Figure 15.
 !>
@@ -21,7 +21,7 @@
 !> the largest unexpanded patch over the producer's nodes) and never grows it, so that
 !> nothing is allocated per patch; a patch that outgrows it (only after expansion) is
 !> solved in the second workspace reset to its own size. The solves' kernels
-!> (sprc_recovery_dense) depend only on the patch's values and sizes, not on capacities,
+!> (sprc_core_dense) depend only on the patch's values and sizes, not on capacities,
 !> and results are stored per patch: the bits do not depend on the thread count or the
 !> schedule. The solves call no BLAS; OpenBLAS is held to one thread inside the loop all
 !> the same (sprc_core_blas_threads), for a producer's `fill` that might. Errors are
@@ -35,7 +35,7 @@ module sprc_recovery_patch_loop
    use sprc_core_blas_threads, only: blas_serial_begin, blas_serial_end
    use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reserve
    use sprc_recovery_workspace, only: recovery_workspace_type, workspace_reserve, workspace_init
-   use sprc_recovery_solve, only: recover_spr, recover_sprc
+   use sprc_recovery_patch_solve, only: recover_spr, recover_sprc
    implicit none
    private
 

@@ -14,7 +14,7 @@
 !> `private` copy first: gfortran does not apply default initialisation to
 !> OpenMP private copies, and a garbage capacity would be trusted.
 !>
-!> Contact patches (sprc_grid_contact) keep in the thread's workspace what they need
+!> Contact patches (sprc_estimate_contact_patches) keep in the thread's workspace what they need
 !> besides it (`contact`): the workspace and patch of the Omega_aux fit, allocated on the
 !> thread's first contact patch and kept.
 module sprc_recovery_workspace
@@ -77,7 +77,7 @@ module sprc_recovery_workspace
       real(wp), allocatable :: tau(:), tau_p(:)
       integer, allocatable :: jpvt(:), jpvt_p(:)
       !> If true, the solves accumulate the wall time spent inside the dense kernels
-      !> (sprc_recovery_dense and the small products) and their nominal flop counts.
+      !> (sprc_core_dense and the small products) and their nominal flop counts.
       logical :: timing = .false.
       !> Seconds spent in the dense kernels (only if `timing`).
       real(wp) :: lapack_seconds = 0.0_wp
@@ -88,7 +88,7 @@ module sprc_recovery_workspace
       !> hand-written loop (only if `timing`; `design_matrix_flops`), kept apart from `flops`.
       integer(i8) :: design_flops = 0
       real(wp) :: t0 = 0.0_wp
-      !> Contact patches' storage (module notes; its type is sprc_grid_contact's: a producer's).
+      !> Contact patches' storage (module notes; its type is sprc_estimate_contact_patches's: a producer's).
       class(*), allocatable :: contact
    end type recovery_workspace_type
 

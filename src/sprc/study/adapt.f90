@@ -46,7 +46,7 @@ module sprc_study_adapt
    use sprc_study_budget, only: check_level_memory
    use sprc_study_partition, only: largest_over_ranks
    use sprc_fem_nested, only: fe_displacement_type
-   use sprc_contact_solve, only: contact_progress
+   use sprc_contact_pair_solve, only: contact_progress
    implicit none
    private
 

@@ -1,43 +1,32 @@
 !> The memory a level of a study will need, estimated before its grid is built,
-!> and the refusal of a level that cannot fit (a 3D level 9 has 1.3e8 cells:
-!> building it ran out of memory in the middle of the grid).
+!> and the refusal of a level that cannot fit (a deep 3D level would otherwise
+!> run out of memory in the middle of building its grid).
 !>
 !> Cells: the body's grid at a coarse level c (6 in 2D, 4 in 3D, at most the
 !> level itself; 4096 cells at most) gives its inside and cut cells; each
 !> covers 2^(dim (level - c)) cells of the level, the cut ones
 !> 2^((dim - 1)(level - c)) cut cells, and refine_boundary splits each of
-!> those into 2^(dim refine_boundary). An upper estimate of the cells (the
-!> cut cells at level c count whole).
-!> Dofs: dim nodes per cell for Q1, dim 2^dim for Q2.
-!> Bytes: an upper fit of the peak resident memory of the release build on
-!> the example scenes (doc/benchmarks.md): 32 MB + dofs * 2.5 kB (2D) or
+!> those into 2^(dim refine_boundary): an upper estimate (the cut cells at
+!> level c count whole). Dofs: dim nodes per cell for Q1, dim 2^dim for Q2.
+!> Bytes: an upper fit of the peak resident memory of the release build
+!> (the fit and its data: doc/benchmarks.md): 32 MB + dofs * 2.5 kB (2D) or
 !> 10 kB (dofs / 3e4)^(1/3) (3D, where the Cholesky factor fills more; times
-!> 1.75 for Q2). A 3D level sent to the iterative solver (`use_iterative`)
-!> has no factor: 8 kB per dof (times 1.75 for Q2). With
-!> `solver = 'auto'`, a 3D level whose direct estimate exceeds the memory
-!> available is solved iteratively (`check_level_memory`'s `solver`), and
-!> estimated so.
-!> The grid and its quadrature alone (`sprc mesh`, `grid_only`): 16 MB + 128
-!> bytes per cell.
-!> Under an address-space limit (ulimit -v) the virtual size counts, and
-!> OpenBLAS reserves a buffer of 128 MiB for each thread that calls it, when it
-!> first does (sprc_core_blas_threads); without that reserve a level that
-!> passed the check hung in OpenBLAS's retry loop of blas_memory_alloc.
-!> Buffers already taken
-!> (blas_reserve_buffers) are in the virtual size and do not count again.
+!> 1.75 for Q2); a 3D level sent to the iterative solver (`use_iterative`)
+!> has no factor: 8 kB per dof (times 1.75 for Q2). With `solver = 'auto'` a
+!> 3D level whose direct estimate does not fit is solved iteratively, and
+!> estimated so. The grid and its quadrature alone (`sprc mesh`,
+!> `grid_only`): 16 MB + 128 bytes per cell.
+!> Under an address-space limit (ulimit -v) the virtual size counts, and with
+!> it OpenBLAS's buffer of 128 MiB per calling thread (sprc_core_blas_threads:
+!> without it OpenBLAS can loop in its allocator); buffers already taken
+!> (blas_reserve_buffers) do not count again.
 !>
-!> Bodies in contact (`check_coupled_memory`) are solved in one block system
-!> of all their unknowns: the estimate is that of one level with the sum of
-!> their dofs (a direct factor fills with the whole system's size, so the
-!> pair costs more than its bodies apart), plus the contact recovery's
-!> Omega_aux data: each slave surface cell's SPR-C patches sample the other
-!> body in a prism about three cells deep (sprc_recovery_contact_aux), each
-!> of the 2^(d-1) patches at a surface cell its own, with dim + 6 reals
-!> (point and stress) per sampling point at (order + 1)^dim points a cell:
-!> 3 * 2^(d-1) (order + 1)^d (d + 6) * 8 bytes per slave cut cell, times 2
-!> for the patch matrices built from them (`aux_bytes`). 'auto' sends the
-!> coupled system to the iterative solver when its direct estimate does not
-!> fit, as for one body.
+!> Bodies in contact (`check_coupled_memory`): one level with the sum of their
+!> dofs (one direct factor of the whole system), plus the contact recovery's
+!> Omega_aux data: per slave cut cell 3 * 2^(d-1) (order + 1)^d (d + 6) * 8
+!> bytes (a prism about three cells deep per patch, dim + 6 reals per sampling
+!> point, sprc_recovery_contact_aux), times 2 for the patch matrices
+!> (`aux_bytes`). 'auto' treats the coupled system as one body.
 module sprc_study_budget
    !$ use omp_lib, only: omp_get_max_threads
    use sprc_core_kinds, only: wp, i8

@@ -10,7 +10,7 @@
 !> Bodies without `&contact` between them are independent problems: each
 !> body's results are exactly those of a scene holding that body alone.
 !> The bodies joined by `&contact` pairs (a component of the contact graph,
-!> `contact_components`) are solved together (sprc_contact_solve: one block
+!> `contact_components`) are solved together (sprc_contact_pair_solve: one block
 !> system, one active-set iteration over the cells of all its pairs) in one
 !> unit system (the modulus unit of the slave of the component's first pair,
 !> the largest strain unit of its bodies), and every pair's contact result
@@ -19,7 +19,7 @@
 !> several pairs `solve_contact_assembly`'s (frictionless or stick, FE
 !> stabilization; the rest is refused, stat_unsupported, before any
 !> computation). A body of several pairs recovers with one contact
-!> description per pair (sprc_grid_patches: what a patch touching two
+!> description per pair (sprc_estimate_patches: what a patch touching two
 !> pairs takes). With
 !> `stabilization = 'recovered'` the pair is solved with a zero
 !> stabilization traction first (penalty), then re-solved with the slave
@@ -44,18 +44,18 @@ module sprc_study_level
    use sprc_grid_tree, only: grid_type
    use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature, default_points
    use sprc_grid_cut_mesh, only: cut_mesh_type
-   use sprc_grid_patches, only: recovery_input_type, recover_grid, boundary_points
+   use sprc_estimate_patches, only: recovery_input_type, recover_grid, boundary_points
    use sprc_recovery_patch, only: patch_type
-   use sprc_grid_recovered_field, only: recovered_field_type, method_spr, method_sprc, field_eval
+   use sprc_estimate_recovered_field, only: recovered_field_type, method_spr, method_sprc, field_eval
    use sprc_recovery_contact_operators, only: contact_traction, contact_law_frictionless, contact_law_slip, &
       & contact_law_stick
    use sprc_recovery_operators, only: traction_operator
-   use sprc_grid_contact, only: grid_contact_type, new_grid_contact, point_cells_type, new_point_cells, cells_box
-   use sprc_grid_recovered_estimate, only: zz_estimate_type, estimate_error
+   use sprc_estimate_contact_patches, only: grid_contact_type, new_grid_contact, point_cells_type, new_point_cells, cells_box
+   use sprc_estimate_norms, only: zz_estimate_type, estimate_error
    use sprc_fem_bc, only: fe_bc_type
    use sprc_fem_problem, only: elasticity_problem_type
    use sprc_fem_nested, only: fe_displacement_type
-   use sprc_fem_recovery_input, only: fe_recovery_input
+   use sprc_estimate_fe_input, only: fe_recovery_input
    use sprc_fem_dilatation, only: dilatation_choice
    use sprc_study_spec, only: scene_type, contact_spec_type, recovery_degree, contact_unsupported, contact_components
    use sprc_study_model, only: build_bodies, build_exact, body_conditions, analysis_kind, analysis_units_type, &
@@ -68,7 +68,7 @@ module sprc_study_level
    use sprc_contact_result, only: contact_result_type, new_contact_result, contact_open, contact_stick, &
       & contact_slip
    use sprc_contact_surface, only: contact_surface_type, slave_surface_points, initial_gaps
-   use sprc_contact_solve, only: contact_solution_type, solve_contact_pair, friction_kind, friction_coulomb, &
+   use sprc_contact_pair_solve, only: contact_solution_type, solve_contact_pair, friction_kind, friction_coulomb, &
       & friction_frictionless, contact_progress, default_max_iterations, contact_factor_type, contact_body_type, &
       & contact_pair_type, solve_contact_assembly
    use sprc_fem_element, only: traction_matrix
@@ -260,7 +260,7 @@ contains
       integer, intent(in) :: level
       type(level_type), intent(out), target :: result
       type(error_type), allocatable, intent(out) :: error
-      !> Told after each contact iteration (sprc_contact_solve's `contact_progress`).
+      !> Told after each contact iteration (sprc_contact_pair_solve's `contact_progress`).
       procedure(contact_progress), optional :: progress
       !> Per body, its displacement at another level (`hold_displacement`),
       !> where an iterative solve of the body starts (`sprc_fem_nested`).
@@ -475,7 +475,7 @@ contains
    end function level_share
 
    !> The recoveries and estimates of a body from its recovery input; `contacts` are its
-   !> contact surfaces, one per pair (SPR-C's coupled contact patches, sprc_grid_contact).
+   !> contact surfaces, one per pair (SPR-C's coupled contact patches, sprc_estimate_contact_patches).
    subroutine recover_body(study, sb, bl, input, error, contacts)
       type(study_type), intent(in) :: study
       type(study_body_type), intent(in) :: sb
@@ -536,7 +536,7 @@ contains
    end function in_contact
 
    !> One contact pair at this level: slave points and gaps, the coupled
-   !> solve (sprc_contact_solve), then each body's errors and recoveries; the
+   !> solve (sprc_contact_pair_solve), then each body's errors and recoveries; the
    !> contact result in scene units. The block solves count in the slave
    !> body's t_solve; points, gaps and contact terms add to `t_contact`.
    subroutine run_contact(study, spec, bodies, result, t_contact, error, jump, progress)
@@ -702,7 +702,7 @@ contains
    !> After an assembly's FE solve: every member's exact error, recoveries and
    !> estimates, SPR-C with one contact description per pair the member
    !> belongs to (`pair_contact`, the pair's other body as body (2));
-   !> sprc_grid_patches says what a patch touching two pairs takes.
+   !> sprc_estimate_patches says what a patch touching two pairs takes.
    subroutine finish_assembly(study, ks, members, pairs, results, bodies, error)
       type(study_type), intent(in) :: study
       integer, intent(in) :: ks(:), members(:)
@@ -753,7 +753,7 @@ contains
       end do
    end subroutine finish_assembly
 
-   !> Tur's recovered stabilization (sprc_contact_solve notes): the pair
+   !> Tur's recovered stabilization (sprc_contact_pair_solve notes): the pair
    !> solved with a zero stabilization traction first (the penalty method,
    !> SPD for every kappa), then again and again with the slave body's
    !> recovered traction sigma* n of the previous solution at the slave
@@ -784,7 +784,7 @@ contains
    end subroutine stabilize_recovered
 
    !> The iteration of `stabilize_recovered` with the block factor kept
-   !> between updates (sprc_contact_solve: the matrix depends on the active
+   !> between updates (sprc_contact_pair_solve: the matrix depends on the active
    !> set only).
    subroutine recovered_updates(study, spec, surface, names, bodies, factor, sol, pstar, error)
       type(study_type), intent(in) :: study
@@ -893,7 +893,7 @@ contains
 
    !> After a pair's FE solve: both bodies' exact errors, recoveries and estimates, SPR-C
    !> with each body's contact surface (`pair_contact`): the coupled contact patches of
-   !> both bodies, each with the other as body (2) (sprc_grid_contact).
+   !> both bodies, each with the other as body (2) (sprc_estimate_contact_patches).
    subroutine finish_pair(study, spec, surface, result, bodies, error)
       type(study_type), intent(in) :: study
       type(contact_spec_type), intent(in) :: spec
@@ -927,7 +927,7 @@ contains
       end do
    end subroutine finish_pair
 
-   !> The contact surface of side b (1 slave, 2 master) for its recovery (sprc_grid_contact):
+   !> The contact surface of side b (1 slave, 2 master) for its recovery (sprc_estimate_contact_patches):
    !> each of the body's boundary points on its contact shape takes the state of the nearest
    !> slave point (side 2: nearest master point of a slave point) within the size of its
    !> element, else open; closed states give the law (frictionless; stick; Coulomb: stick
@@ -1193,7 +1193,7 @@ contains
    end subroutine traction_jump
 
    !> Recovery and estimate with one method (1 SPR, 2 SPR-C) at the patch degree `degree`.
-   !> With `contacts` (one per pair of the body), SPR-C's contact patches (sprc_grid_contact).
+   !> With `contacts` (one per pair of the body), SPR-C's contact patches (sprc_estimate_contact_patches).
    subroutine recover_and_estimate(study, sb, input, bl, m, degree, error, contacts)
       type(study_type), intent(in) :: study
       type(study_body_type), intent(in) :: sb
@@ -1274,7 +1274,7 @@ contains
    end subroutine sum_row
 
    !> eta, err and theta of method m (1 SPR, 2 SPR-C) from the bodies' norms,
-   !> with the formulas of `sprc_grid_recovered_estimate`.
+   !> with the formulas of `sprc_estimate_norms`.
    subroutine sum_method_columns(row, m, bodies, have_exact)
       type(report_row_type), intent(inout) :: row
       integer, intent(in) :: m

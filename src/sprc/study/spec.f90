@@ -8,6 +8,12 @@ module sprc_study_spec
    use sprc_core_text, only: real_text, itoa
    use sprc_recovery_patch_loop, only: auto_degree
    use sprc_geometry_facets, only: facet_set_type
+   ! The defaults and limits scene validation needs from the layers that own
+   ! them, handed to io here so that io (file formats) names no fem or grid module.
+   use sprc_fem_dilatation, only: projected_poisson
+   use sprc_fem_linear_solver, only: solver_names, auto_iterative_min_dofs, auto_never
+   use sprc_fem_problem, only: default_gamma, gamma_note
+   use sprc_grid_tree, only: grid_max_level
    implicit none
    private
 
@@ -15,6 +21,8 @@ module sprc_study_spec
    public :: adapt_spec_type, default_max_level
    public :: recovery_degree, contact_unsupported, contact_components
    public :: default_kappa, default_stabilization, kappa_range, kappa_note
+   public :: projected_poisson, solver_names, auto_iterative_min_dofs, auto_never, default_gamma, gamma_note
+   public :: grid_max_level
 
    !> Default of `&contact kappa`, the dimensionless factor of the contact
    !> stabilization (effective stiffness kappa*E/h, thesis eq. 5): the centre,

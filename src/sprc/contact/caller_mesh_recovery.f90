@@ -1,0 +1,714 @@
+!> SPR-C recovery of bodies in contact on the caller's own meshes (thesis eqs. 103-138):
+!> each body as `recover_on_mesh` takes it (sprc_recovery_caller_mesh) plus, per contact pair, the
+!> contact facets of both bodies with their law; out come each body's recovery and, at the
+!> slave facets' quadrature points, the recovered contact tractions of both bodies and
+!> their jump.
+!>
+!> The core is the grid pipeline's, not a copy: each body is recovered by recover_on_mesh
+!> with its contact facets as contact points, and a patch holding one is solved by
+!> `contact_patch_solve` (sprc_estimate_contact_patches) with the pair's other body as body (2): its
+!> integration points (weight*|J|, FE stresses) and its boundary points other than contact
+!> facets (traction, pressure, symmetry, free facets) inside the prism Omega_aux over the
+!> patch's contact points, found through the grid pipeline's point cells (a counting sort
+!> once per body, never a scan per patch), depth 3 patch sizes, doubled while the fit lacks
+!> rank. Both bodies get contact-aware patches (the mirrored treatment): each is body (1)
+!> of its own patches. SPR (`method` = mesh_method_spr) ignores contact.
+!>
+!> Input (`contact_body_type`, `contact_pair_type`): pointer components the caller
+!> associates with its arrays (no copy), 1-based. Per pair: slave and master body,
+!> contact facets of each (element sides of that body, as boundary facets), the law per
+!> facet or one for all (contact_open: a free surface; contact_law_frictionless,
+!> _slip, _stick), mu (needed by slip), the slip direction of each body relative to the
+!> other (one for all or per facet; the master's defaults to the opposite of a uniform
+!> slave direction), optionally the FE contact pressure at the slave points (reported).
+!> Several pairs and several bodies per call; a patch whose contact points belong to two
+!> pairs is an error (the core couples one other body per patch).
+!>
+!> Output (`mesh_contact_recovery_type`): bodies(i) as recover_on_mesh gives it; pairs(k)
+!> at the quadrature points of the slave facets (`mesh_facet_points`, in facet order): the
+!> points, weights, slave outward normals n, the recovered contact pressure of the slave
+!> p = -n.sigma*_s n and of the master -n.sigma*_m n, the tangential tractions of both
+!> (on each body, its own outward normal), and the jump t_s + t_m = (sigma*_s -
+!> sigma*_m) n (action-reaction residual). The master's field is evaluated in the master
+!> element holding the point, or the nearest one (mesh_recovery_eval_near) when the meshes
+!> of a curved surface do not match.
+!>
+!> Errors name the argument as the caller wrote it (Fortran bodies(2)%..., or C / Python
+!> bodies[1], pairs[0].slave_facets[3] with c_indices).
+module sprc_contact_caller_mesh_recovery
+   use sprc_core_kinds, only: wp, i8
+   use sprc_core_text, only: itoa
+   use sprc_core_error, only: error_type, fatal_error, stat_invalid_input
+   use sprc_core_material, only: voigt_size
+   use sprc_recovery_operators, only: traction_operator
+   use sprc_recovery_patch, only: patch_type, recovered_patch_type, patch_reset, patch_reserve, &
+      & boundary_traction, boundary_symmetry
+   use sprc_recovery_workspace, only: recovery_workspace_type
+   use sprc_recovery_contact_operators, only: contact_law_frictionless, contact_law_slip, contact_law_stick
+   use sprc_recovery_caller_mesh_element, only: element_facet_nodes, element_degree, element_name, facet_npoints
+   use sprc_recovery_caller_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_contact_solver_type, mesh_facet_points, &
+      & mesh_recovery_eval, mesh_recovery_eval_near, mesh_method_sprc, mesh_method_spr, mesh_reference_unit, &
+      & facet_traction, facet_pressure, facet_symmetry, facet_free
+   use sprc_recovery_patch_loop, only: auto_degree
+   use sprc_recovery_caller_mesh_check, only: check_mesh_arrays, check_mesh_facets
+   use sprc_estimate_contact_patches, only: grid_contact_type, new_grid_contact, contact_patch_solve
+   implicit none
+   private
+
+   public :: contact_body_type, contact_pair_type, mesh_contact_recovery_type, contact_pair_recovery_type
+   public :: recover_contact_on_mesh, contact_open, contact_law_frictionless, contact_law_slip, contact_law_stick
+   public :: mu_not_given
+
+   !> Law of an open contact facet (a free surface).
+   integer, parameter :: contact_open = 0
+   !> contact_pair_type%mu when not given.
+   real(wp), parameter :: mu_not_given = -huge(1.0_wp)
+   !> Padding of the master's element bins for slave points off its mesh (element extents).
+   real(wp), parameter :: near_pad = 0.5_wp
+
+   !> One body: the arguments of recover_on_mesh (module notes; pointers to the caller's arrays).
+   type :: contact_body_type
+      integer :: dim = 0, analysis = 0, element_type = 0
+      real(wp) :: young = 0.0_wp, poisson = 0.0_wp
+      !> nodes(dim, nnode); connectivity(nen, nelem), 1-based.
+      real(wp), pointer, contiguous :: nodes(:, :) => null()
+      integer, pointer, contiguous :: connectivity(:, :) => null()
+      !> Integration points (dim, ngp, nelem), weight*|J| (ngp, nelem), FE stresses (nstress, ngp, nelem).
+      real(wp), pointer, contiguous :: gp(:, :, :) => null(), gw(:, :) => null(), gs(:, :, :) => null()
+      !> Given or not: body force (dim); boundary facets (nfn, nfacet), kinds, tractions (dim, nfacet);
+      !> reference coordinates of the points (dim, ngp, nelem) in the convention `reference`.
+      real(wp), pointer, contiguous :: body_force(:) => null(), facet_traction(:, :) => null(), &
+         & gauss_xi(:, :, :) => null()
+      integer, pointer, contiguous :: facet_nodes(:, :) => null(), facet_kind(:) => null()
+      integer :: reference = mesh_reference_unit
+   end type contact_body_type
+
+   !> One contact pair (module notes).
+   type :: contact_pair_type
+      !> Bodies (indices into the bodies).
+      integer :: slave = 0, master = 0
+      !> Contact facets (nfn, nfacet) of each body, 1-based node indices of that body.
+      integer, pointer, contiguous :: slave_facets(:, :) => null(), master_facets(:, :) => null()
+      !> Law per facet, or one entry for all (contact_open, contact_law_*).
+      integer, pointer, contiguous :: slave_law(:) => null(), master_law(:) => null()
+      !> Friction coefficient (slip law).
+      real(wp) :: mu = mu_not_given
+      !> Slip direction of each body relative to the other, (dim, 1) for all or (dim, nfacet).
+      real(wp), pointer, contiguous :: slave_slip(:, :) => null(), master_slip(:, :) => null()
+      !> Optional FE contact pressure at the slave points (nq nfacet, the output's order).
+      real(wp), pointer, contiguous :: pressure(:) => null()
+   end type contact_pair_type
+
+   !> Recovered contact tractions of one pair at the slave facets' points (module notes).
+   type :: contact_pair_recovery_type
+      integer :: slave = 0, master = 0, npoints = 0
+      real(wp), allocatable :: x(:, :), w(:), normal(:, :)
+      !> Slave facet and element of each point.
+      integer, allocatable :: facet(:), element(:)
+      real(wp), allocatable :: pressure(:), pressure_master(:)
+      real(wp), allocatable :: traction_tangential(:, :), traction_tangential_master(:, :), jump(:, :)
+      !> The caller's FE pressure (if given).
+      real(wp), allocatable :: pressure_fe(:)
+   end type contact_pair_recovery_type
+
+   type :: mesh_contact_recovery_type
+      type(mesh_recovery_type), allocatable :: bodies(:)
+      type(contact_pair_recovery_type), allocatable :: pairs(:)
+   end type mesh_contact_recovery_type
+
+   !> A body's contact patches: the other body of each pair (unused entries empty).
+   type, extends(mesh_contact_solver_type) :: others_type
+      type(grid_contact_type), allocatable :: other(:)
+   contains
+      procedure :: solve => others_solve
+   end type others_type
+
+   !> One body's side of its pairs: contact facets, law, slip, pair of each.
+   type :: side_type
+      integer, allocatable :: facets(:, :), law(:), pair(:)
+      real(wp), allocatable :: slip(:, :)
+   end type side_type
+
+contains
+
+   !> Recover bodies in contact (module notes). method mesh_method_sprc (contact-aware) or
+   !> mesh_method_spr; degree and max_rounds as recover_on_mesh's (degree 0 or absent: each
+   !> body's 'auto').
+   subroutine recover_contact_on_mesh(bodies, pairs, method, result, error, degree, max_rounds, c_indices)
+      type(contact_body_type), intent(in) :: bodies(:)
+      type(contact_pair_type), intent(in) :: pairs(:)
+      integer, intent(in) :: method
+      type(mesh_contact_recovery_type), intent(out) :: result
+      type(error_type), allocatable, intent(out) :: error
+      integer, intent(in), optional :: degree, max_rounds
+      logical, intent(in), optional :: c_indices
+      type(side_type), allocatable :: sides(:)
+      type(others_type), allocatable :: others(:)
+      logical :: ci
+      integer :: b, k
+
+      ci = .false.
+      if (present(c_indices)) ci = c_indices
+      call check_input(bodies, pairs, method, ci, error)
+      if (allocated(error)) return
+      allocate (sides(size(bodies)), others(size(bodies)), result%bodies(size(bodies)), result%pairs(size(pairs)))
+      call gather_sides(bodies, pairs, sides)
+      if (method == mesh_method_sprc) then
+         do b = 1, size(bodies)
+            allocate (others(b)%other(size(pairs)))
+         end do
+         do k = 1, size(pairs)
+            call other_body(bodies, pairs(k)%master, pairs(k)%mu, ci, others(pairs(k)%slave)%other(k), error)
+            if (allocated(error)) return
+            call other_body(bodies, pairs(k)%slave, pairs(k)%mu, ci, others(pairs(k)%master)%other(k), error)
+            if (allocated(error)) return
+         end do
+      end if
+      do b = 1, size(bodies)
+         call recover_body(bodies(b), sides(b), others(b), method, result%bodies(b), ci, error, degree, max_rounds)
+         if (allocated(error)) then
+            error%message = body_name(ci, b)//': '//error%message
+            return
+         end if
+      end do
+      do k = 1, size(pairs)
+         call pair_tractions(bodies, pairs(k), result%bodies, ci, k, result%pairs(k), error)
+         if (allocated(error)) return
+      end do
+   end subroutine recover_contact_on_mesh
+
+   !> One body's recovery with its contact facets.
+   subroutine recover_body(body, side, others, method, rec, ci, error, degree, max_rounds)
+      type(contact_body_type), intent(in) :: body
+      type(side_type), intent(in) :: side
+      type(others_type), intent(in) :: others
+      integer, intent(in) :: method
+      type(mesh_recovery_type), intent(out) :: rec
+      logical, intent(in) :: ci
+      type(error_type), allocatable, intent(out) :: error
+      integer, intent(in), optional :: degree, max_rounds
+      integer :: deg
+
+      deg = auto_degree(method == mesh_method_sprc, element_degree(body%element_type))
+      if (present(degree)) then
+         if (degree > 0) deg = degree
+      end if
+      if (method == mesh_method_sprc .and. size(side%law) > 0) then
+         call recover_on_mesh(body%dim, body%analysis, body%nodes, body%element_type, body%connectivity, body%gp, &
+            & body%gw, body%gs, body%young, body%poisson, method, rec, error, body_force=body%body_force, &
+            & facet_nodes=body%facet_nodes, facet_kind=body%facet_kind, facet_traction=body%facet_traction, &
+            & degree=deg, max_rounds=max_rounds, c_indices=ci, gauss_xi=body%gauss_xi, reference=body%reference, &
+            & contact_facets=side%facets, contact_law=side%law, contact_slip=side%slip, contact_pair=side%pair, &
+            & contact_solver=others)
+      else
+         call recover_on_mesh(body%dim, body%analysis, body%nodes, body%element_type, body%connectivity, body%gp, &
+            & body%gw, body%gs, body%young, body%poisson, method, rec, error, body_force=body%body_force, &
+            & facet_nodes=body%facet_nodes, facet_kind=body%facet_kind, facet_traction=body%facet_traction, &
+            & degree=deg, max_rounds=max_rounds, c_indices=ci, gauss_xi=body%gauss_xi, reference=body%reference)
+      end if
+   end subroutine recover_body
+
+   !> The coupled solve of a patch of this body with the pair's other body (module notes).
+   subroutine others_solve(self, pair, patch, law, slip, degree, ws, rec, error)
+      class(others_type), intent(in) :: self
+      integer, intent(in) :: pair, law(:), degree
+      type(patch_type), intent(in) :: patch
+      real(wp), intent(in) :: slip(:, :)
+      type(recovery_workspace_type), intent(inout) :: ws
+      type(recovered_patch_type), intent(out) :: rec
+      type(error_type), allocatable, intent(out) :: error
+
+      call contact_patch_solve(self%other(pair), patch, law, slip, degree, ws, rec, error)
+   end subroutine others_solve
+
+   !> Body o as the other body of a pair: its integration points and its boundary points
+   !> other than contact facets (module notes).
+   subroutine other_body(bodies, o, mu, ci, other, error)
+      type(contact_body_type), intent(in) :: bodies(:)
+      integer, intent(in) :: o
+      real(wp), intent(in) :: mu
+      logical, intent(in) :: ci
+      type(grid_contact_type), intent(out) :: other
+      type(error_type), allocatable, intent(out) :: error
+      type(patch_type) :: bnd
+      real(wp), allocatable :: slip0(:, :), bf(:)
+      integer, allocatable :: law0(:)
+      integer :: d, n, ns
+
+      associate (b => bodies(o))
+         d = b%dim
+         ns = voigt_size(b%analysis)
+         n = size(b%gw)
+         call boundary_of(b, ci, bnd, error)
+         if (allocated(error)) then
+            error%message = body_name(ci, o)//': '//error%message
+            return
+         end if
+         allocate (law0(0), slip0(d, 0), bf(d))
+         bf = 0.0_wp
+         if (associated(b%body_force)) bf = b%body_force
+         call new_grid_contact(other, 0, law0, slip0, max(mu, 0.0_wp), reshape(b%gp, [d, n]), reshape(b%gw, [n]), &
+            & reshape(b%gs, [ns, n]), b%young, b%poisson, bf, error, boundary=bnd)
+      end associate
+   end subroutine other_body
+
+   !> The boundary points of a body's facets (traction, pressure, symmetry, free) as a
+   !> patch's boundary arrays: the constraints of its Omega_aux fits.
+   subroutine boundary_of(b, ci, bnd, error)
+      type(contact_body_type), intent(in) :: b
+      logical, intent(in) :: ci
+      type(patch_type), intent(out) :: bnd
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: x(:, :), w(:), n(:, :)
+      integer, allocatable :: owner(:), facet(:)
+      integer :: d, j, f
+
+      d = b%dim
+      call patch_reset(bnd, d, b%analysis, b%young, b%poisson, [(0.0_wp, j=1, d)], 1.0_wp)
+      if (.not. associated(b%facet_nodes)) return
+      call mesh_facet_points(d, b%nodes, b%element_type, b%connectivity, b%facet_nodes, ci, 'facet_nodes', x, w, n, &
+         & owner, facet, error)
+      if (allocated(error)) return
+      call patch_reserve(bnd, 0, size(w))
+      bnd%nbpoints = size(w)
+      do j = 1, size(w)
+         f = facet(j)
+         bnd%bx(:, j) = 0.0_wp
+         bnd%bx(1:d, j) = x(:, j)
+         bnd%bw(j) = w(j)
+         bnd%bn(:, j) = 0.0_wp
+         bnd%bn(1:d, j) = n(:, j)
+         bnd%btraction(:, j) = 0.0_wp
+         bnd%bkind(j) = boundary_traction
+         bnd%bpiece(j) = 1
+         select case (b%facet_kind(f))
+         case (facet_traction)
+            bnd%btraction(1:d, j) = b%facet_traction(:, f)
+         case (facet_pressure)
+            bnd%btraction(1:d, j) = -b%facet_traction(1, f)*n(:, j)
+         case (facet_symmetry)
+            bnd%bkind(j) = boundary_symmetry
+            bnd%bpiece(j) = 2
+         case default
+         end select
+      end do
+   end subroutine boundary_of
+
+   !> Each body's contact facets over the pairs, with law, slip and pair per facet.
+   subroutine gather_sides(bodies, pairs, sides)
+      type(contact_body_type), intent(in) :: bodies(:)
+      type(contact_pair_type), intent(in) :: pairs(:)
+      type(side_type), intent(inout) :: sides(:)
+      integer :: b, k, nf, nfn, m, f, d
+
+      do b = 1, size(bodies)
+         d = bodies(b)%dim
+         nfn = element_facet_nodes(bodies(b)%element_type)
+         nf = 0
+         do k = 1, size(pairs)
+            if (pairs(k)%slave == b) nf = nf + size(pairs(k)%slave_facets, 2)
+            if (pairs(k)%master == b) nf = nf + size(pairs(k)%master_facets, 2)
+         end do
+         allocate (sides(b)%facets(nfn, nf), sides(b)%law(nf), sides(b)%pair(nf), sides(b)%slip(d, nf))
+         m = 0
+         do k = 1, size(pairs)
+            if (pairs(k)%slave == b) then
+               do f = 1, size(pairs(k)%slave_facets, 2)
+                  m = m + 1
+                  sides(b)%facets(:, m) = pairs(k)%slave_facets(:, f)
+                  sides(b)%law(m) = entry(pairs(k)%slave_law, f)
+                  sides(b)%pair(m) = k
+                  sides(b)%slip(:, m) = slip_of(pairs(k), .true., f, d)
+               end do
+            end if
+            if (pairs(k)%master == b) then
+               do f = 1, size(pairs(k)%master_facets, 2)
+                  m = m + 1
+                  sides(b)%facets(:, m) = pairs(k)%master_facets(:, f)
+                  sides(b)%law(m) = entry(pairs(k)%master_law, f)
+                  sides(b)%pair(m) = k
+                  sides(b)%slip(:, m) = slip_of(pairs(k), .false., f, d)
+               end do
+            end if
+         end do
+      end do
+   end subroutine gather_sides
+
+   !> law(f), or law(1) for a single entry.
+   pure integer function entry(law, f)
+      integer, intent(in) :: law(:), f
+      entry = law(min(f, size(law)))
+   end function entry
+
+   !> The slip direction of facet f on one side (zero where not given).
+   pure function slip_of(pair, slave, f, d) result(s)
+      type(contact_pair_type), intent(in) :: pair
+      logical, intent(in) :: slave
+      integer, intent(in) :: f, d
+      real(wp) :: s(d)
+
+      s = 0.0_wp
+      if (slave) then
+         if (associated(pair%slave_slip)) s = pair%slave_slip(:, min(f, size(pair%slave_slip, 2)))
+      else if (associated(pair%master_slip)) then
+         s = pair%master_slip(:, min(f, size(pair%master_slip, 2)))
+      else if (associated(pair%slave_slip)) then
+         ! A uniform slave direction: the master slides the other way.
+         if (size(pair%slave_slip, 2) == 1) s = -pair%slave_slip(:, 1)
+      end if
+   end function slip_of
+
+   !> The pair's output at the slave facets' points (module notes).
+   subroutine pair_tractions(bodies, pair, recs, ci, k, out, error)
+      type(contact_body_type), intent(in) :: bodies(:)
+      type(contact_pair_type), intent(in) :: pair
+      type(mesh_recovery_type), intent(in) :: recs(:)
+      logical, intent(in) :: ci
+      integer, intent(in) :: k
+      type(contact_pair_recovery_type), intent(out) :: out
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: ss(:, :), sm(:, :)
+      real(wp) :: g(3, 6), ts(3), tm(3), nv(3)
+      integer :: d, ns, i, np
+
+      associate (s => bodies(pair%slave))
+         d = s%dim
+         ns = voigt_size(s%analysis)
+         call mesh_facet_points(d, s%nodes, s%element_type, s%connectivity, pair%slave_facets, ci, &
+            & pair_field(ci, k, 'slave_facets'), out%x, out%w, out%normal, out%element, out%facet, error)
+      end associate
+      if (allocated(error)) return
+      np = size(out%w)
+      out%slave = pair%slave
+      out%master = pair%master
+      out%npoints = np
+      allocate (ss(ns, np), sm(ns, np), out%pressure(np), out%pressure_master(np), out%traction_tangential(d, np), &
+         & out%traction_tangential_master(d, np), out%jump(d, np))
+      call mesh_recovery_eval(recs(pair%slave), out%x, ss, error, out%element)
+      if (.not. allocated(error)) call mesh_recovery_eval_near(recs(pair%master), out%x, sm, near_pad, error)
+      if (allocated(error)) then
+         error%message = pair_field(ci, k, 'points')//': '//error%message
+         return
+      end if
+      do i = 1, np
+         nv = 0.0_wp
+         nv(1:d) = out%normal(:, i)
+         call traction_operator(d, nv, g)
+         ts(1:d) = matmul(g(1:d, 1:ns), ss(:, i))
+         tm(1:d) = -matmul(g(1:d, 1:ns), sm(:, i))
+         out%pressure(i) = -dot_product(ts(1:d), nv(1:d))
+         out%pressure_master(i) = dot_product(tm(1:d), nv(1:d))
+         out%traction_tangential(:, i) = ts(1:d) + out%pressure(i)*nv(1:d)
+         out%traction_tangential_master(:, i) = tm(1:d) - out%pressure_master(i)*nv(1:d)
+         out%jump(:, i) = ts(1:d) + tm(1:d)
+      end do
+      if (associated(pair%pressure)) out%pressure_fe = pair%pressure
+   end subroutine pair_tractions
+
+   !> Validation of the bodies and pairs (module notes): what recover_on_mesh checks per
+   !> body it checks itself; here the pairs and what they index.
+   subroutine check_input(bodies, pairs, method, ci, error)
+      type(contact_body_type), intent(in) :: bodies(:)
+      type(contact_pair_type), intent(in) :: pairs(:)
+      integer, intent(in) :: method
+      logical, intent(in) :: ci
+      type(error_type), allocatable, intent(out) :: error
+      integer :: b, k
+
+      if (method /= mesh_method_spr .and. method /= mesh_method_sprc) then
+         call fail('method = '//itoa(method)//' is not spr (1) or sprc (2)')
+      else if (size(bodies) < 2) then
+         call fail('need at least 2 bodies, got '//itoa(size(bodies)))
+      else if (size(pairs) < 1) then
+         call fail('need at least 1 contact pair')
+      end if
+      if (allocated(error)) return
+      do b = 1, size(bodies)
+         associate (x => bodies(b))
+            if (.not. (associated(x%nodes) .and. associated(x%connectivity) .and. associated(x%gp) .and. &
+               & associated(x%gw) .and. associated(x%gs))) then
+               call fail(body_name(ci, b)//': nodes, connectivity, gauss points, weights and stresses must be given')
+            else if (x%dim /= bodies(1)%dim .or. x%analysis /= bodies(1)%analysis) then
+               call fail(body_name(ci, b)//': dim = '//itoa(x%dim)//', analysis = '//itoa(x%analysis)// &
+                  & ' differ from '//body_name(ci, 1)//'''s ('//itoa(bodies(1)%dim)//', '// &
+                  & itoa(bodies(1)%analysis)//')')
+            else if (element_facet_nodes(x%element_type) == 0) then
+               call fail(body_name(ci, b)//': element_type = '//itoa(x%element_type)//' is unknown')
+            end if
+            if (allocated(error)) return
+            ! The arrays before any recovery: a body's bad values are read by the other's contact patches.
+            call check_mesh_arrays(x%dim, x%analysis, x%nodes, x%element_type, x%connectivity, x%gp, x%gw, x%gs, ci, &
+               & error, x%body_force)
+            if (.not. allocated(error)) call check_mesh_facets(x%dim, x%element_type, size(x%nodes, 2), ci, error, &
+               & x%facet_nodes, x%facet_kind, x%facet_traction)
+            if (allocated(error)) error%message = 'recover_contact: '//body_name(ci, b)//': '//error%message
+         end associate
+         if (allocated(error)) return
+      end do
+      do k = 1, size(pairs)
+         call check_pair(bodies, pairs(k), k, ci, error)
+         if (allocated(error)) return
+         call check_facing(bodies, pairs(k), k, ci, error)
+         if (allocated(error)) return
+      end do
+   contains
+      subroutine fail(message)
+         character(len=*), intent(in) :: message
+         call fatal_error(error, 'recover_contact: '//message, stat_invalid_input)
+      end subroutine fail
+   end subroutine check_input
+
+   !> The two sides of a pair face each other: each side's facets are sides of its body's
+   !> elements (mesh_facet_points, which names the facet), and the boxes of the two sides'
+   !> facet nodes, padded by the largest facet extent, overlap (else the facets of one side
+   !> are not where the other's are: a facet of the wrong body, or of another pair).
+   subroutine check_facing(bodies, pair, k, ci, error)
+      type(contact_body_type), intent(in) :: bodies(:)
+      type(contact_pair_type), intent(in) :: pair
+      integer, intent(in) :: k
+      logical, intent(in) :: ci
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: x(:, :), w(:), n(:, :)
+      integer, allocatable :: owner(:), facet(:)
+      real(wp) :: lo(3, 2), hi(3, 2), pad
+      integer :: d, s, b, f
+
+      d = bodies(pair%slave)%dim
+      pad = 0.0_wp
+      do s = 1, 2
+         b = merge(pair%slave, pair%master, s == 1)
+         associate (fn => merge_facets(s))
+            call mesh_facet_points(d, bodies(b)%nodes, bodies(b)%element_type, bodies(b)%connectivity, fn, ci, &
+               & pair_field(ci, k, trim(merge('slave_facets ', 'master_facets', s == 1))), x, w, n, owner, facet, error)
+            if (allocated(error)) then
+               error%message = 'recover_contact: '//error%message
+               return
+            end if
+            lo(1:d, s) = huge(1.0_wp)
+            hi(1:d, s) = -huge(1.0_wp)
+            do f = 1, size(fn, 2)
+               lo(1:d, s) = min(lo(1:d, s), minval(bodies(b)%nodes(:, fn(:, f)), dim=2))
+               hi(1:d, s) = max(hi(1:d, s), maxval(bodies(b)%nodes(:, fn(:, f)), dim=2))
+               pad = max(pad, maxval(maxval(bodies(b)%nodes(:, fn(:, f)), dim=2) - &
+                  & minval(bodies(b)%nodes(:, fn(:, f)), dim=2)))
+            end do
+         end associate
+      end do
+      if (any(lo(1:d, 1) > hi(1:d, 2) + pad) .or. any(lo(1:d, 2) > hi(1:d, 1) + pad)) &
+         & call fatal_error(error, 'recover_contact: '//pair_field(ci, k, '')//': the slave and master facets do '// &
+         & 'not face each other (the boxes of their nodes, padded by the largest facet, are apart): a facet of '// &
+         & 'the wrong body?', stat_invalid_input)
+   contains
+      function merge_facets(s) result(fn)
+         integer, intent(in) :: s
+         integer, pointer, contiguous :: fn(:, :)
+         if (s == 1) then
+            fn => pair%slave_facets
+         else
+            fn => pair%master_facets
+         end if
+      end function merge_facets
+   end subroutine check_facing
+
+   !> One pair: bodies, facets (shapes, node ranges), laws, mu, slip directions, pressure.
+   subroutine check_pair(bodies, pair, k, ci, error)
+      type(contact_body_type), intent(in) :: bodies(:)
+      type(contact_pair_type), intent(in) :: pair
+      integer, intent(in) :: k
+      logical, intent(in) :: ci
+      type(error_type), allocatable, intent(out) :: error
+      logical :: slip_law
+      integer :: npts
+
+      if (pair%slave < 1 .or. pair%slave > size(bodies)) then
+         call fail(field('slave')//' = '//idx(pair%slave)//' is not a body in '//idx(1)//'..'//idx(size(bodies)))
+      else if (pair%master < 1 .or. pair%master > size(bodies)) then
+         call fail(field('master')//' = '//idx(pair%master)//' is not a body in '//idx(1)//'..'//idx(size(bodies)))
+      else if (pair%master == pair%slave) then
+         call fail(field('master')//' = '//field('slave')//' = '//idx(pair%slave)//': a pair needs two bodies')
+      else if (.not. associated(pair%slave_facets) .or. .not. associated(pair%master_facets)) then
+         call fail('needs the contact facets of both sides ('//field('slave_facets')//' and '// &
+            & field('master_facets')//')')
+      else if (.not. (mu_unset(pair%mu) .or. (pair%mu >= 0.0_wp .and. pair%mu <= huge(1.0_wp)))) then
+         call fail(field('mu')//' = '//rstr(pair%mu)//' must be finite and >= 0')
+      end if
+      if (allocated(error)) return
+      call check_side(.true.)
+      if (allocated(error)) return
+      call check_side(.false.)
+      if (allocated(error)) return
+      npts = facet_npoints(element_facet_nodes(bodies(pair%slave)%element_type))*size(pair%slave_facets, 2)
+      slip_law = any(pair%slave_law == contact_law_slip) .or. any(pair%master_law == contact_law_slip)
+      if (slip_law .and. mu_unset(pair%mu)) then
+         call fail('has slip facets but '//field('mu')//' is not given')
+      else if (associated(pair%pressure)) then
+         if (size(pair%pressure) /= npts) then
+            call fail(field('pressure')//' has '//itoa(size(pair%pressure))//' entries; need one per slave point ('// &
+               & itoa(npts)//')')
+         else if (.not. all(abs(pair%pressure) <= huge(1.0_wp))) then
+            call fail(field('pressure')//' is not finite')
+         end if
+      end if
+   contains
+      subroutine check_side(slave)
+         logical, intent(in) :: slave
+         integer, pointer, contiguous :: facets(:, :), law(:)
+         real(wp), pointer, contiguous :: slip(:, :)
+         character(len=:), allocatable :: sname
+         integer :: b, nfn, f, a, d, nf
+
+         if (slave) then
+            b = pair%slave
+            facets => pair%slave_facets
+            law => pair%slave_law
+            slip => pair%slave_slip
+            sname = 'slave'
+         else
+            b = pair%master
+            facets => pair%master_facets
+            law => pair%master_law
+            slip => pair%master_slip
+            sname = 'master'
+         end if
+         d = bodies(b)%dim
+         nfn = element_facet_nodes(bodies(b)%element_type)
+         nf = size(facets, 2)
+         if (nf < 1) then
+            call fail(field(sname//'_facets')//' is empty: a pair needs contact facets on both sides')
+         else if (size(facets, 1) /= nfn) then
+            call fail(field(sname//'_facets')//' has '//itoa(size(facets, 1))//' nodes per facet; a facet of '// &
+               & element_name(bodies(b)%element_type)//' ('//body_name(ci, b)//') has '//itoa(nfn))
+         else if (.not. associated(law)) then
+            call fail(field(sname//'_law')//' is not given')
+         else if (size(law) /= 1 .and. size(law) /= nf) then
+            call fail(field(sname//'_law')//' has '//itoa(size(law))//' entries; need 1 or one per facet ('// &
+               & itoa(nf)//')')
+         end if
+         if (allocated(error)) return
+         do f = 1, nf
+            do a = 1, nfn
+               if (facets(a, f) < 1 .or. facets(a, f) > size(bodies(b)%nodes, 2)) then
+                  call fail(entry2(sname//'_facets', a, f)//' = '//idx(facets(a, f))//' is not a node of '// &
+                     & body_name(ci, b)//' in '//idx(1)//'..'//idx(size(bodies(b)%nodes, 2)))
+                  return
+               end if
+            end do
+         end do
+         do f = 1, size(law)
+            if (law(f) /= contact_open .and. law(f) /= contact_law_frictionless .and. law(f) /= contact_law_slip &
+               & .and. law(f) /= contact_law_stick) then
+               call fail(entry1(sname//'_law', f)//' = '//itoa(law(f))//' is not open (0), frictionless (1), '// &
+                  & 'slip (2) or stick (3)')
+               return
+            end if
+         end do
+         if (associated(slip)) then
+            if (size(slip, 1) /= d .or. (size(slip, 2) /= 1 .and. size(slip, 2) /= nf)) then
+               call fail(field(sname//'_slip')//' has shape ('//itoa(size(slip, 1))//', '//itoa(size(slip, 2))// &
+                  & '); need ('//itoa(d)//', 1) or ('//itoa(d)//', '//itoa(nf)//')')
+               return
+            end if
+         end if
+         if (.not. any(law == contact_law_slip)) return
+         if (.not. associated(slip)) then
+            if (slave .or. .not. associated(pair%slave_slip)) then
+               call fail('has slip facets but no '//field(sname//'_slip')//' (the slip direction)')
+            else if (size(pair%slave_slip, 2) /= 1) then
+               call fail('has slip facets but no '//field('master_slip')//' (the master''s direction defaults to '// &
+                  & 'the opposite of a uniform slave_slip only)')
+            end if
+         else
+            do f = 1, nf
+               if (law(min(f, size(law))) /= contact_law_slip) cycle
+               a = min(f, size(slip, 2))
+               if (.not. all(abs(slip(:, a)) <= huge(1.0_wp))) then
+                  call fail(field(sname//'_slip')//' is not finite ('//entry2(sname//'_slip', 0, a)//')')
+               else if (.not. (norm2(slip(:, a)) > 0.0_wp)) then
+                  call fail(field(sname//'_slip')//' is zero on a slip facet ('//entry2(sname//'_slip', 0, a)//')')
+               end if
+               if (allocated(error)) return
+            end do
+         end if
+      end subroutine check_side
+      subroutine fail(message)
+         character(len=*), intent(in) :: message
+         call fatal_error(error, 'recover_contact: '//pair_field(ci, k, '')//' '//message, stat_invalid_input)
+      end subroutine fail
+      function field(name) result(s)
+         character(len=*), intent(in) :: name
+         character(len=:), allocatable :: s
+         s = pair_field(ci, k, name)
+      end function field
+      function idx(i) result(s)
+         integer, intent(in) :: i
+         character(len=:), allocatable :: s
+         s = itoa(merge(i - 1, i, ci))
+      end function idx
+      function entry1(name, i) result(s)
+         character(len=*), intent(in) :: name
+         integer, intent(in) :: i
+         character(len=:), allocatable :: s
+         if (ci) then
+            s = pair_field(ci, k, name)//'['//itoa(i - 1)//']'
+         else
+            s = pair_field(ci, k, name)//'('//itoa(i)//')'
+         end if
+      end function entry1
+      function entry2(name, a, f) result(s)
+         character(len=*), intent(in) :: name
+         integer, intent(in) :: a, f
+         character(len=:), allocatable :: s
+         if (ci) then
+            s = pair_field(ci, k, name)//'['//itoa(f - 1)//']'
+            if (a > 0) s = s//'['//itoa(a - 1)//']'
+         else
+            if (a > 0) then
+               s = pair_field(ci, k, name)//'('//itoa(a)//', '//itoa(f)//')'
+            else
+               s = pair_field(ci, k, name)//'(:, '//itoa(f)//')'
+            end if
+         end if
+      end function entry2
+      pure function rstr(x) result(s)
+         real(wp), intent(in) :: x
+         character(len=:), allocatable :: s
+         character(len=32) :: buf
+         write (buf, '(es12.4)') x
+         s = trim(adjustl(buf))
+      end function rstr
+   end subroutine check_pair
+
+   !> True if mu is mu_not_given (bit for bit).
+   pure logical function mu_unset(mu)
+      real(wp), intent(in) :: mu
+      mu_unset = transfer(mu, 1_i8) == transfer(mu_not_given, 1_i8)
+   end function mu_unset
+
+   !> Body b as the caller names it.
+   pure function body_name(ci, b) result(s)
+      logical, intent(in) :: ci
+      integer, intent(in) :: b
+      character(len=:), allocatable :: s
+      if (ci) then
+         s = 'bodies['//itoa(b - 1)//']'
+      else
+         s = 'bodies('//itoa(b)//')'
+      end if
+   end function body_name
+
+   !> Field `name` of pair k as the caller names it ('' for the pair itself).
+   pure function pair_field(ci, k, name) result(s)
+      logical, intent(in) :: ci
+      integer, intent(in) :: k
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable :: s
+      if (ci) then
+         s = 'pairs['//itoa(k - 1)//']'
+         if (len(name) > 0) s = s//'.'//name
+      else
+         s = 'pairs('//itoa(k)//')'
+         if (len(name) > 0) s = s//'%'//name
+      end if
+   end function pair_field
+
+end module sprc_contact_caller_mesh_recovery

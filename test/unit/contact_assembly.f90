@@ -1,0 +1,219 @@
+!> Tests of contact assemblies: several `&contact` pairs solved as one
+!> coupled system per component of the contact graph (sprc_study_level,
+!> sprc_contact_pair_solve's solve_contact_assembly).
+!>
+!> - A stack of three blocks of different materials on offset grids, the
+!>   middle one the slave of one pair and the master of the other, under a
+!>   uniform pressure: the uniform stress in every body and the pressure 1 at
+!>   every closed point of both pairs to round-off, C eps/rcond with rcond
+!>   the block solver's condition estimate and C = 10 (as the one-pair patch
+!>   test, sprc_test_contact_fe); with SPR and SPR-C the recovered fields
+!>   too. The middle block (0.3 tall, cells 0.36 at level 2) has vertex
+!>   patches holding contact points of both pairs (10 at levels 2 and 3),
+!>   where one pair's coupled contact patch wins and the other's points are
+!>   left out (sprc_estimate_patches): keeping them fails Q2 (the patch's
+!>   contact normals cancel), letting the pair with fewer points win fails
+!>   Q1.
+!> - Three concentric rings with two interference fits and a bore pressure
+!>   against the layered_cylinder closed form (on the real radii): err_fe
+!>   at a rate of at least 0.95 p over the last two levels, theta_sprc in
+!>   [0.95, 1.05] at the finest level; each pair's pressure error: Q1 at
+!>   the finest level at most half of that at the coarsest, Q2 at every
+!>   level at most a tenth of err_fe (the Q2 pressure starts near 1e-5 and
+!>   levels off at about 3e-6 from level 5, independently of kappa: not
+!>   resolved here); Q1 and Q2, plane strain and plane stress.
+!> - Two Hertz rollers on one block (two pairs sharing the block's top as
+!>   master surface): each pair's peak pressure within the single roller's
+!>   3 % of its own Hertz p0.
+module sprc_test_contact_assembly
+   use sprc_core_kinds, only: wp
+   use sprc_core_error, only: error_type
+   use sprc_core_text, only: real_text
+   use sprc_io_namelist, only: read_text_file
+   use sprc_study_level, only: study_type, level_type
+   use sprc_test_study, only: run_text
+   use sprc_contact_result, only: contact_open
+   use sprc_testsuite, only: unittest_type, new_unittest, check, replaced
+   implicit none
+   private
+
+   public :: collect_contact_assembly
+
+   character(len=*), parameter :: stack_2d = 'test/data/contact/stack_2d.nml'
+   character(len=*), parameter :: rollers_2d = 'example/scenes/two_rollers.nml'
+   character(len=*), parameter :: rings = 'example/scenes/layered_rings.nml'
+
+contains
+
+   subroutine collect_contact_assembly(testsuite)
+      type(unittest_type), allocatable, intent(out) :: testsuite(:)
+      testsuite = [ &
+         new_unittest('stack_q1', test_stack_q1), &
+         new_unittest('stack_q2', test_stack_q2), &
+         new_unittest('layered_rings_q1_plane_strain', test_rings_q1_strain), &
+         new_unittest('layered_rings_q1_plane_stress', test_rings_q1_stress), &
+         new_unittest('layered_rings_q2_plane_strain', test_rings_q2_strain), &
+         new_unittest('layered_rings_q2_plane_stress', test_rings_q2_stress), &
+         new_unittest('two_rollers', test_two_rollers) &
+         ]
+   end subroutine collect_contact_assembly
+
+   subroutine test_stack_q1(error)
+      type(error_type), allocatable, intent(out) :: error
+      call stack_case(1, 3, error)
+   end subroutine test_stack_q1
+
+   subroutine test_stack_q2(error)
+      type(error_type), allocatable, intent(out) :: error
+      call stack_case(2, 2, error)
+   end subroutine test_stack_q2
+
+   !> The stack at `order` and `level` with SPR and SPR-C (module notes).
+   subroutine stack_case(order, level, error)
+      integer, intent(in) :: order, level
+      type(error_type), allocatable, intent(out) :: error
+      type(level_type) :: result
+      type(study_type) :: study
+      character(len=:), allocatable :: text
+      real(wp) :: tol, worst, pworst, unit, sigma(3)
+      integer :: b, e, q, k
+
+      call read_text_file(stack_2d, text, error)
+      if (allocated(error)) return
+      text = replaced(text, 'order    = 1', 'order    = '//achar(48 + order))
+      text = replaced(text, "recovery = 'none'", "recovery = 'both'")
+      call run_text(text, level, result, error, study)
+      if (allocated(error)) return
+      call check(error, size(result%contacts), 2, 'two pairs')
+      if (allocated(error)) return
+      tol = 0.0_wp
+      worst = 0.0_wp
+      do b = 1, 3
+         associate (pb => result%bodies(b)%problem)
+            unit = study%bodies(b)%units%modulus*study%bodies(b)%units%strain
+            tol = max(tol, 10.0_wp*epsilon(1.0_wp)/pb%rcond)
+            do e = 1, pb%mesh%grid%n_leaves
+               do q = pb%mesh%vol_ptr(e), pb%mesh%vol_ptr(e + 1) - 1
+                  call pb%stress_in_element(e, pb%mesh%vol_x(:, q), sigma)
+                  worst = max(worst, maxval(abs(sigma*unit - [0.0_wp, -1.0_wp, 0.0_wp])))
+               end do
+            end do
+         end associate
+      end do
+      call check(error, worst <= tol, 'uniform stress: max error '//real_text(worst)//' > '//real_text(tol))
+      if (allocated(error)) return
+      do k = 1, 2
+         associate (c => result%contacts(k))
+            call check(error, all(c%state /= contact_open), 'pair '//achar(48 + k)//': every slave point closed')
+            if (allocated(error)) return
+            pworst = maxval(abs(c%p_fe - 1.0_wp))
+            call check(error, pworst <= tol, 'pair '//achar(48 + k)//': pressure error '//real_text(pworst)//' > '// &
+               & real_text(tol))
+            if (allocated(error)) return
+         end associate
+      end do
+      ! The recovered fields (relative energy errors of a uniform field of norm O(1)).
+      call check(error, max(result%row%err_fe, result%row%err_spr, result%row%err_sprc) <= tol, &
+         & 'err_fe, err_spr, err_sprc '//real_text(result%row%err_fe)//', '//real_text(result%row%err_spr)// &
+         & ', '//real_text(result%row%err_sprc)//' > '//real_text(tol))
+      if (allocated(error)) return
+      ! One component: its iterations counted once, not once per pair.
+      call check(error, result%row%contact_iterations, result%contacts(1)%iterations, 'contact_iterations')
+   end subroutine stack_case
+
+   subroutine test_rings_q1_strain(error)
+      type(error_type), allocatable, intent(out) :: error
+      call rings_case(1, 'plane_strain', [3, 4, 5], error)
+   end subroutine test_rings_q1_strain
+
+   subroutine test_rings_q1_stress(error)
+      type(error_type), allocatable, intent(out) :: error
+      call rings_case(1, 'plane_stress', [3, 4, 5], error)
+   end subroutine test_rings_q1_stress
+
+   subroutine test_rings_q2_strain(error)
+      type(error_type), allocatable, intent(out) :: error
+      call rings_case(2, 'plane_strain', [2, 3, 4], error)
+   end subroutine test_rings_q2_strain
+
+   subroutine test_rings_q2_stress(error)
+      type(error_type), allocatable, intent(out) :: error
+      call rings_case(2, 'plane_stress', [2, 3, 4], error)
+   end subroutine test_rings_q2_stress
+
+   !> The layered rings at `order` in `analysis` on `levels` (module notes).
+   subroutine rings_case(order, analysis, levels, error)
+      integer, intent(in) :: order, levels(3)
+      character(len=*), intent(in) :: analysis
+      type(error_type), allocatable, intent(out) :: error
+      type(level_type) :: result
+      character(len=:), allocatable :: text, what
+      real(wp) :: err(3), theta, perr(2, 3), rate
+      integer :: l, k
+
+      call read_text_file(rings, text, error)
+      if (allocated(error)) return
+      text = replaced(text, 'order    = 1', 'order    = '//achar(48 + order))
+      text = replaced(text, "analysis = 'plane_strain'", "analysis = '"//analysis//"'")
+      text = replaced(text, "recovery = 'both'", "recovery = 'sprc'")
+      text = replaced(text, "output   = 'out/layered_rings'", "output   = ''")
+      what = 'Q'//achar(48 + order)//' '//analysis//': '
+      do l = 1, 3
+         call run_text(text, levels(l), result, error)
+         if (allocated(error)) return
+         err(l) = result%row%err_fe
+         theta = result%row%theta_sprc
+         do k = 1, 2
+            associate (c => result%contacts(k))
+               perr(k, l) = sqrt(sum(c%weight*(c%p_fe - c%p_exact)**2)/sum(c%weight*c%p_exact**2))
+            end associate
+         end do
+      end do
+      rate = log(err(2)/err(3))/log(2.0_wp)
+      call check(error, rate >= 0.95_wp*order, what//'err_fe rate '//real_text(rate)//' (err_fe '// &
+         & real_text(err(2))//', '//real_text(err(3))//')')
+      if (allocated(error)) return
+      call check(error, theta >= 0.95_wp .and. theta <= 1.05_wp, what//'theta_sprc '//real_text(theta))
+      if (allocated(error)) return
+      do k = 1, 2
+         if (order == 1) then
+            call check(error, perr(k, 3) <= 0.5_wp*perr(k, 1), what//'pair '//achar(48 + k)//' pressure error '// &
+               & real_text(perr(k, 1))//' -> '//real_text(perr(k, 3))//' does not converge')
+         else
+            call check(error, all(perr(k, :) <= 0.1_wp*err), what//'pair '//achar(48 + k)//' pressure errors '// &
+               & real_text(perr(k, 1))//', '//real_text(perr(k, 2))//', '//real_text(perr(k, 3))// &
+               & ' not a tenth of err_fe')
+         end if
+         if (allocated(error)) return
+      end do
+   end subroutine rings_case
+
+   !> Each roller's peak within 3 % of its Hertz p0 = 2P/(pi a), a =
+   !> sqrt(4 P R/(pi E*)), 1/E* = 2 (1 - nu^2)/E (module notes).
+   subroutine test_two_rollers(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), parameter :: pi = acos(-1.0_wp), young = 1000.0_wp, nu = 0.3_wp, radius = 1.0_wp
+      real(wp), parameter :: load(2) = [1.0788436_wp, 2.1576872_wp]
+      type(level_type) :: result
+      character(len=:), allocatable :: text
+      real(wp) :: e_star, a, p0, pmax
+      integer :: k
+
+      call read_text_file(rollers_2d, text, error)
+      if (allocated(error)) return
+      text = replaced(replaced(text, "recovery = 'both'", "recovery = 'none'"), "output   = 'out/two_rollers'", &
+         & "output   = ''")
+      call run_text(text, 6, result, error)
+      if (allocated(error)) return
+      e_star = young/(2.0_wp*(1.0_wp - nu**2))
+      do k = 1, 2
+         a = sqrt(4.0_wp*load(k)*radius/(pi*e_star))
+         p0 = 2.0_wp*load(k)/(pi*a)
+         pmax = maxval(result%contacts(k)%p_fe)
+         call check(error, abs(pmax/p0 - 1.0_wp) <= 0.03_wp, 'roller '//achar(48 + k)//': p_max/p0 = '// &
+            & real_text(pmax/p0))
+         if (allocated(error)) return
+      end do
+   end subroutine test_two_rollers
+
+end module sprc_test_contact_assembly
