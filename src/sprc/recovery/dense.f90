@@ -23,7 +23,7 @@ module sprc_recovery_dense
    implicit none
    private
 
-   public :: qr_pivoted, apply_qt, apply_q, solve_upper
+   public :: qr_pivoted, apply_qt, apply_q, solve_upper, reflector, reflect
 
 contains
 
