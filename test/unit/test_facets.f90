@@ -333,7 +333,7 @@ contains
       if (allocated(error)) return
       d = set%dim
       call facet_cell_rule(full, shape%solid, lo, hi, q, .true., .false., compress=.false.)
-      call facet_cell_rule(comp, shape%solid, lo, hi, q, .true., .false.)
+      call facet_cell_rule(comp, shape%solid, lo, hi, q, .true., .false., compress=.true.)
       deg = 2*q - 1
       m = merge((deg + 1)*(deg + 2)/2, (deg + 1)*(deg + 2)*(deg + 3)/6, d == 2)
       vol = sum(full%vol_w(1:full%nvol))

@@ -20,7 +20,7 @@
 !> 2 qs - 3 = 2 q - 1 on a tetrahedron and 2 qs - 2 on a triangle, i.e. every
 !> total degree the tensor rule of q points integrates.
 !>
-!> Compression: the cell's volume rule is then replaced by at most M of its own
+!> Compression (on request): the cell's volume rule is then replaced by at most M of its own
 !> points with new positive weights that give the same moments of every
 !> polynomial of total degree 2 q - 1 (M of them: 20 in 2D / 56 in 3D for
 !> q = 3), so the compressed rule is exact wherever the full one is
@@ -99,8 +99,9 @@ contains
    !> (module notes). member_in / member_out: is a point of the cell in the
    !> body where it is inside / outside the solid (the other shapes decided
    !> over the cell). Surface normals point out of the body. Face-plane
-   !> fragments are left to `facet_face_rule`. compress = .false.: the full
-   !> volume rule (default: compressed, module notes).
+   !> fragments are left to `facet_face_rule`. compress = .true.: the volume
+   !> rule compressed (module notes); off by default, its cost (of order M^2
+   !> times the full rule's points per cell) exceeds the clipping's.
    pure subroutine facet_cell_rule(rule, solid, lo, hi, q, member_in, member_out, compress)
       type(facet_rule_type), intent(inout) :: rule
       type(facet_solid_type), intent(in) :: solid
@@ -152,7 +153,7 @@ contains
             call partition(rule, solid, ctx, n + 1, rule%nfrag, 1, n, face_class == 1)
          end if
          rule%nvol_full = rule%nvol
-         squeeze = .true.
+         squeeze = .false.
          if (present(compress)) squeeze = compress
          if (squeeze) call compress_volume(rule, lo, hi, 2*q - 1)
       end associate d_block
@@ -725,7 +726,7 @@ contains
       logical, intent(out) :: ok
       real(wp) :: qr(m, m), tau(m), qtb(m), z(m, 1), r(m), gbest, alpha
       real(wp), allocatable :: g(:)
-      integer :: state(n), it, j, jbest, i, kk, imin
+      integer :: state(n), it, j, jbest, i, kk, imin, first
       logical :: solved, added
 
       ! state: 0 free, 1 passive, 2 set aside (entered with a non-positive weight)
@@ -771,9 +772,10 @@ contains
             end if
             if (z(k, 1) <= 0.0_wp .and. list(k) == jbest .and. v(k) == 0.0_wp) then
                ! round-off let it in: set it aside, the others keep their weights
+               ! (the QR of the columns before it is unchanged: drop its reflector)
                state(jbest) = 2
                k = k - 1
-               call rebuild(a, m, list, v, state, k, qr, tau, qtb, b)
+               call rebuild(a, m, list, v, state, k, k + 1, qr, tau, qtb, b)
                exit
             end if
             alpha = 1.0_wp
@@ -789,6 +791,7 @@ contains
             v(1:k) = v(1:k) + alpha*(z(1:k, 1) - v(1:k))
             if (imin > 0) v(imin) = 0.0_wp
             kk = 0
+            first = k + 1
             do i = 1, k
                if (v(i) > 0.0_wp) then
                   kk = kk + 1
@@ -796,10 +799,11 @@ contains
                   v(kk) = v(i)
                else
                   state(list(i)) = 0
+                  first = min(first, i)
                end if
             end do
             k = kk
-            call rebuild(a, m, list, v, state, k, qr, tau, qtb, b)
+            call rebuild(a, m, list, v, state, k, first, qr, tau, qtb, b)
             if (k == 0) exit
          end do
          r = b
@@ -833,18 +837,23 @@ contains
       added = .true.
    end subroutine add_column
 
-   !> The QR of the columns list(1:k) of a from scratch; a column that turns out
-   !> dependent leaves the list (with its weight v) and is set aside (state 2).
-   pure subroutine rebuild(a, m, list, v, state, k, qr, tau, qtb, b)
+   !> The QR of the columns list(1:k) of a from column `first` on (columns before
+   !> it and their reflectors are unchanged: Householder QR's column j depends on
+   !> columns 1..j only); a column that turns out dependent leaves the list (with
+   !> its weight v) and is set aside (state 2).
+   pure subroutine rebuild(a, m, list, v, state, k, first, qr, tau, qtb, b)
       real(wp), intent(in) :: a(:, :), b(:)
-      integer, intent(in) :: m
+      integer, intent(in) :: m, first
       integer, intent(inout) :: list(:), state(:), k
       real(wp), intent(inout) :: v(:), qr(m, m), tau(m), qtb(m)
       integer :: i, kk
       logical :: added
-      qtb(1:m) = b(1:m)
-      kk = 0
-      do i = 1, k
+      qtb = b(1:m)
+      kk = min(first - 1, k)
+      do i = 1, kk
+         call reflect(m - i + 1, qr(i + 1:m, i), tau(i), qtb(i:m))
+      end do
+      do i = kk + 1, k
          call add_column(a(1:m, list(i)), m, kk, qr, tau, qtb, added)
          if (added) then
             list(kk) = list(i)
