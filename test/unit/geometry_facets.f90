@@ -24,6 +24,7 @@ module sprc_test_facets
    use sprc_geometry_body, only: body_type, new_body, csg_add, csg_subtract
    use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature, cell_rule_type, cell_rule, &
       & default_points
+   use sprc_grid_facet_rule, only: facet_rule_type, facet_cell_rule
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type
    implicit none
    private
@@ -52,7 +53,8 @@ contains
          new_unittest('polygons_2d', test_polygons), &
          new_unittest('mixed_csg', test_mixed), &
          new_unittest('classification', test_classification), &
-         new_unittest('shape_errors', test_shape_errors) &
+         new_unittest('shape_errors', test_shape_errors), &
+         new_unittest('compressed_rule', test_compressed) &
          ]
    end subroutine collect_facets
 
@@ -278,6 +280,97 @@ contains
       refused = allocated(error) .and. shape%kind == 0
       call check(error, refused, 'a vertex index out of range is refused')
    end subroutine test_shape_errors
+
+   !> The compressed volume rule of a cut cell (sprc_grid_facet_rule, module
+   !> notes) against the full one: at most M = C(2q - 1 + dim, dim) points and
+   !> fewer than the full rule, positive weights, and the same integral of every
+   !> monomial of total degree <= 2q - 1 in the cell's coordinates scaled to
+   !> [-1, 1]. Such a monomial is a combination of the Legendre products with
+   !> coefficients of absolute sum 1 (|x^n| and every P_k are 1 at x = 1, and
+   !> the coefficients are >= 0), so the moments' acceptance bound M^2 eps V
+   !> bounds its error too. Cells aligned with the facets' vertices and
+   !> offset, q = 3 (Q1) and 4 (Q2), 3D (sphere, rotated box) and 2D (star).
+   subroutine test_compressed(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(facet_set_type) :: set
+      real(wp) :: p(2, 10), a
+      integer :: i, q
+
+      call facets_sphere(set, [0.01_wp, 0.02_wp, -0.03_wp], 0.8_wp, 32, 16)
+      do q = 3, 4
+         call compressed_case(set, [0.7_wp, -0.1_wp, -0.1_wp], [0.95_wp, 0.15_wp, 0.15_wp], q, 'sphere', error)
+         if (allocated(error)) return
+         call compressed_case(set, [0.25_wp, 0.5_wp, 0.25_wp], [0.5_wp, 0.75_wp, 0.5_wp], q, 'sphere aligned', error)
+         if (allocated(error)) return
+      end do
+      call facets_box(set, [0.1_wp, 0.0_wp, 0.05_wp], [0.6_wp, 0.4_wp, 0.3_wp], [0.3_wp, -0.2_wp, 0.5_wp])
+      call compressed_case(set, [0.3_wp, 0.0_wp, 0.0_wp], [0.8_wp, 0.5_wp, 0.5_wp], 3, 'rotated box', error)
+      if (allocated(error)) return
+      do i = 1, 10
+         a = (i - 1)*pi/5 + 0.1_wp
+         p(:, i) = merge(0.8_wp, 0.35_wp, mod(i, 2) == 1)*[cos(a), sin(a)]
+      end do
+      call facets_polygon(set, p)
+      do q = 3, 4
+         call compressed_case(set, [-0.5_wp, -0.5_wp], [0.5_wp, 0.5_wp], q, 'star', error)
+         if (allocated(error)) return
+      end do
+   end subroutine test_compressed
+
+   subroutine compressed_case(set, lo, hi, q, name, error)
+      type(facet_set_type), intent(in) :: set
+      real(wp), intent(in) :: lo(:), hi(:)
+      integer, intent(in) :: q
+      character(len=*), intent(in) :: name
+      type(error_type), allocatable, intent(out) :: error
+      type(shape_type) :: shape
+      type(facet_rule_type) :: full, comp
+      real(wp) :: tol, vol, ifull, icomp, worst
+      integer :: d, m, e(3), deg, e1, e2, e3
+      character(len=200) :: msg
+
+      call new_facet_shape(shape, name, set, error)
+      if (allocated(error)) return
+      d = set%dim
+      call facet_cell_rule(full, shape%solid, lo, hi, q, .true., .false., compress=.false.)
+      call facet_cell_rule(comp, shape%solid, lo, hi, q, .true., .false., compress=.true.)
+      deg = 2*q - 1
+      m = merge((deg + 1)*(deg + 2)/2, (deg + 1)*(deg + 2)*(deg + 3)/6, d == 2)
+      vol = sum(full%vol_w(1:full%nvol))
+      tol = real(m, wp)**2*epsilon(1.0_wp)*vol
+      write (msg, '(a, ": ", i0, " points of ", i0, ", M = ", i0)') name, comp%nvol, full%nvol, m
+      call check(error, comp%nvol <= m .and. comp%nvol < full%nvol .and. comp%nvol_full == full%nvol, trim(msg))
+      if (allocated(error)) return
+      call check(error, all(comp%vol_w(1:comp%nvol) > 0.0_wp), name//': a weight is not positive')
+      if (allocated(error)) return
+      worst = 0.0_wp
+      do e1 = 0, deg
+         do e2 = 0, deg - e1
+            do e3 = 0, merge(deg - e1 - e2, 0, d == 3)
+               e = [e1, e2, e3]
+               ifull = moment(full%vol_x(:, 1:full%nvol), full%vol_w(1:full%nvol))
+               icomp = moment(comp%vol_x(:, 1:comp%nvol), comp%vol_w(1:comp%nvol))
+               worst = max(worst, abs(icomp - ifull))
+            end do
+         end do
+      end do
+      write (msg, '(a, ": a moment is off by ", es10.3, " > ", es10.3)') name, worst, tol
+      call check(error, worst <= tol, trim(msg))
+   contains
+      real(wp) function moment(x, w)
+         real(wp), intent(in) :: x(:, :), w(:)
+         integer :: j, k
+         real(wp) :: t
+         moment = 0.0_wp
+         do j = 1, size(w)
+            t = w(j)
+            do k = 1, d
+               t = t*((2.0_wp*x(k, j) - lo(k) - hi(k))/(hi(k) - lo(k)))**e(k)
+            end do
+            moment = moment + t
+         end do
+      end function moment
+   end subroutine compressed_case
 
    ! ------------------------------------------------------------ checks
 

@@ -23,7 +23,7 @@ module sprc_core_dense
    implicit none
    private
 
-   public :: qr_pivoted, apply_qt, apply_q, solve_upper
+   public :: qr_pivoted, apply_qt, apply_q, solve_upper, reflector, reflect
 
 contains
 

@@ -20,6 +20,22 @@
 !> 2 qs - 3 = 2 q - 1 on a tetrahedron and 2 qs - 2 on a triangle, i.e. every
 !> total degree the tensor rule of q points integrates.
 !>
+!> Compression (on request): the cell's volume rule is then replaced by at most M of its own
+!> points with new positive weights that give the same moments of every
+!> polynomial of total degree 2 q - 1 (M of them: 20 in 2D / 56 in 3D for
+!> q = 3), so the compressed rule is exact wherever the full one is
+!> (Tchakaloff: such a rule exists among the points). The weights solve the
+!> non-negative least-squares problem A v = A w, v >= 0 (A: the products of
+!> Legendre polynomials in the cell's coordinates scaled to [-1, 1], at the
+!> points) by Lawson and Hanson's active set method, whose passive set is at
+!> most M columns of full rank; the columns' QR is updated as columns enter.
+!> Every basis function is at most 1 on the cell and the weights sum to its
+!> measure V, so the moments' round-off is of order eps V; the compressed
+!> rule is kept when every moment matches within M^2 eps V (the QR
+!> solve's backward error with at most M columns of entries at most 1), else
+!> the full rule stays. A cell that no fragment crosses gets the tensor rule
+!> of q points per direction where it is in the body.
+!>
 !> Surface: each fragment crossing the cell (not in a face plane of the cell)
 !> is fanned into triangles (a segment in 2D) with the qs-point rule; its
 !> normal is the facet's exact outward normal. Fragments in a face plane of
@@ -33,6 +49,7 @@
 module sprc_grid_facet_rule
    use sprc_core_kinds, only: wp
    use sprc_core_gauss, only: max_gauss_points, gauss_legendre_nodes
+   use sprc_core_dense, only: reflector, reflect, solve_upper
    use sprc_geometry_facet_solid, only: facet_solid_type, solid_query_box, solid_inside, clip_to_box, &
       & polygon_measure, snap_area, snap_length, on_face_plane, max_clip_vertices
    implicit none
@@ -51,6 +68,8 @@ module sprc_grid_facet_rule
       integer, allocatable :: surf_facet(:)
       !> Planes that split a region (statistics).
       integer :: nsplit = 0
+      !> Volume points before compression (statistics; nvol when not compressed).
+      integer :: nvol_full = 0
       integer, allocatable, private :: cand(:)
       !> Polygon pool of the fragments and the regions' faces: vertices (3, :), per
       !> polygon its first vertex, vertex count and facet (0 for a region's face).
@@ -60,6 +79,10 @@ module sprc_grid_facet_rule
       !> The reference rules of the simplex (dim, nref) with weights, the triangle and the segment.
       integer, private :: dim = 0, qs = 0
       real(wp), allocatable, private :: ref_x(:, :), ref_w(:), tri_x(:, :), tri_w(:), seg_x(:), seg_w(:)
+      !> Compression: the moment matrix (M, nvol), the exponents of its rows (3, M).
+      real(wp), allocatable, private :: ca(:, :)
+      integer, allocatable, private :: cexp(:, :)
+      integer, private :: cdeg = -1, cdim = 0
    end type facet_rule_type
 
    !> What the BSP needs besides the pools.
@@ -76,17 +99,20 @@ contains
    !> (module notes). member_in / member_out: is a point of the cell in the
    !> body where it is inside / outside the solid (the other shapes decided
    !> over the cell). Surface normals point out of the body. Face-plane
-   !> fragments are left to `facet_face_rule`.
-   pure subroutine facet_cell_rule(rule, solid, lo, hi, q, member_in, member_out)
+   !> fragments are left to `facet_face_rule`. compress = .true.: the volume
+   !> rule compressed (module notes); off by default, its cost (of order M^2
+   !> times the full rule's points per cell) exceeds the clipping's.
+   pure subroutine facet_cell_rule(rule, solid, lo, hi, q, member_in, member_out, compress)
       type(facet_rule_type), intent(inout) :: rule
       type(facet_solid_type), intent(in) :: solid
       real(wp), intent(in) :: lo(:), hi(:)
       integer, intent(in) :: q
       logical, intent(in) :: member_in, member_out
+      logical, intent(in), optional :: compress
       type(context_type) :: ctx
       real(wp) :: poly(3, max_clip_vertices), h, x(3), sgn
       integer :: i, n, nv, m, side, f, face_class
-      logical :: inside, on
+      logical :: inside, on, squeeze
 
       call prepare(rule, solid%dim, q)
       d_block: associate (d => solid%dim)
@@ -122,12 +148,43 @@ contains
                call solid_inside(solid, x, inside, on)
                face_class = merge(1, 0, inside)
             end if
-            call leaf(rule, ctx, n + 1, rule%nfrag, face_class == 1)
+            if (merge(member_in, member_out, face_class == 1)) call box_points(rule, d, lo, hi, q)
          else
             call partition(rule, solid, ctx, n + 1, rule%nfrag, 1, n, face_class == 1)
          end if
+         rule%nvol_full = rule%nvol
+         squeeze = .false.
+         if (present(compress)) squeeze = compress
+         if (squeeze) call compress_volume(rule, lo, hi, 2*q - 1)
       end associate d_block
    end subroutine facet_cell_rule
+
+   !> Tensor Gauss rule of q points per direction on the box [lo, hi].
+   pure subroutine box_points(rule, d, lo, hi, q)
+      type(facet_rule_type), intent(inout) :: rule
+      integer, intent(in) :: d, q
+      real(wp), intent(in) :: lo(:), hi(:)
+      real(wp) :: t(max_gauss_points), w(max_gauss_points), x(3), wt
+      integer :: i, j, k, nq
+
+      nq = min(q, max_gauss_points)
+      call gauss_legendre_nodes(nq, t, w)
+      x = 0.0_wp
+      do k = 1, merge(nq, 1, d == 3)
+         do j = 1, nq
+            do i = 1, nq
+               x(1) = 0.5_wp*(lo(1) + hi(1)) + 0.5_wp*(hi(1) - lo(1))*t(i)
+               x(2) = 0.5_wp*(lo(2) + hi(2)) + 0.5_wp*(hi(2) - lo(2))*t(j)
+               wt = w(i)*w(j)*product(0.5_wp*(hi(1:d) - lo(1:d)))
+               if (d == 3) then
+                  x(3) = 0.5_wp*(lo(3) + hi(3)) + 0.5_wp*(hi(3) - lo(3))*t(k)
+                  wt = wt*w(k)
+               end if
+               call push_volume(rule, x, wt)
+            end do
+         end do
+      end do
+   end subroutine box_points
 
    !> Surface points of the fragments of `solid` lying in the face planes of the
    !> cell [lo, hi], with the facet's outward normal and surf_facet = f where the
@@ -564,6 +621,249 @@ contains
          m = abs(a(1)*(b(2)*c(3) - b(3)*c(2)) - a(2)*(b(1)*c(3) - b(3)*c(1)) + a(3)*(b(1)*c(2) - b(2)*c(1)))/6.0_wp
       end if
    end function simplex_measure
+
+   ! ------------------------------------------------------------ compression
+
+   !> Replace the volume rule of the cell [lo, hi] by at most M of its points with
+   !> the same moments up to total degree `degree` (module notes); unchanged where
+   !> it has at most M points or the solve does not match the moments.
+   pure subroutine compress_volume(rule, lo, hi, degree)
+      type(facet_rule_type), intent(inout) :: rule
+      real(wp), intent(in) :: lo(:), hi(:)
+      integer, intent(in) :: degree
+      real(wp), allocatable :: b(:), v(:), x(:, :)
+      integer, allocatable :: list(:)
+      real(wp) :: tol
+      integer :: m, n, k, i
+      logical :: ok
+
+      n = rule%nvol
+      call moment_exponents(rule, degree, m)
+      if (n <= m) return
+      if (size(rule%ca, 2) < n) then
+         deallocate (rule%ca)
+         allocate (rule%ca(m, 2*n))
+      end if
+      call moment_matrix(rule, lo, hi, degree, m, n)
+      b = matmul(rule%ca(1:m, 1:n), rule%vol_w(1:n))
+      tol = real(m, wp)**2*epsilon(1.0_wp)*sum(rule%vol_w(1:n))
+      allocate (list(m), v(m))
+      call nnls(rule%ca, m, n, b, tol, list, v, k, ok)
+      if (.not. ok) return
+      allocate (x(3, k))
+      do i = 1, k
+         x(:, i) = rule%vol_x(:, list(i))
+      end do
+      rule%vol_x(:, 1:k) = x
+      rule%vol_w(1:k) = v(1:k)
+      rule%nvol = k
+   end subroutine compress_volume
+
+   !> Exponents of the products of Legendre polynomials of total degree <= degree
+   !> in rule%dim dimensions (rule%cexp(:, 1:m)), and the moment matrix's storage.
+   pure subroutine moment_exponents(rule, degree, m)
+      type(facet_rule_type), intent(inout) :: rule
+      integer, intent(in) :: degree
+      integer, intent(out) :: m
+      integer :: a, b, c, pass
+
+      if (rule%cdeg == degree .and. rule%cdim == rule%dim) then
+         m = size(rule%cexp, 2)
+         return
+      end if
+      if (allocated(rule%cexp)) deallocate (rule%cexp, rule%ca)
+      do pass = 1, 2
+         m = 0
+         do a = 0, degree
+            do b = 0, degree - a
+               do c = 0, merge(degree - a - b, 0, rule%dim == 3)
+                  m = m + 1
+                  if (pass == 2) rule%cexp(:, m) = [a, b, c]
+               end do
+            end do
+         end do
+         if (pass == 1) allocate (rule%cexp(3, m), rule%ca(m, 256))
+      end do
+      rule%cdeg = degree
+      rule%cdim = rule%dim
+   end subroutine moment_exponents
+
+   !> rule%ca(i, j): the i-th Legendre product at volume point j, in the cell's
+   !> coordinates scaled to [-1, 1].
+   pure subroutine moment_matrix(rule, lo, hi, degree, m, n)
+      type(facet_rule_type), intent(inout) :: rule
+      real(wp), intent(in) :: lo(:), hi(:)
+      integer, intent(in) :: degree, m, n
+      real(wp) :: p(0:degree, 3), t
+      integer :: j, k, l, i, d
+
+      d = rule%dim
+      p = 1.0_wp
+      do j = 1, n
+         do k = 1, d
+            t = (2.0_wp*rule%vol_x(k, j) - lo(k) - hi(k))/(hi(k) - lo(k))
+            if (degree >= 1) p(1, k) = t
+            do l = 1, degree - 1
+               p(l + 1, k) = (real(2*l + 1, wp)*t*p(l, k) - real(l, wp)*p(l - 1, k))/real(l + 1, wp)
+            end do
+         end do
+         do i = 1, m
+            rule%ca(i, j) = p(rule%cexp(1, i), 1)*p(rule%cexp(2, i), 2)*p(rule%cexp(3, i), 3)
+         end do
+      end do
+   end subroutine moment_matrix
+
+   !> Lawson-Hanson non-negative least squares min |A v - b|, v >= 0, with A =
+   !> a(1:m, 1:n): ok when every residual is at most tol, with the k <= m
+   !> columns list(1:k) and their weights v(1:k) > 0. The passive columns' QR
+   !> is kept in Householder form (qr, tau, qtb = Q^T b) and extended as a
+   !> column enters; a column leaving rebuilds it.
+   pure subroutine nnls(a, m, n, b, tol, list, v, k, ok)
+      real(wp), intent(in) :: a(:, :), b(:), tol
+      integer, intent(in) :: m, n
+      integer, intent(out) :: list(:), k
+      real(wp), intent(out) :: v(:)
+      logical, intent(out) :: ok
+      real(wp) :: qr(m, m), tau(m), qtb(m), z(m, 1), r(m), gbest, alpha
+      real(wp), allocatable :: g(:)
+      integer :: state(n), it, j, jbest, i, kk, imin, first
+      logical :: solved, added
+
+      ! state: 0 free, 1 passive, 2 set aside (entered with a non-positive weight)
+      state = 0
+      k = 0
+      v = 0.0_wp
+      r = b
+      qtb = b
+      ok = .false.
+      do it = 1, 3*m
+         if (maxval(abs(r)) <= tol) then
+            ok = k > 0
+            return
+         end if
+         if (k == m) return
+         ! A^T r by matmul: the library's kernel, also in builds with run-time checks
+         g = matmul(r, a(1:m, 1:n))
+         jbest = 0
+         gbest = 0.0_wp
+         do j = 1, n
+            if (state(j) /= 0) cycle
+            if (g(j) > gbest) then
+               gbest = g(j)
+               jbest = j
+            end if
+         end do
+         if (jbest == 0) return
+         call add_column(a(1:m, jbest), m, k, qr, tau, qtb, added)
+         if (.not. added) then
+            state(jbest) = 2
+            cycle
+         end if
+         list(k) = jbest
+         state(jbest) = 1
+         v(k) = 0.0_wp
+         do
+            z(1:k, 1) = qtb(1:k)
+            call solve_upper(k, qr, 1, z, solved)
+            if (.not. solved) return
+            if (all(z(1:k, 1) > 0.0_wp)) then
+               v(1:k) = z(1:k, 1)
+               exit
+            end if
+            if (z(k, 1) <= 0.0_wp .and. list(k) == jbest .and. v(k) == 0.0_wp) then
+               ! round-off let it in: set it aside, the others keep their weights
+               ! (the QR of the columns before it is unchanged: drop its reflector)
+               state(jbest) = 2
+               k = k - 1
+               call rebuild(a, m, list, v, state, k, k + 1, qr, tau, qtb, b)
+               exit
+            end if
+            alpha = 1.0_wp
+            imin = 0
+            do i = 1, k
+               if (z(i, 1) <= 0.0_wp) then
+                  if (v(i)/(v(i) - z(i, 1)) < alpha) then
+                     alpha = v(i)/(v(i) - z(i, 1))
+                     imin = i
+                  end if
+               end if
+            end do
+            v(1:k) = v(1:k) + alpha*(z(1:k, 1) - v(1:k))
+            if (imin > 0) v(imin) = 0.0_wp
+            kk = 0
+            first = k + 1
+            do i = 1, k
+               if (v(i) > 0.0_wp) then
+                  kk = kk + 1
+                  list(kk) = list(i)
+                  v(kk) = v(i)
+               else
+                  state(list(i)) = 0
+                  first = min(first, i)
+               end if
+            end do
+            k = kk
+            call rebuild(a, m, list, v, state, k, first, qr, tau, qtb, b)
+            if (k == 0) exit
+         end do
+         r = b
+         do i = 1, k
+            r = r - v(i)*a(1:m, list(i))
+         end do
+      end do
+   end subroutine nnls
+
+   !> Append column c as column k + 1 of the Householder QR (qr, tau) and update
+   !> qtb; not added (k unchanged) when c lies in the span of the first k
+   !> columns to round-off.
+   pure subroutine add_column(c, m, k, qr, tau, qtb, added)
+      integer, intent(in) :: m
+      real(wp), intent(in) :: c(m)
+      integer, intent(inout) :: k
+      real(wp), intent(inout) :: qr(m, m), tau(m), qtb(m)
+      logical, intent(out) :: added
+      integer :: i
+
+      added = .false.
+      if (k >= m) return
+      qr(1:m, k + 1) = c(1:m)
+      do i = 1, k
+         call reflect(m - i + 1, qr(i + 1:m, i), tau(i), qr(i:m, k + 1))
+      end do
+      if (norm2(qr(k + 1:m, k + 1)) <= real(m, wp)*epsilon(1.0_wp)*norm2(c(1:m))) return
+      k = k + 1
+      call reflector(qr(k:m, k), tau(k))
+      call reflect(m - k + 1, qr(k + 1:m, k), tau(k), qtb(k:m))
+      added = .true.
+   end subroutine add_column
+
+   !> The QR of the columns list(1:k) of a from column `first` on (columns before
+   !> it and their reflectors are unchanged: Householder QR's column j depends on
+   !> columns 1..j only); a column that turns out dependent leaves the list (with
+   !> its weight v) and is set aside (state 2).
+   pure subroutine rebuild(a, m, list, v, state, k, first, qr, tau, qtb, b)
+      real(wp), intent(in) :: a(:, :), b(:)
+      integer, intent(in) :: m, first
+      integer, intent(inout) :: list(:), state(:), k
+      real(wp), intent(inout) :: v(:), qr(m, m), tau(m), qtb(m)
+      integer :: i, kk
+      logical :: added
+      qtb = b(1:m)
+      kk = min(first - 1, k)
+      do i = 1, kk
+         call reflect(m - i + 1, qr(i + 1:m, i), tau(i), qtb(i:m))
+      end do
+      do i = kk + 1, k
+         call add_column(a(1:m, list(i)), m, kk, qr, tau, qtb, added)
+         if (added) then
+            list(kk) = list(i)
+            v(kk) = v(i)
+         else
+            state(list(i)) = 2
+         end if
+      end do
+      k = kk
+   end subroutine rebuild
 
    ! ------------------------------------------------------------ growing arrays
 
