@@ -43,6 +43,10 @@ contains
          new_unittest('patch_2d_stick_same_material', test_patch_2d_stick), &
          new_unittest('patch_3d_q1', test_patch_3d_q1), &
          new_unittest('patch_3d_q2', test_patch_3d_q2), &
+         new_unittest('patch_2d_q1_linear', test_patch_2d_q1_linear), &
+         new_unittest('patch_2d_q2_linear', test_patch_2d_q2_linear), &
+         new_unittest('patch_2d_stick_linear', test_patch_2d_stick_linear), &
+         new_unittest('patch_3d_q1_linear', test_patch_3d_q1_linear), &
          new_unittest('lost_contact_names_body', test_lost_contact), &
          new_unittest('shrink_fit_q1_plane_strain', test_shrink_q1), &
          new_unittest('shrink_fit_q2_plane_stress_ratio_1000', test_shrink_q2), &
@@ -87,7 +91,7 @@ contains
    !> replaced), checked against the uniform state of normal stress -1 across
    !> the interface (2D sigma_yy, 3D sigma_zz; `ns` Voigt components) and the
    !> contact pressure `p_exact` (default 1) at every closed slave point.
-   subroutine patch_case(path, order, level, old, new, ns, error, stick, p_exact, recovered)
+   subroutine patch_case(path, order, level, old, new, ns, error, stick, p_exact, recovered, linear)
       character(len=*), intent(in) :: path, old, new
       integer, intent(in) :: order, level, ns
       type(error_type), allocatable, intent(out) :: error
@@ -95,6 +99,8 @@ contains
       real(wp), intent(in), optional :: p_exact
       !> With the recovered stabilization (`test_patch_2d_q1_recovered`).
       logical, intent(in), optional :: recovered
+      !> With the linear multiplier (`test_patch_2d_q1_linear`).
+      logical, intent(in), optional :: linear
       type(level_type) :: result
       real(wp) :: worst, pworst, tol
       character(len=:), allocatable :: text
@@ -105,6 +111,7 @@ contains
       if (len(old) > 0) text = replaced(text, old, new)
       if (present(stick)) text = replaced(text, "friction='frictionless'", "friction='stick'")
       if (present(recovered)) text = replaced(text, '&contact ', "&contact stabilization='recovered' ")
+      if (present(linear)) text = replaced(text, '&contact ', "&contact multiplier='linear' ")
       call uniform_errors(text, level, ns, result, worst, pworst, tol, error, p_exact)
       if (allocated(error)) return
       if (present(recovered)) tol = tol + sqrt(epsilon(1.0_wp))
@@ -347,6 +354,30 @@ contains
       type(error_type), allocatable, intent(out) :: error
       call patch_case(patch_3d, 2, 1, '', '', 6, error)
    end subroutine test_patch_3d_q2
+
+   !> The patch tests with the linear multiplier (sprc_contact_solve notes):
+   !> its hats sum to one at every point, so the uniform pressure is in the
+   !> space and every point's pressure is exact to the solve's round-off.
+   subroutine test_patch_2d_q1_linear(error)
+      type(error_type), allocatable, intent(out) :: error
+      call patch_case(patch_2d, 1, 3, '', '', 3, error, linear=.true.)
+   end subroutine test_patch_2d_q1_linear
+
+   subroutine test_patch_2d_q2_linear(error)
+      type(error_type), allocatable, intent(out) :: error
+      call patch_case(patch_2d, 2, 2, '', '', 3, error, linear=.true.)
+   end subroutine test_patch_2d_q2_linear
+
+   subroutine test_patch_2d_stick_linear(error)
+      type(error_type), allocatable, intent(out) :: error
+      call patch_case(patch_2d, 1, 3, "young=3.0 poisson=0.2", "young=1.0 poisson=0.3", 3, error, stick=.true., &
+         & linear=.true.)
+   end subroutine test_patch_2d_stick_linear
+
+   subroutine test_patch_3d_q1_linear(error)
+      type(error_type), allocatable, intent(out) :: error
+      call patch_case(patch_3d, 1, 2, '', '', 6, error, linear=.true.)
+   end subroutine test_patch_3d_q1_linear
 
    !> A body held only by contact whose contact surface is far from the master
    !> surface: an error naming the body, not a singular-matrix message.
