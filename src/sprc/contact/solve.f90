@@ -109,9 +109,6 @@ module sprc_contact_solve
    !> Multiplier spaces (doc/scene.md `multiplier`): constant on each contact
    !> cell, or continuous and multilinear on the contact cells' lattice.
    integer, parameter :: multiplier_constant = 0, multiplier_linear = 1
-   !> A linear multiplier's node whose hat covers less than this share of a
-   !> full hat's measure is dropped (`node_cells`).
-   real(wp), parameter :: sliver_hat = 0.25_wp
    !> Active-set iterations before giving up.
    integer, parameter :: default_max_iterations = 50
    !> A slip direction counts as settled when it moves by less than this
@@ -613,9 +610,9 @@ contains
       type(point_operators_type), intent(inout) :: ops
       integer, intent(in) :: rep(:), shift(:)
       type(error_type), allocatable, intent(out) :: error
-      integer, allocatable :: node(:, :), keys(:, :), table(:), fill(:), ptr(:), point(:), axis(:), parent(:), id(:)
-      real(wp), allocatable :: phi(:, :), val(:), nsum(:, :)
-      real(wp) :: lo(3), hi(3), h(3), t(3), f, area(surface%npoint)
+      integer, allocatable :: node(:, :), keys(:, :), table(:), axis(:), parent(:), id(:)
+      real(wp), allocatable :: phi(:, :), nsum(:, :)
+      real(wp) :: lo(3), hi(3), h(3), t(3), f
       integer :: d, nc, i, c, e, k, v, m, nn, nslot, stat, kt(2), vkey(5), scale, j, r
 
       d = surface%dim
@@ -653,7 +650,6 @@ contains
          ! The macro box's lower corner: the root's corner rounded down to the macro lattice.
          lo(1:d) = lo(1:d) - (hi(1:d) - lo(1:d))*modulo(slave%mesh%grid%leaf_coord(1:d, e), 2**shift(e))
          t(1:d) = min(1.0_wp, max(0.0_wp, (surface%x(:, i) - lo(1:d))/h(1:d)))
-         area(i) = product(h(kt(1:d - 1)))
          scale = 2**(grid_max_level - slave%mesh%grid%leaf_level(e) + shift(e))
          do v = 1, nc
             vkey(1) = k
@@ -701,105 +697,8 @@ contains
             if (node(v, i) > 0) node(v, i) = id(node(v, i))
          end do
       end do
-      call drop_slivers()
-      allocate (fill(nn), source=0, stat=stat)
-      if (stat == 0) allocate (ptr(nn + 1), stat=stat)
-      call check_allocation(stat, 'contact cells', 'the nodes'' points', nn, 8, error)
-      if (allocated(error)) return
-      do i = 1, surface%npoint
-         do v = 1, nc
-            if (node(v, i) > 0) fill(node(v, i)) = fill(node(v, i)) + 1
-         end do
-      end do
-      ptr(1) = 1
-      do m = 1, nn
-         ptr(m + 1) = ptr(m) + fill(m)
-      end do
-      allocate (point(ptr(nn + 1) - 1), val(ptr(nn + 1) - 1), stat=stat)
-      call check_allocation(stat, 'contact cells', 'the nodes'' points', ptr(nn + 1) - 1, 12, error)
-      if (allocated(error)) return
-      fill = 0
-      do i = 1, surface%npoint
-         do v = 1, nc
-            m = node(v, i)
-            if (m == 0) cycle
-            ! Two hats of a point on one node (rows joined) add up.
-            if (fill(m) > 0) then
-               if (point(ptr(m) + fill(m) - 1) == i) then
-                  val(ptr(m) + fill(m) - 1) = val(ptr(m) + fill(m) - 1) + phi(v, i)
-                  cycle
-               end if
-            end if
-            point(ptr(m) + fill(m)) = i
-            val(ptr(m) + fill(m)) = phi(v, i)
-            fill(m) = fill(m) + 1
-         end do
-      end do
-      do m = 1, nn
-         ptr(m + 1) = ptr(m) + fill(m)
-      end do
-      ops%ncell = nn
-      ops%cell_point = [(point(ptr(m):ptr(m) + fill(m) - 1), m=1, nn)]
-      ops%cell_phi = [(val(ptr(m):ptr(m) + fill(m) - 1), m=1, nn)]
-      do m = 1, nn
-         ptr(m + 1) = ptr(m) + fill(m)
-      end do
-      call move_alloc(ptr, ops%cell_ptr)
+      call node_lists(node, phi, nn, ops, error)
    contains
-      !> A node whose hat covers less than `sliver_hat` of a full hat's
-      !> measure (h^(dim-1) of its cells) is barely constrained by the
-      !> displacements, and its multiplier is noise that the hat carries to
-      !> its points: it is dropped and its points' other hats scaled to sum
-      !> to one (unless it is all they have).
-      subroutine drop_slivers()
-         real(wp) :: measure(nn), full(nn), total
-         logical :: keep(nc)
-         measure = 0.0_wp
-         full = 0.0_wp
-         do i = 1, surface%npoint
-            do v = 1, nc
-               m = node(v, i)
-               if (m == 0) cycle
-               measure(m) = measure(m) + surface%weight(i)*phi(v, i)
-               full(m) = max(full(m), area(i))
-            end do
-         end do
-         do i = 1, surface%npoint
-            keep = .false.
-            do v = 1, nc
-               if (node(v, i) > 0) keep(v) = measure(node(v, i)) >= sliver_hat*full(node(v, i))
-            end do
-            total = sum(phi(:, i), mask=keep)
-            if (.not. total > 0.0_wp) cycle
-            where (.not. keep)
-               node(:, i) = 0
-               phi(:, i) = 0.0_wp
-            end where
-            phi(:, i) = phi(:, i)/total
-         end do
-         ! Renumber the nodes that kept a point.
-         full = 0.0_wp
-         do i = 1, surface%npoint
-            do v = 1, nc
-               if (node(v, i) > 0) full(node(v, i)) = 1.0_wp
-            end do
-         end do
-         id(1:nn) = 0
-         r = 0
-         do m = 1, nn
-            if (full(m) > 0.0_wp) then
-               r = r + 1
-               id(m) = r
-            end if
-         end do
-         nn = r
-         do i = 1, surface%npoint
-            do v = 1, nc
-               if (node(v, i) > 0) node(v, i) = id(node(v, i))
-            end do
-         end do
-      end subroutine drop_slivers
-
       !> The node of `key` (0 if absent and not `add`).
       integer function find_key(key, add) result(found)
          integer, intent(in) :: key(:)
@@ -840,6 +739,46 @@ contains
          parent(max(ra, rb)) = min(ra, rb)
       end subroutine join
    end subroutine node_cells
+
+   !> The cells of `node_cells` from each point's nodes node(:, i) (0: none)
+   !> and hats phi(:, i): nodes 1..nn, each with its points in point order.
+   subroutine node_lists(node, phi, nn, ops, error)
+      integer, intent(in) :: node(:, :), nn
+      real(wp), intent(in) :: phi(:, :)
+      type(point_operators_type), intent(inout) :: ops
+      type(error_type), allocatable, intent(out) :: error
+      integer, allocatable :: fill(:)
+      integer :: i, v, m, q, stat
+
+      allocate (fill(nn), source=0, stat=stat)
+      call check_allocation(stat, 'contact cells', 'the nodes'' points', nn, 4, error)
+      if (allocated(error)) return
+      do i = 1, size(node, 2)
+         do v = 1, size(node, 1)
+            if (node(v, i) > 0) fill(node(v, i)) = fill(node(v, i)) + 1
+         end do
+      end do
+      if (allocated(ops%cell_ptr)) deallocate (ops%cell_ptr, ops%cell_point, ops%cell_phi)
+      allocate (ops%cell_ptr(nn + 1), ops%cell_point(sum(fill)), ops%cell_phi(sum(fill)), stat=stat)
+      call check_allocation(stat, 'contact cells', 'the nodes'' points', sum(fill) + nn, 12, error)
+      if (allocated(error)) return
+      ops%cell_ptr(1) = 1
+      do m = 1, nn
+         ops%cell_ptr(m + 1) = ops%cell_ptr(m) + fill(m)
+      end do
+      fill = 0
+      do i = 1, size(node, 2)
+         do v = 1, size(node, 1)
+            m = node(v, i)
+            if (m == 0) cycle
+            q = ops%cell_ptr(m) + fill(m)
+            ops%cell_point(q) = i
+            ops%cell_phi(q) = phi(v, i)
+            fill(m) = fill(m) + 1
+         end do
+      end do
+      ops%ncell = nn
+   end subroutine node_lists
 
    !> macro(e): the representative of slave root e's contact macro cell, the
    !> first root of the contact (in leaf order) with the same ancestor `shift`
