@@ -670,35 +670,42 @@ contains
             phi(v, i) = f
          end do
       end do
-      ! One node per vertex over neighbouring rows (union-find, the lower index the root).
-      allocate (parent(nn), id(nn), stat=stat)
-      call check_allocation(stat, 'contact cells', 'the nodes'' classes', nn, 8, error)
+      call join_rows(error)
       if (allocated(error)) return
-      parent = [(m, m=1, nn)]
-      do m = 1, nn
-         vkey(1:d + 2) = keys(:, m)
-         vkey(1 + vkey(1)) = vkey(1 + vkey(1)) + vkey(d + 2)
-         r = find_key(vkey(1:d + 2), .false.)
-         if (r > 0) call join(m, r)
-      end do
-      nn = 0
-      do m = 1, size(parent)
-         r = root_of(m)
-         if (r == m) then
-            nn = nn + 1
-            id(m) = nn
-         end if
-      end do
-      do m = 1, size(parent)
-         id(m) = id(root_of(m))
-      end do
-      do i = 1, surface%npoint
-         do v = 1, nc
-            if (node(v, i) > 0) node(v, i) = id(node(v, i))
-         end do
-      end do
       call node_lists(node, phi, nn, ops, error)
    contains
+      !> One node per vertex over neighbouring rows (union-find, the lower
+      !> index the root): nodes renumbered 1..nn, node(:, :) remapped.
+      subroutine join_rows(error)
+         type(error_type), allocatable, intent(out) :: error
+         allocate (parent(nn), id(nn), stat=stat)
+         call check_allocation(stat, 'contact cells', 'the nodes'' classes', nn, 8, error)
+         if (allocated(error)) return
+         parent = [(m, m=1, nn)]
+         do m = 1, nn
+            vkey(1:d + 2) = keys(:, m)
+            vkey(1 + vkey(1)) = vkey(1 + vkey(1)) + vkey(d + 2)
+            r = find_key(vkey(1:d + 2), .false.)
+            if (r > 0) call join(m, r)
+         end do
+         nn = 0
+         do m = 1, size(parent)
+            r = root_of(m)
+            if (r == m) then
+               nn = nn + 1
+               id(m) = nn
+            end if
+         end do
+         do m = 1, size(parent)
+            id(m) = id(root_of(m))
+         end do
+         do i = 1, surface%npoint
+            do v = 1, nc
+               if (node(v, i) > 0) node(v, i) = id(node(v, i))
+            end do
+         end do
+      end subroutine join_rows
+
       !> The node of `key` (0 if absent and not `add`).
       integer function find_key(key, add) result(found)
          integer, intent(in) :: key(:)
