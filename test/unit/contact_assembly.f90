@@ -50,6 +50,7 @@ contains
       testsuite = [ &
          new_unittest('stack_q1', test_stack_q1), &
          new_unittest('stack_q2', test_stack_q2), &
+         new_unittest('stack_q1_linear', test_stack_q1_linear), &
          new_unittest('layered_rings_q1_plane_strain', test_rings_q1_strain), &
          new_unittest('layered_rings_q1_plane_stress', test_rings_q1_stress), &
          new_unittest('layered_rings_q2_plane_strain', test_rings_q2_strain), &
@@ -68,10 +69,17 @@ contains
       call stack_case(2, 2, error)
    end subroutine test_stack_q2
 
+   !> The stack with the linear multiplier on both pairs: still exact.
+   subroutine test_stack_q1_linear(error)
+      type(error_type), allocatable, intent(out) :: error
+      call stack_case(1, 3, error, linear=.true.)
+   end subroutine test_stack_q1_linear
+
    !> The stack at `order` and `level` with SPR and SPR-C (module notes).
-   subroutine stack_case(order, level, error)
+   subroutine stack_case(order, level, error, linear)
       integer, intent(in) :: order, level
       type(error_type), allocatable, intent(out) :: error
+      logical, intent(in), optional :: linear
       type(level_type) :: result
       type(study_type) :: study
       character(len=:), allocatable :: text
@@ -82,6 +90,10 @@ contains
       if (allocated(error)) return
       text = replaced(text, 'order    = 1', 'order    = '//achar(48 + order))
       text = replaced(text, "recovery = 'none'", "recovery = 'both'")
+      if (present(linear)) then
+         text = replaced(text, "&contact slave='middle'", "&contact multiplier='linear' slave='middle'")
+         text = replaced(text, "&contact slave='top'", "&contact multiplier='linear' slave='top'")
+      end if
       call run_text(text, level, result, error, study)
       if (allocated(error)) return
       call check(error, size(result%contacts), 2, 'two pairs')

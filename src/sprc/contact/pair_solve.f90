@@ -6,12 +6,12 @@
 !> - Multiplier: stabilized (gamma = kappa E_s/h, h the smallest edge of the slave
 !>   point's aggregate root), with p_N the slave's FE traction (Nitsche-type) or,
 !>   with `recovered`, its recovered traction of the previous solution.
-!> - Multiplier space: P0 on contact cells (`macro_cells`, `group_cells`): slave
-!>   aggregates sharing a parent cell, spanning at least two master cells where
-!>   those are larger, turning at most a quarter turn (`turns_too_far`); P0 on the
-!>   slave cells is not inf-sup stable against the trace. The multiplier is
-!>   eliminated cell by cell (lambda_c = pbar + gamma gbar; the block is SPD above
-!>   the trace-inverse bound, doc/theory.md section 6).
+!> - Multiplier space: P0 on contact cells (`macro_cells`, `group_cells`: slave
+!>   aggregates of a parent cell, spanning two master cells where those are larger,
+!>   turning at most a quarter turn), as P0 on slave cells is not inf-sup stable;
+!>   eliminated cell by cell (lambda_c = pbar + gamma gbar, SPD above the
+!>   trace-inverse bound). `multiplier='linear'` (`node_cells`): hats of the cells'
+!>   vertex lattice along the surface, eliminated node by node (mass lumped).
 !> - Frame: at point i lambda_c acts as R_i lambda_c, R_i the least rotation from the
 !>   cell's mean normal to n_i (`frame_rotation`): a uniform pressure on a curved
 !>   surface is in the space (a Cartesian constant costs Q2 its order).
@@ -56,6 +56,7 @@ module sprc_contact_pair_solve
    use sprc_fem_umfpack, only: umfpack_solver_type
    use sprc_fem_cholmod, only: cholmod_solver_type
    use sprc_contact_surface, only: contact_surface_type
+   use sprc_grid_tree, only: grid_max_level
    use sprc_contact_result, only: contact_open, contact_stick, contact_slip
    implicit none
    private
@@ -63,6 +64,7 @@ module sprc_contact_pair_solve
    public :: contact_solution_type, solve_contact_pair, friction_kind, contact_progress, contact_factor_type
    public :: contact_body_type, contact_pair_type, solve_contact_assembly
    public :: friction_frictionless, friction_stick, friction_coulomb, default_max_iterations
+   public :: multiplier_constant, multiplier_linear, multiplier_kind
 
    abstract interface
       !> Told after each iteration of the contact nonlinearity (the library
@@ -77,6 +79,9 @@ module sprc_contact_pair_solve
 
    !> Friction laws (doc/scene.md `friction`).
    integer, parameter :: friction_frictionless = 0, friction_stick = 1, friction_coulomb = 2
+   !> Multiplier spaces (doc/scene.md `multiplier`): constant on each contact
+   !> cell, or continuous and multilinear on the contact cells' lattice.
+   integer, parameter :: multiplier_constant = 0, multiplier_linear = 1
    !> Active-set iterations before giving up.
    integer, parameter :: default_max_iterations = 50
    !> A slip direction counts as settled when it moves by less than this
@@ -94,8 +99,12 @@ module sprc_contact_pair_solve
       !> g(u) - g0 n = gop(:, ptr(i):ptr(i+1)-1) u(dofs(...)); slave traction sigma(u_s) n likewise with top.
       real(wp), allocatable :: gop(:, :), top(:, :)
       !> Contact cells: points cell_point(cell_ptr(c) : cell_ptr(c+1)-1); the cell of each point (0: none).
+      !> A point of a linear multiplier belongs to the cells (nodes) of its hats.
       integer :: ncell = 0
       integer, allocatable :: cell_ptr(:), cell_point(:), cell_of_point(:)
+      !> The multiplier's basis function of each cell at each of its points,
+      !> parallel to cell_point: 1 (constant multiplier) or the node's hat.
+      real(wp), allocatable :: cell_phi(:)
       !> Penalty gamma = kappa E_s/h of each contact cell.
       real(wp), allocatable :: gamma(:)
    end type point_operators_type
@@ -184,6 +193,8 @@ module sprc_contact_pair_solve
    !> friction law (frictionless or stick) and kappa.
    type :: contact_pair_type
       integer :: slave = 0, master = 0, friction = friction_frictionless
+      !> The multiplier space (`multiplier_constant` or `multiplier_linear`).
+      integer :: multiplier = multiplier_constant
       real(wp) :: kappa = 0.0_wp
       type(contact_surface_type) :: surface
    end type contact_pair_type
@@ -202,6 +213,16 @@ module sprc_contact_pair_solve
 
 contains
 
+   !> The multiplier constant of a doc/scene.md `multiplier` name (-1 if unknown).
+   pure integer function multiplier_kind(name)
+      character(len=*), intent(in) :: name
+      select case (name)
+      case ('constant'); multiplier_kind = multiplier_constant
+      case ('linear'); multiplier_kind = multiplier_linear
+      case default; multiplier_kind = -1
+      end select
+   end function multiplier_kind
+
    !> The friction constant of a doc/scene.md `friction` name (-1 if unknown).
    pure integer function friction_kind(name)
       character(len=*), intent(in) :: name
@@ -218,7 +239,7 @@ contains
    !> both problems hold their solution (`set_solution`). `names` are the slave
    !> and master body names for messages.
    subroutine solve_contact_pair(slave, master, surface, friction, kappa, names, sol, error, max_iterations, mu, &
-         & loads, progress, recovered, factor)
+         & loads, progress, recovered, factor, multiplier)
       type(elasticity_problem_type), intent(inout) :: slave, master
       type(contact_surface_type), intent(in) :: surface
       integer, intent(in) :: friction
@@ -240,6 +261,8 @@ contains
       !> With `recovered`: the factor of the previous solve (module notes),
       !> updated.
       type(contact_factor_type), intent(inout), optional, target :: factor
+      !> The multiplier space (`multiplier_constant`, the default, or `multiplier_linear`).
+      integer, intent(in), optional :: multiplier
       type(point_operators_type) :: ops
       type(cell_operators_type), allocatable :: cells(:)
       type(csr_type) :: k
@@ -259,7 +282,7 @@ contains
       maxit = default_max_iterations
       if (present(max_iterations)) maxit = max_iterations
       call timer%start()
-      call point_operators(slave, master, surface, kappa, ops, error)
+      call point_operators(slave, master, surface, kappa, ops, error, multiplier=multiplier)
       if (allocated(error)) return
       allocate (cells(ops%ncell), closed(ops%ncell), next(ops%ncell), stat=stat)
       call check_allocation(stat, 'contact solve', 'the contact cells', ops%ncell, 2, error)
@@ -396,20 +419,20 @@ contains
    !> Gap and traction operators of every point with a master point.
    !> `offsets`: the slave's and the master's first dof less one in the
    !> system's numbering (default 0 and the slave's dofs: the pair's block system).
-   subroutine point_operators(slave, master, surface, kappa, ops, error, offsets)
+   subroutine point_operators(slave, master, surface, kappa, ops, error, offsets, multiplier)
       type(elasticity_problem_type), intent(in) :: slave, master
       type(contact_surface_type), intent(in) :: surface
       real(wp), intent(in) :: kappa
       type(point_operators_type), intent(out) :: ops
       type(error_type), allocatable, intent(out) :: error
-      integer, intent(in), optional :: offsets(2)
+      integer, intent(in), optional :: offsets(2), multiplier
       type(local_type), allocatable :: loc(:)
       integer :: i, q0, q1, d, c, stat, off(2)
 
       d = surface%dim
       off = [0, slave%n_dofs()]
       if (present(offsets)) off = offsets
-      call group_cells(surface, slave, master, ops, error)
+      call group_cells(surface, slave, master, ops, error, multiplier)
       if (allocated(error)) return
       allocate (loc(surface%npoint), ops%ptr(surface%npoint + 1), ops%gamma(ops%ncell), stat=stat)
       call check_allocation(stat, 'contact operators', 'the points'' operators', surface%npoint, 128, error)
@@ -459,23 +482,24 @@ contains
    !> joins the group of at least that measure whose centroid is nearest: a
    !> multiplier on a sliver is barely constrained by the displacements, and
    !> its pressure is noise that can open it falsely.
-   subroutine group_cells(surface, slave, master, ops, error)
+   subroutine group_cells(surface, slave, master, ops, error, multiplier)
       type(contact_surface_type), intent(in) :: surface
       type(elasticity_problem_type), intent(in) :: slave, master
       type(point_operators_type), intent(inout) :: ops
       type(error_type), allocatable, intent(out) :: error
+      integer, intent(in), optional :: multiplier
       integer :: key(surface%npoint), group(slave%mesh%grid%n_leaves), cell_of_leaf(slave%mesh%grid%n_leaves)
       integer :: fill(slave%mesh%grid%n_leaves), i, e, c, best, n_leaves, d, stat
       real(wp) :: measure(slave%mesh%grid%n_leaves), centroid(surface%dim, slave%mesh%grid%n_leaves), dist, best_dist
       logical :: small(slave%mesh%grid%n_leaves)
-      integer :: macro(slave%mesh%grid%n_leaves)
+      integer :: macro(slave%mesh%grid%n_leaves), shift(slave%mesh%grid%n_leaves)
 
       n_leaves = slave%mesh%grid%n_leaves
       d = surface%dim
       key = 0
       measure = 0.0_wp
       centroid = 0.0_wp
-      call macro_cells(surface, slave, master, macro)
+      call macro_cells(surface, slave, master, macro, shift)
       do i = 1, surface%npoint
          if (.not. surface%has_master(i)) cycle
          key(i) = macro(slave%root(surface%slave_cell(i)))
@@ -532,7 +556,209 @@ contains
          ops%cell_point(ops%cell_ptr(c) + fill(c)) = i
          fill(c) = fill(c) + 1
       end do
+      allocate (ops%cell_phi(size(ops%cell_point)), source=1.0_wp, stat=stat)
+      call check_allocation(stat, 'contact cells', 'the cells'' basis', size(ops%cell_point), 8, error)
+      if (allocated(error) .or. .not. present(multiplier)) return
+      if (multiplier == multiplier_linear) call node_cells(surface, slave, ops, pack([(e, e=1, n_leaves)], &
+         & cell_of_leaf > 0), shift, error)
    end subroutine group_cells
+
+   !> The cells of the linear multiplier (module notes): nodes of hats along
+   !> the surface. A contact cell's box is its macro cell (`shift` levels
+   !> above its representative root `rep(c)`); its normal axis k is the axis
+   !> nearest its mean normal, and its hats are the multilinear ones of the
+   !> box's vertex lattice in the other axes (a point's coordinates clamped to
+   !> the box: a sliver joined to a neighbour cell), so they sum to one at
+   !> every point and a uniform pressure lies in the space. A node is keyed by
+   !> k, the box's row along k and the vertex in the other axes on the finest
+   !> lattice; the nodes of the same vertex in neighbouring rows are one (the
+   !> surface passing from row to row), so the multiplier is continuous
+   !> between cells of one size and normal axis. Hats over the whole box (both
+   !> rows of vertices) would make two nodes with nearly the same constraint
+   !> where the surface runs near a lattice line, and their difference free:
+   !> an oscillating pressure. Nodes come in the order of their first point.
+   subroutine node_cells(surface, slave, ops, rep, shift, error)
+      type(contact_surface_type), intent(in) :: surface
+      type(elasticity_problem_type), intent(in) :: slave
+      type(point_operators_type), intent(inout) :: ops
+      integer, intent(in) :: rep(:), shift(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer, allocatable :: node(:, :), keys(:, :), table(:), axis(:), parent(:), id(:)
+      real(wp), allocatable :: phi(:, :), nsum(:, :)
+      real(wp) :: lo(3), hi(3), h(3), t(3), f
+      integer :: d, nc, i, c, e, k, v, m, nn, nslot, stat, kt(2), vkey(5), scale, j, r
+
+      d = surface%dim
+      nc = 2**(d - 1)
+      allocate (node(nc, surface%npoint), phi(nc, surface%npoint), keys(d + 2, nc*size(ops%cell_point)), &
+         & axis(ops%ncell), nsum(d, ops%ncell), stat=stat)
+      call check_allocation(stat, 'contact cells', 'the multiplier''s nodes', nc*surface%npoint, 12 + 4*(d + 2), error)
+      if (allocated(error)) return
+      nslot = 2
+      do while (nslot < 2*nc*size(ops%cell_point))
+         nslot = 2*nslot
+      end do
+      allocate (table(0:nslot - 1), source=0, stat=stat)
+      call check_allocation(stat, 'contact cells', 'the nodes'' table', nslot, 4, error)
+      if (allocated(error)) return
+      nsum = 0.0_wp
+      do i = 1, surface%npoint
+         c = ops%cell_of_point(i)
+         if (c > 0) nsum(:, c) = nsum(:, c) + surface%weight(i)*surface%normal(:, i)
+      end do
+      do c = 1, ops%ncell
+         axis(c) = maxloc(abs(nsum(:, c)), 1)
+      end do
+      node = 0
+      phi = 0.0_wp
+      nn = 0
+      do i = 1, surface%npoint
+         c = ops%cell_of_point(i)
+         if (c == 0) cycle
+         e = rep(c)
+         k = axis(c)
+         kt(1:d - 1) = pack([(j, j=1, d)], [(j, j=1, d)] /= k)
+         call slave%mesh%grid%leaf_box(e, lo(1:d), hi(1:d))
+         h(1:d) = (hi(1:d) - lo(1:d))*2**shift(e)
+         ! The macro box's lower corner: the root's corner rounded down to the macro lattice.
+         lo(1:d) = lo(1:d) - (hi(1:d) - lo(1:d))*modulo(slave%mesh%grid%leaf_coord(1:d, e), 2**shift(e))
+         t(1:d) = min(1.0_wp, max(0.0_wp, (surface%x(:, i) - lo(1:d))/h(1:d)))
+         scale = 2**(grid_max_level - slave%mesh%grid%leaf_level(e) + shift(e))
+         do v = 1, nc
+            vkey(1) = k
+            vkey(2:d + 1) = (slave%mesh%grid%leaf_coord(1:d, e)/2**shift(e))*scale
+            vkey(d + 2) = scale
+            f = 1.0_wp
+            do j = 1, d - 1
+               if (btest(v - 1, j - 1)) then
+                  f = f*t(kt(j))
+                  vkey(1 + kt(j)) = vkey(1 + kt(j)) + scale
+               else
+                  f = f*(1.0_wp - t(kt(j)))
+               end if
+            end do
+            if (.not. f > 0.0_wp) cycle
+            m = find_key(vkey(1:d + 2), .true.)
+            node(v, i) = m
+            phi(v, i) = f
+         end do
+      end do
+      call join_rows(error)
+      if (allocated(error)) return
+      call node_lists(node, phi, nn, ops, error)
+   contains
+      !> One node per vertex over neighbouring rows (union-find, the lower
+      !> index the root): nodes renumbered 1..nn, node(:, :) remapped.
+      subroutine join_rows(error)
+         type(error_type), allocatable, intent(out) :: error
+         allocate (parent(nn), id(nn), stat=stat)
+         call check_allocation(stat, 'contact cells', 'the nodes'' classes', nn, 8, error)
+         if (allocated(error)) return
+         parent = [(m, m=1, nn)]
+         do m = 1, nn
+            vkey(1:d + 2) = keys(:, m)
+            vkey(1 + vkey(1)) = vkey(1 + vkey(1)) + vkey(d + 2)
+            r = find_key(vkey(1:d + 2), .false.)
+            if (r > 0) call join(m, r)
+         end do
+         nn = 0
+         do m = 1, size(parent)
+            r = root_of(m)
+            if (r == m) then
+               nn = nn + 1
+               id(m) = nn
+            end if
+         end do
+         do m = 1, size(parent)
+            id(m) = id(root_of(m))
+         end do
+         do i = 1, surface%npoint
+            do v = 1, nc
+               if (node(v, i) > 0) node(v, i) = id(node(v, i))
+            end do
+         end do
+      end subroutine join_rows
+
+      !> The node of `key` (0 if absent and not `add`).
+      integer function find_key(key, add) result(found)
+         integer, intent(in) :: key(:)
+         logical, intent(in) :: add
+         integer :: slot
+         slot = int(iand(hash_int(key), int(nslot - 1, i8)))
+         do
+            if (table(slot) == 0) then
+               found = 0
+               if (.not. add) return
+               nn = nn + 1
+               keys(:, nn) = key
+               table(slot) = nn
+               found = nn
+               return
+            end if
+            if (all(keys(:, table(slot)) == key)) then
+               found = table(slot)
+               return
+            end if
+            slot = iand(slot + 1, nslot - 1)
+         end do
+      end function find_key
+
+      integer function root_of(m) result(r)
+         integer, intent(in) :: m
+         r = m
+         do while (parent(r) /= r)
+            r = parent(r)
+         end do
+      end function root_of
+
+      subroutine join(a, b)
+         integer, intent(in) :: a, b
+         integer :: ra, rb
+         ra = root_of(a)
+         rb = root_of(b)
+         parent(max(ra, rb)) = min(ra, rb)
+      end subroutine join
+   end subroutine node_cells
+
+   !> The cells of `node_cells` from each point's nodes node(:, i) (0: none)
+   !> and hats phi(:, i): nodes 1..nn, each with its points in point order.
+   subroutine node_lists(node, phi, nn, ops, error)
+      integer, intent(in) :: node(:, :), nn
+      real(wp), intent(in) :: phi(:, :)
+      type(point_operators_type), intent(inout) :: ops
+      type(error_type), allocatable, intent(out) :: error
+      integer, allocatable :: fill(:)
+      integer :: i, v, m, q, stat
+
+      allocate (fill(nn), source=0, stat=stat)
+      call check_allocation(stat, 'contact cells', 'the nodes'' points', nn, 4, error)
+      if (allocated(error)) return
+      do i = 1, size(node, 2)
+         do v = 1, size(node, 1)
+            if (node(v, i) > 0) fill(node(v, i)) = fill(node(v, i)) + 1
+         end do
+      end do
+      if (allocated(ops%cell_ptr)) deallocate (ops%cell_ptr, ops%cell_point, ops%cell_phi)
+      allocate (ops%cell_ptr(nn + 1), ops%cell_point(sum(fill)), ops%cell_phi(sum(fill)), stat=stat)
+      call check_allocation(stat, 'contact cells', 'the nodes'' points', sum(fill) + nn, 12, error)
+      if (allocated(error)) return
+      ops%cell_ptr(1) = 1
+      do m = 1, nn
+         ops%cell_ptr(m + 1) = ops%cell_ptr(m) + fill(m)
+      end do
+      fill = 0
+      do i = 1, size(node, 2)
+         do v = 1, size(node, 1)
+            m = node(v, i)
+            if (m == 0) cycle
+            q = ops%cell_ptr(m) + fill(m)
+            ops%cell_point(q) = i
+            ops%cell_phi(q) = phi(v, i)
+            fill(m) = fill(m) + 1
+         end do
+      end do
+      ops%ncell = nn
+   end subroutine node_lists
 
    !> macro(e): the representative of slave root e's contact macro cell, the
    !> first root of the contact (in leaf order) with the same ancestor `shift`
@@ -540,13 +766,14 @@ contains
    !> as the master cells of the root's points (module notes). A macro cell
    !> whose surface turns too far (`turns_too_far`) goes one level down for
    !> all its roots, to the roots themselves at the least.
-   subroutine macro_cells(surface, slave, master, macro)
+   subroutine macro_cells(surface, slave, master, macro, shift)
       type(contact_surface_type), intent(in) :: surface
       type(elasticity_problem_type), intent(in) :: slave, master
       integer, intent(out) :: macro(:)
+      !> Of each root: the levels from it up to its macro cell.
+      integer, intent(out) :: shift(:)
       integer, allocatable :: roots(:)
       logical :: used(size(macro)), wide(size(macro))
-      integer :: shift(size(macro))
       integer :: i, e, r
 
       used = .false.
@@ -662,6 +889,7 @@ contains
       real(wp), allocatable :: g(:, :)
       integer :: j, i, q, q0, q1, np, d, stat
       real(wp) :: nrm(surface%dim), rt(surface%dim, surface%dim), npt(surface%dim, ops%cell_ptr(c + 1) - ops%cell_ptr(c))
+      real(wp) :: wi
 
       d = surface%dim
       np = ops%cell_ptr(c + 1) - ops%cell_ptr(c)
@@ -682,7 +910,7 @@ contains
          & 8, error)
       if (allocated(error)) return
       associate (pts => ops%cell_point(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1))
-         cell%w = surface%weight(pts)
+         cell%w = surface%weight(pts)*ops%cell_phi(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1)
          do j = 1, np
             npt(:, j) = contact_normal(surface, pts(j), friction)
          end do
@@ -695,6 +923,7 @@ contains
       cell%tdev = 0.0_wp
       do j = 1, np
          i = ops%cell_point(ops%cell_ptr(c) + j - 1)
+         wi = cell%w(j)
          q0 = ops%ptr(i)
          q1 = ops%ptr(i + 1) - 1
          nrm = surface%normal(:, i)
@@ -705,15 +934,15 @@ contains
             rt = transpose(cell%rot(:, :, j))
             g(:, pos) = matmul(rt, ops%gop(:, q0:q1))
             cell%tdev(:, pos, j) = matmul(rt, ops%top(:, q0:q1))
-            cell%g0bar = cell%g0bar + surface%weight(i)*surface%g0(i)*dot_product(nrm, surface%master_normal(:, i))* &
+            cell%g0bar = cell%g0bar + wi*surface%g0(i)*dot_product(nrm, surface%master_normal(:, i))* &
                & matmul(rt, surface%master_normal(:, i))
          else
             g(1, pos) = matmul(nrm, ops%gop(:, q0:q1))
             cell%tdev(1, pos, j) = matmul(nrm, ops%top(:, q0:q1))
-            cell%g0bar = cell%g0bar + surface%weight(i)*surface%g0(i)
+            cell%g0bar = cell%g0bar + wi*surface%g0(i)
          end if
-         cell%gbar = cell%gbar + surface%weight(i)*g
-         cell%tbar = cell%tbar + surface%weight(i)*cell%tdev(:, :, j)
+         cell%gbar = cell%gbar + wi*g
+         cell%tbar = cell%tbar + wi*cell%tdev(:, :, j)
       end do
       cell%measure = sum(cell%w)
       cell%gbar = cell%gbar/cell%measure
@@ -1175,25 +1404,32 @@ contains
       real(wp), intent(in) :: mu, tau(:, :), slip(:, :), x(:)
       integer, intent(in) :: state(:)
       type(contact_solution_type), intent(inout) :: sol
-      real(wp) :: lam_n, lam_t(size(slip, 1))
+      real(wp) :: lam_n, lam_t(size(slip, 1)), largest(size(sol%pressure))
       integer :: c, i, j
 
+      largest = 0.0_wp
       do c = 1, size(cells)
          call cell_multiplier(ops, cells, c, slip(:, c), x, lam_n, lam_t)
          sol%lambda_n(c) = lam_n
          do j = ops%cell_ptr(c), ops%cell_ptr(c + 1) - 1
             i = ops%cell_point(j)
-            sol%closed(i) = state(c) /= contact_open
-            sol%slipping(i) = state(c) == contact_slip
-            sol%pressure(i) = 0.0_wp
-            sol%tangential(i) = 0.0_wp
-            if (state(c) == contact_open) cycle
-            sol%pressure(i) = -lam_n
-            if (state(c) == contact_slip) lam_t = -mu*lam_n*tau(:, c)
-            sol%traction_t(:, i) = matmul(cells(c)%rot(:, :, j - ops%cell_ptr(c) + 1), lam_t)
-            sol%tangential(i) = norm2(lam_t)
+            ! A point's state is that of its largest basis function's cell.
+            if (ops%cell_phi(j) > largest(i)) then
+               largest(i) = ops%cell_phi(j)
+               sol%closed(i) = state(c) /= contact_open
+               sol%slipping(i) = state(c) == contact_slip
+            end if
+         end do
+         if (state(c) == contact_open) cycle
+         if (state(c) == contact_slip) lam_t = -mu*lam_n*tau(:, c)
+         do j = ops%cell_ptr(c), ops%cell_ptr(c + 1) - 1
+            i = ops%cell_point(j)
+            sol%pressure(i) = sol%pressure(i) - ops%cell_phi(j)*lam_n
+            sol%traction_t(:, i) = sol%traction_t(:, i) + &
+               & ops%cell_phi(j)*matmul(cells(c)%rot(:, :, j - ops%cell_ptr(c) + 1), lam_t)
          end do
       end do
+      sol%tangential = norm2(sol%traction_t, dim=1)
    end subroutine coulomb_output
 
    !> Solve the unsymmetric block system with UMFPACK.
@@ -1442,11 +1678,12 @@ contains
       type(error_type), allocatable, intent(out) :: error
       !> The cells' mean stabilization tractions (recovered stabilization).
       real(wp), intent(in), optional :: pstar(:, :)
-      real(wp) :: lam(surface%dim), lami(surface%dim), nrm(surface%dim)
+      real(wp) :: lam(surface%dim), lami(surface%dim), nrm(surface%dim), phi, largest(surface%npoint)
       integer :: i, c, j
 
       call point_gaps(surface, ops, size(cells), x, sol, error)
       if (allocated(error)) return
+      largest = 0.0_wp
       do c = 1, size(cells)
          associate (cell => cells(c), pts => ops%cell_point(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1))
             lam = 0.0_wp
@@ -1460,22 +1697,29 @@ contains
             else
                sol%lambda_n(c) = dot_product(lam, cell%nbar)
             end if
-            if (.not. closed(c)) cycle
             do j = 1, size(pts)
                i = pts(j)
+               phi = ops%cell_phi(ops%cell_ptr(c) + j - 1)
+               ! A point's state is that of its largest basis function's cell.
+               if (phi > largest(pts(j))) then
+                  largest(i) = phi
+                  sol%closed(i) = closed(c)
+               end if
+               if (.not. closed(c)) cycle
                nrm = surface%normal(:, i)
-               sol%closed(i) = .true.
                if (cell%rows == 1) then
-                  sol%pressure(i) = -lam(1)
+                  sol%pressure(i) = sol%pressure(i) - phi*lam(1)
                else
-                  lami = matmul(cell%rot(:, :, j), lam)
-                  sol%pressure(i) = -dot_product(lami, nrm)
-                  sol%traction_t(:, i) = lami - dot_product(lami, nrm)*nrm
-                  sol%tangential(i) = norm2(sol%traction_t(:, i))
+                  lami = phi*matmul(cell%rot(:, :, j), lam)
+                  sol%pressure(i) = sol%pressure(i) - dot_product(lami, nrm)
+                  sol%traction_t(:, i) = sol%traction_t(:, i) + lami - dot_product(lami, nrm)*nrm
                end if
             end do
          end associate
       end do
+      if (size(cells) > 0) then
+         if (cells(1)%rows > 1) sol%tangential = norm2(sol%traction_t, dim=1)
+      end if
    end subroutine evaluate
 
    !> The recovered stabilization traction must be finite, one vector per
@@ -1525,9 +1769,10 @@ contains
          do j = ops%cell_ptr(c), ops%cell_ptr(c + 1) - 1
             i = ops%cell_point(j)
             if (cells(c)%rows == 1) then
-               pstar(1, c) = pstar(1, c) + surface%weight(i)*dot_product(surface%normal(:, i), recovered(:, i))
+               pstar(1, c) = pstar(1, c) + surface%weight(i)*ops%cell_phi(j)* &
+                  & dot_product(surface%normal(:, i), recovered(:, i))
             else
-               pstar(:, c) = pstar(:, c) + surface%weight(i)* &
+               pstar(:, c) = pstar(:, c) + surface%weight(i)*ops%cell_phi(j)* &
                   & matmul(transpose(cells(c)%rot(:, :, j - ops%cell_ptr(c) + 1)), recovered(:, i))
             end if
          end do
@@ -1654,7 +1899,7 @@ contains
       associate (slave => bodies(pair%slave)%problem, master => bodies(pair%master)%problem)
          call check_pair(slave, master, pair%surface, pair%friction, pair%kappa, error)
          if (.not. allocated(error)) call point_operators(slave, master, pair%surface, pair%kappa, work%ops, error, &
-            & [offset(pair%slave), offset(pair%master)])
+            & [offset(pair%slave), offset(pair%master)], pair%multiplier)
          if (allocated(error)) return
          allocate (work%cells(work%ops%ncell), work%closed(work%ops%ncell), stat=stat)
          call check_allocation(stat, 'contact solve', 'the contact cells', work%ops%ncell, 2, error)

@@ -12,7 +12,7 @@ module sprc_io_scene
    use sprc_study_spec, only: scene_type, body_spec_type, shape_spec_type, bc_spec_type, exact_spec_type, &
       & contact_spec_type, recovery_degree, default_stabilization, contact_unsupported, default_max_level, &
       & contact_components, projected_poisson, solver_names, auto_iterative_min_dofs, auto_never, default_gamma, &
-      & gamma_note, grid_max_level
+      & gamma_note, grid_max_level, default_multiplier
    use sprc_io_scene_facets, only: load_facets, facet_kind, facet_summary, group_surface
    use sprc_io_namelist, only: nml_group_type, parse_namelist, read_text_file, nml_get, nml_get_array, &
       & nml_has, nml_check_consumed, nml_field_error, nml_group_error, nml_item_text
@@ -36,7 +36,7 @@ module sprc_io_scene
       & 'inner outer interference point normal load direction angle mode1 mode2 radii bodies'
    character(len=*), parameter :: exact_keys = 'kind '//exact_fields
    character(len=*), parameter :: contact_keys = 'slave master slave_surface master_surface friction mu kappa '// &
-      & 'steps stabilization'
+      & 'steps stabilization multiplier'
 
    character(len=*), parameter :: adapt_keys = 'target max_steps max_dofs strategy fraction max_level'
    character(len=*), parameter :: strategies = 'optimal fraction'
@@ -53,6 +53,7 @@ module sprc_io_scene
       & 'compound_sphere layered_cylinder layered_sphere hertz_cylinder hertz_sphere corner'
    character(len=*), parameter :: frictions = 'frictionless coulomb stick'
    character(len=*), parameter :: stabilizations = 'fe recovered'
+   character(len=*), parameter :: multipliers = 'constant linear'
 
    !> Deepest uniform level accepted, 2D and 3D: 4^14 and 8^9 cells are already
    !> far beyond what a direct solver handles.
@@ -1056,6 +1057,9 @@ contains
             c%stabilization = default_stabilization
             call get_choice(g, 'stabilization', stabilizations, .false., c%stabilization, error)
             if (allocated(error)) return
+            c%multiplier = default_multiplier
+            call get_choice(g, 'multiplier', multipliers, .false., c%multiplier, error)
+            if (allocated(error)) return
             call nml_check_consumed(g, error)
             if (.not. allocated(error)) call check_pair_unique(g, scene%contacts(1:n), error)
             if (allocated(error)) return
@@ -1767,7 +1771,7 @@ contains
       if (c%friction == 'coulomb') text = text//', mu = '//real_text(c%mu)
       text = text//', kappa = '//real_text(c%kappa)
       if (.not. c%has_kappa) text = text//' (default)'
-      text = text//', steps = '//itoa(c%steps)//', stabilization = '//c%stabilization
+      text = text//', steps = '//itoa(c%steps)//', stabilization = '//c%stabilization//', multiplier = '//c%multiplier
    end function contact_line
 
    !> One line per component of the contact graph (the bodies solved together,

@@ -70,7 +70,7 @@ module sprc_study_level
    use sprc_contact_surface, only: contact_surface_type, slave_surface_points, initial_gaps
    use sprc_contact_pair_solve, only: contact_solution_type, solve_contact_pair, friction_kind, friction_coulomb, &
       & friction_frictionless, contact_progress, default_max_iterations, contact_factor_type, contact_body_type, &
-      & contact_pair_type, solve_contact_assembly
+      & contact_pair_type, solve_contact_assembly, multiplier_kind
    use sprc_fem_element, only: traction_matrix
    use sprc_core_text, only: itoa, real_text
    implicit none
@@ -571,12 +571,13 @@ contains
          names(2) = spec%master
          if (friction_kind(spec%friction) == friction_coulomb) then
             call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, friction_coulomb, spec%kappa, &
-               & names, sol, error, mu=spec%mu, loads=loads, progress=progress)
+               & names, sol, error, mu=spec%mu, loads=loads, progress=progress, &
+               & multiplier=multiplier_kind(spec%multiplier))
          else if (spec%stabilization == 'recovered') then
             call stabilize_recovered(study, spec, surface, names, bodies, sol, tstar, error)
          else
             call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, friction_kind(spec%friction), &
-               & spec%kappa, names, sol, error, progress=progress)
+               & spec%kappa, names, sol, error, progress=progress, multiplier=multiplier_kind(spec%multiplier))
          end if
       end block
       if (allocated(error)) return
@@ -666,6 +667,7 @@ contains
             pairs(p)%master = findloc(members, spec%master_index, 1)
             pairs(p)%friction = friction_kind(spec%friction)
             pairs(p)%kappa = spec%kappa
+            pairs(p)%multiplier = multiplier_kind(spec%multiplier)
             call pair_surface(study, spec, bodies, pairs(p)%surface, error)
          end associate
          if (allocated(error)) return
@@ -808,7 +810,7 @@ contains
          & 8*surface%dim, error)
       if (allocated(error)) return
       call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, friction_kind(spec%friction), &
-         & spec%kappa, names, sol, error, recovered=pstar, factor=factor)
+         & spec%kappa, names, sol, error, recovered=pstar, factor=factor, multiplier=multiplier_kind(spec%multiplier))
       if (allocated(error)) return
       iterations = sol%iterations
       t_solve = sol%t_solve
@@ -820,7 +822,8 @@ contains
          call timer%stop()
          t_contact = t_contact + timer%elapsed
          if (.not. allocated(error)) call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, &
-            & friction_kind(spec%friction), spec%kappa, names, next, error, recovered=pstar, factor=factor)
+            & friction_kind(spec%friction), spec%kappa, names, next, error, recovered=pstar, factor=factor, &
+            & multiplier=multiplier_kind(spec%multiplier))
          if (allocated(error)) return
          iterations = iterations + next%iterations
          t_solve = t_solve + next%t_solve

@@ -20,7 +20,7 @@ module sprc_study_spec
    public :: scene_type, body_spec_type, shape_spec_type, bc_spec_type, exact_spec_type, contact_spec_type
    public :: adapt_spec_type, default_max_level
    public :: recovery_degree, contact_unsupported, contact_components
-   public :: default_kappa, default_stabilization, kappa_range, kappa_note
+   public :: default_kappa, default_stabilization, kappa_range, kappa_note, default_multiplier
    public :: projected_poisson, solver_names, auto_iterative_min_dofs, auto_never, default_gamma, gamma_note
    public :: grid_max_level
 
@@ -45,6 +45,8 @@ module sprc_study_spec
    !> the recovered variant gives the same results to 4 digits at 1.0-1.15x
    !> the time (README "Contact", figures in the commit that chose it).
    character(len=*), parameter :: default_stabilization = 'fe'
+   !> Default of `&contact multiplier` (doc/scene.md).
+   character(len=*), parameter :: default_multiplier = 'constant'
 
    !> One elastic body.
    type :: body_spec_type
@@ -188,6 +190,8 @@ module sprc_study_spec
       integer :: steps = 1
       !> Source of the stabilization stress: 'fe' | 'recovered'.
       character(len=:), allocatable :: stabilization
+      !> The multiplier space: 'constant' | 'linear' (`default_multiplier`).
+      character(len=:), allocatable :: multiplier
    end type contact_spec_type
 
    !> Default of `&adapt max_level`, 2D and 3D: the deepest cell an adaptive
