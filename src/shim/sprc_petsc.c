@@ -161,6 +161,7 @@ extern PetscErrorCode PCMGSetInterpolation(PC, PetscInt, Mat);
 extern PetscErrorCode PCMGGetSmoother(PC, PetscInt, KSP *);
 extern PetscErrorCode KSPChebyshevSetEigenvalues(KSP, PetscReal, PetscReal);
 extern PetscErrorCode KSPChebyshevEstEigSet(KSP, PetscReal, PetscReal, PetscReal, PetscReal);
+extern PetscErrorCode PCRedundantGetKSP(PC, KSP *);
 extern PetscErrorCode PCMGGetCoarseSolve(PC, KSP *);
 extern PetscErrorCode PCFactorSetMatSolverType(PC, MatSolverType);
 
@@ -180,7 +181,7 @@ extern PetscErrorCode PCFactorSetMatSolverType(PC, MatSolverType);
     X(VecScatterBegin) X(VecScatterEnd) X(VecScatterDestroy) X(MPI_Comm_rank) X(MPI_Comm_size) X(PetscFinalize)   \
     X(MPI_Allreduce) X(MatSeqAIJSetPreallocationCSR) X(PCMGSetLevels) X(PCMGSetGalerkin) X(PCMGSetInterpolation)   \
     X(PCMGGetSmoother) X(KSPChebyshevSetEigenvalues) X(PCMGGetCoarseSolve) X(PCFactorSetMatSolverType)       \
-    X(KSPChebyshevEstEigSet)
+    X(KSPChebyshevEstEigSet) X(PCRedundantGetKSP)
 
 /* One pointer per function, set by load_petsc; from here on every call of
  * such a function goes through its pointer. */
@@ -247,6 +248,7 @@ static void *p_mpi_int, *p_op_min; /* Open MPI's MPI_INT and MPI_MIN */
 #define PCMGGetSmoother (*p_PCMGGetSmoother)
 #define KSPChebyshevSetEigenvalues (*p_KSPChebyshevSetEigenvalues)
 #define KSPChebyshevEstEigSet (*p_KSPChebyshevEstEigSet)
+#define PCRedundantGetKSP (*p_PCRedundantGetKSP)
 #define PCMGGetCoarseSolve (*p_PCMGGetCoarseSolve)
 #define PCFactorSetMatSolverType (*p_PCFactorSetMatSolverType)
 #undef PETSC_COMM_SELF
@@ -582,11 +584,19 @@ static int build_multigrid(PC pc, PetscInt n, PetscInt dim, const sprc_petsc_lev
         /* The coarsest level by MUMPS's LU (PETSc's own by default): with the
          * contact nodes kept on every level (sprc_fem_multigrid) it holds the
          * whole contact surface, a 2D-like graph whose factor MUMPS builds
-         * faster than PETSc's own LU. */
+         * faster than PETSc's own LU. On several ranks every rank factors
+         * the whole coarse matrix by MUMPS on its own (PCREDUNDANT): MUMPS
+         * across ranks schedules its work by the ranks' load as it goes, so
+         * its factor, and the solution, changed bits from run to run. */
         KSP coarse;
         PC lu;
         TRY(PCMGGetCoarseSolve(pc, &coarse));
         TRY(KSPGetPC(coarse, &lu));
+        if (distributed) {
+            TRY(PCSetType(lu, "redundant"));
+            TRY(PCRedundantGetKSP(lu, &coarse));
+            TRY(KSPGetPC(coarse, &lu));
+        }
         TRY(PCSetType(lu, "lu"));
         TRY(PCFactorSetMatSolverType(lu, "mumps"));
     }
