@@ -47,6 +47,11 @@
 !>   only by the contact has no usable hierarchy of its own). Each iteration
 !>   starts from the previous solution; the stopping test is the single body's
 !>   energy bound tightened for pointwise values (`contact_tolerance`).
+!> - Ranks (mpirun, `share`): each rank holds its rows of the block system
+!>   only (the bodies assembled so by sprc_study_partition's
+!>   `assemble_pair_rows`); the contact cells' terms are computed by every
+!>   rank, the solve is distributed (the hierarchy's prolongations too) and
+!>   its solution gathered, so gaps and active sets are the same on all.
 !>
 !> Assemblies (`solve_contact_assembly`): several bodies and the pairs between
 !> them, one block system with every body's reduced system on the diagonal

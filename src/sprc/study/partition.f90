@@ -25,8 +25,10 @@
 !>   A forced direct solve is refused: the direct solvers need the whole K.
 !> - Recovery, estimate and exact error: `sprc_grid_share` (patches and
 !>   elements in contiguous ranges, the records and element terms gathered;
-!>   partition_type is the share whose gather is MPI's). A scene with
-!>   `&contact` keeps them (and its assembly) on the whole level on every rank.
+!>   partition_type is the share whose gather is MPI's), for contact scenes too.
+!> - Contact pairs (frictionless or stick, iterative): each rank assembles its
+!>   rows of the pair's block system (`assemble_pair_rows`), the slave's
+!>   unknowns then the master's, split by whole masters as the solve splits them.
 !>
 !> What is not partitioned: every rank holds the whole grid, points and the
 !> gathered solution and recovered fields (doc/distributed.md). A serial run (one rank) takes none of these
