@@ -386,6 +386,8 @@ contains
             return
          end if
       end do
+      ! PETSc's copy of the block system, its hierarchy and coarse factor: not the recovery's to carry
+      call own%krylov%destroy()
       call slave%set_solution(x(1:slave%n_dofs()), error)
       if (.not. allocated(error)) call master%set_solution(x(slave%n_dofs() + 1:), error)
    end subroutine solve_contact_pair
