@@ -160,6 +160,8 @@ extern PetscErrorCode PCMGSetGalerkin(PC, PCMGGalerkinType);
 extern PetscErrorCode PCMGSetInterpolation(PC, PetscInt, Mat);
 extern PetscErrorCode PCMGGetSmoother(PC, PetscInt, KSP *);
 extern PetscErrorCode KSPChebyshevSetEigenvalues(KSP, PetscReal, PetscReal);
+extern PetscErrorCode KSPChebyshevEstEigSet(KSP, PetscReal, PetscReal, PetscReal, PetscReal);
+extern PetscErrorCode PCRedundantGetKSP(PC, KSP *);
 extern PetscErrorCode PCMGGetCoarseSolve(PC, KSP *);
 extern PetscErrorCode PCFactorSetMatSolverType(PC, MatSolverType);
 
@@ -178,7 +180,8 @@ extern PetscErrorCode PCFactorSetMatSolverType(PC, MatSolverType);
     X(KSPGetConvergedReasonString) X(MatMPIAIJSetPreallocationCSR) X(VecCreateMPI) X(VecScatterCreateToAll)   \
     X(VecScatterBegin) X(VecScatterEnd) X(VecScatterDestroy) X(MPI_Comm_rank) X(MPI_Comm_size) X(PetscFinalize)   \
     X(MPI_Allreduce) X(MatSeqAIJSetPreallocationCSR) X(PCMGSetLevels) X(PCMGSetGalerkin) X(PCMGSetInterpolation)   \
-    X(PCMGGetSmoother) X(KSPChebyshevSetEigenvalues) X(PCMGGetCoarseSolve) X(PCFactorSetMatSolverType)
+    X(PCMGGetSmoother) X(KSPChebyshevSetEigenvalues) X(PCMGGetCoarseSolve) X(PCFactorSetMatSolverType)       \
+    X(KSPChebyshevEstEigSet) X(PCRedundantGetKSP)
 
 /* One pointer per function, set by load_petsc; from here on every call of
  * such a function goes through its pointer. */
@@ -244,6 +247,8 @@ static void *p_mpi_int, *p_op_min; /* Open MPI's MPI_INT and MPI_MIN */
 #define PCMGSetInterpolation (*p_PCMGSetInterpolation)
 #define PCMGGetSmoother (*p_PCMGGetSmoother)
 #define KSPChebyshevSetEigenvalues (*p_KSPChebyshevSetEigenvalues)
+#define KSPChebyshevEstEigSet (*p_KSPChebyshevEstEigSet)
+#define PCRedundantGetKSP (*p_PCRedundantGetKSP)
 #define PCMGGetCoarseSolve (*p_PCMGGetCoarseSolve)
 #define PCFactorSetMatSolverType (*p_PCFactorSetMatSolverType)
 #undef PETSC_COMM_SELF
@@ -485,7 +490,11 @@ typedef struct {
  * the eigenvalues of B A lie in (0, 1]: the Chebyshev interval is [0.1, 1]
  * with no eigenvalue estimate (which would cost ten sweeps per level). Jacobi
  * in its place (GAMG's default) needed 27 iterations on the sphere octant at
- * 159k unknowns instead of 9. PETSC_OPTIONS (-mg_levels_...) still applies. */
+ * 159k unknowns instead of 9. On several ranks PETSc's SOR sweeps each rank's
+ * rows alone (a block Jacobi of Gauss-Seidel sweeps), whose B^-1 no longer
+ * bounds A: there the interval comes from PETSc's estimate of the largest
+ * eigenvalue (0.1 and 1.1 times it). PETSC_OPTIONS (-mg_levels_...) still
+ * applies. */
 static int set_smoothers(PC pc, PetscInt levels, char *msg, int64_t len)
 {
     PetscInt l;
@@ -494,16 +503,52 @@ static int set_smoothers(PC pc, PetscInt levels, char *msg, int64_t len)
         PC sweep;
         TRY(PCMGGetSmoother(pc, l, &smoother));
         TRY(KSPSetType(smoother, "chebyshev"));
-        TRY(KSPChebyshevSetEigenvalues(smoother, 1.0, 0.1));
+        if (distributed)
+            TRY(KSPChebyshevEstEigSet(smoother, 0.0, 0.1, 0.0, 1.1));
+        else
+            TRY(KSPChebyshevSetEigenvalues(smoother, 1.0, 0.1));
         TRY(KSPGetPC(smoother, &sweep));
         TRY(PCSetType(sweep, "sor"));
     }
     return SPRC_OK;
 }
 
+void sprc_petsc_own_blocks(int64_t blocks, int64_t *first, int64_t *last);
+
+/* A prolongation of a distributed solve (every rank is given all its rows:
+ * 0-based CSR, `rows` + 1 row starts from 0, columns global): this rank's
+ * rows are those of its fine blocks, its columns those of its coarse blocks
+ * (sprc_petsc_own_blocks on each level's blocks, as the finest level's rows
+ * of the matrix), as MATMPIAIJ (PETSc copies them). */
+static int distributed_prolongation(PetscInt rows, PetscInt cols, PetscInt dim, const PetscInt *rowptr,
+                                    const PetscInt *col, const double *val, Mat *p, char *msg, int64_t len)
+{
+    int64_t first, last, cfirst, clast;
+    PetscInt *local, lo, n, i;
+    PetscErrorCode ierr;
+
+    sprc_petsc_own_blocks(rows / dim, &first, &last);
+    sprc_petsc_own_blocks(cols / dim, &cfirst, &clast);
+    lo = (PetscInt)(first * dim);
+    n = (PetscInt)((last - first) * dim);
+    local = malloc(((size_t)n + 1) * sizeof(*local));
+    if (local == NULL) return report(SPRC_NO_MEMORY, msg, len, "PETSc setup: cannot allocate a prolongation's rows");
+    for (i = 0; i <= n; ++i) local[i] = rowptr[lo + i] - rowptr[lo];
+    ierr = MatCreate(SPRC_COMM_WORLD, p);
+    if (!ierr) ierr = MatSetSizes(*p, n, (PetscInt)((clast - cfirst) * dim), rows, cols);
+    if (!ierr) ierr = MatSetBlockSize(*p, dim);
+    if (!ierr) ierr = MatSetType(*p, "mpiaij");
+    if (!ierr) ierr = MatMPIAIJSetPreallocationCSR(*p, local, col + rowptr[lo], val + rowptr[lo]);
+    free(local);
+    if (ierr) return petsc_failure(ierr, "MatMPIAIJSetPreallocationCSR (prolongation)", msg, len);
+    return SPRC_OK;
+}
+
 /* PCMG on the hierarchy `mg` with Galerkin coarse matrices P^T A P (PETSc
  * copies the prolongations). PCMG numbers its levels from the coarsest (0)
- * to the finest (levels - 1). */
+ * to the finest (levels - 1). On several ranks the prolongations are
+ * distributed (`distributed_prolongation`), the Galerkin products and
+ * MUMPS's coarse factor too. */
 static int build_multigrid(PC pc, PetscInt n, PetscInt dim, const sprc_petsc_levels *mg, char *msg, int64_t len)
 {
     PetscInt levels = mg->n_levels + 1, rows = n, k;
@@ -518,11 +563,16 @@ static int build_multigrid(PC pc, PetscInt n, PetscInt dim, const sprc_petsc_lev
         if (cols < 1 || cols > rows || cols % dim != 0 || nnz < rows)
             return report(SPRC_INVALID, msg, len, "PETSc setup: multigrid level %d maps %d unknowns to %d (%d entries)",
                           (int)k, (int)cols, (int)rows, (int)nnz);
-        TRY(MatCreate(PETSC_COMM_SELF, &p));
-        TRY(MatSetSizes(p, rows, cols, rows, cols));
-        TRY(MatSetBlockSize(p, dim));
-        TRY(MatSetType(p, "seqaij"));
-        TRY(MatSeqAIJSetPreallocationCSR(p, rowptr, col, val));
+        if (distributed) {
+            int status = distributed_prolongation(rows, cols, dim, rowptr, col, val, &p, msg, len);
+            if (status != SPRC_OK) return status;
+        } else {
+            TRY(MatCreate(PETSC_COMM_SELF, &p));
+            TRY(MatSetSizes(p, rows, cols, rows, cols));
+            TRY(MatSetBlockSize(p, dim));
+            TRY(MatSetType(p, "seqaij"));
+            TRY(MatSeqAIJSetPreallocationCSR(p, rowptr, col, val));
+        }
         TRY(PCMGSetInterpolation(pc, levels - 1 - k, p));
         TRY(MatDestroy(&p));
         rowptr += rows + 1;
@@ -534,19 +584,27 @@ static int build_multigrid(PC pc, PetscInt n, PetscInt dim, const sprc_petsc_lev
         /* The coarsest level by MUMPS's LU (PETSc's own by default): with the
          * contact nodes kept on every level (sprc_fem_multigrid) it holds the
          * whole contact surface, a 2D-like graph whose factor MUMPS builds
-         * faster than PETSc's own LU. */
+         * faster than PETSc's own LU. On several ranks every rank factors
+         * the whole coarse matrix by MUMPS on its own (PCREDUNDANT): MUMPS
+         * across ranks schedules its work by the ranks' load as it goes, so
+         * its factor, and the solution, changed bits from run to run. */
         KSP coarse;
         PC lu;
         TRY(PCMGGetCoarseSolve(pc, &coarse));
         TRY(KSPGetPC(coarse, &lu));
+        if (distributed) {
+            TRY(PCSetType(lu, "redundant"));
+            TRY(PCRedundantGetKSP(lu, &coarse));
+            TRY(KSPGetPC(coarse, &lu));
+        }
         TRY(PCSetType(lu, "lu"));
         TRY(PCFactorSetMatSolverType(lu, "mumps"));
     }
     return set_smoothers(pc, levels, msg, len);
 }
 
-/* CG (symmetric) or GMRES with geometric multigrid on the hierarchy `mg`
- * (one rank), or GAMG (no hierarchy, or several ranks); the hierarchy's
+/* CG (symmetric) or GMRES with geometric multigrid on the hierarchy `mg`,
+ * or GAMG (no hierarchy); the hierarchy's
  * coarse matrices are built here (KSPSetUp). PETSc options given in
  * PETSC_OPTIONS are applied (-ksp_view and the like, for experiments). */
 static int build_solver(sprc_petsc *s, PetscInt n, PetscInt dim, const sprc_petsc_levels *mg, char *msg, int64_t len)
@@ -556,7 +614,7 @@ static int build_solver(sprc_petsc *s, PetscInt n, PetscInt dim, const sprc_pets
     TRY(KSPSetOperators(s->ksp, s->a, s->a));
     TRY(KSPSetType(s->ksp, s->symmetric ? "cg" : "gmres"));
     TRY(KSPGetPC(s->ksp, &pc));
-    if (mg != NULL && mg->n_levels > 0 && !distributed) {
+    if (mg != NULL && mg->n_levels > 0) {
         int status = build_multigrid(pc, n, dim, mg, msg, len);
         if (status != SPRC_OK) return status;
         s->pc_name = "geometric multigrid";

@@ -28,11 +28,10 @@
 !>   moves to the load (SPD for every gamma > 0); frictionless and stick only; with
 !>   a `contact_factor_type` the factor is reused while the active set repeats.
 !> - Iterative solves (`block_solver_type`, 'iterative' or 'auto' from
-!>   `auto_coupled_min_dofs`): PETSc CG (GMRES where slipping cells make the system
-!>   unsymmetric or CG meets an indefinite one), preconditioned by both bodies'
-!>   multigrid hierarchies stacked block-diagonally (`stack_hierarchies`, contact
-!>   nodes kept on every level: a body held only by the contact has no usable
-!>   hierarchy of its own); stopping test `contact_tolerance`.
+!>   `auto_coupled_min_dofs`): CG (GMRES if unsymmetric or indefinite), both bodies'
+!>   multigrids stacked (`stack_hierarchies`, contact nodes kept, Galerkin coarse
+!>   operators of each new fine matrix), warm starts, `contact_tolerance`; under
+!>   mpirun (`share`) each rank holds its rows and the solution is gathered.
 !>
 !> Assemblies (`solve_contact_assembly`): several bodies and their pairs in one block
 !> system (bodies' reduced systems on the diagonal in body order, every pair's cells
@@ -58,11 +57,12 @@ module sprc_contact_pair_solve
    use sprc_contact_surface, only: contact_surface_type
    use sprc_grid_tree, only: grid_max_level
    use sprc_contact_result, only: contact_open, contact_stick, contact_slip
+   use sprc_grid_share, only: share_type
    implicit none
    private
 
    public :: contact_solution_type, solve_contact_pair, friction_kind, contact_progress, contact_factor_type
-   public :: contact_body_type, contact_pair_type, solve_contact_assembly
+   public :: contact_body_type, contact_pair_type, solve_contact_assembly, pair_iterative
    public :: friction_frictionless, friction_stick, friction_coulomb, default_max_iterations
    public :: multiplier_constant, multiplier_linear, multiplier_kind
 
@@ -239,7 +239,7 @@ contains
    !> both problems hold their solution (`set_solution`). `names` are the slave
    !> and master body names for messages.
    subroutine solve_contact_pair(slave, master, surface, friction, kappa, names, sol, error, max_iterations, mu, &
-         & loads, progress, recovered, factor, multiplier)
+         & loads, progress, recovered, factor, multiplier, share, bounds)
       type(elasticity_problem_type), intent(inout) :: slave, master
       type(contact_surface_type), intent(in) :: surface
       integer, intent(in) :: friction
@@ -263,6 +263,13 @@ contains
       type(contact_factor_type), intent(inout), optional, target :: factor
       !> The multiplier space (`multiplier_constant`, the default, or `multiplier_linear`).
       integer, intent(in), optional :: multiplier
+      !> With several ranks (`sprc_study_partition`'s `assemble_pair_rows`):
+      !> both problems hold only this rank's rows of the block system, rows
+      !> bounds(r + 1) .. bounds(r + 2) - 1 on rank r of `share`; the solve
+      !> must be iterative (distributed), and the rigid-mode check gathers
+      !> its rows (`free_motions`). Frictionless and stick only.
+      class(share_type), intent(in), optional :: share
+      integer(i8), intent(in), optional :: bounds(:)
       type(point_operators_type) :: ops
       type(cell_operators_type), allocatable :: cells(:)
       type(csr_type) :: k
@@ -313,6 +320,11 @@ contains
       call check_allocation(stat, 'contact solve', 'the solution of both bodies', n, 8, error)
       if (.not. allocated(error)) call block_solver_setup(slave, master, ops, bs, error)
       if (allocated(error)) return
+      if (present(share) .and. (friction == friction_coulomb .or. .not. bs%iterative)) then
+         call fatal_error(error, 'contact solve: a block system whose rows are shared out among ranks needs the '// &
+            & 'iterative solver and frictionless or stick contact', stat_invalid_input)
+         return
+      end if
       if (friction == friction_coulomb) then
          if (.not. present(mu)) then
             call fatal_error(error, 'contact solve: Coulomb friction needs mu', stat_invalid_input)
@@ -335,14 +347,15 @@ contains
          call timer%reset()
          call timer%start()
          if (kept) then
-            call factored_solve(slave, master, ops, cells, closed, pstar, names, it, factor, x, sol, error)
+            call factored_solve(slave, master, ops, cells, closed, pstar, names, it, factor, x, sol, error, share, &
+               & bounds)
          else if (present(recovered)) then
             call block_system(slave, master, ops, cells, closed, k, f, error, pstar)
          else
             call block_system(slave, master, ops, cells, closed, k, f, error)
          end if
          if (.not. (allocated(error) .or. kept)) &
-            & call check_held(slave, master, k, names, closed_points(ops, closed), it, error)
+            & call check_held(slave, master, k, names, closed_points(ops, closed), it, error, share, bounds)
          if (.not. (allocated(error) .or. kept)) call solve_block(bs, k, f, x, sol, error)
          call timer%stop()
          sol%t_solve = sol%t_solve + timer%elapsed
@@ -372,6 +385,8 @@ contains
             return
          end if
       end do
+      ! PETSc's copy of the block system, its hierarchy and coarse factor: not the recovery's to carry
+      call own%krylov%destroy()
       call slave%set_solution(x(1:slave%n_dofs()), error)
       if (.not. allocated(error)) call master%set_solution(x(slave%n_dofs() + 1:), error)
    end subroutine solve_contact_pair
@@ -1089,7 +1104,8 @@ contains
    !> and the factor solves it; else the block system is assembled, checked
    !> for free rigid modes and factorized (CHOLMOD: SPD for every gamma),
    !> replacing the factor.
-   subroutine factored_solve(slave, master, ops, cells, closed, pstar, names, it, factor, x, sol, error)
+   subroutine factored_solve(slave, master, ops, cells, closed, pstar, names, it, factor, x, sol, error, share, &
+         & bounds)
       type(elasticity_problem_type), intent(in) :: slave, master
       type(point_operators_type), intent(in) :: ops
       type(cell_operators_type), intent(in) :: cells(:)
@@ -1101,6 +1117,8 @@ contains
       real(wp), intent(inout) :: x(:)
       type(contact_solution_type), intent(inout) :: sol
       type(error_type), allocatable, intent(out) :: error
+      class(share_type), intent(in), optional :: share
+      integer(i8), intent(in), optional :: bounds(:)
       type(csr_type) :: k
       real(wp), allocatable :: f(:)
       logical :: same
@@ -1114,7 +1132,8 @@ contains
          call factor%chol%destroy()
          if (allocated(factor%closed)) deallocate (factor%closed)
          call block_system(slave, master, ops, cells, closed, k, f, error, pstar)
-         if (.not. allocated(error)) call check_held(slave, master, k, names, closed_points(ops, closed), it, error)
+         if (.not. allocated(error)) &
+            & call check_held(slave, master, k, names, closed_points(ops, closed), it, error, share, bounds)
          if (allocated(error)) return
          if (factor%bs%iterative) then
             call krylov_setup(factor%bs%krylov, k, .true., error)
@@ -1452,13 +1471,16 @@ contains
    end subroutine solve_unsymmetric
 
    !> Every rigid-body mode of both bodies must be resisted by the block
-   !> system; a free one is an error naming the body (module notes).
-   subroutine check_held(slave, master, k, names, nclosed, iteration, error)
+   !> system; a free one is an error naming the body (module notes). With
+   !> `share`, k holds this rank's rows of `bounds` (`solve_contact_pair`).
+   subroutine check_held(slave, master, k, names, nclosed, iteration, error, share, bounds)
       type(elasticity_problem_type), intent(in) :: slave, master
       type(csr_type), intent(in) :: k
       character(len=*), intent(in) :: names(2)
       integer, intent(in) :: nclosed, iteration
       type(error_type), allocatable, intent(out) :: error
+      class(share_type), intent(in), optional :: share
+      integer(i8), intent(in), optional :: bounds(:)
       real(wp), allocatable :: rs(:, :), rm(:, :), r(:, :), vec(:, :)
       logical :: involved(12)
       integer :: nfree, j, ns, ms, b, stat
@@ -1475,7 +1497,7 @@ contains
       if (allocated(error)) return
       r(1:size(rs, 1), 1:ns) = rs
       r(size(rs, 1) + 1:, ns + 1:) = rm
-      call free_motions(k, r, vec, nfree, error)
+      call free_motions(k, r, vec, nfree, error, share, bounds)
       if (allocated(error) .or. nfree == 0) return
       involved = .false.
       do j = 1, nfree
@@ -1523,13 +1545,11 @@ contains
       type(prolongation_type), allocatable :: ps(:), pm(:), p(:)
       integer, allocatable :: dof(:, :)
       logical, allocatable :: touched(:)
-      integer :: ns, choice
+      integer :: ns
       logical :: found_s, found_m
 
       if (bs%ready) return
-      choice = slave%solver
-      if (master%solver == solver_iterative) choice = solver_iterative
-      bs%iterative = use_iterative(choice, slave%dim, slave%degree, slave%n_dofs() + master%n_dofs(), coupled=.true.)
+      bs%iterative = pair_iterative(slave, master)
       bs%ready = .true.
       if (.not. bs%iterative) return
       call start_petsc(error)
@@ -1556,6 +1576,17 @@ contains
       bs%krylov%tolerance = contact_tolerance(0.5_wp**max(slave%mesh%grid%max_level, master%mesh%grid%max_level), &
          & slave%degree, slave%dim)
    end subroutine block_solver_setup
+
+   !> Whether the block system of the pair is solved iteratively (module
+   !> notes): the bodies' solver settings (iterative if either asks for it)
+   !> by `use_iterative`'s rule for coupled systems.
+   pure logical function pair_iterative(slave, master)
+      type(elasticity_problem_type), intent(in) :: slave, master
+      integer :: choice
+      choice = slave%solver
+      if (master%solver == solver_iterative) choice = solver_iterative
+      pair_iterative = use_iterative(choice, slave%dim, slave%degree, slave%n_dofs() + master%n_dofs(), coupled=.true.)
+   end function pair_iterative
 
    !> The Krylov stopping tolerance of the block system (a relative energy
    !> bound): the single body's `iteration_tolerance` 1e-7 (h/L)^p (h the

@@ -2,9 +2,10 @@
 !> gradients (GMRES when the system is not symmetric), through the C shim
 !> src/shim/sprc_petsc.c, preconditioned by geometric multigrid on the grid's
 !> node lattice (`set_lattice`, `sprc_fem_multigrid`: PCMG with Galerkin
-!> coarse matrices) or, without a lattice and on several MPI ranks (the
-!> hierarchy is built for one rank), by smoothed-aggregation algebraic
-!> multigrid (GAMG) with the rigid-body near-null space.
+!> coarse matrices) or on the caller's prolongations (`set_hierarchy`, also
+!> on several MPI ranks) or, without either and with a lattice on several
+!> ranks, by smoothed-aggregation algebraic multigrid (GAMG) with the
+!> rigid-body near-null space.
 !>
 !> Blocks. GAMG aggregates whole nodes (block size = dim) and interpolates the
 !> rigid-body modes exactly, so it needs each unknown's node and component.
@@ -288,7 +289,9 @@ contains
    !> `set_blocks`; `p(1)%n_fine` is the number of blocks), kept for every
    !> later `factorize`: the hierarchy of several bodies in one system
    !> (`stack_hierarchies`), built once and used for each of the systems
-   !> that differ in their coupling terms only. A distributed solve keeps GAMG.
+   !> that differ in their coupling terms only. A distributed solve takes it
+   !> too: each rank's rows of each prolongation (those of its blocks on both
+   !> levels, the shim's split) become PETSc's parallel matrices.
    subroutine set_hierarchy(self, p, error)
       class(petsc_solver_type), intent(inout) :: self
       type(prolongation_type), intent(in) :: p(:)
@@ -333,7 +336,9 @@ contains
       end if
       call padded_csr(self, a, self%rowptr, self%col, self%val, error)
       if (allocated(error)) return
-      if ((allocated(self%lattice) .or. allocated(self%hierarchy)) .and. solve_ranks == 1) then
+      ! A caller's hierarchy serves distributed solves too (its prolongations
+      ! distributed by the shim); a lattice's only one rank, GAMG on several.
+      if (allocated(self%hierarchy) .or. (allocated(self%lattice) .and. solve_ranks == 1)) then
          if (allocated(self%hierarchy)) then
             p = self%hierarchy
          else

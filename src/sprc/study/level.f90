@@ -61,7 +61,7 @@ module sprc_study_level
    use sprc_study_model, only: build_bodies, build_exact, body_conditions, analysis_kind, analysis_units_type, &
       & analysis_units, in_units
    use sprc_study_budget, only: check_level_memory, check_coupled_memory
-   use sprc_study_partition, only: partition_type, start_partition, integrate_level, solve_level
+   use sprc_study_partition, only: partition_type, start_partition, integrate_level, solve_level, assemble_pair_rows
    use sprc_grid_share, only: share_type
    use sprc_study_row, only: report_row_type
    use sprc_study_contact_row, only: fill_contact_exact, fill_contact_row
@@ -70,7 +70,7 @@ module sprc_study_level
    use sprc_contact_surface, only: contact_surface_type, slave_surface_points, initial_gaps
    use sprc_contact_pair_solve, only: contact_solution_type, solve_contact_pair, friction_kind, friction_coulomb, &
       & friction_frictionless, contact_progress, default_max_iterations, contact_factor_type, contact_body_type, &
-      & contact_pair_type, solve_contact_assembly, multiplier_kind
+      & contact_pair_type, solve_contact_assembly, multiplier_kind, pair_iterative
    use sprc_fem_element, only: traction_matrix
    use sprc_core_text, only: itoa, real_text
    implicit none
@@ -425,7 +425,8 @@ contains
       if (allocated(error)) return
       bl%problem%solver = solver
       if (in_contact) then
-         call bl%problem%assemble(error)
+         ! shared out among ranks, the pair assembles it (`assemble_shared_pair`)
+         if (.not. study%partition%shared()) call bl%problem%assemble(error)
          return
       end if
       if (present(start)) allocate (bl%problem%start, source=start)
@@ -464,14 +465,13 @@ contains
    end subroutine exact_error
 
    !> `part` (the study's partition) when the level's element work is shared
-   !> out among ranks, else null: an absent `share` (a body in contact keeps
-   !> the whole-level recovery on every rank, doc/distributed.md).
+   !> out among ranks, else null: an absent `share`.
    function level_share(study, part) result(share)
       type(study_type), intent(in) :: study
       type(partition_type), intent(in), target :: part
       class(share_type), pointer :: share
       share => null()
-      if (part%shared() .and. size(study%scene%contacts) == 0) share => part
+      if (part%shared()) share => part
    end function level_share
 
    !> The recoveries and estimates of a body from its recovery input; `contacts` are its
@@ -552,11 +552,19 @@ contains
       type(contact_surface_type) :: surface
       type(contact_solution_type) :: sol
       type(timer_type) :: timer
+      type(partition_type), target :: part
+      class(share_type), pointer :: share
       real(wp), allocatable :: loads(:, :), tstar(:, :)
+      integer(i8), allocatable :: bounds(:)
       integer :: s, m, b, k
 
       s = spec%slave_index
       m = spec%master_index
+      call assemble_shared_pair(study, spec, bodies, bounds, error)
+      if (allocated(error)) return
+      part = study%partition
+      share => null()
+      if (allocated(bounds)) share => part
       call timer%start()
       call pair_surface(study, spec, bodies, surface, error)
       call timer%stop()
@@ -577,10 +585,19 @@ contains
             call stabilize_recovered(study, spec, surface, names, bodies, sol, tstar, error)
          else
             call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, friction_kind(spec%friction), &
-               & spec%kappa, names, sol, error, progress=progress, multiplier=multiplier_kind(spec%multiplier))
+               & spec%kappa, names, sol, error, progress=progress, multiplier=multiplier_kind(spec%multiplier), &
+               & share=share, bounds=bounds)
          end if
       end block
       if (allocated(error)) return
+      ! Each rank's rows of K serve no one after the distributed solve: their room goes to the recovery.
+      if (allocated(bounds)) then
+         do b = 1, 2
+            k = merge(s, m, b == 1)
+            deallocate (bodies(k)%problem%k%rowptr, bodies(k)%problem%k%col, bodies(k)%problem%k%val, &
+               & bodies(k)%problem%f)
+         end do
+      end if
       bodies(s)%problem%t_solve = sol%t_solve
       bodies(m)%problem%t_solve = 0.0_wp
       ! Both bodies were solved in the block system: its solver and condition estimate.
@@ -602,6 +619,31 @@ contains
       if (allocated(error)) return
       t_contact = t_contact + timer%elapsed + sol%t_contact
    end subroutine run_contact
+
+   !> A pair's bodies assembled when the level is shared out among ranks
+   !> (`run_body` leaves them unassembled then): where the pair's solve is
+   !> distributed (frictionless or stick with the FE stabilization, through
+   !> the iterative solver) each rank assembles only its rows of the block
+   !> system (`assemble_pair_rows`, `bounds` its rows' split); otherwise both
+   !> bodies whole on every rank (`bounds` not allocated).
+   subroutine assemble_shared_pair(study, spec, bodies, bounds, error)
+      type(study_type), intent(in) :: study
+      type(contact_spec_type), intent(in) :: spec
+      type(body_level_type), intent(inout) :: bodies(:)
+      integer(i8), allocatable, intent(out) :: bounds(:)
+      type(error_type), allocatable, intent(out) :: error
+
+      if (.not. study%partition%shared()) return
+      associate (slave => bodies(spec%slave_index)%problem, master => bodies(spec%master_index)%problem)
+         if (friction_kind(spec%friction) /= friction_coulomb .and. spec%stabilization /= 'recovered' .and. &
+            & pair_iterative(slave, master)) then
+            call assemble_pair_rows(study%partition, slave, master, bounds, error)
+         else
+            call slave%assemble(error)
+            if (.not. allocated(error)) call master%assemble(error)
+         end if
+      end associate
+   end subroutine assemble_shared_pair
 
    !> A pair's slave points with their initial gaps to the master
    !> (sprc_contact_surface), the gaps in the pair's units.
@@ -657,6 +699,9 @@ contains
       call check_allocation(stat, 'contact assembly', 'its bodies and pairs', size(ks) + size(members), 64, error)
       if (allocated(error)) return
       do j = 1, size(members)
+         ! a level shared out among ranks leaves them unassembled (`run_body`); the assembly's solve is direct
+         if (study%partition%shared()) call bodies(members(j))%problem%assemble(error)
+         if (allocated(error)) return
          cb(j)%problem => bodies(members(j))%problem
          cb(j)%name = study%bodies(members(j))%name
       end do

@@ -25,8 +25,10 @@
 !>   A forced direct solve is refused: the direct solvers need the whole K.
 !> - Recovery, estimate and exact error: `sprc_grid_share` (patches and
 !>   elements in contiguous ranges, the records and element terms gathered;
-!>   partition_type is the share whose gather is MPI's). A scene with
-!>   `&contact` keeps them (and its assembly) on the whole level on every rank.
+!>   partition_type is the share whose gather is MPI's), for contact scenes too.
+!> - Contact pairs (frictionless or stick, iterative): each rank assembles its
+!>   rows of the pair's block system (`assemble_pair_rows`), the slave's
+!>   unknowns then the master's, split by whole masters as the solve splits them.
 !>
 !> What is not partitioned: every rank holds the whole grid, points and the
 !> gathered solution and recovered fields (doc/distributed.md). A serial run (one rank) takes none of these
@@ -50,7 +52,7 @@ module sprc_study_partition
    private
 
    public :: partition_type, start_partition, owned_rows, cut_cell_work
-   public :: integrate_level, solve_level, largest_over_ranks, fail_together
+   public :: integrate_level, solve_level, largest_over_ranks, fail_together, assemble_pair_rows
 
    !> This process's place among the ranks of a partitioned level (rank 0 of
    !> 1: serial).
@@ -222,6 +224,47 @@ contains
       ubar = problem%ubar
       call problem%set_solution(ubar, error)
    end subroutine solve_level
+
+   !> The rows of a contact pair's block system (the slave's reduced unknowns,
+   !> then the master's) shared out as its distributed solve shares them:
+   !> rank r owns the rows of the masters r B/R .. (r + 1) B/R - 1 of the B
+   !> masters of both bodies in that order (`owned_rows` on the pair's block
+   !> layout, `sprc_petsc_own_blocks`). Each rank assembles and keeps only
+   !> its rows of each body (`keep_rows`, possibly none of one body);
+   !> bounds(r + 1) is rank r's first row of the block system, bounds(R + 1)
+   !> its order plus one. A failure on any rank is an error on all of them.
+   subroutine assemble_pair_rows(part, slave, master, bounds, error)
+      type(partition_type), intent(in) :: part
+      type(elasticity_problem_type), intent(inout) :: slave, master
+      integer(i8), allocatable, intent(out) :: bounds(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(timer_type) :: timer
+      integer, allocatable :: dof(:, :)
+      integer :: r, ns, rows(2), rs(2), rm(2)
+
+      ns = slave%n_dofs()
+      associate (cs => slave%constraints, cm => master%constraints)
+         dof = reshape([cs%dof, merge(cm%dof + ns, 0, cm%dof > 0)], [slave%dim, cs%n_masters + cm%n_masters])
+      end associate
+      allocate (bounds(part%ranks + 1))
+      do r = 0, part%ranks - 1
+         rows = owned_rows(dof, r, part%ranks)
+         bounds(r + 1) = rows(1)
+      end do
+      bounds(part%ranks + 1) = ns + master%n_dofs() + 1
+      rows = owned_rows(dof, part%rank, part%ranks)
+      ! the slave's rows lo..min(hi, ns), the master's those above ns; an empty range as [lo, lo - 1]
+      rs = [min(rows(1), ns + 1), min(rows(2), ns)]
+      rm = [max(rows(1), ns + 1) - ns, max(rows(2) - ns, max(rows(1), ns + 1) - ns - 1)]
+      call slave%assemble(error, rs)
+      if (.not. allocated(error)) call master%assemble(error, rm)
+      call timer%start()
+      if (.not. allocated(error)) call keep_rows(rs, slave%k, slave%f, error)
+      if (.not. allocated(error)) call keep_rows(rm, master%k, master%f, error)
+      call timer%stop()
+      slave%t_assembly = slave%t_assembly + timer%elapsed
+      call part%agree('the contact pair''s assembly', error)
+   end subroutine assemble_pair_rows
 
    !> Whether every rank calls this within `seconds`, as after a failure that
    !> all of them know of (`agree`); false when this rank failed alone (the
