@@ -46,7 +46,11 @@
 !>   contact terms through Galerkin products of each new fine matrix (a body held
 !>   only by the contact has no usable hierarchy of its own). Each iteration
 !>   starts from the previous solution; the stopping test is the single body's
-!>   energy bound tightened for pointwise values (`contact_tolerance`).
+!>   energy bound tightened for pointwise values (`contact_tolerance`), looser
+!>   while the active set changes (`active_set_tolerance`, `confirm_set`). The
+!>   preconditioner is set up anew for each active set: one set up for an
+!>   earlier set (a lagged preconditioner) let CG take several times as many
+!>   iterations, as many cells change state between the first sets.
 !>
 !> Assemblies (`solve_contact_assembly`): several bodies and the pairs between
 !> them, one block system with every body's reduced system on the diagonal
@@ -271,7 +275,7 @@ contains
       real(wp), allocatable :: slip(:, :), tau(:, :), pstar(:, :)
       type(block_solver_type), target :: own
       type(block_solver_type), pointer :: bs
-      integer :: it, maxit, n, c, switched, stat
+      integer :: it, maxit, n, c, switched, stat, last_switched
       logical :: kept
 
       call check_pair(slave, master, surface, friction, kappa, error)
@@ -309,7 +313,7 @@ contains
       n = slave%n_dofs() + master%n_dofs()
       allocate (x(n), source=0.0_wp, stat=stat)
       call check_allocation(stat, 'contact solve', 'the solution of both bodies', n, 8, error)
-      if (.not. allocated(error)) call block_solver_setup(slave, master, ops, bs, error)
+      if (.not. allocated(error)) call block_solver_setup(slave, master, ops, kappa, bs, error)
       if (allocated(error)) return
       if (friction == friction_coulomb) then
          if (.not. present(mu)) then
@@ -328,6 +332,7 @@ contains
          if (allocated(error)) return
          call coulomb_output(ops, cells, mu, state, tau, slip, x, sol)
       end if
+      last_switched = huge(1)
       do it = 1, merge(0, maxit, friction == friction_coulomb)
          sol%iterations = it
          call timer%reset()
@@ -363,6 +368,9 @@ contains
          end if
          if (present(progress)) call progress(1, 1, it, switched)
          if (switched == 0) exit
+         ! loose solves that do not shrink the change of the set: tight ones from here on
+         if (switched >= last_switched) bs%loose = bs%tight
+         last_switched = switched
          closed = next
          if (it == maxit) then
             call fatal_error(error, "contact '"//trim(names(1))//"' on '"//trim(names(2))// &
@@ -1302,9 +1310,11 @@ contains
    !> Decide between the direct and the iterative solver (module notes) and,
    !> for the iterative one, set up the block layout of both bodies and their
    !> stacked multigrid hierarchy; nothing happens when `bs` is ready.
-   subroutine block_solver_setup(slave, master, ops, bs, error)
+   subroutine block_solver_setup(slave, master, ops, kappa, bs, error)
       type(elasticity_problem_type), intent(in) :: slave, master
       type(point_operators_type), intent(in) :: ops
+      !> The contact stabilization factor (`active_set_tolerance`).
+      real(wp), intent(in) :: kappa
       type(block_solver_type), intent(inout) :: bs
       type(error_type), allocatable, intent(out) :: error
       type(prolongation_type), allocatable :: ps(:), pm(:), p(:)
@@ -1343,7 +1353,7 @@ contains
       end associate
       h_over_l = 0.5_wp**max(slave%mesh%grid%max_level, master%mesh%grid%max_level)
       bs%tight = contact_tolerance(h_over_l, slave%degree, slave%dim)
-      bs%loose = max(active_set_tolerance(h_over_l, slave%dim), bs%tight)
+      bs%loose = max(active_set_tolerance(h_over_l, slave%dim, kappa), bs%tight)
       bs%krylov%tolerance = bs%tight
    end subroutine block_solver_setup
 
@@ -1364,14 +1374,17 @@ contains
    !> The Krylov tolerance of the active-set iterations before the set
    !> repeats: they only decide the sign of each cell's multiplier, and the
    !> set they end on is confirmed by a solve to `contact_tolerance`
-   !> (`confirm_set`). By the inverse estimate of `contact_tolerance` a
-   !> relative energy error of 1e-2 (h/L)^(d/2) moves a cell's multiplier by
-   !> at most about 1 % of the peak: only cells within 1 % of changing sign
-   !> can be put on the wrong side, and the confirming solve sees them.
-   pure real(wp) function active_set_tolerance(h_over_l, dim) result(tau)
-      real(wp), intent(in) :: h_over_l
+   !> (`confirm_set`). The multiplier pbar + gamma gbar amplifies a gap error
+   !> by gamma = kappa E/h: a strain error e in a cell moves it by about
+   !> kappa E e, and by the inverse estimate of `contact_tolerance` e is at
+   !> most (L/h)^(d/2) times the relative energy error. A bound of
+   !> 1e-2 (h/L)^(d/2)/kappa keeps a cell's multiplier within about 1 % of
+   !> the stress scale, so only cells that close to changing sign can be put
+   !> on the wrong side, and the confirming solve sees them.
+   pure real(wp) function active_set_tolerance(h_over_l, dim, kappa) result(tau)
+      real(wp), intent(in) :: h_over_l, kappa
       integer, intent(in) :: dim
-      tau = 1.0e-2_wp*h_over_l**(0.5_wp*dim)
+      tau = 1.0e-2_wp*h_over_l**(0.5_wp*dim)/max(kappa, 1.0_wp)
    end function active_set_tolerance
 
    !> The points whose contact cell changes state from `closed` to `next`.
