@@ -7,7 +7,7 @@ module sprc_io_scene
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
    use sprc_core_kinds, only: wp, i8
    use sprc_fem_dilatation, only: projected_poisson
-   use sprc_fem_linear_solver, only: solver_names, auto_iterative_min_dofs, auto_never
+   use sprc_fem_linear_solver, only: solver_names, auto_iterative_min_dofs, auto_coupled_iterative_min_dofs, auto_never
    use sprc_fem_problem, only: default_gamma, gamma_note
    use sprc_core_text, only: itoa, real_text, lower
    use sprc_core_error, only: error_type, fatal_error
@@ -1570,7 +1570,7 @@ contains
    function solver_line(scene) result(text)
       type(scene_type), intent(in) :: scene
       character(len=:), allocatable :: text, head
-      integer :: d
+      integer :: d, b
 
       text = ''
       if (scene%solver /= 'auto') return
@@ -1581,6 +1581,14 @@ contains
          text = head//'CHOLMOD)'
       else if (auto_iterative_min_dofs(d, scene%order) == auto_never) then
          text = head//'CHOLMOD; CG + geometric multigrid where CHOLMOD would not fit in memory)'
+      else if (size(scene%contacts) > 0) then
+         text = head//'each &contact pair''s bodies are one coupled system, CG + geometric multigrid from '// &
+            & itoa(auto_coupled_iterative_min_dofs(d, scene%order))//' unknowns over both bodies or where '// &
+            & 'CHOLMOD would not fit in memory, CHOLMOD below'
+         if (any([(.not. (any(scene%contacts%slave_index == b) .or. any(scene%contacts%master_index == b)), &
+            & b = 1, size(scene%bodies))])) &
+            & text = text//'; a body in no pair from '//itoa(auto_iterative_min_dofs(d, scene%order))//' unknowns'
+         text = text//')'
       else
          text = head//'CG + geometric multigrid from '//itoa(auto_iterative_min_dofs(d, scene%order))// &
             & ' unknowns or where CHOLMOD would not fit in memory, CHOLMOD below)'
