@@ -30,7 +30,9 @@
 !> - Iterative solves (`block_solver_type`, 'iterative' or 'auto' from
 !>   `auto_coupled_min_dofs`): CG (GMRES if unsymmetric or indefinite), both bodies'
 !>   multigrids stacked (`stack_hierarchies`, contact nodes kept, Galerkin coarse
-!>   operators of each new fine matrix), warm starts, `contact_tolerance`; under
+!>   operators of each new fine matrix, set up anew per active set: a lagged one
+!>   costs CG several times the iterations), warm starts, `contact_tolerance`
+!>   (looser while the set changes: `active_set_tolerance`, `confirm_set`); under
 !>   mpirun (`share`) each rank holds its rows and the solution is gathered.
 !>
 !> Assemblies (`solve_contact_assembly`): several bodies and their pairs in one block
@@ -140,6 +142,9 @@ module sprc_contact_pair_solve
    type :: block_solver_type
       logical :: ready = .false., iterative = .false.
       type(petsc_solver_type) :: krylov
+      !> The Krylov tolerances of the final solve (`contact_tolerance`) and
+      !> of the solves while the active set changes (`active_set_tolerance`).
+      real(wp) :: tight = 0.0_wp, loose = 0.0_wp
    end type block_solver_type
 
    !> The CHOLMOD factor of a recovered-stabilization block system and the
@@ -280,7 +285,7 @@ contains
       real(wp), allocatable :: slip(:, :), tau(:, :), pstar(:, :)
       type(block_solver_type), target :: own
       type(block_solver_type), pointer :: bs
-      integer :: it, maxit, n, c, switched, stat
+      integer :: it, maxit, n, c, switched, stat, last_switched
       logical :: kept
 
       call check_pair(slave, master, surface, friction, kappa, error)
@@ -318,7 +323,7 @@ contains
       n = slave%n_dofs() + master%n_dofs()
       allocate (x(n), source=0.0_wp, stat=stat)
       call check_allocation(stat, 'contact solve', 'the solution of both bodies', n, 8, error)
-      if (.not. allocated(error)) call block_solver_setup(slave, master, ops, bs, error)
+      if (.not. allocated(error)) call block_solver_setup(slave, master, ops, kappa, bs, error)
       if (allocated(error)) return
       if (present(share) .and. (friction == friction_coulomb .or. .not. bs%iterative)) then
          call fatal_error(error, 'contact solve: a block system whose rows are shared out among ranks needs the '// &
@@ -342,6 +347,7 @@ contains
          if (allocated(error)) return
          call coulomb_output(ops, cells, mu, state, tau, slip, x, sol)
       end if
+      last_switched = huge(1)
       do it = 1, merge(0, maxit, friction == friction_coulomb)
          sol%iterations = it
          call timer%reset()
@@ -369,14 +375,18 @@ contains
          end if
          if (allocated(error)) return
          next = sol%lambda_n < 0.0_wp
-         switched = 0
-         do c = 1, ops%ncell
-            if (next(c) .neqv. closed(c)) switched = switched + ops%cell_ptr(c + 1) - ops%cell_ptr(c)
-         end do
+         switched = switched_points(ops, closed, next)
          call timer%stop()
          sol%t_contact = sol%t_contact + timer%elapsed
+         if (switched == 0 .and. .not. kept .and. bs%iterative .and. bs%krylov%tolerance > bs%tight) then
+            call confirm_set(surface, ops, cells, closed, bs, f, x, sol, next, switched, error, pstar)
+            if (allocated(error)) return
+         end if
          if (present(progress)) call progress(1, 1, it, switched)
          if (switched == 0) exit
+         ! loose solves that do not shrink the change of the set: tight ones from here on
+         if (switched >= last_switched) bs%loose = bs%tight
+         last_switched = switched
          closed = next
          if (it == maxit) then
             call fatal_error(error, "contact '"//trim(names(1))//"' on '"//trim(names(2))// &
@@ -1527,6 +1537,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: note
       if (bs%iterative) then
+         bs%krylov%tolerance = bs%loose
          call iterative_block(bs%krylov, k, f, .true., x, sol, error)
          return
       end if
@@ -1537,9 +1548,11 @@ contains
    !> Decide between the direct and the iterative solver (module notes) and,
    !> for the iterative one, set up the block layout of both bodies and their
    !> stacked multigrid hierarchy; nothing happens when `bs` is ready.
-   subroutine block_solver_setup(slave, master, ops, bs, error)
+   subroutine block_solver_setup(slave, master, ops, kappa, bs, error)
       type(elasticity_problem_type), intent(in) :: slave, master
       type(point_operators_type), intent(in) :: ops
+      !> The contact stabilization factor (`active_set_tolerance`).
+      real(wp), intent(in) :: kappa
       type(block_solver_type), intent(inout) :: bs
       type(error_type), allocatable, intent(out) :: error
       type(prolongation_type), allocatable :: ps(:), pm(:), p(:)
@@ -1547,6 +1560,7 @@ contains
       logical, allocatable :: touched(:)
       integer :: ns
       logical :: found_s, found_m
+      real(wp) :: h_over_l
 
       if (bs%ready) return
       bs%iterative = pair_iterative(slave, master)
@@ -1573,8 +1587,10 @@ contains
             if (allocated(error)) return
          end if
       end associate
-      bs%krylov%tolerance = contact_tolerance(0.5_wp**max(slave%mesh%grid%max_level, master%mesh%grid%max_level), &
-         & slave%degree, slave%dim)
+      h_over_l = 0.5_wp**max(slave%mesh%grid%max_level, master%mesh%grid%max_level)
+      bs%tight = contact_tolerance(h_over_l, slave%degree, slave%dim)
+      bs%loose = max(active_set_tolerance(h_over_l, slave%dim, kappa), bs%tight)
+      bs%krylov%tolerance = bs%tight
    end subroutine block_solver_setup
 
    !> Whether the block system of the pair is solved iteratively (module
@@ -1601,6 +1617,55 @@ contains
       integer, intent(in) :: degree, dim
       tau = max(iteration_tolerance(h_over_l, degree)*h_over_l**(0.5_wp*dim), 1.0e-12_wp)
    end function contact_tolerance
+
+   !> The Krylov tolerance of the active-set iterations before the set
+   !> repeats: they only decide the sign of each cell's multiplier, and the
+   !> set they end on is confirmed by a solve to `contact_tolerance`
+   !> (`confirm_set`). The multiplier pbar + gamma gbar amplifies a gap error
+   !> by gamma = kappa E/h: a strain error e in a cell moves it by about
+   !> kappa E e, and by the inverse estimate of `contact_tolerance` e is at
+   !> most (L/h)^(d/2) times the relative energy error. A bound of
+   !> 1e-2 (h/L)^(d/2)/kappa keeps a cell's multiplier within about 1 % of
+   !> the stress scale, so only cells that close to changing sign can be put
+   !> on the wrong side, and the confirming solve sees them.
+   pure real(wp) function active_set_tolerance(h_over_l, dim, kappa) result(tau)
+      real(wp), intent(in) :: h_over_l, kappa
+      integer, intent(in) :: dim
+      tau = 1.0e-2_wp*h_over_l**(0.5_wp*dim)/max(kappa, 1.0_wp)
+   end function active_set_tolerance
+
+   !> The points whose contact cell changes state from `closed` to `next`.
+   pure integer function switched_points(ops, closed, next) result(switched)
+      type(point_operators_type), intent(in) :: ops
+      logical, intent(in) :: closed(:), next(:)
+      switched = sum(ops%cell_ptr(2:) - ops%cell_ptr(:size(closed)), mask=next .neqv. closed)
+   end function switched_points
+
+   !> The active set repeated after a solve to `active_set_tolerance`: solve
+   !> the same system again (its preconditioner set up) to the final
+   !> tolerance from that solution and evaluate again; `switched` says
+   !> whether the set still repeats.
+   subroutine confirm_set(surface, ops, cells, closed, bs, f, x, sol, next, switched, error, pstar)
+      type(contact_surface_type), intent(in) :: surface
+      type(point_operators_type), intent(in) :: ops
+      type(cell_operators_type), intent(in) :: cells(:)
+      logical, intent(in) :: closed(:)
+      type(block_solver_type), intent(inout) :: bs
+      real(wp), intent(in) :: f(:)
+      real(wp), intent(inout) :: x(:)
+      type(contact_solution_type), intent(inout) :: sol
+      logical, intent(out) :: next(:)
+      integer, intent(out) :: switched
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), intent(in), optional :: pstar(:, :)
+
+      bs%krylov%tolerance = bs%tight
+      call krylov_solve(bs%krylov, f, x, sol, error)
+      if (.not. allocated(error)) call evaluate(surface, ops, cells, closed, x, sol, error, pstar)
+      if (allocated(error)) return
+      next = sol%lambda_n < 0.0_wp
+      switched = switched_points(ops, closed, next)
+   end subroutine confirm_set
 
    !> The blocks (masters) of `dof` with a component in `touched` (0: none).
    pure function kept_masters(touched, dof) result(keep)

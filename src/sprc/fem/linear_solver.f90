@@ -24,7 +24,7 @@ module sprc_fem_linear_solver
 
    public :: linear_solver_type, backend_error, message_length, blas_threads, set_blas_threads
    public :: solver_auto, solver_direct, solver_iterative, solver_names, solver_choice, use_iterative, &
-      & auto_iterative_min_dofs, auto_never, solve_ranks, set_solve_ranks
+      & auto_iterative_min_dofs, auto_coupled_iterative_min_dofs, auto_never, solve_ranks, set_solve_ranks
 
    !> The scene's `solver`: 'auto', 'direct' (CHOLMOD, UMFPACK) or 'iterative'
    !> (Krylov + multigrid, `sprc_fem_petsc`, `sprc_fem_multigrid`); codes in `solver_names` order.
@@ -362,7 +362,7 @@ contains
       if (present(direct_fits)) fits = direct_fits
       min_dofs = auto_iterative_min_dofs(dim, degree)
       if (present(coupled)) then
-         if (coupled .and. min_dofs /= auto_never) min_dofs = auto_coupled_min_dofs(dim, degree)
+         if (coupled) min_dofs = auto_coupled_iterative_min_dofs(dim, degree)
       end if
       use_iterative = choice == solver_iterative .or. (choice == solver_auto .and. &
          & (solve_ranks > 1 .or. .not. fits .or. n >= min_dofs))
@@ -377,6 +377,14 @@ contains
          & degree >= lbound(auto_min_dofs, 2) .and. degree <= ubound(auto_min_dofs, 2)) &
          & min_dofs = auto_min_dofs(dim, degree)
    end function auto_iterative_min_dofs
+
+   !> 'auto''s threshold for the coupled system of bodies in contact
+   !> (`auto_coupled_min_dofs`; `auto_never` where a single body has none).
+   pure integer function auto_coupled_iterative_min_dofs(dim, degree) result(min_dofs)
+      integer, intent(in) :: dim, degree
+      min_dofs = auto_iterative_min_dofs(dim, degree)
+      if (min_dofs /= auto_never) min_dofs = auto_coupled_min_dofs(dim, degree)
+   end function auto_coupled_iterative_min_dofs
 
    !> Set `solve_ranks` (by sprc_fem_petsc's `start_ranks` only).
    subroutine set_solve_ranks(ranks)

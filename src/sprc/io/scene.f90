@@ -12,6 +12,7 @@ module sprc_io_scene
    use sprc_study_spec, only: scene_type, body_spec_type, shape_spec_type, bc_spec_type, exact_spec_type, &
       & contact_spec_type, recovery_degree, default_stabilization, contact_unsupported, default_max_level, &
       & contact_components, projected_poisson, solver_names, auto_iterative_min_dofs, auto_never, default_gamma, &
+      & auto_coupled_iterative_min_dofs, &
       & gamma_note, grid_max_level, default_multiplier
    use sprc_io_scene_facets, only: load_facets, facet_kind, facet_summary, group_surface
    use sprc_io_namelist, only: nml_group_type, parse_namelist, read_text_file, nml_get, nml_get_array, &
@@ -1571,7 +1572,7 @@ contains
    function solver_line(scene) result(text)
       type(scene_type), intent(in) :: scene
       character(len=:), allocatable :: text, head
-      integer :: d
+      integer :: d, b
 
       text = ''
       if (scene%solver /= 'auto') return
@@ -1582,6 +1583,14 @@ contains
          text = head//'CHOLMOD)'
       else if (auto_iterative_min_dofs(d, scene%order) == auto_never) then
          text = head//'CHOLMOD; CG + geometric multigrid where CHOLMOD would not fit in memory)'
+      else if (size(scene%contacts) > 0) then
+         text = head//'each &contact pair''s bodies are one coupled system, CG + geometric multigrid from '// &
+            & itoa(auto_coupled_iterative_min_dofs(d, scene%order))//' unknowns over both bodies or where '// &
+            & 'CHOLMOD would not fit in memory, CHOLMOD below'
+         if (any([(.not. (any(scene%contacts%slave_index == b) .or. any(scene%contacts%master_index == b)), &
+            & b = 1, size(scene%bodies))])) &
+            & text = text//'; a body in no pair from '//itoa(auto_iterative_min_dofs(d, scene%order))//' unknowns'
+         text = text//')'
       else
          text = head//'CG + geometric multigrid from '//itoa(auto_iterative_min_dofs(d, scene%order))// &
             & ' unknowns or where CHOLMOD would not fit in memory, CHOLMOD below)'

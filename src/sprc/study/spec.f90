@@ -11,7 +11,7 @@ module sprc_study_spec
    ! The defaults and limits scene validation needs from the layers that own
    ! them, handed to io here so that io (file formats) names no fem or grid module.
    use sprc_fem_dilatation, only: projected_poisson
-   use sprc_fem_linear_solver, only: solver_names, auto_iterative_min_dofs, auto_never
+   use sprc_fem_linear_solver, only: solver_names, auto_iterative_min_dofs, auto_never, auto_coupled_iterative_min_dofs
    use sprc_fem_problem, only: default_gamma, gamma_note
    use sprc_grid_tree, only: grid_max_level
    implicit none
@@ -22,6 +22,7 @@ module sprc_study_spec
    public :: recovery_degree, contact_unsupported, contact_components
    public :: default_kappa, default_stabilization, kappa_range, kappa_note, default_multiplier
    public :: projected_poisson, solver_names, auto_iterative_min_dofs, auto_never, default_gamma, gamma_note
+   public :: auto_coupled_iterative_min_dofs
    public :: grid_max_level
 
    !> Default of `&contact kappa`, the dimensionless factor of the contact
