@@ -17,6 +17,11 @@
 !> contact pressures and their jump are exact up to round-off: tolerance sqrt(eps) of the
 !> stress scale (the tier of sprc_test_mesh_recovery, whose notes give the reason).
 !>
+!> A gap between the bodies (the master shifted along the normal by 1.5 of its cells: the
+!> undeformed slave points of a curved contact lie off the master's mesh so): the master's
+!> pressure is taken at the facing point of its mesh, and the uniform field is still
+!> reproduced on both sides with a zero jump (quad4 on tri3, hex8 on tet4).
+!>
 !> That the contact rows act: with noisy FE stresses and a frictionless law, the recovered
 !> tangential traction of each body at the contact points is zero up to round-off (each
 !> contact patch is constrained on the whole plane), and the plain recovery without contact
@@ -67,7 +72,8 @@ contains
          new_unittest('wrong_slip_direction_not_exact', test_wrong_slip), &
          new_unittest('validation_errors', test_validation), &
          new_unittest('legacy_wrapper', test_legacy), &
-         new_unittest('three_bodies_two_pairs', test_two_pairs) &
+         new_unittest('three_bodies_two_pairs', test_two_pairs), &
+         new_unittest('master_off_by_a_gap', test_gap) &
          ]
    end subroutine collect_contact_mesh
 
@@ -617,5 +623,39 @@ contains
          deallocate (gs3)
       end do
    end subroutine test_two_pairs
+
+   !> The master shifted off the slave by a gap (module notes).
+   subroutine test_gap(error)
+      type(error_type), allocatable, intent(out) :: error
+
+      call gap_case(error, elem_quad4, elem_tri3, 3)
+      if (allocated(error)) return
+      call gap_case(error, elem_hex8, elem_tet4, 2)
+   end subroutine test_gap
+
+   subroutine gap_case(error, e1, e2, m)
+      type(error_type), allocatable, intent(out) :: error
+      integer, intent(in) :: e1, e2, m
+      type(problem_type) :: pb
+      real(wp) :: err, g
+      integer :: d, i, j
+
+      call build_problem(pb, e1, e2, m, contact_law_frictionless, .false., 0.0_wp)
+      d = pb%c(1)%dim
+      g = 0.9_wp/m
+      associate (c => pb%c(2))
+         do j = 1, size(c%x, 2)
+            c%x(:, j) = c%x(:, j) + g*pb%rot(1:d, d)
+         end do
+         do j = 1, size(c%gp, 3)
+            do i = 1, size(c%gp, 2)
+               c%gp(:, i, j) = c%gp(:, i, j) + g*pb%rot(1:d, d)
+            end do
+         end do
+      end associate
+      call run_exact(error, pb, contact_law_frictionless, err)
+      if (allocated(error)) return
+      call check(error, err <= tol, 'dim '//rtoa(real(d, wp))//': largest deviation / scale = '//rtoa(err))
+   end subroutine gap_case
 
 end module sprc_test_contact_mesh
