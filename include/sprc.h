@@ -435,8 +435,10 @@ int sprc_get_contact_points(sprc_error error, sprc_contact_recovery recovery, in
  *   pressure = -n.sigma*_slave.n, pressure_master = -n.sigma*_master.n  [npoints]
  *   traction_tangential (slave), traction_tangential_master  [npoints][dim]
  *   jump = (sigma*_slave - sigma*_master) n (action-reaction) [npoints][dim]
- * The master's field is taken in its element holding the point, or in the
- * nearest one when the meshes of a curved surface do not match. */
+ * The master's field is taken at the facing point: the nearest point of the
+ * elements owning the master's contact facets (the point itself where it lies
+ * in one; on a curved contact the undeformed slave points lie off the
+ * master's mesh by the gap). */
 void sprc_get_contact_pair(sprc_error error, sprc_contact_recovery recovery, int pair, int npoints, double *points,
                            double *weights, double *normals, double *pressure, double *pressure_master,
                            double *traction_tangential, double *traction_tangential_master, double *jump);

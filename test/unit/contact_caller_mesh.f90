@@ -17,6 +17,26 @@
 !> contact pressures and their jump are exact up to round-off: tolerance sqrt(eps) of the
 !> stress scale (the tier of sprc_test_mesh_recovery, whose notes give the reason).
 !>
+!> A gap between the bodies (the master shifted along the normal by 1.5 of its cells: the
+!> undeformed slave points of a curved contact lie off the master's mesh so): the master's
+!> pressure is taken at the facing point of its mesh, and the uniform field is still
+!> reproduced on both sides with a zero jump (quad4 on tri3, hex8 on tet4).
+!>
+!> Agreement with the grid pipeline: two blocks of different materials, the upper one
+!> narrower (its edge concentrates the stress: the fields are not in the recovery space), the
+!> interface and every boundary on grid planes of both grids (no cut cells), stick and
+!> frictionless, 2D Q1/Q2 and 3D Q1, run through the pipeline at level 2 with p + 1 Gauss
+!> points per direction (the rule of the caller's facets: then the boundary and contact
+!> points are the same), and exported as a caller's mesh gives it: grid nodes, the VTK
+!> connectivity, the volume points, weights and FE stresses, each cell side that carries
+!> boundary points as a facet of its shape's kind, the contact shape's sides as contact
+!> facets with the pair's law (every pipeline contact point is closed). The patches are
+!> the same (one per vertex node over its elements, h the largest distance to their
+!> nodes, the same boundary points and Omega_aux), so the nodal stresses of both bodies
+!> and the slave's pressure at the pipeline's contact points (its p_sprc) agree up to the
+!> order of summation: tier sqrt(eps) of the stress scale (the patch solves' round-off,
+!> conditioning not estimated); the differences are 1e-15 .. 7e-15 (hex27: 1.3e-13).
+!>
 !> That the contact rows act: with noisy FE stresses and a frictionless law, the recovered
 !> tangential traction of each body at the contact points is zero up to round-off (each
 !> contact patch is constrained on the whole plane), and the plain recovery without contact
@@ -33,6 +53,13 @@ module sprc_test_contact_mesh
       & recover_contact_on_mesh, contact_law_frictionless, contact_law_slip, contact_law_stick
    use sprc_test_mesh_recovery, only: case_type, build_case, node_id
    use sprc_legacy, only: sprc_recover_contact_mesh
+   use sprc_io_scene, only: scene_type, read_scene_text
+   use sprc_study_level, only: study_type, level_type, prepare_study, run_level
+   use sprc_estimate_fe_input, only: fe_recovery_input
+   use sprc_estimate_patches, only: recovery_input_type, bc_none, bc_traction, bc_pressure, bc_symmetry
+   use sprc_estimate_recovered_field, only: field_eval
+   use sprc_contact_result, only: contact_open
+   use sprc_recovery_caller_mesh, only: facet_traction, facet_pressure, facet_symmetry
    implicit none
    private
 
@@ -41,6 +68,12 @@ module sprc_test_contact_mesh
    real(wp), parameter :: tol = sqrt(epsilon(1.0_wp))
    !> Friction coefficient of the slip cases.
    real(wp), parameter :: mu = 0.3_wp
+
+   !> One body of the grid pipeline as a caller's mesh (test_grid_agreement).
+   type :: exported_type
+      real(wp), allocatable :: x(:, :), gp(:, :, :), gw(:, :), gs(:, :, :), traction(:, :)
+      integer, allocatable :: conn(:, :), facets(:, :), kind(:), contact(:, :)
+   end type exported_type
 
    !> A two-body problem: the cases, their facets on the contact plane, the rotation, the field.
    type :: problem_type
@@ -67,7 +100,9 @@ contains
          new_unittest('wrong_slip_direction_not_exact', test_wrong_slip), &
          new_unittest('validation_errors', test_validation), &
          new_unittest('legacy_wrapper', test_legacy), &
-         new_unittest('three_bodies_two_pairs', test_two_pairs) &
+         new_unittest('three_bodies_two_pairs', test_two_pairs), &
+         new_unittest('master_off_by_a_gap', test_gap), &
+         new_unittest('grid_pipeline_agreement', test_grid_agreement) &
          ]
    end subroutine collect_contact_mesh
 
@@ -617,5 +652,287 @@ contains
          deallocate (gs3)
       end do
    end subroutine test_two_pairs
+
+   !> The master shifted off the slave by a gap (module notes).
+   subroutine test_gap(error)
+      type(error_type), allocatable, intent(out) :: error
+
+      call gap_case(error, elem_quad4, elem_tri3, 3)
+      if (allocated(error)) return
+      call gap_case(error, elem_hex8, elem_tet4, 2)
+   end subroutine test_gap
+
+   subroutine gap_case(error, e1, e2, m)
+      type(error_type), allocatable, intent(out) :: error
+      integer, intent(in) :: e1, e2, m
+      type(problem_type) :: pb
+      real(wp) :: err, g
+      integer :: d, i, j
+
+      call build_problem(pb, e1, e2, m, contact_law_frictionless, .false., 0.0_wp)
+      d = pb%c(1)%dim
+      g = 0.9_wp/m
+      associate (c => pb%c(2))
+         do j = 1, size(c%x, 2)
+            c%x(:, j) = c%x(:, j) + g*pb%rot(1:d, d)
+         end do
+         do j = 1, size(c%gp, 3)
+            do i = 1, size(c%gp, 2)
+               c%gp(:, i, j) = c%gp(:, i, j) + g*pb%rot(1:d, d)
+            end do
+         end do
+      end associate
+      call run_exact(error, pb, contact_law_frictionless, err)
+      if (allocated(error)) return
+      call check(error, err <= tol, 'dim '//rtoa(real(d, wp))//': largest deviation / scale = '//rtoa(err))
+   end subroutine gap_case
+
+   !> Agreement with the grid pipeline (module notes): the aligned two-block scene recovered
+   !> by the pipeline (SPR-C, level 2) and, exported, by recover_contact_on_mesh; 2D Q1 and
+   !> Q2, 3D Q1, stick and frictionless.
+   subroutine test_grid_agreement(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: friction(2) = ['stick       ', 'frictionless']
+      integer :: k, order, d
+
+      do d = 2, 3
+         ! Q2 in 3D (hex27) agrees as well (1.3e-13) but costs 8.5 s a case: left out.
+         do order = 1, merge(2, 1, d == 2)
+            do k = 1, 2
+               call agreement_case(error, d, trim(friction(k)), order)
+               if (allocated(error)) then
+                  error%message = 'dim '//achar(48 + d)//', '//trim(friction(k))//', order '//achar(48 + order)// &
+                     & ': '//error%message
+                  return
+               end if
+            end do
+         end do
+      end do
+   end subroutine test_grid_agreement
+
+   !> The scene of test_grid_agreement: two blocks of different materials, the upper one
+   !> narrower (a stress concentration under its edge), the interface y = 1/2 and every
+   !> boundary on grid planes of both grids (h = 1/4 and 1/8 at level 2); in 3D the same
+   !> extruded in z with symmetry on z = 0 and free sides z = 1/2 (lower) and 3/8 (upper).
+   pure function agreement_scene(d, friction, order) result(text)
+      integer, intent(in) :: d, order
+      character(len=*), intent(in) :: friction
+      character(len=:), allocatable :: text, z, z0, nz, nl
+
+      nl = new_line('a')
+      z = merge(',0', '  ', d == 3)
+      z0 = trim(z)
+      nz = ''
+      if (d == 3) then
+         nz = "&shape body='lower' op='intersect' kind='halfspace' name='l_z0' point=0,0,0 normal=0,0,-1 /"//nl// &
+            & "&shape body='lower' op='intersect' kind='halfspace' name='l_z1' point=0,0,0.5 normal=0,0,1 /"//nl// &
+            & "&shape body='upper' op='intersect' kind='halfspace' name='u_z0' point=0,0,0 normal=0,0,-1 /"//nl// &
+            & "&shape body='upper' op='intersect' kind='halfspace' name='u_z1' point=0,0,0.375 normal=0,0,1 /"//nl// &
+            & "&bc on='l_z0' type='symmetry' /"//nl//"&bc on='u_z0' type='symmetry' /"//nl
+      end if
+      text = "&scene title='agreement' analysis='"//trim(merge('plane_strain', 'solid       ', d == 2))// &
+         & "' order="//achar(48 + order)//" levels=2 box_min=0,-0.5"//z0//" box_size=1 recovery='sprc' output='' /"//nl// &
+         & "&body name='lower' young=1.0 poisson=0.3 /"//nl// &
+         & "&body name='upper' young=3.0 poisson=0.2 box_min=0,0.5"//z0//" box_size=0.5 /"//nl// &
+         & "&shape body='lower' op='add' kind='box' name='lb' lower=-1,-1"//trim(merge(',-1', '   ', d == 3))// &
+         & " upper=2,2"//trim(merge(',2', '  ', d == 3))//" /"//nl// &
+         & "&shape body='lower' op='intersect' kind='halfspace' name='l_x0' point=0,0"//z0//" normal=-1,0"//z0//" /"//nl// &
+         & "&shape body='lower' op='intersect' kind='halfspace' name='l_y0' point=0,0"//z0//" normal=0,-1"//z0//" /"//nl// &
+         & "&shape body='lower' op='intersect' kind='halfspace' name='l_x1' point=0.5,0"//z0//" normal=1,0"//z0//" /"//nl// &
+         & "&shape body='lower' op='intersect' kind='halfspace' name='l_top' point=0,0.5"//z0//" normal=0,1"//z0//" /"//nl// &
+         & "&shape body='upper' op='add' kind='box' name='ub' lower=-1,-1"//trim(merge(',-1', '   ', d == 3))// &
+         & " upper=2,2"//trim(merge(',2', '  ', d == 3))//" /"//nl// &
+         & "&shape body='upper' op='intersect' kind='halfspace' name='u_x0' point=0,0"//z0//" normal=-1,0"//z0//" /"//nl// &
+         & "&shape body='upper' op='intersect' kind='halfspace' name='u_x1' point=0.375,0"//z0//" normal=1,0"//z0// &
+         & " /"//nl// &
+         & "&shape body='upper' op='intersect' kind='halfspace' name='u_bot' point=0,0.5"//z0//" normal=0,-1"//z0//" /"//nl// &
+         & "&shape body='upper' op='intersect' kind='halfspace' name='u_top' point=0,0.75"//z0//" normal=0,1"//z0//" /"// &
+         & nl//nz// &
+         & "&bc on='l_x0' type='symmetry' /"//nl// &
+         & "&bc on='l_y0' type='symmetry' /"//nl// &
+         & "&bc on='u_x0' type='symmetry' /"//nl// &
+         & "&bc on='u_top' type='pressure' value=1.0 /"//nl// &
+         & "&contact slave='upper' master='lower' slave_surface='u_bot' master_surface='l_top' friction='"// &
+         & friction//"' /"//nl
+   end function agreement_scene
+
+   !> One case of test_grid_agreement (module notes).
+   subroutine agreement_case(error, d, friction, order)
+      type(error_type), allocatable, intent(out) :: error
+      integer, intent(in) :: d, order
+      character(len=*), intent(in) :: friction
+      type(scene_type) :: scene
+      type(study_type) :: study
+      type(level_type) :: lv
+      type(recovery_input_type) :: inp(2)
+      type(exported_type), target :: ex(2)
+      type(contact_body_type) :: bodies(2)
+      type(contact_pair_type) :: pairs(1)
+      type(mesh_contact_recovery_type) :: res
+      integer, allocatable, target :: laws(:)
+      real(wp) :: sig(6), sm(6, 1), worst, scale, g(3, 6), nv(3), p_pipe, tol, dp
+      integer :: b, n, e, i, cshape(2), etype, ns
+      character(len=:), allocatable :: what
+
+      ns = merge(3, 6, d == 2)
+      call read_scene_text(agreement_scene(d, friction, order), 'agreement', scene, error)
+      if (allocated(error)) return
+      ! 2 (Q1) or 3 (Q2) Gauss points per direction, the rule of the caller's facets.
+      call prepare_study(scene, order + 1, study, error)
+      if (allocated(error)) return
+      call run_level(study, 2, lv, error)
+      if (allocated(error)) return
+      cshape = [study%scene%shapes(scene%contacts(1)%master_surface_index)%body_shape, &
+         & study%scene%shapes(scene%contacts(1)%slave_surface_index)%body_shape]
+      etype = merge(merge(elem_quad4, elem_quad9, order == 1), merge(elem_hex8, elem_hex27, order == 1), d == 2)
+      do b = 1, 2
+         call fe_recovery_input(lv%bodies(b)%problem, inp(b), error)
+         if (allocated(error)) return
+         call export_body(lv%bodies(b)%problem%mesh%nodes%x, lv%bodies(b)%problem%mesh%nodes%connectivity, &
+            & inp(b), cshape(b), ex(b), error)
+         if (allocated(error)) return
+         bodies(b)%dim = d
+         bodies(b)%analysis = inp(b)%analysis
+         bodies(b)%element_type = etype
+         bodies(b)%young = inp(b)%young
+         bodies(b)%poisson = inp(b)%poisson
+         bodies(b)%nodes => ex(b)%x
+         bodies(b)%connectivity => ex(b)%conn
+         bodies(b)%gp => ex(b)%gp
+         bodies(b)%gw => ex(b)%gw
+         bodies(b)%gs => ex(b)%gs
+         bodies(b)%facet_nodes => ex(b)%facets
+         bodies(b)%facet_kind => ex(b)%kind
+         bodies(b)%facet_traction => ex(b)%traction
+      end do
+      ! Every contact point of the pipeline closed: then every contact facet has the law.
+      call check(error, all(lv%contacts(1)%state /= contact_open), 'an open contact point in the pipeline')
+      if (allocated(error)) return
+      laws = [merge(contact_law_stick, contact_law_frictionless, friction == 'stick')]
+      pairs(1)%slave = 2
+      pairs(1)%master = 1
+      pairs(1)%slave_facets => ex(2)%contact
+      pairs(1)%master_facets => ex(1)%contact
+      pairs(1)%slave_law => laws
+      pairs(1)%master_law => laws
+      call recover_contact_on_mesh(bodies, pairs, mesh_method_sprc, res, error, degree=study%degree(2))
+      if (allocated(error)) return
+      scale = 1.0_wp
+      worst = 0.0_wp
+      ! Nodal stresses: the pipeline's field at each vertex node (its patch value there).
+      do b = 1, 2
+         associate (nodes => lv%bodies(b)%problem%mesh%nodes, field => lv%bodies(b)%field(2))
+            do n = 1, nodes%n_nodes
+               if (field%patch_of_node(n) == 0) cycle
+               e = nodes%node_element(nodes%node_element_ptr(n))
+               call field_eval(field, e, nodes%x(:, n), sig, error)
+               if (allocated(error)) return
+               if (maxval(abs(sig(1:ns) - res%bodies(b)%nodal(:, n))) > worst) what = 'nodal stress'
+               worst = max(worst, maxval(abs(sig(1:ns) - res%bodies(b)%nodal(:, n))))
+            end do
+         end associate
+      end do
+      ! The slave's recovered pressure at the pipeline's contact points (its p_sprc).
+      associate (c => lv%contacts(1))
+         do i = 1, size(c%weight)
+            call mesh_recovery_eval(res%bodies(2), c%x(:, i:i), sm(1:ns, :), error)
+            if (allocated(error)) return
+            nv = 0.0_wp
+            nv(1:d) = c%normal(:, i)
+            call traction_operator(d, nv, g)
+            p_pipe = c%p_sprc(i)
+            dp = abs(p_pipe + dot_product(nv(1:d), matmul(g(1:d, 1:ns), sm(1:ns, 1))))
+            if (dp > worst) what = 'p_sprc'
+            worst = max(worst, dp)
+         end do
+      end associate
+      ! The round-off tier of the patch solves (sprc_test_contact_recovery's tol_exact: the
+      ! solves are backward stable, their conditioning not estimated).
+      tol = sqrt(epsilon(1.0_wp))*scale
+      call check(error, worst <= tol, 'pipeline vs caller''s mesh: largest difference '//rtoa(worst)//' ('// &
+         & what//'), tolerance '//rtoa(tol))
+   end subroutine agreement_case
+
+   !> A grid body (nodes x, VTK connectivity) and its recovery input as a caller's mesh: the
+   !> integration points per element, the boundary facets (each cell side that carries
+   !> boundary points, its kind from the point's shape), the contact facets (shape cshape).
+   subroutine export_body(x, conn, inp, cshape, ex, error)
+      real(wp), intent(in) :: x(:, :)
+      integer, intent(in) :: conn(:, :), cshape
+      type(recovery_input_type), intent(in) :: inp
+      type(exported_type), intent(out) :: ex
+      type(error_type), allocatable, intent(out) :: error
+      integer, allocatable :: fac(:, :), kind(:), cfac(:, :)
+      real(wp), allocatable :: tr(:, :)
+      logical, allocatable :: done(:, :)
+      integer :: ne, ngp, e, k, a, nf, nc, side, s, nen, on(9), m, nfn, d, ns, ax
+      real(wp) :: h
+
+      d = size(x, 1)
+      ns = merge(3, 6, d == 2)
+      ne = size(conn, 2)
+      nen = size(conn, 1)
+      ! Facet nodes: 2 or 3 (quad4, quad9), 4 or 9 (hex8, hex27).
+      nfn = merge(merge(2, 3, nen == 4), merge(4, 9, nen == 8), d == 2)
+      ngp = inp%elem_ptr(2) - inp%elem_ptr(1)
+      call check(error, all(inp%elem_ptr(2:) - inp%elem_ptr(:ne) == ngp), 'cells with different point counts')
+      if (allocated(error)) return
+      ex%x = x
+      ex%conn = conn
+      allocate (ex%gp(d, ngp, ne), ex%gw(ngp, ne), ex%gs(ns, ngp, ne))
+      do e = 1, ne
+         ex%gp(:, :, e) = inp%x(:, inp%elem_ptr(e):inp%elem_ptr(e + 1) - 1)
+         ex%gw(:, e) = inp%w(inp%elem_ptr(e):inp%elem_ptr(e + 1) - 1)
+         ex%gs(:, :, e) = inp%stress(:, inp%elem_ptr(e):inp%elem_ptr(e + 1) - 1)
+      end do
+      allocate (fac(nfn, 2*d*ne), kind(2*d*ne), tr(d, 2*d*ne), cfac(nfn, 2*d*ne), done(2*d, ne))
+      done = .false.
+      nf = 0
+      nc = 0
+      do e = 1, ne
+         h = maxval(x(:, conn(:, e))) - minval(x(:, conn(:, e)))
+         do k = inp%belem_ptr(e), inp%belem_ptr(e + 1) - 1
+            ! The side: 2 ax - 1 (ax-) or 2 ax (ax+), from the outward normal of an aligned boundary.
+            ax = maxloc(abs(inp%bn(:, k)), dim=1)
+            side = 2*ax - merge(1, 0, inp%bn(ax, k) < 0.0_wp)
+            if (done(side, e)) cycle
+            done(side, e) = .true.
+            ! The side's nodes: those on the point's plane, in element order.
+            m = 0
+            do a = 1, nen
+               if (abs(dot_product(x(:, conn(a, e)) - inp%bx(:, k), inp%bn(:, k))) < 1.0e-12_wp*h) then
+                  m = m + 1
+                  if (m <= 9) on(m) = conn(a, e)
+               end if
+            end do
+            call check(error, m == nfn, 'a side with '//rtoa(real(m, wp))//' nodes')
+            if (allocated(error)) return
+            s = inp%bshape(k)
+            if (s == cshape) then
+               nc = nc + 1
+               cfac(:, nc) = on(1:nfn)
+               cycle
+            end if
+            if (inp%bc_kind(s) == bc_none) cycle
+            nf = nf + 1
+            fac(:, nf) = on(1:nfn)
+            tr(:, nf) = 0.0_wp
+            select case (inp%bc_kind(s))
+            case (bc_symmetry)
+               kind(nf) = facet_symmetry
+            case (bc_pressure)
+               kind(nf) = facet_pressure
+               tr(1, nf) = inp%bc_pressure(s)
+            case default
+               kind(nf) = facet_traction
+               tr(:, nf) = inp%bc_traction(1:d, s)
+            end select
+         end do
+      end do
+      ex%facets = fac(:, :nf)
+      ex%kind = kind(:nf)
+      ex%traction = tr(:, :nf)
+      ex%contact = cfac(:, :nc)
+   end subroutine export_body
 
 end module sprc_test_contact_mesh

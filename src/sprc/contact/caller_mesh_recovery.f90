@@ -29,9 +29,13 @@
 !> points, weights, slave outward normals n, the recovered contact pressure of the slave
 !> p = -n.sigma*_s n and of the master -n.sigma*_m n, the tangential tractions of both
 !> (on each body, its own outward normal), and the jump t_s + t_m = (sigma*_s -
-!> sigma*_m) n (action-reaction residual). The master's field is evaluated in the master
-!> element holding the point, or the nearest one (mesh_recovery_eval_near) when the meshes
-!> of a curved surface do not match.
+!> sigma*_m) n (action-reaction residual). The master's field is evaluated at the facing
+!> point of each slave point: the nearest point of the elements that own the master's contact
+!> facets (each element's reference coordinates clamped to its cell), the slave point itself
+!> where it lies in one. On a curved surface (a roller on a block) the undeformed slave
+!> points lie off the master's mesh by the gap, up to a few elements on a fine mesh; the
+!> facing point is where the master's traction acts against them. It is found by a ring
+!> search of bins over those elements (mesh_bins), never a scan per point.
 !>
 !> Errors name the argument as the caller wrote it (Fortran bodies(2)%..., or C / Python
 !> bodies[1], pairs[0].slave_facets[3] with c_indices).
@@ -45,9 +49,11 @@ module sprc_contact_caller_mesh_recovery
       & boundary_traction, boundary_symmetry
    use sprc_recovery_workspace, only: recovery_workspace_type
    use sprc_recovery_contact_operators, only: contact_law_frictionless, contact_law_slip, contact_law_stick
-   use sprc_recovery_caller_mesh_element, only: element_facet_nodes, element_degree, element_name, facet_npoints
+   use sprc_recovery_caller_mesh_element, only: element_facet_nodes, element_degree, element_name, facet_npoints, &
+      & element_inverse_map, element_map, element_simplex, element_nodes
+   use sprc_recovery_caller_mesh_bins, only: element_bins_type, build_element_bins
    use sprc_recovery_caller_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_contact_solver_type, mesh_facet_points, &
-      & mesh_recovery_eval, mesh_recovery_eval_near, mesh_method_sprc, mesh_method_spr, mesh_reference_unit, &
+      & mesh_recovery_eval, mesh_method_sprc, mesh_method_spr, mesh_reference_unit, &
       & facet_traction, facet_pressure, facet_symmetry, facet_free
    use sprc_recovery_patch_loop, only: auto_degree
    use sprc_recovery_caller_mesh_check, only: check_mesh_arrays, check_mesh_facets
@@ -63,8 +69,6 @@ module sprc_contact_caller_mesh_recovery
    integer, parameter :: contact_open = 0
    !> contact_pair_type%mu when not given.
    real(wp), parameter :: mu_not_given = -huge(1.0_wp)
-   !> Padding of the master's element bins for slave points off its mesh (element extents).
-   real(wp), parameter :: near_pad = 0.5_wp
 
    !> One body: the arguments of recover_on_mesh (module notes; pointers to the caller's arrays).
    type :: contact_body_type
@@ -367,8 +371,9 @@ contains
       integer, intent(in) :: k
       type(contact_pair_recovery_type), intent(out) :: out
       type(error_type), allocatable, intent(out) :: error
-      real(wp), allocatable :: ss(:, :), sm(:, :)
+      real(wp), allocatable :: ss(:, :), sm(:, :), ym(:, :)
       real(wp) :: g(3, 6), ts(3), tm(3), nv(3)
+      integer, allocatable :: em(:)
       integer :: d, ns, i, np
 
       associate (s => bodies(pair%slave))
@@ -385,7 +390,8 @@ contains
       allocate (ss(ns, np), sm(ns, np), out%pressure(np), out%pressure_master(np), out%traction_tangential(d, np), &
          & out%traction_tangential_master(d, np), out%jump(d, np))
       call mesh_recovery_eval(recs(pair%slave), out%x, ss, error, out%element)
-      if (.not. allocated(error)) call mesh_recovery_eval_near(recs(pair%master), out%x, sm, near_pad, error)
+      if (.not. allocated(error)) call facing_points(bodies(pair%master), pair%master_facets, out%x, ym, em, error)
+      if (.not. allocated(error)) call mesh_recovery_eval(recs(pair%master), ym, sm, error, em)
       if (allocated(error)) then
          error%message = pair_field(ci, k, 'points')//': '//error%message
          return
@@ -404,6 +410,107 @@ contains
       end do
       if (associated(pair%pressure)) out%pressure_fe = pair%pressure
    end subroutine pair_tractions
+
+   !> The facing points y (dim, np) of the points x on the master body b and their elements
+   !> (module notes): the nearest point of the elements owning b's contact facets `facets`.
+   !> Bins over those elements' boxes; for each point the rings of bins around its own are
+   !> searched until the ring lies farther than the nearest point found (an element is in
+   !> every bin its box overlaps, so one first met in ring r lies at least (r - 1) bin sides
+   !> away).
+   subroutine facing_points(b, facets, x, y, elem, error)
+      type(contact_body_type), intent(in) :: b
+      integer, intent(in) :: facets(:, :)
+      real(wp), intent(in) :: x(:, :)
+      real(wp), allocatable, intent(out) :: y(:, :)
+      integer, allocatable, intent(out) :: elem(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(element_bins_type) :: bins
+      real(wp), allocatable :: fx(:, :), fw(:), fn(:, :), lo(:, :), hi(:, :)
+      integer, allocatable :: owner(:), facet(:), cand(:)
+      logical, allocatable :: mark(:)
+      real(wp) :: best, yc(3), side
+      integer :: d, i, k, e, r, c(3), nen
+
+      d = b%dim
+      nen = element_nodes(b%element_type)
+      call mesh_facet_points(d, b%nodes, b%element_type, b%connectivity, facets, .false., 'master_facets', fx, fw, &
+         & fn, owner, facet, error)
+      if (allocated(error)) return
+      allocate (mark(size(b%connectivity, 2)))
+      mark = .false.
+      mark(owner) = .true.
+      cand = pack([(e, e=1, size(mark))], mark)
+      allocate (lo(d, size(cand)), hi(d, size(cand)), y(d, size(x, 2)), elem(size(x, 2)))
+      do k = 1, size(cand)
+         lo(:, k) = minval(b%nodes(:, b%connectivity(1:nen, cand(k))), dim=2)
+         hi(:, k) = maxval(b%nodes(:, b%connectivity(1:nen, cand(k))), dim=2)
+      end do
+      call build_element_bins(lo, hi, 0.0_wp, bins, error)
+      if (allocated(error)) return
+      side = minval(bins%size(1:d))
+      do i = 1, size(x, 2)
+         c = 0
+         do k = 1, d
+            c(k) = int(max(0.0_wp, min(real(bins%n(k) - 1, wp), (x(k, i) - bins%origin(k))/bins%size(k))))
+         end do
+         best = huge(1.0_wp)
+         elem(i) = 0
+         do r = 0, maxval(bins%n(1:d))
+            call ring(r)
+            if (elem(i) > 0 .and. best <= r*side) exit
+         end do
+         if (elem(i) == 0) then
+            call fatal_error(error, 'no element of the master''s contact facets maps a point near slave point '// &
+               & itoa(i), stat_invalid_input)
+            return
+         end if
+      end do
+   contains
+      !> The candidates of the bins at Chebyshev distance r from c (point i).
+      subroutine ring(r)
+         integer, intent(in) :: r
+         integer :: j(3), jl(3), jh(3), q, bb, j1, j2, j3
+
+         jl = 0
+         jh = 0
+         jl(1:d) = max(0, c(1:d) - r)
+         jh(1:d) = min(bins%n(1:d) - 1, c(1:d) + r)
+         do j3 = jl(3), jh(3)
+            do j2 = jl(2), jh(2)
+               do j1 = jl(1), jh(1)
+                  j = [j1, j2, j3]
+                  if (maxval(abs(j(1:d) - c(1:d))) /= r) cycle
+                  bb = 1 + j1 + bins%n(1)*(j2 + bins%n(2)*j3)
+                  do q = bins%ptr(bb), bins%ptr(bb + 1) - 1
+                     call try(cand(bins%list(q)))
+                  end do
+               end do
+            end do
+         end do
+      end subroutine ring
+      !> Element e's nearest point to x(:, i) (reference coordinates clamped to its cell).
+      subroutine try(e)
+         integer, intent(in) :: e
+         real(wp) :: xi(3), dist
+         logical :: ok
+
+         call element_inverse_map(b%element_type, b%nodes(:, b%connectivity(1:nen, e)), x(:, i), xi(1:d), ok)
+         if (.not. ok) return
+         xi(1:d) = max(xi(1:d), 0.0_wp)
+         if (element_simplex(b%element_type)) then
+            if (sum(xi(1:d)) > 1.0_wp) xi(1:d) = xi(1:d)/sum(xi(1:d))
+         else
+            xi(1:d) = min(xi(1:d), 1.0_wp)
+         end if
+         call element_map(b%element_type, b%nodes(:, b%connectivity(1:nen, e)), xi(1:d), yc(1:d))
+         dist = norm2(yc(1:d) - x(:, i))
+         if (dist < best .or. (dist == best .and. e < elem(i))) then
+            best = dist
+            elem(i) = e
+            y(:, i) = yc(1:d)
+         end if
+      end subroutine try
+   end subroutine facing_points
 
    !> Validation of the bodies and pairs (module notes): what recover_on_mesh checks per
    !> body it checks itself; here the pairs and what they index.
