@@ -1663,29 +1663,62 @@ contains
       if (len(list) == 0) text = 'none'
    end function none_if_empty
 
-   !> Type of the &bc on shape `k`; without one, 'contact' for a contact
-   !> surface, else 'free'.
-   function surface_type(scene, k) result(type)
+   !> Type of the &bc on surface (shape `k`, group `g`; g = 0 the shape's
+   !> whole surface); without one, 'contact' for a contact surface, else
+   !> 'free'. A group without a condition of its own takes its shape's, so the
+   !> listings name it only when it has one (`surface_name_list`).
+   function surface_type(scene, k, g) result(type)
       type(scene_type), intent(in) :: scene
-      integer, intent(in) :: k
+      integer, intent(in) :: k, g
       character(len=:), allocatable :: type
       integer :: i
       type = 'free'
       do i = 1, size(scene%contacts)
-         if (scene%contacts(i)%slave_surface_index == k .or. scene%contacts(i)%master_surface_index == k) type = 'contact'
+         associate (c => scene%contacts(i))
+            if ((c%slave_surface_index == k .and. c%slave_group == g) .or. &
+               & (c%master_surface_index == k .and. c%master_group == g)) type = 'contact'
+         end associate
       end do
       do i = 1, size(scene%bcs)
-         if (scene%bcs(i)%shape_index == k) type = scene%bcs(i)%type
+         if (scene%bcs(i)%shape_index == k .and. scene%bcs(i)%group == g) type = scene%bcs(i)%type
       end do
    end function surface_type
 
+   !> The named surfaces (a shape's whole surface, then its groups that have a
+   !> condition of their own) whose type is one of `types` (blank separated),
+   !> quoted and joined.
+   function surface_name_list(scene, types) result(text)
+      type(scene_type), intent(in) :: scene
+      character(len=*), intent(in) :: types
+      character(len=:), allocatable :: text, type
+      integer :: k, g, ng
+      text = ''
+      do k = 1, size(scene%shapes)
+         ng = 0
+         if (allocated(scene%shapes(k)%facets%group_name)) ng = size(scene%shapes(k)%facets%group_name)
+         do g = 0, ng
+            type = surface_type(scene, k, g)
+            if (g > 0 .and. type == 'free' .and. .not. any(scene%bcs%shape_index == k .and. scene%bcs%group == g)) &
+               & cycle
+            if (.not. has_word(types, type)) cycle
+            if (g == 0) then
+               text = join(text, "'"//scene%shapes(k)%name//"'")
+            else
+               text = join(text, "'"//trim(scene%shapes(k)%facets%group_name(g))//"'")
+            end if
+         end do
+      end do
+   end function surface_name_list
+
+   !> Surfaces without a &bc and not in a contact.
    function free_surfaces(scene) result(text)
       type(scene_type), intent(in) :: scene
       character(len=:), allocatable :: text
       integer :: k
       text = ''
       do k = 1, size(scene%shapes)
-         if (any(scene%bcs%shape_index == k) .or. surface_type(scene, k) == 'contact') cycle
+         if (any(scene%bcs%shape_index == k .and. scene%bcs%group == 0) .or. surface_type(scene, k, 0) == 'contact') &
+            & cycle
          text = join(text, "'"//scene%shapes(k)%name//"'")
       end do
    end function free_surfaces
@@ -1695,25 +1728,14 @@ contains
    function traction_surfaces(scene) result(text)
       type(scene_type), intent(in) :: scene
       character(len=:), allocatable :: text
-      integer :: k
-      text = ''
-      do k = 1, size(scene%shapes)
-         select case (surface_type(scene, k))
-         case ('free', 'pressure', 'traction', 'exact_traction')
-            text = join(text, "'"//scene%shapes(k)%name//"'")
-         end select
-      end do
+      text = surface_name_list(scene, 'free pressure traction exact_traction')
    end function traction_surfaces
 
    function surfaces_of_type(scene, type) result(text)
       type(scene_type), intent(in) :: scene
       character(len=*), intent(in) :: type
       character(len=:), allocatable :: text
-      integer :: k
-      text = ''
-      do k = 1, size(scene%shapes)
-         if (surface_type(scene, k) == type) text = join(text, "'"//scene%shapes(k)%name//"'")
-      end do
+      text = surface_name_list(scene, type)
    end function surfaces_of_type
 
    function shape_line(shape) result(text)
