@@ -307,7 +307,7 @@ contains
       logical, intent(out) :: hit
       real(wp), intent(out) :: t
       real(wp), parameter :: margin = 64.0_wp*epsilon(1.0_wp)
-      real(wp) :: p(3, 3), y(3), m(3), x(3), b(3), e1(3), e2(3), nn(3), cosine
+      real(wp) :: p(3, 3), y(3), m(3), x(3), b(3), cosine
 
       hit = .false.
       t = 0.0_wp
@@ -320,18 +320,7 @@ contains
       if (.not. abs(cosine) > margin) return
       t = dot_product(p(:, 1) - y, self%normal(:, f))/cosine
       x = y + t*m
-      e1 = p(:, 2) - p(:, 1)
-      if (self%dim == 2) then
-         b(2) = dot_product(x - p(:, 1), e1)/dot_product(e1, e1)
-         b(1) = 1.0_wp - b(2)
-         b(3) = 0.0_wp
-      else
-         e2 = p(:, 3) - p(:, 1)
-         nn = cross(e1, e2)
-         b(2) = dot_product(cross(x - p(:, 1), e2), nn)/dot_product(nn, nn)
-         b(3) = dot_product(cross(e1, x - p(:, 1)), nn)/dot_product(nn, nn)
-         b(1) = 1.0_wp - b(2) - b(3)
-      end if
+      b = barycentric(self%dim, p, x)
       hit = all(b >= -margin)
    end subroutine solid_line_facet
 
@@ -560,7 +549,7 @@ contains
       real(wp), intent(in) :: y(3), t(3)
       logical, intent(out) :: hit, edge
       real(wp), parameter :: margin = 1.0e-9_wp
-      real(wp) :: p(3, 3), sy, st, r, x(3), b(3), e1(3), e2(3), nn(3), den
+      real(wp) :: p(3, 3), sy, st, r, x(3), b(3)
 
       hit = .false.
       edge = .false.
@@ -571,21 +560,7 @@ contains
       if (.not. (sy < st .or. sy > st)) return
       r = sy/(sy - st)
       x = y + r*(t - y)
-      if (self%dim == 2) then
-         e1 = p(:, 2) - p(:, 1)
-         den = dot_product(e1, e1)
-         b(1) = dot_product(x - p(:, 1), e1)/den
-         b(2) = 1.0_wp - b(1)
-         b(3) = 1.0_wp
-      else
-         e1 = p(:, 2) - p(:, 1)
-         e2 = p(:, 3) - p(:, 1)
-         nn = cross(e1, e2)
-         den = dot_product(nn, nn)
-         b(2) = dot_product(cross(x - p(:, 1), e2), nn)/den
-         b(3) = dot_product(cross(e1, x - p(:, 1)), nn)/den
-         b(1) = 1.0_wp - b(2) - b(3)
-      end if
+      b = barycentric(self%dim, p, x)
       if (any(b < -margin)) return
       if (any(b < margin) .or. min(abs(sy), abs(st)) <= margin*abs(sy - st)) then
          edge = .true.
@@ -593,6 +568,28 @@ contains
       end if
       hit = .true.
    end subroutine segment_crosses
+
+   !> Barycentric coordinates of x (in the plane of the facet with vertices
+   !> p) with respect to them; 2D: the segment's two, and 1 in the third (so
+   !> that a test over all three reads the same in 2D and 3D).
+   pure function barycentric(dim, p, x) result(b)
+      integer, intent(in) :: dim
+      real(wp), intent(in) :: p(3, 3), x(3)
+      real(wp) :: b(3), e1(3), e2(3), nn(3), den
+      e1 = p(:, 2) - p(:, 1)
+      if (dim == 2) then
+         b(2) = dot_product(x - p(:, 1), e1)/dot_product(e1, e1)
+         b(1) = 1.0_wp - b(2)
+         b(3) = 1.0_wp
+      else
+         e2 = p(:, 3) - p(:, 1)
+         nn = cross(e1, e2)
+         den = dot_product(nn, nn)
+         b(2) = dot_product(cross(x - p(:, 1), e2), nn)/den
+         b(3) = dot_product(cross(e1, x - p(:, 1)), nn)/den
+         b(1) = 1.0_wp - b(2) - b(3)
+      end if
+   end function barycentric
 
    ! ------------------------------------------------------------ boxes
 
