@@ -15,7 +15,9 @@ module sprc_test_contact_surface
    use sprc_geometry_body, only: body_type, new_body, csg_add, csg_subtract, csg_intersect
    use sprc_grid_tree, only: grid_type
    use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature
-   use sprc_contact_ray, only: ray_hit_type, nearest_crossing, max_visits
+   use sprc_contact_ray, only: ray_hit_type, nearest_crossing, facet_crossing, max_visits
+   use sprc_geometry_facets, only: facet_set_type
+   use sprc_geometry_shape, only: new_facet_shape
    use sprc_contact_surface, only: contact_surface_type, new_contact_surface, slave_surface_points, initial_gaps, &
       & linearized_gap
    use sprc_test_exact, only: expect_error, random => uniform
@@ -47,6 +49,8 @@ contains
          new_unittest('grazing_incidence', test_grazing), &
          new_unittest('ellipse_far_away', test_ellipse_far), &
          new_unittest('random_lines_box_cylinder', test_random_lines), &
+         new_unittest('facet_lines', test_facet_lines), &
+         new_unittest('facet_groups_and_csg', test_facet_groups), &
          new_unittest('line_in_the_surface', test_line_in_surface), &
          new_unittest('linearized_gap', test_linearized_gap), &
          new_unittest('errors', test_errors) &
@@ -609,6 +613,148 @@ contains
       end if
    end subroutine box_entry
 
+   !> Lines against a box given as 12 facets (facet_crossing: ray-facet
+   !> intersection through the hierarchy) and against the closed-form entry
+   !> point: found iff the line enters the box within the search length, at
+   !> the same t within the reported tolerance plus a few ulps (as
+   !> random_lines_box_cylinder on the primitive box).
+   subroutine test_facet_lines(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: body
+      type(ray_hit_type) :: hit
+      real(wp), parameter :: length = 10.0_wp, lo(3) = [-1.0_wp, -0.5_wp, -2.0_wp], hi(3) = [1.5_wp, 0.5_wp, 1.0_wp]
+      real(wp) :: x0(3), n(3), t_expected, margin
+      integer(i8) :: seed
+      integer :: k, decided, nhit
+      logical :: expect
+
+      call facet_box_body(body, lo, hi, error)
+      if (allocated(error)) return
+      seed = 2026_i8
+      decided = 0
+      nhit = 0
+      do k = 1, 400
+         x0 = 6.0_wp*[random(seed), random(seed), random(seed)] - 3.0_wp
+         n = 6.0_wp*[random(seed), random(seed), random(seed)] - 3.0_wp - x0
+         n = n/norm2(n)
+         if (all(x0 > lo .and. x0 < hi)) cycle
+         call box_entry(x0, n, lo, hi, t_expected, margin)
+         call facet_crossing(body, 1, 1, x0, n, 0.0_wp, length, .true., hit)
+         if (margin < 1.0e-9_wp .or. abs(t_expected - length) < 1.0e-9_wp) cycle
+         decided = decided + 1
+         expect = t_expected <= length
+         call check(error, hit%found .eqv. expect, 'facet line: hit iff it crosses')
+         if (allocated(error)) return
+         if (.not. expect) cycle
+         nhit = nhit + 1
+         call check(error, hit%t, t_expected, hit%tolerance + closed_form_ulps*(3.0_wp + t_expected), &
+            & 'facet line: t of the entry')
+         if (allocated(error)) return
+         call check(error, abs(dot_product(hit%normal, n)) > 0.0_wp .and. dot_product(hit%normal, n) <= 0.0_wp, &
+            & 'facet line: the normal faces the line')
+         if (allocated(error)) return
+      end do
+      call check(error, decided > 300 .and. nhit > 80 .and. decided - nhit > 80, &
+         & 'facet lines: most lines decided, many hits and many misses')
+   end subroutine test_facet_lines
+
+   !> Surfaces of a faceted box with groups 'top' (z = hi), 'bottom' and
+   !> 'side': a vertical line meets the group asked for only; a back-facing
+   !> group only without `facing`; a line through the diagonal edge that
+   !> splits the top face is met (closed facets); after an intersect with the
+   !> halfspace x >= 0 the top at x < 0 no longer bounds the body; a box
+   !> subtracted from a larger one (a cavity) has the flipped normals.
+   !> Exact values: every coordinate is a dyadic rational, so t is exact.
+   subroutine test_facet_groups(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(body_type) :: body, cut, cavity
+      type(shape_type) :: s
+      type(ray_hit_type) :: hit
+      real(wp), parameter :: lo(3) = [-0.5_wp, -0.5_wp, -0.5_wp], hi(3) = [0.5_wp, 0.5_wp, 0.25_wp]
+      real(wp), parameter :: down(3) = [0.0_wp, 0.0_wp, -1.0_wp]
+      integer :: top, bottom
+
+      call facet_box_body(body, lo, hi, error)
+      if (allocated(error)) return
+      top = body%surface_index('top')
+      bottom = body%surface_index('bottom')
+      call check(error, top > 1 .and. bottom > 1 .and. top /= bottom, 'group surface ids')
+      if (allocated(error)) return
+      call facet_crossing(body, 1, top, [0.125_wp, 0.25_wp, 1.0_wp], down, 0.0_wp, 4.0_wp, .true., hit)
+      call check(error, hit%found .and. hit%t == 0.75_wp .and. all(hit%normal == [0.0_wp, 0.0_wp, 1.0_wp]), &
+         & 'top group met at z = 0.25')
+      if (allocated(error)) return
+      call facet_crossing(body, 1, bottom, [0.125_wp, 0.25_wp, 1.0_wp], down, 0.0_wp, 4.0_wp, .true., hit)
+      call check(error, .not. hit%found, 'bottom group faces away from a line going down')
+      if (allocated(error)) return
+      call facet_crossing(body, 1, bottom, [0.125_wp, 0.25_wp, 1.0_wp], down, 0.0_wp, 4.0_wp, .false., hit)
+      call check(error, hit%found .and. hit%t == 1.5_wp, 'bottom group met at z = -0.5 without facing')
+      if (allocated(error)) return
+      ! the top face's two triangles share the diagonal x = y
+      call facet_crossing(body, 1, top, [0.375_wp, 0.375_wp, 1.0_wp], down, 0.0_wp, 4.0_wp, .true., hit)
+      call check(error, hit%found .and. hit%t == 0.75_wp, 'a line through the edge between two facets')
+      if (allocated(error)) return
+      cut = body
+      call new_halfspace(s, 'sym', [0.0_wp, 0.0_wp, 0.0_wp], [-1.0_wp, 0.0_wp, 0.0_wp], error)
+      if (allocated(error)) return
+      call cut%add_shape(csg_intersect, s, error)
+      if (allocated(error)) return
+      ! the group ids follow the shapes: the cut body's differ from the box's
+      top = cut%surface_index('top')
+      call facet_crossing(cut, 1, top, [-0.125_wp, 0.25_wp, 1.0_wp], down, 0.0_wp, 4.0_wp, .true., hit)
+      call check(error, .not. hit%found, 'top cut away at x < 0 does not bound the body')
+      if (allocated(error)) return
+      call facet_crossing(cut, 1, top, [0.125_wp, 0.25_wp, 1.0_wp], down, 0.0_wp, 4.0_wp, .true., hit)
+      call check(error, hit%found .and. hit%t == 0.75_wp, 'top kept at x > 0')
+      if (allocated(error)) return
+      call new_body(cavity, 'cavity')
+      call new_box(s, 'outer', [-2.0_wp, -2.0_wp, -2.0_wp], [2.0_wp, 2.0_wp, 2.0_wp], error)
+      if (allocated(error)) return
+      call cavity%add_shape(csg_add, s, error)
+      if (allocated(error)) return
+      call cavity%add_shape(csg_subtract, body%shapes(1), error)
+      if (allocated(error)) return
+      call facet_crossing(cavity, 2, cavity%surface_index('top'), [0.125_wp, 0.25_wp, 0.0_wp], -down, 0.0_wp, &
+         & 4.0_wp, .true., hit)
+      call check(error, hit%found .and. hit%t == 0.25_wp .and. all(hit%normal == [0.0_wp, 0.0_wp, -1.0_wp]), &
+         & 'cavity roof met from inside with the flipped normal')
+   end subroutine test_facet_groups
+
+   !> A body of one faceted box [lo, hi] of 12 triangles, outward, in the
+   !> groups 'top' (z = hi), 'bottom' (z = lo) and 'side'.
+   subroutine facet_box_body(body, lo, hi, error)
+      type(body_type), intent(out) :: body
+      real(wp), intent(in) :: lo(3), hi(3)
+      type(error_type), allocatable, intent(out) :: error
+      ! corners: bit 0 x, bit 1 y, bit 2 z; each face counter-clockwise from outside
+      integer, parameter :: quads(4, 6) = reshape([1, 3, 4, 2, 5, 6, 8, 7, 1, 2, 6, 5, 3, 7, 8, 4, 1, 5, 7, 3, &
+         & 2, 4, 8, 6], [4, 6])
+      integer, parameter :: face_group(6) = [2, 1, 3, 3, 3, 3]
+      type(facet_set_type) :: set
+      type(shape_type) :: s
+      integer :: i, f
+
+      set%dim = 3
+      set%nvert = 8
+      set%nfacet = 12
+      allocate (set%vert(3, 8), set%facet(3, 12), set%group(12), set%file_index(12))
+      do i = 1, 8
+         set%vert(:, i) = merge(hi, lo, [btest(i - 1, 0), btest(i - 1, 1), btest(i - 1, 2)])
+      end do
+      do f = 1, 6
+         set%facet(:, 2*f - 1) = quads([1, 2, 3], f)
+         set%facet(:, 2*f) = quads([1, 3, 4], f)
+         set%group(2*f - 1:2*f) = face_group(f)
+      end do
+      set%file_index = [(f - 1, f=1, 12)]
+      set%group_name = [character(len=64) :: 'top', 'bottom', 'side']
+      set%source = 'test box'
+      call new_facet_shape(s, 'box', set, error)
+      if (allocated(error)) return
+      call new_body(body, 'faceted')
+      call body%add_shape(csg_add, s, error)
+   end subroutine facet_box_body
+
    !> g = g0 + (u_m - u_s).n_s on the shaft-in-hub pair: a common rigid
    !> translation leaves g = g0; the hub moved by d changes g by d.n_s; the
    !> shaft expanded radially by e (u_s = e x) closes the gap by e |x|; an
@@ -706,7 +852,7 @@ contains
       call grid%build(disk, 2, [-1.5_wp, -1.5_wp], 3.0_wp, 2, 0, error)
       if (allocated(error)) return
       call initial_gaps(surf, disk, 2, grid, 1.0_wp, e)
-      call expect_error(error, e, "shape 2 of master body 'disk' does not exist", 'shape index')
+      call expect_error(error, e, "surface 2 of master body 'disk' does not exist", 'surface index')
       if (allocated(error)) return
       call initial_gaps(surf, disk, 1, grid, 0.0_wp, e)
       call expect_error(error, e, 'search_distance must be finite and > 0', 'distance 0')
@@ -731,7 +877,7 @@ contains
          & 'surface without points')
       if (allocated(error)) return
       call slave_surface_points(surf, grid, disk, quad, 3, e)
-      call expect_error(error, e, "shape 3 of body 'disk' does not exist", 'slave shape index')
+      call expect_error(error, e, "surface 3 of body 'disk' does not exist", 'slave surface index')
       if (allocated(error)) return
    end subroutine test_errors
 

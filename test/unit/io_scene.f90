@@ -56,6 +56,7 @@ contains
          new_unittest('contact_defaults', test_contact_defaults), &
          new_unittest('contact_shrink_fit', test_shrink_fit), &
          new_unittest('contact_hertz_roller', test_hertz_roller), &
+         new_unittest('contact_on_polygon_group', test_contact_group), &
          new_unittest('contact_uniform_exact', test_uniform_exact), &
          new_unittest('body_local_shape_indices', test_body_shapes), &
          new_unittest('missing_file', test_missing_file), &
@@ -540,6 +541,30 @@ contains
       if (allocated(error)) return
       call check(error, index(summary, 'box_size        = 1.0e100') > 0, 'box_size 1e100')
    end subroutine test_summary_reals
+
+   !> A contact surface named by a polygon edge (a group of a faceted shape):
+   !> its shape and group; the summary lists it among the contact surfaces and
+   !> its shape's rest (edges without a condition) as traction-free.
+   subroutine test_contact_group(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: s
+      character(len=:), allocatable :: summary
+      integer :: k
+      call read_file_ok('example/facets/hertz_cylinder_polygon.nml', s, error)
+      if (allocated(error)) return
+      k = s%contacts(1)%master_surface_index
+      call check(error, k > 0, 'master surface found')
+      if (allocated(error)) return
+      call check(error, s%shapes(k)%name == 'block_part' .and. s%contacts(1)%master_group > 0 .and. &
+         & s%contacts(1)%slave_group == 0, 'master: a group of block_part; slave: a whole shape')
+      if (allocated(error)) return
+      call check(error, s%shapes(k)%facets%group_name(s%contacts(1)%master_group) == 'block_top', 'group block_top')
+      if (allocated(error)) return
+      summary = scene_summary(s)
+      call check_switch(error, summary, 'SPR-C contact', "on (surfaces 'rim', 'block_top')")
+      if (allocated(error)) return
+      call check(error, index(summary, "traction-free (no &bc): 'block_part'") > 0, 'the rest of the polygon is free')
+   end subroutine test_contact_group
 
    subroutine test_contact(error)
       type(error_type), allocatable, intent(out) :: error

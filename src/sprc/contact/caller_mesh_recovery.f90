@@ -251,8 +251,8 @@ contains
          allocate (law0(0), slip0(d, 0), bf(d))
          bf = 0.0_wp
          if (associated(b%body_force)) bf = b%body_force
-         call new_grid_contact(other, 0, law0, slip0, max(mu, 0.0_wp), reshape(b%gp, [d, n]), reshape(b%gw, [n]), &
-            & reshape(b%gs, [ns, n]), b%young, b%poisson, bf, error, boundary=bnd)
+         call new_grid_contact(other, [integer ::], law0, slip0, max(mu, 0.0_wp), reshape(b%gp, [d, n]), &
+            & reshape(b%gw, [n]), reshape(b%gs, [ns, n]), b%young, b%poisson, bf, error, boundary=bnd)
       end associate
    end subroutine other_body
 

@@ -33,17 +33,28 @@
 !> a crossing at the midpoint, none a grazing touch (not a root). A line that
 !> runs in the surface (e.g. along a box face) is split only down to 2^-12 of
 !> the search interval, each piece one candidate, so the work stays bounded.
+!>
+!> A faceted shape's surface (`facet_crossing`) is met exactly instead: the
+!> facets whose boxes the search segment meets (through the facet hierarchy)
+!> are intersected with the line one by one; a crossing counts if it lies on
+!> the facet (closed, to a few ulps: a line through an edge meets both
+!> facets), on the asked surface (the whole shape or one named group), faces
+!> the line when asked (the facet's outward normal, flipped for a subtracted
+!> shape) and bounds the body. The crossing nearest the start wins, the
+!> lowest facet on a tie (an edge: either facet's normal is the body's).
+!> Its tolerance: t_tol plus the snapping length over |n . normal|.
 !> Tolerances: t_tol = 8 eps (|x0|_inf + max(|a|, |b|)) on a segment [a, b], a
 !> few ulps of the coordinates there. A root's reported `tolerance` bounds
 !> |t - t_exact|: half the final bracket plus tol_f/|f'(t)| (it grows towards
 !> tangency). More than `max_visits` segments (a guard against hangs) fails.
 module sprc_contact_ray
    use sprc_core_kinds, only: wp
-   use sprc_geometry_body, only: body_type, snap_tolerance
+   use sprc_geometry_body, only: body_type, snap_tolerance, csg_subtract
+   use sprc_geometry_facet_solid, only: solid_query_segment, solid_line_facet
    implicit none
    private
 
-   public :: ray_hit_type, nearest_crossing, position_tolerance, max_visits
+   public :: ray_hit_type, nearest_crossing, facet_crossing, position_tolerance, max_visits
 
    !> Guard on the segments one search may visit (module notes).
    integer, parameter :: max_visits = 100000
@@ -112,6 +123,59 @@ contains
          call search(body, line, t_hi, t_lo, hit, done)
       end if
    end subroutine nearest_crossing
+
+   !> The crossing of the line x0 + t n (n unit) with the faceted shape
+   !> `shape` of `body` where it bounds the body, on the facets of surface
+   !> `surface` of the body (the shape's id: every facet; a group's id: the
+   !> group's), the first in [t_lo, t_hi] from the end nearer to 0 (module
+   !> notes). `facing` as nearest_crossing's.
+   pure subroutine facet_crossing(body, shape, surface, x0, n, t_lo, t_hi, facing, hit)
+      class(body_type), intent(in) :: body
+      integer, intent(in) :: shape, surface
+      real(wp), intent(in) :: x0(:), n(:), t_lo, t_hi
+      logical, intent(in) :: facing
+      type(ray_hit_type), intent(out) :: hit
+      integer, allocatable :: list(:)
+      real(wp) :: t, near, x(3), m(3), pad, tol, t_tol
+      logical :: meets
+      integer :: i, f, g, nlist, d, best
+
+      d = size(x0)
+      near = merge(t_lo, t_hi, abs(t_lo) <= abs(t_hi))
+      best = 0
+      associate (solid => body%shapes(shape)%solid)
+         pad = snap_tolerance(body%shapes(shape), x0, x0) + position_tolerance(x0, t_lo, t_hi)
+         call solid_query_segment(solid, x0, n, min(t_lo, t_hi), max(t_lo, t_hi), pad, list, nlist)
+         hit%visits = nlist
+         do i = 1, nlist
+            f = list(i)
+            g = 0
+            if (allocated(solid%set%group)) g = solid%set%group(f)
+            if (surface /= shape .and. body%group_surface(shape, g) /= surface) cycle
+            call solid_line_facet(solid, f, x0, n, meets, t)
+            if (.not. meets .or. t < min(t_lo, t_hi) .or. t > max(t_lo, t_hi)) cycle
+            if (best > 0) then
+               if (abs(t - near) > abs(hit%t - near)) cycle
+               if (abs(t - near) == abs(hit%t - near) .and. f > best) cycle
+            end if
+            m = 0.0_wp
+            m(1:d) = solid%normal(1:d, f)
+            if (body%ops(shape) == csg_subtract) m = -m
+            if (facing .and. dot_product(m(1:d), n(1:d)) > 0.0_wp) cycle
+            x = 0.0_wp
+            x(1:d) = x0(1:d) + t*n(1:d)
+            t_tol = position_tolerance(x0, t, t)
+            tol = snap_tolerance(body%shapes(shape), x(1:d), x(1:d))
+            if (.not. body%is_boundary_on(x(1:d), shape, tol + t_tol)) cycle
+            best = f
+            hit%t = t
+            hit%tolerance = t_tol + tol/abs(dot_product(m(1:d), n(1:d)))
+            hit%x = x
+            hit%normal = m
+         end do
+      end associate
+      hit%found = best > 0
+   end subroutine facet_crossing
 
    !> Depth-first search of the segment from `near` to `far` (either order
    !> on the t axis), nearer half first. `done` once a root is accepted or

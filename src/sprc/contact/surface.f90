@@ -10,7 +10,8 @@
 !>
 !> Gap (`initial_gaps`): the line through a slave point x_s along its normal
 !> n_s is intersected with the master surface on the master body's exact
-!> implicit geometry (sprc_contact_ray). If x_s lies outside the master body
+!> implicit geometry (sprc_contact_ray; a faceted surface by ray-facet
+!> intersection through its facet hierarchy). If x_s lies outside the master body
 !> the crossing is sought ahead, t in [-margin, L]; if inside (the shapes
 !> overlap) behind, t in [-L, margin]; L = `search_distance`, margin four
 !> times the distance that the side test's tolerance stands for (tol over
@@ -32,11 +33,12 @@ module sprc_contact_surface
    use sprc_core_text, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_not_converged
    use sprc_core_alloc, only: check_allocation
-   use sprc_geometry_body, only: body_type, snap_tolerance, body_name, shape_name
+   use sprc_geometry_body, only: body_type, snap_tolerance, body_name
    use sprc_grid_tree, only: grid_type
    use sprc_grid_quadrature, only: cut_quadrature_type, cell_rule_type, cell_rule, boundary_face_rule
    use sprc_geometry_region, only: cell_inside
-   use sprc_contact_ray, only: ray_hit_type, nearest_crossing, position_tolerance
+   use sprc_contact_ray, only: ray_hit_type, nearest_crossing, facet_crossing, position_tolerance
+   use sprc_geometry_shape, only: shape_facets
    implicit none
    private
 
@@ -114,8 +116,9 @@ contains
       call check_allocation(stat, 'contact surface', 'its points', n, 8*(2*d + 1) + 4, error)
    end subroutine new_contact_surface
 
-   !> The surface points of shape `shape` of `body` from the cut-cell rules of
-   !> every leaf of its grid, in leaf order. With `split_grid` (the master
+   !> The surface points of surface `surface` of `body` (a surface id,
+   !> sprc_geometry_body: a shape's whole surface with its facet groups, or one
+   !> group) from the cut-cell rules of every leaf of its grid, in leaf order. With `split_grid` (the master
    !> body's grid) each leaf holding such points is cut into sub-boxes at the
    !> planes of that grid's finest lattice (every master leaf face lies on
    !> one), and the rules are taken on the sub-boxes: then no part of the
@@ -123,12 +126,12 @@ contains
    !> surfaces touch, and a master displacement piecewise polynomial over the
    !> master cells is integrated exactly (the contact patch test; without it
    !> the Gauss points of a slave cell integrate across the master's kinks).
-   subroutine slave_surface_points(self, grid, body, quad, shape, error, split_grid)
+   subroutine slave_surface_points(self, grid, body, quad, surface, error, split_grid)
       type(contact_surface_type), intent(out) :: self
       type(grid_type), intent(in) :: grid
       type(body_type), intent(in) :: body
       type(cut_quadrature_type), intent(in) :: quad
-      integer, intent(in) :: shape
+      integer, intent(in) :: surface
       type(error_type), allocatable, intent(out) :: error
       type(grid_type), intent(in), optional :: split_grid
       type(cell_rule_type) :: rule
@@ -138,9 +141,9 @@ contains
       type(planes_type) :: planes(3)
       integer :: leaf, n, d, j(3), k, stat
 
-      if (shape < 1 .or. shape > body%nshape) then
-         call fatal_error(error, "contact surface: shape "//itoa(shape)//" of body '"//body_name(body)// &
-            & "' does not exist (it has "//itoa(body%nshape)//')')
+      if (surface < 1 .or. surface > body%nsurface()) then
+         call fatal_error(error, "contact surface: surface "//itoa(surface)//" of body '"//body_name(body)// &
+            & "' does not exist (it has "//itoa(body%nsurface())//')')
          return
       end if
       d = grid%dim
@@ -181,7 +184,7 @@ contains
          end do
       end do
       if (n == 0) then
-         call fatal_error(error, "contact surface: surface '"//shape_name(body%shapes(shape))//"' of body '"// &
+         call fatal_error(error, "contact surface: surface '"//body%surface_name(surface)//"' of body '"// &
             & body_name(body)//"' has no quadrature points on the grid (it does not bound the body)")
          return
       end if
@@ -202,10 +205,10 @@ contains
          if (allocated(error)) error%message = 'contact surface, leaf '//itoa(leaf)//': '//error%message
       end subroutine leaf_rule
 
-      !> Is surface id on the contact shape (the shape or one of its faceted groups)?
+      !> Is a point of surface id on the contact surface?
       elemental logical function on_shape(id)
          integer, intent(in) :: id
-         on_shape = body%surface_shape(id) == shape
+         on_shape = body%surface_part(surface, id)
       end function on_shape
 
       subroutine collect(leaf, rule)
@@ -270,20 +273,20 @@ contains
       call move_alloc(c2, cell)
    end subroutine grow
 
-   !> Initial gaps of every slave point to shape `shape` of `master` (module
-   !> notes), searched up to `search_distance` along the normal; master
-   !> points located in `master_grid`.
-   subroutine initial_gaps(self, master, shape, master_grid, search_distance, error)
+   !> Initial gaps of every slave point to surface `surface` of `master` (a
+   !> surface id as for `slave_surface_points`; module notes), searched up to
+   !> `search_distance` along the normal; master points located in `master_grid`.
+   subroutine initial_gaps(self, master, surface, master_grid, search_distance, error)
       type(contact_surface_type), intent(inout) :: self
       type(body_type), intent(in) :: master
-      integer, intent(in) :: shape
+      integer, intent(in) :: surface
       type(grid_type), intent(in) :: master_grid
       real(wp), intent(in) :: search_distance
       type(error_type), allocatable, intent(out) :: error
       type(ray_hit_type) :: hit
       integer :: i, stat
 
-      call check_gap_input(self, master, shape, master_grid, search_distance, error)
+      call check_gap_input(self, master, surface, master_grid, search_distance, error)
       if (allocated(error)) return
       associate (d => self%dim, n => self%npoint)
          if (allocated(self%has_master)) deallocate (self%has_master, self%g0, self%g0_tolerance, self%master_x, &
@@ -296,7 +299,7 @@ contains
          call check_allocation(stat, 'contact gap', 'the master points', n, 8*(2*d + 2) + 8, error)
          if (allocated(error)) return
          do i = 1, n
-            call gap_of_point(master, shape, self%x(:, i), self%normal(:, i), search_distance, hit)
+            call gap_of_point(master, surface, self%x(:, i), self%normal(:, i), search_distance, hit)
             if (hit%exhausted) then
                call fatal_error(error, 'contact gap: the search along the normal of slave point '//itoa(i)// &
                   & ' did not isolate a crossing within '//itoa(hit%visits - 1)//' segments', stat_not_converged)
@@ -346,17 +349,17 @@ contains
       end do
    end subroutine linearized_gap
 
-   subroutine check_gap_input(self, master, shape, master_grid, search_distance, error)
+   subroutine check_gap_input(self, master, surface, master_grid, search_distance, error)
       type(contact_surface_type), intent(in) :: self
       type(body_type), intent(in) :: master
-      integer, intent(in) :: shape
+      integer, intent(in) :: surface
       type(grid_type), intent(in) :: master_grid
       real(wp), intent(in) :: search_distance
       type(error_type), allocatable, intent(out) :: error
 
-      if (shape < 1 .or. shape > master%nshape) then
-         call fatal_error(error, "contact gap: shape "//itoa(shape)//" of master body '"//body_name(master)// &
-            & "' does not exist (it has "//itoa(master%nshape)//')')
+      if (surface < 1 .or. surface > master%nsurface()) then
+         call fatal_error(error, "contact gap: surface "//itoa(surface)//" of master body '"//body_name(master)// &
+            & "' does not exist (it has "//itoa(master%nsurface())//')')
       else if (master%dim /= self%dim .or. master_grid%dim /= self%dim) then
          call fatal_error(error, 'contact gap: slave points are '//itoa(self%dim)//'D, the master body '// &
             & itoa(master%dim)//'D, its grid '//itoa(master_grid%dim)//'D')
@@ -367,12 +370,15 @@ contains
 
    !> The crossing for one slave point: ahead if x is outside the master body
    !> (or on it), behind if inside.
-   pure subroutine gap_of_point(master, shape, x, n, search_distance, hit)
+   pure subroutine gap_of_point(master, surface, x, n, search_distance, hit)
       type(body_type), intent(in) :: master
-      integer, intent(in) :: shape
+      integer, intent(in) :: surface
       real(wp), intent(in) :: x(:), n(:), search_distance
       type(ray_hit_type), intent(out) :: hit
-      real(wp) :: tol, margin, slope
+      real(wp) :: tol, margin, slope, t_lo, t_hi
+      integer :: shape
+
+      shape = master%surface_shape(surface)
 
       ! Within tol of the surface the side is not decided: start the search a
       ! margin behind, the distance that tol can stand for (tol/|grad phi|).
@@ -380,9 +386,16 @@ contains
       slope = max(norm2(master%shapes(shape)%gradient(x)), epsilon(1.0_wp))
       margin = min(search_distance, 4.0_wp*(tol/slope + position_tolerance(x, 0.0_wp, 0.0_wp)))
       if (master%phi(x) < -tol) then
-         call nearest_crossing(master, shape, x, n, -search_distance, margin, .true., hit)
+         t_lo = -search_distance
+         t_hi = margin
       else
-         call nearest_crossing(master, shape, x, n, -margin, search_distance, .true., hit)
+         t_lo = -margin
+         t_hi = search_distance
+      end if
+      if (master%shapes(shape)%kind == shape_facets) then
+         call facet_crossing(master, shape, surface, x, n, t_lo, t_hi, .true., hit)
+      else
+         call nearest_crossing(master, shape, x, n, t_lo, t_hi, .true., hit)
       end if
    end subroutine gap_of_point
 

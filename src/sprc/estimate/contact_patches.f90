@@ -64,9 +64,10 @@ module sprc_estimate_contact_patches
 
    !> One body's contact surface for the grid recovery (module notes).
    type :: grid_contact_type
-      !> The body's shape index of its contact surface (the bshape of its boundary points).
-      integer :: shape = 0
-      !> Per boundary point k of the body's recovery input (read where bshape(k) = shape): the
+      !> The surface ids of the body's contact surface (the bshape values of its boundary
+      !> points there: a shape's, and those of its facet groups).
+      integer, allocatable :: surfaces(:)
+      !> Per boundary point k of the body's recovery input (read where bshape(k) is in surfaces): the
       !> contact law (contact_law_frictionless, _slip, _stick; 0 = open) and, for slip, the slip
       !> direction of this body relative to the other, slip(1:dim, k).
       integer, allocatable :: law(:)
@@ -88,14 +89,14 @@ module sprc_estimate_contact_patches
 
 contains
 
-   !> The contact description of one body: `shape`, law(k) and slip(1:dim, k) per boundary
+   !> The contact description of one body: `surfaces`, law(k) and slip(1:dim, k) per boundary
    !> point of its recovery input, mu, and the other body's volume points y(1:dim, j), weights
    !> w(j), FE stresses stress(:, j), material and body force. Errors (stat_invalid_input):
    !> sizes that disagree, an unknown law, a non-finite point.
-   subroutine new_grid_contact(self, shape, law, slip, mu, y, w, stress, young, poisson, body_force, error, depth, &
+   subroutine new_grid_contact(self, surfaces, law, slip, mu, y, w, stress, young, poisson, body_force, error, depth, &
       & boundary)
       type(grid_contact_type), intent(out) :: self
-      integer, intent(in) :: shape, law(:)
+      integer, intent(in) :: surfaces(:), law(:)
       real(wp), intent(in) :: slip(:, :), mu, y(:, :), w(:), stress(:, :), young, poisson, body_force(:)
       type(error_type), allocatable, intent(out) :: error
       real(wp), intent(in), optional :: depth
@@ -118,7 +119,7 @@ contains
          call fatal_error(error, 'grid contact: the other body''s points are not finite', stat_invalid_input)
          return
       end if
-      self%shape = shape
+      self%surfaces = surfaces
       self%law = law
       self%slip = slip
       self%mu = mu

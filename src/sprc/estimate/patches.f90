@@ -28,15 +28,13 @@
 !> sprc_recovery_patch_loop; this module supplies the grid's patches (`grid_source_type`)
 !> and names a failing patch by its node.
 !>
-!> Contact (SPR-C with a `grid_contact_type`, sprc_estimate_contact_patches): the body's boundary points
-!> on the contact shape are contact points where their law is closed and free-surface
-!> (zero-traction) points where it is open; a patch holding a contact point is solved by
-!> the coupled contact solve (contact wins, the thesis), expanded like any other patch when it
-!> lacks rank. A body of several pairs has one description per pair (`contacts`): a point
-!> is a contact point of the first pair that closes it. A patch holding contact points of
-!> several pairs is solved with the pair holding most (the first on a tie), the others'
-!> points left out: a coupled solve has one other body, and their points are neither free
-!> nor in contact with it.
+!> Contact (SPR-C with a `grid_contact_type`, sprc_estimate_contact_patches): boundary points
+!> on the contact surface (surface ids: a shape's with its facet groups, or one group) are
+!> contact points where their law is closed, free-surface points where it is open; a patch
+!> holding one is solved by the coupled contact solve (contact wins, the thesis). A body of
+!> several pairs has one description per pair (`contacts`): a point belongs to the first
+!> that closes it; a patch with points of several pairs takes the pair holding most (the
+!> first on a tie) and leaves the others' out (a coupled solve has one other body).
 module sprc_estimate_patches
    use sprc_core_kinds, only: wp
    use sprc_core_text, only: itoa, rtoa
@@ -550,7 +548,7 @@ contains
 
       d = self%nodes%dim
       if (associated(self%contacts)) then
-         if (any(self%contacts%shape == self%input%bshape(k))) then
+         if (on_contact(self, k)) then
             t = 0.0_wp
             kind = merge(boundary_contact, boundary_traction, contact_of(self, k) > 0)
             return
@@ -614,13 +612,24 @@ contains
       call recover_patch_default(self, node, elements, patch, degree, sprc, ws, rec, error)
    end subroutine grid_recover
 
+   !> Is boundary point k on the contact surface of one of the contacts?
+   pure logical function on_contact(self, k)
+      class(grid_source_type), intent(in) :: self
+      integer, intent(in) :: k
+      integer :: i
+      on_contact = .false.
+      do i = 1, size(self%contacts)
+         if (any(self%contacts(i)%surfaces == self%input%bshape(k))) on_contact = .true.
+      end do
+   end function on_contact
+
    !> The contact description (index into `contacts`) that closes boundary point k: the
    !> first whose shape k lies on with a closed law; 0 if none (module notes).
    pure integer function contact_of(self, k)
       class(grid_source_type), intent(in) :: self
       integer, intent(in) :: k
       do contact_of = 1, size(self%contacts)
-         if (self%contacts(contact_of)%shape /= self%input%bshape(k)) cycle
+         if (.not. any(self%contacts(contact_of)%surfaces == self%input%bshape(k))) cycle
          if (self%contacts(contact_of)%law(k) /= 0) return
       end do
       contact_of = 0
@@ -654,11 +663,11 @@ contains
    end subroutine one_pair_patch
 
    !> The recovery boundary points of `input` (kinds and tractions as the patches take them,
-   !> bc_none left out) other than those on shape `skip_shape`, in the boundary arrays of
+   !> bc_none left out) other than those on the surfaces `skip` (ids), in the boundary arrays of
    !> `points` (a contact's other body, sprc_estimate_contact_patches). `exact` as recover_grid's.
-   subroutine boundary_points(input, dim, skip_shape, points, exact)
+   subroutine boundary_points(input, dim, skip, points, exact)
       type(recovery_input_type), intent(in) :: input
-      integer, intent(in) :: dim, skip_shape
+      integer, intent(in) :: dim, skip(:)
       type(patch_type), intent(out) :: points
       class(exact_solution_type), intent(in), optional :: exact
       real(wp) :: t(3)
@@ -668,7 +677,7 @@ contains
       ! One reservation (adding points one by one would grow the arrays at every point).
       call patch_reserve(points, 0, size(input%bw))
       do k = 1, size(input%bw)
-         if (input%bshape(k) == skip_shape) cycle
+         if (any(skip == input%bshape(k))) cycle
          call boundary_data(input, k, dim, kind, t, exact)
          if (kind == 0) cycle
          points%nbpoints = points%nbpoints + 1

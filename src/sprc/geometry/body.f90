@@ -85,6 +85,8 @@ module sprc_geometry_body
       procedure :: surface_shape
       procedure :: surface_name
       procedure :: group_surface
+      procedure :: surface_part
+      procedure :: surface_parts
    end type body_type
 
 contains
@@ -257,6 +259,28 @@ contains
       end do
       id = id + g
    end function group_surface
+
+   !> Is surface `part` (the id a surface point carries) part of surface `id`:
+   !> the same, or a group of shape `id`'s file?
+   pure logical function surface_part(self, id, part)
+      class(body_type), intent(in) :: self
+      integer, intent(in) :: id, part
+      surface_part = part == id
+      if (surface_part .or. id < 1 .or. id > self%nshape) return
+      surface_part = self%surface_shape(part) == id
+   end function surface_part
+
+   !> The ids of the points of surface `id` (`surface_part`): id, and for a
+   !> faceted shape's whole surface the ids of its groups.
+   pure function surface_parts(self, id) result(ids)
+      class(body_type), intent(in) :: self
+      integer, intent(in) :: id
+      integer, allocatable :: ids(:)
+      integer :: g
+      ids = [id]
+      if (id < 1 .or. id > self%nshape) return
+      ids = [id, (self%group_surface(id, g), g=1, ngroup(self%shapes(id)))]
+   end function surface_parts
 
    !> Named groups of a faceted shape (0 for the other kinds).
    pure integer function ngroup(shape)

@@ -5,7 +5,9 @@
 !> Hierarchy: binary tree over the facets' bounding boxes, split at the median
 !> centroid along the longest centroid extent (quickselect: O(n log n) build),
 !> at most `leaf_size` facets per leaf. Queries: facets whose box meets a
-!> box, nearest facet of a point (branch and bound), crossings of a segment.
+!> box, facets whose box meets a segment (slab test: the cost grows with the
+!> facets near the segment, not with all of them), nearest facet of a point
+!> (branch and bound), crossings of a segment.
 !>
 !> Inside test (`solid_inside`): parity of the crossings of the segment from
 !> the point to the centroid of its nearest facet f, combined with the side
@@ -31,7 +33,7 @@ module sprc_geometry_facet_solid
    private
 
    public :: facet_solid_type, new_facet_solid
-   public :: solid_query_box, solid_nearest, solid_inside, solid_box_class
+   public :: solid_query_box, solid_query_segment, solid_line_facet, solid_nearest, solid_inside, solid_box_class
    public :: clip_to_box, polygon_measure, facet_points, snap_area, snap_length, on_face_plane, face_cover
 
    !> Facets per leaf of the hierarchy.
@@ -238,6 +240,89 @@ contains
          end if
       end do
    end subroutine solid_query_box
+
+   !> Facets whose bounding box, padded by `pad`, meets the segment x0 + t n,
+   !> t in [ta, tb] (ta <= tb; x0, n of size dim): list(1:n), grown as
+   !> needed, in hierarchy order.
+   pure subroutine solid_query_segment(self, x0, n, ta, tb, pad, list, nlist)
+      type(facet_solid_type), intent(in) :: self
+      real(wp), intent(in) :: x0(:), n(:), ta, tb, pad
+      integer, allocatable, intent(inout) :: list(:)
+      integer, intent(out) :: nlist
+      integer :: stack(128), top, node, i
+
+      nlist = 0
+      if (.not. allocated(list)) allocate (list(64))
+      top = 1
+      stack(1) = 1
+      do while (top > 0)
+         node = stack(top)
+         top = top - 1
+         if (.not. segment_meets_box(self%dim, x0, n, ta, tb, self%lo(:, node) - pad, self%hi(:, node) + pad)) cycle
+         if (self%count(node) > 0) then
+            do i = self%first(node), self%first(node) + self%count(node) - 1
+               call push_int(list, nlist, self%order(i))
+            end do
+         else
+            stack(top + 1) = self%right(node)
+            stack(top + 2) = node + 1
+            top = top + 2
+         end if
+      end do
+   end subroutine solid_query_segment
+
+   !> Slab test: does x0 + t n, t in [ta, tb], meet the closed box [lo, hi]?
+   pure logical function segment_meets_box(d, x0, n, ta, tb, lo, hi) result(meets)
+      integer, intent(in) :: d
+      real(wp), intent(in) :: x0(:), n(:), ta, tb, lo(:), hi(:)
+      real(wp) :: t0, t1, a, b
+      integer :: k
+
+      t0 = ta
+      t1 = tb
+      meets = .false.
+      do k = 1, d
+         if (n(k) == 0.0_wp) then
+            if (x0(k) < lo(k) .or. x0(k) > hi(k)) return
+            cycle
+         end if
+         a = (lo(k) - x0(k))/n(k)
+         b = (hi(k) - x0(k))/n(k)
+         t0 = max(t0, min(a, b))
+         t1 = min(t1, max(a, b))
+         if (t0 > t1) return
+      end do
+      meets = .true.
+   end function segment_meets_box
+
+   !> Where the line x0 + t n (n unit, size dim) crosses facet f: `hit` if it
+   !> meets the closed facet (barycentric coordinates >= -margin, margin a
+   !> few ulps, so that a line through a shared edge or vertex meets every
+   !> facet there) and is not parallel to its plane (|n . normal| above
+   !> rounding); then t.
+   pure subroutine solid_line_facet(self, f, x0, n, hit, t)
+      type(facet_solid_type), intent(in) :: self
+      integer, intent(in) :: f
+      real(wp), intent(in) :: x0(:), n(:)
+      logical, intent(out) :: hit
+      real(wp), intent(out) :: t
+      real(wp), parameter :: margin = 64.0_wp*epsilon(1.0_wp)
+      real(wp) :: p(3, 3), y(3), m(3), x(3), b(3), cosine
+
+      hit = .false.
+      t = 0.0_wp
+      call facet_points(self, f, p)
+      y = 0.0_wp
+      m = 0.0_wp
+      y(1:self%dim) = x0(1:self%dim)
+      m(1:self%dim) = n(1:self%dim)
+      cosine = dot_product(m, self%normal(:, f))
+      if (.not. abs(cosine) > margin) return
+      t = dot_product(p(:, 1) - y, self%normal(:, f))/cosine
+      x = y + t*m
+      b = barycentric(self%dim, p, x)
+      hit = all(b >= -margin)
+   end subroutine solid_line_facet
 
    pure subroutine push_int(list, n, v)
       integer, allocatable, intent(inout) :: list(:)
@@ -464,7 +549,7 @@ contains
       real(wp), intent(in) :: y(3), t(3)
       logical, intent(out) :: hit, edge
       real(wp), parameter :: margin = 1.0e-9_wp
-      real(wp) :: p(3, 3), sy, st, r, x(3), b(3), e1(3), e2(3), nn(3), den
+      real(wp) :: p(3, 3), sy, st, r, x(3), b(3)
 
       hit = .false.
       edge = .false.
@@ -475,21 +560,7 @@ contains
       if (.not. (sy < st .or. sy > st)) return
       r = sy/(sy - st)
       x = y + r*(t - y)
-      if (self%dim == 2) then
-         e1 = p(:, 2) - p(:, 1)
-         den = dot_product(e1, e1)
-         b(1) = dot_product(x - p(:, 1), e1)/den
-         b(2) = 1.0_wp - b(1)
-         b(3) = 1.0_wp
-      else
-         e1 = p(:, 2) - p(:, 1)
-         e2 = p(:, 3) - p(:, 1)
-         nn = cross(e1, e2)
-         den = dot_product(nn, nn)
-         b(2) = dot_product(cross(x - p(:, 1), e2), nn)/den
-         b(3) = dot_product(cross(e1, x - p(:, 1)), nn)/den
-         b(1) = 1.0_wp - b(2) - b(3)
-      end if
+      b = barycentric(self%dim, p, x)
       if (any(b < -margin)) return
       if (any(b < margin) .or. min(abs(sy), abs(st)) <= margin*abs(sy - st)) then
          edge = .true.
@@ -497,6 +568,28 @@ contains
       end if
       hit = .true.
    end subroutine segment_crosses
+
+   !> Barycentric coordinates of x (in the plane of the facet with vertices
+   !> p) with respect to them; 2D: the segment's two, and 1 in the third (so
+   !> that a test over all three reads the same in 2D and 3D).
+   pure function barycentric(dim, p, x) result(b)
+      integer, intent(in) :: dim
+      real(wp), intent(in) :: p(3, 3), x(3)
+      real(wp) :: b(3), e1(3), e2(3), nn(3), den
+      e1 = p(:, 2) - p(:, 1)
+      if (dim == 2) then
+         b(2) = dot_product(x - p(:, 1), e1)/dot_product(e1, e1)
+         b(1) = 1.0_wp - b(2)
+         b(3) = 1.0_wp
+      else
+         e2 = p(:, 3) - p(:, 1)
+         nn = cross(e1, e2)
+         den = dot_product(nn, nn)
+         b(2) = dot_product(cross(x - p(:, 1), e2), nn)/den
+         b(3) = dot_product(cross(e1, x - p(:, 1)), nn)/den
+         b(1) = 1.0_wp - b(2) - b(3)
+      end if
+   end function barycentric
 
    ! ------------------------------------------------------------ boxes
 

@@ -517,7 +517,7 @@ contains
             call get_name(g, 'on', bc%on, error)
             if (allocated(error)) return
             bc%shape_index = shape_index(scene, bc%on)
-            call check_unambiguous(g, scene, bc%on, bc%shape_index, error)
+            call check_unambiguous(g, 'on', scene, bc%on, bc%shape_index, error)
             if (allocated(error)) return
             if (bc%shape_index == 0) then
                call group_surface(scene%shapes, bc%on, bc%shape_index, bc%group, error)
@@ -565,8 +565,9 @@ contains
    !> A shape's name that is also a group of another shape's file could mean
    !> either surface: refused. (A group named like its own shape is that
    !> shape's whole surface when `on` names it.)
-   subroutine check_unambiguous(g, scene, name, k, error)
+   subroutine check_unambiguous(g, key, scene, name, k, error)
       type(nml_group_type), intent(in) :: g
+      character(len=*), intent(in) :: key
       type(scene_type), intent(in) :: scene
       character(len=*), intent(in) :: name
       integer, intent(in) :: k
@@ -576,7 +577,7 @@ contains
       do j = 1, size(scene%shapes)
          if (j == k .or. .not. allocated(scene%shapes(j)%facets%group_name)) cycle
          if (.not. any(scene%shapes(j)%facets%group_name == name)) cycle
-         call nml_field_error(g, 'on', "names shape '"//name//"' and a group of the file of shape '"// &
+         call nml_field_error(g, key, "names shape '"//name//"' and a group of the file of shape '"// &
             & scene%shapes(j)%name//"': rename one", error)
          return
       end do
@@ -595,9 +596,7 @@ contains
 
       n = size(bcs)
       do j = 1, n - 1
-         if (bcs(j)%shape_index /= bcs(n)%shape_index) cycle
-         ! Two groups of one file are two surfaces; a group is part of the whole.
-         if (bcs(j)%group /= bcs(n)%group .and. bcs(j)%group > 0 .and. bcs(n)%group > 0) cycle
+         if (.not. surfaces_overlap(bcs(j)%shape_index, bcs(j)%group, bcs(n)%shape_index, bcs(n)%group)) cycle
          if (bcs(j)%type /= bcs(n)%type .or. .not. any(bcs(n)%type == [character(len=12) :: 'pressure', &
             & 'traction', 'displacement'])) then
             call nml_field_error(g, 'on', "this surface already has a &bc of type = '"//bcs(j)%type// &
@@ -1023,10 +1022,10 @@ contains
                return
             end if
             call get_surface_ref(g, 'slave_surface', scene, c%slave_index, c%slave_surface, &
-               & c%slave_surface_index, error)
+               & c%slave_surface_index, c%slave_group, error)
             if (allocated(error)) return
             call get_surface_ref(g, 'master_surface', scene, c%master_index, c%master_surface, &
-               & c%master_surface_index, error)
+               & c%master_surface_index, c%master_group, error)
             if (allocated(error)) return
             c%friction = 'frictionless'
             call get_choice(g, 'friction', frictions, .false., c%friction, error)
@@ -1088,13 +1087,16 @@ contains
                   & (o%slave_index == c%master_index .and. o%master_index == c%slave_index)) then
                   call nml_field_error(g, 'master', "bodies '"//c%slave//"' and '"//c%master//"' are already "// &
                      & 'a pair (&contact '//itoa(k)//'): two bodies touch through one pair', error)
-               else if (o%slave_surface_index == c%slave_surface_index) then
+               else if (surfaces_overlap(o%slave_surface_index, o%slave_group, c%slave_surface_index, &
+                  & c%slave_group)) then
                   call nml_field_error(g, 'slave_surface', 'is already the slave surface of &contact '//itoa(k)// &
                      & ': a slave point has one master', error)
-               else if (o%master_surface_index == c%slave_surface_index) then
+               else if (surfaces_overlap(o%master_surface_index, o%master_group, c%slave_surface_index, &
+                  & c%slave_group)) then
                   call nml_field_error(g, 'slave_surface', 'is the master surface of &contact '//itoa(k)// &
                      & ': a surface is the slave or the master of its pairs, not both', error)
-               else if (o%slave_surface_index == c%master_surface_index) then
+               else if (surfaces_overlap(o%slave_surface_index, o%slave_group, c%master_surface_index, &
+                  & c%master_group)) then
                   call nml_field_error(g, 'master_surface', 'is the slave surface of &contact '//itoa(k)// &
                      & ': a surface is the slave or the master of its pairs, not both', error)
                end if
@@ -1103,6 +1105,14 @@ contains
          end do
       end associate
    end subroutine check_pair_unique
+
+   !> Do surface (shape k1, group g1) and (k2, g2) share points? Two groups of
+   !> one file are two surfaces; a group (g > 0) is part of its shape's whole
+   !> surface (g = 0).
+   pure logical function surfaces_overlap(k1, g1, k2, g2)
+      integer, intent(in) :: k1, g1, k2, g2
+      surfaces_overlap = k1 == k2 .and. (g1 == g2 .or. g1 == 0 .or. g2 == 0)
+   end function surfaces_overlap
 
    !> A compound exact solution needs a &contact between its inner and outer
    !> bodies, a Hertz one a &contact at all: without it their fields do not hold.
@@ -1165,26 +1175,44 @@ contains
    end subroutine get_body_ref
 
    !> A shape surface that must belong to body `ibody`.
-   subroutine get_surface_ref(g, key, scene, ibody, name, index, error)
+   subroutine get_surface_ref(g, key, scene, ibody, name, index, group, error)
       type(nml_group_type), intent(inout) :: g
       character(len=*), intent(in) :: key
       type(scene_type), intent(in) :: scene
       integer, intent(in) :: ibody
       character(len=:), allocatable, intent(out) :: name
-      integer, intent(out) :: index
+      integer, intent(out) :: index, group
       type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: why
+      integer :: k
       index = 0
+      group = 0
       call get_name(g, key, name, error)
       if (allocated(error)) return
       index = shape_index(scene, name)
+      call check_unambiguous(g, key, scene, name, index, error)
+      if (allocated(error)) return
       if (index == 0) then
-         call nml_field_error(g, key, 'no &shape has this name; surfaces: '//shape_names(scene), error)
+         call group_surface(scene%shapes, name, index, group, error)
+         if (allocated(error)) then
+            why = error%message
+            call nml_field_error(g, key, why//'; surfaces: '//shape_names(scene), error)
+            return
+         end if
+      end if
+      if (index == 0) then
+         call nml_field_error(g, key, 'no &shape and no group of a faceted shape has this name; surfaces: '// &
+            & shape_names(scene), error)
       else if (scene%shapes(index)%body_index /= ibody) then
          call nml_field_error(g, key, "is a surface of body '"//scene%shapes(index)%body//"', not of '"// &
             & scene%bodies(ibody)%name//"'", error)
-      else if (any(scene%bcs%shape_index == index)) then
-         call nml_field_error(g, key, "has a &bc (type = '"//scene%bcs(findloc(scene%bcs%shape_index, index, 1))%type// &
-            & "'): a contact surface takes its conditions from &contact alone", error)
+      else
+         do k = 1, size(scene%bcs)
+            if (.not. surfaces_overlap(scene%bcs(k)%shape_index, scene%bcs(k)%group, index, group)) cycle
+            call nml_field_error(g, key, "has a &bc (type = '"//scene%bcs(k)%type// &
+               & "'): a contact surface takes its conditions from &contact alone", error)
+            return
+         end do
       end if
    end subroutine get_surface_ref
 
@@ -1645,29 +1673,62 @@ contains
       if (len(list) == 0) text = 'none'
    end function none_if_empty
 
-   !> Type of the &bc on shape `k`; without one, 'contact' for a contact
-   !> surface, else 'free'.
-   function surface_type(scene, k) result(type)
+   !> Type of the &bc on surface (shape `k`, group `g`; g = 0 the shape's
+   !> whole surface); without one, 'contact' for a contact surface, else
+   !> 'free'. A group without a condition of its own takes its shape's, so the
+   !> listings name it only when it has one (`surface_name_list`).
+   function surface_type(scene, k, g) result(type)
       type(scene_type), intent(in) :: scene
-      integer, intent(in) :: k
+      integer, intent(in) :: k, g
       character(len=:), allocatable :: type
       integer :: i
       type = 'free'
       do i = 1, size(scene%contacts)
-         if (scene%contacts(i)%slave_surface_index == k .or. scene%contacts(i)%master_surface_index == k) type = 'contact'
+         associate (c => scene%contacts(i))
+            if ((c%slave_surface_index == k .and. c%slave_group == g) .or. &
+               & (c%master_surface_index == k .and. c%master_group == g)) type = 'contact'
+         end associate
       end do
       do i = 1, size(scene%bcs)
-         if (scene%bcs(i)%shape_index == k) type = scene%bcs(i)%type
+         if (scene%bcs(i)%shape_index == k .and. scene%bcs(i)%group == g) type = scene%bcs(i)%type
       end do
    end function surface_type
 
+   !> The named surfaces (a shape's whole surface, then its groups that have a
+   !> condition of their own) whose type is one of `types` (blank separated),
+   !> quoted and joined.
+   function surface_name_list(scene, types) result(text)
+      type(scene_type), intent(in) :: scene
+      character(len=*), intent(in) :: types
+      character(len=:), allocatable :: text, type
+      integer :: k, g, ng
+      text = ''
+      do k = 1, size(scene%shapes)
+         ng = 0
+         if (allocated(scene%shapes(k)%facets%group_name)) ng = size(scene%shapes(k)%facets%group_name)
+         do g = 0, ng
+            type = surface_type(scene, k, g)
+            if (g > 0 .and. type == 'free' .and. .not. any(scene%bcs%shape_index == k .and. scene%bcs%group == g)) &
+               & cycle
+            if (.not. has_word(types, type)) cycle
+            if (g == 0) then
+               text = join(text, "'"//scene%shapes(k)%name//"'")
+            else
+               text = join(text, "'"//trim(scene%shapes(k)%facets%group_name(g))//"'")
+            end if
+         end do
+      end do
+   end function surface_name_list
+
+   !> Surfaces without a &bc and not in a contact.
    function free_surfaces(scene) result(text)
       type(scene_type), intent(in) :: scene
       character(len=:), allocatable :: text
       integer :: k
       text = ''
       do k = 1, size(scene%shapes)
-         if (any(scene%bcs%shape_index == k) .or. surface_type(scene, k) == 'contact') cycle
+         if (any(scene%bcs%shape_index == k .and. scene%bcs%group == 0) .or. surface_type(scene, k, 0) == 'contact') &
+            & cycle
          text = join(text, "'"//scene%shapes(k)%name//"'")
       end do
    end function free_surfaces
@@ -1677,25 +1738,14 @@ contains
    function traction_surfaces(scene) result(text)
       type(scene_type), intent(in) :: scene
       character(len=:), allocatable :: text
-      integer :: k
-      text = ''
-      do k = 1, size(scene%shapes)
-         select case (surface_type(scene, k))
-         case ('free', 'pressure', 'traction', 'exact_traction')
-            text = join(text, "'"//scene%shapes(k)%name//"'")
-         end select
-      end do
+      text = surface_name_list(scene, 'free pressure traction exact_traction')
    end function traction_surfaces
 
    function surfaces_of_type(scene, type) result(text)
       type(scene_type), intent(in) :: scene
       character(len=*), intent(in) :: type
       character(len=:), allocatable :: text
-      integer :: k
-      text = ''
-      do k = 1, size(scene%shapes)
-         if (surface_type(scene, k) == type) text = join(text, "'"//scene%shapes(k)%name//"'")
-      end do
+      text = surface_name_list(scene, type)
    end function surfaces_of_type
 
    function shape_line(shape) result(text)

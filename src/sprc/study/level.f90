@@ -58,7 +58,7 @@ module sprc_study_level
    use sprc_estimate_fe_input, only: fe_recovery_input
    use sprc_fem_dilatation, only: dilatation_choice
    use sprc_study_spec, only: scene_type, contact_spec_type, recovery_degree, contact_unsupported, contact_components
-   use sprc_study_model, only: build_bodies, build_exact, body_conditions, analysis_kind, analysis_units_type, &
+   use sprc_study_model, only: scene_surface, build_bodies, build_exact, body_conditions, analysis_kind, analysis_units_type, &
       & analysis_units, in_units
    use sprc_study_budget, only: check_level_memory, check_coupled_memory
    use sprc_study_partition, only: partition_type, start_partition, integrate_level, solve_level, assemble_pair_rows
@@ -659,9 +659,9 @@ contains
       m = spec%master_index
       associate (slave => bodies(s)%problem%mesh, master => bodies(m)%problem%mesh)
          call slave_surface_points(surface, slave%grid, slave%body, slave%quad, &
-            & study%scene%shapes(spec%slave_surface_index)%body_shape, error, split_grid=master%grid)
+            & scene_surface(study%scene, spec%slave_surface_index, spec%slave_group), error, split_grid=master%grid)
          if (.not. allocated(error)) call initial_gaps(surface, master%body, &
-            & study%scene%shapes(spec%master_surface_index)%body_shape, master%grid, &
+            & scene_surface(study%scene, spec%master_surface_index, spec%master_group), master%grid, &
             & max(study%bodies(s)%box_size, study%bodies(m)%box_size), error)
       end associate
       if (allocated(error)) then
@@ -1001,11 +1001,23 @@ contains
       type(point_cells_type) :: cells
       real(wp), allocatable :: sx(:, :)
       integer, allocatable :: near(:), sel(:)
-      integer :: shape, nb, e, k, i, j, inear, d, o, oshape, nnear, stat
+      integer, allocatable :: surfaces(:), osurfaces(:)
+      integer :: nb, e, k, i, j, inear, d, o, nnear, stat
 
       d = study%dim
       nb = size(input%bw)
-      shape = study%scene%shapes(merge(spec%slave_surface_index, spec%master_surface_index, side == 1))%body_shape
+      o = merge(spec%master_index, spec%slave_index, side == 1)
+      if (side == 1) then
+         surfaces = study%bodies(spec%slave_index)%geometry%surface_parts( &
+            & scene_surface(study%scene, spec%slave_surface_index, spec%slave_group))
+         osurfaces = study%bodies(o)%geometry%surface_parts( &
+            & scene_surface(study%scene, spec%master_surface_index, spec%master_group))
+      else
+         surfaces = study%bodies(spec%master_index)%geometry%surface_parts( &
+            & scene_surface(study%scene, spec%master_surface_index, spec%master_group))
+         osurfaces = study%bodies(o)%geometry%surface_parts( &
+            & scene_surface(study%scene, spec%slave_surface_index, spec%slave_group))
+      end if
       allocate (law(nb), slip(d, nb), stat=stat)
       call check_allocation(stat, 'pair_contact', 'the contact law of each boundary point', nb, 4 + 8*d, error)
       if (allocated(error)) return
@@ -1025,7 +1037,7 @@ contains
          if (input%belem_ptr(e + 1) == input%belem_ptr(e)) cycle
          size_e = element_size(nodes, e)
          do k = input%belem_ptr(e), input%belem_ptr(e + 1) - 1
-            if (input%bshape(k) /= shape) cycle
+            if (.not. any(surfaces == input%bshape(k))) cycle
             best = huge(1.0_wp)
             inear = 0
             call cells_box(cells, sx, input%bx(:, k) - size_e, input%bx(:, k) + size_e, near, nnear)
@@ -1061,14 +1073,12 @@ contains
             end if
          end do
       end do
-      o = merge(spec%master_index, spec%slave_index, side == 1)
-      oshape = study%scene%shapes(merge(spec%master_surface_index, spec%slave_surface_index, side == 1))%body_shape
       if (allocated(study%bodies(o)%exact)) then
-         call boundary_points(other, d, oshape, oboundary, study%bodies(o)%exact)
+         call boundary_points(other, d, osurfaces, oboundary, study%bodies(o)%exact)
       else
-         call boundary_points(other, d, oshape, oboundary)
+         call boundary_points(other, d, osurfaces, oboundary)
       end if
-      call new_grid_contact(contact, shape, law, slip, spec%mu, other%x, other%w, other%stress, other%young, &
+      call new_grid_contact(contact, surfaces, law, slip, spec%mu, other%x, other%w, other%stress, other%young, &
          & other%poisson, other%body_force(1:d), error, boundary=oboundary)
    end subroutine pair_contact
 

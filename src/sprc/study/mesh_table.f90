@@ -11,14 +11,15 @@ module sprc_study_mesh_table
    use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature, cell_rule_type, cell_rule, &
       & default_points
    use sprc_study_spec, only: scene_type
-   use sprc_study_model, only: build_bodies
+   use sprc_study_model, only: build_bodies, scene_surface
    use sprc_study_budget, only: check_level_memory
    implicit none
    private
 
    public :: mesh_row_type, surface_measure_type, mesh_study, study_levels, check_surfaces
 
-   !> The boundary measure of one surface (a shape named by `&bc` or `&contact`).
+   !> The boundary measure of one surface named by `&bc` or `&contact` (a shape,
+   !> or a named group of a faceted shape).
    type :: surface_measure_type
       character(len=:), allocatable :: name
       real(wp) :: measure = 0.0_wp
@@ -35,7 +36,8 @@ module sprc_study_mesh_table
       !> summed from the cut-cell quadrature.
       real(wp) :: measure = 0.0_wp, boundary_measure = 0.0_wp
       !> The named surfaces of the body (`&bc`, `&contact`), in file order: each one's
-      !> part of boundary_measure (the surface points the quadrature tags with its shape).
+      !> part of boundary_measure (the surface points the quadrature tags with its shape,
+      !> or its group).
       type(surface_measure_type), allocatable :: surfaces(:)
       !> Gauss points per direction used.
       integer :: points = 0
@@ -93,7 +95,7 @@ contains
       type(grid_type) :: grid
       type(timer_type) :: timer
       type(cut_quadrature_type) :: quad
-      real(wp), allocatable :: by_shape(:)
+      real(wp), allocatable :: by_surface(:)
       integer, allocatable :: named(:)
       integer :: l, b, k, j
 
@@ -127,7 +129,7 @@ contains
             rows(k)%points = quad%q
             call timer%reset()
             call timer%start()
-            call integrate_measures(grid, bodies(b), quad, rows(k)%measure, rows(k)%boundary_measure, by_shape, &
+            call integrate_measures(grid, bodies(b), quad, rows(k)%measure, rows(k)%boundary_measure, by_surface, &
                & error)
             call timer%stop()
             rows(k)%t_quadrature = timer%elapsed
@@ -135,8 +137,8 @@ contains
             named = named_surfaces(scene, b)
             allocate (rows(k)%surfaces(size(named)))
             do j = 1, size(named)
-               rows(k)%surfaces(j)%name = scene%shapes(named(j))%name
-               rows(k)%surfaces(j)%measure = by_shape(scene%shapes(named(j))%body_shape)
+               rows(k)%surfaces(j)%name = bodies(b)%surface_name(named(j))
+               rows(k)%surfaces(j)%measure = by_surface(named(j))
             end do
          end do
       end do
@@ -144,24 +146,25 @@ contains
 
    !> Sum of the volume and surface weights of every active cell's rule, in
    !> leaf order with compensated (Neumaier) sums, so that the printed 15
-   !> digits are the quadrature's, not the summation's; by_shape(i) is the
-   !> part of boundary_measure whose points the quadrature tags with shape i.
-   subroutine integrate_measures(grid, body, quad, measure, boundary_measure, by_shape, error)
+   !> digits are the quadrature's, not the summation's; by_surface(i) is the
+   !> part of boundary_measure whose points the quadrature tags with surface
+   !> id i (sprc_geometry_body): a shape's includes its groups'.
+   subroutine integrate_measures(grid, body, quad, measure, boundary_measure, by_surface, error)
       type(grid_type), intent(in) :: grid
       type(body_type), intent(in) :: body
       type(cut_quadrature_type), intent(in) :: quad
       real(wp), intent(out) :: measure, boundary_measure
-      real(wp), allocatable, intent(out) :: by_shape(:)
+      real(wp), allocatable, intent(out) :: by_surface(:)
       type(error_type), allocatable, intent(out) :: error
       type(cell_rule_type) :: rule
       real(wp) :: lo(3), hi(3), vol(2), surf(2)
-      real(wp), allocatable :: shape_acc(:, :)
-      integer :: leaf, d, q, s
+      real(wp), allocatable :: acc(:, :)
+      integer :: leaf, d, q, s, id
 
       d = grid%dim
       vol = 0.0_wp
       surf = 0.0_wp
-      allocate (shape_acc(2, body%nshape), source=0.0_wp)
+      allocate (acc(2, body%nsurface()), source=0.0_wp)
       do leaf = 1, grid%n_leaves
          call grid%leaf_box(leaf, lo(1:d), hi(1:d))
          call cell_rule(quad, body, lo(1:d), hi(1:d), rule, error)
@@ -169,36 +172,52 @@ contains
          call neumaier_add(vol, rule%vol_w(1:rule%nvol))
          call neumaier_add(surf, rule%surf_w(1:rule%nsurf))
          do q = 1, rule%nsurf
-            s = body%surface_shape(rule%surf_shape(q))
-            if (s >= 1 .and. s <= body%nshape) call neumaier_add(shape_acc(:, s), rule%surf_w(q:q))
+            id = rule%surf_shape(q)
+            s = body%surface_shape(id)
+            if (s < 1) cycle
+            call neumaier_add(acc(:, id), rule%surf_w(q:q))
+            if (id /= s) call neumaier_add(acc(:, s), rule%surf_w(q:q))
          end do
       end do
       measure = vol(1) + vol(2)
       boundary_measure = surf(1) + surf(2)
-      by_shape = shape_acc(1, :) + shape_acc(2, :)
+      by_surface = acc(1, :) + acc(2, :)
    end subroutine integrate_measures
 
-   !> Indices in `scene%shapes` of body b's surfaces named by a `&bc` or a `&contact`, in file order.
-   pure function named_surfaces(scene, b) result(list)
+   !> Body b's surface ids (sprc_geometry_body) named by a `&bc` or a `&contact`, ascending:
+   !> its shapes in file order, then the named groups of its faceted shapes.
+   function named_surfaces(scene, b) result(list)
       type(scene_type), intent(in) :: scene
       integer, intent(in) :: b
       integer, allocatable :: list(:)
-      logical :: named(size(scene%shapes))
-      integer :: s, k
+      logical, allocatable :: named(:)
+      integer :: k, n
 
-      named = .false.
+      n = 0
+      do k = 1, size(scene%shapes)
+         if (scene%shapes(k)%body_index /= b) cycle
+         n = n + 1
+         if (allocated(scene%shapes(k)%facets%group_name)) n = n + size(scene%shapes(k)%facets%group_name)
+      end do
+      allocate (named(n), source=.false.)
       if (allocated(scene%bcs)) then
          do k = 1, size(scene%bcs)
-            if (scene%bcs(k)%shape_index > 0) named(scene%bcs(k)%shape_index) = .true.
+            call mark(scene%bcs(k)%shape_index, scene%bcs(k)%group)
          end do
       end if
       if (allocated(scene%contacts)) then
          do k = 1, size(scene%contacts)
-            if (scene%contacts(k)%slave_surface_index > 0) named(scene%contacts(k)%slave_surface_index) = .true.
-            if (scene%contacts(k)%master_surface_index > 0) named(scene%contacts(k)%master_surface_index) = .true.
+            call mark(scene%contacts(k)%slave_surface_index, scene%contacts(k)%slave_group)
+            call mark(scene%contacts(k)%master_surface_index, scene%contacts(k)%master_group)
          end do
       end if
-      list = pack([(s, s=1, size(scene%shapes))], named .and. scene%shapes%body_index == b)
+      list = pack([(k, k=1, n)], named)
+   contains
+      subroutine mark(shape, group)
+         integer, intent(in) :: shape, group
+         if (shape < 1) return
+         if (scene%shapes(shape)%body_index == b) named(scene_surface(scene, shape, group)) = .true.
+      end subroutine mark
    end function named_surfaces
 
    !> Every body must have material and every surface named by a `&bc` or a
@@ -221,7 +240,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       logical, intent(in), optional :: grid_only
       type(cut_quadrature_type) :: quad
-      real(wp), allocatable :: by_shape(:)
+      real(wp), allocatable :: by_surface(:)
       integer, allocatable :: named(:)
       real(wp) :: measure
       integer :: b, j, i
@@ -234,7 +253,7 @@ contains
             error%message = "body '"//bodies(b)%name//"', level "//itoa(level)//': '//error%message
             return
          end if
-         call body_measures(scene, bodies(b), b, level, quad, measure, by_shape, error)
+         call body_measures(scene, bodies(b), b, level, quad, measure, by_surface, error)
          if (allocated(error)) return
          if (.not. measure > 0.0_wp) then
             call fatal_error(error, "body '"//bodies(b)%name//"' is empty at level "//itoa(level)// &
@@ -243,22 +262,22 @@ contains
          end if
          named = named_surfaces(scene, b)
          do j = 1, size(named)
-            i = scene%shapes(named(j))%body_shape
-            if (by_shape(i) > 0.0_wp) cycle
+            i = named(j)
+            if (by_surface(i) > 0.0_wp) cycle
             call uncovered_error(scene, bodies(b), b, i, level, quad, error)
             return
          end do
       end do
    end subroutine check_surfaces
 
-   !> Body b's measure and each shape's boundary measure on its grid at `level`.
-   subroutine body_measures(scene, body, b, level, quad, measure, by_shape, error)
+   !> Body b's measure and each surface's boundary measure on its grid at `level`.
+   subroutine body_measures(scene, body, b, level, quad, measure, by_surface, error)
       type(scene_type), intent(in) :: scene
       type(body_type), intent(in) :: body
       integer, intent(in) :: b, level
       type(cut_quadrature_type), intent(in) :: quad
       real(wp), intent(out) :: measure
-      real(wp), allocatable, intent(out) :: by_shape(:)
+      real(wp), allocatable, intent(out) :: by_surface(:)
       type(error_type), allocatable, intent(out) :: error
       type(grid_type) :: grid
       real(wp) :: boundary_measure
@@ -269,37 +288,44 @@ contains
          error%message = "body '"//body%name//"', level "//itoa(level)//': '//error%message
          return
       end if
-      call integrate_measures(grid, body, quad, measure, boundary_measure, by_shape, error)
+      call integrate_measures(grid, body, quad, measure, boundary_measure, by_surface, error)
    end subroutine body_measures
 
-   !> The error for shape i of body b, whose surface does not bound the body:
-   !> why, from the bodies of its first k shapes (k = i, i+1, ...): none of
-   !> shape i's surface bounds the first i (it misses the shapes before it, or
-   !> lies outside the box), or shape k is the first after which none does.
-   subroutine uncovered_error(scene, body, b, i, level, quad, error)
+   !> The error for surface id of body b (a shape i's whole surface, or a
+   !> group g of faceted shape i), which does not bound the body: why, from the
+   !> bodies of its first k shapes (k = i, i+1, ...): none of the surface
+   !> bounds the first i (it misses the shapes before it, or lies outside the
+   !> box), or shape k is the first after which none does.
+   subroutine uncovered_error(scene, body, b, id, level, quad, error)
       type(scene_type), intent(in) :: scene
       type(body_type), intent(in) :: body
-      integer, intent(in) :: b, i, level
+      integer, intent(in) :: b, id, level
       type(cut_quadrature_type), intent(in) :: quad
       type(error_type), allocatable, intent(out) :: error
       type(body_type) :: prefix
-      real(wp), allocatable :: by_shape(:)
+      real(wp), allocatable :: by_surface(:)
       real(wp) :: measure
       character(len=:), allocatable :: what, why
-      integer :: k
+      integer :: k, i, g
+
+      i = body%surface_shape(id)
+      g = 0
+      if (id /= i) g = id - body%group_surface(i, 1) + 1
 
       call new_body(prefix, body%name)
       do k = 1, body%nshape
          call prefix%add_shape(body%ops(k), body%shapes(k), error)
          if (allocated(error)) return
          if (k < i) cycle
-         call body_measures(scene, prefix, b, level, quad, measure, by_shape, error)
+         call body_measures(scene, prefix, b, level, quad, measure, by_surface, error)
          if (allocated(error)) return
-         if (.not. by_shape(i) > 0.0_wp) exit
+         ! the prefix body's id of the surface: its groups follow its k shapes
+         if (.not. by_surface(prefix%group_surface(i, g)) > 0.0_wp) exit
       end do
       k = min(k, body%nshape)
-      what = "surface '"//shape_name(body%shapes(i))//"' does not bound body '"//body%name// &
-         & "' (boundary measure 0 at level "//itoa(level)//'): '
+      what = "surface '"//body%surface_name(id)//"'"
+      if (g > 0) what = what//" (a group of shape '"//shape_name(body%shapes(i))//"')"
+      what = what//" does not bound body '"//body%name//"' (boundary measure 0 at level "//itoa(level)//'): '
       if (k > i) then
          why = "shape '"//shape_name(body%shapes(k))//"' ("//csg_op_name(body%ops(k))// &
             & ') covers the last of it, or takes it where their surfaces coincide (sprc mesh shows each named '// &

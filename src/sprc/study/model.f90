@@ -29,7 +29,7 @@ module sprc_study_model
    private
 
    public :: build_bodies, build_exact, body_conditions, analysis_kind, analysis_units, in_units, scene_warnings
-   public :: build_exact_pressure, exact_has_field
+   public :: build_exact_pressure, exact_has_field, scene_surface
 
    !> Units of an analysis: moduli divided by `modulus`, displacements by `strain`
    !> (lengths unchanged), stresses and loads by modulus*strain. Both are powers of two, so
@@ -504,25 +504,33 @@ contains
       end do
    end subroutine body_conditions
 
-   !> The body's surface id a condition acts on (sprc_geometry_body, module
-   !> notes): its shape's index in the body, or for a group of a faceted shape
-   !> the id after the body's shapes and the groups of the shapes before it.
+   !> The body's surface id a condition acts on (`scene_surface`).
    pure integer function bc_surface(scene, bc) result(id)
       type(scene_type), intent(in) :: scene
       type(bc_spec_type), intent(in) :: bc
-      integer :: k, body
-
-      id = scene%shapes(bc%shape_index)%body_shape
-      if (bc%group <= 0) return
-      body = scene%shapes(bc%shape_index)%body_index
-      id = count(scene%shapes%body_index == body)
-      do k = 1, size(scene%shapes)
-         if (scene%shapes(k)%body_index /= body) cycle
-         if (scene%shapes(k)%body_shape >= scene%shapes(bc%shape_index)%body_shape) cycle
-         if (allocated(scene%shapes(k)%facets%group_name)) id = id + size(scene%shapes(k)%facets%group_name)
-      end do
-      id = id + bc%group
+      id = scene_surface(scene, bc%shape_index, bc%group)
    end function bc_surface
+
+   !> The body's surface id (sprc_geometry_body, module notes) of shape k of
+   !> the scene (index in `scene%shapes`) or of its group `group` (> 0): the
+   !> shape's index in its body, or for a group of a faceted shape the id
+   !> after the body's shapes and the groups of the shapes before it.
+   pure integer function scene_surface(scene, k, group) result(id)
+      type(scene_type), intent(in) :: scene
+      integer, intent(in) :: k, group
+      integer :: j, body
+
+      id = scene%shapes(k)%body_shape
+      if (group <= 0) return
+      body = scene%shapes(k)%body_index
+      id = count(scene%shapes%body_index == body)
+      do j = 1, size(scene%shapes)
+         if (scene%shapes(j)%body_index /= body) cycle
+         if (scene%shapes(j)%body_shape >= scene%shapes(k)%body_shape) cycle
+         if (allocated(scene%shapes(j)%facets%group_name)) id = id + size(scene%shapes(j)%facets%group_name)
+      end do
+      id = id + group
+   end function scene_surface
 
    !> Whether the scene's exact solution has a stress field (every kind but
    !> hertz_*, which give the contact pressure only): the energy-norm error

@@ -177,9 +177,12 @@ module sprc_study_spec
       !> Body names and their indices in `scene%bodies`.
       character(len=:), allocatable :: slave, master
       integer :: slave_index = 0, master_index = 0
-      !> Shape surfaces in contact and their indices in `scene%shapes`.
+      !> Surfaces in contact: their names, their shapes' indices in `scene%shapes`
+      !> and, for a group of a faceted shape, the group (index in its
+      !> `facets%group_name`; 0 for the shape's whole surface).
       character(len=:), allocatable :: slave_surface, master_surface
       integer :: slave_surface_index = 0, master_surface_index = 0
+      integer :: slave_group = 0, master_group = 0
       !> 'frictionless' | 'coulomb' | 'stick'.
       character(len=:), allocatable :: friction
       !> Friction coefficient (coulomb), >= 0.
