@@ -41,7 +41,7 @@ module sprc_study_budget
    implicit none
    private
 
-   public :: level_memory, check_level_memory, check_coupled_memory, coupled_memory, memory_check_wanted
+   public :: level_memory, check_level_memory, check_coupled_memory, coupled_memory, memory_check_wanted, level_cells
 
    real(wp), parameter :: base_bytes = 32.0e6_wp, per_dof_2d = 2.5e3_wp, per_dof_3d = 1.0e4_wp, &
       & dofs_3d = 3.0e4_wp, q2_factor_3d = 1.75_wp, per_dof_3d_iterative = 8.0e3_wp
@@ -158,16 +158,20 @@ contains
    !> `bodies(members)` solved in one block system, `slaves` those of them
    !> whose contact surfaces carry slave points (module notes); `available`,
    !> `direct_fits` and `known_dofs` (per member) as for `level_memory`.
+   !> Without `bodies`, `known_cells(:, k)` are member k's cells and cut cells
+   !> (`level_cells`): a caller holding bodies as a component of an array
+   !> passes these rather than a copy of every body's geometry.
    subroutine coupled_memory(scene, bodies, members, slaves, level, cells, dofs, bytes, error, available, &
-      & direct_fits, known_dofs)
+      & direct_fits, known_dofs, known_cells)
       type(scene_type), intent(in) :: scene
-      type(body_type), intent(in) :: bodies(:)
+      type(body_type), intent(in), optional :: bodies(:)
       integer, intent(in) :: members(:), slaves(:), level
       real(wp), intent(out) :: cells, dofs, bytes
       type(error_type), allocatable, intent(out) :: error
       integer(i8), intent(in), optional :: available
       logical, intent(out), optional :: direct_fits
       real(wp), intent(in), optional :: known_dofs(:)
+      real(wp), intent(in), optional :: known_cells(:, :)
       real(wp) :: c, cut, extra
       integer :: k
 
@@ -180,6 +184,9 @@ contains
             c = known_dofs(k)/real(scene%dim*scene%order**scene%dim, wp)
             ! a surface of an adapted mesh: that of a uniform grid of c cells, an upper estimate
             cut = 2.0_wp*real(scene%dim, wp)*c**(real(scene%dim - 1, wp)/real(scene%dim, wp))
+         else if (present(known_cells)) then
+            c = known_cells(1, k)
+            cut = known_cells(2, k)
          else
             call level_cells(scene, bodies(members(k)), level, c, cut, error)
             if (allocated(error)) return
@@ -262,13 +269,13 @@ contains
    !> them is built, when their estimate exceeds the memory available;
    !> `solver` becomes `solver_iterative` where 'auto' found that a direct
    !> solve of the coupled system would not fit.
-   subroutine check_coupled_memory(scene, bodies, members, slaves, level, error, solver, known_dofs)
+   subroutine check_coupled_memory(scene, bodies, members, slaves, level, error, solver, known_dofs, known_cells)
       type(scene_type), intent(in) :: scene
-      type(body_type), intent(in) :: bodies(:)
+      type(body_type), intent(in), optional :: bodies(:)
       integer, intent(in) :: members(:), slaves(:), level
       type(error_type), allocatable, intent(out) :: error
       integer, intent(out), optional :: solver
-      real(wp), intent(in), optional :: known_dofs(:)
+      real(wp), intent(in), optional :: known_dofs(:), known_cells(:, :)
       real(wp) :: cells, dofs, bytes, reserve
       integer(i8) :: avail, usable
       character(len=:), allocatable :: source
@@ -280,7 +287,7 @@ contains
       if (allocated(error) .or. .not. wanted) return
       call usable_memory(avail, usable, reserve, source)
       call coupled_memory(scene, bodies, members, slaves, level, cells, dofs, bytes, error, usable, direct_fits, &
-         & known_dofs)
+         & known_dofs, known_cells)
       if (allocated(error)) return
       bytes = bytes + reserve
       if (avail < 0 .or. bytes <= real(avail, wp)) then

@@ -60,7 +60,7 @@ module sprc_study_level
    use sprc_study_spec, only: scene_type, contact_spec_type, recovery_degree, contact_unsupported, contact_components
    use sprc_study_model, only: scene_surface, build_bodies, build_exact, body_conditions, analysis_kind, analysis_units_type, &
       & analysis_units, in_units
-   use sprc_study_budget, only: check_level_memory, check_coupled_memory
+   use sprc_study_budget, only: check_level_memory, check_coupled_memory, level_cells
    use sprc_study_partition, only: partition_type, start_partition, integrate_level, solve_level, assemble_pair_rows
    use sprc_grid_share, only: share_type
    use sprc_study_row, only: report_row_type
@@ -503,16 +503,23 @@ contains
       integer, allocatable, intent(out) :: solver(:)
       type(error_type), allocatable, intent(out) :: error
       type(mesh_source_type), intent(in), optional :: source(:)
-      integer :: k, choice, members(2)
+      integer :: k, j, choice, members(2)
+      real(wp) :: cells(2, 2)
 
       allocate (solver(size(study%bodies)), source=0)
       do k = 1, size(study%scene%contacts)
          members = [study%scene%contacts(k)%slave_index, study%scene%contacts(k)%master_index]
          if (present(source)) then
-            call check_coupled_memory(study%scene, study%bodies%geometry, members, members(1:1), level, error, &
-               & choice, [source(members(1))%dofs, source(members(2))%dofs])
+            call check_coupled_memory(study%scene, members=members, slaves=members(1:1), level=level, error=error, &
+               & solver=choice, known_dofs=[source(members(1))%dofs, source(members(2))%dofs])
          else
-            call check_coupled_memory(study%scene, study%bodies%geometry, members, members(1:1), level, error, choice)
+            ! per member, not `study%bodies%geometry`: that would copy every body's geometry
+            do j = 1, 2
+               call level_cells(study%scene, study%bodies(members(j))%geometry, level, cells(1, j), cells(2, j), error)
+               if (allocated(error)) exit
+            end do
+            if (.not. allocated(error)) call check_coupled_memory(study%scene, members=members, slaves=members(1:1), &
+               & level=level, error=error, solver=choice, known_cells=cells)
          end if
          if (allocated(error)) then
             error%message = "&contact '"//study%scene%contacts(k)%slave//"' on '"//study%scene%contacts(k)%master// &
