@@ -19,9 +19,16 @@
 !>   at a rate of at least 0.95 p over the last two levels, theta_sprc in
 !>   [0.95, 1.05] at the finest level; each pair's pressure error: Q1 at
 !>   the finest level at most half of that at the coarsest, Q2 at every
-!>   level at most a tenth of err_fe (the Q2 pressure starts near 1e-5 and
-!>   levels off at about 3e-6 from level 5, independently of kappa: not
-!>   resolved here); Q1 and Q2, plane strain and plane stress.
+!>   level at most a tenth of err_fe; each pair's mean pressure (the force
+!>   the interface carries, a functional of the solution) converging at a
+!>   rate of at least 0.95 p over the three levels (Q2: 2.8 to 3.9), which
+!>   a reference off by the interference (delta/r = 1e-5) would stop, as
+!>   would a wrong sampling of p_ex. The Q2 multiplier's L2 error pauses near 4e-6
+!>   at levels 5-6 (5e-7 at level 7) while its mean is right to 1e-8 and
+!>   1e-9 of p: most of it (87 % of the square at level 6) is two adjacent
+!>   contact cells at a sliver of the slave's cut boundary, a local
+!>   oscillation of the multiplier, not the reference. Q1 and Q2, plane
+!>   strain and plane stress.
 !> - Two Hertz rollers on one block (two pairs sharing the block's top as
 !>   master surface): each pair's peak pressure within the single roller's
 !>   3 % of its own Hertz p0.
@@ -148,7 +155,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(level_type) :: result
       character(len=:), allocatable :: text, what
-      real(wp) :: err(3), theta, perr(2, 3), rate
+      real(wp) :: err(3), theta, perr(2, 3), pmean(2, 3), rate
       integer :: l, k
 
       call read_text_file(rings, text, error)
@@ -166,6 +173,7 @@ contains
          do k = 1, 2
             associate (c => result%contacts(k))
                perr(k, l) = sqrt(sum(c%weight*(c%p_fe - c%p_exact)**2)/sum(c%weight*c%p_exact**2))
+               pmean(k, l) = abs(sum(c%weight*(c%p_fe - c%p_exact)))/sum(c%weight*c%p_exact)
             end associate
          end do
       end do
@@ -184,6 +192,10 @@ contains
                & real_text(perr(k, 1))//', '//real_text(perr(k, 2))//', '//real_text(perr(k, 3))// &
                & ' not a tenth of err_fe')
          end if
+         if (allocated(error)) return
+         rate = log(pmean(k, 1)/pmean(k, 3))/log(2.0_wp**(levels(3) - levels(1)))
+         call check(error, rate >= 0.95_wp*order, what//'pair '//achar(48 + k)//' mean pressure error '// &
+            & real_text(pmean(k, 1))//' -> '//real_text(pmean(k, 3))//': rate '//real_text(rate))
          if (allocated(error)) return
       end do
    end subroutine rings_case
