@@ -44,7 +44,7 @@ module sprc_test_contact_assembly
    use sprc_io_namelist, only: read_text_file
    use sprc_study_level, only: study_type, level_type
    use sprc_test_study, only: run_text
-   use sprc_contact_result, only: contact_open
+   use sprc_contact_result, only: contact_open, contact_result_type
    use sprc_testsuite, only: unittest_type, new_unittest, check, replaced
    implicit none
    private
@@ -178,10 +178,7 @@ contains
          err(l) = result%row%err_fe
          theta = result%row%theta_sprc
          do k = 1, 2
-            associate (c => result%contacts(k))
-               perr(k, l) = sqrt(sum(c%weight*(c%p_fe - c%p_exact)**2)/sum(c%weight*c%p_exact**2))
-               pmean(k, l) = abs(sum(c%weight*(c%p_fe - c%p_exact)))/sum(c%weight*c%p_exact)
-            end associate
+            call pressure_errors(result%contacts(k), perr(k, l), pmean(k, l))
          end do
       end do
       rate = log(err(2)/err(3))/log(2.0_wp)
@@ -222,10 +219,7 @@ contains
          if (allocated(error)) return
          err(l) = result%row%err_fe
          do k = 1, 2
-            associate (c => result%contacts(k))
-               perr(k, l) = sqrt(sum(c%weight*(c%p_fe - c%p_exact)**2)/sum(c%weight*c%p_exact**2))
-               pmean(k, l) = abs(sum(c%weight*(c%p_fe - c%p_exact)))/sum(c%weight*c%p_exact)
-            end associate
+            call pressure_errors(result%contacts(k), perr(k, l), pmean(k, l))
          end do
       end do
       rate = log(err(1)/err(2))/log(2.0_wp)
@@ -238,6 +232,15 @@ contains
             & ' -> '//real_text(perr(k, 2))//', mean '//real_text(pmean(k, 1))//' -> '//real_text(pmean(k, 2)))
       end do
    end subroutine test_layered_sphere
+
+   !> The relative L2 error of a pair's multiplier over its slave surface, and that of its
+   !> surface mean (the force the interface carries).
+   subroutine pressure_errors(c, perr, pmean)
+      type(contact_result_type), intent(in) :: c
+      real(wp), intent(out) :: perr, pmean
+      perr = sqrt(sum(c%weight*(c%p_fe - c%p_exact)**2)/sum(c%weight*c%p_exact**2))
+      pmean = abs(sum(c%weight*(c%p_fe - c%p_exact)))/sum(c%weight*c%p_exact)
+   end subroutine pressure_errors
 
    !> Each roller's peak within 3 % of its Hertz p0 = 2P/(pi a), a =
    !> sqrt(4 P R/(pi E*)), 1/E* = 2 (1 - nu^2)/E (module notes).
