@@ -6,7 +6,9 @@
 !> rates in h, the peaks p_max_fe, p_max_sprc against p_max_exact, and the traction jump:
 !> the relative L2 jump of the normal traction between the two bodies at the closed slave
 !> points (`level_type%traction_jump`) with the FE stresses, SPR and SPR-C, and the ratios
-!> FE/SPR-C and SPR/SPR-C (issue 12's traction-continuity item asks for 10 or more).
+!> FE/SPR-C and SPR/SPR-C (issue 12's traction-continuity item asks for 10 or more); last
+!> err_p_fe_stress, the error of the slave's FE-stress pressure -n.sigma_h.n, and its ratio
+!> to err_p_sprc.
 !> Run (levels as `sprc run --levels`):
 !>   fpm run --profile release --example contact_study -- SCENE.nml 3,4,5,6,7
 program contact_study
@@ -41,16 +43,18 @@ program contact_study
       stop 2
    end if
    write (*, '(a)') 'level  h        err_fe    err_spr   err_sprc  th_sprc  err_p_fe  rate  err_p_spr rate  '// &
-      & 'err_p_sprc rate  p_max_fe   p_max_sprc p_max_ex   jump_fe   jump_spr  jump_sprc fe/sprc spr/sprc'
+      & 'err_p_sprc rate  p_max_fe   p_max_sprc p_max_ex   jump_fe   jump_spr  jump_sprc fe/sprc spr/sprc'// &
+      & ' err_p_fest fest/sprc'
    previous = -1.0_wp
    do i = 1, size(levels)
       call run_level(study, levels(i), result, error)
       if (allocated(error)) call fail(error)
       associate (r => result%row, j => result%traction_jump(:, 1))
          now = [r%h, r%err_p_fe, r%err_p_spr, r%err_p_sprc]
-         write (*, '(i5,es9.2,3a10,a9,3(es10.3,a6),3es11.4,3es10.3,2f8.2)') levels(i), r%h, num(r%err_fe), &
-            & num(r%err_spr), num(r%err_sprc), fixed(r%theta_sprc), now(2), rate(2), now(3), rate(3), now(4), rate(4), &
-            & r%p_max_fe, r%p_max_sprc, r%p_max_exact, j, j(1)/j(3), j(2)/j(3)
+         write (*, '(i5,es9.2,3a10,a9,3(es10.3,a6),3es11.4,3es10.3,2f8.2,a11,f10.2)') levels(i), r%h, &
+            & num(r%err_fe), num(r%err_spr), num(r%err_sprc), fixed(r%theta_sprc), now(2), rate(2), now(3), rate(3), &
+            & now(4), rate(4), r%p_max_fe, r%p_max_sprc, r%p_max_exact, j, j(1)/j(3), j(2)/j(3), &
+            & num(r%err_p_fe_stress), r%err_p_fe_stress/r%err_p_sprc
       end associate
       previous = now
    end do

@@ -19,9 +19,21 @@
 !>   at a rate of at least 0.95 p over the last two levels, theta_sprc in
 !>   [0.95, 1.05] at the finest level; each pair's pressure error: Q1 at
 !>   the finest level at most half of that at the coarsest, Q2 at every
-!>   level at most a tenth of err_fe (the Q2 pressure starts near 1e-5 and
-!>   levels off at about 3e-6 from level 5, independently of kappa: not
-!>   resolved here); Q1 and Q2, plane strain and plane stress.
+!>   level at most a tenth of err_fe; each pair's mean pressure (the force
+!>   the interface carries, a functional of the solution) converging at a
+!>   rate of at least 0.95 p over the three levels (Q2: 2.8 to 3.9), which
+!>   a reference off by the interference (delta/r = 1e-5) would stop, as
+!>   would a wrong sampling of p_ex. The Q2 multiplier's L2 error pauses near 4e-6
+!>   at levels 5-6 (5e-7 at level 7) while its mean is right to 1e-8 and
+!>   1e-9 of p: most of it (87 % of the square at level 6) is two adjacent
+!>   contact cells at a sliver of the slave's cut boundary, a local
+!>   oscillation of the multiplier, not the reference. Q1 and Q2, plane
+!>   strain and plane stress.
+!> - Three concentric spherical shells (octant, Q1) against layered_sphere
+!>   on the real radii, levels 2 and 3: err_fe at a rate of at least 0.85
+!>   (a stated pre-asymptotic tier: 0.89 at levels 2-3, 0.97 at 3-4, which
+!>   costs too much here), each pair's pressure error and mean pressure
+!>   error at a rate of at least 0.95 p (1.39-1.41 and 1.75-1.80).
 !> - Two Hertz rollers on one block (two pairs sharing the block's top as
 !>   master surface): each pair's peak pressure within the single roller's
 !>   3 % of its own Hertz p0.
@@ -32,7 +44,7 @@ module sprc_test_contact_assembly
    use sprc_io_namelist, only: read_text_file
    use sprc_study_level, only: study_type, level_type
    use sprc_test_study, only: run_text
-   use sprc_contact_result, only: contact_open
+   use sprc_contact_result, only: contact_open, contact_result_type
    use sprc_testsuite, only: unittest_type, new_unittest, check, replaced
    implicit none
    private
@@ -42,6 +54,7 @@ module sprc_test_contact_assembly
    character(len=*), parameter :: stack_2d = 'test/data/contact/stack_2d.nml'
    character(len=*), parameter :: rollers_2d = 'example/scenes/two_rollers.nml'
    character(len=*), parameter :: rings = 'example/scenes/layered_rings.nml'
+   character(len=*), parameter :: shells = 'test/data/contact/layered_sphere.nml'
 
 contains
 
@@ -55,6 +68,7 @@ contains
          new_unittest('layered_rings_q1_plane_stress', test_rings_q1_stress), &
          new_unittest('layered_rings_q2_plane_strain', test_rings_q2_strain), &
          new_unittest('layered_rings_q2_plane_stress', test_rings_q2_stress), &
+         new_unittest('layered_sphere_q1', test_layered_sphere), &
          new_unittest('two_rollers', test_two_rollers) &
          ]
    end subroutine collect_contact_assembly
@@ -160,7 +174,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(level_type) :: result
       character(len=:), allocatable :: text, what
-      real(wp) :: err(3), theta, perr(2, 3), rate
+      real(wp) :: err(3), theta, perr(2, 3), pmean(2, 3), rate
       integer :: l, k
 
       call read_text_file(rings, text, error)
@@ -176,9 +190,7 @@ contains
          err(l) = result%row%err_fe
          theta = result%row%theta_sprc
          do k = 1, 2
-            associate (c => result%contacts(k))
-               perr(k, l) = sqrt(sum(c%weight*(c%p_fe - c%p_exact)**2)/sum(c%weight*c%p_exact**2))
-            end associate
+            call pressure_errors(result%contacts(k), perr(k, l), pmean(k, l))
          end do
       end do
       rate = log(err(2)/err(3))/log(2.0_wp)
@@ -197,8 +209,50 @@ contains
                & ' not a tenth of err_fe')
          end if
          if (allocated(error)) return
+         rate = log(pmean(k, 1)/pmean(k, 3))/log(2.0_wp**(levels(3) - levels(1)))
+         call check(error, rate >= 0.95_wp*order, what//'pair '//achar(48 + k)//' mean pressure error '// &
+            & real_text(pmean(k, 1))//' -> '//real_text(pmean(k, 3))//': rate '//real_text(rate))
+         if (allocated(error)) return
       end do
    end subroutine rings_case
+
+   !> The layered shells (module notes).
+   subroutine test_layered_sphere(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(level_type) :: result
+      character(len=:), allocatable :: text
+      real(wp) :: err(2), perr(2, 2), pmean(2, 2), rate
+      integer :: l, k
+
+      call read_text_file(shells, text, error)
+      if (allocated(error)) return
+      do l = 1, 2
+         call run_text(text, l + 1, result, error)
+         if (allocated(error)) return
+         err(l) = result%row%err_fe
+         do k = 1, 2
+            call pressure_errors(result%contacts(k), perr(k, l), pmean(k, l))
+         end do
+      end do
+      rate = log(err(1)/err(2))/log(2.0_wp)
+      call check(error, rate >= 0.85_wp, 'err_fe rate '//real_text(rate)//' (err_fe '//real_text(err(1))//', '// &
+         & real_text(err(2))//')')
+      do k = 1, 2
+         if (allocated(error)) return
+         rate = min(log(perr(k, 1)/perr(k, 2)), log(pmean(k, 1)/pmean(k, 2)))/log(2.0_wp)
+         call check(error, rate >= 0.95_wp, 'pair '//achar(48 + k)//' pressure error '//real_text(perr(k, 1))// &
+            & ' -> '//real_text(perr(k, 2))//', mean '//real_text(pmean(k, 1))//' -> '//real_text(pmean(k, 2)))
+      end do
+   end subroutine test_layered_sphere
+
+   !> The relative L2 error of a pair's multiplier over its slave surface, and that of its
+   !> surface mean (the force the interface carries).
+   subroutine pressure_errors(c, perr, pmean)
+      type(contact_result_type), intent(in) :: c
+      real(wp), intent(out) :: perr, pmean
+      perr = sqrt(sum(c%weight*(c%p_fe - c%p_exact)**2)/sum(c%weight*c%p_exact**2))
+      pmean = abs(sum(c%weight*(c%p_fe - c%p_exact)))/sum(c%weight*c%p_exact)
+   end subroutine pressure_errors
 
    !> Each roller's peak within 3 % of its Hertz p0 = 2P/(pi a), a =
    !> sqrt(4 P R/(pi E*)), 1/E* = 2 (1 - nu^2)/E (module notes).

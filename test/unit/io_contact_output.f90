@@ -44,9 +44,10 @@ contains
    subroutine test_csv_read_back(error)
       type(error_type), allocatable, intent(out) :: error
       character(len=*), parameter :: path = dir//'test_contact.csv'
-      ! SCENE.md's columns, then the trailing signed tangential traction and the pair (extensions).
+      ! SCENE.md's columns, then the trailing signed tangential traction, the pair and the
+      ! FE-stress pressure (extensions).
       character(len=*), parameter :: contract = 'level,x,y,z,weight,gap,state,p_fe,p_spr,p_sprc,p_exact,ts_fe,ts_sprc,'// &
-         & 'tx_fe,ty_fe,tz_fe,pair'
+         & 'tx_fe,ty_fe,tz_fe,pair,p_fe_stress'
       type(contact_level_type) :: levels(2)
       character(len=:), allocatable :: text
       character(len=400) :: lines(10)
@@ -78,6 +79,9 @@ contains
                if (allocated(error)) return
                call check(error, cell_of(trim(lines(row)), 17), itoa(k), 'line '//itoa(row)//': pair')
                if (allocated(error)) return
+               call check_cell(cell_of(trim(lines(row)), 18), levels(l)%contacts(k)%p_fe_stress(i), &
+                  & 'line '//itoa(row)//': p_fe_stress', error)
+               if (allocated(error)) return
             end do
          end do
       end do
@@ -94,7 +98,7 @@ contains
       integer :: j
 
       where = 'line of level '//itoa(level)//' point '//itoa(i)//': '
-      call check(error, count_sub(line, ','), 16, where//'17 cells')
+      call check(error, count_sub(line, ','), 17, where//'18 cells')
       if (allocated(error)) return
       call check(error, cell_of(line, 1), itoa(level), where//'level')
       if (allocated(error)) return

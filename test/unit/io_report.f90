@@ -101,6 +101,11 @@ contains
          rows(i)%err_p_fe = 0.1_wp/3.0_wp**i
          rows(i)%err_p_spr = 0.2_wp/3.0_wp**i
          rows(i)%err_p_sprc = 0.3_wp/3.0_wp**i
+         rows(i)%p_max_fe_stress = 1.4e-4_wp*i
+         rows(i)%err_p_fe_stress = 0.4_wp/3.0_wp**i
+         rows(i)%jump_fe = 0.5_wp/7.0_wp**i
+         rows(i)%jump_spr = 0.6_wp/7.0_wp**i
+         rows(i)%jump_sprc = 0.7_wp/7.0_wp**i
          rows(i)%solver_iterations = 100*i + 7
       end do
       rows(1)%err_p_spr = report_empty
@@ -148,7 +153,7 @@ contains
          't_assembly,t_solve,t_recovery,t_estimate,t_total,err_fe,err_spr,err_sprc,eta_spr,eta_sprc,'// &
          'theta_spr,theta_sprc,'// &
          'contact_iterations,t_contact,contact_measure,p_max_fe,p_max_spr,p_max_sprc,p_max_exact,err_p_fe,'// &
-         'err_p_spr,err_p_sprc,solver_iterations'
+         'err_p_spr,err_p_sprc,p_max_fe_stress,err_p_fe_stress,jump_fe,jump_spr,jump_sprc,solver_iterations'
 
       call write_report_csv(path, contact_rows(), error)
       if (allocated(error)) return
@@ -158,13 +163,13 @@ contains
       if (allocated(error)) return
       line = text(index(text, new_line('a')) + 1:)
       line = line(:index(line, new_line('a')) - 1)
-      call check(error, count_char(line, ','), 29, 'every row has 30 cells')
+      call check(error, count_char(line, ','), 34, 'every row has 35 cells')
       if (allocated(error)) return
       call check(error, cell_of(line, 20), '4', 'contact_iterations an integer')
       if (allocated(error)) return
       call check(error, cell_of(line, 28), '', 'err_p_spr empty')
       if (allocated(error)) return
-      call check(error, cell_of(line, 30), '107', 'solver_iterations an integer (last cell)')
+      call check(error, cell_of(line, 35), '107', 'solver_iterations an integer (last cell)')
    end subroutine test_csv_header_contact
 
    !> Every column of a study with contact reads back bit for bit, and the rows
@@ -391,7 +396,7 @@ contains
    !> With contact the table has all 30 columns, contact ones included.
    subroutine test_table_contact(error)
       type(error_type), allocatable, intent(out) :: error
-      call check_table(contact_rows(), 30, error)
+      call check_table(contact_rows(), 35, error)
    end subroutine test_table_contact
 
    subroutine check_table(rows, ncolumns, error)
@@ -399,7 +404,7 @@ contains
       integer, intent(in) :: ncolumns
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: table
-      character(len=600) :: lines(5)
+      character(len=800) :: lines(5)
       integer :: i, j, n, first(n_report_columns), last(n_report_columns), ncol, pos
       integer, allocatable :: columns(:)
       character(len=:), allocatable :: name

@@ -302,14 +302,17 @@ contains
    !> Two pairs of hand-made results (see `contact_sample`), the row by hand:
    !> measure 0.5 + 1 + 0.25; p_max_fe 4, p_max_sprc 3, p_max_exact 3, SPR not
    !> run; ||p_ex||^2 = 0.5*4 + 4 + 0.25*9 = 8.25, FE error^2 = 1 + 0.25,
-   !> SPR-C error^2 = 0.5 + 1 + 0.25.
+   !> SPR-C error^2 = 0.5 + 1 + 0.25; p_max_fe_stress 2.5, FE-stress error^2 =
+   !> 0.5*0.25 + 0.25 + 0.25*0.25 + 0.25 = 0.6875; the jumps the worst pair's
+   !> (a negative jump is a pair without one).
    subroutine test_contact_row(error)
       type(error_type), allocatable, intent(out) :: error
       type(contact_result_type), allocatable :: contacts(:)
       type(report_row_type) :: row
+      real(wp), parameter :: jump(3, 2) = reshape([0.1_wp, 0.2_wp, 0.05_wp, -1.0_wp, 0.3_wp, -1.0_wp], [3, 2])
 
       contacts = contact_sample()
-      call fill_contact_row(contacts, row, error)
+      call fill_contact_row(contacts, row, error, jump)
       if (allocated(error)) return
       call check(error, row%has_contact, 'has_contact')
       if (allocated(error)) return
@@ -326,6 +329,18 @@ contains
       call check(error, row%err_p_fe, sqrt(1.25_wp/8.25_wp), roundoff, 'err_p_fe', rel=.true.)
       if (allocated(error)) return
       call check(error, row%err_p_sprc, sqrt(1.75_wp/8.25_wp), roundoff, 'err_p_sprc', rel=.true.)
+      if (allocated(error)) return
+      call check(error, row%p_max_fe_stress, 2.5_wp, 0.0_wp, 'p_max_fe_stress')
+      if (allocated(error)) return
+      call check(error, row%err_p_fe_stress, sqrt(0.6875_wp/8.25_wp), roundoff, 'err_p_fe_stress', rel=.true.)
+      if (allocated(error)) return
+      call check(error, all([row%jump_fe, row%jump_spr, row%jump_sprc] == [0.1_wp, 0.3_wp, 0.05_wp]), &
+         & 'jumps: the worst pair''s')
+      if (allocated(error)) return
+      call fill_contact_row(contacts, row, error, reshape([-1.0_wp, -1.0_wp, -1.0_wp], [3, 1]))
+      if (allocated(error)) return
+      call check(error, is_empty(row%jump_fe) .and. is_empty(row%jump_spr) .and. is_empty(row%jump_sprc), &
+         & 'no pair with a jump: empty')
    end subroutine test_contact_row
 
    !> Without an exact pressure the exact and error columns are empty; the
@@ -451,6 +466,7 @@ contains
       contacts(1)%p_fe = [2.0_wp, 1.0_wp, 0.0_wp]
       contacts(1)%p_sprc = [1.0_wp, 1.0_wp, 1.0_wp]
       contacts(1)%p_exact = [2.0_wp, 2.0_wp, 0.0_wp]
+      contacts(1)%p_fe_stress = [2.5_wp, 1.5_wp, 0.5_wp]
       contacts(1)%ts_fe = [0.6_wp, 0.1_wp, 0.0_wp]
       contacts(1)%iterations = 3
       call new_contact_result(contacts(2), reshape([2.0_wp, 1.0_wp], [2, 1]), [0.25_wp], &
@@ -460,6 +476,7 @@ contains
       contacts(2)%p_fe = [4.0_wp]
       contacts(2)%p_sprc = [3.0_wp]
       contacts(2)%p_exact = [3.0_wp]
+      contacts(2)%p_fe_stress = [2.0_wp]
       contacts(2)%ts_fe = [1.2_wp]
    end function contact_sample
 

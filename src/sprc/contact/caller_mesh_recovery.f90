@@ -10,8 +10,8 @@
 !> integration points (weight*|J|, FE stresses) and its boundary points other than contact
 !> facets (traction, pressure, symmetry, free facets) inside the prism Omega_aux over the
 !> patch's contact points, found through the grid pipeline's point cells (a counting sort
-!> once per body, never a scan per patch), depth 3 patch sizes, doubled while the fit lacks
-!> rank. Both bodies get contact-aware patches (the mirrored treatment): each is body (1)
+!> once per body, never a scan per patch), depth 3 patch sizes in 2D and 2 in 3D
+!> (sprc_estimate_contact_patches's default), doubled while the fit lacks rank. Both bodies get contact-aware patches (the mirrored treatment): each is body (1)
 !> of its own patches. SPR (`method` = mesh_method_spr) ignores contact.
 !>
 !> Input (`contact_body_type`, `contact_pair_type`): pointer components the caller

@@ -1,7 +1,8 @@
 !> What a contact solve gives at one level, per slave-surface point, for the
 !> report (doc/scene.md "The report"), `PREFIX_contact.csv` / `.svg` and the
 !> HDF5/XDMF point set. Producers: the contact FE (p_fe, ts_fe, gap, state)
-!> and the recoveries (p_spr, p_sprc, ts_sprc); the exact solution gives
+!> and the recoveries (p_spr, p_sprc, ts_sprc), the slave's FE stresses
+!> (p_fe_stress); the exact solution gives
 !> p_exact. A real value that does not apply is empty (`report_empty`).
 module sprc_contact_result
    use sprc_core_kinds, only: wp
@@ -33,6 +34,9 @@ module sprc_contact_result
       !> Contact pressure p = -n.sigma.n (positive in compression) from the FE contact
       !> formulation, SPR, SPR-C and the exact solution.
       real(wp), allocatable :: p_fe(:), p_spr(:), p_sprc(:), p_exact(:)
+      !> The pressure -n.sigma_h.n of the slave's own FE stresses at the point, which
+      !> the contact multiplier p_fe and the recovered p_spr, p_sprc are measured against.
+      real(wp), allocatable :: p_fe_stress(:)
       !> Magnitude of the tangential traction: FE formulation and SPR-C.
       real(wp), allocatable :: ts_fe(:), ts_sprc(:)
       !> The FE tangential traction on the slave body as a vector (dim, npoint):
@@ -67,11 +71,11 @@ contains
       if (stat == 0) allocate (self%weight, source=weight, stat=stat)
       if (stat == 0) allocate (self%normal, source=normal, stat=stat)
       if (stat == 0) allocate (self%gap(n), self%p_fe(n), self%p_spr(n), self%p_sprc(n), self%p_exact(n), &
-         & self%ts_fe(n), self%ts_sprc(n), source=report_empty, stat=stat)
+         & self%p_fe_stress(n), self%ts_fe(n), self%ts_sprc(n), source=report_empty, stat=stat)
       if (stat == 0) allocate (self%t_fe(self%dim, n), source=report_empty, stat=stat)
       if (stat == 0) allocate (self%state(n), source=contact_open, stat=stat)
       call check_allocation(stat, 'contact result', 'the values of each slave point', n, &
-         & 8*(3*self%dim + 8) + 4, error)
+         & 8*(3*self%dim + 9) + 4, error)
    end subroutine new_contact_result
 
    !> The doc/scene.md name of a state.

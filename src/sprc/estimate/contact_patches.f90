@@ -9,10 +9,12 @@
 !> get a description, each with the other as body (2): the master-side patches are the
 !> mirrored ones, so both recovered fields near the contact surface are contact-aware.
 !>
-!> Omega_aux depth: `depth` times the patch size h, default 3 h: a prism of one patch size
-!> holds mostly the other body's cut cells, whose stresses are the poorest; deeper ones stop
-!> gaining at 3 h and do not over-smooth the Hertz peak. The solve doubles it while the
-!> Omega_aux fit lacks rank.
+!> Omega_aux depth: `depth` times the patch size h, by default `default_aux_depth(dim)`: 3 h
+!> in 2D, 2 h in 3D. A prism of one patch size holds mostly the other body's cut cells, whose
+!> stresses are the poorest; in 2D deeper ones stop gaining at 3 h and do not over-smooth the
+!> Hertz peak. In 3D 2 h fits better than 3 h on the compound sphere (err_sprc, theta, the
+!> pressure, the traction jump), ties on the Hertz sphere, and its prisms hold fewer points
+!> (doc/benchmarks.md). The solve doubles it while the Omega_aux fit lacks rank.
 !>
 !> The other body's volume and boundary points are sorted into uniform cells once (a
 !> counting sort, `point_cells_type`): a patch passes the solve only those in the bounding
@@ -40,8 +42,6 @@ module sprc_estimate_contact_patches
    public :: grid_contact_type, new_grid_contact, contact_patch_solve, default_aux_depth
    public :: point_cells_type, new_point_cells, cells_box, cells_prism, aux_bounds
 
-   !> Omega_aux depth in patch sizes (module notes).
-   real(wp), parameter :: default_aux_depth = 3.0_wp
    !> Mean points per cell of the other body's point cells.
    real(wp), parameter :: points_per_cell = 8.0_wp
 
@@ -74,8 +74,8 @@ module sprc_estimate_contact_patches
       real(wp), allocatable :: slip(:, :)
       !> Coulomb friction coefficient (slip law).
       real(wp) :: mu = 0.0_wp
-      !> Omega_aux depth in patch sizes.
-      real(wp) :: depth = default_aux_depth
+      !> Omega_aux depth in patch sizes (`default_aux_depth` of the dimension unless given).
+      real(wp) :: depth = 0.0_wp
       !> The other body: volume points, weight*|J|, FE stresses, and their cells.
       real(wp), allocatable :: y(:, :), w(:), stress(:, :)
       type(point_cells_type) :: cells
@@ -88,6 +88,12 @@ module sprc_estimate_contact_patches
    end type grid_contact_type
 
 contains
+
+   !> The Omega_aux depth in patch sizes of a `dim`-dimensional body (module notes).
+   pure real(wp) function default_aux_depth(dim)
+      integer, intent(in) :: dim
+      default_aux_depth = merge(2.0_wp, 3.0_wp, dim == 3)
+   end function default_aux_depth
 
    !> The contact description of one body: `surfaces`, law(k) and slip(1:dim, k) per boundary
    !> point of its recovery input, mu, and the other body's volume points y(1:dim, j), weights
@@ -123,6 +129,7 @@ contains
       self%law = law
       self%slip = slip
       self%mu = mu
+      self%depth = default_aux_depth(size(y, 1))
       if (present(depth)) self%depth = depth
       if (present(boundary)) self%boundary = boundary
       self%young = young

@@ -3,7 +3,8 @@
 !> `level,x,y,z,weight,gap,state,p_fe,p_spr,p_sprc,p_exact,ts_fe,ts_sprc`,
 !> then (trailing) `tx_fe,ty_fe,tz_fe`, the FE
 !> tangential traction on the slave body as a vector (`tz_fe` empty in 2D),
-!> and `pair`, the point's `&contact` pair (1-based, scene order),
+!> `pair`, the point's `&contact` pair (1-based, scene order), and
+!> `p_fe_stress`, the pressure -n.sigma_h.n of the slave's FE stresses,
 !> reals as in the report CSV (read back bit for bit), `z` empty in
 !> 2D, `state` open / stick / slip, an empty value (not computed) an empty
 !> cell. The pairs of a level follow each other in `&contact` order.
@@ -18,9 +19,10 @@ module sprc_io_contact_csv
 
    public :: contact_level_type, contact_csv_header, write_contact_csv
 
-   !> The CSV header: doc/scene.md's columns, then the signed tangential traction and the pair.
+   !> The CSV header: doc/scene.md's columns, then the signed tangential traction, the pair
+   !> and the pressure of the slave's FE stresses.
    character(len=*), parameter :: contact_csv_header = 'level,x,y,z,weight,gap,state,p_fe,p_spr,p_sprc,p_exact,'// &
-      & 'ts_fe,ts_sprc,tx_fe,ty_fe,tz_fe,pair'
+      & 'ts_fe,ts_sprc,tx_fe,ty_fe,tz_fe,pair,p_fe_stress'
 
    !> The contact results of one level of a study.
    type :: contact_level_type
@@ -51,7 +53,7 @@ contains
             do i = 1, levels(l)%contacts(k)%npoint
                if (stat /= 0) exit
                write (unit, '(a)', iostat=stat, iomsg=msg) point_line(levels(l)%level, levels(l)%contacts(k), i)// &
-                  & ','//itoa(k)
+                  & ','//itoa(k)//','//csv_real(levels(l)%contacts(k)%p_fe_stress(i))
             end do
          end do
       end do

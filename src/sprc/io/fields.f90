@@ -17,7 +17,7 @@
 !> Voigt order, xx yy xy (2D) or xx yy zz xy yz xz (3D).
 !> Per `&contact` pair (a grid `contact_<k>` of Polyvertex cells, one per
 !> slave-surface quadrature point; `nodes` are the points): the columns of
-!> `PREFIX_contact.csv` (`p_fe`, `p_spr`, `p_sprc`, `p_exact`, `gap`,
+!> `PREFIX_contact.csv` (`p_fe`, `p_spr`, `p_sprc`, `p_exact`, `p_fe_stress`, `gap`,
 !> `ts_fe`, `ts_sprc`, `weight`, `state` 0 open / 1 stick / 2 slip) and the
 !> slave normal `normal` (dim).
 !> Values in the scene's units (the analysis ran in `units`); an empty value
@@ -208,6 +208,7 @@ contains
       if (.not. allocated(error)) call scalar('p_spr', c%p_spr, 'stress')
       if (.not. allocated(error)) call scalar('p_sprc', c%p_sprc, 'stress')
       if (.not. allocated(error)) call scalar('p_exact', c%p_exact, 'stress')
+      if (.not. allocated(error)) call scalar('p_fe_stress', c%p_fe_stress, 'stress')
       if (.not. allocated(error)) call scalar('gap', c%gap, 'length')
       if (.not. allocated(error)) call scalar('ts_fe', c%ts_fe, 'stress')
       if (.not. allocated(error)) call scalar('ts_sprc', c%ts_sprc, 'stress')

@@ -21,9 +21,9 @@ module sprc_io_report
    public :: report_column, report_empty, is_empty
    public :: n_report_columns, report_columns, report_csv_header, report_column_indices, report_header, csv_real
 
-   !> Number of columns a report may have: the 19 of every study, the 10
+   !> Number of columns a report may have: the 19 of every study, the 15
    !> contact columns, `solver_iterations` and the 2 adaptive columns.
-   integer, parameter :: n_report_columns = 32
+   integer, parameter :: n_report_columns = 37
 
    !> Column names, in the contract's order (doc/scene.md "The report").
    character(len=18), parameter :: report_columns(n_report_columns) = [character(len=18) :: &
@@ -31,15 +31,16 @@ module sprc_io_report
       & 't_solve', 't_recovery', 't_estimate', 't_total', 'err_fe', 'err_spr', 'err_sprc', &
       & 'eta_spr', 'eta_sprc', 'theta_spr', 'theta_sprc', &
       & 'contact_iterations', 't_contact', 'contact_measure', 'p_max_fe', 'p_max_spr', 'p_max_sprc', &
-      & 'p_max_exact', 'err_p_fe', 'err_p_spr', 'err_p_sprc', 'solver_iterations', 'step', 't_adapt']
+      & 'p_max_exact', 'err_p_fe', 'err_p_spr', 'err_p_sprc', 'p_max_fe_stress', 'err_p_fe_stress', &
+      & 'jump_fe', 'jump_spr', 'jump_sprc', 'solver_iterations', 'step', 't_adapt']
 
    !> Columns 1..n_base_columns are in every report, in this order, first; the
    !> contact columns (first_contact_column..last_contact_column) only in a
    !> study with contact; `solver_iterations` in every report; the adaptive
    !> columns (`step`, `t_adapt`, from first_adapt_column) last, only in an
    !> adaptive study, so that a uniform study's report is what it was.
-   integer, parameter :: n_base_columns = 19, first_contact_column = 20, last_contact_column = 29, &
-      & first_adapt_column = 31
+   integer, parameter :: n_base_columns = 19, first_contact_column = 20, last_contact_column = 34, &
+      & first_adapt_column = 36
 
    !> The CSV header of the columns every report starts with, exactly as doc/scene.md
    !> states it (`report_header` gives a report's whole header).
@@ -53,7 +54,8 @@ module sprc_io_report
       & kind_integer, kind_integer, kind_sig3, kind_sig3, kind_sig3, kind_sig3, kind_sig3, kind_sig3, &
       & kind_sig3, kind_error, kind_error, kind_error, kind_error, kind_error, kind_sig3, kind_sig3, &
       & kind_integer, kind_sig3, kind_error, kind_error, kind_error, kind_error, kind_error, kind_error, &
-      & kind_error, kind_error, kind_integer, kind_integer, kind_sig3]
+      & kind_error, kind_error, kind_error, kind_error, kind_error, kind_error, kind_error, kind_integer, &
+      & kind_integer, kind_sig3]
 
 contains
 
@@ -142,10 +144,15 @@ contains
       case (27); x = row%err_p_fe
       case (28); x = row%err_p_spr
       case (29); x = row%err_p_sprc
-      case (31)
+      case (30); x = row%p_max_fe_stress
+      case (31); x = row%err_p_fe_stress
+      case (32); x = row%jump_fe
+      case (33); x = row%jump_spr
+      case (34); x = row%jump_sprc
+      case (36)
          x = report_empty
          if (row%step >= 0) x = real(row%step, wp)
-      case (32); x = row%t_adapt
+      case (37); x = row%t_adapt
       case default; x = real(row%solver_iterations, wp)
       end select
    end function row_values
@@ -181,7 +188,12 @@ contains
       case (27); row%err_p_fe = x
       case (28); row%err_p_spr = x
       case (29); row%err_p_sprc = x
-      case (32); row%t_adapt = x
+      case (30); row%p_max_fe_stress = x
+      case (31); row%err_p_fe_stress = x
+      case (32); row%jump_fe = x
+      case (33); row%jump_spr = x
+      case (34); row%jump_sprc = x
+      case (37); row%t_adapt = x
       end select
    end subroutine set_real
 
@@ -197,8 +209,8 @@ contains
       case (4); row%cut_elements = n
       case (5); row%dofs = n
       case (20); row%contact_iterations = int(n)
-      case (30); row%solver_iterations = int(n)
-      case (31); row%step = int(n)
+      case (35); row%solver_iterations = int(n)
+      case (36); row%step = int(n)
       end select
    end subroutine set_integer
 
@@ -213,7 +225,7 @@ contains
       case (4); n = row%cut_elements
       case (5); n = row%dofs
       case (20); n = int(row%contact_iterations, i8)
-      case (31); n = int(row%step, i8)
+      case (36); n = int(row%step, i8)
       case default; n = int(row%solver_iterations, i8)
       end select
    end function row_integer

@@ -1899,7 +1899,7 @@ contains
             text = text//'  load history: off (friction '//c%friction//': all stages are one linear load)'//nl
          end if
       end associate
-      text = text//'  contact columns (contact_iterations ... err_p_sprc): on'//nl
+      text = text//'  contact columns (contact_iterations ... jump_sprc): on'//nl
       if (len(scene%output) > 0) then
          text = text//'  contact files: on ('//scene%output//'_contact.csv, '//scene%output//'_contact.svg)'//nl
       else

@@ -25,8 +25,9 @@
 !>
 !> Size (the thesis: too small an Omega_aux holds only boundary cells, whose FE stresses are
 !> the poorest; too large a one over-smooths). The caller chooses `depth`. The grid recovery
-!> takes 3 patch sizes (sprc_estimate_contact_patches, which gives the measurements: depth h, 2h, 3h, 4h
-!> on the shrink fit and the Hertz cylinder). A fit on Omega_aux that is rank deficient (too
+!> takes 3 patch sizes in 2D and 2 in 3D (sprc_estimate_contact_patches, which gives the measurements:
+!> depth h, 2h, 3h, 4h on the shrink fit and the Hertz cylinder; 2h, 3h on the compound and
+!> Hertz spheres). A fit on Omega_aux that is rank deficient (too
 !> few points of body (2), e.g. much coarser cells) is the caller's cue to double depth, like
 !> the expansion of a rank-deficient patch (recover_contact_patch does).
 module sprc_recovery_contact_aux

@@ -3,19 +3,22 @@
 !>
 !> Over the slave points i of every pair, with weights w_i (surface measure):
 !> - contact_measure = sum of w_i over the closed points (state /= open);
-!> - p_max_X = max_i p_X,i (X = fe, spr, sprc, exact);
+!> - p_max_X = max_i p_X,i (X = fe, spr, sprc, exact, fe_stress);
 !> - err_p_X = sqrt(sum w_i (p_X,i - p_ex,i)^2) / sqrt(sum w_i p_ex,i^2), the
 !>   relative L2 error over the whole slave surface (the exact pressure is 0
 !>   where the exact solution is open, as `exact_pressure_type` gives it).
 !> A column is empty where it does not apply: p_max_X when p_X is empty at
 !> some point (not computed), err_p_X also without an exact pressure or when
 !> the exact pressure is zero everywhere (a relative error of nothing).
+!> With `jump` (rows FE, SPR, SPR-C, a column per pair, negative where not
+!> measured: `level_type%traction_jump`), jump_fe, jump_spr, jump_sprc are the
+!> worst pair's, empty where no pair has one.
 !> The row's iteration count and contact time are the contact solve's to set.
 !>
 !> After a level's contact solve and recoveries:
 !> ```fortran
 !> call fill_contact_exact(study%scene, result%contacts, error)   ! p_exact where &exact gives it
-!> call fill_contact_row(result%contacts, result%row, error)
+!> call fill_contact_row(result%contacts, result%row, error, result%traction_jump)
 !> ```
 module sprc_study_contact_row
    use sprc_core_kinds, only: wp
@@ -65,17 +68,18 @@ contains
    !> The contact columns of `row` from the level's contact results; `has_contact` set.
    !> The slave points of all pairs are gathered in arrays allocated with stat=
    !> (sprc_core_alloc): an allocation that fails is `error`.
-   subroutine fill_contact_row(contacts, row, error)
+   subroutine fill_contact_row(contacts, row, error, jump)
       type(contact_result_type), intent(in) :: contacts(:)
       type(report_row_type), intent(inout) :: row
       type(error_type), allocatable, intent(out) :: error
-      real(wp), allocatable :: w(:), p_fe(:), p_spr(:), p_sprc(:), p_ex(:)
+      real(wp), intent(in), optional :: jump(:, :)
+      real(wp), allocatable :: w(:), p_fe(:), p_spr(:), p_sprc(:), p_ex(:), p_fe_stress(:)
       logical, allocatable :: closed(:)
       integer :: k, n, m, stat
 
       n = sum(contacts%npoint)
-      allocate (w(n), p_fe(n), p_spr(n), p_sprc(n), p_ex(n), closed(n), stat=stat)
-      call check_allocation(stat, 'contact report row', 'the slave points of the pairs', n, 44, error)
+      allocate (w(n), p_fe(n), p_spr(n), p_sprc(n), p_ex(n), p_fe_stress(n), closed(n), stat=stat)
+      call check_allocation(stat, 'contact report row', 'the slave points of the pairs', n, 52, error)
       if (allocated(error)) return
       n = 0
       do k = 1, size(contacts)
@@ -86,6 +90,7 @@ contains
             p_spr(n + 1:n + m) = c%p_spr
             p_sprc(n + 1:n + m) = c%p_sprc
             p_ex(n + 1:n + m) = c%p_exact
+            p_fe_stress(n + 1:n + m) = c%p_fe_stress
             closed(n + 1:n + m) = c%state /= contact_open
             n = n + m
          end associate
@@ -99,7 +104,21 @@ contains
       row%err_p_fe = relative_l2(p_fe, p_ex, w)
       row%err_p_spr = relative_l2(p_spr, p_ex, w)
       row%err_p_sprc = relative_l2(p_sprc, p_ex, w)
+      row%p_max_fe_stress = maximum(p_fe_stress)
+      row%err_p_fe_stress = relative_l2(p_fe_stress, p_ex, w)
+      if (present(jump)) then
+         row%jump_fe = worst(jump(1, :))
+         row%jump_spr = worst(jump(2, :))
+         row%jump_sprc = worst(jump(3, :))
+      end if
    end subroutine fill_contact_row
+
+   !> The largest non-negative value; empty if there is none.
+   pure real(wp) function worst(x)
+      real(wp), intent(in) :: x(:)
+      worst = report_empty
+      if (any(x >= 0.0_wp)) worst = maxval(x, mask=x >= 0.0_wp)
+   end function worst
 
    !> Largest value; empty if there is none or any is empty.
    pure real(wp) function maximum(p)

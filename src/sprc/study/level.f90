@@ -328,7 +328,7 @@ contains
          result%row%t_contact = t_contact
          call fill_contact_exact(study%scene, result%contacts, error)
          if (allocated(error)) return
-         call fill_contact_row(result%contacts, result%row, error)
+         call fill_contact_row(result%contacts, result%row, error, result%traction_jump)
          if (allocated(error)) return
       end if
       result%row%t_total = wall_time() - t_start
@@ -1181,10 +1181,10 @@ contains
       result%iterations = sol%iterations
    end subroutine contact_result
 
-   !> p_spr, p_sprc and ts_sprc of a contact result (scene units) from the slave body's
-   !> recovered fields (SPR, SPR-C where run) at its slave points: p = -n.sigma*.n,
-   !> ts = |sigma* n - (n.sigma* n) n| (sprc_recovery_contact_operators). SPR-C's field
-   !> there comes from the coupled contact patches (`finish_pair`).
+   !> p_fe_stress, p_spr, p_sprc and ts_sprc of a contact result (scene units) from the slave
+   !> body's FE stresses and recovered fields (SPR, SPR-C where run) at its slave points:
+   !> p = -n.sigma.n, ts = |sigma n - (n.sigma n) n| (sprc_recovery_contact_operators).
+   !> SPR-C's field there comes from the coupled contact patches (`finish_pair`).
    subroutine recovered_tractions(surface, bl, run, units, result, error)
       type(contact_surface_type), intent(in) :: surface
       type(body_level_type), intent(in) :: bl
@@ -1198,19 +1198,28 @@ contains
       d = surface%dim
       unit = units%modulus*units%strain
       if (size(surface%slave_cell) < surface%npoint) return
-      do m = 1, 2
-         if (.not. run(m)) cycle
+      do m = 0, 2
+         if (m > 0) then
+            if (.not. run(m)) cycle
+         end if
          do i = 1, surface%npoint
             if (surface%slave_cell(i) < 1) cycle
-            call field_eval(bl%field(m), surface%slave_cell(i), surface%x(:, i), sigma, error)
-            if (allocated(error)) return
-            call contact_traction(d, surface%normal(:, i), sigma, p, ts)
-            if (m == 1) then
-               result%p_spr(i) = p*unit
+            if (m == 0) then
+               call bl%problem%stress_in_element(surface%slave_cell(i), surface%x(:, i), sigma(1:merge(3, 6, d == 2)))
             else
+               call field_eval(bl%field(m), surface%slave_cell(i), surface%x(:, i), sigma, error)
+               if (allocated(error)) return
+            end if
+            call contact_traction(d, surface%normal(:, i), sigma, p, ts)
+            select case (m)
+            case (0)
+               result%p_fe_stress(i) = p*unit
+            case (1)
+               result%p_spr(i) = p*unit
+            case default
                result%p_sprc(i) = p*unit
                result%ts_sprc(i) = ts*unit
-            end if
+            end select
          end do
       end do
    end subroutine recovered_tractions

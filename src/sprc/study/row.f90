@@ -34,13 +34,17 @@ module sprc_study_row
       !> Contact columns (doc/scene.md; only scenes with `&contact`, `has_contact`):
       !> contact iterations summed over increments, contact time (search, gaps,
       !> contact terms), measure of the closed slave surface, maximum pressures and
-      !> relative L2 pressure errors over the slave surface.
+      !> relative L2 pressure errors over the slave surface (fe the contact multiplier,
+      !> fe_stress the slave's FE stresses -n.sigma_h.n); the relative jump of the normal
+      !> traction between the two bodies with the FE stresses, SPR and SPR-C (worst pair).
       logical :: has_contact = .false.
       integer :: contact_iterations = 0
       real(wp) :: t_contact = report_empty, contact_measure = report_empty
       real(wp) :: p_max_fe = report_empty, p_max_spr = report_empty, p_max_sprc = report_empty
       real(wp) :: p_max_exact = report_empty
       real(wp) :: err_p_fe = report_empty, err_p_spr = report_empty, err_p_sprc = report_empty
+      real(wp) :: p_max_fe_stress = report_empty, err_p_fe_stress = report_empty
+      real(wp) :: jump_fe = report_empty, jump_spr = report_empty, jump_sprc = report_empty
       !> Krylov iterations of the level's solves (0 for a direct solve).
       integer :: solver_iterations = 0
       !> Adaptive studies (`&adapt`): the step (0 the start mesh; -1, empty, in a
