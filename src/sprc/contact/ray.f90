@@ -1,52 +1,23 @@
-!> Where a line meets a body's named surface on its exact implicit geometry:
-!> the root finder of the contact gap (thesis eq. 3).
+!> Where a line meets a body's named surface on its exact geometry: the root
+!> finder of the contact gap (thesis eq. 3). The method, its tie rules and
+!> tolerances are derived in doc/theory.md, section 6b.
 !>
-!> The line is x(t) = x0 + t n (n a unit vector); the surface is the zero set
-!> of shape s's level set f(t) = phi_s(x(t)), restricted to the part that
-!> bounds the body (`body%is_boundary_on`). Sought: in a search interval
-!> [t_lo, t_hi] on one side of 0 (it may reach a small margin past 0), the
-!> first crossing met going from the end nearer to 0 towards the other end,
-!> i.e. the crossing nearest to the start.
-!>
-!> Method, robust for every shape kind without a Lipschitz bound on phi:
-!> 1. Isolation by certified enclosures. A segment [a, b] of the line lies in
-!>    the box spanned by x(a), x(b); `phi_range` over that box encloses f on
-!>    the segment. A segment whose enclosure excludes 0 (beyond the snapping
-!>    tolerance of sprc_geometry_body, the rounding of phi) has no root and is
-!>    dropped. Otherwise, if the enclosure of f' = grad phi . n over the box
-!>    (from `gradient_range`, interval sums) excludes 0, f is monotone there:
-!>    at most one root, solved in step 2. Otherwise the segment is halved and
-!>    the half nearer the start is searched first, so the first accepted
-!>    root is the nearest one. Only segments near the surface or near a tangency are
-!>    split: the work is O(log(length/t_tol)) per root or turning point.
-!> 2. A monotone segment with a sign change of f at its ends is solved by
-!>    safeguarded Newton: Newton steps that leave the bracket are replaced by
-!>    bisection, and a Newton step shorter than t_tol/2 (converged: f is at
-!>    its rounding level) is closed by evaluating f at t -+ t_tol/2.
-!>    Stopping test: bracket width <= t_tol (or f = 0 exactly); the answer is
-!>    the bracket's midpoint.
-!> 3. A root is accepted if it lies on the part of the surface that bounds
-!>    the body and the surface faces the line's direction (n . n_body <= 0
-!>    is asked by the caller through `facing`); otherwise the search goes on
-!>    beyond it.
-!> Segments shorter than t_tol are not split further: a sign change there is
-!> a crossing at the midpoint, none a grazing touch (not a root). A line that
-!> runs in the surface (e.g. along a box face) is split only down to 2^-12 of
-!> the search interval, each piece one candidate, so the work stays bounded.
-!>
-!> A faceted shape's surface (`facet_crossing`) is met exactly instead: the
-!> facets whose boxes the search segment meets (through the facet hierarchy)
-!> are intersected with the line one by one; a crossing counts if it lies on
-!> the facet (closed, to a few ulps: a line through an edge meets both
-!> facets), on the asked surface (the whole shape or one named group), faces
-!> the line when asked (the facet's outward normal, flipped for a subtracted
-!> shape) and bounds the body. The crossing nearest the start wins, the
-!> lowest facet on a tie (an edge: either facet's normal is the body's).
-!> Its tolerance: t_tol plus the snapping length over |n . normal|.
-!> Tolerances: t_tol = 8 eps (|x0|_inf + max(|a|, |b|)) on a segment [a, b], a
-!> few ulps of the coordinates there. A root's reported `tolerance` bounds
-!> |t - t_exact|: half the final bracket plus tol_f/|f'(t)| (it grows towards
-!> tangency). More than `max_visits` segments (a guard against hangs) fails.
+!> The line is x(t) = x0 + t n (n a unit vector); sought, in a search interval
+!> [t_lo, t_hi] on one side of 0, the crossing of the surface nearest the start
+!> that bounds the body (`body%is_boundary_on`) and, when asked (`facing`),
+!> faces the line.
+!> - Implicit shapes: certified enclosures of phi and grad phi . n over a
+!>   segment's box (`phi_range`, `gradient_range`) drop segments without a root
+!>   and isolate monotone ones, which safeguarded Newton solves to a bracket of
+!>   t_tol; other segments are halved, the half nearer the start first, so the
+!>   first accepted root is the nearest. A line running in the surface is split
+!>   only to 2^-12 of the interval.
+!> - Faceted shapes (`facet_crossing`): the facets the segment's box meets in
+!>   the facet hierarchy are intersected one by one; a crossing counts on the
+!>   closed facet, on the asked surface (shape or named group), facing and
+!>   bounding as above; nearest wins, the lowest facet on a tie.
+!> - t_tol = 8 eps (|x0|_inf + max(|a|, |b|)); a root's `tolerance` bounds
+!>   |t - t_exact|; more than `max_visits` segments fails (a guard).
 module sprc_contact_ray
    use sprc_core_kinds, only: wp
    use sprc_geometry_body, only: body_type, snap_tolerance, csg_subtract

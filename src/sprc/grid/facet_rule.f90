@@ -1,51 +1,22 @@
 !> Quadrature of a grid cell cut by a faceted solid (sprc_geometry_facet_solid),
 !> exact for the polyhedron (polygon in 2D): the volume rule integrates over
-!> cell ∩ solid, the surface rule over the facets clipped to the cell.
+!> cell ∩ solid, the surface rule over the facets clipped to the cell. The
+!> construction and its round-off rules are in doc/theory.md, section 2a.
 !>
-!> Volume: the cell is partitioned by a binary space partition whose
-!> splitting planes are the planes of the facet fragments (facets clipped to
-!> the cell) that cross the current region. Regions are convex polytopes kept
-!> as their face loops (a polygon in 2D), clipped by each plane (Sutherland-
-!> Hodgman on every face, the new face from the points on the plane ordered
-!> by angle), so a region's size grows only with the planes that bound it. A
-!> fragment is used once: the region on its back side is inside the solid
-!> next to it, the front side outside. When no fragment is left in a region,
-!> the region is inside or outside as the side of the last plane says
-!> (solid-leaf BSP: the last fragment lies on the region's boundary and no
-!> facet crosses the region). A plane that does not cross the region (the
-!> fragment lies on its boundary) only sets that class. Inside regions are
-!> split into simplices (a fan from one vertex over the fanned faces) that
-!> get a collapsed (Duffy) product Gauss rule of qs = q + 1 points per
-!> direction: positive weights, exact for polynomials of total degree
-!> 2 qs - 3 = 2 q - 1 on a tetrahedron and 2 qs - 2 on a triangle, i.e. every
-!> total degree the tensor rule of q points integrates.
-!>
-!> Compression (on request): the cell's volume rule is then replaced by at most M of its own
-!> points with new positive weights that give the same moments of every
-!> polynomial of total degree 2 q - 1 (M of them: 20 in 2D / 56 in 3D for
-!> q = 3), so the compressed rule is exact wherever the full one is
-!> (Tchakaloff: such a rule exists among the points). The weights solve the
-!> non-negative least-squares problem A v = A w, v >= 0 (A: the products of
-!> Legendre polynomials in the cell's coordinates scaled to [-1, 1], at the
-!> points) by Lawson and Hanson's active set method, whose passive set is at
-!> most M columns of full rank; the columns' QR is updated as columns enter.
-!> Every basis function is at most 1 on the cell and the weights sum to its
-!> measure V, so the moments' round-off is of order eps V; the compressed
-!> rule is kept when every moment matches within M^2 eps V (the QR
-!> solve's backward error with at most M columns of entries at most 1), else
-!> the full rule stays. A cell that no fragment crosses gets the tensor rule
-!> of q points per direction where it is in the body.
-!>
-!> Surface: each fragment crossing the cell (not in a face plane of the cell)
-!> is fanned into triangles (a segment in 2D) with the qs-point rule; its
-!> normal is the facet's exact outward normal. Fragments in a face plane of
-!> the cell are boundaries on grid planes (`facet_face_rule`): they belong to
-!> the cell on the body side, as for the primitives.
-!>
-!> Round-off: plane sides within the solid's snapping length count as on the
-!> plane; fragments, faces and simplices of measure below the snapping
-!> measure (16 eps h^(dim-1), 16 eps h^dim) are dropped, and points of a
-!> region within 4 snapping lengths are merged.
+!> - Volume: a solid-leaf binary space partition of the cell by the planes of
+!>   the facet fragments crossing it (regions kept as convex polytopes, clipped
+!>   face by face); inside regions are fanned into simplices with a collapsed
+!>   (Duffy) Gauss rule of q + 1 points per direction: positive weights, exact
+!>   for every total degree the tensor rule of q points integrates. A cell no
+!>   fragment crosses gets the tensor rule.
+!> - Compression (on request): at most M of the rule's own points with new
+!>   positive weights keeping every moment of total degree 2q - 1 (Tchakaloff;
+!>   Lawson-Hanson NNLS), kept when every moment matches within M^2 eps V.
+!> - Surface: fragments crossing the cell are fanned with the same rule and
+!>   carry the facet's exact normal; fragments in a face plane of the cell
+!>   belong to the cell on the body side (`facet_face_rule`).
+!> - Round-off: sides within the snapping length count as on the plane; pieces
+!>   below the snapping measure are dropped, nearby points merged.
 module sprc_grid_facet_rule
    use sprc_core_kinds, only: wp
    use sprc_core_gauss, only: max_gauss_points, gauss_legendre_nodes
