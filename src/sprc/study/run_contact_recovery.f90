@@ -1,0 +1,398 @@
+!> The recoveries of a contact pair (`sprc_study_run_contact`): each body's
+!> coupled SPR-C description of the pair (`pair_contact`), its recovered
+!> tractions, and the `stabilization = 'recovered'` iteration that re-solves
+!> the pair with the slave body's recovered traction until it settles.
+module sprc_study_run_contact_recovery
+   use sprc_core_kinds, only: wp
+   use sprc_core_error, only: error_type, fatal_error, stat_not_converged
+   use sprc_core_timer, only: timer_type
+   use sprc_core_alloc, only: check_allocation
+   use sprc_grid_nodes, only: grid_nodes_type
+   use sprc_estimate_patches, only: recovery_input_type, recover_grid, boundary_points
+   use sprc_recovery_patch, only: patch_type
+   use sprc_estimate_recovered_field, only: recovered_field_type, method_sprc, field_eval
+   use sprc_recovery_contact_operators, only: contact_traction, contact_law_frictionless, contact_law_slip, &
+      & contact_law_stick
+   use sprc_estimate_contact_patches, only: grid_contact_type, new_grid_contact, point_cells_type, &
+      & new_point_cells, cells_box
+   use sprc_estimate_fe_input, only: fe_recovery_input
+   use sprc_study_spec, only: contact_spec_type
+   use sprc_study_model, only: scene_surface, analysis_units_type
+   use sprc_contact_result, only: contact_result_type, new_contact_result, contact_open, contact_stick, &
+      & contact_slip
+   use sprc_contact_surface, only: contact_surface_type
+   use sprc_contact_pair_solve, only: contact_solution_type, solve_contact_pair, friction_kind, friction_coulomb, &
+      & friction_frictionless, default_max_iterations, contact_factor_type, multiplier_kind
+   use sprc_fem_element, only: traction_matrix
+   use sprc_core_text, only: itoa, real_text
+   use sprc_study_level_types, only: study_type, body_level_type
+   use sprc_study_run_estimate, only: recover_body
+   use sprc_study_run_bodies, only: exact_error
+   implicit none
+   private
+
+   public :: stabilize_recovered, finish_pair, pair_contact, recovered_tractions, contact_result
+
+contains
+
+   !> Tur's recovered stabilization (sprc_contact_pair_solve notes): the pair
+   !> solved with a zero stabilization traction first (the penalty method,
+   !> SPD for every kappa), then again and again with the slave body's
+   !> recovered traction sigma* n of the previous solution at the slave
+   !> points as the known stabilization traction, until an update leaves
+   !> the active set as it was and moves the contact traction (pressure and tangential part, L2 over
+   !> the slave surface) by at most sqrt(eps) of its norm: the fixed point's
+   !> own round-off tier, as the update contracts by about C_I/kappa (the
+   !> traction operator's bound over the penalty). `sol%iterations` sums every
+   !> active-set iteration of every solve (doc/scene.md contact_iterations), and
+   !> `sol%t_contact` the stabilization's recoveries (the stabilization
+   !> traction is a contact term; t_recovery stays the reported fields'); an
+   !> iteration that has not settled after default_max_iterations updates is
+   !> stat_not_converged.
+   subroutine stabilize_recovered(study, spec, surface, names, bodies, sol, pstar, error)
+      type(study_type), intent(in) :: study
+      type(contact_spec_type), intent(in) :: spec
+      type(contact_surface_type), intent(in) :: surface
+      character(len=*), intent(in) :: names(2)
+      type(body_level_type), intent(inout) :: bodies(:)
+      type(contact_solution_type), intent(out) :: sol
+      !> The stabilization traction of the last solve (dim, npoint; pair units).
+      real(wp), allocatable, intent(out) :: pstar(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_factor_type) :: factor
+
+      call recovered_updates(study, spec, surface, names, bodies, factor, sol, pstar, error)
+      call factor%destroy()
+   end subroutine stabilize_recovered
+
+   !> The iteration of `stabilize_recovered` with the block factor kept
+   !> between updates (sprc_contact_pair_solve: the matrix depends on the active
+   !> set only).
+   subroutine recovered_updates(study, spec, surface, names, bodies, factor, sol, pstar, error)
+      type(study_type), intent(in) :: study
+      type(contact_spec_type), intent(in) :: spec
+      type(contact_surface_type), intent(in) :: surface
+      character(len=*), intent(in) :: names(2)
+      type(body_level_type), intent(inout) :: bodies(:)
+      type(contact_factor_type), intent(inout) :: factor
+      type(contact_solution_type), intent(out) :: sol
+      real(wp), allocatable, intent(out) :: pstar(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_solution_type) :: next
+      type(timer_type) :: timer
+      real(wp) :: change, size_, t_solve, t_contact
+      integer :: s, m, it, iterations, stat
+
+      s = spec%slave_index
+      m = spec%master_index
+      allocate (pstar(surface%dim, surface%npoint), source=0.0_wp, stat=stat)
+      call check_allocation(stat, 'contact pair', 'the recovered traction of each slave point', surface%npoint, &
+         & 8*surface%dim, error)
+      if (allocated(error)) return
+      call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, friction_kind(spec%friction), &
+         & spec%kappa, names, sol, error, recovered=pstar, factor=factor, multiplier=multiplier_kind(spec%multiplier))
+      if (allocated(error)) return
+      iterations = sol%iterations
+      t_solve = sol%t_solve
+      t_contact = sol%t_contact
+      do it = 1, default_max_iterations
+         call timer%reset()
+         call timer%start()
+         call slave_recovered_traction(study, spec, surface, sol, bodies, pstar, error)
+         call timer%stop()
+         t_contact = t_contact + timer%elapsed
+         if (.not. allocated(error)) call solve_contact_pair(bodies(s)%problem, bodies(m)%problem, surface, &
+            & friction_kind(spec%friction), spec%kappa, names, next, error, recovered=pstar, factor=factor, &
+            & multiplier=multiplier_kind(spec%multiplier))
+         if (allocated(error)) return
+         iterations = iterations + next%iterations
+         t_solve = t_solve + next%t_solve
+         t_contact = t_contact + next%t_contact
+         change = sqrt(sum(surface%weight*((next%pressure - sol%pressure)**2 + (next%tangential - sol%tangential)**2)))
+         size_ = sqrt(sum(surface%weight*(next%pressure**2 + next%tangential**2)))
+         if (all(next%closed .eqv. sol%closed) .and. change <= sqrt(epsilon(1.0_wp))*size_) exit
+         if (it == default_max_iterations) then
+            call fatal_error(error, "contact '"//trim(names(1))//"' on '"//trim(names(2))//"': the recovered "// &
+               & 'stabilization did not settle in '//itoa(it)//' updates; the last moved the contact traction by '// &
+               & real_text(change/max(size_, tiny(1.0_wp)))//' of its norm and switched '// &
+               & itoa(count(next%closed .neqv. sol%closed))//' points (raise kappa)', stat_not_converged)
+            return
+         end if
+         sol = next
+      end do
+      sol = next
+      sol%iterations = iterations
+      sol%t_solve = t_solve
+      sol%t_contact = t_contact
+   end subroutine recovered_updates
+
+   !> The slave body's recovered traction sigma* n at every slave point
+   !> (dim, npoint; zero where the point has no slave cell), in the pair's
+   !> units: the slave's SPR-C recovery of the current solution `sol`, with
+   !> the patch degree of the scene's SPR-C and the pair's coupled contact
+   !> patches (`pair_contact` of sol's contact states, the master's FE
+   !> stresses as body (2)): the field the report's p_sprc comes from, so
+   !> that a settled iteration is stabilized by the recovered stress it
+   !> reports. Open parts of the contact surface are free surfaces.
+   subroutine slave_recovered_traction(study, spec, surface, sol, bodies, pstar, error)
+      type(study_type), intent(in) :: study
+      type(contact_spec_type), intent(in) :: spec
+      type(contact_surface_type), intent(in) :: surface
+      type(contact_solution_type), intent(in) :: sol
+      type(body_level_type), intent(in) :: bodies(:)
+      real(wp), allocatable, intent(out) :: pstar(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      type(recovery_input_type) :: inputs(2)
+      type(contact_result_type) :: result
+      type(grid_contact_type) :: contact(1)
+      type(recovered_field_type) :: field
+      real(wp) :: sigma(6), tn(3, 6)
+      integer :: i, d, s, stat
+
+      d = surface%dim
+      s = spec%slave_index
+      call contact_result(surface, sol, spec, study%bodies(s)%units, result, error)
+      if (.not. allocated(error)) call fe_recovery_input(bodies(s)%problem, inputs(1), error)
+      if (.not. allocated(error)) call fe_recovery_input(bodies(spec%master_index)%problem, inputs(2), error)
+      if (.not. allocated(error)) call pair_contact(study, spec, surface, result, 1, inputs(1), &
+         & bodies(s)%problem%mesh%nodes, inputs(2), contact(1), error)
+      if (allocated(error)) return
+      associate (mesh => bodies(s)%problem%mesh)
+         call recover_grid(inputs(1), mesh%grid, mesh%nodes, mesh%hanging, method_sprc, study%degree(2), field, &
+            & error, contacts=contact)
+      end associate
+      if (allocated(error)) return
+      allocate (pstar(d, surface%npoint), source=0.0_wp, stat=stat)
+      call check_allocation(stat, 'contact pair', 'the recovered traction of each slave point', surface%npoint, 8*d, error)
+      if (allocated(error)) return
+      do i = 1, surface%npoint
+         if (surface%slave_cell(i) < 1 .or. .not. surface%has_master(i)) cycle
+         call field_eval(field, surface%slave_cell(i), surface%x(:, i), sigma, error)
+         if (allocated(error)) return
+         call traction_matrix(d, surface%normal(:, i), tn(1:d, 1:bodies(s)%problem%nstress))
+         pstar(:, i) = matmul(tn(1:d, 1:bodies(s)%problem%nstress), sigma(1:bodies(s)%problem%nstress))
+      end do
+   end subroutine slave_recovered_traction
+
+   !> After a pair's FE solve: both bodies' exact errors, recoveries and estimates, SPR-C
+   !> with each body's contact surface (`pair_contact`): the coupled contact patches of
+   !> both bodies, each with the other as body (2) (sprc_estimate_contact_patches).
+   subroutine finish_pair(study, spec, surface, result, bodies, error)
+      type(study_type), intent(in) :: study
+      type(contact_spec_type), intent(in) :: spec
+      type(contact_surface_type), intent(in) :: surface
+      type(contact_result_type), intent(in) :: result
+      type(body_level_type), intent(inout) :: bodies(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(recovery_input_type) :: inputs(2)
+      type(grid_contact_type) :: contacts(2)
+      integer :: b, k(2)
+
+      k = [spec%slave_index, spec%master_index]
+      do b = 1, 2
+         call exact_error(study, study%bodies(k(b)), bodies(k(b)), error)
+         if (.not. allocated(error) .and. any(study%run)) call fe_recovery_input(bodies(k(b))%problem, inputs(b), error)
+         if (allocated(error)) then
+            error%message = 'body '''//study%bodies(k(b))%name//''': '//error%message
+            return
+         end if
+      end do
+      if (.not. any(study%run)) return
+      do b = 1, 2
+         call pair_contact(study, spec, surface, result, b, inputs(b), &
+            & bodies(k(b))%problem%mesh%nodes, inputs(3 - b), contacts(b), error)
+         if (.not. allocated(error)) &
+            & call recover_body(study, study%bodies(k(b)), bodies(k(b)), inputs(b), error, contacts(b:b))
+         if (allocated(error)) then
+            error%message = 'body '''//study%bodies(k(b))%name//''': '//error%message
+            return
+         end if
+      end do
+   end subroutine finish_pair
+
+   !> The contact surface of side b (1 slave, 2 master) for its recovery (sprc_estimate_contact_patches):
+   !> each of the body's boundary points on its contact shape takes the state of the nearest
+   !> slave point (side 2: nearest master point of a slave point) within the size of its
+   !> element, else open; closed states give the law (frictionless; stick; Coulomb: stick
+   !> or slip) and, for slip, the slip direction of the body relative to the other: opposed
+   !> to the contact's FE tangential traction on the slave (`result%t_fe`) on the slave side,
+   !> along it on the master side.
+   !> The other body's volume points, FE stresses and boundary points (its contact surface
+   !> left out) are `other`'s.
+   subroutine pair_contact(study, spec, surface, result, side, input, nodes, other, contact, error)
+      type(study_type), intent(in) :: study
+      type(contact_spec_type), intent(in) :: spec
+      type(contact_surface_type), intent(in) :: surface
+      type(contact_result_type), intent(in) :: result
+      integer, intent(in) :: side
+      type(recovery_input_type), intent(in) :: input, other
+      type(grid_nodes_type), intent(in) :: nodes
+      type(grid_contact_type), intent(out) :: contact
+      type(error_type), allocatable, intent(out) :: error
+      integer, allocatable :: law(:)
+      real(wp), allocatable :: slip(:, :)
+      real(wp) :: t(3), size_e, dist, best
+      type(patch_type) :: oboundary
+      type(point_cells_type) :: cells
+      real(wp), allocatable :: sx(:, :)
+      integer, allocatable :: near(:), sel(:)
+      integer, allocatable :: surfaces(:), osurfaces(:)
+      integer :: nb, e, k, i, j, inear, d, o, nnear, stat
+
+      d = study%dim
+      nb = size(input%bw)
+      o = merge(spec%master_index, spec%slave_index, side == 1)
+      if (side == 1) then
+         surfaces = study%bodies(spec%slave_index)%geometry%surface_parts( &
+            & scene_surface(study%scene, spec%slave_surface_index, spec%slave_group))
+         osurfaces = study%bodies(o)%geometry%surface_parts( &
+            & scene_surface(study%scene, spec%master_surface_index, spec%master_group))
+      else
+         surfaces = study%bodies(spec%master_index)%geometry%surface_parts( &
+            & scene_surface(study%scene, spec%master_surface_index, spec%master_group))
+         osurfaces = study%bodies(o)%geometry%surface_parts( &
+            & scene_surface(study%scene, spec%slave_surface_index, spec%slave_group))
+      end if
+      allocate (law(nb), slip(d, nb), stat=stat)
+      call check_allocation(stat, 'pair_contact', 'the contact law of each boundary point', nb, 4 + 8*d, error)
+      if (allocated(error)) return
+      law = 0
+      slip = 0.0_wp
+      ! This side's points of the slave points (on the master side those with a master point), in cells.
+      if (side == 1) then
+         sel = [(i, i=1, surface%npoint)]
+         sx = surface%x
+      else
+         sel = pack([(i, i=1, surface%npoint)], surface%has_master)
+         sx = surface%master_x(:, sel)
+      end if
+      call new_point_cells(cells, sx, error)
+      if (allocated(error)) return
+      do e = 1, nodes%n_elements
+         if (input%belem_ptr(e + 1) == input%belem_ptr(e)) cycle
+         size_e = element_size(nodes, e)
+         do k = input%belem_ptr(e), input%belem_ptr(e + 1) - 1
+            if (.not. any(surfaces == input%bshape(k))) cycle
+            best = huge(1.0_wp)
+            inear = 0
+            call cells_box(cells, sx, input%bx(:, k) - size_e, input%bx(:, k) + size_e, near, nnear)
+            do j = 1, nnear
+               i = sel(near(j))
+               dist = norm2(sx(:, near(j)) - input%bx(:, k))
+               if (dist < best .or. (dist == best .and. i < inear)) then
+                  best = dist
+                  inear = i
+               end if
+            end do
+            if (inear == 0 .or. best > size_e) cycle
+            if (result%state(inear) == contact_open) cycle
+            select case (friction_kind(spec%friction))
+            case (friction_frictionless)
+               law(k) = contact_law_frictionless
+            case (friction_coulomb)
+               law(k) = merge(contact_law_slip, contact_law_stick, result%state(inear) == contact_slip)
+            case default
+               law(k) = contact_law_stick
+            end select
+            if (law(k) /= contact_law_slip) cycle
+            ! The direction of the contact's own tangential traction at the slave point (the
+            ! multiplier, of magnitude mu p_fe on a slipping point), not that of the slave's FE
+            ! stress there: near the edge of the contact zone the stress of a cut cell gave a
+            ! tangential traction of the wrong sign (Cattaneo-Mindlin).
+            t(1:d) = result%t_fe(:, inear)
+            ! No tangential traction to give a direction: then mu p ~ 0, and stick is safe.
+            if (.not. (norm2(t(1:d)) > sqrt(epsilon(1.0_wp))*abs(result%p_fe(inear)))) then
+               law(k) = contact_law_stick
+            else
+               slip(:, k) = merge(-1.0_wp, 1.0_wp, side == 1)*t(1:d)
+            end if
+         end do
+      end do
+      if (allocated(study%bodies(o)%exact)) then
+         call boundary_points(other, d, osurfaces, oboundary, study%bodies(o)%exact)
+      else
+         call boundary_points(other, d, osurfaces, oboundary)
+      end if
+      call new_grid_contact(contact, surfaces, law, slip, spec%mu, other%x, other%w, other%stress, other%young, &
+         & other%poisson, other%body_force(1:d), error, boundary=oboundary)
+   end subroutine pair_contact
+
+   !> The largest edge of element e's box.
+   pure real(wp) function element_size(nodes, e)
+      type(grid_nodes_type), intent(in) :: nodes
+      integer, intent(in) :: e
+      integer :: nv
+
+      nv = 2**nodes%dim
+      element_size = maxval(maxval(nodes%x(:, nodes%connectivity(1:nv, e)), dim=2) - &
+         & minval(nodes%x(:, nodes%connectivity(1:nv, e)), dim=2))
+   end function element_size
+
+   !> p_fe_stress, p_spr, p_sprc and ts_sprc of a contact result (scene units) from the slave
+   !> body's FE stresses and recovered fields (SPR, SPR-C where run) at its slave points:
+   !> p = -n.sigma.n, ts = |sigma n - (n.sigma n) n| (sprc_recovery_contact_operators).
+   !> SPR-C's field there comes from the coupled contact patches (`finish_pair`).
+   subroutine recovered_tractions(surface, bl, run, units, result, error)
+      type(contact_surface_type), intent(in) :: surface
+      type(body_level_type), intent(in) :: bl
+      logical, intent(in) :: run(2)
+      type(analysis_units_type), intent(in) :: units
+      type(contact_result_type), intent(inout) :: result
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: sigma(6), p, ts, unit
+      integer :: i, m, d
+
+      d = surface%dim
+      unit = units%modulus*units%strain
+      if (size(surface%slave_cell) < surface%npoint) return
+      do m = 0, 2
+         if (m > 0) then
+            if (.not. run(m)) cycle
+         end if
+         do i = 1, surface%npoint
+            if (surface%slave_cell(i) < 1) cycle
+            if (m == 0) then
+               call bl%problem%stress_in_element(surface%slave_cell(i), surface%x(:, i), sigma(1:merge(3, 6, d == 2)))
+            else
+               call field_eval(bl%field(m), surface%slave_cell(i), surface%x(:, i), sigma, error)
+               if (allocated(error)) return
+            end if
+            call contact_traction(d, surface%normal(:, i), sigma, p, ts)
+            select case (m)
+            case (0)
+               result%p_fe_stress(i) = p*unit
+            case (1)
+               result%p_spr(i) = p*unit
+            case default
+               result%p_sprc(i) = p*unit
+               result%ts_sprc(i) = ts*unit
+            end select
+         end do
+      end do
+   end subroutine recovered_tractions
+
+   !> The contact result of a pair in scene units (pressures times the stress
+   !> unit, gaps times the displacement unit).
+   subroutine contact_result(surface, sol, spec, units, result, error)
+      type(contact_surface_type), intent(in) :: surface
+      type(contact_solution_type), intent(in) :: sol
+      type(contact_spec_type), intent(in) :: spec
+      type(analysis_units_type), intent(in) :: units
+      type(contact_result_type), intent(out) :: result
+      type(error_type), allocatable, intent(out) :: error
+      integer :: closed_state
+
+      call new_contact_result(result, surface%x, surface%weight, surface%normal, spec%slave_index, spec%master_index, &
+         & error)
+      if (allocated(error)) return
+      closed_state = merge(contact_slip, contact_stick, friction_kind(spec%friction) == friction_frictionless)
+      where (surface%has_master) result%gap = sol%gap*units%strain
+      result%state = merge(closed_state, contact_open, sol%closed)
+      where (sol%slipping) result%state = contact_slip
+      result%p_fe = (sol%pressure*units%modulus)*units%strain
+      result%ts_fe = (sol%tangential*units%modulus)*units%strain
+      result%t_fe = (sol%traction_t*units%modulus)*units%strain
+      result%iterations = sol%iterations
+   end subroutine contact_result
+
+end module sprc_study_run_contact_recovery
