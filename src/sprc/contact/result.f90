@@ -35,7 +35,7 @@ module sprc_contact_result
       !> formulation, SPR, SPR-C and the exact solution.
       real(wp), allocatable :: p_fe(:), p_spr(:), p_sprc(:), p_exact(:)
       !> The pressure -n.sigma_h.n of the slave's own FE stresses at the point, which
-      !> the contact multiplier p_fe and the recovered p_spr, p_sprc are measured against.
+      !> the contact multiplier p_fe and the recovered p_spr, p_sprc are compared with.
       real(wp), allocatable :: p_fe_stress(:)
       !> Magnitude of the tangential traction: FE formulation and SPR-C.
       real(wp), allocatable :: ts_fe(:), ts_sprc(:)

@@ -11,7 +11,7 @@
 !> some point (not computed), err_p_X also without an exact pressure or when
 !> the exact pressure is zero everywhere (a relative error of nothing).
 !> With `jump` (rows FE, SPR, SPR-C, a column per pair, negative where not
-!> measured: `level_type%traction_jump`), jump_fe, jump_spr, jump_sprc are the
+!> computed: `level_type%traction_jump`), jump_fe, jump_spr, jump_sprc are the
 !> worst pair's, empty where no pair has one.
 !> The row's iteration count and contact time are the contact solve's to set.
 !>
