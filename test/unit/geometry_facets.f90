@@ -349,28 +349,14 @@ contains
          do e2 = 0, deg - e1
             do e3 = 0, merge(deg - e1 - e2, 0, d == 3)
                e = [e1, e2, e3]
-               ifull = moment(full%vol_x(:, 1:full%nvol), full%vol_w(1:full%nvol))
-               icomp = moment(comp%vol_x(:, 1:comp%nvol), comp%vol_w(1:comp%nvol))
+               ifull = scaled_moment(full%vol_x(:, 1:full%nvol), full%vol_w(1:full%nvol), lo, hi, e, d)
+               icomp = scaled_moment(comp%vol_x(:, 1:comp%nvol), comp%vol_w(1:comp%nvol), lo, hi, e, d)
                worst = max(worst, abs(icomp - ifull))
             end do
          end do
       end do
       write (msg, '(a, ": a moment is off by ", es10.3, " > ", es10.3)') name, worst, tol
       call check(error, worst <= tol, trim(msg))
-   contains
-      real(wp) function moment(x, w)
-         real(wp), intent(in) :: x(:, :), w(:)
-         integer :: j, k
-         real(wp) :: t
-         moment = 0.0_wp
-         do j = 1, size(w)
-            t = w(j)
-            do k = 1, d
-               t = t*((2.0_wp*x(k, j) - lo(k) - hi(k))/(hi(k) - lo(k)))**e(k)
-            end do
-            moment = moment + t
-         end do
-      end function moment
    end subroutine compressed_case
 
    !> The cell quadrature compresses the volume rule of every cell a faceted
@@ -451,28 +437,31 @@ contains
          do e2 = 0, deg - e1
             do e3 = 0, merge(deg - e1 - e2, 0, d == 3)
                e = [e1, e2, e3]
-               worst = max(worst, abs(moment(rule%vol_x(:, 1:rule%nvol), rule%vol_w(1:rule%nvol)) - &
-                  & moment(full%vol_x(:, 1:full%nvol), full%vol_w(1:full%nvol))))
+               worst = max(worst, abs(scaled_moment(rule%vol_x(:, 1:rule%nvol), rule%vol_w(1:rule%nvol), lo, hi, e, d) - &
+                  & scaled_moment(full%vol_x(:, 1:full%nvol), full%vol_w(1:full%nvol), lo, hi, e, d)))
             end do
          end do
       end do
       write (msg, '(a, ": a moment is off by ", es10.3, " > ", es10.3)') name, worst, tol
       call check(error, worst <= tol, trim(msg))
-   contains
-      real(wp) function moment(x, w)
-         real(wp), intent(in) :: x(:, :), w(:)
-         integer :: j, k
-         real(wp) :: t
-         moment = 0.0_wp
-         do j = 1, size(w)
-            t = w(j)
-            do k = 1, d
-               t = t*((2.0_wp*x(k, j) - lo(k) - hi(k))/(hi(k) - lo(k)))**e(k)
-            end do
-            moment = moment + t
-         end do
-      end function moment
    end subroutine cell_compressed_case
+
+   !> Sum of w times the monomial of exponents e(1:d) in the coordinates of the
+   !> box [lo, hi] scaled to [-1, 1].
+   real(wp) function scaled_moment(x, w, lo, hi, e, d) result(moment)
+      real(wp), intent(in) :: x(:, :), w(:), lo(:), hi(:)
+      integer, intent(in) :: e(3), d
+      integer :: j, k
+      real(wp) :: t
+      moment = 0.0_wp
+      do j = 1, size(w)
+         t = w(j)
+         do k = 1, d
+            t = t*((2.0_wp*x(k, j) - lo(k) - hi(k))/(hi(k) - lo(k)))**e(k)
+         end do
+         moment = moment + t
+      end do
+   end function scaled_moment
 
    ! ------------------------------------------------------------ checks
 
