@@ -54,7 +54,8 @@ contains
          new_unittest('mixed_csg', test_mixed), &
          new_unittest('classification', test_classification), &
          new_unittest('shape_errors', test_shape_errors), &
-         new_unittest('compressed_rule', test_compressed) &
+         new_unittest('compressed_rule', test_compressed), &
+         new_unittest('cell_rule_compressed', test_cell_compressed) &
          ]
    end subroutine collect_facets
 
@@ -348,29 +349,119 @@ contains
          do e2 = 0, deg - e1
             do e3 = 0, merge(deg - e1 - e2, 0, d == 3)
                e = [e1, e2, e3]
-               ifull = moment(full%vol_x(:, 1:full%nvol), full%vol_w(1:full%nvol))
-               icomp = moment(comp%vol_x(:, 1:comp%nvol), comp%vol_w(1:comp%nvol))
+               ifull = scaled_moment(full%vol_x(:, 1:full%nvol), full%vol_w(1:full%nvol), lo, hi, e, d)
+               icomp = scaled_moment(comp%vol_x(:, 1:comp%nvol), comp%vol_w(1:comp%nvol), lo, hi, e, d)
                worst = max(worst, abs(icomp - ifull))
             end do
          end do
       end do
       write (msg, '(a, ": a moment is off by ", es10.3, " > ", es10.3)') name, worst, tol
       call check(error, worst <= tol, trim(msg))
-   contains
-      real(wp) function moment(x, w)
-         real(wp), intent(in) :: x(:, :), w(:)
-         integer :: j, k
-         real(wp) :: t
-         moment = 0.0_wp
-         do j = 1, size(w)
-            t = w(j)
-            do k = 1, d
-               t = t*((2.0_wp*x(k, j) - lo(k) - hi(k))/(hi(k) - lo(k)))**e(k)
-            end do
-            moment = moment + t
-         end do
-      end function moment
    end subroutine compressed_case
+
+   !> The cell quadrature compresses the volume rule of every cell a faceted
+   !> solid cuts, once per cell after its sub-boxes (sprc_grid_quadrature,
+   !> `cut_rule`): at most M = C(2q - 1 + dim, dim) points, positive weights,
+   !> and every monomial of total degree <= 2q - 1 in the cell's coordinates
+   !> scaled to [-1, 1] integrated as the uncompressed polyhedral rule of the
+   !> whole cell does (facet_cell_rule without compression: no sub-boxes, an
+   !> independent path). Tolerance: the stated sqrt(eps) tier times the cell's
+   !> measure (the moments are matched to M^2 eps in the basis of the points'
+   !> bounding box; a rule exact to a lower degree is off by >= 1e-5 here).
+   !> Cells: a sphere of 2048 facets (the cell meets more than 32: halved),
+   !> a tiny cut of it (inside fraction < 1e-3) where small weights must stay
+   !> positive, q = 3 and 4; a 2D circle of 256 segments, q = 4.
+   subroutine test_cell_compressed(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(facet_set_type) :: set
+      real(wp) :: p(2, 256), a
+      integer :: q, i
+
+      call facets_sphere(set, [0.01_wp, 0.02_wp, -0.03_wp], 0.8_wp, 64, 32)
+      do q = 3, 4
+         call cell_compressed_case(set, [0.4_wp, -0.3_wp, -0.3_wp], [1.0_wp, 0.3_wp, 0.3_wp], q, .false., &
+            & 'sphere', error)
+         if (allocated(error)) return
+      end do
+      call cell_compressed_case(set, [0.8095_wp, -0.05_wp, -0.05_wp], [0.9095_wp, 0.05_wp, 0.05_wp], 4, .true., &
+         & 'sphere tiny cut', error)
+      if (allocated(error)) return
+      do i = 1, 256
+         a = (i - 1)*pi/128 + 0.01_wp
+         p(:, i) = 0.8_wp*[cos(a), sin(a)]
+      end do
+      call facets_polygon(set, p)
+      call cell_compressed_case(set, [0.3_wp, 0.3_wp], [0.7_wp, 0.7_wp], 4, .false., 'circle', error)
+   end subroutine test_cell_compressed
+
+   subroutine cell_compressed_case(set, lo, hi, q, tiny, name, error)
+      type(facet_set_type), intent(in) :: set
+      real(wp), intent(in) :: lo(:), hi(:)
+      integer, intent(in) :: q
+      logical, intent(in) :: tiny
+      character(len=*), intent(in) :: name
+      type(error_type), allocatable, intent(out) :: error
+      type(shape_type) :: shape
+      type(body_type) :: body
+      type(cut_quadrature_type) :: quad
+      type(cell_rule_type) :: rule
+      type(facet_rule_type) :: full
+      real(wp) :: tol, vol, worst
+      integer :: d, m, e(3), deg, e1, e2, e3
+      character(len=200) :: msg
+
+      d = set%dim
+      call make_body(set, body, error)
+      if (allocated(error)) return
+      call new_facet_shape(shape, name, set, error)
+      if (allocated(error)) return
+      call new_cut_quadrature(quad, d, q, error)
+      if (allocated(error)) return
+      call cell_rule(quad, body, lo, hi, rule, error)
+      if (allocated(error)) return
+      call facet_cell_rule(full, shape%solid, lo, hi, q, .true., .false., compress=.false.)
+      deg = 2*q - 1
+      m = merge((deg + 1)*(deg + 2)/2, (deg + 1)*(deg + 2)*(deg + 3)/6, d == 2)
+      vol = product(hi(1:d) - lo(1:d))
+      write (msg, '(a, ": inside fraction ", es10.3)') name, sum(full%vol_w(1:full%nvol))/vol
+      call check(error, (sum(full%vol_w(1:full%nvol)) < 1.0e-3_wp*vol) .eqv. tiny, trim(msg))
+      if (allocated(error)) return
+      write (msg, '(a, ": ", i0, " points, the full rule ", i0, ", M = ", i0)') name, rule%nvol, full%nvol, m
+      call check(error, rule%nvol <= m .and. full%nvol > m, trim(msg))
+      if (allocated(error)) return
+      call check(error, all(rule%vol_w(1:rule%nvol) > 0.0_wp), name//': a weight is not positive')
+      if (allocated(error)) return
+      tol = sqrt(epsilon(1.0_wp))*vol
+      worst = 0.0_wp
+      do e1 = 0, deg
+         do e2 = 0, deg - e1
+            do e3 = 0, merge(deg - e1 - e2, 0, d == 3)
+               e = [e1, e2, e3]
+               worst = max(worst, abs(scaled_moment(rule%vol_x(:, 1:rule%nvol), rule%vol_w(1:rule%nvol), lo, hi, e, d) - &
+                  & scaled_moment(full%vol_x(:, 1:full%nvol), full%vol_w(1:full%nvol), lo, hi, e, d)))
+            end do
+         end do
+      end do
+      write (msg, '(a, ": a moment is off by ", es10.3, " > ", es10.3)') name, worst, tol
+      call check(error, worst <= tol, trim(msg))
+   end subroutine cell_compressed_case
+
+   !> Sum of w times the monomial of exponents e(1:d) in the coordinates of the
+   !> box [lo, hi] scaled to [-1, 1].
+   real(wp) function scaled_moment(x, w, lo, hi, e, d) result(moment)
+      real(wp), intent(in) :: x(:, :), w(:), lo(:), hi(:)
+      integer, intent(in) :: e(3), d
+      integer :: j, k
+      real(wp) :: t
+      moment = 0.0_wp
+      do j = 1, size(w)
+         t = w(j)
+         do k = 1, d
+            t = t*((2.0_wp*x(k, j) - lo(k) - hi(k))/(hi(k) - lo(k)))**e(k)
+         end do
+         moment = moment + t
+      end do
+   end function scaled_moment
 
    ! ------------------------------------------------------------ checks
 

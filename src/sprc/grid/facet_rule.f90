@@ -9,9 +9,14 @@
 !>   (Duffy) Gauss rule of q + 1 points per direction: positive weights, exact
 !>   for every total degree the tensor rule of q points integrates. A cell no
 !>   fragment crosses gets the tensor rule.
-!> - Compression (on request): at most M of the rule's own points with new
+!> - Compression (`compress_points`; the cell quadrature applies it to every
+!>   cell a faceted solid cuts): at most M of the rule's own points with new
 !>   positive weights keeping every moment of total degree 2q - 1 (Tchakaloff;
 !>   Lawson-Hanson NNLS), kept when every moment matches within M^2 eps V.
+!>   The points stay in the body; positive weights keep the stiffness of a
+!>   small cut semi-definite. NNLS costs of order M^2 per candidate point,
+!>   so it first draws from a spread subset of about 3M points and only if
+!>   that cannot reach the moments from all of them.
 !> - Surface: fragments crossing the cell are fanned with the same rule and
 !>   carry the facet's exact normal; fragments in a face plane of the cell
 !>   belong to the cell on the body side (`facet_face_rule`).
@@ -26,7 +31,10 @@ module sprc_grid_facet_rule
    implicit none
    private
 
-   public :: facet_rule_type, facet_cell_rule, facet_face_rule
+   public :: facet_rule_type, facet_cell_rule, facet_face_rule, compress_points
+
+   !> Candidates of the first compression solve, in multiples of the moments M.
+   integer, parameter :: candidate_factor = 4
 
    !> Points of one cell and the work arrays, reused across cells (one per thread).
    type :: facet_rule_type
@@ -50,8 +58,7 @@ module sprc_grid_facet_rule
       !> The reference rules of the simplex (dim, nref) with weights, the triangle and the segment.
       integer, private :: dim = 0, qs = 0
       real(wp), allocatable, private :: ref_x(:, :), ref_w(:), tri_x(:, :), tri_w(:), seg_x(:), seg_w(:)
-      !> Compression: the moment matrix (M, nvol), the exponents of its rows (3, M).
-      real(wp), allocatable, private :: ca(:, :)
+      !> Compression: the exponents of the moments' Legendre products (3, M).
       integer, allocatable, private :: cexp(:, :)
       integer, private :: cdeg = -1, cdim = 0
    end type facet_rule_type
@@ -71,8 +78,8 @@ contains
    !> body where it is inside / outside the solid (the other shapes decided
    !> over the cell). Surface normals point out of the body. Face-plane
    !> fragments are left to `facet_face_rule`. compress = .true.: the volume
-   !> rule compressed (module notes); off by default, its cost (of order M^2
-   !> times the full rule's points per cell) exceeds the clipping's.
+   !> rule compressed (module notes); off by default (the cell quadrature
+   !> compresses once per cell, after all its boxes).
    pure subroutine facet_cell_rule(rule, solid, lo, hi, q, member_in, member_out, compress)
       type(facet_rule_type), intent(inout) :: rule
       type(facet_solid_type), intent(in) :: solid
@@ -602,84 +609,160 @@ contains
       type(facet_rule_type), intent(inout) :: rule
       real(wp), intent(in) :: lo(:), hi(:)
       integer, intent(in) :: degree
-      real(wp), allocatable :: b(:), v(:), x(:, :)
-      integer, allocatable :: list(:)
-      real(wp) :: tol
-      integer :: m, n, k, i
-      logical :: ok
-
-      n = rule%nvol
-      call moment_exponents(rule, degree, m)
-      if (n <= m) return
-      if (size(rule%ca, 2) < n) then
-         deallocate (rule%ca)
-         allocate (rule%ca(m, 2*n))
-      end if
-      call moment_matrix(rule, lo, hi, degree, m, n)
-      b = matmul(rule%ca(1:m, 1:n), rule%vol_w(1:n))
-      tol = real(m, wp)**2*epsilon(1.0_wp)*sum(rule%vol_w(1:n))
-      allocate (list(m), v(m))
-      call nnls(rule%ca, m, n, b, tol, list, v, k, ok)
-      if (.not. ok) return
-      allocate (x(3, k))
-      do i = 1, k
-         x(:, i) = rule%vol_x(:, list(i))
-      end do
-      rule%vol_x(:, 1:k) = x
-      rule%vol_w(1:k) = v(1:k)
-      rule%nvol = k
+      call compress_points(rule, rule%dim, lo, hi, degree, rule%vol_x, rule%vol_w, rule%nvol)
    end subroutine compress_volume
 
+   !> The points x(:, 1:n) with weights w of a rule on (part of) the box [lo, hi]
+   !> in `dim` dimensions replaced by at most M of them with new positive
+   !> weights keeping every moment of total degree <= `degree` (module notes);
+   !> `work` holds the moment matrix. The moments are Legendre products in the
+   !> coordinates of the points' bounding box scaled to [-1, 1] (the cell's
+   !> would be ill-conditioned for a thin piece). NNLS costs of order M^2 per
+   !> candidate point: it draws first from f M of the points sampled by weight
+   !> (`spread_picks`), f = candidate_factor, 4 f, 16 f, ... while below n/2,
+   !> then from all n. Unchanged where n <= M or no solve matches.
+   pure subroutine compress_points(work, dim, lo, hi, degree, x, w, n)
+      type(facet_rule_type), intent(inout) :: work
+      integer, intent(in) :: dim, degree
+      real(wp), intent(in) :: lo(:), hi(:)
+      real(wp), intent(inout) :: x(:, :), w(:)
+      integer, intent(inout) :: n
+      real(wp), allocatable :: b(:), v(:), y(:, :), col(:, :)
+      integer, allocatable :: list(:), pick(:)
+      real(wp) :: tol, blo(3), bhi(3)
+      integer :: m, k, i, nc
+      logical :: ok
+
+      call moment_exponents(work, dim, degree, m)
+      if (n <= m) return
+      blo(1:dim) = minval(x(1:dim, 1:n), dim=2)
+      bhi(1:dim) = maxval(x(1:dim, 1:n), dim=2)
+      do i = 1, dim
+         if (.not. bhi(i) > blo(i)) then
+            blo(i) = lo(i)
+            bhi(i) = hi(i)
+         end if
+      end do
+      allocate (b(m), col(m, 1), list(m), v(m))
+      b = 0.0_wp
+      do i = 1, n
+         call moment_matrix(work, dim, x(:, i:i), blo, bhi, degree, col)
+         b = b + w(i)*col(:, 1)
+      end do
+      tol = real(m, wp)**2*epsilon(1.0_wp)*sum(w(1:n))
+      ok = .false.
+      nc = candidate_factor*m
+      do while (2*nc < n .and. .not. ok)
+         call spread_picks(w(1:n), nc, pick)
+         call solve_on(work, dim, degree, x, pick, blo, bhi, b, tol, list, v, k, ok)
+         nc = 4*nc
+      end do
+      if (.not. ok) call solve_on(work, dim, degree, x, [(i, i=1, n)], blo, bhi, b, tol, list, v, k, ok)
+      if (.not. ok) return
+      allocate (y(3, k))
+      do i = 1, k
+         y(:, i) = x(:, list(i))
+      end do
+      x(:, 1:k) = y
+      w(1:k) = v(1:k)
+      n = k
+   end subroutine compress_points
+
+   !> `compress_points`' NNLS on the points x(:, cand); list(1:k) then indexes x.
+   pure subroutine solve_on(work, dim, degree, x, cand, blo, bhi, b, tol, list, v, k, ok)
+      type(facet_rule_type), intent(in) :: work
+      integer, intent(in) :: dim, degree, cand(:)
+      real(wp), intent(in) :: x(:, :), blo(:), bhi(:), b(:), tol
+      integer, intent(out) :: list(:), k
+      real(wp), intent(out) :: v(:)
+      logical, intent(out) :: ok
+      real(wp), allocatable :: col(:, :)
+
+      allocate (col(size(b), size(cand)))
+      call moment_matrix(work, dim, x(:, cand), blo, bhi, degree, col)
+      call nnls(col, size(b), size(cand), b, tol, list, v, k, ok)
+      if (ok) list(1:k) = cand(list(1:k))
+   end subroutine solve_on
+
+   !> About nc of the points 1..size(w), drawn in proportion to their weights
+   !> (systematic sampling: the points where the running sum of w crosses
+   !> (i - 1/2) W/nc, each once), ascending: a discrete copy of the rule's
+   !> measure, whose cone holds the moments where the solve needs them.
+   pure subroutine spread_picks(w, nc, pick)
+      real(wp), intent(in) :: w(:)
+      integer, intent(in) :: nc
+      integer, allocatable, intent(out) :: pick(:)
+      real(wp) :: total, run, next
+      integer :: j, k
+
+      allocate (pick(nc))
+      total = sum(w)
+      run = 0.0_wp
+      k = 0
+      next = 0.5_wp*total/nc
+      do j = 1, size(w)
+         run = run + w(j)
+         if (run < next) cycle
+         k = k + 1
+         pick(k) = j
+         do while (next <= run)
+            next = next + total/nc
+         end do
+         if (k == nc) exit
+      end do
+      pick = pick(1:k)
+   end subroutine spread_picks
+
    !> Exponents of the products of Legendre polynomials of total degree <= degree
-   !> in rule%dim dimensions (rule%cexp(:, 1:m)), and the moment matrix's storage.
-   pure subroutine moment_exponents(rule, degree, m)
+   !> in `dim` dimensions (rule%cexp(:, 1:m)).
+   pure subroutine moment_exponents(rule, dim, degree, m)
       type(facet_rule_type), intent(inout) :: rule
-      integer, intent(in) :: degree
+      integer, intent(in) :: dim, degree
       integer, intent(out) :: m
       integer :: a, b, c, pass
 
-      if (rule%cdeg == degree .and. rule%cdim == rule%dim) then
+      if (rule%cdeg == degree .and. rule%cdim == dim) then
          m = size(rule%cexp, 2)
          return
       end if
-      if (allocated(rule%cexp)) deallocate (rule%cexp, rule%ca)
+      if (allocated(rule%cexp)) deallocate (rule%cexp)
       do pass = 1, 2
          m = 0
          do a = 0, degree
             do b = 0, degree - a
-               do c = 0, merge(degree - a - b, 0, rule%dim == 3)
+               do c = 0, merge(degree - a - b, 0, dim == 3)
                   m = m + 1
                   if (pass == 2) rule%cexp(:, m) = [a, b, c]
                end do
             end do
          end do
-         if (pass == 1) allocate (rule%cexp(3, m), rule%ca(m, 256))
+         if (pass == 1) allocate (rule%cexp(3, m))
       end do
       rule%cdeg = degree
-      rule%cdim = rule%dim
+      rule%cdim = dim
    end subroutine moment_exponents
 
-   !> rule%ca(i, j): the i-th Legendre product at volume point j, in the cell's
-   !> coordinates scaled to [-1, 1].
-   pure subroutine moment_matrix(rule, lo, hi, degree, m, n)
-      type(facet_rule_type), intent(inout) :: rule
-      real(wp), intent(in) :: lo(:), hi(:)
-      integer, intent(in) :: degree, m, n
+   !> col(i, j): the i-th Legendre product (rule%cexp) at point x(:, j), in the
+   !> coordinates of the box [lo, hi] scaled to [-1, 1].
+   pure subroutine moment_matrix(rule, d, x, lo, hi, degree, col)
+      type(facet_rule_type), intent(in) :: rule
+      real(wp), intent(in) :: x(:, :), lo(:), hi(:)
+      integer, intent(in) :: d, degree
+      real(wp), intent(out) :: col(:, :)
       real(wp) :: p(0:degree, 3), t
-      integer :: j, k, l, i, d
+      integer :: j, k, l, i
 
-      d = rule%dim
       p = 1.0_wp
-      do j = 1, n
+      do j = 1, size(x, 2)
          do k = 1, d
-            t = (2.0_wp*rule%vol_x(k, j) - lo(k) - hi(k))/(hi(k) - lo(k))
+            t = (2.0_wp*x(k, j) - lo(k) - hi(k))/(hi(k) - lo(k))
             if (degree >= 1) p(1, k) = t
             do l = 1, degree - 1
                p(l + 1, k) = (real(2*l + 1, wp)*t*p(l, k) - real(l, wp)*p(l - 1, k))/real(l + 1, wp)
             end do
          end do
-         do i = 1, m
-            rule%ca(i, j) = p(rule%cexp(1, i), 1)*p(rule%cexp(2, i), 2)*p(rule%cexp(3, i), 3)
+         do i = 1, size(col, 1)
+            col(i, j) = p(rule%cexp(1, i), 1)*p(rule%cexp(2, i), 2)*p(rule%cexp(3, i), 3)
          end do
       end do
    end subroutine moment_matrix

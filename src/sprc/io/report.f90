@@ -633,7 +633,7 @@ contains
       line = 'level='//itoa(row%level)//' body='//row%body//' internal='//itoa(row%internal)// &
          ' cut='//itoa(row%cut)//' external='//itoa(row%external)//' measure='//trim(adjustl(m))// &
          ' boundary_measure='//trim(adjustl(bm))//' points='//itoa(row%points)//' t_mesh='//trim(adjustl(t))// &
-         ' t_quadrature='//trim(adjustl(tq))
+         ' t_quadrature='//trim(adjustl(tq))//' volume_points='//itoa(row%volume_points)
       if (.not. allocated(row%surfaces)) return
       do i = 1, size(row%surfaces)
          write (m, '(es24.16)') row%surfaces(i)%measure
