@@ -20,13 +20,15 @@ HDF5_LDIR := $(shell pkg-config --libs-only-L hdf5 2>/dev/null || echo -L/usr/li
 DEP_LIBS := $(HDF5_LDIR) -lhdf5_fortran -lhdf5 -lcholmod -lumfpack -lsuitesparseconfig -llapack -lblas \
             -lgfortran -lgomp -lm
 
-.PHONY: all deps build run test bench clean help lib install fuzz doc
+.PHONY: all deps build run test test-full memcheck bench clean help lib install fuzz doc
 
 all: build
 
 help:
 	@echo "make run     install what is missing, build (release) and run the driver on its default scene"
 	@echo "make test    install what is missing and run the whole test suite"
+	@echo "make test-full  the expensive tiers make test leaves out: unit --full, test-driver --full, every scene under valgrind"
+	@echo "make memcheck   every scene under valgrind (make test: a stratified subset)"
 	@echo "make bench   benchmarks (sparse direct solvers, grid build, faceted solids, recovery on a caller's mesh)"
 	@echo "make fuzz    5000 seeded mutants of the example scenes (check, run) and of geometry files (check) (FUZZ_COUNT, FUZZ_SEED)"
 	@echo "make doc     the API reference and doc/ pages (FORD) in build/doc/index.html"
@@ -47,6 +49,19 @@ run: deps
 
 test: deps
 	@tools/run-tests
+
+# The expensive tiers `make test` leaves out for its time limit: the unit
+# tests' full variants (sprc_testsuite's full_tier), the driver tests' (the
+# out-of-memory sweep) and valgrind over every scene (make test: the
+# stratified subset of tools/memcheck-scenes).
+test-full: deps
+	$(FPM) test unit -- --full
+	@tools/test-driver --full
+	@tools/memcheck-scenes --all
+
+memcheck: deps
+	$(FPM) build
+	@tools/memcheck-scenes --all
 
 # The API reference (FORD): fails on a FORD warning about the public API.
 doc: deps

@@ -2,10 +2,11 @@
 !> test; prints one line per test and `N passed, M failed` last; exits non-zero
 !> on any failure or an unknown selection. Suites are named LAYER/NAME after the
 !> layer they test (doc/architecture.md); SUITE is LAYER/NAME, NAME, or LAYER/
-!> for every suite of the layer.
+!> for every suite of the layer. `unit --full [SUITE [TEST]]` runs the
+!> expensive variants of the tiered tests too (sprc_testsuite, `make test-full`).
 program sprc_unit_tests
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
-   use sprc_testsuite, only: testsuite_type, new_testsuite, run_testsuite
+   use sprc_testsuite, only: testsuite_type, new_testsuite, run_testsuite, set_full_tier
    use sprc_test_core, only: collect_core
    use sprc_test_poly, only: collect_poly
    use sprc_test_sparse, only: collect_sparse
@@ -48,7 +49,7 @@ program sprc_unit_tests
 
    type(testsuite_type), allocatable :: suites(:)
    character(len=:), allocatable :: suite_name, test_name
-   integer :: i, npass, nfail, nrun
+   integer :: i, npass, nfail, nrun, first
 
    suites = [ &
       new_testsuite('core/core', collect_core), &
@@ -92,7 +93,13 @@ program sprc_unit_tests
       ]
 
    call get_arg(1, suite_name)
-   call get_arg(2, test_name)
+   first = 1
+   if (suite_name == '--full') then
+      call set_full_tier(.true.)
+      first = 2
+   end if
+   call get_arg(first, suite_name)
+   call get_arg(first + 1, test_name)
    npass = 0
    nfail = 0
    nrun = 0

@@ -9,6 +9,10 @@
 !> returns the text unchanged and records the pattern, and `run_testsuite`
 !> fails the test that called it, naming the pattern (also a `should_fail`
 !> test: its expected failure must not come from a broken variant).
+!>
+!> Tiers: `make test` runs each test's cheap tier, which still decides the
+!> test's claim (a coarser level, fewer variants); `unit --full` (`make
+!> test-full`) adds the expensive variants. A test asks `full_tier()`.
 module sprc_testsuite
    use sprc_core_kinds, only: wp, i8
    use sprc_core_error, only: error_type, fatal_error, stat_internal
@@ -17,7 +21,7 @@ module sprc_testsuite
 
    public :: unittest_type, testsuite_type, new_unittest, new_testsuite
    public :: check, test_failed, run_testsuite, error_type, collect_interface, replaced
-   public :: take_replace_failure
+   public :: take_replace_failure, full_tier, set_full_tier
 
    abstract interface
       !> A test: allocates `error` when it fails.
@@ -59,7 +63,20 @@ module sprc_testsuite
    !> parallel regions).
    character(len=:), allocatable, save :: replace_failure
 
+   !> Whether the expensive variants run too (`unit --full`).
+   logical, save :: full = .false.
+
 contains
+
+   !> Whether the tests run their expensive variants too (`unit --full`).
+   logical function full_tier()
+      full_tier = full
+   end function full_tier
+
+   subroutine set_full_tier(on)
+      logical, intent(in) :: on
+      full = on
+   end subroutine set_full_tier
 
    function new_unittest(name, test, should_fail) result(self)
       character(len=*), intent(in) :: name
