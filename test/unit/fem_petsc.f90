@@ -470,8 +470,10 @@ contains
 
    !> Iterations on a small 3D problem (sphere octant, planes off the grid,
    !> level 4: 11k unknowns, a hierarchy of three levels) from zero to the
-   !> same tolerance: geometric multigrid needs at most half of GAMG's
-   !> iterations and at most 12 (measured: 8 against 24).
+   !> same tolerance: geometric multigrid needs fewer iterations than GAMG
+   !> and at most 20 (measured: 16 against 24, with one Gauss-Seidel sweep
+   !> on each side of the coarse correction; 8 with the two Chebyshev
+   !> steps of symmetric sweeps, which cost more per iteration).
    subroutine test_mg_iterations(error)
       type(error_type), allocatable, intent(out) :: error
       type(elasticity_problem_type) :: problem
@@ -501,7 +503,7 @@ contains
             if (allocated(error)) return
          end block
       end do
-      call check(error, 2*its(2) <= its(1) .and. its(2) <= 12, 'geometric multigrid '//itoa(its(2))// &
+      call check(error, its(2) < its(1) .and. its(2) <= 20, 'geometric multigrid '//itoa(its(2))// &
          & ' iterations, GAMG '//itoa(its(1)))
    end subroutine test_mg_iterations
 

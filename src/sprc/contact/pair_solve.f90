@@ -1588,7 +1588,7 @@ contains
          end if
       end associate
       h_over_l = 0.5_wp**max(slave%mesh%grid%max_level, master%mesh%grid%max_level)
-      bs%tight = contact_tolerance(h_over_l, slave%degree, slave%dim)
+      bs%tight = contact_tolerance(h_over_l, slave%degree, slave%dim, kappa)
       bs%loose = max(active_set_tolerance(h_over_l, slave%dim, kappa), bs%tight)
       bs%krylov%tolerance = bs%tight
    end subroutine block_solver_setup
@@ -1606,16 +1606,19 @@ contains
 
    !> The Krylov stopping tolerance of the block system (a relative energy
    !> bound): the single body's `iteration_tolerance` 1e-7 (h/L)^p (h the
-   !> finer grid's finest cell, L its box) times (h/L)^(d/2). A contact
+   !> finer grid's finest cell, L its box) times (h/L)^(d/2)/kappa. A contact
    !> report's pressures (p_max, each point's p) are pointwise tractions, which
-   !> the energy norm bounds only through an inverse estimate: a traction
-   !> error in one cell of size h is at most C (L/h)^(d/2) times the relative
-   !> energy error (the cell's share of the energy). Not below 1e-12, the
-   !> round-off of the solve.
-   pure real(wp) function contact_tolerance(h_over_l, degree, dim) result(tau)
-      real(wp), intent(in) :: h_over_l
+   !> the energy norm bounds only through an inverse estimate: a strain error
+   !> e in one cell of size h is at most C (L/h)^(d/2) times the relative
+   !> energy error (the cell's share of the energy). A closed cell's
+   !> multiplier pbar + gamma gbar, gamma = kappa E/h, takes it twice: E e
+   !> through the traction pbar and, the gap moving by about h e, kappa E e
+   !> through gamma gbar; so the bound carries 1/kappa (kappa >= 1) as
+   !> `active_set_tolerance` does. Not below 1e-12, the round-off of the solve.
+   pure real(wp) function contact_tolerance(h_over_l, degree, dim, kappa) result(tau)
+      real(wp), intent(in) :: h_over_l, kappa
       integer, intent(in) :: degree, dim
-      tau = max(iteration_tolerance(h_over_l, degree)*h_over_l**(0.5_wp*dim), 1.0e-12_wp)
+      tau = max(iteration_tolerance(h_over_l, degree)*h_over_l**(0.5_wp*dim)/max(kappa, 1.0_wp), 1.0e-12_wp)
    end function contact_tolerance
 
    !> The Krylov tolerance of the active-set iterations before the set
