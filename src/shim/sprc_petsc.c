@@ -157,6 +157,8 @@ extern PetscErrorCode KSPDestroy(KSP *);
 extern PetscErrorCode PCSetType(PC, PCType);
 extern PetscErrorCode PCApply(PC, Vec, Vec);
 extern PetscErrorCode KSPGetConvergedReasonString(KSP, const char **);
+extern PetscErrorCode MatSeqAIJGetArray(Mat, PetscScalar *[]);
+extern PetscErrorCode MatSeqAIJRestoreArray(Mat, PetscScalar *[]);
 extern PetscErrorCode MatSeqAIJSetPreallocationCSR(Mat, const PetscInt[], const PetscInt[], const PetscScalar[]);
 extern PetscErrorCode PCMGSetLevels(PC, PetscInt, MPI_Comm *);
 extern PetscErrorCode PCMGSetGalerkin(PC, PCMGGalerkinType);
@@ -188,7 +190,7 @@ extern PetscErrorCode PCFactorSetMatSolverType(PC, MatSolverType);
     X(MPI_Allreduce) X(MatSeqAIJSetPreallocationCSR) X(PCMGSetLevels) X(PCMGSetGalerkin) X(PCMGSetInterpolation)   \
     X(PCMGGetSmoother) X(PCMGGetCoarseSolve) X(PCFactorSetMatSolverType)       \
     X(KSPChebyshevEstEigSet) X(PCRedundantGetKSP) X(PCMGSetDistinctSmoothUp) X(PCMGGetSmootherUp)               \
-    X(PCMGGetSmootherDown) X(PCSORSetSymmetric)
+    X(PCMGGetSmootherDown) X(PCSORSetSymmetric) X(MatSeqAIJGetArray) X(MatSeqAIJRestoreArray)
 
 /* One pointer per function, set by load_petsc; from here on every call of
  * such a function goes through its pointer. */
@@ -257,6 +259,8 @@ static void *p_mpi_int, *p_op_min; /* Open MPI's MPI_INT and MPI_MIN */
 #define PCMGGetSmootherUp (*p_PCMGGetSmootherUp)
 #define PCMGGetSmootherDown (*p_PCMGGetSmootherDown)
 #define PCSORSetSymmetric (*p_PCSORSetSymmetric)
+#define MatSeqAIJGetArray (*p_MatSeqAIJGetArray)
+#define MatSeqAIJRestoreArray (*p_MatSeqAIJRestoreArray)
 #define KSPChebyshevEstEigSet (*p_KSPChebyshevEstEigSet)
 #define PCRedundantGetKSP (*p_PCRedundantGetKSP)
 #define PCMGGetCoarseSolve (*p_PCMGGetCoarseSolve)
@@ -744,6 +748,25 @@ int sprc_petsc_setup(void **handle, int64_t n, int dim, const int32_t *rowptr, c
     status = agree_status(status, "setup", msg, len);
     if (status != SPRC_OK) sprc_petsc_free(handle);
     return status;
+}
+
+/* The values of a one-rank solver's matrix were changed in place (the
+ * caller's arrays, sprc_petsc_setup's `borrowed`), its pattern kept: the
+ * restore of PETSc's array marks the matrix changed (and drops SOR's cached
+ * diagonal), and the set-up is redone for the same nonzero pattern, so
+ * PCMG's Galerkin products and the coarse LU (MUMPS) redo only their
+ * numeric phase. */
+int sprc_petsc_update(void *handle, char *msg, int64_t len)
+{
+    sprc_petsc *s = handle;
+    PetscScalar *values;
+    if (s == NULL || distributed)
+        return report(SPRC_INVALID, msg, len, "PETSc update: no one-rank solver was set up");
+    TRY(MatSeqAIJGetArray(s->a, &values));
+    TRY(MatSeqAIJRestoreArray(s->a, &values));
+    TRY(KSPSetOperators(s->ksp, s->a, s->a));
+    TRY(KSPSetUp(s->ksp));
+    return SPRC_OK;
 }
 
 /* This rank's rows of the whole vector a into v. */
