@@ -51,6 +51,8 @@
     X(INSERT_VALUES, 1)                 \
     X(SCATTER_FORWARD, 0)               \
     X(PC_MG_GALERKIN_BOTH, 0)           \
+    X(SOR_LOCAL_FORWARD_SWEEP, 4)       \
+    X(SOR_LOCAL_BACKWARD_SWEEP, 8)      \
     X(PETSC_ERR_MEM, 55)
 
 #ifdef SPRC_PETSC_HEADERS
@@ -72,6 +74,7 @@ typedef enum { NORM_1 = 0, NORM_2 = 1 } NormType;
 typedef int KSPNormType;
 typedef int KSPConvergedReason;
 typedef int PCMGGalerkinType;
+typedef int MatSORType;
 typedef struct ompi_communicator_t *MPI_Comm;
 typedef struct ompi_datatype_t *MPI_Datatype;
 typedef struct ompi_op_t *MPI_Op;
@@ -154,12 +157,17 @@ extern PetscErrorCode KSPDestroy(KSP *);
 extern PetscErrorCode PCSetType(PC, PCType);
 extern PetscErrorCode PCApply(PC, Vec, Vec);
 extern PetscErrorCode KSPGetConvergedReasonString(KSP, const char **);
+extern PetscErrorCode MatSeqAIJGetArray(Mat, PetscScalar *[]);
+extern PetscErrorCode MatSeqAIJRestoreArray(Mat, PetscScalar *[]);
 extern PetscErrorCode MatSeqAIJSetPreallocationCSR(Mat, const PetscInt[], const PetscInt[], const PetscScalar[]);
 extern PetscErrorCode PCMGSetLevels(PC, PetscInt, MPI_Comm *);
 extern PetscErrorCode PCMGSetGalerkin(PC, PCMGGalerkinType);
 extern PetscErrorCode PCMGSetInterpolation(PC, PetscInt, Mat);
 extern PetscErrorCode PCMGGetSmoother(PC, PetscInt, KSP *);
-extern PetscErrorCode KSPChebyshevSetEigenvalues(KSP, PetscReal, PetscReal);
+extern PetscErrorCode PCMGSetDistinctSmoothUp(PC);
+extern PetscErrorCode PCMGGetSmootherUp(PC, PetscInt, KSP *);
+extern PetscErrorCode PCMGGetSmootherDown(PC, PetscInt, KSP *);
+extern PetscErrorCode PCSORSetSymmetric(PC, MatSORType);
 extern PetscErrorCode KSPChebyshevEstEigSet(KSP, PetscReal, PetscReal, PetscReal, PetscReal);
 extern PetscErrorCode PCRedundantGetKSP(PC, KSP *);
 extern PetscErrorCode PCMGGetCoarseSolve(PC, KSP *);
@@ -180,8 +188,9 @@ extern PetscErrorCode PCFactorSetMatSolverType(PC, MatSolverType);
     X(KSPGetConvergedReasonString) X(MatMPIAIJSetPreallocationCSR) X(VecCreateMPI) X(VecScatterCreateToAll)   \
     X(VecScatterBegin) X(VecScatterEnd) X(VecScatterDestroy) X(MPI_Comm_rank) X(MPI_Comm_size) X(PetscFinalize)   \
     X(MPI_Allreduce) X(MatSeqAIJSetPreallocationCSR) X(PCMGSetLevels) X(PCMGSetGalerkin) X(PCMGSetInterpolation)   \
-    X(PCMGGetSmoother) X(KSPChebyshevSetEigenvalues) X(PCMGGetCoarseSolve) X(PCFactorSetMatSolverType)       \
-    X(KSPChebyshevEstEigSet) X(PCRedundantGetKSP)
+    X(PCMGGetSmoother) X(PCMGGetCoarseSolve) X(PCFactorSetMatSolverType)       \
+    X(KSPChebyshevEstEigSet) X(PCRedundantGetKSP) X(PCMGSetDistinctSmoothUp) X(PCMGGetSmootherUp)               \
+    X(PCMGGetSmootherDown) X(PCSORSetSymmetric) X(MatSeqAIJGetArray) X(MatSeqAIJRestoreArray)
 
 /* One pointer per function, set by load_petsc; from here on every call of
  * such a function goes through its pointer. */
@@ -246,7 +255,12 @@ static void *p_mpi_int, *p_op_min; /* Open MPI's MPI_INT and MPI_MIN */
 #define PCMGSetGalerkin (*p_PCMGSetGalerkin)
 #define PCMGSetInterpolation (*p_PCMGSetInterpolation)
 #define PCMGGetSmoother (*p_PCMGGetSmoother)
-#define KSPChebyshevSetEigenvalues (*p_KSPChebyshevSetEigenvalues)
+#define PCMGSetDistinctSmoothUp (*p_PCMGSetDistinctSmoothUp)
+#define PCMGGetSmootherUp (*p_PCMGGetSmootherUp)
+#define PCMGGetSmootherDown (*p_PCMGGetSmootherDown)
+#define PCSORSetSymmetric (*p_PCSORSetSymmetric)
+#define MatSeqAIJGetArray (*p_MatSeqAIJGetArray)
+#define MatSeqAIJRestoreArray (*p_MatSeqAIJRestoreArray)
 #define KSPChebyshevEstEigSet (*p_KSPChebyshevEstEigSet)
 #define PCRedundantGetKSP (*p_PCRedundantGetKSP)
 #define PCMGGetCoarseSolve (*p_PCMGGetCoarseSolve)
@@ -481,32 +495,54 @@ typedef struct {
     const double *val;
 } sprc_petsc_levels;
 
-/* Smoothing on PCMG's levels 1 .. levels - 1: two Chebyshev steps
- * preconditioned by PETSc's SOR in its default form, a symmetric
- * Gauss-Seidel sweep (omega = 1), before and after the coarse correction:
- * the same symmetric polynomial on both sides makes the V-cycle symmetric
- * and positive definite, as CG's preconditioner must be. With A = L + D + L^T
- * the sweep is B with B^-1 = (D + L) D^-1 (D + L^T) = A + L D^-1 L^T >= A, so
- * the eigenvalues of B A lie in (0, 1]: the Chebyshev interval is [0.1, 1]
- * with no eigenvalue estimate (which would cost ten sweeps per level). Jacobi
- * in its place (GAMG's default) needed 27 iterations on the sphere octant at
- * 159k unknowns instead of 9. On several ranks PETSc's SOR sweeps each rank's
- * rows alone (a block Jacobi of Gauss-Seidel sweeps), whose B^-1 no longer
- * bounds A: there the interval comes from PETSc's estimate of the largest
- * eigenvalue (0.1 and 1.1 times it). PETSC_OPTIONS (-mg_levels_...) still
- * applies. */
+/* One smoothing step on a PCMG level: Richardson on PETSc's SOR (omega =
+ * 1, Gauss-Seidel) sweeping `sweep` (SOR_LOCAL_FORWARD_SWEEP or
+ * SOR_LOCAL_BACKWARD_SWEEP); PETSc applies it as one MatSOR call, with no
+ * separate residual. */
+static int set_sweep(KSP smoother, MatSORType sweep, char *msg, int64_t len)
+{
+    PC pc;
+    TRY(KSPSetType(smoother, "richardson"));
+    TRY(KSPSetTolerances(smoother, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT, 1));
+    TRY(KSPGetPC(smoother, &pc));
+    TRY(PCSetType(pc, "sor"));
+    TRY(PCSORSetSymmetric(pc, sweep));
+    return SPRC_OK;
+}
+
+/* Smoothing on PCMG's levels 1 .. levels - 1. One rank: one forward
+ * Gauss-Seidel sweep before the coarse correction and one backward sweep
+ * after it. The backward sweep is the adjoint of the forward one (with A =
+ * L + D + L^T their iteration matrices are I - (D + L)^-1 A and
+ * I - (D + L^T)^-1 A), so the V-cycle is symmetric and, Gauss-Seidel
+ * converging for SPD A, positive definite: CG's preconditioner. Each sweep
+ * reads the matrix once; the two Chebyshev steps of symmetric sweeps used
+ * before read it about six times per side and bought fewer iterations than
+ * that costs (doc/benchmarks.md). On several ranks PETSc's SOR sweeps each
+ * rank's rows alone (a block Jacobi of Gauss-Seidel sweeps), which need
+ * not converge undamped: there two Chebyshev steps of symmetric sweeps on
+ * the interval from PETSc's estimate of the largest eigenvalue (0.1 and 1.1
+ * times it). PETSC_OPTIONS (-mg_levels_...) still applies. */
 static int set_smoothers(PC pc, PetscInt levels, char *msg, int64_t len)
 {
     PetscInt l;
+    if (!distributed) TRY(PCMGSetDistinctSmoothUp(pc));
     for (l = 1; l < levels; ++l) {
         KSP smoother;
         PC sweep;
+        int status;
+        if (!distributed) {
+            TRY(PCMGGetSmootherDown(pc, l, &smoother));
+            status = set_sweep(smoother, SOR_LOCAL_FORWARD_SWEEP, msg, len);
+            if (status != SPRC_OK) return status;
+            TRY(PCMGGetSmootherUp(pc, l, &smoother));
+            status = set_sweep(smoother, SOR_LOCAL_BACKWARD_SWEEP, msg, len);
+            if (status != SPRC_OK) return status;
+            continue;
+        }
         TRY(PCMGGetSmoother(pc, l, &smoother));
         TRY(KSPSetType(smoother, "chebyshev"));
-        if (distributed)
-            TRY(KSPChebyshevEstEigSet(smoother, 0.0, 0.1, 0.0, 1.1));
-        else
-            TRY(KSPChebyshevSetEigenvalues(smoother, 1.0, 0.1));
+        TRY(KSPChebyshevEstEigSet(smoother, 0.0, 0.1, 0.0, 1.1));
         TRY(KSPGetPC(smoother, &sweep));
         TRY(PCSetType(sweep, "sor"));
     }
@@ -712,6 +748,25 @@ int sprc_petsc_setup(void **handle, int64_t n, int dim, const int32_t *rowptr, c
     status = agree_status(status, "setup", msg, len);
     if (status != SPRC_OK) sprc_petsc_free(handle);
     return status;
+}
+
+/* The values of a one-rank solver's matrix were changed in place (the
+ * caller's arrays, sprc_petsc_setup's `borrowed`), its pattern kept: the
+ * restore of PETSc's array marks the matrix changed (and drops SOR's cached
+ * diagonal), and the set-up is redone for the same nonzero pattern, so
+ * PCMG's Galerkin products and the coarse LU (MUMPS) redo only their
+ * numeric phase. */
+int sprc_petsc_update(void *handle, char *msg, int64_t len)
+{
+    sprc_petsc *s = handle;
+    PetscScalar *values;
+    if (s == NULL || distributed)
+        return report(SPRC_INVALID, msg, len, "PETSc update: no one-rank solver was set up");
+    TRY(MatSeqAIJGetArray(s->a, &values));
+    TRY(MatSeqAIJRestoreArray(s->a, &values));
+    TRY(KSPSetOperators(s->ksp, s->a, s->a));
+    TRY(KSPSetUp(s->ksp));
+    return SPRC_OK;
 }
 
 /* This rank's rows of the whole vector a into v. */

@@ -51,6 +51,7 @@ contains
          new_unittest('multigrid_linear_fields_q1', test_mg_linear_q1), &
          new_unittest('multigrid_linear_fields_q2', test_mg_linear_q2), &
          new_unittest('multigrid_iterations', test_mg_iterations), &
+         new_unittest('update_same_pattern', test_update), &
          new_unittest('multigrid_bad_lattice', test_mg_bad_lattice) &
          ]
    end subroutine collect_petsc
@@ -470,8 +471,10 @@ contains
 
    !> Iterations on a small 3D problem (sphere octant, planes off the grid,
    !> level 4: 11k unknowns, a hierarchy of three levels) from zero to the
-   !> same tolerance: geometric multigrid needs at most half of GAMG's
-   !> iterations and at most 12 (measured: 8 against 24).
+   !> same tolerance: geometric multigrid needs fewer iterations than GAMG
+   !> and at most 20 (measured: 16 against 24, with one Gauss-Seidel sweep
+   !> on each side of the coarse correction; 8 with the two Chebyshev
+   !> steps of symmetric sweeps, which cost more per iteration).
    subroutine test_mg_iterations(error)
       type(error_type), allocatable, intent(out) :: error
       type(elasticity_problem_type) :: problem
@@ -501,9 +504,65 @@ contains
             if (allocated(error)) return
          end block
       end do
-      call check(error, 2*its(2) <= its(1) .and. its(2) <= 12, 'geometric multigrid '//itoa(its(2))// &
+      call check(error, its(2) < its(1) .and. its(2) <= 20, 'geometric multigrid '//itoa(its(2))// &
          & ' iterations, GAMG '//itoa(its(1)))
    end subroutine test_mg_iterations
+
+   !> `update` with new values on the same pattern (K + s I, s the mean
+   !> diagonal: a change the old preconditioner does not scale away) gives
+   !> what a solver factorized anew on them gives: the same iterations and
+   !> the same solution to 1e-9 relative (the same Galerkin products and
+   !> coarse factor up to the order of their sums; the solves stop at 1e-9).
+   !> With the preconditioner of K kept (the matrix not marked changed),
+   !> 14 iterations against 8.
+   subroutine test_update(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(elasticity_problem_type) :: problem
+      type(petsc_solver_type) :: kept, fresh
+      real(wp), allocatable :: x(:), xf(:)
+      integer :: i, its
+      real(wp) :: shift
+
+      call off_grid_sphere(problem, 3, 0, 1, error)
+      if (allocated(error)) return
+      allocate (x(size(problem%f)), xf(size(problem%f)))
+      call multigrid_solver(kept, problem, error)
+      if (.not. allocated(error)) call multigrid_solver(fresh, problem, error)
+      if (.not. allocated(error)) call kept%factorize(problem%k, error)
+      if (allocated(error)) return
+      shift = 0.0_wp
+      do i = 1, problem%k%nrows
+         shift = shift + sum(problem%k%val(problem%k%rowptr(i):problem%k%rowptr(i + 1) - 1), &
+            & mask=problem%k%col(problem%k%rowptr(i):problem%k%rowptr(i + 1) - 1) == i)
+      end do
+      shift = shift/problem%k%nrows
+      do i = 1, problem%k%nrows
+         where (problem%k%col(problem%k%rowptr(i):problem%k%rowptr(i + 1) - 1) == i) &
+            & problem%k%val(problem%k%rowptr(i):problem%k%rowptr(i + 1) - 1) = &
+            & problem%k%val(problem%k%rowptr(i):problem%k%rowptr(i + 1) - 1) + shift
+      end do
+      call kept%update(problem%k, error)
+      if (.not. allocated(error)) call kept%solve(problem%f, x, error)
+      if (.not. allocated(error)) call fresh%factorize(problem%k, error)
+      if (.not. allocated(error)) call fresh%solve(problem%f, xf, error)
+      if (allocated(error)) return
+      its = kept%iterations
+      call check(error, its == fresh%iterations .and. maxval(abs(x - xf)) <= 1.0e-9_wp*maxval(abs(xf)), &
+         & 'updated: '//itoa(its)//' iterations, anew: '//itoa(fresh%iterations)//', solutions differ by '// &
+         & itoa(nint(1.0e12_wp*maxval(abs(x - xf))/maxval(abs(xf))))//'e-12 relative')
+      call kept%destroy()
+      call fresh%destroy()
+   end subroutine test_update
+
+   subroutine multigrid_solver(krylov, problem, error)
+      type(petsc_solver_type), intent(inout) :: krylov
+      type(elasticity_problem_type), intent(in) :: problem
+      type(error_type), allocatable, intent(out) :: error
+      call krylov%set_blocks(problem%constraints%dof, problem%mesh%nodes%x(:, problem%constraints%master_node), error)
+      if (.not. allocated(error)) call krylov%set_lattice(problem%mesh%nodes%lattice(:, &
+         & problem%constraints%master_node), 2, error)
+      krylov%tolerance = 1.0e-9_wp
+   end subroutine multigrid_solver
 
    !> Lattice points that do not fit the blocks, two blocks at one point,
    !> or a point off the node step: each a clear error, never a crash.

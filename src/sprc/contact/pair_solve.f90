@@ -31,7 +31,8 @@
 !>   `auto_coupled_min_dofs`): CG (GMRES if unsymmetric or indefinite), both bodies'
 !>   multigrids stacked (`stack_hierarchies`, contact nodes kept, Galerkin coarse
 !>   operators of each new fine matrix, set up anew per active set: a lagged one
-!>   costs CG several times the iterations), warm starts, `contact_tolerance`
+!>   costs CG several times the iterations; on a kept pattern, `kept_system`, only
+!>   the numeric products and coarse factor are redone), warm starts, `contact_tolerance`
 !>   (looser while the set changes: `active_set_tolerance`, `confirm_set`); under
 !>   mpirun (`share`) each rank holds its rows and the solution is gathered.
 !>
@@ -145,6 +146,10 @@ module sprc_contact_pair_solve
       !> The Krylov tolerances of the final solve (`contact_tolerance`) and
       !> of the solves while the active set changes (`active_set_tolerance`).
       real(wp) :: tight = 0.0_wp, loose = 0.0_wp
+      !> The cells whose blocks the kept pattern of the iterative block
+      !> system holds, and both bodies' K on it (`kept_system`).
+      logical, allocatable :: cover(:)
+      real(wp), allocatable :: base(:)
    end type block_solver_type
 
    !> The CHOLMOD factor of a recovered-stabilization block system and the
@@ -357,6 +362,8 @@ contains
                & bounds)
          else if (present(recovered)) then
             call block_system(slave, master, ops, cells, closed, k, f, error, pstar)
+         else if (bs%iterative .and. .not. present(share)) then
+            call kept_system(slave, master, ops, cells, closed, bs, k, f, error)
          else
             call block_system(slave, master, ops, cells, closed, k, f, error)
          end if
@@ -1086,6 +1093,90 @@ contains
       if (.not. allocated(error)) call block_load(slave, master, ops, cells, closed, f, pstar)
    end subroutine block_system
 
+   !> The block system of `block_system` (FE stabilization) on a pattern
+   !> kept across active sets for the iterative solver, whose set-up then
+   !> redoes only its numeric part (`petsc_solver_type%update`): both
+   !> bodies' K and the blocks of every cell closed in any set so far
+   !> (`bs%cover`), explicit zeros where a cell is open. A set that closes a
+   !> cell outside the pattern widens it.
+   subroutine kept_system(slave, master, ops, cells, closed, bs, k, f, error)
+      type(elasticity_problem_type), intent(in) :: slave, master
+      type(point_operators_type), intent(in) :: ops
+      type(cell_operators_type), intent(in) :: cells(:)
+      logical, intent(in) :: closed(:)
+      type(block_solver_type), intent(inout) :: bs
+      type(csr_type), intent(inout) :: k
+      real(wp), allocatable, intent(out) :: f(:)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: kc(:, :)
+      integer :: c
+
+      if (.not. allocated(bs%cover)) allocate (bs%cover(size(closed)), source=.false.)
+      if (any(closed .and. .not. bs%cover) .or. .not. allocated(bs%base)) then
+         bs%cover = bs%cover .or. closed
+         call cover_pattern(slave, master, cells, bs%cover, k, error)
+         if (allocated(error)) return
+         bs%base = k%val
+      else
+         k%val = bs%base
+      end if
+      do c = 1, size(cells)
+         if (.not. closed(c)) cycle
+         call tied_block(cells(c), ops%gamma(c), kc)
+         call add_block(k, cells(c)%dofs, kc)
+      end do
+      call block_load(slave, master, ops, cells, closed, f)
+   end subroutine kept_system
+
+   !> Both bodies' K with explicit zeros at the entries of the cells `cover`.
+   subroutine cover_pattern(slave, master, cells, cover, k, error)
+      type(elasticity_problem_type), intent(in) :: slave, master
+      type(cell_operators_type), intent(in) :: cells(:)
+      logical, intent(in) :: cover(:)
+      type(csr_type), intent(out) :: k
+      type(error_type), allocatable, intent(out) :: error
+      type(coo_type) :: coo
+      integer(i8) :: capacity
+      integer :: ns, c
+
+      ns = slave%n_dofs()
+      capacity = slave%k%nnz() + master%k%nnz() + sum(int(cells%nu, i8)**2, mask=cover)
+      call coo%init(ns + master%n_dofs(), ns + master%n_dofs(), error, capacity=capacity)
+      if (.not. allocated(error)) call add_csr(coo, slave%k, 0, error)
+      if (.not. allocated(error)) call add_csr(coo, master%k, ns, error)
+      do c = 1, size(cells)
+         if (allocated(error)) return
+         if (cover(c)) call coo%add(cells(c)%dofs, spread(spread(0.0_wp, 1, cells(c)%nu), 2, cells(c)%nu), error)
+      end do
+      if (.not. allocated(error)) call coo%to_csr(k, error)
+   end subroutine cover_pattern
+
+   !> k(dofs(i), dofs(j)) += b(i, j), every entry in k's pattern (columns
+   !> ascending in each row: found by bisection).
+   pure subroutine add_block(k, dofs, b)
+      type(csr_type), intent(inout) :: k
+      integer, intent(in) :: dofs(:)
+      real(wp), intent(in) :: b(:, :)
+      integer(i8) :: lo, hi, mid
+      integer :: i, j
+
+      do i = 1, size(dofs)
+         do j = 1, size(dofs)
+            lo = k%rowptr(dofs(i))
+            hi = k%rowptr(dofs(i) + 1) - 1
+            do while (lo < hi)
+               mid = (lo + hi)/2
+               if (k%col(mid) < dofs(j)) then
+                  lo = mid + 1
+               else
+                  hi = mid
+               end if
+            end do
+            k%val(lo) = k%val(lo) + b(i, j)
+         end do
+      end do
+   end subroutine add_block
+
    !> The load of `block_system`.
    pure subroutine block_load(slave, master, ops, cells, closed, f, pstar)
       type(elasticity_problem_type), intent(in) :: slave, master
@@ -1588,7 +1679,7 @@ contains
          end if
       end associate
       h_over_l = 0.5_wp**max(slave%mesh%grid%max_level, master%mesh%grid%max_level)
-      bs%tight = contact_tolerance(h_over_l, slave%degree, slave%dim)
+      bs%tight = contact_tolerance(h_over_l, slave%degree, slave%dim, kappa)
       bs%loose = max(active_set_tolerance(h_over_l, slave%dim, kappa), bs%tight)
       bs%krylov%tolerance = bs%tight
    end subroutine block_solver_setup
@@ -1606,16 +1697,19 @@ contains
 
    !> The Krylov stopping tolerance of the block system (a relative energy
    !> bound): the single body's `iteration_tolerance` 1e-7 (h/L)^p (h the
-   !> finer grid's finest cell, L its box) times (h/L)^(d/2). A contact
+   !> finer grid's finest cell, L its box) times (h/L)^(d/2)/kappa. A contact
    !> report's pressures (p_max, each point's p) are pointwise tractions, which
-   !> the energy norm bounds only through an inverse estimate: a traction
-   !> error in one cell of size h is at most C (L/h)^(d/2) times the relative
-   !> energy error (the cell's share of the energy). Not below 1e-12, the
-   !> round-off of the solve.
-   pure real(wp) function contact_tolerance(h_over_l, degree, dim) result(tau)
-      real(wp), intent(in) :: h_over_l
+   !> the energy norm bounds only through an inverse estimate: a strain error
+   !> e in one cell of size h is at most C (L/h)^(d/2) times the relative
+   !> energy error (the cell's share of the energy). A closed cell's
+   !> multiplier pbar + gamma gbar, gamma = kappa E/h, takes it twice: E e
+   !> through the traction pbar and, the gap moving by about h e, kappa E e
+   !> through gamma gbar; so the bound carries 1/kappa (kappa >= 1) as
+   !> `active_set_tolerance` does. Not below 1e-12, the round-off of the solve.
+   pure real(wp) function contact_tolerance(h_over_l, degree, dim, kappa) result(tau)
+      real(wp), intent(in) :: h_over_l, kappa
       integer, intent(in) :: degree, dim
-      tau = max(iteration_tolerance(h_over_l, degree)*h_over_l**(0.5_wp*dim), 1.0e-12_wp)
+      tau = max(iteration_tolerance(h_over_l, degree)*h_over_l**(0.5_wp*dim)/max(kappa, 1.0_wp), 1.0e-12_wp)
    end function contact_tolerance
 
    !> The Krylov tolerance of the active-set iterations before the set
@@ -1676,14 +1770,15 @@ contains
       keep = [(any(touched(dof(:, m))), m = 1, size(dof, 2))]
    end function kept_masters
 
-   !> Set up the Krylov solver on k (CG when `symmetric`, else GMRES).
+   !> Set up the Krylov solver on k (CG when `symmetric`, else GMRES): its
+   !> numeric part only when k has the pattern of the last set-up.
    subroutine krylov_setup(krylov, k, symmetric, error)
       type(petsc_solver_type), intent(inout) :: krylov
       type(csr_type), intent(in) :: k
       logical, intent(in) :: symmetric
       type(error_type), allocatable, intent(out) :: error
       krylov%symmetric = symmetric
-      call krylov%factorize(k, error)
+      call krylov%update(k, error)
       if (allocated(error)) error%message = 'contact solve (iterative setup): '//error%message
    end subroutine krylov_setup
 

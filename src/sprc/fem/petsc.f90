@@ -65,6 +65,10 @@ module sprc_fem_petsc
       !> only. On one rank it is PETSc's matrix itself, so it lives until `destroy`.
       integer(c_int32_t), allocatable :: rowptr(:), col(:)
       real(wp), allocatable :: val(:)
+      !> Where each entry of the factorized matrix (its CSR order) sits in
+      !> `val` (one rank only; `update`), and the `symmetric` it was set up with.
+      integer(i8), allocatable :: entry(:)
+      logical :: setup_symmetric = .true.
       !> Bound of the relative energy norm of the iteration error (CG; see
       !> energy_test in the shim) at which a solve stops.
       real(wp), public :: tolerance = 1.0e-8_wp
@@ -84,6 +88,7 @@ module sprc_fem_petsc
       procedure :: set_blocks
       procedure :: set_lattice
       procedure :: set_hierarchy
+      procedure :: update
       procedure :: factorize_backend => petsc_factorize
       procedure :: solve_backend => petsc_solve
       procedure :: destroy_backend => petsc_destroy
@@ -145,6 +150,13 @@ module sprc_fem_petsc
          integer(c_int64_t), value :: blocks
          integer(c_int64_t), intent(out) :: first, last
       end subroutine sprc_petsc_own_blocks
+
+      integer(c_int) function sprc_petsc_update(handle, msg, len) bind(c)
+         import :: c_ptr, c_int, c_int64_t, c_char
+         type(c_ptr), value :: handle
+         character(kind=c_char), intent(inout) :: msg(*)
+         integer(c_int64_t), value :: len
+      end function sprc_petsc_update
 
       integer(c_int) function sprc_petsc_multigrid(handle) bind(c)
          import :: c_ptr, c_int
@@ -364,8 +376,99 @@ contains
       if (borrowed == 0 .or. status /= 0) deallocate (self%rowptr, self%col, self%val)
       call backend_error(status, msg, error)
       self%iterations = 0
-      if (status == 0) self%multigrid = sprc_petsc_multigrid(self%handle) /= 0
+      if (status /= 0) return
+      self%multigrid = sprc_petsc_multigrid(self%handle) /= 0
+      self%setup_symmetric = self%symmetric
+      if (borrowed /= 0) call entry_map(self, a, error)
    end subroutine petsc_factorize
+
+   !> New values of the matrix of the last `factorize`, `a` with its
+   !> pattern: the set-up keeps its symbolic work (the blocked copy's layout,
+   !> PETSc's Galerkin products and coarse LU redo only their numeric part).
+   !> Another pattern, another `symmetric`, several ranks or nothing set up:
+   !> a `factorize`.
+   subroutine update(self, a, error)
+      class(petsc_solver_type), intent(inout) :: self
+      type(csr_type), intent(in) :: a
+      type(error_type), allocatable, intent(out) :: error
+      character(kind=c_char, len=message_length) :: msg
+      integer(c_int) :: status
+      integer :: saved
+
+      if (.not. same_pattern(self, a)) then
+         call self%factorize(a, error)
+         return
+      end if
+      self%val(self%entry) = a%val
+      msg = ''
+      saved = blas_serial_begin()
+      status = sprc_petsc_update(self%handle, msg, int(len(msg), c_int64_t))
+      call blas_serial_end(saved)
+      call backend_error(status, msg, error)
+      self%iterations = 0
+      if (allocated(error)) call self%destroy()
+   end subroutine update
+
+   !> Whether `a` has the pattern (rows, and columns in their order) of the
+   !> matrix set up last on one rank, with the same `symmetric`: each entry
+   !> maps by `entry` to its column in its own row of the blocked copy, and
+   !> each row has as many entries as that row.
+   logical function same_pattern(self, a) result(same)
+      class(petsc_solver_type), intent(in) :: self
+      type(csr_type), intent(in) :: a
+      integer(i8) :: q
+      integer :: i, p
+
+      same = c_associated(self%handle) .and. allocated(self%entry) .and. allocated(self%val) .and. &
+         & self%factorized .and. (self%symmetric .eqv. self%setup_symmetric) .and. a%nrows == self%n
+      if (.not. same) return
+      same = size(self%entry, kind=i8) == a%nnz()
+      do i = 1, a%nrows
+         if (.not. same) return
+         p = self%slot(i)
+         same = a%rowptr(i + 1) - a%rowptr(i) == int(self%rowptr(p + 1) - self%rowptr(p), i8)
+         do q = a%rowptr(i), a%rowptr(i + 1) - 1
+            if (self%entry(q) <= self%rowptr(p) .or. self%entry(q) > self%rowptr(p + 1)) then
+               same = .false.
+            else if (self%col(self%entry(q)) /= self%slot(a%col(q)) - 1) then
+               same = .false.
+            end if
+         end do
+      end do
+   end function same_pattern
+
+   !> `entry` of the blocked copy set up from `a` on one rank (`update`):
+   !> each entry's place found in its sorted row.
+   subroutine entry_map(self, a, error)
+      class(petsc_solver_type), intent(inout) :: self
+      type(csr_type), intent(in) :: a
+      type(error_type), allocatable, intent(out) :: error
+      integer(i8) :: q, lo, hi, mid
+      integer :: i, p, stat
+      integer(c_int32_t) :: c
+
+      if (allocated(self%entry)) deallocate (self%entry)
+      allocate (self%entry(a%nnz()), stat=stat)
+      call check_allocation(stat, 'iterative solver', 'the place of each matrix entry', a%nnz(), 8, error)
+      if (allocated(error)) return
+      do i = 1, a%nrows
+         p = self%slot(i)
+         do q = a%rowptr(i), a%rowptr(i + 1) - 1
+            c = int(self%slot(a%col(q)) - 1, c_int32_t)
+            lo = self%rowptr(p) + 1
+            hi = self%rowptr(p + 1)
+            do while (lo < hi)
+               mid = (lo + hi)/2
+               if (self%col(mid) < c) then
+                  lo = mid + 1
+               else
+                  hi = mid
+               end if
+            end do
+            self%entry(q) = lo
+         end do
+      end do
+   end subroutine entry_map
 
    !> The scalar prolongations p as the shim takes them: each coarse node a
    !> block of dim unknowns, component c of a block interpolated from
@@ -529,6 +632,7 @@ contains
    subroutine petsc_destroy(self)
       class(petsc_solver_type), intent(inout) :: self
       if (c_associated(self%handle)) call sprc_petsc_free(self%handle)
+      if (allocated(self%entry)) deallocate (self%entry)
       if (allocated(self%rowptr)) deallocate (self%rowptr)
       if (allocated(self%col)) deallocate (self%col)
       if (allocated(self%val)) deallocate (self%val)

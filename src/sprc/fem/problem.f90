@@ -1118,17 +1118,7 @@ contains
       allocate (kr(nd, nm), diag(nd), stat=stat)
       call check_allocation(stat, 'elasticity solve', 'the rigid-body check (K times each motion)', nd, 8*(nm + 1), error)
       allocate (g(nm, nm), s(nm), lam(nm), vec(nm, 0))
-      do i = 1, nm
-         if (.not. allocated(error)) call k%matvec(r(:, i), kr(:, i), error)
-      end do
-      if (.not. allocated(error)) then
-         diag = 0.0_wp
-         do i = 1, nd
-            do q = k%rowptr(i), k%rowptr(i + 1) - 1
-               if (k%col(q) == i) diag(i) = k%val(q)
-            end do
-         end do
-      end if
+      if (.not. allocated(error)) call products(error)
       if (present(share) .and. present(bounds)) then
          call share%agree('the rigid-body check', error)
          do i = 1, nm
@@ -1158,6 +1148,34 @@ contains
          nfree = nfree + 1
       end do
       vec = g(:, 1:nfree)
+   contains
+      !> kr = K r, every motion in one pass over K (each column summed in
+      !> `matvec`'s order), and K's diagonal.
+      subroutine products(error)
+         type(error_type), allocatable, intent(out) :: error
+         real(wp), allocatable :: rt(:, :)
+         real(wp) :: acc(nm)
+         character(len=96) :: buf
+
+         if (k%nrows /= nd .or. k%ncols /= nd) then
+            write (buf, '(i0," x ",i0," matrix, motions of size ",i0)') k%nrows, k%ncols, nd
+            call fatal_error(error, 'rigid-body check: '//trim(buf), stat_invalid_input)
+            return
+         end if
+         allocate (rt(nm, nd), stat=stat)
+         call check_allocation(stat, 'elasticity solve', 'the rigid-body motions by row', nd, 8*nm, error)
+         if (allocated(error)) return
+         rt = transpose(r)
+         diag = 0.0_wp
+         do i = 1, nd
+            acc = 0.0_wp
+            do q = k%rowptr(i), k%rowptr(i + 1) - 1
+               acc = acc + k%val(q)*rt(:, k%col(q))
+               if (k%col(q) == i) diag(i) = k%val(q)
+            end do
+            kr(i, :) = acc
+         end do
+      end subroutine products
    end subroutine free_motions
 
    !> The iterative solver when `solver` asks for it at this size (`use_iterative`);
