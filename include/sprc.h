@@ -414,7 +414,9 @@ int sprc_contact_add_pair(sprc_error error, sprc_contact_input input, int slave,
                           const int *master_facets, const int *master_law, const double *master_slip, double mu,
                           const double *pressure);
 
-/* Recover (SPRC_METHOD_SPRC or SPRC_METHOD_SPR, patch degree 'auto'); a new
+/* Recover (SPRC_METHOD_SPRC or SPRC_METHOD_SPR, optionally OR-ed with
+ * SPRC_RECOVERY_P or SPRC_RECOVERY_P_PLUS_1 as in sprc_recover: each body's
+ * patch degree is then its element's, or one more; else 'auto'); a new
  * contact recovery or NULL with the error set. Messages name the entries as
  * C does: bodies[i]: gauss_weights[e][q], pairs[k].slave_facets[f][a], ... */
 sprc_contact_recovery sprc_recover_contact(sprc_error error, sprc_contact_input input, int method);

@@ -161,3 +161,35 @@ def test_unknown_method():
     bodies, pairs = problem("frictionless")
     with pytest.raises(ValueError, match="method = 'zz'"):
         sprc.recover_contact(bodies, pairs, method="zz")
+
+
+def quadratic_field(x):
+    """Airy phi = x^2 y^2 - x^4 / 3 (biharmonic): sigma_xx = 2x^2, sigma_yy = 2y^2 - 4x^2,
+    sigma_xy = -4xy; equilibrium, compatibility, and sigma_xy = 0 on y = 0 (frictionless)."""
+    t, y = x[..., 0], x[..., 1]
+    return np.stack([2 * t**2, 2 * y**2 - 4 * t**2, -4 * t * y], axis=-1)
+
+
+def test_degree_p_plus_1_recovers_a_quadratic_field():
+    """A quadratic field of the frictionless law on quad4 bodies: in the recovery space at
+    degree 'p+1' (2), so recovered to round-off; at 'auto' (1, quad4's) it is not."""
+    bodies, pairs = problem("frictionless", "quad4", "quad4", m=4)
+    for b in bodies:
+        b["gauss_stress"] = quadratic_field(b["gauss_points"])
+    res = sprc.recover_contact(bodies, pairs, degree="p+1")
+    scale = 4.0
+    for b, rec in zip(bodies, res.bodies):
+        assert np.abs(rec.nodal_stress - quadratic_field(b["nodes"])).max() < TOL * scale
+    pr = res.pairs[0]
+    assert np.abs(pr.pressure + quadratic_field(pr.points)[:, 1]).max() < TOL * scale
+    assert np.abs(pr.jump).max() < TOL * scale
+    low = sprc.recover_contact(bodies, pairs, degree="auto")
+    assert np.abs(low.bodies[0].nodal_stress - quadratic_field(bodies[0]["nodes"])).max() > 1e-3 * scale
+    assert np.array_equal(sprc.recover_contact(bodies, pairs, degree="p").bodies[0].nodal_stress,
+                          low.bodies[0].nodal_stress)
+
+
+def test_unknown_degree():
+    bodies, pairs = problem("frictionless")
+    with pytest.raises(ValueError, match=r"degree = 'p\+2'"):
+        sprc.recover_contact(bodies, pairs, degree="p+2")

@@ -137,8 +137,10 @@ contains
 
    !> Recover bodies in contact (module notes). method mesh_method_sprc (contact-aware) or
    !> mesh_method_spr; degree and max_rounds as recover_on_mesh's (degree 0 or absent: each
-   !> body's 'auto').
-   subroutine recover_contact_on_mesh(bodies, pairs, method, result, error, degree, max_rounds, c_indices)
+   !> body's 'auto'); `degree_above` (0 or 1, the C and Python flags) sets each body's degree
+   !> to its element's plus it instead of 'auto' (a positive `degree` wins).
+   subroutine recover_contact_on_mesh(bodies, pairs, method, result, error, degree, max_rounds, c_indices, &
+      & degree_above)
       type(contact_body_type), intent(in) :: bodies(:)
       type(contact_pair_type), intent(in) :: pairs(:)
       integer, intent(in) :: method
@@ -146,6 +148,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer, intent(in), optional :: degree, max_rounds
       logical, intent(in), optional :: c_indices
+      integer, intent(in), optional :: degree_above
       type(side_type), allocatable :: sides(:)
       type(others_type), allocatable :: others(:)
       logical :: ci
@@ -155,6 +158,13 @@ contains
       if (present(c_indices)) ci = c_indices
       call check_input(bodies, pairs, method, ci, error)
       if (allocated(error)) return
+      if (present(degree_above)) then
+         if (degree_above /= 0 .and. degree_above /= 1) then
+            call fatal_error(error, 'recover_contact: degree_above = '//itoa(degree_above)//' is not 0 (the '// &
+               & 'element''s degree) or 1 (one above)', stat_invalid_input)
+            return
+         end if
+      end if
       allocate (sides(size(bodies)), others(size(bodies)), result%bodies(size(bodies)), result%pairs(size(pairs)))
       call gather_sides(bodies, pairs, sides)
       if (method == mesh_method_sprc) then
@@ -169,7 +179,8 @@ contains
          end do
       end if
       do b = 1, size(bodies)
-         call recover_body(bodies(b), sides(b), others(b), method, result%bodies(b), ci, error, degree, max_rounds)
+         call recover_body(bodies(b), sides(b), others(b), method, result%bodies(b), ci, error, degree, max_rounds, &
+            & degree_above)
          if (allocated(error)) then
             error%message = body_name(ci, b)//': '//error%message
             return
@@ -182,7 +193,7 @@ contains
    end subroutine recover_contact_on_mesh
 
    !> One body's recovery with its contact facets.
-   subroutine recover_body(body, side, others, method, rec, ci, error, degree, max_rounds)
+   subroutine recover_body(body, side, others, method, rec, ci, error, degree, max_rounds, degree_above)
       type(contact_body_type), intent(in) :: body
       type(side_type), intent(in) :: side
       type(others_type), intent(in) :: others
@@ -190,10 +201,11 @@ contains
       type(mesh_recovery_type), intent(out) :: rec
       logical, intent(in) :: ci
       type(error_type), allocatable, intent(out) :: error
-      integer, intent(in), optional :: degree, max_rounds
+      integer, intent(in), optional :: degree, max_rounds, degree_above
       integer :: deg
 
       deg = auto_degree(method == mesh_method_sprc, element_degree(body%element_type))
+      if (present(degree_above)) deg = element_degree(body%element_type) + degree_above
       if (present(degree)) then
          if (degree > 0) deg = degree
       end if
