@@ -192,7 +192,11 @@ def _pair(k, pair, nbody, info):
     return args, keep, pressure
 
 
-def recover_contact(bodies, pairs, method="sprc", degree="auto"):
+#: sprc.h SPRC_CONTACT_NO_EDGES.
+_NO_EDGES = 1024
+
+
+def recover_contact(bodies, pairs, method="sprc", degree="auto", edges=True):
     """Recover the stresses of bodies in contact, each on your own mesh (SPR-C
     with contact-aware patches on both sides of every pair, the seed's eqs.
     103-138), and the contact tractions on the slave facets.
@@ -219,6 +223,11 @@ def recover_contact(bodies, pairs, method="sprc", degree="auto"):
     method   'sprc' (default; contact-aware) or 'spr' (contact ignored).
     degree   each body's patch degree, as :func:`sprc.recover`'s: 'auto'
              (default), 'p' (its element's degree) or 'p+1' (one more).
+    edges    True (default): in 2D, the patches near an edge of a contact zone
+             (a closed frictionless slave facet next to an open one) add the
+             edge field (the pressure falls like the square root of the
+             distance to the edge; its point and amplitude fitted to both
+             bodies' stresses); False: polynomials only.
 
     Several pairs and bodies per call; a patch whose contact points belong
     to two pairs raises (give the pairs' facets apart). Returns a
@@ -228,6 +237,10 @@ def recover_contact(bodies, pairs, method="sprc", degree="auto"):
     ``pairs[k].slave_facets[f][a]``) for what the library rejects.
     """
     mcode = _code("method", method, METHODS) | _code("degree", degree, DEGREES)
+    if not isinstance(edges, (bool, np.bool_)):
+        raise ValueError(f"edges = {edges!r} must be True or False")
+    if not edges:
+        mcode |= _NO_EDGES
     try:
         bodies, pairs = list(bodies), list(pairs)
     except TypeError:

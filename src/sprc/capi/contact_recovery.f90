@@ -36,6 +36,10 @@ module sprc_capi_contact_recovery
       integer :: nbody = 0, npair = 0
    end type capi_contact_input_type
 
+   !> Flag OR-ed into sprc_recover_contact's method (sprc.h SPRC_CONTACT_NO_EDGES): no edge
+   !> field at the edges of frictionless contact zones.
+   integer(c_int), parameter :: flag_no_edges = 1024
+
    type :: capi_contact_recovery_type
       type(mesh_contact_recovery_type) :: result
    end type capi_contact_recovery_type
@@ -235,10 +239,11 @@ contains
       type(capi_contact_recovery_type), pointer :: rec
       type(error_type), allocatable :: error
       integer :: stat, m
+      logical :: edges
 
       rech = c_null_ptr
       if (.not. get_input(errh, inh, 'sprc_recover_contact', err, in)) return
-      call check_method_flags('sprc_recover_contact', method, error)
+      call check_method_flags('sprc_recover_contact', iand(method, not(flag_no_edges)), error)
       if (allocated(error)) then
          call set_capi_error(err, error)
          return
@@ -255,12 +260,13 @@ contains
          call set_capi_error(err, message='sprc_recover_contact: out of memory', stat=stat_out_of_memory)
          return
       end if
+      edges = iand(method, flag_no_edges) == 0
       if (iand(method, ior(flag_p, flag_p_plus_1)) /= 0) then
          call recover_contact_on_mesh(in%bodies(1:in%nbody), in%pairs(1:in%npair), m, rec%result, error, &
-            & c_indices=.true., degree_above=merge(1, 0, iand(method, flag_p_plus_1) /= 0))
+            & c_indices=.true., degree_above=merge(1, 0, iand(method, flag_p_plus_1) /= 0), edges=edges)
       else
          call recover_contact_on_mesh(in%bodies(1:in%nbody), in%pairs(1:in%npair), m, rec%result, error, &
-            & c_indices=.true.)
+            & c_indices=.true., edges=edges)
       end if
       if (allocated(error)) then
          deallocate (rec)

@@ -14,6 +14,14 @@
 !> (sprc_estimate_contact_patches's default), doubled while the fit lacks rank. Both bodies get contact-aware patches (the mirrored treatment): each is body (1)
 !> of its own patches. SPR (`method` = mesh_method_spr) ignores contact.
 !>
+!> Contact edges (2D, frictionless; sprc_contact_edge_fit): where a closed facet of a slave
+!> meets an open one, the pressure falls like the square root of the distance to the edge
+!> of the contact zone. The edge's point and amplitude K are fitted to both bodies' data, and
+!> the contact patches within its radius recover sigma_h - K S, the other body's Omega_aux
+!> data likewise, and add K S back (S the edge field of sprc_recovery_contact_edge, each body
+!> with its own normal: the contact law and the open side's freedom hold for it, so the
+!> patches' constraints hold for the remainder). `edges` = false turns it off.
+!>
 !> Input (`contact_body_type`, `contact_pair_type`): pointer components the caller
 !> associates with its arrays (no copy), 1-based. Per pair: slave and master body,
 !> contact facets of each (element sides of that body, as boundary facets), the law per
@@ -151,9 +159,11 @@ contains
    !> Recover bodies in contact (module notes). method mesh_method_sprc (contact-aware) or
    !> mesh_method_spr; degree and max_rounds as recover_on_mesh's (degree 0 or absent: each
    !> body's 'auto'); `degree_above` (0 or 1, the C and Python flags) sets each body's degree
-   !> to its element's plus it instead of 'auto' (a positive `degree` wins).
+   !> to its element's plus it instead of 'auto' (a positive `degree` wins). `edges` (default
+   !> true): the patches at the edges of frictionless contact zones in 2D take the edge field
+   !> (module notes); false: polynomials only.
    subroutine recover_contact_on_mesh(bodies, pairs, method, result, error, degree, max_rounds, c_indices, &
-      & degree_above)
+      & degree_above, edges)
       type(contact_body_type), intent(in) :: bodies(:)
       type(contact_pair_type), intent(in) :: pairs(:)
       integer, intent(in) :: method
@@ -162,6 +172,7 @@ contains
       integer, intent(in), optional :: degree, max_rounds
       logical, intent(in), optional :: c_indices
       integer, intent(in), optional :: degree_above
+      logical, intent(in), optional :: edges
       type(side_type), allocatable :: sides(:)
       type(others_type), allocatable :: others(:)
       logical :: ci
@@ -193,7 +204,7 @@ contains
          do b = 1, size(bodies)
             allocate (others(b)%sites(0))
          end do
-         if (bodies(1)%dim == 2) then
+         if (bodies(1)%dim == 2 .and. opt_true(edges)) then
             do k = 1, size(pairs)
                call pair_edges(bodies, pairs(k), k, ci, others, error)
                if (allocated(error)) return
@@ -917,6 +928,13 @@ contains
          s = trim(adjustl(buf))
       end function rstr
    end subroutine check_pair
+
+   !> flag, .true. when absent.
+   pure logical function opt_true(flag)
+      logical, intent(in), optional :: flag
+      opt_true = .true.
+      if (present(flag)) opt_true = flag
+   end function opt_true
 
    !> True if mu is mu_not_given (bit for bit).
    pure logical function mu_unset(mu)
