@@ -18,7 +18,7 @@
 !>    One scan over the bodies' points per edge (edges are few).
 module sprc_contact_edge_fit
    use sprc_core_kinds, only: wp
-   use sprc_core_dense, only: qr_pivoted, apply_qt, solve_upper
+   use sprc_core_dense, only: qr_pivoted, apply_qt
    use sprc_recovery_contact_edge, only: edge_stress
    implicit none
    private
@@ -110,56 +110,94 @@ contains
    end subroutine find_contact_edges
 
    !> Point and amplitude of `edge` from the slave's and the master's FE data (module notes,
-   !> 2): points x(2, n), weight*|J| w(n), stresses s(3, n) of each.
+   !> 2): points x(2, n), weight*|J| w(n), stresses s(3, n) of each. The polynomial columns are
+   !> factored once (pivoted QR, Q^T applied to the data); each trial point then costs the
+   !> edge column's projection: with r_b, r_s the parts of the data and of the column
+   !> orthogonal to the polynomials, K = r_s.r_b / |r_s|^2 and the squared residual is
+   !> |r_b|^2 - (r_s.r_b)^2 / |r_s|^2.
    pure subroutine fit_contact_edge(edge, x1, w1, s1, x2, w2, s2)
       type(contact_edge_type), intent(inout) :: edge
       real(wp), intent(in) :: x1(:, :), w1(:), s1(:, :), x2(:, :), w2(:), s2(:, :)
       type(cloud_type) :: c(2)
-      real(wp) :: a, b, r0, best, sb, f1, f2, x3, x4, k
+      real(wp), allocatable :: a(:, :), rb(:, :), tau(:), vn(:, :)
+      integer, allocatable :: jpvt(:)
+      real(wp) :: lo, hi, best, sb, f1, f2, x3, x4, k, r0
       real(wp), parameter :: g = 0.6180339887498949_wp
-      integer :: i, it, nrow
+      integer :: i, it, m, n, r
 
       call gather(edge, x1, w1, s1, 1.0_wp, c(1))
       call gather(edge, x2, w2, s2, -1.0_wp, c(2))
-      nrow = 3*(size(c(1)%w) + size(c(2)%w))
+      m = 3*(size(c(1)%w) + size(c(2)%w))
+      n = 2*3*nsmooth
       edge%amplitude = 0.0_wp
-      if (nrow < 2*(1 + 2*3*nsmooth)) return
-      call residual(edge, c, edge%vertex, .false., r0, k)
+      if (m < 2*(n + 1)) return
+      allocate (a(m, n), rb(m, 1), tau(n), vn(n, 2), jpvt(n))
+      call smooth_columns(edge, c, a, rb(:, 1))
+      if (.not. (norm2(rb) > 0.0_wp)) return
+      r0 = norm2(rb)
+      call qr_pivoted(m, n, a, jpvt, tau, vn)
+      r = 0
+      do i = 1, n
+         if (abs(a(i, i)) > 1.0e3_wp*epsilon(1.0_wp)*real(m, wp)*abs(a(1, 1))) r = i
+      end do
+      call apply_qt(m, r, a, tau, 1, rb)
+      rb(1:r, 1) = 0.0_wp
+      ! relative residual without the edge field
+      r0 = norm2(rb(:, 1))/r0
       best = huge(1.0_wp)
       sb = 0.0_wp
       do i = 0, nscan - 1
-         a = s_min + (s_max - s_min)*i/real(nscan - 1, wp)
-         call residual(edge, c, edge%vertex + a*edge%length*edge%tangent, .true., f1, k)
+         x3 = s_min + (s_max - s_min)*i/real(nscan - 1, wp)
+         call trial(x3, f1, k)
          if (f1 < best) then
             best = f1
-            sb = a
+            sb = x3
          end if
       end do
-      a = max(s_min, sb - (s_max - s_min)/(nscan - 1))
-      b = min(s_max, sb + (s_max - s_min)/(nscan - 1))
-      x3 = b - g*(b - a)
-      x4 = a + g*(b - a)
-      call residual(edge, c, edge%vertex + x3*edge%length*edge%tangent, .true., f1, k)
-      call residual(edge, c, edge%vertex + x4*edge%length*edge%tangent, .true., f2, k)
+      lo = max(s_min, sb - (s_max - s_min)/(nscan - 1))
+      hi = min(s_max, sb + (s_max - s_min)/(nscan - 1))
+      x3 = hi - g*(hi - lo)
+      x4 = lo + g*(hi - lo)
+      call trial(x3, f1, k)
+      call trial(x4, f2, k)
       do it = 1, ngolden
          if (f1 < f2) then
-            b = x4
+            hi = x4
             x4 = x3
             f2 = f1
-            x3 = b - g*(b - a)
-            call residual(edge, c, edge%vertex + x3*edge%length*edge%tangent, .true., f1, k)
+            x3 = hi - g*(hi - lo)
+            call trial(x3, f1, k)
          else
-            a = x3
+            lo = x3
             x3 = x4
             f1 = f2
-            x4 = a + g*(b - a)
-            call residual(edge, c, edge%vertex + x4*edge%length*edge%tangent, .true., f2, k)
+            x4 = lo + g*(hi - lo)
+            call trial(x4, f2, k)
          end if
       end do
-      sb = 0.5_wp*(a + b)
+      sb = 0.5_wp*(lo + hi)
+      call trial(sb, best, k)
       edge%point = edge%vertex + sb*edge%length*edge%tangent
-      call residual(edge, c, edge%point, .true., best, k)
       if (k > 0.0_wp .and. best < keep_ratio*r0) edge%amplitude = k
+   contains
+      !> Relative residual f and amplitude k with the edge at vertex + s L t.
+      pure subroutine trial(s, f, k)
+         real(wp), intent(in) :: s
+         real(wp), intent(out) :: f, k
+         real(wp) :: rs(m, 1), ss, sr, bb
+
+         call edge_column(edge, c, edge%vertex + s*edge%length*edge%tangent, rs(:, 1))
+         call apply_qt(m, r, a, tau, 1, rs)
+         rs(1:r, 1) = 0.0_wp
+         ss = dot_product(rs(:, 1), rs(:, 1))
+         sr = dot_product(rs(:, 1), rb(:, 1))
+         bb = dot_product(rb(:, 1), rb(:, 1))
+         k = 0.0_wp
+         f = r0
+         if (.not. (ss > 0.0_wp) .or. .not. (bb > 0.0_wp)) return
+         k = sr/ss
+         f = r0*sqrt(max(0.0_wp, 1.0_wp - sr**2/(ss*bb)))
+      end subroutine trial
    end subroutine fit_contact_edge
 
    !> The points of one body within the radius of the vertex.
@@ -180,55 +218,50 @@ contains
       c%sign = sgn
    end subroutine gather
 
-   !> Relative residual of the fit with the edge at `point` (with_edge) or without it, and K.
-   pure subroutine residual(edge, c, point, with_edge, res, k)
+   !> The weighted rows of the smooth part (a quadratic per body and component, in
+   !> (x - vertex)/radius) and of the data, three rows per point.
+   pure subroutine smooth_columns(edge, c, a, b)
       type(contact_edge_type), intent(in) :: edge
       type(cloud_type), intent(in) :: c(2)
-      real(wp), intent(in) :: point(2)
-      logical, intent(in) :: with_edge
-      real(wp), intent(out) :: res, k
-      real(wp), allocatable :: a(:, :), rhs(:, :), tau(:), vn(:, :)
-      integer, allocatable :: jpvt(:)
-      real(wp) :: se(3), t(2), p(nsmooth)
-      integer :: m, n, o, b, i, cc, r, j
-      logical :: ok
+      real(wp), intent(out) :: a(:, :), b(:)
+      real(wp) :: t(2), p(nsmooth), sw
+      integer :: bd, i, cc, j, o
 
-      o = merge(1, 0, with_edge)
-      n = o + 2*3*nsmooth
-      m = 3*(size(c(1)%w) + size(c(2)%w))
-      allocate (a(m, n), rhs(m, 1), tau(n), vn(n, 2), jpvt(n))
       a = 0.0_wp
       j = 0
-      do b = 1, 2
-         do i = 1, size(c(b)%w)
-            call edge_stress(point, edge%tangent, c(b)%sign*edge%normal, 1.0_wp, c(b)%x(:, i), se)
-            t = (c(b)%x(:, i) - edge%vertex)/edge%radius
+      do bd = 1, 2
+         do i = 1, size(c(bd)%w)
+            t = (c(bd)%x(:, i) - edge%vertex)/edge%radius
             p = [1.0_wp, t(1), t(2), t(1)**2, t(1)*t(2), t(2)**2]
+            sw = sqrt(c(bd)%w(i))
             do cc = 1, 3
                j = j + 1
-               if (with_edge) a(j, 1) = sqrt(c(b)%w(i))*se(cc)
-               a(j, o + ((b - 1)*3 + cc - 1)*nsmooth + 1:o + ((b - 1)*3 + cc)*nsmooth) = sqrt(c(b)%w(i))*p
-               rhs(j, 1) = sqrt(c(b)%w(i))*c(b)%s(cc, i)
+               o = ((bd - 1)*3 + cc - 1)*nsmooth
+               a(j, o + 1:o + nsmooth) = sw*p
+               b(j) = sw*c(bd)%s(cc, i)
             end do
          end do
       end do
-      res = norm2(rhs)
-      k = 0.0_wp
-      if (.not. (res > 0.0_wp)) return
-      call qr_pivoted(m, n, a, jpvt, tau, vn)
-      r = 0
-      do i = 1, n
-         if (abs(a(i, i)) > 1.0e3_wp*epsilon(1.0_wp)*real(m, wp)*abs(a(1, 1))) r = i
+   end subroutine smooth_columns
+
+   !> The weighted rows of the edge field of unit amplitude at `point` (each body its normal).
+   pure subroutine edge_column(edge, c, point, col)
+      type(contact_edge_type), intent(in) :: edge
+      type(cloud_type), intent(in) :: c(2)
+      real(wp), intent(in) :: point(2)
+      real(wp), intent(out) :: col(:)
+      real(wp) :: se(3)
+      integer :: bd, i, j
+
+      j = 0
+      do bd = 1, 2
+         do i = 1, size(c(bd)%w)
+            call edge_stress(point, edge%tangent, c(bd)%sign*edge%normal, 1.0_wp, c(bd)%x(:, i), se)
+            col(j + 1:j + 3) = sqrt(c(bd)%w(i))*se
+            j = j + 3
+         end do
       end do
-      call apply_qt(m, r, a, tau, 1, rhs)
-      res = norm2(rhs(r + 1:m, 1))/res
-      if (.not. with_edge) return
-      call solve_upper(r, a, 1, rhs(1:r, :), ok)
-      if (.not. ok) return
-      do i = 1, r
-         if (jpvt(i) == 1) k = rhs(i, 1)
-      end do
-   end subroutine residual
+   end subroutine edge_column
 
    !> s(1:3, i) := s(1:3, i) - K S(x(:, i)) for the body whose outward normal is sgn times the
    !> edge's (1 the slave, -1 the master).
