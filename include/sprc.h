@@ -414,9 +414,17 @@ int sprc_contact_add_pair(sprc_error error, sprc_contact_input input, int slave,
                           const int *master_facets, const int *master_law, const double *master_slip, double mu,
                           const double *pressure);
 
-/* Recover (SPRC_METHOD_SPRC or SPRC_METHOD_SPR, patch degree 'auto'); a new
- * contact recovery or NULL with the error set. Messages name the entries as
- * C does: bodies[i]: gauss_weights[e][q], pairs[k].slave_facets[f][a], ... */
+/* Recover (SPRC_METHOD_SPRC or SPRC_METHOD_SPR, optionally OR-ed with
+ * SPRC_RECOVERY_P or SPRC_RECOVERY_P_PLUS_1 as in sprc_recover: each body's
+ * patch degree is then its element's, or one more; else 'auto'); a new
+ * contact recovery or NULL with the error set. In 2D, where a closed
+ * frictionless slave facet meets an open one, the patches near that edge of
+ * the contact zone add the edge field (the pressure falls like the square
+ * root of the distance to the edge; its point and amplitude fitted to both
+ * bodies' stresses); SPRC_CONTACT_NO_EDGES OR-ed into method turns it off.
+ * Messages name the entries as C does: bodies[i]: gauss_weights[e][q],
+ * pairs[k].slave_facets[f][a], ... */
+#define SPRC_CONTACT_NO_EDGES 1024
 sprc_contact_recovery sprc_recover_contact(sprc_error error, sprc_contact_input input, int method);
 
 /* Body `body` (0-based) as a new sprc_recovery (a copy; read it with the

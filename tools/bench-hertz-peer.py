@@ -11,9 +11,12 @@ the facets), of SPR's and of SPR-C's (-n.sigma*.n at the facets' Gauss points), 
 median wall time of the contact recovery against the two bodies' SPR-C recoveries without
 contact (the same calls without the pairs), with the thread count.
 
-Usage: python3 tools/bench-hertz-peer.py [N ...] [--runs R] [--fixture PATH]
+Usage: python3 tools/bench-hertz-peer.py [N ...] [--runs R] [--degree D] [--bands] [--fixture PATH]
   N          mesh sizes h = a/N (default 6 12 24);
   --runs     timing repetitions (default 7);
+  --degree   SPR-C's patch degree, sprc.recover_contact's: auto (default), p or p+1;
+  --bands    also the squared errors per band of x/a (where the error sits: the
+             contact edge x -> a against the interior);
   --fixture  also write the fixture of the first N there (write_fixture;
              python/tests/data/hertz_kratos_a12.npz is N = 12).
 Needs libsprc (`make lib`) and a Python with Kratos: $KRATOS_PYTHON, default
@@ -95,10 +98,14 @@ def rel_l2(p, p_ex, w):
     return np.sqrt(np.sum(w * (p - p_ex) ** 2) / np.sum(w * p_ex**2))
 
 
-def errors(d):
-    """Relative L2 errors of the pressure: Kratos', SPR's, SPR-C's; and the max |p_s - p_m|."""
+BANDS = (0.0, 0.5, 0.8, 0.9, 1.0, 1.1, 1.3, 4.0)
+
+
+def errors(d, degree="auto", bands=False):
+    """Relative L2 errors of the pressure: Kratos', SPR's, SPR-C's; and the max |p_s - p_m|.
+    With `bands`, also the rows of the squared relative errors per band of x/a."""
     roller, block, pair = bodies_and_pair(d)
-    res = sprc.recover_contact([roller, block], [pair], method="sprc")
+    res = sprc.recover_contact([roller, block], [pair], method="sprc", degree=degree)
     c = res.pairs[0]
     p_ex = hertz(c.points[:, 0], float(d["a"]))
     spr = sprc.recover(**{k: v for k, v in roller.items() if k != "boundary"}, method="spr")
@@ -106,17 +113,29 @@ def errors(d):
     n = c.normals
     p_spr = -(s[:, 0] * n[:, 0] ** 2 + s[:, 1] * n[:, 1] ** 2 + 2 * s[:, 2] * n[:, 0] * n[:, 1])
     p_fe = fe_pressure_at(d, pair["slave_facets"], c.points)
-    return (rel_l2(p_fe, p_ex, c.weights), rel_l2(p_spr, p_ex, c.weights), rel_l2(c.pressure, p_ex, c.weights),
-            np.max(np.abs(c.pressure - c.pressure_master)) / p_ex.max())
+    out = (rel_l2(p_fe, p_ex, c.weights), rel_l2(p_spr, p_ex, c.weights), rel_l2(c.pressure, p_ex, c.weights),
+           np.max(np.abs(c.pressure - c.pressure_master)) / p_ex.max())
+    if not bands:
+        return out
+    s = c.points[:, 0] / float(d["a"])
+    den = np.sum(c.weights * p_ex**2)
+    rows = []
+    for lo, hi in zip(BANDS[:-1], BANDS[1:]):
+        m = (s >= lo) & (s < hi)
+        rows.append((lo, hi) + tuple(np.sum(c.weights[m] * (p - p_ex)[m] ** 2) / den for p in (p_fe, p_spr,
+                                                                                              c.pressure)))
+    return out, rows
 
 
-def timing(d, runs):
+def timing(d, runs, degree="auto"):
+
+
     """Median wall times: the contact recovery; the two bodies' SPR-C recoveries without contact."""
     roller, block, pair = bodies_and_pair(d)
     t_contact, t_plain = [], []
     for _ in range(runs):
         t0 = time.perf_counter()
-        sprc.recover_contact([roller, block], [pair], method="sprc")
+        sprc.recover_contact([roller, block], [pair], method="sprc", degree=degree)
         t1 = time.perf_counter()
         sprc.recover(**roller, method="sprc")
         sprc.recover(**block, method="sprc")
@@ -166,12 +185,16 @@ def peer_data(n, cache):
 
 
 def main():
-    args, runs, fixture = [], 7, None
+    args, runs, fixture, degree, bands = [], 7, None, "auto", False
     argv = sys.argv[1:]
     while argv:
         a = argv.pop(0)
         if a == "--runs":
             runs = int(argv.pop(0))
+        elif a == "--degree":
+            degree = argv.pop(0)
+        elif a == "--bands":
+            bands = True
         elif a == "--fixture":
             fixture = argv.pop(0)
         else:
@@ -180,20 +203,34 @@ def main():
     cache = ROOT / "build" / "bench-hertz-peer"
     cache.mkdir(parents=True, exist_ok=True)
     threads = os.environ.get("OMP_NUM_THREADS", "all")
-    print(f"Hertz roller, Kratos ALM mortar (Q4, graded) -> sprc; OMP_NUM_THREADS={threads}, {runs} runs")
+    print(f"Hertz roller, Kratos ALM mortar (Q4, graded) -> sprc (degree {degree}); OMP_NUM_THREADS={threads}, "
+          f"{runs} runs")
     print("| h | Q4 (roller + block) | err_p Kratos | err_p SPR | err_p SPR-C | max|p_s-p_m|/p0 | contact [ms] "
           "| 2 bodies [ms] | ratio |")
     print("|---|---|---|---|---|---|---|---|---|")
+    band_rows = []
     for n in sizes:
         path = peer_data(n, cache)
         d = np.load(path)
         if fixture and n == sizes[0]:
             write_fixture(d, fixture)
-        e_fe, e_spr, e_sprc, jump = errors(d)
-        tc, tp = timing(d, runs)
+        if bands:
+            (e_fe, e_spr, e_sprc, jump), rows = errors(d, degree, bands=True)
+            band_rows.append((n, rows))
+        else:
+            e_fe, e_spr, e_sprc, jump = errors(d, degree)
+        tc, tp = timing(d, runs, degree)
         ne = f"{len(d['roller_elements'])} + {len(d['block_elements'])}"
         print(f"| a/{n} | {ne} | {100 * e_fe:.2f} % | {100 * e_spr:.2f} % | {100 * e_sprc:.2f} % | {jump:.2e} "
               f"| {1e3 * tc:.1f} | {1e3 * tp:.1f} | {tc / tp:.2f} |")
+
+
+    for n, rows in band_rows:
+        print(f"\nh = a/{n}: squared relative L2 error x 1e4 per band of x/a (they sum to the squares above)")
+        print("| x/a | Kratos | SPR | SPR-C |")
+        print("|---|---|---|---|")
+        for lo, hi, e1, e2, e3 in rows:
+            print(f"| [{lo:g}, {hi:g}) | {1e4 * e1:.3f} | {1e4 * e2:.3f} | {1e4 * e3:.3f} |")
 
 
 if __name__ == "__main__":

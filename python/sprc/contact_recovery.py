@@ -13,8 +13,8 @@ import ctypes
 import numpy as np
 
 from . import library
-from .recovery import (ANALYSES, ELEMENT_TYPES, METHODS, REFERENCES, Recovery, _c_double_p, _c_int_p, _code,
-                       _doubles, _facets, _ints, _ptr)
+from .recovery import (ANALYSES, DEGREES, ELEMENT_TYPES, METHODS, REFERENCES, Recovery, _c_double_p, _c_int_p,
+                       _code, _doubles, _facets, _ints, _ptr)
 
 __all__ = ["recover_contact", "ContactRecovery", "ContactPair", "CONTACT_LAWS"]
 
@@ -192,7 +192,11 @@ def _pair(k, pair, nbody, info):
     return args, keep, pressure
 
 
-def recover_contact(bodies, pairs, method="sprc"):
+#: sprc.h SPRC_CONTACT_NO_EDGES.
+_NO_EDGES = 1024
+
+
+def recover_contact(bodies, pairs, method="sprc", degree="auto", edges=True):
     """Recover the stresses of bodies in contact, each on your own mesh (SPR-C
     with contact-aware patches on both sides of every pair, the seed's eqs.
     103-138), and the contact tractions on the slave facets.
@@ -217,6 +221,13 @@ def recover_contact(bodies, pairs, method="sprc"):
              ``pressure``  optional: your FE contact pressure at the slave
                  points [n * points per facet], kept as ``pressure_fe``.
     method   'sprc' (default; contact-aware) or 'spr' (contact ignored).
+    degree   each body's patch degree, as :func:`sprc.recover`'s: 'auto'
+             (default), 'p' (its element's degree) or 'p+1' (one more).
+    edges    True (default): in 2D, the patches near an edge of a contact zone
+             (a closed frictionless slave facet next to an open one) add the
+             edge field (the pressure falls like the square root of the
+             distance to the edge; its point and amplitude fitted to both
+             bodies' stresses); False: polynomials only.
 
     Several pairs and bodies per call; a patch whose contact points belong
     to two pairs raises (give the pairs' facets apart). Returns a
@@ -225,7 +236,11 @@ def recover_contact(bodies, pairs, method="sprc"):
     named 0-based, ``bodies[i]: gauss_weights[e][q]``,
     ``pairs[k].slave_facets[f][a]``) for what the library rejects.
     """
-    mcode = _code("method", method, METHODS)
+    mcode = _code("method", method, METHODS) | _code("degree", degree, DEGREES)
+    if not isinstance(edges, (bool, np.bool_)):
+        raise ValueError(f"edges = {edges!r} must be True or False")
+    if not edges:
+        mcode |= _NO_EDGES
     try:
         bodies, pairs = list(bodies), list(pairs)
     except TypeError:

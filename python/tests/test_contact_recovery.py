@@ -161,3 +161,111 @@ def test_unknown_method():
     bodies, pairs = problem("frictionless")
     with pytest.raises(ValueError, match="method = 'zz'"):
         sprc.recover_contact(bodies, pairs, method="zz")
+
+
+def quadratic_field(x):
+    """Airy phi = x^2 y^2 - x^4 / 3 (biharmonic): sigma_xx = 2x^2, sigma_yy = 2y^2 - 4x^2,
+    sigma_xy = -4xy; equilibrium, compatibility, and sigma_xy = 0 on y = 0 (frictionless)."""
+    t, y = x[..., 0], x[..., 1]
+    return np.stack([2 * t**2, 2 * y**2 - 4 * t**2, -4 * t * y], axis=-1)
+
+
+def test_degree_p_plus_1_recovers_a_quadratic_field():
+    """A quadratic field of the frictionless law on quad4 bodies: in the recovery space at
+    degree 'p+1' (2), so recovered to round-off; at 'auto' (1, quad4's) it is not."""
+    bodies, pairs = problem("frictionless", "quad4", "quad4", m=4)
+    for b in bodies:
+        b["gauss_stress"] = quadratic_field(b["gauss_points"])
+    res = sprc.recover_contact(bodies, pairs, degree="p+1")
+    scale = 4.0
+    for b, rec in zip(bodies, res.bodies):
+        assert np.abs(rec.nodal_stress - quadratic_field(b["nodes"])).max() < TOL * scale
+    pr = res.pairs[0]
+    assert np.abs(pr.pressure + quadratic_field(pr.points)[:, 1]).max() < TOL * scale
+    assert np.abs(pr.jump).max() < TOL * scale
+    low = sprc.recover_contact(bodies, pairs, degree="auto")
+    assert np.abs(low.bodies[0].nodal_stress - quadratic_field(bodies[0]["nodes"])).max() > 1e-3 * scale
+    assert np.array_equal(sprc.recover_contact(bodies, pairs, degree="p").bodies[0].nodal_stress,
+                          low.bodies[0].nodal_stress)
+
+
+def test_unknown_degree():
+    bodies, pairs = problem("frictionless")
+    with pytest.raises(ValueError, match=r"degree = 'p\+2'"):
+        sprc.recover_contact(bodies, pairs, degree="p+2")
+
+
+def edge_field(x, xe, normal):
+    """Westergaard's field Z = -i sqrt(z) of a frictionless contact edge at (xe, 0), the tangent
+    +x pointing from the closed side (x < xe) to the open one, the body's outward normal
+    (0, normal): pressure sqrt(xe - x) on the closed side, free on the open side. Written
+    here from the formulas (and checked by finite differences in the test), apart from the
+    library's."""
+    xi, eta = x[..., 0] - xe, np.minimum(normal * x[..., 1], 0.0)
+    sq = np.conj(np.sqrt(xi + 1j * np.abs(eta)))
+    at_edge = sq == 0  # the field vanishes there (eta Z' -> 0)
+    z, zp = -1j * sq, np.where(at_edge, 0.0, -1j / (2 * np.where(at_edge, 1.0, sq)))
+    sxx, syy, sxy = z.real - eta * zp.imag, z.real + eta * zp.imag, -eta * zp.real
+    return np.stack([sxx, syy, normal * sxy], axis=-1)
+
+
+def test_edge_field_is_an_elastic_contact_edge():
+    """The test's edge field: equilibrium and compatibility (plane strain, by central
+    differences, truncation O(d^2) against the field's scale), shear free on y = 0, pressure
+    sqrt(xe - x) on the closed side and free on the open side."""
+    xe, d = 0.3, 1e-4
+    pts = np.array([[0.1, -0.2], [0.5, -0.05], [0.35, -0.4], [0.0, -0.01]])
+    ex, ey = np.array([d, 0.0]), np.array([0.0, d])
+
+    def f(p):
+        return edge_field(p, xe, 1.0)
+
+    div = np.stack([(f(pts + ex)[:, 0] - f(pts - ex)[:, 0] + f(pts + ey)[:, 2] - f(pts - ey)[:, 2]) / (2 * d),
+                    (f(pts + ex)[:, 2] - f(pts - ex)[:, 2] + f(pts + ey)[:, 1] - f(pts - ey)[:, 1]) / (2 * d)])
+    assert np.abs(div).max() < 1e-6
+    # compatibility of plane strain without body force: laplacian(sxx + syy) = 0
+    tr = lambda p: f(p)[:, 0] + f(p)[:, 1]  # noqa: E731
+    lap = (tr(pts + ex) + tr(pts - ex) + tr(pts + ey) + tr(pts - ey) - 4 * tr(pts)) / d**2
+    assert np.abs(lap).max() < 1e-4
+    s = np.linspace(-0.5, 0.5, 11)
+    surf = f(np.stack([xe + s, np.zeros_like(s)], axis=1))
+    assert np.abs(surf[:, 2]).max() == 0.0
+    assert np.allclose(-surf[:, 1], np.sqrt(np.maximum(-s, 0.0)), rtol=0, atol=1e-15)
+    # the master's (outward normal -y, the body above): the same pressure, its shear sign flipped
+    up = edge_field(np.stack([xe + s, np.zeros_like(s)], axis=1), xe, -1.0)
+    assert np.array_equal(up[:, :2], surf[:, :2])
+
+
+def test_contact_edge_field_recovered():
+    """Two quad4 bodies, the contact closed for x < xe = 0.55 (inside a slave facet), open
+    beyond; the FE stresses are the edge field plus a uniform sigma_xx (free on the open
+    side). The edge's point is fitted by golden sections to |delta| <= 0.25 L 0.618^30 =
+    7e-8 L, so the pressure on the closed facets near the edge (within 2 L of the facet's
+    vertex) is exact up to sqrt(|delta|) = 2.6e-4 sqrt(L) (the square root is 1/2-Hoelder,
+    K = 1): checked at 1e-3 sqrt(L). Without the edge field the linear patches miss the
+    square root by much more (the best line through sqrt on [0, L] is off by sqrt(L)/8):
+    checked above 1e-2 sqrt(L)."""
+    xe, m = 0.55, 6
+    b0, b1 = body("quad4", m, "frictionless", -1.0), body("quad4", m + 1, "frictionless", 0.0)
+    for b, nrm in ((b0, 1.0), (b1, -1.0)):
+        b["gauss_stress"] = edge_field(b["gauss_points"], xe, nrm) + np.array([0.2, 0.0, 0.0])
+    sf, mf = line_facets(b0, 0.0), line_facets(b1, 0.0)
+    length = 1.0 / m
+    law = ["frictionless" if b0["nodes"][f, 0].min() < xe else "open" for f in sf]
+    vertex = max(b0["nodes"][f, 0].max() for f, lw in zip(sf, law) if lw != "open")
+    mlaw = ["frictionless" if b1["nodes"][f, 0].min() < vertex else "open" for f in mf]
+    pairs = [dict(slave=0, master=1, slave_facets=sf, master_facets=mf, law=law, master_law=mlaw)]
+    errs = []
+    for edges in (True, False):
+        pr = sprc.recover_contact([b0, b1], pairs, edges=edges).pairs[0]
+        x = pr.points[:, 0]
+        near = (x < vertex) & (x > vertex - 2 * length)
+        errs.append(np.abs(pr.pressure - np.sqrt(np.maximum(xe - x, 0.0)))[near].max() / np.sqrt(length))
+    assert errs[0] < 1e-3, errs
+    assert errs[1] > 1e-2, errs
+
+
+def test_edges_must_be_bool():
+    bodies, pairs = problem("frictionless")
+    with pytest.raises(ValueError, match="edges = 'no'"):
+        sprc.recover_contact(bodies, pairs, edges="no")

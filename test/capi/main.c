@@ -1256,6 +1256,17 @@ static void test_contact_bad_input(void) {
     add_quad_body(err, in3, &c.b);
     sprc_contact_add_pair(err, in3, 0, 1, M, &c.top[0][0], c.law, NULL, M, &c.bottom[0][0], c.law, NULL, 0.0, NULL);
     CONTACT_FAILS(sprc_recover_contact(err, in3, 9), "method = 9");
+    CONTACT_FAILS(sprc_recover_contact(err, in3, SPRC_METHOD_SPRC | 2048), "unknown flag bits");
+    CONTACT_FAILS(sprc_recover_contact(err, in3, SPRC_METHOD_SPRC | SPRC_RECOVERY_P | SPRC_RECOVERY_P_PLUS_1),
+                  "sets both SPRC_RECOVERY_P_PLUS_1 and SPRC_RECOVERY_P");
+    CONTACT_FAILS(sprc_recover_contact(err, in3, 3 | SPRC_RECOVERY_P),
+                  "is not SPRC_METHOD_SPR (1) or SPRC_METHOD_SPRC");
+    rec = sprc_recover_contact(err, in3, SPRC_METHOD_SPRC | SPRC_RECOVERY_P_PLUS_1);
+    CHECK(rec != NULL, "SPRC_RECOVERY_P_PLUS_1 failed");
+    sprc_delete_contact_recovery(&rec);
+    rec = sprc_recover_contact(err, in3, SPRC_METHOD_SPRC | SPRC_CONTACT_NO_EDGES | SPRC_RECOVERY_P);
+    CHECK(rec != NULL, "SPRC_CONTACT_NO_EDGES failed");
+    sprc_delete_contact_recovery(&rec);
     rec = sprc_recover_contact(err, in3, SPRC_METHOD_SPRC);
     CHECK(rec != NULL, "the good input failed");
     CONTACT_FAILS(sprc_get_contact_pair(err, rec, 0, 3, &x[0][0], NULL, NULL, NULL, NULL, NULL, NULL, NULL),

@@ -25,7 +25,7 @@ module sprc_capi_recovery
    private
 
    public :: capi_recovery_type, mesh_sizes_type, check_sizes, check_pointers, one_based, method_mask, flag_p, &
-      & flag_p_plus_1
+      & flag_p_plus_1, check_method_flags
    public :: sprc_recover, sprc_recover_xi, sprc_recover_reference, sprc_get_recovery_nodal_stress, &
       & sprc_get_recovery_element_error, &
       & sprc_get_recovery_global_error, sprc_get_recovery_eta, sprc_eval_recovery, sprc_delete_recovery
@@ -132,12 +132,7 @@ contains
       sz = mesh_sizes_type(dim, analysis, nnode, element_type, nen, nelem, ngp, voigt_size(analysis), nfacet, &
          & facet_nnode)
       call check_sizes(sz, error)
-      if (.not. allocated(error) .and. iand(method, not(ior(method_mask, ior(flag_p_plus_1, flag_p)))) /= 0) &
-         & call fail(error, 'sprc_recover: method = '//itoa(method)//' has unknown flag bits (the flags are '// &
-         & 'SPRC_RECOVERY_P_PLUS_1 = 256 and SPRC_RECOVERY_P = 512)')
-      if (.not. allocated(error) .and. iand(method, flag_p_plus_1) /= 0 .and. iand(method, flag_p) /= 0) &
-         & call fail(error, 'sprc_recover: method = '//itoa(method)//' sets both SPRC_RECOVERY_P_PLUS_1 and '// &
-         & 'SPRC_RECOVERY_P')
+      if (.not. allocated(error)) call check_method_flags('sprc_recover', method, error)
       if (.not. allocated(error) .and. reference /= mesh_reference_unit .and. reference /= mesh_reference_symmetric) &
          & call fail(error, 'sprc_recover: reference = '//itoa(reference)//' is not SPRC_REFERENCE_UNIT ('// &
          & itoa(mesh_reference_unit)//') or SPRC_REFERENCE_SYMMETRIC ('//itoa(mesh_reference_symmetric)//')')
@@ -443,6 +438,21 @@ contains
          ok = .true.
       end if
    end function check_out
+
+   !> The degree flags OR-ed into `method` of entry `entry`: no unknown bit, not both.
+   pure subroutine check_method_flags(entry, method, error)
+      character(len=*), intent(in) :: entry
+      integer(c_int), intent(in) :: method
+      type(error_type), allocatable, intent(out) :: error
+
+      if (iand(method, not(ior(method_mask, ior(flag_p_plus_1, flag_p)))) /= 0) then
+         call fail(error, entry//': method = '//itoa(method)//' has unknown flag bits (the flags are '// &
+            & 'SPRC_RECOVERY_P_PLUS_1 = 256 and SPRC_RECOVERY_P = 512)')
+      else if (iand(method, flag_p_plus_1) /= 0 .and. iand(method, flag_p) /= 0) then
+         call fail(error, entry//': method = '//itoa(method)//' sets both SPRC_RECOVERY_P_PLUS_1 and '// &
+            & 'SPRC_RECOVERY_P')
+      end if
+   end subroutine check_method_flags
 
    pure subroutine fail(error, message)
       type(error_type), allocatable, intent(out) :: error

@@ -14,6 +14,14 @@
 !> (sprc_estimate_contact_patches's default), doubled while the fit lacks rank. Both bodies get contact-aware patches (the mirrored treatment): each is body (1)
 !> of its own patches. SPR (`method` = mesh_method_spr) ignores contact.
 !>
+!> Contact edges (2D, frictionless; sprc_contact_edge_fit): where a closed facet of a slave
+!> meets an open one, the pressure falls like the square root of the distance to the edge
+!> of the contact zone. The edge's point and amplitude K are fitted to both bodies' data, and
+!> the contact patches within its radius recover sigma_h - K S, the other body's Omega_aux
+!> data likewise, and add K S back (S the edge field of sprc_recovery_contact_edge, each body
+!> with its own normal: the contact law and the open side's freedom hold for it, so the
+!> patches' constraints hold for the remainder). `edges` = false turns it off.
+!>
 !> Input (`contact_body_type`, `contact_pair_type`): pointer components the caller
 !> associates with its arrays (no copy), 1-based. Per pair: slave and master body,
 !> contact facets of each (element sides of that body, as boundary facets), the law per
@@ -58,6 +66,7 @@ module sprc_contact_caller_mesh_recovery
    use sprc_recovery_patch_loop, only: auto_degree
    use sprc_recovery_caller_mesh_check, only: check_mesh_arrays, check_mesh_facets
    use sprc_estimate_contact_patches, only: grid_contact_type, new_grid_contact, contact_patch_solve
+   use sprc_contact_edge_fit, only: contact_edge_type, find_contact_edges, fit_contact_edge, edge_subtract
    implicit none
    private
 
@@ -120,9 +129,21 @@ module sprc_contact_caller_mesh_recovery
       type(contact_pair_recovery_type), allocatable :: pairs(:)
    end type mesh_contact_recovery_type
 
-   !> A body's contact patches: the other body of each pair (unused entries empty).
+   !> A contact edge of a pair as one body's patches see it (module notes): the edge, the
+   !> sign of this body's normal against the edge's (1 slave, -1 master), and the pair's
+   !> other body with the edge field subtracted from its stresses.
+   type :: edge_site_type
+      integer :: pair = 0
+      real(wp) :: sign = 1.0_wp
+      type(contact_edge_type) :: edge
+      type(grid_contact_type) :: other
+   end type edge_site_type
+
+   !> A body's contact patches: the other body of each pair (unused entries empty), and the
+   !> contact edges near which its patches are enriched.
    type, extends(mesh_contact_solver_type) :: others_type
       type(grid_contact_type), allocatable :: other(:)
+      type(edge_site_type), allocatable :: sites(:)
    contains
       procedure :: solve => others_solve
    end type others_type
@@ -137,8 +158,12 @@ contains
 
    !> Recover bodies in contact (module notes). method mesh_method_sprc (contact-aware) or
    !> mesh_method_spr; degree and max_rounds as recover_on_mesh's (degree 0 or absent: each
-   !> body's 'auto').
-   subroutine recover_contact_on_mesh(bodies, pairs, method, result, error, degree, max_rounds, c_indices)
+   !> body's 'auto'); `degree_above` (0 or 1, the C and Python flags) sets each body's degree
+   !> to its element's plus it instead of 'auto' (a positive `degree` wins). `edges` (default
+   !> true): the patches at the edges of frictionless contact zones in 2D take the edge field
+   !> (module notes); false: polynomials only.
+   subroutine recover_contact_on_mesh(bodies, pairs, method, result, error, degree, max_rounds, c_indices, &
+      & degree_above, edges)
       type(contact_body_type), intent(in) :: bodies(:)
       type(contact_pair_type), intent(in) :: pairs(:)
       integer, intent(in) :: method
@@ -146,6 +171,8 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer, intent(in), optional :: degree, max_rounds
       logical, intent(in), optional :: c_indices
+      integer, intent(in), optional :: degree_above
+      logical, intent(in), optional :: edges
       type(side_type), allocatable :: sides(:)
       type(others_type), allocatable :: others(:)
       logical :: ci
@@ -155,6 +182,13 @@ contains
       if (present(c_indices)) ci = c_indices
       call check_input(bodies, pairs, method, ci, error)
       if (allocated(error)) return
+      if (present(degree_above)) then
+         if (degree_above /= 0 .and. degree_above /= 1) then
+            call fatal_error(error, 'recover_contact: degree_above = '//itoa(degree_above)//' is not 0 (the '// &
+               & 'element''s degree) or 1 (one above)', stat_invalid_input)
+            return
+         end if
+      end if
       allocate (sides(size(bodies)), others(size(bodies)), result%bodies(size(bodies)), result%pairs(size(pairs)))
       call gather_sides(bodies, pairs, sides)
       if (method == mesh_method_sprc) then
@@ -167,9 +201,19 @@ contains
             call other_body(bodies, pairs(k)%slave, pairs(k)%mu, ci, others(pairs(k)%master)%other(k), error)
             if (allocated(error)) return
          end do
+         do b = 1, size(bodies)
+            allocate (others(b)%sites(0))
+         end do
+         if (bodies(1)%dim == 2 .and. opt_true(edges)) then
+            do k = 1, size(pairs)
+               call pair_edges(bodies, pairs(k), k, ci, others, error)
+               if (allocated(error)) return
+            end do
+         end if
       end if
       do b = 1, size(bodies)
-         call recover_body(bodies(b), sides(b), others(b), method, result%bodies(b), ci, error, degree, max_rounds)
+         call recover_body(bodies(b), sides(b), others(b), method, result%bodies(b), ci, error, degree, max_rounds, &
+            & degree_above)
          if (allocated(error)) then
             error%message = body_name(ci, b)//': '//error%message
             return
@@ -182,7 +226,7 @@ contains
    end subroutine recover_contact_on_mesh
 
    !> One body's recovery with its contact facets.
-   subroutine recover_body(body, side, others, method, rec, ci, error, degree, max_rounds)
+   subroutine recover_body(body, side, others, method, rec, ci, error, degree, max_rounds, degree_above)
       type(contact_body_type), intent(in) :: body
       type(side_type), intent(in) :: side
       type(others_type), intent(in) :: others
@@ -190,10 +234,11 @@ contains
       type(mesh_recovery_type), intent(out) :: rec
       logical, intent(in) :: ci
       type(error_type), allocatable, intent(out) :: error
-      integer, intent(in), optional :: degree, max_rounds
+      integer, intent(in), optional :: degree, max_rounds, degree_above
       integer :: deg
 
       deg = auto_degree(method == mesh_method_sprc, element_degree(body%element_type))
+      if (present(degree_above)) deg = element_degree(body%element_type) + degree_above
       if (present(degree)) then
          if (degree > 0) deg = degree
       end if
@@ -212,7 +257,9 @@ contains
       end if
    end subroutine recover_body
 
-   !> The coupled solve of a patch of this body with the pair's other body (module notes).
+   !> The coupled solve of a patch of this body with the pair's other body (module notes). A
+   !> patch within the radius of one of the pair's enriched edges (the nearest) recovers
+   !> sigma_h - S with the other body's sigma_h - S and adds S back.
    subroutine others_solve(self, pair, patch, law, slip, degree, ws, rec, error)
       class(others_type), intent(in) :: self
       integer, intent(in) :: pair, law(:), degree
@@ -221,21 +268,116 @@ contains
       type(recovery_workspace_type), intent(inout) :: ws
       type(recovered_patch_type), intent(out) :: rec
       type(error_type), allocatable, intent(out) :: error
+      type(patch_type) :: split
+      real(wp) :: dist, best
+      integer :: j, near
 
-      call contact_patch_solve(self%other(pair), patch, law, slip, degree, ws, rec, error)
+      near = 0
+      best = huge(1.0_wp)
+      do j = 1, size(self%sites)
+         if (self%sites(j)%pair /= pair .or. self%sites(j)%edge%amplitude == 0.0_wp) cycle
+         dist = norm2(patch%x0(1:2) - self%sites(j)%edge%point)
+         if (dist < self%sites(j)%edge%radius .and. dist < best) then
+            best = dist
+            near = j
+         end if
+      end do
+      if (near == 0) then
+         call contact_patch_solve(self%other(pair), patch, law, slip, degree, ws, rec, error)
+         return
+      end if
+      associate (site => self%sites(near))
+         split = patch
+         call edge_subtract(site%edge, site%sign, split%x(:, 1:split%npoints), split%stress(:, 1:split%npoints))
+         call contact_patch_solve(site%other, split, law, slip, degree, ws, rec, error)
+         if (allocated(error)) return
+         rec%edge_amplitude = site%edge%amplitude
+         rec%edge_point = site%edge%point
+         rec%edge_tangent = site%edge%tangent
+         rec%edge_normal = site%sign*site%edge%normal
+      end associate
    end subroutine others_solve
+
+   !> The frictionless contact edges of pair k (sprc_contact_edge_fit) from its slave's states
+   !> and both bodies' data, as sites of both bodies' patches.
+   subroutine pair_edges(bodies, pair, k, ci, others, error)
+      type(contact_body_type), intent(in) :: bodies(:)
+      type(contact_pair_type), intent(in) :: pair
+      integer, intent(in) :: k
+      logical, intent(in) :: ci
+      type(others_type), intent(inout) :: others(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_edge_type), allocatable :: edges(:)
+      real(wp), allocatable :: x(:, :), w(:), n(:, :), fn(:, :)
+      integer, allocatable :: owner(:), facet(:), law(:)
+      integer :: f, j, nf, s, m
+
+      s = pair%slave
+      m = pair%master
+      nf = size(pair%slave_facets, 2)
+      associate (b => bodies(s))
+         call mesh_facet_points(b%dim, b%nodes, b%element_type, b%connectivity, pair%slave_facets, ci, &
+            & pair_field(ci, k, 'slave_facets'), x, w, n, owner, facet, error)
+      end associate
+      if (allocated(error)) return
+      allocate (fn(2, nf), law(nf))
+      do j = size(facet), 1, -1
+         fn(:, facet(j)) = n(1:2, j)
+      end do
+      do f = 1, nf
+         law(f) = entry(pair%slave_law, f)
+      end do
+      call find_contact_edges(bodies(s)%nodes, pair%slave_facets, law, contact_law_frictionless, fn, edges)
+      do j = 1, size(edges)
+         associate (b1 => bodies(s), b2 => bodies(m))
+            call fit_contact_edge(edges(j), reshape(b1%gp, [2, size(b1%gw)]), reshape(b1%gw, [size(b1%gw)]), &
+               & reshape(b1%gs, [3, size(b1%gw)]), reshape(b2%gp, [2, size(b2%gw)]), reshape(b2%gw, [size(b2%gw)]), &
+               & reshape(b2%gs, [3, size(b2%gw)]))
+         end associate
+         if (edges(j)%amplitude == 0.0_wp) cycle
+         call add_site(others(s), bodies, m, 1.0_wp, edges(j))
+         if (allocated(error)) return
+         call add_site(others(m), bodies, s, -1.0_wp, edges(j))
+         if (allocated(error)) return
+      end do
+   contains
+      !> Site of edge e for the patches of the body whose other body is o (its normal sgn
+      !> times the edge's is that of the body whose patches see it).
+      subroutine add_site(oth, bodies, o, sgn, e)
+         type(others_type), intent(inout) :: oth
+         type(contact_body_type), intent(in) :: bodies(:)
+         integer, intent(in) :: o
+         real(wp), intent(in) :: sgn
+         type(contact_edge_type), intent(in) :: e
+         type(edge_site_type), allocatable :: tmp(:)
+         integer :: q
+
+         q = size(oth%sites)
+         allocate (tmp(q + 1))
+         tmp(1:q) = oth%sites
+         tmp(q + 1)%pair = k
+         tmp(q + 1)%sign = sgn
+         tmp(q + 1)%edge = e
+         call other_body(bodies, o, pair%mu, ci, tmp(q + 1)%other, error, e, -sgn)
+         call move_alloc(tmp, oth%sites)
+      end subroutine add_site
+   end subroutine pair_edges
 
    !> Body o as the other body of a pair: its integration points and its boundary points
    !> other than contact facets (module notes).
-   subroutine other_body(bodies, o, mu, ci, other, error)
+   !> With `edge`: the edge field of the body whose outward normal is `sgn` times the edge's
+   !> subtracted from its stresses.
+   subroutine other_body(bodies, o, mu, ci, other, error, edge, sgn)
       type(contact_body_type), intent(in) :: bodies(:)
       integer, intent(in) :: o
       real(wp), intent(in) :: mu
       logical, intent(in) :: ci
       type(grid_contact_type), intent(out) :: other
       type(error_type), allocatable, intent(out) :: error
+      type(contact_edge_type), intent(in), optional :: edge
+      real(wp), intent(in), optional :: sgn
       type(patch_type) :: bnd
-      real(wp), allocatable :: slip0(:, :), bf(:)
+      real(wp), allocatable :: slip0(:, :), bf(:), gs(:, :)
       integer, allocatable :: law0(:)
       integer :: d, n, ns
 
@@ -251,8 +393,10 @@ contains
          allocate (law0(0), slip0(d, 0), bf(d))
          bf = 0.0_wp
          if (associated(b%body_force)) bf = b%body_force
+         gs = reshape(b%gs, [ns, n])
+         if (present(edge)) call edge_subtract(edge, sgn, reshape(b%gp, [d, n]), gs)
          call new_grid_contact(other, [integer ::], law0, slip0, max(mu, 0.0_wp), reshape(b%gp, [d, n]), &
-            & reshape(b%gw, [n]), reshape(b%gs, [ns, n]), b%young, b%poisson, bf, error, boundary=bnd)
+            & reshape(b%gw, [n]), gs, b%young, b%poisson, bf, error, boundary=bnd)
       end associate
    end subroutine other_body
 
@@ -784,6 +928,13 @@ contains
          s = trim(adjustl(buf))
       end function rstr
    end subroutine check_pair
+
+   !> flag, .true. when absent.
+   pure logical function opt_true(flag)
+      logical, intent(in), optional :: flag
+      opt_true = .true.
+      if (present(flag)) opt_true = flag
+   end function opt_true
 
    !> True if mu is mu_not_given (bit for bit).
    pure logical function mu_unset(mu)

@@ -8,6 +8,7 @@ module sprc_recovery_estimate
    use sprc_core_material, only: voigt_size, compliance_matrix
    use sprc_core_poly, only: poly_exponents_2d, poly_exponents_3d, poly_max_degree, poly_max_terms
    use sprc_recovery_patch, only: recovered_patch_type
+   use sprc_recovery_contact_edge, only: edge_stress
    implicit none
    private
 
@@ -50,7 +51,15 @@ contains
       real(wp), intent(in) :: x(:, :)
       real(wp), intent(inout) :: sigma(:, :)
 
+      real(wp) :: se(3)
+      integer :: i
+
       call eval_points(rec, rec%nterms, rec%nstress, rec%coef, x, sigma)
+      if (rec%edge_amplitude == 0.0_wp) return
+      do i = 1, size(x, 2)
+         call edge_stress(rec%edge_point, rec%edge_tangent, rec%edge_normal, rec%edge_amplitude, x(1:2, i), se)
+         sigma(1:3, i) = sigma(1:3, i) + se
+      end do
    end subroutine eval_recovered_points
 
    !> The kernel of `eval_recovered_points`, with the coefficients coef(nt, ns) of explicit

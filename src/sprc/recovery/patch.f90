@@ -130,6 +130,10 @@ module sprc_recovery_patch
       !> True when a discarded pivot was above round-off (max_dropped_ratio > recovery_bite_ratio):
       !> the rank tolerance, not exact dependence, decided the rank.
       logical :: tolerance_bites = .false.
+      !> A 2D patch at the edge of a frictionless contact zone adds the edge field of amplitude
+      !> edge_amplitude (sprc_recovery_contact_edge: edge point, unit tangent towards the open
+      !> side, the body's outward normal) to its polynomial; 0: none.
+      real(wp) :: edge_amplitude = 0.0_wp, edge_point(2) = 0.0_wp, edge_tangent(2) = 0.0_wp, edge_normal(2) = 0.0_wp
    end type recovered_patch_type
 
 contains

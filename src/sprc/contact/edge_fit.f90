@@ -1,0 +1,281 @@
+!> The edges of frictionless contact zones on a caller's 2D meshes and the amplitude of their
+!> edge field (sprc_recovery_contact_edge), for the SPR-C patches there
+!> (sprc_contact_caller_mesh_recovery).
+!>
+!> 1. `find_contact_edges`: an edge is a vertex of the slave's contact facets shared by
+!>    exactly one closed facet, frictionless, and an open one (the caller's states): the
+!>    tangent t points along the closed facet towards the open side, the normal is the
+!>    slave's outward one of that facet. Stick and slip edges are left to the polynomials
+!>    (their edge fields differ).
+!> 2. `fit_contact_edge`: the caller's states place the edge within a facet length L (a facet
+!>    closed where any of it is in contact). The edge point x_e = v + s L t, s in
+!>    [s_min, s_max] (v the vertex), and the amplitude K come from the data: the least squares
+!>    fit of both bodies' FE stresses at their integration points within fit_facets L of v by
+!>    K S (S of each body: the same point and tangent, its own outward normal) plus a
+!>    quadratic polynomial per body and component; s minimises the residual (a scan of
+!>    nscan values, then golden sections). The edge is kept when K > 0 (compression) and the
+!>    S column lowers the residual by the factor keep_ratio at least; else K = 0.
+!>    One scan over the bodies' points per edge (edges are few).
+module sprc_contact_edge_fit
+   use sprc_core_kinds, only: wp
+   use sprc_core_dense, only: qr_pivoted, apply_qt
+   use sprc_recovery_contact_edge, only: edge_stress
+   implicit none
+   private
+
+   public :: contact_edge_type, find_contact_edges, fit_contact_edge, edge_subtract
+   public :: fit_facets, s_min, s_max
+
+   !> Fit and enrichment radius, in facet lengths from the vertex.
+   real(wp), parameter :: fit_facets = 4.0_wp
+   !> Range of the edge point along t, in facet lengths from the vertex.
+   real(wp), parameter :: s_min = -1.5_wp, s_max = 0.5_wp
+   !> The edge field must lower the fit's residual to this fraction at least.
+   real(wp), parameter :: keep_ratio = 0.95_wp
+   integer, parameter :: nscan = 17, ngolden = 30
+   !> Quadratic terms per component of the smooth part.
+   integer, parameter :: nsmooth = 6
+
+   !> One edge (module notes): vertex, facet length, fitted point, unit tangent (towards the
+   !> open side), the slave's unit outward normal, amplitude (0: not enriched), radius.
+   type :: contact_edge_type
+      real(wp) :: vertex(2) = 0.0_wp, length = 0.0_wp
+      real(wp) :: point(2) = 0.0_wp, tangent(2) = 0.0_wp, normal(2) = 0.0_wp
+      real(wp) :: amplitude = 0.0_wp, radius = 0.0_wp
+   end type contact_edge_type
+
+   !> One body's points for the fit.
+   type :: cloud_type
+      real(wp), allocatable :: x(:, :), w(:), s(:, :)
+      real(wp) :: sign = 1.0_wp
+   end type cloud_type
+
+contains
+
+   !> The edges of the slave's contact facets (module notes, 1). nodes(2, nnode); facets(nfn,
+   !> nf) 1-based; law(nf) (0 open, law_frictionless closed and frictionless, other codes
+   !> closed with friction); normal(2, nf) the outward normal of each facet.
+   pure subroutine find_contact_edges(nodes, facets, law, law_frictionless, normal, edges)
+      real(wp), intent(in) :: nodes(:, :), normal(:, :)
+      integer, intent(in) :: facets(:, :), law(:), law_frictionless
+      type(contact_edge_type), allocatable, intent(out) :: edges(:)
+      integer, allocatable :: nclosed(:), nopen(:)
+      type(contact_edge_type) :: buf(size(facets, 2))
+      integer :: f, k, v(2), m
+
+      allocate (nclosed(size(nodes, 2)), nopen(size(nodes, 2)))
+      nclosed = 0
+      nopen = 0
+      do f = 1, size(facets, 2)
+         v = vertices(f)
+         if (law(f) == 0) then
+            nopen(v) = nopen(v) + 1
+         else
+            nclosed(v) = nclosed(v) + 1
+         end if
+      end do
+      m = 0
+      do f = 1, size(facets, 2)
+         if (law(f) /= law_frictionless) cycle
+         v = vertices(f)
+         do k = 1, 2
+            if (nclosed(v(k)) /= 1 .or. nopen(v(k)) < 1) cycle
+            m = m + 1
+            buf(m)%vertex = nodes(1:2, v(k))
+            buf(m)%length = norm2(nodes(1:2, v(k)) - nodes(1:2, v(3 - k)))
+            buf(m)%tangent = (nodes(1:2, v(k)) - nodes(1:2, v(3 - k)))/buf(m)%length
+            buf(m)%normal = normal(1:2, f)
+            buf(m)%point = buf(m)%vertex
+            buf(m)%radius = fit_facets*buf(m)%length
+         end do
+      end do
+      edges = buf(1:m)
+   contains
+      !> The two vertices of facet f (of a quadratic facet the two nodes farthest apart).
+      pure function vertices(f) result(vv)
+         integer, intent(in) :: f
+         integer :: vv(2), a, b
+         real(wp) :: best
+         vv = facets(1:2, f)
+         best = -1.0_wp
+         do a = 1, size(facets, 1)
+            do b = a + 1, size(facets, 1)
+               if (norm2(nodes(1:2, facets(a, f)) - nodes(1:2, facets(b, f))) > best) then
+                  best = norm2(nodes(1:2, facets(a, f)) - nodes(1:2, facets(b, f)))
+                  vv = [facets(a, f), facets(b, f)]
+               end if
+            end do
+         end do
+      end function vertices
+   end subroutine find_contact_edges
+
+   !> Point and amplitude of `edge` from the slave's and the master's FE data (module notes,
+   !> 2): points x(2, n), weight*|J| w(n), stresses s(3, n) of each. The polynomial columns are
+   !> factored once (pivoted QR, Q^T applied to the data); each trial point then costs the
+   !> edge column's projection: with r_b, r_s the parts of the data and of the column
+   !> orthogonal to the polynomials, K = r_s.r_b / |r_s|^2 and the squared residual is
+   !> |r_b|^2 - (r_s.r_b)^2 / |r_s|^2.
+   pure subroutine fit_contact_edge(edge, x1, w1, s1, x2, w2, s2)
+      type(contact_edge_type), intent(inout) :: edge
+      real(wp), intent(in) :: x1(:, :), w1(:), s1(:, :), x2(:, :), w2(:), s2(:, :)
+      type(cloud_type) :: c(2)
+      real(wp), allocatable :: a(:, :), rb(:, :), tau(:), vn(:, :)
+      integer, allocatable :: jpvt(:)
+      real(wp) :: lo, hi, best, sb, f1, f2, x3, x4, k, r0
+      real(wp), parameter :: g = 0.6180339887498949_wp
+      integer :: i, it, m, n, r
+
+      call gather(edge, x1, w1, s1, 1.0_wp, c(1))
+      call gather(edge, x2, w2, s2, -1.0_wp, c(2))
+      m = 3*(size(c(1)%w) + size(c(2)%w))
+      n = 2*3*nsmooth
+      edge%amplitude = 0.0_wp
+      if (m < 2*(n + 1)) return
+      allocate (a(m, n), rb(m, 1), tau(n), vn(n, 2), jpvt(n))
+      call smooth_columns(edge, c, a, rb(:, 1))
+      if (.not. (norm2(rb) > 0.0_wp)) return
+      r0 = norm2(rb)
+      call qr_pivoted(m, n, a, jpvt, tau, vn)
+      r = 0
+      do i = 1, n
+         if (abs(a(i, i)) > 1.0e3_wp*epsilon(1.0_wp)*real(m, wp)*abs(a(1, 1))) r = i
+      end do
+      call apply_qt(m, r, a, tau, 1, rb)
+      rb(1:r, 1) = 0.0_wp
+      ! relative residual without the edge field
+      r0 = norm2(rb(:, 1))/r0
+      best = huge(1.0_wp)
+      sb = 0.0_wp
+      do i = 0, nscan - 1
+         x3 = s_min + (s_max - s_min)*i/real(nscan - 1, wp)
+         call trial(x3, f1, k)
+         if (f1 < best) then
+            best = f1
+            sb = x3
+         end if
+      end do
+      lo = max(s_min, sb - (s_max - s_min)/(nscan - 1))
+      hi = min(s_max, sb + (s_max - s_min)/(nscan - 1))
+      x3 = hi - g*(hi - lo)
+      x4 = lo + g*(hi - lo)
+      call trial(x3, f1, k)
+      call trial(x4, f2, k)
+      do it = 1, ngolden
+         if (f1 < f2) then
+            hi = x4
+            x4 = x3
+            f2 = f1
+            x3 = hi - g*(hi - lo)
+            call trial(x3, f1, k)
+         else
+            lo = x3
+            x3 = x4
+            f1 = f2
+            x4 = lo + g*(hi - lo)
+            call trial(x4, f2, k)
+         end if
+      end do
+      sb = 0.5_wp*(lo + hi)
+      call trial(sb, best, k)
+      edge%point = edge%vertex + sb*edge%length*edge%tangent
+      if (k > 0.0_wp .and. best < keep_ratio*r0) edge%amplitude = k
+   contains
+      !> Relative residual f and amplitude k with the edge at vertex + s L t.
+      pure subroutine trial(s, f, k)
+         real(wp), intent(in) :: s
+         real(wp), intent(out) :: f, k
+         real(wp) :: rs(m, 1), ss, sr, bb
+
+         call edge_column(edge, c, edge%vertex + s*edge%length*edge%tangent, rs(:, 1))
+         call apply_qt(m, r, a, tau, 1, rs)
+         rs(1:r, 1) = 0.0_wp
+         ss = dot_product(rs(:, 1), rs(:, 1))
+         sr = dot_product(rs(:, 1), rb(:, 1))
+         bb = dot_product(rb(:, 1), rb(:, 1))
+         k = 0.0_wp
+         f = r0
+         if (.not. (ss > 0.0_wp) .or. .not. (bb > 0.0_wp)) return
+         k = sr/ss
+         f = r0*sqrt(max(0.0_wp, 1.0_wp - sr**2/(ss*bb)))
+      end subroutine trial
+   end subroutine fit_contact_edge
+
+   !> The points of one body within the radius of the vertex.
+   pure subroutine gather(edge, x, w, s, sgn, c)
+      type(contact_edge_type), intent(in) :: edge
+      real(wp), intent(in) :: x(:, :), w(:), s(:, :), sgn
+      type(cloud_type), intent(out) :: c
+      logical :: inside(size(w))
+      integer :: i, n
+
+      do i = 1, size(w)
+         inside(i) = norm2(x(1:2, i) - edge%vertex) < edge%radius
+      end do
+      n = count(inside)
+      c%x = reshape(pack(x(1:2, :), spread(inside, 1, 2)), [2, n])
+      c%s = reshape(pack(s(1:3, :), spread(inside, 1, 3)), [3, n])
+      c%w = pack(w, inside)
+      c%sign = sgn
+   end subroutine gather
+
+   !> The weighted rows of the smooth part (a quadratic per body and component, in
+   !> (x - vertex)/radius) and of the data, three rows per point.
+   pure subroutine smooth_columns(edge, c, a, b)
+      type(contact_edge_type), intent(in) :: edge
+      type(cloud_type), intent(in) :: c(2)
+      real(wp), intent(out) :: a(:, :), b(:)
+      real(wp) :: t(2), p(nsmooth), sw
+      integer :: bd, i, cc, j, o
+
+      a = 0.0_wp
+      j = 0
+      do bd = 1, 2
+         do i = 1, size(c(bd)%w)
+            t = (c(bd)%x(:, i) - edge%vertex)/edge%radius
+            p = [1.0_wp, t(1), t(2), t(1)**2, t(1)*t(2), t(2)**2]
+            sw = sqrt(c(bd)%w(i))
+            do cc = 1, 3
+               j = j + 1
+               o = ((bd - 1)*3 + cc - 1)*nsmooth
+               a(j, o + 1:o + nsmooth) = sw*p
+               b(j) = sw*c(bd)%s(cc, i)
+            end do
+         end do
+      end do
+   end subroutine smooth_columns
+
+   !> The weighted rows of the edge field of unit amplitude at `point` (each body its normal).
+   pure subroutine edge_column(edge, c, point, col)
+      type(contact_edge_type), intent(in) :: edge
+      type(cloud_type), intent(in) :: c(2)
+      real(wp), intent(in) :: point(2)
+      real(wp), intent(out) :: col(:)
+      real(wp) :: se(3)
+      integer :: bd, i, j
+
+      j = 0
+      do bd = 1, 2
+         do i = 1, size(c(bd)%w)
+            call edge_stress(point, edge%tangent, c(bd)%sign*edge%normal, 1.0_wp, c(bd)%x(:, i), se)
+            col(j + 1:j + 3) = sqrt(c(bd)%w(i))*se
+            j = j + 3
+         end do
+      end do
+   end subroutine edge_column
+
+   !> s(1:3, i) := s(1:3, i) - K S(x(:, i)) for the body whose outward normal is sgn times the
+   !> edge's (1 the slave, -1 the master).
+   pure subroutine edge_subtract(edge, sgn, x, s)
+      type(contact_edge_type), intent(in) :: edge
+      real(wp), intent(in) :: sgn, x(:, :)
+      real(wp), intent(inout) :: s(:, :)
+      real(wp) :: se(3)
+      integer :: i
+
+      do i = 1, size(x, 2)
+         call edge_stress(edge%point, edge%tangent, sgn*edge%normal, edge%amplitude, x(1:2, i), se)
+         s(1:3, i) = s(1:3, i) - se
+      end do
+   end subroutine edge_subtract
+
+end module sprc_contact_edge_fit
