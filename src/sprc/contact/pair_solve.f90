@@ -7,11 +7,12 @@
 !>   point's aggregate root), with p_N the slave's FE traction (Nitsche-type) or,
 !>   with `recovered`, its recovered traction of the previous solution.
 !> - Multiplier space: P0 on contact cells (`macro_cells`, `group_cells`: slave
-!>   aggregates of a parent cell, spanning two master cells where those are larger,
-!>   turning at most a quarter turn), as P0 on slave cells is not inf-sup stable;
-!>   eliminated cell by cell (lambda_c = pbar + gamma gbar, SPD above the
-!>   trace-inverse bound). `multiplier='linear'` (`node_cells`): hats of the cells'
-!>   vertex lattice along the surface, eliminated node by node (mass lumped).
+!>   aggregates of a parent cell, spanning two master cells where those are larger
+!>   by more than a quarter level, turning at most a quarter turn), as P0 on slave
+!>   cells is not inf-sup stable; eliminated cell by cell (lambda_c = pbar +
+!>   gamma gbar, SPD above the trace-inverse bound). `multiplier='linear'`
+!>   (`node_cells`): hats of the cells' vertex lattice along the surface,
+!>   eliminated node by node (mass lumped).
 !> - Frame: at point i lambda_c acts as R_i lambda_c, R_i the least rotation from the
 !>   cell's mean normal to n_i (`frame_rotation`): a uniform pressure on a curved
 !>   surface is in the space (a Cartesian constant costs Q2 its order).
@@ -66,7 +67,7 @@ module sprc_contact_pair_solve
    public :: contact_solution_type, solve_contact_pair, friction_kind, contact_progress, contact_factor_type
    public :: contact_body_type, contact_pair_type, solve_contact_assembly, pair_iterative
    public :: friction_frictionless, friction_stick, friction_coulomb, default_max_iterations
-   public :: multiplier_constant, multiplier_linear, multiplier_kind
+   public :: multiplier_constant, multiplier_linear, multiplier_kind, master_levels
 
    abstract interface
       !> Told after each iteration of the contact nonlinearity (the library
@@ -93,6 +94,14 @@ module sprc_contact_pair_solve
    !> (`turns_too_far`): cos 45 degrees, less a round-off margin so that an
    !> exact quarter turn (a quarter model's one cell) stays one cell.
    real(wp), parameter :: cos_max_turn = sqrt(0.5_wp) - 1.0e-12_wp
+   !> A contact cell widens to span two master cells (`master_levels`) once
+   !> the master cells exceed the slave's by more than this factor, a quarter
+   !> of a level (2^(1/4)): grids on different root boxes have any size
+   !> ratio, and a cell of two slave cells over master cells up to 1.15
+   !> times the slave's gives pressures as good as over equal cells, from
+   !> 1.2 times three to ten times worse (doc/benchmarks.md, "Contact cells
+   !> over a coarser master").
+   real(wp), parameter :: master_ratio_tol = 2.0_wp**0.25_wp
 
    !> The contact operators of the points with a master point (local dofs in
    !> the block numbering, gap and traction operators) and their contact cells.
@@ -807,8 +816,7 @@ contains
          if (.not. surface%has_master(i)) cycle
          r = slave%root(surface%slave_cell(i))
          used(r) = .true.
-         shift(r) = max(shift(r), 1 + max(0, ceiling(log(cell_size(master, surface%master_cell(i))/ &
-            & cell_size(slave, r))/log(2.0_wp) - 1.0e-6_wp)))
+         shift(r) = max(shift(r), 1 + master_levels(cell_size(master, surface%master_cell(i))/cell_size(slave, r)))
       end do
       roots = pack([(e, e=1, size(macro))], used)
       do
@@ -866,6 +874,16 @@ contains
          k(3:) = slave%mesh%grid%leaf_coord(1:d, e)/2**shift(e)
       end function root_key
    end subroutine group_roots
+
+   !> The levels a contact cell of two slave cells goes up so that it spans
+   !> two master cells, for master cells `ratio` times the slave's: the
+   !> nearest power of two at or above the ratio, the ratio first divided by
+   !> `master_ratio_tol` (a master cell at most that much larger counts as
+   !> the same size; module notes).
+   pure integer function master_levels(ratio)
+      real(wp), intent(in) :: ratio
+      master_levels = max(0, ceiling(log(ratio/master_ratio_tol)/log(2.0_wp)))
+   end function master_levels
 
    !> wide(m): the points of macro cell m (representative m) have a normal
    !> more than `max_turn` from the cell's mean normal. A cell's multiplier is
