@@ -12,7 +12,8 @@
 !>   cells is not inf-sup stable; eliminated cell by cell (lambda_c = pbar +
 !>   gamma gbar, SPD above the trace-inverse bound). `multiplier='linear'`
 !>   (`node_cells`): hats of the cells' vertex lattice along the surface,
-!>   eliminated node by node (mass lumped).
+!>   eliminated node by node (mass lumped), a closed node's hat cut to the
+!>   points its closed nodes own (`cut_edges`).
 !> - Frame: at point i lambda_c acts as R_i lambda_c, R_i the least rotation from the
 !>   cell's mean normal to n_i (`frame_rotation`): a uniform pressure on a curved
 !>   surface is in the space (a Cartesian constant costs Q2 its order).
@@ -116,6 +117,10 @@ module sprc_contact_pair_solve
       !> The multiplier's basis function of each cell at each of its points,
       !> parallel to cell_point: 1 (constant multiplier) or the node's hat.
       real(wp), allocatable :: cell_phi(:)
+      !> Linear multiplier: each point's owner, the node of its largest hat
+      !> (its state), and the hats before `cut_edges` masks them.
+      integer, allocatable :: owner(:)
+      real(wp), allocatable :: phi_full(:)
       !> Penalty gamma = kappa E_s/h of each contact cell.
       real(wp), allocatable :: gamma(:)
    end type point_operators_type
@@ -361,6 +366,10 @@ contains
          sol%iterations = it
          call timer%reset()
          call timer%start()
+         if (allocated(ops%owner) .and. .not. present(recovered)) then
+            call cut_edges(surface, ops, cells, closed, friction, error)
+            if (allocated(error)) return
+         end if
          if (kept) then
             call factored_solve(slave, master, ops, cells, closed, pstar, names, it, factor, x, sol, error, share, &
                & bounds)
@@ -411,6 +420,38 @@ contains
    end subroutine solve_contact_pair
 
    !> The points of the closed contact cells.
+   !> The linear multiplier's closed nodes act on (and carry pressure at)
+   !> only the points whose owner (the node of their largest hat, their
+   !> state) is closed: a closed node next to an open one loses the half of
+   !> its hat beyond the midpoint. Its mean gap would otherwise take in the
+   !> open side's gap, pressing the closed side in, and its pressure would
+   !> run on past the contact edge to the open node. Nodes whose hats change
+   !> are rebuilt; the hats depend on the active set alone.
+   subroutine cut_edges(surface, ops, cells, closed, friction, error)
+      type(contact_surface_type), intent(in) :: surface
+      type(point_operators_type), intent(inout) :: ops
+      type(cell_operators_type), intent(inout) :: cells(:)
+      logical, intent(in) :: closed(:)
+      integer, intent(in) :: friction
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: phi(maxval(ops%cell_ptr(2:) - ops%cell_ptr(:ops%ncell)))
+      integer :: c, q0, q1, n
+      do c = 1, ops%ncell
+         q0 = ops%cell_ptr(c)
+         q1 = ops%cell_ptr(c + 1) - 1
+         n = q1 - q0 + 1
+         phi(1:n) = ops%phi_full(q0:q1)
+         if (closed(c)) phi(1:n) = merge(phi(1:n), 0.0_wp, closed(ops%owner(ops%cell_point(q0:q1))))
+         ! A node owning none of its points (a sliver's) keeps its whole hat.
+         if (.not. any(phi(1:n) > 0.0_wp)) phi(1:n) = ops%phi_full(q0:q1)
+         if (all(phi(1:n) == ops%cell_phi(q0:q1))) cycle
+         ops%cell_phi(q0:q1) = phi(1:n)
+         call cell_operators(surface, ops, c, merge(friction_stick, friction, friction == friction_coulomb), cells(c), &
+            & error)
+         if (allocated(error)) return
+      end do
+   end subroutine cut_edges
+
    pure integer function closed_points(ops, closed)
       type(point_operators_type), intent(in) :: ops
       logical, intent(in) :: closed(:)
@@ -792,6 +833,20 @@ contains
          end do
       end do
       ops%ncell = nn
+      ops%phi_full = ops%cell_phi
+      allocate (ops%owner(size(node, 2)), source=0)
+      do i = 1, size(node, 2)
+         q = 0
+         do v = 1, size(node, 1)
+            if (node(v, i) == 0) cycle
+            if (q == 0) then
+               q = v
+            else if (phi(v, i) > phi(q, i) .or. (phi(v, i) == phi(q, i) .and. node(v, i) < node(q, i))) then
+               q = v
+            end if
+         end do
+         if (q > 0) ops%owner(i) = node(q, i)
+      end do
    end subroutine node_lists
 
    !> macro(e): the representative of slave root e's contact macro cell, the
@@ -1814,8 +1869,10 @@ contains
             do j = 1, size(pts)
                i = pts(j)
                phi = ops%cell_phi(ops%cell_ptr(c) + j - 1)
-               ! A point's state is that of its largest basis function's cell.
-               if (phi > largest(pts(j))) then
+               ! A point's state is that of its largest basis function's cell (its owner).
+               if (allocated(ops%owner)) then
+                  sol%closed(i) = closed(ops%owner(i))
+               else if (phi > largest(pts(j))) then
                   largest(i) = phi
                   sol%closed(i) = closed(c)
                end if
