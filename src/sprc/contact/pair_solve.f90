@@ -2007,6 +2007,11 @@ contains
          solved%iterations = it
          call timer%reset()
          call timer%start()
+         do p = 1, size(pairs)
+            if (.not. allocated(work(p)%ops%owner)) cycle
+            call cut_edges(pairs(p)%surface, work(p)%ops, work(p)%cells, work(p)%closed, pairs(p)%friction, error)
+            if (allocated(error)) return
+         end do
          call assembly_system(bodies, offset, work, k, f, error)
          if (.not. allocated(error)) call check_held_bodies(bodies, k, &
             & sum([(closed_points(work(p)%ops, work(p)%closed), p=1, size(pairs))]), it, error)
