@@ -20,6 +20,8 @@ module sprc_test_contact_fe
    use sprc_exact_hertz, only: cattaneo_mindlin_traction
    use sprc_grid_quadrature, only: default_points
    use sprc_study_spec, only: default_kappa
+   use sprc_contact_pair_solve, only: master_levels
+   use sprc_core_text, only: itoa
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, replaced
    implicit none
    private
@@ -54,6 +56,8 @@ contains
          new_unittest('shrink_fit_q2_plane_strain', test_shrink_q2_strain), &
          new_unittest('hertz_2d', test_hertz_2d), &
          new_unittest('hertz_2d_linear_multiplier', test_hertz_2d_linear), &
+         new_unittest('contact_cells_master_ratio', test_master_levels), &
+         new_unittest('hertz_2d_master_1pct_coarser', test_hertz_2d_coarser_master), &
          new_unittest('kappa_decades', test_kappa_decades), &
          new_unittest('incline_stick_exact_frictionless_not', test_incline), &
          new_unittest('bodies_in_contact_share_units', test_units), &
@@ -554,23 +558,48 @@ contains
    end subroutine test_hertz_2d
 
    !> The linear multiplier follows the Hertz pressure p0 sqrt(1 - x^2/a^2)
-   !> closer than any multiplier constant on the contact cells can: at level 5
-   !> (h = a/12.8, contact cells 2h = a/6.4 wide), the roller's grid offset
-   !> by 0.6 h, its relative L2 error over the slave surface is below 6.30 %,
-   !> the least L2 projection error of the exact pressure onto piecewise
-   !> constants on cells a/6.4 wide over every offset of the cells (computed
-   !> from the closed form by quadrature, 1.5e5 points: 6.30 % to 8.98 %).
-   !> The constant multiplier's error here is 11.6 %, the linear one's 4.6 %.
+   !> closer than any multiplier constant on the slave cells themselves can:
+   !> at level 5 (h = a/12.8, contact cells 2h = a/6.4 wide), the roller's
+   !> grid offset by 0.4 h, its relative L2 error over the slave surface is
+   !> below 3.54 %, the least L2 projection error of the exact pressure onto
+   !> piecewise constants on cells a/12.8 wide over every offset of the
+   !> cells (computed from the closed form by quadrature, 6e5 points: 3.54 %
+   !> to 4.78 %; on cells a/6.4: 6.30 % to 8.98 %). The constant
+   !> multiplier's error here is 12.2 %, the linear one's 3.4 % (5.9 % with
+   !> the whole hats of the closed nodes next to the contact edge, whose
+   !> pressure ran on past it). No pressure where the state is open.
    subroutine test_hertz_2d_linear(error)
       type(error_type), allocatable, intent(out) :: error
       call hertz_offset_case('linear', error)
    end subroutine test_hertz_2d_linear
 
-   !> `test_hertz_2d_linear` with the multiplier space `multiplier`.
-   subroutine hertz_offset_case(multiplier, error)
-      character(len=*), intent(in) :: multiplier
+   !> A contact cell is two slave cells wide over master cells up to a
+   !> quarter level larger (equal grids on root boxes 1 % apart), and spans
+   !> two master cells beyond: 2^(levels+1) slave cells >= 2 master cells
+   !> once the ratio exceeds 2^(1/4), never more than the next power of two.
+   subroutine test_master_levels(error)
       type(error_type), allocatable, intent(out) :: error
-      real(wp), parameter :: a = 0.05_wp, load = 1.0788436_wp, pi = acos(-1.0_wp), bound = 0.0630_wp
+      real(wp), parameter :: ratio(8) = [0.5_wp, 1.0_wp, 1.01_wp, 1.15_wp, 1.3_wp, 2.0_wp, 2.02_wp, 4.0_wp]
+      integer, parameter :: expected(8) = [0, 0, 0, 0, 1, 1, 1, 2]
+      integer :: i
+      do i = 1, size(ratio)
+         call check(error, master_levels(ratio(i)) == expected(i), 'master cells '//real_text(ratio(i))// &
+            & ' times the slave''s: '//itoa(master_levels(ratio(i)))//' levels, expected '//itoa(expected(i)))
+         if (allocated(error)) return
+      end do
+   end subroutine test_master_levels
+
+   !> The Hertz case of `test_hertz_2d` at level 5 (h = a/12.8) with the
+   !> block's grid 1 % coarser than the roller's: the contact cells stay two
+   !> slave cells (a/6.4) wide, as on equal grids. Cells of four slave cells
+   !> (a/3.2) cannot bring the constant multiplier's relative L2 pressure
+   !> error below 10.83 %, the least L2 projection error of the exact
+   !> pressure onto constants on such cells over every offset (closed form
+   !> by quadrature, 3e5 points; 10.83 % to 16.69 %). Measured: 9.8 % (9.4 %
+   !> on equal grids).
+   subroutine test_hertz_2d_coarser_master(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), parameter :: a = 0.05_wp, load = 1.0788436_wp, pi = acos(-1.0_wp), bound = 0.1083_wp
       type(level_type) :: result
       character(len=:), allocatable :: text
       real(wp), allocatable :: p_ex(:)
@@ -578,7 +607,30 @@ contains
 
       call read_text_file(hertz_2d, text, error)
       if (allocated(error)) return
-      text = replaced(text, "box_min=0.0, 0.0 box_size=2.0", "box_min=-0.00234375, 0.0 box_size=2.0")
+      text = replaced(text, "box_min=0.0, -1.99 box_size=2.0", "box_min=0.0, -1.99 box_size=2.02")
+      call run_text(text, 5, result, error)
+      if (allocated(error)) return
+      p0 = 2.0_wp*load/(pi*a)
+      associate (c => result%contacts(1))
+         p_ex = p0*sqrt(max(0.0_wp, 1.0_wp - (c%x(1, :)/a)**2))
+         rel = sqrt(sum(c%weight*(c%p_fe - p_ex)**2)/sum(c%weight*p_ex**2))
+      end associate
+      call check(error, rel < bound, 'relative L2 pressure error '//real_text(rel)//' >= '//real_text(bound))
+   end subroutine test_hertz_2d_coarser_master
+
+   !> `test_hertz_2d_linear` with the multiplier space `multiplier`.
+   subroutine hertz_offset_case(multiplier, error)
+      character(len=*), intent(in) :: multiplier
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), parameter :: a = 0.05_wp, load = 1.0788436_wp, pi = acos(-1.0_wp), bound = 0.0354_wp
+      type(level_type) :: result
+      character(len=:), allocatable :: text
+      real(wp), allocatable :: p_ex(:)
+      real(wp) :: p0, rel
+
+      call read_text_file(hertz_2d, text, error)
+      if (allocated(error)) return
+      text = replaced(text, "box_min=0.0, 0.0 box_size=2.0", "box_min=-0.0015625, 0.0 box_size=2.0")
       text = replaced(text, '&contact ', "&contact multiplier='"//multiplier//"' ")
       call run_text(text, 5, result, error)
       if (allocated(error)) return
@@ -588,6 +640,11 @@ contains
          rel = sqrt(sum(c%weight*(c%p_fe - p_ex)**2)/sum(c%weight*p_ex**2))
       end associate
       call check(error, rel < bound, 'relative L2 pressure error '//real_text(rel)//' >= '//real_text(bound))
+      if (allocated(error)) return
+      associate (c => result%contacts(1))
+         call check(error, all(c%p_fe == 0.0_wp .or. c%state /= contact_open), 'pressure '// &
+            & real_text(maxval(c%p_fe, mask=c%state == contact_open))//' at an open point')
+      end associate
    end subroutine hertz_offset_case
 
    !> Issue 11's kappa sweep: err_fe and p_max_fe at a hundredth and a

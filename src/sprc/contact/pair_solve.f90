@@ -7,11 +7,13 @@
 !>   point's aggregate root), with p_N the slave's FE traction (Nitsche-type) or,
 !>   with `recovered`, its recovered traction of the previous solution.
 !> - Multiplier space: P0 on contact cells (`macro_cells`, `group_cells`: slave
-!>   aggregates of a parent cell, spanning two master cells where those are larger,
-!>   turning at most a quarter turn), as P0 on slave cells is not inf-sup stable;
-!>   eliminated cell by cell (lambda_c = pbar + gamma gbar, SPD above the
-!>   trace-inverse bound). `multiplier='linear'` (`node_cells`): hats of the cells'
-!>   vertex lattice along the surface, eliminated node by node (mass lumped).
+!>   aggregates of a parent cell, spanning two master cells where those are larger
+!>   by more than a quarter level, turning at most a quarter turn), as P0 on slave
+!>   cells is not inf-sup stable; eliminated cell by cell (lambda_c = pbar +
+!>   gamma gbar, SPD above the trace-inverse bound). `multiplier='linear'`
+!>   (`node_cells`): hats of the cells' vertex lattice along the surface,
+!>   eliminated node by node (mass lumped), a closed node's hat cut to the
+!>   points its closed nodes own (`cut_edges`).
 !> - Frame: at point i lambda_c acts as R_i lambda_c, R_i the least rotation from the
 !>   cell's mean normal to n_i (`frame_rotation`): a uniform pressure on a curved
 !>   surface is in the space (a Cartesian constant costs Q2 its order).
@@ -67,7 +69,7 @@ module sprc_contact_pair_solve
    public :: contact_solution_type, solve_contact_pair, friction_kind, contact_progress, contact_factor_type
    public :: contact_body_type, contact_pair_type, solve_contact_assembly, pair_iterative
    public :: friction_frictionless, friction_stick, friction_coulomb, default_max_iterations
-   public :: multiplier_constant, multiplier_linear, multiplier_kind
+   public :: multiplier_constant, multiplier_linear, multiplier_kind, master_levels
 
    abstract interface
       !> Told after each iteration of the contact nonlinearity (the library
@@ -94,6 +96,14 @@ module sprc_contact_pair_solve
    !> (`turns_too_far`): cos 45 degrees, less a round-off margin so that an
    !> exact quarter turn (a quarter model's one cell) stays one cell.
    real(wp), parameter :: cos_max_turn = sqrt(0.5_wp) - 1.0e-12_wp
+   !> A contact cell widens to span two master cells (`master_levels`) once
+   !> the master cells exceed the slave's by more than this factor, a quarter
+   !> of a level (2^(1/4)): grids on different root boxes have any size
+   !> ratio, and a cell of two slave cells over master cells up to 1.15
+   !> times the slave's gives pressures as good as over equal cells, from
+   !> 1.2 times three to ten times worse (doc/benchmarks.md, "Contact cells
+   !> over a coarser master").
+   real(wp), parameter :: master_ratio_tol = 2.0_wp**0.25_wp
 
    !> The contact operators of the points with a master point (local dofs in
    !> the block numbering, gap and traction operators) and their contact cells.
@@ -108,6 +118,10 @@ module sprc_contact_pair_solve
       !> The multiplier's basis function of each cell at each of its points,
       !> parallel to cell_point: 1 (constant multiplier) or the node's hat.
       real(wp), allocatable :: cell_phi(:)
+      !> Linear multiplier: each point's owner, the node of its largest hat
+      !> (its state), and the hats before `cut_edges` masks them.
+      integer, allocatable :: owner(:)
+      real(wp), allocatable :: phi_full(:)
       !> Penalty gamma = kappa E_s/h of each contact cell.
       real(wp), allocatable :: gamma(:)
    end type point_operators_type
@@ -357,6 +371,10 @@ contains
          sol%iterations = it
          call timer%reset()
          call timer%start()
+         if (allocated(ops%owner) .and. .not. present(recovered)) then
+            call cut_edges(surface, ops, cells, closed, friction, error)
+            if (allocated(error)) return
+         end if
          if (kept) then
             call factored_solve(slave, master, ops, cells, closed, pstar, names, it, factor, x, sol, error, share, &
                & bounds)
@@ -409,6 +427,38 @@ contains
    end subroutine solve_contact_pair
 
    !> The points of the closed contact cells.
+   !> The linear multiplier's closed nodes act on (and carry pressure at)
+   !> only the points whose owner (the node of their largest hat, their
+   !> state) is closed: a closed node next to an open one loses the half of
+   !> its hat beyond the midpoint. Its mean gap would otherwise take in the
+   !> open side's gap, pressing the closed side in, and its pressure would
+   !> run on past the contact edge to the open node. Nodes whose hats change
+   !> are rebuilt; the hats depend on the active set alone.
+   subroutine cut_edges(surface, ops, cells, closed, friction, error)
+      type(contact_surface_type), intent(in) :: surface
+      type(point_operators_type), intent(inout) :: ops
+      type(cell_operators_type), intent(inout) :: cells(:)
+      logical, intent(in) :: closed(:)
+      integer, intent(in) :: friction
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: phi(maxval(ops%cell_ptr(2:) - ops%cell_ptr(:ops%ncell)))
+      integer :: c, q0, q1, n
+      do c = 1, ops%ncell
+         q0 = ops%cell_ptr(c)
+         q1 = ops%cell_ptr(c + 1) - 1
+         n = q1 - q0 + 1
+         phi(1:n) = ops%phi_full(q0:q1)
+         if (closed(c)) phi(1:n) = merge(phi(1:n), 0.0_wp, closed(ops%owner(ops%cell_point(q0:q1))))
+         ! A node owning none of its points (a sliver's) keeps its whole hat.
+         if (.not. any(phi(1:n) > 0.0_wp)) phi(1:n) = ops%phi_full(q0:q1)
+         if (all(phi(1:n) == ops%cell_phi(q0:q1))) cycle
+         ops%cell_phi(q0:q1) = phi(1:n)
+         call cell_operators(surface, ops, c, merge(friction_stick, friction, friction == friction_coulomb), cells(c), &
+            & error)
+         if (allocated(error)) return
+      end do
+   end subroutine cut_edges
+
    pure integer function closed_points(ops, closed)
       type(point_operators_type), intent(in) :: ops
       logical, intent(in) :: closed(:)
@@ -790,6 +840,20 @@ contains
          end do
       end do
       ops%ncell = nn
+      ops%phi_full = ops%cell_phi
+      allocate (ops%owner(size(node, 2)), source=0)
+      do i = 1, size(node, 2)
+         q = 0
+         do v = 1, size(node, 1)
+            if (node(v, i) == 0) cycle
+            if (q == 0) then
+               q = v
+            else if (phi(v, i) > phi(q, i) .or. (phi(v, i) == phi(q, i) .and. node(v, i) < node(q, i))) then
+               q = v
+            end if
+         end do
+         if (q > 0) ops%owner(i) = node(q, i)
+      end do
    end subroutine node_lists
 
    !> macro(e): the representative of slave root e's contact macro cell, the
@@ -814,8 +878,7 @@ contains
          if (.not. surface%has_master(i)) cycle
          r = slave%root(surface%slave_cell(i))
          used(r) = .true.
-         shift(r) = max(shift(r), 1 + max(0, ceiling(log(cell_size(master, surface%master_cell(i))/ &
-            & cell_size(slave, r))/log(2.0_wp) - 1.0e-6_wp)))
+         shift(r) = max(shift(r), 1 + master_levels(cell_size(master, surface%master_cell(i))/cell_size(slave, r)))
       end do
       roots = pack([(e, e=1, size(macro))], used)
       do
@@ -873,6 +936,16 @@ contains
          k(3:) = slave%mesh%grid%leaf_coord(1:d, e)/2**shift(e)
       end function root_key
    end subroutine group_roots
+
+   !> The levels a contact cell of two slave cells goes up so that it spans
+   !> two master cells, for master cells `ratio` times the slave's: the
+   !> nearest power of two at or above the ratio, the ratio first divided by
+   !> `master_ratio_tol` (a master cell at most that much larger counts as
+   !> the same size; module notes).
+   pure integer function master_levels(ratio)
+      real(wp), intent(in) :: ratio
+      master_levels = max(0, ceiling(log(ratio/master_ratio_tol)/log(2.0_wp)))
+   end function master_levels
 
    !> wide(m): the points of macro cell m (representative m) have a normal
    !> more than `max_turn` from the cell's mean normal. A cell's multiplier is
@@ -1891,8 +1964,10 @@ contains
             do j = 1, size(pts)
                i = pts(j)
                phi = ops%cell_phi(ops%cell_ptr(c) + j - 1)
-               ! A point's state is that of its largest basis function's cell.
-               if (phi > largest(pts(j))) then
+               ! A point's state is that of its largest basis function's cell (its owner).
+               if (allocated(ops%owner)) then
+                  sol%closed(i) = closed(ops%owner(i))
+               else if (phi > largest(pts(j))) then
                   largest(i) = phi
                   sol%closed(i) = closed(c)
                end if
@@ -2027,6 +2102,11 @@ contains
          solved%iterations = it
          call timer%reset()
          call timer%start()
+         do p = 1, size(pairs)
+            if (.not. allocated(work(p)%ops%owner)) cycle
+            call cut_edges(pairs(p)%surface, work(p)%ops, work(p)%cells, work(p)%closed, pairs(p)%friction, error)
+            if (allocated(error)) return
+         end do
          call assembly_system(bodies, offset, work, k, f, error)
          if (.not. allocated(error)) call check_held_bodies(bodies, k, &
             & sum([(closed_points(work(p)%ops, work(p)%closed), p=1, size(pairs))]), it, error)
