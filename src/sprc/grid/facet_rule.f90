@@ -31,10 +31,13 @@ module sprc_grid_facet_rule
    implicit none
    private
 
-   public :: facet_rule_type, facet_cell_rule, facet_face_rule, compress_points
+   public :: facet_rule_type, facet_cell_rule, facet_face_rule, compress_points, moment_count
+   public :: compress_min_factor
 
    !> Candidates of the first compression solve, in multiples of the moments M.
    integer, parameter :: candidate_factor = 4
+   !> The cell quadrature compresses rules of more than this many times M points.
+   integer, parameter :: compress_min_factor = 8
 
    !> Points of one cell and the work arrays, reused across cells (one per thread).
    type :: facet_rule_type
@@ -741,6 +744,12 @@ contains
       rule%cdeg = degree
       rule%cdim = dim
    end subroutine moment_exponents
+
+   !> M: the number of monomials of total degree <= `degree` in `dim` variables.
+   pure integer function moment_count(dim, degree) result(m)
+      integer, intent(in) :: dim, degree
+      m = merge((degree + 1)*(degree + 2)/2, (degree + 1)*(degree + 2)*(degree + 3)/6, dim == 2)
+   end function moment_count
 
    !> col(i, j): the i-th Legendre product (rule%cexp) at point x(:, j), in the
    !> coordinates of the box [lo, hi] scaled to [-1, 1].

@@ -37,7 +37,8 @@ module sprc_grid_quadrature
    use sprc_core_gauss, only: max_gauss_points, gauss_legendre_nodes
    use sprc_geometry_region, only: cell_outside, cell_inside, cell_cut
    use sprc_geometry_shape, only: shape_halfspace, shape_box, shape_facets
-   use sprc_grid_facet_rule, only: facet_rule_type, facet_cell_rule, facet_face_rule, compress_points
+   use sprc_grid_facet_rule, only: facet_rule_type, facet_cell_rule, facet_face_rule, compress_points, &
+      & moment_count, compress_min_factor
    use sprc_geometry_facet_solid, only: facet_solid_type, face_cover, solid_nearest, solid_query_box
    use sprc_geometry_body, only: body_type, csg_add, csg_intersect, snap_tolerance
    use sprc_grid_quadric, only: ncoef, max_shape_quadrics, quadric_range, derivative_range, &
@@ -384,6 +385,9 @@ contains
    !> positive-weight points with the same moments up to degree 2q - 1, the
    !> degree the uncut cell's tensor rule integrates (sprc_grid_facet_rule,
    !> `compress_points`): assembly, recovery and estimate loop over them.
+   !> Rules of at most compress_min_factor M points stay as they are: there
+   !> the NNLS (M^2 per candidate, all points when the sampled solves miss the
+   !> moments) costs more than the dropped points save downstream.
    pure subroutine cut_rule(quad, body, lo, hi, rule)
       type(cut_quadrature_type), intent(in) :: quad
       class(body_type), intent(in) :: body
@@ -394,7 +398,8 @@ contains
       call body%active_shapes(lo, hi, active, n)
       if (any(body%shapes(active(1:n))%kind == shape_facets)) then
          call mixed_box(quad, body, lo, hi, lo, hi, 0, rule)
-         call compress_points(rule%facets, quad%dim, lo, hi, 2*quad%q - 1, rule%vol_x, rule%vol_w, rule%nvol)
+         if (rule%nvol > compress_min_factor*moment_count(quad%dim, 2*quad%q - 1)) &
+            & call compress_points(rule%facets, quad%dim, lo, hi, 2*quad%q - 1, rule%vol_x, rule%vol_w, rule%nvol)
       else
          call saye_rule(quad, body, lo, hi, rule, active(1:n))
       end if
