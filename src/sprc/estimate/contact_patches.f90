@@ -72,6 +72,11 @@ module sprc_estimate_contact_patches
       !> direction of this body relative to the other, slip(1:dim, k).
       integer, allocatable :: law(:)
       real(wp), allocatable :: slip(:, :)
+      !> Per boundary point k (as law; empty if not given): the other body's point paired with
+      !> it, at bx(:, k) + offset(1:dim, k), and ratio(k) = dA_other/dA_own, the ratio of the two
+      !> surfaces' measures there (sprc_recovery_contact_patch_solve: the contact rows balance
+      !> forces between surfaces that an interference or a closed gap keeps apart).
+      real(wp), allocatable :: offset(:, :), ratio(:)
       !> Coulomb friction coefficient (slip law).
       real(wp) :: mu = 0.0_wp
       !> Omega_aux depth in patch sizes (`default_aux_depth` of the dimension unless given).
@@ -100,7 +105,7 @@ contains
    !> w(j), FE stresses stress(:, j), material and body force. Errors (stat_invalid_input):
    !> sizes that disagree, an unknown law, a non-finite point.
    subroutine new_grid_contact(self, surfaces, law, slip, mu, y, w, stress, young, poisson, body_force, error, depth, &
-      & boundary)
+      & boundary, offset, ratio)
       type(grid_contact_type), intent(out) :: self
       integer, intent(in) :: surfaces(:), law(:)
       real(wp), intent(in) :: slip(:, :), mu, y(:, :), w(:), stress(:, :), young, poisson, body_force(:)
@@ -108,12 +113,26 @@ contains
       real(wp), intent(in), optional :: depth
       !> The other body's boundary points (`boundary`).
       type(patch_type), intent(in), optional :: boundary
+      !> The paired points and measure ratios per boundary point (`offset`, `ratio` of the type).
+      real(wp), intent(in), optional :: offset(:, :), ratio(:)
       integer :: n
 
       n = size(w)
       if (size(slip, 2) /= size(law) .or. size(y, 2) /= n .or. size(stress, 2) /= n) then
          call fatal_error(error, 'grid contact: law/slip or y/w/stress disagree in size', stat_invalid_input)
          return
+      end if
+      if (present(offset) .neqv. present(ratio)) then
+         call fatal_error(error, 'grid contact: offset and ratio go together', stat_invalid_input)
+         return
+      end if
+      if (present(offset)) then
+         if (size(offset, 2) /= size(law) .or. size(ratio) /= size(law) .or. size(offset, 1) < size(y, 1)) then
+            call fatal_error(error, 'grid contact: offset/ratio and law disagree in size', stat_invalid_input)
+            return
+         end if
+         self%offset = offset
+         self%ratio = ratio
       end if
       if (any(law /= 0 .and. law /= contact_law_frictionless .and. law /= contact_law_slip .and. &
          & law /= contact_law_stick)) then
@@ -353,11 +372,13 @@ contains
    !> law(j), slip(1:dim, j) per boundary point j of `patch`, body (2) the other body's points
    !> (module notes). rec is the patch's recovered stress. The Omega_aux storage is the
    !> thread's (in `ws`, module notes).
-   subroutine contact_patch_solve(self, patch, law, slip, degree, ws, rec, error)
+   subroutine contact_patch_solve(self, patch, law, slip, degree, ws, rec, error, offset, ratio)
       type(grid_contact_type), intent(in) :: self
       type(patch_type), intent(in) :: patch
       integer, intent(in) :: law(:), degree
       real(wp), intent(in) :: slip(:, :)
+      !> Per boundary point of `patch`: the paired points and measure ratios (the type's).
+      real(wp), intent(in), optional :: offset(:, :), ratio(:)
       type(recovery_workspace_type), intent(inout) :: ws
       type(recovered_patch_type), intent(out) :: rec
       type(error_type), allocatable, intent(out) :: error
@@ -398,7 +419,8 @@ contains
             call prism_boundary(self, aux, sc%bbox)
             call recover_contact_patch(patch, degree, law, self%mu, slip, self%y, self%w, self%stress, self%young, &
                & self%poisson, self%depth*patch%h, ws, sc%ws2, sc%patch2, rec, rec2, error, &
-               & body_force2=self%body_force, max_doublings=k, boundary2=sc%bbox, candidates=idx(1:n))
+               & body_force2=self%body_force, max_doublings=k, boundary2=sc%bbox, candidates=idx(1:n), offset=offset, &
+               & ratio=ratio)
             if (.not. allocated(error)) return
             if (index(error%message, 'Omega_aux fit') == 0) return
          end do
