@@ -78,6 +78,7 @@ contains
          new_unittest('coupled_wrong_law', test_coupled_wrong_law), &
          new_unittest('coupled_offset', test_coupled_offset), &
          new_unittest('paired_point_ring', test_paired_point), &
+         new_unittest('coupled_weight2', test_coupled_weight), &
          new_unittest('coupled_errors', test_coupled_errors), &
          new_unittest('contact_patch_depth', test_contact_patch_depth), &
          new_unittest('study_patch_pressures', test_study_patch_pressures), &
@@ -500,6 +501,40 @@ contains
       end do
    end subroutine test_coupled_offset
 
+   !> recover_sprc_contact's weight2 on data that disagree across the contact: coupled_laws'
+   !> fields with body (2)'s normal stress raised by a constant (still in equilibrium and
+   !> compatible, but its traction on the contact plane no longer balances body (1)'s). Weighed
+   !> by w2, the fit of the weighed-up body keeps its own data up to O(1/w) of the disagreement
+   !> (the constrained least squares moves the two fits in the ratio of their weights), so with
+   !> w2 = 1e8 body (2)'s recovered field is its data within 1e-6 of the stress scale (100 times
+   !> the 1e-8 the ratio gives), with w2 = 1e-8 body (1)'s is; with w2 = 1 neither is (both move
+   !> by a share of the 0.3 raised). 2D and 3D, p = 1 and 2, frictionless.
+   subroutine test_coupled_weight(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(linear_field_t) :: f1, f2
+      real(wp) :: err1(3), err2(3), res
+      integer :: dim, p, k
+      real(wp), parameter :: w(3) = [1.0e8_wp, 1.0e-8_wp, 1.0_wp]
+      character(len=200) :: buf
+
+      do dim = 2, 3
+         do p = 1, 2
+            call law_fields(dim, contact_law_frictionless, 0.0_wp, f1, f2)
+            f2%e = f2%e + 0.3_wp
+            do k = 1, 3
+               call coupled_case(dim, p, contact_law_frictionless, 0.0_wp, f1, f2, err1(k), err2(k), res, error, &
+                  & weight2=w(k))
+               if (allocated(error)) return
+            end do
+            write (buf, '("dim ",i0,", p = ",i0,": body (2) w2 = 1e8 ",es9.2,", body (1) w2 = 1e-8 ",es9.2, &
+               & ", w2 = 1: ",es9.2,", ",es9.2)') dim, p, err2(1), err1(2), err1(3), err2(3)
+            call check(error, err2(1) <= 1.0e-6_wp .and. err1(2) <= 1.0e-6_wp .and. min(err1(3), err2(3)) > 1.0e-3_wp, &
+               & trim(buf))
+            if (allocated(error)) return
+         end do
+      end do
+   end subroutine test_coupled_weight
+
    !> The paired point of a slave point on a circle (sphere) of radius R whose master surface is
    !> the concentric one of radius R + g (g < 0: an interference): offset g n on the slave side
    !> (the master point), g n_m on the master side (the slave point), and the measure ratio
@@ -671,13 +706,13 @@ contains
    end subroutine test_grid_exact_3d
 
    !> Action-reaction of the recovered stresses on the compound cylinder (example shrink fit,
-   !> level 5): the jump of the normal traction between the two bodies at the contact points
-   !> (level_type%traction_jump) is zero in the exact solution; the FE and SPR stresses jump
-   !> by 8.4e-2 and 9.1e-2 of the traction there, SPR-C's contact patches by 1.9e-2. A
-   !> regression guard: SPR-C's jump below half of either; the report's jump columns are
-   !> these. The pressure of the slave's FE stresses, -n.sigma_h.n, is 4.0 times as far
-   !> from the exact one as SPR-C's (err_p_fe_stress 1.91e-2, err_p_sprc 4.78e-3; 2.0 to 4.0
-   !> times at levels 3 to 7): guarded at half of it.
+   !> level 6): the jump of the normal traction between the two bodies at the contact points
+   !> (level_type%traction_jump) is zero in the exact solution; a regression guard: SPR-C's
+   !> jump below half of the FE stresses' and SPR's; the report's jump columns are these. The
+   !> slave's SPR-C pressure is at most a third as far from the exact one as that of its FE
+   !> stresses, -n.sigma_h.n (the acceptance of the contact pressure): it holds with the hub's
+   !> coarser first layer weighed down in the contact patches (sprc_estimate_contact_patches)
+   !> and fails without (a factor of 2.2 at this level, doc/benchmarks.md).
    subroutine test_traction_jump(error)
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: text
@@ -685,7 +720,7 @@ contains
 
       call read_text_file('example/scenes/shrink_fit.nml', text, error)
       if (allocated(error)) return
-      call run_text(text, 5, result, error)
+      call run_text(text, 6, result, error)
       if (allocated(error)) return
       associate (j => result%traction_jump(:, 1), r => result%row)
          call check(error, all(j >= 0.0_wp) .and. j(3) <= 0.5_wp*j(1) .and. j(3) <= 0.5_wp*j(2), &
@@ -694,8 +729,8 @@ contains
          call check(error, all([r%jump_fe, r%jump_spr, r%jump_sprc] == j), 'report columns jump_fe, jump_spr, '// &
             & 'jump_sprc: '//rtoa(r%jump_fe)//', '//rtoa(r%jump_spr)//', '//rtoa(r%jump_sprc))
          if (allocated(error)) return
-         call check(error, r%err_p_sprc <= 0.5_wp*r%err_p_fe_stress, 'err_p_sprc '//rtoa(r%err_p_sprc)// &
-            & ' not below half of err_p_fe_stress '//rtoa(r%err_p_fe_stress))
+         call check(error, r%err_p_sprc <= r%err_p_fe_stress/3, 'err_p_sprc '//rtoa(r%err_p_sprc)// &
+            & ' not below a third of err_p_fe_stress '//rtoa(r%err_p_fe_stress))
       end associate
    end subroutine test_traction_jump
 
@@ -999,7 +1034,7 @@ contains
    !> With depth0, Omega_aux and its points come from recover_contact_patch (all of body (2)'s
    !> points passed, depth0 its first depth; depth_used returned).
    subroutine coupled_case(dim, degree, law, mu, f1, f2, err1, err2, res, error, depth0, depth_used, mirror, shift, &
-      & scale, ignore)
+      & scale, ignore, weight2)
       integer, intent(in) :: dim, degree, law
       real(wp), intent(in) :: mu
       type(linear_field_t), intent(in) :: f1, f2
@@ -1015,6 +1050,8 @@ contains
       !> unless `ignore`.
       real(wp), intent(in), optional :: shift, scale
       logical, intent(in), optional :: ignore
+      !> recover_sprc_contact's weight2 (test_coupled_weight).
+      real(wp), intent(in), optional :: weight2
       type(linear_field_t) :: fa, fb
       real(wp) :: g, rs, offs(3, 200), rat(200)
       logical :: pass
@@ -1125,6 +1162,9 @@ contains
             & body_force2=body_force(fb), depth_used=depth_used)
          if (allocated(error)) return
          rank = -1
+      else if (present(weight2)) then
+         call recover_sprc_contact(p1, p2, degree, laws, mu, sl, ws1, ws2, rec1, rec2, error, contact_rank=rank, &
+            & weight2=weight2)
       else if (pass) then
          call recover_sprc_contact(p1, p2, degree, laws, mu, sl, ws1, ws2, rec1, rec2, error, contact_rank=rank, &
             & offset=offs(1:dim, 1:nc), ratio=rat(1:nc))

@@ -574,7 +574,7 @@ contains
       integer, allocatable :: law(:), owner(:)
       real(wp), allocatable :: slip(:, :), offset(:, :), ratio(:)
       type(patch_type) :: own
-      real(wp) :: t(3)
+      real(wp) :: t(3), h1
       integer :: i, j, k, kind, d, win
 
       d = self%nodes%dim
@@ -602,15 +602,19 @@ contains
                   ratio(j) = self%contacts(owner(j))%ratio(k)
                end do
             end do
+            h1 = 0.0_wp
+            do i = 1, size(elements)
+               h1 = max(h1, maxval(self%elem_hi(1:d, elements(i)) - self%elem_lo(1:d, elements(i))))
+            end do
             win = 1
             do i = 2, size(self%contacts)
                if (count(owner == i) > count(owner == win)) win = i
             end do
             if (all(owner == 0 .or. owner == win)) then
-               call contact_patch_solve(self%contacts(win), patch, law, slip, degree, ws, rec, error, offset, ratio)
+               call contact_patch_solve(self%contacts(win), patch, law, slip, degree, ws, rec, error, offset, ratio, h1)
             else
                call one_pair_patch(patch, owner, win, law, slip, offset, ratio, own)
-               call contact_patch_solve(self%contacts(win), own, law, slip, degree, ws, rec, error, offset, ratio)
+               call contact_patch_solve(self%contacts(win), own, law, slip, degree, ws, rec, error, offset, ratio, h1)
             end if
             return
          end if

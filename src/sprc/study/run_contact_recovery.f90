@@ -155,7 +155,7 @@ contains
       if (.not. allocated(error)) call fe_recovery_input(bodies(s)%problem, inputs(1), error)
       if (.not. allocated(error)) call fe_recovery_input(bodies(spec%master_index)%problem, inputs(2), error)
       if (.not. allocated(error)) call pair_contact(study, spec, surface, result, 1, inputs(1), &
-         & bodies(s)%problem%mesh%nodes, inputs(2), contact(1), error)
+         & bodies(s)%problem%mesh%nodes, inputs(2), contact(1), error, bodies(spec%master_index)%problem%mesh%nodes)
       if (allocated(error)) return
       associate (mesh => bodies(s)%problem%mesh)
          call recover_grid(inputs(1), mesh%grid, mesh%nodes, mesh%hanging, method_sprc, study%degree(2), field, &
@@ -200,7 +200,7 @@ contains
       if (.not. any(study%run)) return
       do b = 1, 2
          call pair_contact(study, spec, surface, result, b, inputs(b), &
-            & bodies(k(b))%problem%mesh%nodes, inputs(3 - b), contacts(b), error)
+            & bodies(k(b))%problem%mesh%nodes, inputs(3 - b), contacts(b), error, bodies(k(3 - b))%problem%mesh%nodes)
          if (.not. allocated(error)) &
             & call recover_body(study, study%bodies(k(b)), bodies(k(b)), inputs(b), error, contacts(b:b))
          if (allocated(error)) then
@@ -219,7 +219,7 @@ contains
    !> along it on the master side.
    !> The other body's volume points, FE stresses and boundary points (its contact surface
    !> left out) are `other`'s.
-   subroutine pair_contact(study, spec, surface, result, side, input, nodes, other, contact, error)
+   subroutine pair_contact(study, spec, surface, result, side, input, nodes, other, contact, error, other_nodes)
       type(study_type), intent(in) :: study
       type(contact_spec_type), intent(in) :: spec
       type(contact_surface_type), intent(in) :: surface
@@ -229,8 +229,11 @@ contains
       type(grid_nodes_type), intent(in) :: nodes
       type(grid_contact_type), intent(out) :: contact
       type(error_type), allocatable, intent(out) :: error
+      !> The other body's nodes: with them its fit weighs by the cells' sizes (the grid contact's
+      !> fe_order and cell, sprc_estimate_contact_patches).
+      type(grid_nodes_type), intent(in), optional :: other_nodes
       integer, allocatable :: law(:)
-      real(wp), allocatable :: slip(:, :), offset(:, :), ratio(:)
+      real(wp), allocatable :: slip(:, :), offset(:, :), ratio(:), cell(:)
       real(wp) :: t(3), size_e, dist, best
       type(patch_type) :: oboundary
       type(point_cells_type) :: cells
@@ -319,8 +322,21 @@ contains
       else
          call boundary_points(other, d, osurfaces, oboundary)
       end if
+      if (.not. present(other_nodes)) then
+         call new_grid_contact(contact, surfaces, law, slip, spec%mu, other%x, other%w, other%stress, other%young, &
+            & other%poisson, other%body_force(1:d), error, boundary=oboundary, offset=offset, ratio=ratio)
+         return
+      end if
+      allocate (cell(size(other%w)), stat=stat)
+      call check_allocation(stat, 'pair_contact', 'the cell size of each of the other body''s points', size(other%w), &
+         & 8, error)
+      if (allocated(error)) return
+      do e = 1, other_nodes%n_elements
+         cell(other%elem_ptr(e):other%elem_ptr(e + 1) - 1) = element_size(other_nodes, e)
+      end do
       call new_grid_contact(contact, surfaces, law, slip, spec%mu, other%x, other%w, other%stress, other%young, &
-         & other%poisson, other%body_force(1:d), error, boundary=oboundary, offset=offset, ratio=ratio)
+         & other%poisson, other%body_force(1:d), error, boundary=oboundary, offset=offset, ratio=ratio, &
+         & fe_order=study%order, cell=cell)
    end subroutine pair_contact
 
    !> The other body's point paired with a boundary point of normal bn near slave point i, as
