@@ -85,7 +85,9 @@ module sprc_estimate_contact_patches
       !> forces between surfaces that an interference or a closed gap keeps apart).
       real(wp), allocatable :: offset(:, :), ratio(:)
       !> The bodies' FE order p (0: the fits weigh alike) and the cell size (largest box edge)
-      !> of each of the other body's volume points (module notes; empty if not given).
+      !> of each of the other body's volume points (module notes; empty if not given: then the
+      !> cells' sizes are taken from the largest quadrature weights of the patch and of the
+      !> other body's points in Omega_aux, as on a caller's mesh of uncut elements).
       integer :: fe_order = 0
       real(wp), allocatable :: cell(:)
       !> Coulomb friction coefficient (slip law).
@@ -140,17 +142,13 @@ contains
          call fatal_error(error, 'grid contact: offset and ratio go together', stat_invalid_input)
          return
       end if
-      if (present(fe_order) .neqv. present(cell)) then
-         call fatal_error(error, 'grid contact: fe_order and cell go together', stat_invalid_input)
-         return
-      end if
+      if (present(fe_order)) self%fe_order = fe_order
       if (present(cell)) then
          if (size(cell) /= n .or. .not. all(cell > 0.0_wp .and. cell <= huge(1.0_wp))) then
             call fatal_error(error, 'grid contact: cell needs a finite size > 0 per point of the other body', &
                & stat_invalid_input)
             return
          end if
-         self%fe_order = fe_order
          self%cell = cell
       end if
       if (present(offset)) then
@@ -447,8 +445,14 @@ contains
             call cells_prism(self%cells, self%y, aux, idx, n)
             call prism_boundary(self, aux, sc%bbox)
             w2 = 1.0_wp
-            if (present(h1) .and. self%fe_order > 0 .and. allocated(self%cell) .and. n > 0) &
-               & w2 = (h1/maxval(self%cell(idx(1:n))))**(2*self%fe_order)
+            if (self%fe_order > 0 .and. n > 0) then
+               if (present(h1) .and. allocated(self%cell)) then
+                  w2 = (h1/maxval(self%cell(idx(1:n))))**(2*self%fe_order)
+               else if (patch%npoints > 0) then
+                  ! Uncut elements of one quadrature rule: the largest weights are as the cells' measures.
+                  w2 = (maxval(patch%w(1:patch%npoints))/maxval(self%w(idx(1:n))))**(2.0_wp*self%fe_order/patch%dim)
+               end if
+            end if
             call recover_contact_patch(patch, degree, law, self%mu, slip, self%y, self%w, self%stress, self%young, &
                & self%poisson, self%depth*patch%h, ws, sc%ws2, sc%patch2, rec, rec2, error, &
                & body_force2=self%body_force, max_doublings=k, boundary2=sc%bbox, candidates=idx(1:n), offset=offset, &
