@@ -29,6 +29,8 @@ module sprc_test_contact_recovery
    use sprc_core_dense, only: qr_pivoted
    use sprc_estimate_contact_patches, only: point_cells_type, new_point_cells, cells_box, cells_prism, aux_bounds
    use sprc_exact_hertz, only: cattaneo_mindlin_traction
+   use sprc_contact_surface, only: contact_surface_type, new_contact_surface
+   use sprc_study_run_contact_recovery, only: paired_point
    implicit none
    private
 
@@ -74,6 +76,9 @@ contains
          new_unittest('coupled_exact_2d', test_coupled_exact_2d), &
          new_unittest('coupled_exact_3d', test_coupled_exact_3d), &
          new_unittest('coupled_wrong_law', test_coupled_wrong_law), &
+         new_unittest('coupled_offset', test_coupled_offset), &
+         new_unittest('paired_point_ring', test_paired_point), &
+         new_unittest('coupled_weight2', test_coupled_weight), &
          new_unittest('coupled_errors', test_coupled_errors), &
          new_unittest('contact_patch_depth', test_contact_patch_depth), &
          new_unittest('study_patch_pressures', test_study_patch_pressures), &
@@ -459,6 +464,125 @@ contains
       end do
    end subroutine coupled_laws
 
+   !> Surfaces kept apart (an interference): body (2)'s field is that of coupled_laws moved by
+   !> g along the contact normal and divided by a measure ratio r, so that forces balance between
+   !> x_j and x_j + g n with dA2/dA1 = r. With offset g n and ratio r the coupled SPR-C recovers
+   !> both fields and the balance at round-off (2D and 3D, both sides, p = 1 and 2, every law);
+   !> the same data recovered as if the surfaces met (no offset, no ratio) are not recovered
+   !> exactly: the rows equate t1(x_j) with t2(x_j), which the data do not satisfy.
+   subroutine test_coupled_offset(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(linear_field_t) :: f1, f2
+      real(wp) :: err1, err2, res, e0(3)
+      integer :: dim, law, p, side
+      real(wp), parameter :: mu = 0.35_wp, g = -0.07_wp, r = 0.93_wp
+      character(len=200) :: buf
+
+      do dim = 2, 3
+         do side = 1, 2
+            do p = 1, 2
+               do law = contact_law_frictionless, contact_law_stick
+                  call law_fields(dim, law, mu, f1, f2)
+                  call coupled_case(dim, p, law, mu, f1, f2, err1, err2, res, error, mirror=side == 2, shift=g, &
+                     & scale=r)
+                  if (allocated(error)) return
+                  call coupled_case(dim, p, law, mu, f1, f2, e0(1), e0(2), e0(3), error, mirror=side == 2, shift=g, &
+                     & scale=r, ignore=.true.)
+                  if (allocated(error)) return
+                  write (buf, '("dim ",i0,", side ",i0,", p = ",i0,", law ",i0,": errors ",es9.2,", ",es9.2, &
+                     & ", balance ",es9.2,"; without the offset ",es9.2," (tier ",es9.2,")")') dim, side, p, law, err1, &
+                     & err2, res, max(e0(1), e0(2)), tol_exact
+                  call check(error, max(err1, err2, res) <= tol_exact .and. max(e0(1), e0(2)) > 1.0e3_wp*tol_exact, &
+                     & trim(buf))
+                  if (allocated(error)) return
+               end do
+            end do
+         end do
+      end do
+   end subroutine test_coupled_offset
+
+   !> recover_sprc_contact's weight2 on data that disagree across the contact: coupled_laws'
+   !> fields with body (2)'s normal stress raised by a constant (still in equilibrium and
+   !> compatible, but its traction on the contact plane no longer balances body (1)'s). Weighed
+   !> by w2, the fit of the weighed-up body keeps its own data up to O(1/w) of the disagreement
+   !> (the constrained least squares moves the two fits in the ratio of their weights), so with
+   !> w2 = 1e8 body (2)'s recovered field is its data within 1e-6 of the stress scale (100 times
+   !> the 1e-8 the ratio gives), with w2 = 1e-8 body (1)'s is; with w2 = 1 neither is (both move
+   !> by a share of the 0.3 raised). 2D and 3D, p = 1 and 2, frictionless.
+   subroutine test_coupled_weight(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(linear_field_t) :: f1, f2
+      real(wp) :: err1(3), err2(3), res
+      integer :: dim, p, k
+      real(wp), parameter :: w(3) = [1.0e8_wp, 1.0e-8_wp, 1.0_wp]
+      character(len=200) :: buf
+
+      do dim = 2, 3
+         do p = 1, 2
+            call law_fields(dim, contact_law_frictionless, 0.0_wp, f1, f2)
+            f2%e = f2%e + 0.3_wp
+            do k = 1, 3
+               call coupled_case(dim, p, contact_law_frictionless, 0.0_wp, f1, f2, err1(k), err2(k), res, error, &
+                  & weight2=w(k))
+               if (allocated(error)) return
+            end do
+            write (buf, '("dim ",i0,", p = ",i0,": body (2) w2 = 1e8 ",es9.2,", body (1) w2 = 1e-8 ",es9.2, &
+               & ", w2 = 1: ",es9.2,", ",es9.2)') dim, p, err2(1), err1(2), err1(3), err2(3)
+            call check(error, err2(1) <= 1.0e-6_wp .and. err1(2) <= 1.0e-6_wp .and. min(err1(3), err2(3)) > 1.0e-3_wp, &
+               & trim(buf))
+            if (allocated(error)) return
+         end do
+      end do
+   end subroutine test_coupled_weight
+
+   !> The paired point of a slave point on a circle (sphere) of radius R whose master surface is
+   !> the concentric one of radius R + g (g < 0: an interference): offset g n on the slave side
+   !> (the master point), g n_m on the master side (the slave point), and the measure ratio
+   !> 1 + g div_s n = 1 + (dim - 1) g/R on the slave side, 1/(1 + (dim - 1) g/(R + g)) on the
+   !> master side, whose points lie on the master surface (the slope of the normal is exact on a
+   !> circle or sphere, so only round-off is left: a few eps
+   !> per term of the sums over the neighbours, 64 eps with room). A wrong sign or a missing
+   !> (dim - 1) is an O(g/R) = 5e-2 error.
+   subroutine test_paired_point(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), parameter :: rr = 2.0_wp, g = -0.1_wp, tol = 64*epsilon(1.0_wp)
+      type(contact_surface_type) :: surface
+      real(wp) :: x(3, 9), n(3, 9), off(3), ratio, want
+      integer :: dim, i, side, np
+
+      do dim = 2, 3
+         np = merge(5, 9, dim == 2)
+         do i = 1, np
+            n(:, i) = 0.0_wp
+            if (dim == 2) then
+               n(1:2, i) = [cos(0.3_wp + 0.05_wp*i), sin(0.3_wp + 0.05_wp*i)]
+            else
+               n(:, i) = [0.04_wp*mod(i - 1, 3) + 0.1_wp, 0.05_wp*((i - 1)/3) - 0.03_wp, 1.0_wp]
+               n(:, i) = n(:, i)/norm2(n(:, i))
+            end if
+            x(:, i) = [0.3_wp, -0.2_wp, 0.7_wp] + rr*n(:, i)
+         end do
+         call new_contact_surface(surface, x(1:dim, 1:np), [(0.1_wp, i=1, np)], n(1:dim, 1:np), [(1, i=1, np)], &
+            & error)
+         if (allocated(error)) return
+         surface%master_x = surface%x + g*surface%normal
+         surface%master_normal = -surface%normal
+         surface%has_master = [(.true., i=1, np)]
+         do side = 1, 2
+            ! The master side sees the points on the master surface (radius R + g), as pair_contact.
+            want = 1.0_wp + (dim - 1)*g/rr
+            if (side == 2) want = 1.0_wp/(1.0_wp + (dim - 1)*g/(rr + g))
+            call paired_point(surface, side, 2, 2, merge(surface%x, surface%master_x, side == 1), [(i, i=1, np)], &
+               & [(i, i=1, np)], &
+               & merge(1.0_wp, -1.0_wp, side == 1)*n(1:dim, 2), off(1:dim), ratio)
+            call check(error, abs(ratio - want) <= tol*want .and. &
+               & all(abs(off(1:dim) - merge(1.0_wp, -1.0_wp, side == 1)*g*n(1:dim, 2)) <= tol*rr), &
+               & 'dim '//itoa(dim)//', side '//itoa(side)//': ratio '//rtoa(ratio)//', expected '//rtoa(want))
+            if (allocated(error)) return
+         end do
+      end do
+   end subroutine test_paired_point
+
    !> Stick data recovered as frictionless: the contact rows force body (1)'s shear traction
    !> to zero, so the recovery cannot be exact (the contact rows act).
    subroutine test_coupled_wrong_law(error)
@@ -582,13 +706,13 @@ contains
    end subroutine test_grid_exact_3d
 
    !> Action-reaction of the recovered stresses on the compound cylinder (example shrink fit,
-   !> level 5): the jump of the normal traction between the two bodies at the contact points
-   !> (level_type%traction_jump) is zero in the exact solution; the FE and SPR stresses jump
-   !> by 8.4e-2 and 9.1e-2 of the traction there, SPR-C's contact patches by 1.9e-2. A
-   !> regression guard: SPR-C's jump below half of either; the report's jump columns are
-   !> these. The pressure of the slave's FE stresses, -n.sigma_h.n, is 4.0 times as far
-   !> from the exact one as SPR-C's (err_p_fe_stress 1.91e-2, err_p_sprc 4.78e-3; 2.0 to 4.0
-   !> times at levels 3 to 7): guarded at half of it.
+   !> level 6): the jump of the normal traction between the two bodies at the contact points
+   !> (level_type%traction_jump) is zero in the exact solution; a regression guard: SPR-C's
+   !> jump below half of the FE stresses' and SPR's; the report's jump columns are these. The
+   !> slave's SPR-C pressure is at most a third as far from the exact one as that of its FE
+   !> stresses, -n.sigma_h.n (the acceptance of the contact pressure): it holds with the hub's
+   !> coarser first layer weighed down in the contact patches (sprc_estimate_contact_patches)
+   !> and fails without (a factor of 2.2 at this level, doc/benchmarks.md).
    subroutine test_traction_jump(error)
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: text
@@ -596,7 +720,7 @@ contains
 
       call read_text_file('example/scenes/shrink_fit.nml', text, error)
       if (allocated(error)) return
-      call run_text(text, 5, result, error)
+      call run_text(text, 6, result, error)
       if (allocated(error)) return
       associate (j => result%traction_jump(:, 1), r => result%row)
          call check(error, all(j >= 0.0_wp) .and. j(3) <= 0.5_wp*j(1) .and. j(3) <= 0.5_wp*j(2), &
@@ -605,8 +729,8 @@ contains
          call check(error, all([r%jump_fe, r%jump_spr, r%jump_sprc] == j), 'report columns jump_fe, jump_spr, '// &
             & 'jump_sprc: '//rtoa(r%jump_fe)//', '//rtoa(r%jump_spr)//', '//rtoa(r%jump_sprc))
          if (allocated(error)) return
-         call check(error, r%err_p_sprc <= 0.5_wp*r%err_p_fe_stress, 'err_p_sprc '//rtoa(r%err_p_sprc)// &
-            & ' not below half of err_p_fe_stress '//rtoa(r%err_p_fe_stress))
+         call check(error, r%err_p_sprc <= r%err_p_fe_stress/3, 'err_p_sprc '//rtoa(r%err_p_sprc)// &
+            & ' not below a third of err_p_fe_stress '//rtoa(r%err_p_fe_stress))
       end associate
    end subroutine test_traction_jump
 
@@ -909,7 +1033,8 @@ contains
    !> largest stress: err1 over body (1)'s points, err2 over Omega_aux's, res the contact residual.
    !> With depth0, Omega_aux and its points come from recover_contact_patch (all of body (2)'s
    !> points passed, depth0 its first depth; depth_used returned).
-   subroutine coupled_case(dim, degree, law, mu, f1, f2, err1, err2, res, error, depth0, depth_used, mirror)
+   subroutine coupled_case(dim, degree, law, mu, f1, f2, err1, err2, res, error, depth0, depth_used, mirror, shift, &
+      & scale, ignore, weight2)
       integer, intent(in) :: dim, degree, law
       real(wp), intent(in) :: mu
       type(linear_field_t), intent(in) :: f1, f2
@@ -920,7 +1045,16 @@ contains
       !> Mirrored: the patch is body (2)'s (above z = 0, contact normal -z, slip -x) and Omega_aux
       !> lies in body (1) (the master-side treatment); errors are then body (2)'s, body (1)'s.
       logical, intent(in), optional :: mirror
+      !> Body (2)'s field moved by shift along the contact normal and divided by scale (the
+      !> surfaces kept apart, test_coupled_offset); the offset and ratio passed to the solve
+      !> unless `ignore`.
+      real(wp), intent(in), optional :: shift, scale
+      logical, intent(in), optional :: ignore
+      !> recover_sprc_contact's weight2 (test_coupled_weight).
+      real(wp), intent(in), optional :: weight2
       type(linear_field_t) :: fa, fb
+      real(wp) :: g, rs, offs(3, 200), rat(200)
+      logical :: pass
       real(wp) :: sgn
       real(wp), parameter :: gx(3) = [-sqrt(0.6_wp), 0.0_wp, sqrt(0.6_wp)], gw(3) = [5, 8, 5]/9.0_wp
       real(wp), parameter :: h2cell = 0.6_wp, off2 = -1.33_wp, depth = 1.5_wp
@@ -945,6 +1079,12 @@ contains
             sgn = -1.0_wp
          end if
       end if
+      g = 0.0_wp
+      rs = 1.0_wp
+      if (present(shift)) g = shift
+      if (present(scale)) rs = scale
+      pass = present(shift) .or. present(scale)
+      if (present(ignore)) pass = pass .and. .not. ignore
       nq = 3**dim
       call new_poly_basis(basis, dim, degree, error)
       if (allocated(error)) return
@@ -989,7 +1129,11 @@ contains
       call new_aux_domain(aux, dim, cx(1:dim, 1:nc), cn(1:dim, 1:nc), cw(1:nc), depth, 0.0_wp, error)
       if (allocated(error)) return
       call patch_reset(p2, dim, merge(plane_strain, solid, dim == 2), 1.0_wp, 0.3_wp, aux%centre(1:dim), depth)
-      p2%body_force(1:dim) = body_force(fb)
+      p2%body_force(1:dim) = body_force(fb)/rs
+      do i = 1, nc
+         offs(:, i) = g*nrm
+         rat(i) = rs
+      end do
       ncell2 = 5
       n2 = 0
       top = merge(ncell2, 1, dim == 3)
@@ -1002,7 +1146,7 @@ contains
             j = c/(ncell2*top)
             x(dim) = sgn*h2cell*(j + 0.5_wp*(1.0_wp + gx(ijk(dim) + 1)))
             wgt = (0.5_wp*h2cell)**dim*product(gw(ijk(1:dim) + 1))
-            s2 = field_stress(dim, fb, x(1:dim))
+            s2 = field_stress(dim, fb, x(1:dim) - g*nrm(1:dim))/rs
             n2 = n2 + 1
             y2(:, n2) = x
             w2(n2) = wgt
@@ -1018,6 +1162,12 @@ contains
             & body_force2=body_force(fb), depth_used=depth_used)
          if (allocated(error)) return
          rank = -1
+      else if (present(weight2)) then
+         call recover_sprc_contact(p1, p2, degree, laws, mu, sl, ws1, ws2, rec1, rec2, error, contact_rank=rank, &
+            & weight2=weight2)
+      else if (pass) then
+         call recover_sprc_contact(p1, p2, degree, laws, mu, sl, ws1, ws2, rec1, rec2, error, contact_rank=rank, &
+            & offset=offs(1:dim, 1:nc), ratio=rat(1:nc))
       else
          call recover_sprc_contact(p1, p2, degree, laws, mu, sl, ws1, ws2, rec1, rec2, error, contact_rank=rank)
       end if
@@ -1044,8 +1194,8 @@ contains
          call contact_law_operator(dim, law, mu, hh, hp, error)
          if (allocated(error)) return
          s1(1:ns) = eval(rec1, cx(1:dim, i))
-         s2(1:ns) = eval(rec2, cx(1:dim, i))
-         res = max(res, maxval(abs(matmul(hh(1:dim, 1:ns), s1(1:ns)) - matmul(hp(1:dim, 1:ns), s2(1:ns)))))
+         s2(1:ns) = eval(rec2, cx(1:dim, i) + g*nrm(1:dim))
+         res = max(res, maxval(abs(matmul(hh(1:dim, 1:ns), s1(1:ns)) - rs*matmul(hp(1:dim, 1:ns), s2(1:ns)))))
       end do
       err1 = err1/smax
       err2 = err2/smax

@@ -12,7 +12,9 @@
 !> patch's contact points, found through the grid pipeline's point cells (a counting sort
 !> once per body, never a scan per patch), depth 3 patch sizes in 2D and 2 in 3D
 !> (sprc_estimate_contact_patches's default), doubled while the fit lacks rank. Both bodies get contact-aware patches (the mirrored treatment): each is body (1)
-!> of its own patches. SPR (`method` = mesh_method_spr) ignores contact.
+!> of its own patches. SPR (`method` = mesh_method_spr) ignores contact. The two fits of a
+!> patch weigh by the bodies' element sizes as in the grid pipeline (fe_order of the grid
+!> contact; the sizes from the largest quadrature weights, the elements being uncut).
 !>
 !> Contact edges (2D, frictionless; sprc_contact_edge_fit): where a closed facet of a slave
 !> meets an open one, the pressure falls like the square root of the distance to the edge
@@ -396,7 +398,8 @@ contains
          gs = reshape(b%gs, [ns, n])
          if (present(edge)) call edge_subtract(edge, sgn, reshape(b%gp, [d, n]), gs)
          call new_grid_contact(other, [integer ::], law0, slip0, max(mu, 0.0_wp), reshape(b%gp, [d, n]), &
-            & reshape(b%gw, [n]), gs, b%young, b%poisson, bf, error, boundary=bnd)
+            & reshape(b%gw, [n]), gs, b%young, b%poisson, bf, error, boundary=bnd, &
+            & fe_order=element_degree(b%element_type))
       end associate
    end subroutine other_body
 

@@ -9,6 +9,13 @@
 !> get a description, each with the other as body (2): the master-side patches are the
 !> mirrored ones, so both recovered fields near the contact surface are contact-aware.
 !>
+!> Where the bodies' grids differ (a shaft on a grid half the hub's) the finer body's data
+!> decide: with `fe_order` p the other body's fit weighs (h1/h2)^(2p) against the patch's own,
+!> h1 the largest cell of the patch, h2 the largest of the other body's cells with points in
+!> Omega_aux: the inverse variance of first-layer stresses that err O(h^p) pointwise, whose
+!> error the fit does not remove (doc/benchmarks.md). Otherwise the coarser body's first layer,
+!> through Omega_aux, sets the finer body's recovered contact traction. Equal cells weigh alike.
+!>
 !> Omega_aux depth: `depth` times the patch size h, by default `default_aux_depth(dim)`: 3 h
 !> in 2D, 2 h in 3D. A prism of one patch size holds mostly the other body's cut cells, whose
 !> stresses are the poorest; in 2D deeper ones stop gaining at 3 h and do not over-smooth the
@@ -72,6 +79,17 @@ module sprc_estimate_contact_patches
       !> direction of this body relative to the other, slip(1:dim, k).
       integer, allocatable :: law(:)
       real(wp), allocatable :: slip(:, :)
+      !> Per boundary point k (as law; empty if not given): the other body's point paired with
+      !> it, at bx(:, k) + offset(1:dim, k), and ratio(k) = dA_other/dA_own, the ratio of the two
+      !> surfaces' measures there (sprc_recovery_contact_patch_solve: the contact rows balance
+      !> forces between surfaces that an interference or a closed gap keeps apart).
+      real(wp), allocatable :: offset(:, :), ratio(:)
+      !> The bodies' FE order p (0: the fits weigh alike) and the cell size (largest box edge)
+      !> of each of the other body's volume points (module notes; empty if not given: then the
+      !> cells' sizes are taken from the largest quadrature weights of the patch and of the
+      !> other body's points in Omega_aux, as on a caller's mesh of uncut elements).
+      integer :: fe_order = 0
+      real(wp), allocatable :: cell(:)
       !> Coulomb friction coefficient (slip law).
       real(wp) :: mu = 0.0_wp
       !> Omega_aux depth in patch sizes (`default_aux_depth` of the dimension unless given).
@@ -100,7 +118,7 @@ contains
    !> w(j), FE stresses stress(:, j), material and body force. Errors (stat_invalid_input):
    !> sizes that disagree, an unknown law, a non-finite point.
    subroutine new_grid_contact(self, surfaces, law, slip, mu, y, w, stress, young, poisson, body_force, error, depth, &
-      & boundary)
+      & boundary, offset, ratio, fe_order, cell)
       type(grid_contact_type), intent(out) :: self
       integer, intent(in) :: surfaces(:), law(:)
       real(wp), intent(in) :: slip(:, :), mu, y(:, :), w(:), stress(:, :), young, poisson, body_force(:)
@@ -108,12 +126,38 @@ contains
       real(wp), intent(in), optional :: depth
       !> The other body's boundary points (`boundary`).
       type(patch_type), intent(in), optional :: boundary
+      !> The paired points and measure ratios per boundary point (`offset`, `ratio` of the type).
+      real(wp), intent(in), optional :: offset(:, :), ratio(:)
+      !> The bodies' FE order and the other body's cell size per volume point (the type's).
+      integer, intent(in), optional :: fe_order
+      real(wp), intent(in), optional :: cell(:)
       integer :: n
 
       n = size(w)
       if (size(slip, 2) /= size(law) .or. size(y, 2) /= n .or. size(stress, 2) /= n) then
          call fatal_error(error, 'grid contact: law/slip or y/w/stress disagree in size', stat_invalid_input)
          return
+      end if
+      if (present(offset) .neqv. present(ratio)) then
+         call fatal_error(error, 'grid contact: offset and ratio go together', stat_invalid_input)
+         return
+      end if
+      if (present(fe_order)) self%fe_order = fe_order
+      if (present(cell)) then
+         if (size(cell) /= n .or. .not. all(cell > 0.0_wp .and. cell <= huge(1.0_wp))) then
+            call fatal_error(error, 'grid contact: cell needs a finite size > 0 per point of the other body', &
+               & stat_invalid_input)
+            return
+         end if
+         self%cell = cell
+      end if
+      if (present(offset)) then
+         if (size(offset, 2) /= size(law) .or. size(ratio) /= size(law) .or. size(offset, 1) < size(y, 1)) then
+            call fatal_error(error, 'grid contact: offset/ratio and law disagree in size', stat_invalid_input)
+            return
+         end if
+         self%offset = offset
+         self%ratio = ratio
       end if
       if (any(law /= 0 .and. law /= contact_law_frictionless .and. law /= contact_law_slip .and. &
          & law /= contact_law_stick)) then
@@ -353,11 +397,15 @@ contains
    !> law(j), slip(1:dim, j) per boundary point j of `patch`, body (2) the other body's points
    !> (module notes). rec is the patch's recovered stress. The Omega_aux storage is the
    !> thread's (in `ws`, module notes).
-   subroutine contact_patch_solve(self, patch, law, slip, degree, ws, rec, error)
+   subroutine contact_patch_solve(self, patch, law, slip, degree, ws, rec, error, offset, ratio, h1)
       type(grid_contact_type), intent(in) :: self
       type(patch_type), intent(in) :: patch
       integer, intent(in) :: law(:), degree
       real(wp), intent(in) :: slip(:, :)
+      !> Per boundary point of `patch`: the paired points and measure ratios (the type's).
+      real(wp), intent(in), optional :: offset(:, :), ratio(:)
+      !> The largest cell of the patch (module notes: the fits' weights).
+      real(wp), intent(in), optional :: h1
       type(recovery_workspace_type), intent(inout) :: ws
       type(recovered_patch_type), intent(out) :: rec
       type(error_type), allocatable, intent(out) :: error
@@ -384,7 +432,7 @@ contains
          type(aux_domain_type) :: aux
          integer, allocatable :: idx(:)
          real(wp), allocatable :: cx(:, :), cn(:, :), cw(:)
-         real(wp) :: dep
+         real(wp) :: dep, w2
          integer :: n, k
 
          call contact_points(patch, cx, cn, cw)
@@ -396,9 +444,19 @@ contains
             if (allocated(error)) return
             call cells_prism(self%cells, self%y, aux, idx, n)
             call prism_boundary(self, aux, sc%bbox)
+            w2 = 1.0_wp
+            if (self%fe_order > 0 .and. n > 0) then
+               if (present(h1) .and. allocated(self%cell)) then
+                  w2 = (h1/maxval(self%cell(idx(1:n))))**(2*self%fe_order)
+               else if (patch%npoints > 0) then
+                  ! Uncut elements of one quadrature rule: the largest weights are as the cells' measures.
+                  w2 = (maxval(patch%w(1:patch%npoints))/maxval(self%w(idx(1:n))))**(2.0_wp*self%fe_order/patch%dim)
+               end if
+            end if
             call recover_contact_patch(patch, degree, law, self%mu, slip, self%y, self%w, self%stress, self%young, &
                & self%poisson, self%depth*patch%h, ws, sc%ws2, sc%patch2, rec, rec2, error, &
-               & body_force2=self%body_force, max_doublings=k, boundary2=sc%bbox, candidates=idx(1:n))
+               & body_force2=self%body_force, max_doublings=k, boundary2=sc%bbox, candidates=idx(1:n), offset=offset, &
+               & ratio=ratio, weight2=w2)
             if (.not. allocated(error)) return
             if (index(error%message, 'Omega_aux fit') == 0) return
          end do

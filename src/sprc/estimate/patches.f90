@@ -572,15 +572,16 @@ contains
       type(recovered_patch_type), intent(out) :: rec
       type(error_type), allocatable, intent(out) :: error
       integer, allocatable :: law(:), owner(:)
-      real(wp), allocatable :: slip(:, :)
+      real(wp), allocatable :: slip(:, :), offset(:, :), ratio(:)
       type(patch_type) :: own
-      real(wp) :: t(3)
+      real(wp) :: t(3), h1
       integer :: i, j, k, kind, d, win
 
       d = self%nodes%dim
       if (sprc .and. associated(self%contacts) .and. patch%nbpoints > 0) then
          if (any(patch%bkind(1:patch%nbpoints) == boundary_contact)) then
-            allocate (law(patch%nbpoints), slip(d, patch%nbpoints), owner(patch%nbpoints))
+            allocate (law(patch%nbpoints), slip(d, patch%nbpoints), owner(patch%nbpoints), offset(d, patch%nbpoints), &
+               & ratio(patch%nbpoints))
             j = 0
             do i = 1, size(elements)
                do k = self%input%belem_ptr(elements(i)), self%input%belem_ptr(elements(i) + 1) - 1
@@ -589,22 +590,31 @@ contains
                   j = j + 1
                   law(j) = 0
                   slip(:, j) = 0.0_wp
+                  offset(:, j) = 0.0_wp
+                  ratio(j) = 1.0_wp
                   owner(j) = 0
                   if (kind /= boundary_contact) cycle
                   owner(j) = contact_of(self, k)
                   law(j) = self%contacts(owner(j))%law(k)
                   slip(:, j) = self%contacts(owner(j))%slip(1:d, k)
+                  if (.not. allocated(self%contacts(owner(j))%ratio)) cycle
+                  offset(:, j) = self%contacts(owner(j))%offset(1:d, k)
+                  ratio(j) = self%contacts(owner(j))%ratio(k)
                end do
+            end do
+            h1 = 0.0_wp
+            do i = 1, size(elements)
+               h1 = max(h1, maxval(self%elem_hi(1:d, elements(i)) - self%elem_lo(1:d, elements(i))))
             end do
             win = 1
             do i = 2, size(self%contacts)
                if (count(owner == i) > count(owner == win)) win = i
             end do
             if (all(owner == 0 .or. owner == win)) then
-               call contact_patch_solve(self%contacts(win), patch, law, slip, degree, ws, rec, error)
+               call contact_patch_solve(self%contacts(win), patch, law, slip, degree, ws, rec, error, offset, ratio, h1)
             else
-               call one_pair_patch(patch, owner, win, law, slip, own)
-               call contact_patch_solve(self%contacts(win), own, law, slip, degree, ws, rec, error)
+               call one_pair_patch(patch, owner, win, law, slip, offset, ratio, own)
+               call contact_patch_solve(self%contacts(win), own, law, slip, degree, ws, rec, error, offset, ratio, h1)
             end if
             return
          end if
@@ -636,12 +646,13 @@ contains
    end function contact_of
 
    !> `patch` without the contact points of pairs other than `win` (owner(j) the pair of
-   !> boundary point j, 0 for a point that is not a contact point); law and slip compacted alike.
-   pure subroutine one_pair_patch(patch, owner, win, law, slip, own)
+   !> boundary point j, 0 for a point that is not a contact point); law, slip, offset and ratio
+   !> compacted alike.
+   pure subroutine one_pair_patch(patch, owner, win, law, slip, offset, ratio, own)
       type(patch_type), intent(in) :: patch
       integer, intent(in) :: owner(:), win
       integer, intent(inout) :: law(:)
-      real(wp), intent(inout) :: slip(:, :)
+      real(wp), intent(inout) :: slip(:, :), offset(:, :), ratio(:)
       type(patch_type), intent(out) :: own
       integer :: j, m
 
@@ -658,6 +669,8 @@ contains
          own%btraction(:, m) = patch%btraction(:, j)
          law(m) = law(j)
          slip(:, m) = slip(:, j)
+         offset(:, m) = offset(:, j)
+         ratio(m) = ratio(j)
       end do
       own%nbpoints = m
    end subroutine one_pair_patch

@@ -18,7 +18,10 @@
 !> by orthogonal transformations (no KKT matrix): with z_b = (I x R_b Pi_b^T) A_b the
 !> objective is |z1 - g1|^2 + |z2 - g2|^2 and the constraints W z = Lambda with
 !> W = C blockdiag(I x Pi_b R_b^-1); the pivoted QR of W^T gives the projection of g.
-!> Each body's weights are normalised by their own sum, so the two fits weigh alike.
+!> Each body's weights are normalised by their own sum, so the two fits weigh alike unless the
+!> caller weighs body (2)'s objective by `weight2` against body (1)'s (the grid recovery:
+!> (h1/h2)^(2p) of the bodies' cell sizes, sprc_estimate_contact_patches). Fields of the
+!> recovery space are recovered exactly with any weight.
 !>
 !> Contact points are the boundary points of patch (1) of kind boundary_contact, with the
 !> law, mu and slip direction given per boundary point (sprc_recovery_contact_operators:
@@ -64,7 +67,7 @@ contains
    !> Errors: invalid input (stat_invalid_input), rank-deficient patches or dependent
    !> constraints (stat_singular).
    subroutine recover_sprc_contact(patch1, patch2, degree, law, mu, slip, ws1, ws2, rec1, rec2, error, &
-      & ncontact_rows, contact_rank)
+      & ncontact_rows, contact_rank, offset, ratio, weight2)
       type(patch_type), intent(in) :: patch1, patch2
       integer, intent(in) :: degree
       integer, intent(in) :: law(:)
@@ -73,10 +76,37 @@ contains
       type(recovered_patch_type), intent(out) :: rec1, rec2
       type(error_type), allocatable, intent(out) :: error
       integer, intent(out), optional :: ncontact_rows, contact_rank
+      !> Where the surfaces of the two bodies are apart (an interference, a gap closed by the
+      !> contact): body (2)'s point paired with contact point j is bx(:, j) + offset(1:dim, j),
+      !> and ratio(j) = dA2/dA1 the ratio of the two surfaces' measures there, so that the rows
+      !> balance forces: t1(x_j) dA1 = -t2(x_j + offset_j) dA2 (the FE contact's balance of
+      !> each slave point with its master point). Default: the same point, ratio 1.
+      real(wp), intent(in), optional :: offset(:, :), ratio(:)
+      !> The weight of body (2)'s objective against body (1)'s (> 0; default 1, alike).
+      real(wp), intent(in), optional :: weight2
       real(wp), allocatable :: c(:, :), lam(:)
+      real(wp) :: sc
       integer :: mc1, mc2, mz, r, n1, n2
 
       call check_contact_input(patch1, law, slip, error, patch2)
+      if (allocated(error)) return
+      if (present(offset)) then
+         if (size(offset, 1) < patch1%dim .or. size(offset, 2) < patch1%nbpoints) call fatal_error(error, &
+            & 'recover_sprc_contact: offset needs '//itoa(patch1%dim)//' x '//itoa(patch1%nbpoints)//' entries', &
+            & stat_invalid_input)
+      end if
+      if (present(weight2) .and. .not. allocated(error)) then
+         if (.not. (weight2 > 0.0_wp .and. weight2 <= huge(1.0_wp))) call fatal_error(error, &
+            & 'recover_sprc_contact: weight2 is not finite and > 0', stat_invalid_input)
+      end if
+      if (present(ratio) .and. .not. allocated(error)) then
+         if (size(ratio) < patch1%nbpoints) then
+            call fatal_error(error, 'recover_sprc_contact: ratio needs '//itoa(patch1%nbpoints)//' boundary points', &
+               & stat_invalid_input)
+         else if (.not. all(ratio(1:patch1%nbpoints) > 0.0_wp)) then
+            call fatal_error(error, 'recover_sprc_contact: a measure ratio is not positive', stat_invalid_input)
+         end if
+      end if
       if (allocated(error)) return
       call sprc_constraints(patch1, degree, ws1, rec1, mc1, .true., error)
       if (allocated(error)) return
@@ -95,11 +125,14 @@ contains
       lam(1:mc1) = ws1%lam(1:mc1)
       c(mc1 + 1:mc1 + mc2, n1 + 1:n1 + n2) = ws2%c(1:mc2, 1:n2)
       lam(mc1 + 1:mc1 + mc2) = ws2%lam(1:mc2)
-      call contact_block(patch1, patch2, degree, law, mu, slip, ws1, ws2, mz, c(mc1 + mc2 + 1:, :), r, rec1, error)
+      call contact_block(patch1, patch2, degree, law, mu, slip, ws1, ws2, mz, c(mc1 + mc2 + 1:, :), r, rec1, error, &
+         & offset, ratio)
       if (allocated(error)) return
       if (present(ncontact_rows)) ncontact_rows = mz
       if (present(contact_rank)) contact_rank = r
-      call coupled_solve(patch1, patch2, ws1, ws2, c(1:mc1 + mc2 + r, :), lam(1:mc1 + mc2 + r), rec1, rec2, error)
+      sc = 1.0_wp
+      if (present(weight2)) sc = sqrt(weight2)
+      call coupled_solve(patch1, patch2, ws1, ws2, c(1:mc1 + mc2 + r, :), lam(1:mc1 + mc2 + r), sc, rec1, rec2, error)
    end subroutine recover_sprc_contact
 
    pure subroutine check_contact_input(patch1, law, slip, error, patch2)
@@ -130,7 +163,7 @@ contains
    end subroutine check_contact_input
 
    !> The contact rows (module notes): rows(1:r, :) of R Pi^T, r the kept rank.
-   subroutine contact_block(patch1, patch2, degree, law, mu, slip, ws1, ws2, mz, rows, r, rec1, error)
+   subroutine contact_block(patch1, patch2, degree, law, mu, slip, ws1, ws2, mz, rows, r, rec1, error, offset, ratio)
       type(patch_type), intent(in) :: patch1, patch2
       integer, intent(in) :: degree, law(:), mz
       real(wp), intent(in) :: mu, slip(:, :)
@@ -139,7 +172,8 @@ contains
       integer, intent(out) :: r
       type(recovered_patch_type), intent(inout) :: rec1
       type(error_type), allocatable, intent(out) :: error
-      real(wp) :: frame(3, 3), h(3, 6), hp(3, 6), p(20), s(3), sq, wsum, z(3, 120), nref(3)
+      real(wp), intent(in), optional :: offset(:, :), ratio(:)
+      real(wp) :: frame(3, 3), h(3, 6), hp(3, 6), p(20), s(3), sq, wsum, z(3, 120), nref(3), x2(3), r2
       real(wp), allocatable :: e(:, :), tau(:), vn(:, :)
       integer, allocatable :: jpvt(:)
       integer :: j, d, n1, n2, m, k, cap, jc
@@ -187,9 +221,13 @@ contains
          call ws1%basis%eval(s(1:d), p)
          call contact_rows(d, ws1%nt, h, p, sq, z(:, 1:n1))
          e(m + 1:m + d, 1:n1) = z(1:d, 1:n1)
-         s(1:d) = (patch1%bx(1:d, j) - patch2%x0(1:d))/patch2%h
+         x2(1:d) = patch1%bx(1:d, j)
+         if (present(offset)) x2(1:d) = x2(1:d) + offset(1:d, j)
+         r2 = 1.0_wp
+         if (present(ratio)) r2 = ratio(j)
+         s(1:d) = (x2(1:d) - patch2%x0(1:d))/patch2%h
          call ws2%basis%eval(s(1:d), p)
-         call contact_rows(d, ws2%nt, hp, p, -sq, z(:, 1:n2))
+         call contact_rows(d, ws2%nt, hp, p, -sq*r2, z(:, 1:n2))
          e(m + 1:m + d, n1 + 1:n1 + n2) = z(1:d, 1:n2)
          m = m + d
       end do
@@ -206,11 +244,14 @@ contains
       end do
    end subroutine contact_block
 
-   !> The constrained minimum of both bodies' fits under the stacked rows c z = lam (module notes).
-   subroutine coupled_solve(patch1, patch2, ws1, ws2, c, lam, rec1, rec2, error)
+   !> The constrained minimum of both bodies' fits under the stacked rows c z = lam (module notes),
+   !> body (2)'s objective weighed by sc^2: in z2' = sc z2 the objective is |z1 - g1|^2 +
+   !> |z2' - sc g2|^2 and body (2)'s constraint columns are divided by sc.
+   subroutine coupled_solve(patch1, patch2, ws1, ws2, c, lam, sc, rec1, rec2, error)
       type(patch_type), intent(in) :: patch1, patch2
       type(recovery_workspace_type), intent(inout) :: ws1, ws2
       real(wp), intent(inout) :: c(:, :), lam(:)
+      real(wp), intent(in) :: sc
       type(recovered_patch_type), intent(inout) :: rec1, rec2
       type(error_type), allocatable, intent(out) :: error
       real(wp), allocatable :: wt(:, :), tau(:), z(:, :), g1(:, :), g2(:, :), vn(:, :)
@@ -248,6 +289,7 @@ contains
          call body_columns(ws1, c(keep(k), 1:n1), wt(1:n1, k), ok)
          if (ok) call body_columns(ws2, c(keep(k), n1 + 1:nn), wt(n1 + 1:nn, k), ok)
          if (.not. ok) exit
+         wt(n1 + 1:nn, k) = wt(n1 + 1:nn, k)/sc
       end do
       if (r > 0 .and. ok) then
          call qr_pivoted(nn, r, wt, jpvt, tau, vn)
@@ -256,7 +298,7 @@ contains
       call body_rhs(patch1, ws1, g1)
       call body_rhs(patch2, ws2, g2)
       z(1:n1, 1) = reshape(g1(1:ws1%nt, 1:ws1%ns), [n1])
-      z(n1 + 1:nn, 1) = reshape(g2(1:ws2%nt, 1:ws2%ns), [n2])
+      z(n1 + 1:nn, 1) = sc*reshape(g2(1:ws2%nt, 1:ws2%ns), [n2])
       if (r > 0 .and. ok) then
          call apply_qt(nn, r, wt, tau, 1, z)
          z(1:r, 1) = lam(keep(jpvt(1:r)))
@@ -268,6 +310,7 @@ contains
             & 'of the patches (singular constrained system)', stat_singular)
          return
       end if
+      z(n1 + 1:nn, 1) = z(n1 + 1:nn, 1)/sc
       rec1%rank_total = r
       rec2%rank_total = r
       call body_coef(ws1, z(1:n1, 1), rec1, ok)
@@ -340,7 +383,8 @@ contains
    !> body (2)'s points j = candidates(i) are considered, in that order (a caller that has
    !> culled them, sprc_estimate_contact_patches: no copy of the points).
    subroutine recover_contact_patch(patch1, degree, law, mu, slip, y2, w2, stress2, young2, poisson2, depth, &
-      & ws1, ws2, patch2, rec1, rec2, error, body_force2, depth_used, max_doublings, boundary2, candidates)
+      & ws1, ws2, patch2, rec1, rec2, error, body_force2, depth_used, max_doublings, boundary2, candidates, offset, &
+      & ratio, weight2)
       type(patch_type), intent(in) :: patch1
       integer, intent(in) :: degree, law(:)
       real(wp), intent(in) :: mu, slip(:, :), y2(:, :), w2(:), stress2(:, :), young2, poisson2, depth
@@ -355,6 +399,8 @@ contains
       !> in the boundary arrays of a patch): those inside Omega_aux constrain its fit.
       type(patch_type), intent(in), optional :: boundary2
       integer, intent(in), optional :: candidates(:)
+      !> Body (2)'s paired points, the measure ratios and body (2)'s weight (recover_sprc_contact's).
+      real(wp), intent(in), optional :: offset(:, :), ratio(:), weight2
       type(aux_domain_type) :: aux
       real(wp), allocatable :: cx(:, :), cn(:, :), cw(:)
       real(wp) :: dep
@@ -395,7 +441,8 @@ contains
          if (present(depth_used)) depth_used = dep
          dep = 2*dep
          if (patch2%npoints == 0 .and. k < kmax) cycle
-         call recover_sprc_contact(patch1, patch2, degree, law, mu, slip, ws1, ws2, rec1, rec2, error)
+         call recover_sprc_contact(patch1, patch2, degree, law, mu, slip, ws1, ws2, rec1, rec2, error, offset=offset, &
+            & ratio=ratio, weight2=weight2)
          if (.not. allocated(error)) return
          if (error%stat /= stat_singular .or. index(error%message, 'Omega_aux fit') == 0) return
       end do

@@ -339,7 +339,8 @@ contains
             end if
             n = n + 1
             call pair_contact(study, study%scene%contacts(ks(p)), pairs(p)%surface, results(ks(p)), side, inputs(j), &
-               & bodies(b)%problem%mesh%nodes, inputs(other), contacts(n), error)
+               & bodies(b)%problem%mesh%nodes, inputs(other), contacts(n), error, &
+               & bodies(members(other))%problem%mesh%nodes)
             if (allocated(error)) exit
          end do
          if (.not. allocated(error)) call recover_body(study, study%bodies(b), bodies(b), inputs(j), error, contacts)

@@ -31,7 +31,7 @@ module sprc_study_run_contact_recovery
    implicit none
    private
 
-   public :: stabilize_recovered, finish_pair, pair_contact, recovered_tractions, contact_result
+   public :: stabilize_recovered, finish_pair, pair_contact, recovered_tractions, contact_result, paired_point
 
 contains
 
@@ -155,7 +155,7 @@ contains
       if (.not. allocated(error)) call fe_recovery_input(bodies(s)%problem, inputs(1), error)
       if (.not. allocated(error)) call fe_recovery_input(bodies(spec%master_index)%problem, inputs(2), error)
       if (.not. allocated(error)) call pair_contact(study, spec, surface, result, 1, inputs(1), &
-         & bodies(s)%problem%mesh%nodes, inputs(2), contact(1), error)
+         & bodies(s)%problem%mesh%nodes, inputs(2), contact(1), error, bodies(spec%master_index)%problem%mesh%nodes)
       if (allocated(error)) return
       associate (mesh => bodies(s)%problem%mesh)
          call recover_grid(inputs(1), mesh%grid, mesh%nodes, mesh%hanging, method_sprc, study%degree(2), field, &
@@ -200,7 +200,7 @@ contains
       if (.not. any(study%run)) return
       do b = 1, 2
          call pair_contact(study, spec, surface, result, b, inputs(b), &
-            & bodies(k(b))%problem%mesh%nodes, inputs(3 - b), contacts(b), error)
+            & bodies(k(b))%problem%mesh%nodes, inputs(3 - b), contacts(b), error, bodies(k(3 - b))%problem%mesh%nodes)
          if (.not. allocated(error)) &
             & call recover_body(study, study%bodies(k(b)), bodies(k(b)), inputs(b), error, contacts(b:b))
          if (allocated(error)) then
@@ -219,7 +219,7 @@ contains
    !> along it on the master side.
    !> The other body's volume points, FE stresses and boundary points (its contact surface
    !> left out) are `other`'s.
-   subroutine pair_contact(study, spec, surface, result, side, input, nodes, other, contact, error)
+   subroutine pair_contact(study, spec, surface, result, side, input, nodes, other, contact, error, other_nodes)
       type(study_type), intent(in) :: study
       type(contact_spec_type), intent(in) :: spec
       type(contact_surface_type), intent(in) :: surface
@@ -229,15 +229,18 @@ contains
       type(grid_nodes_type), intent(in) :: nodes
       type(grid_contact_type), intent(out) :: contact
       type(error_type), allocatable, intent(out) :: error
+      !> The other body's nodes: with them its fit weighs by the cells' sizes (the grid contact's
+      !> fe_order and cell, sprc_estimate_contact_patches).
+      type(grid_nodes_type), intent(in), optional :: other_nodes
       integer, allocatable :: law(:)
-      real(wp), allocatable :: slip(:, :)
+      real(wp), allocatable :: slip(:, :), offset(:, :), ratio(:), cell(:)
       real(wp) :: t(3), size_e, dist, best
       type(patch_type) :: oboundary
       type(point_cells_type) :: cells
       real(wp), allocatable :: sx(:, :)
       integer, allocatable :: near(:), sel(:)
       integer, allocatable :: surfaces(:), osurfaces(:)
-      integer :: nb, e, k, i, j, inear, d, o, nnear, stat
+      integer :: nb, e, k, i, j, inear, mnear, d, o, nnear, stat
 
       d = study%dim
       nb = size(input%bw)
@@ -253,11 +256,13 @@ contains
          osurfaces = study%bodies(o)%geometry%surface_parts( &
             & scene_surface(study%scene, spec%slave_surface_index, spec%slave_group))
       end if
-      allocate (law(nb), slip(d, nb), stat=stat)
-      call check_allocation(stat, 'pair_contact', 'the contact law of each boundary point', nb, 4 + 8*d, error)
+      allocate (law(nb), slip(d, nb), offset(d, nb), ratio(nb), stat=stat)
+      call check_allocation(stat, 'pair_contact', 'the contact law of each boundary point', nb, 12 + 16*d, error)
       if (allocated(error)) return
       law = 0
       slip = 0.0_wp
+      offset = 0.0_wp
+      ratio = 1.0_wp
       ! This side's points of the slave points (on the master side those with a master point), in cells.
       if (side == 1) then
          sel = [(i, i=1, surface%npoint)]
@@ -275,6 +280,7 @@ contains
             if (.not. any(surfaces == input%bshape(k))) cycle
             best = huge(1.0_wp)
             inear = 0
+            mnear = 0
             call cells_box(cells, sx, input%bx(:, k) - size_e, input%bx(:, k) + size_e, near, nnear)
             do j = 1, nnear
                i = sel(near(j))
@@ -282,10 +288,13 @@ contains
                if (dist < best .or. (dist == best .and. i < inear)) then
                   best = dist
                   inear = i
+                  mnear = near(j)
                end if
             end do
             if (inear == 0 .or. best > size_e) cycle
             if (result%state(inear) == contact_open) cycle
+            if (surface%has_master(inear)) call paired_point(surface, side, inear, mnear, sx, sel, near(1:nnear), &
+               & input%bn(:, k), offset(:, k), ratio(k))
             select case (friction_kind(spec%friction))
             case (friction_frictionless)
                law(k) = contact_law_frictionless
@@ -313,9 +322,66 @@ contains
       else
          call boundary_points(other, d, osurfaces, oboundary)
       end if
+      if (.not. present(other_nodes)) then
+         call new_grid_contact(contact, surfaces, law, slip, spec%mu, other%x, other%w, other%stress, other%young, &
+            & other%poisson, other%body_force(1:d), error, boundary=oboundary, offset=offset, ratio=ratio)
+         return
+      end if
+      allocate (cell(size(other%w)), stat=stat)
+      call check_allocation(stat, 'pair_contact', 'the cell size of each of the other body''s points', size(other%w), &
+         & 8, error)
+      if (allocated(error)) return
+      do e = 1, other_nodes%n_elements
+         cell(other%elem_ptr(e):other%elem_ptr(e + 1) - 1) = element_size(other_nodes, e)
+      end do
       call new_grid_contact(contact, surfaces, law, slip, spec%mu, other%x, other%w, other%stress, other%young, &
-         & other%poisson, other%body_force(1:d), error, boundary=oboundary)
+         & other%poisson, other%body_force(1:d), error, boundary=oboundary, offset=offset, ratio=ratio, &
+         & fe_order=study%order, cell=cell)
    end subroutine pair_contact
+
+   !> The other body's point paired with a boundary point of normal bn near slave point i, as
+   !> the FE contact pairs them (sprc_contact_surface): the slave point and its master point
+   !> x_m = x_s + g n_s, g = (x_m - x_s).n_s (negative for an interference). The boundary
+   !> point's partner is offset = g bn on either side (bn = n_s on the slave, -n_s on the
+   !> master), and ratio = dA_other/dA_own, with dA_m/dA_s = (1 + g div_s n_s)/|n_s.n_m|
+   !> (a surface moved by g along its normal changes its measure by 1 + g div_s n, to first
+   !> order in g; the projection onto a master surface of normal n_m divides by the cosine):
+   !> the FE multiplier's force w_s p_s is the master's traction over the projected measure.
+   !> div_s n_s is the least-squares slope of the normal along the surface over the slave
+   !> points near(:) (indices of sx, slave point sel(near(j))): (dim - 1) sum dn.dx / sum
+   !> |dx|^2, exact on a circle or sphere; 0 with no neighbour.
+   pure subroutine paired_point(surface, side, i, m, sx, sel, near, bn, offset, ratio)
+      type(contact_surface_type), intent(in) :: surface
+      !> i: the slave point; m: its index in sx (sx(:, m) its point on this side).
+      integer, intent(in) :: side, i, m, sel(:), near(:)
+      real(wp), intent(in) :: sx(:, :), bn(:)
+      real(wp), intent(out) :: offset(:), ratio
+      real(wp) :: g, num, den, dx(3), curv, scale, cosn
+      integer :: j, d
+
+      d = surface%dim
+      g = dot_product(surface%master_x(1:d, i) - surface%x(1:d, i), surface%normal(1:d, i))
+      num = 0.0_wp
+      den = 0.0_wp
+      do j = 1, size(near)
+         if (sel(near(j)) == i) cycle
+         dx(1:d) = sx(1:d, near(j)) - sx(1:d, m)
+         num = num + dot_product(surface%normal(1:d, sel(near(j))) - surface%normal(1:d, i), dx(1:d))
+         den = den + sum(dx(1:d)**2)
+      end do
+      curv = 0.0_wp
+      if (den > 0.0_wp) curv = (d - 1)*num/den
+      cosn = abs(dot_product(surface%normal(1:d, i), surface%master_normal(1:d, i)))
+      scale = 1.0_wp + g*curv
+      offset(1:d) = g*bn(1:d)
+      ratio = 1.0_wp
+      ! A partner too far off for the first-order measure (beyond any closed contact): as before.
+      if (.not. (scale > 0.5_wp .and. cosn > 0.5_wp)) then
+         offset(1:d) = 0.0_wp
+         return
+      end if
+      ratio = merge(scale/cosn, cosn/scale, side == 1)
+   end subroutine paired_point
 
    !> The largest edge of element e's box.
    pure real(wp) function element_size(nodes, e)
