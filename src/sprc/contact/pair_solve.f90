@@ -322,9 +322,8 @@ contains
          call cell_operators(surface, ops, c, merge(friction_stick, friction, friction == friction_coulomb), cells(c), &
             & error)
          if (allocated(error)) return
-         closed(c) = any(surface%g0(ops%cell_point(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1)) <= &
-            & cell_size(slave, slave%root(surface%slave_cell(ops%cell_point(ops%cell_ptr(c))))))
       end do
+      call first_set(slave, surface, ops, closed)
       if (present(recovered)) then
          call cell_tractions(surface, ops, cells, recovered, pstar, error)
          if (allocated(error)) return
@@ -425,6 +424,31 @@ contains
       call slave%set_solution(x(1:slave%n_dofs()), error)
       if (.not. allocated(error)) call master%set_solution(x(slave%n_dofs() + 1:), error)
    end subroutine solve_contact_pair
+
+   !> The first active set: the candidate cells (a point's initial gap within
+   !> the cell size h) whose smallest gap is within sqrt(eps) h of the pair's
+   !> first contact, max(min g0, 0): the points the bodies touch first when
+   !> they approach rigidly, every point of an interference or a zero-gap fit
+   !> (the round-off of the gaps is eps times the geometry's scale). Closing
+   !> every candidate instead ties cells the load never closes, and the
+   !> primal-dual iteration then opens them a few per active set; from the
+   !> first contact the penetrating cells close in one set.
+   subroutine first_set(slave, surface, ops, closed)
+      type(elasticity_problem_type), intent(in) :: slave
+      type(contact_surface_type), intent(in) :: surface
+      type(point_operators_type), intent(in) :: ops
+      logical, intent(out) :: closed(:)
+      real(wp) :: gmin(size(closed)), h(size(closed)), first
+      integer :: c
+      do c = 1, size(closed)
+         gmin(c) = minval(surface%g0(ops%cell_point(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1)))
+         h(c) = cell_size(slave, slave%root(surface%slave_cell(ops%cell_point(ops%cell_ptr(c)))))
+      end do
+      closed = gmin <= h
+      if (.not. any(closed)) return
+      first = max(minval(gmin, mask=closed), 0.0_wp)
+      closed = closed .and. gmin <= first + sqrt(epsilon(1.0_wp))*h
+   end subroutine first_set
 
    !> The points of the closed contact cells.
    !> The linear multiplier's closed nodes act on (and carry pressure at)
