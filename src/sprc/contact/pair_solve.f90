@@ -2202,10 +2202,8 @@ contains
          do c = 1, work%ops%ncell
             call cell_operators(pair%surface, work%ops, c, pair%friction, work%cells(c), error)
             if (allocated(error)) return
-            work%closed(c) = any(pair%surface%g0(work%ops%cell_point(work%ops%cell_ptr(c):work%ops%cell_ptr(c + 1) &
-               & - 1)) <= cell_size(slave, slave%root(pair%surface%slave_cell(work%ops%cell_point( &
-               & work%ops%cell_ptr(c))))))
          end do
+         call first_set(slave, pair%surface, work%ops, work%closed)
       end associate
    end subroutine pair_work
 
