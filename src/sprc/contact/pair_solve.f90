@@ -18,9 +18,10 @@
 !>   cell's mean normal to n_i (`frame_rotation`): a uniform pressure on a curved
 !>   surface is in the space (a Cartesian constant costs Q2 its order).
 !> - Points: the slave's cut-cell surface points cut at the master grid's planes.
-!> - Active set: primal-dual per contact cell from the cells with g0 <= h, one
-!>   factorization per iteration, until the set repeats (else stat_not_converged); a
-!>   body the closed cells and its conditions leave free is stat_singular, named.
+!> - Active set: primal-dual per contact cell from the first contact (`first_set`:
+!>   the cells with g0 <= h at the smallest gap), one factorization per
+!>   iteration, until the set repeats (else stat_not_converged); a body the
+!>   closed cells and its conditions leave free is stat_singular, named.
 !> - Friction: stick and Coulomb take the cell normal as the mean bisector of the
 !>   two normals (a curved slave gets no spurious shear). Coulomb is path dependent:
 !>   the loads come in increments, states and slip directions iterate until they
