@@ -18,9 +18,10 @@
 !>   cell's mean normal to n_i (`frame_rotation`): a uniform pressure on a curved
 !>   surface is in the space (a Cartesian constant costs Q2 its order).
 !> - Points: the slave's cut-cell surface points cut at the master grid's planes.
-!> - Active set: primal-dual per contact cell from the cells with g0 <= h, one
-!>   factorization per iteration, until the set repeats (else stat_not_converged); a
-!>   body the closed cells and its conditions leave free is stat_singular, named.
+!> - Active set: primal-dual per contact cell from the first contact (`first_set`:
+!>   the cells with g0 <= h at the smallest gap), one factorization per
+!>   iteration, until the set repeats (else stat_not_converged); a body the
+!>   closed cells and its conditions leave free is stat_singular, named.
 !> - Friction: stick and Coulomb take the cell normal as the mean bisector of the
 !>   two normals (a curved slave gets no spurious shear). Coulomb is path dependent:
 !>   the loads come in increments, states and slip directions iterate until they
@@ -322,9 +323,8 @@ contains
          call cell_operators(surface, ops, c, merge(friction_stick, friction, friction == friction_coulomb), cells(c), &
             & error)
          if (allocated(error)) return
-         closed(c) = any(surface%g0(ops%cell_point(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1)) <= &
-            & cell_size(slave, slave%root(surface%slave_cell(ops%cell_point(ops%cell_ptr(c))))))
       end do
+      call first_set(slave, surface, ops, closed)
       if (present(recovered)) then
          call cell_tractions(surface, ops, cells, recovered, pstar, error)
          if (allocated(error)) return
@@ -425,6 +425,31 @@ contains
       call slave%set_solution(x(1:slave%n_dofs()), error)
       if (.not. allocated(error)) call master%set_solution(x(slave%n_dofs() + 1:), error)
    end subroutine solve_contact_pair
+
+   !> The first active set: the candidate cells (a point's initial gap within
+   !> the cell size h) whose smallest gap is within sqrt(eps) h of the pair's
+   !> first contact, max(min g0, 0): the points the bodies touch first when
+   !> they approach rigidly, every point of an interference or a zero-gap fit
+   !> (the round-off of the gaps is eps times the geometry's scale). Closing
+   !> every candidate instead ties cells the load never closes, and the
+   !> primal-dual iteration then opens them a few per active set; from the
+   !> first contact the penetrating cells close in one set.
+   subroutine first_set(slave, surface, ops, closed)
+      type(elasticity_problem_type), intent(in) :: slave
+      type(contact_surface_type), intent(in) :: surface
+      type(point_operators_type), intent(in) :: ops
+      logical, intent(out) :: closed(:)
+      real(wp) :: gmin(size(closed)), h(size(closed)), first
+      integer :: c
+      do c = 1, size(closed)
+         gmin(c) = minval(surface%g0(ops%cell_point(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1)))
+         h(c) = cell_size(slave, slave%root(surface%slave_cell(ops%cell_point(ops%cell_ptr(c)))))
+      end do
+      closed = gmin <= h
+      if (.not. any(closed)) return
+      first = max(minval(gmin, mask=closed), 0.0_wp)
+      closed = closed .and. gmin <= first + sqrt(epsilon(1.0_wp))*h
+   end subroutine first_set
 
    !> The points of the closed contact cells.
    !> The linear multiplier's closed nodes act on (and carry pressure at)
@@ -2178,10 +2203,8 @@ contains
          do c = 1, work%ops%ncell
             call cell_operators(pair%surface, work%ops, c, pair%friction, work%cells(c), error)
             if (allocated(error)) return
-            work%closed(c) = any(pair%surface%g0(work%ops%cell_point(work%ops%cell_ptr(c):work%ops%cell_ptr(c + 1) &
-               & - 1)) <= cell_size(slave, slave%root(pair%surface%slave_cell(work%ops%cell_point( &
-               & work%ops%cell_ptr(c))))))
          end do
+         call first_set(slave, pair%surface, work%ops, work%closed)
       end associate
    end subroutine pair_work
 
