@@ -1,6 +1,7 @@
-!> The edges of frictionless contact zones on a caller's 2D meshes and the amplitude of their
-!> edge field (sprc_recovery_contact_edge), for the SPR-C patches there
-!> (sprc_contact_caller_mesh_recovery).
+!> The edges of frictionless contact zones in 2D and the amplitude of their edge field
+!> (sprc_recovery_contact_edge), for the SPR-C patches there: on a caller's meshes
+!> (sprc_contact_caller_mesh_recovery) and on the grid (sprc_estimate_contact_patches, edges
+!> found from the slave points' states by the study).
 !>
 !> 1. `find_contact_edges`: an edge is a vertex of the slave's contact facets shared by
 !>    exactly one closed facet, frictionless, and an open one (the caller's states): the
