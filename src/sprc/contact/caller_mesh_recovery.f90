@@ -16,7 +16,7 @@
 !> patch weigh by the bodies' element sizes as in the grid pipeline (fe_order of the grid
 !> contact; the sizes from the largest quadrature weights, the elements being uncut).
 !>
-!> Contact edges (2D, frictionless; sprc_contact_edge_fit): where a closed facet of a slave
+!> Contact edges (2D, frictionless; sprc_recovery_contact_edge_fit): where a closed facet of a slave
 !> meets an open one, the pressure falls like the square root of the distance to the edge
 !> of the contact zone. The edge's point and amplitude K are fitted to both bodies' data, and
 !> the contact patches within its radius recover sigma_h - K S, the other body's Omega_aux
@@ -68,7 +68,7 @@ module sprc_contact_caller_mesh_recovery
    use sprc_recovery_patch_loop, only: auto_degree
    use sprc_recovery_caller_mesh_check, only: check_mesh_arrays, check_mesh_facets
    use sprc_estimate_contact_patches, only: grid_contact_type, new_grid_contact, contact_patch_solve
-   use sprc_contact_edge_fit, only: contact_edge_type, find_contact_edges, fit_contact_edge, edge_subtract
+   use sprc_recovery_contact_edge_fit, only: contact_edge_type, find_contact_edges, fit_contact_edge, edge_subtract
    implicit none
    private
 
@@ -300,7 +300,7 @@ contains
       end associate
    end subroutine others_solve
 
-   !> The frictionless contact edges of pair k (sprc_contact_edge_fit) from its slave's states
+   !> The frictionless contact edges of pair k (sprc_recovery_contact_edge_fit) from its slave's states
    !> and both bodies' data, as sites of both bodies' patches.
    subroutine pair_edges(bodies, pair, k, ci, others, error)
       type(contact_body_type), intent(in) :: bodies(:)

@@ -33,6 +33,13 @@
 !> Each thread keeps the Omega_aux fit's workspace and patch in its recovery workspace
 !> (`contact_scratch_type`), allocated on its first contact patch.
 !>
+!> Contact edges (2D, frictionless; `set_grid_contact_edges`): where the contact zone ends on
+!> a smooth surface the pressure falls like the square root of the distance to its edge. A
+!> patch within the radius of an edge fitted to both bodies' data (sprc_recovery_contact_edge_fit)
+!> recovers sigma_h - K S, with the other body's sigma_h - K S in Omega_aux, and adds K S back
+!> (S the edge field of sprc_recovery_contact_edge, each body its own outward normal), as the
+!> caller's-mesh recovery does (sprc_contact_caller_mesh_recovery).
+!>
 !> Small deformations: undeformed points and normals.
 module sprc_estimate_contact_patches
    use sprc_core_kinds, only: wp
@@ -43,10 +50,11 @@ module sprc_estimate_contact_patches
    use sprc_recovery_contact_operators, only: contact_law_frictionless, contact_law_slip, contact_law_stick
    use sprc_recovery_contact_patch_solve, only: recover_contact_patch, aux_max_doublings, contact_points, aux_margin
    use sprc_recovery_contact_aux, only: aux_domain_type, new_aux_domain, aux_contains
+   use sprc_recovery_contact_edge_fit, only: contact_edge_type, edge_subtract
    implicit none
    private
 
-   public :: grid_contact_type, new_grid_contact, contact_patch_solve, default_aux_depth
+   public :: grid_contact_type, new_grid_contact, contact_patch_solve, default_aux_depth, set_grid_contact_edges
    public :: point_cells_type, new_point_cells, cells_box, cells_prism, aux_bounds
 
    !> Mean points per cell of the other body's point cells.
@@ -103,6 +111,12 @@ module sprc_estimate_contact_patches
       type(point_cells_type) :: boundary_cells
       !> The other body's material and body force.
       real(wp) :: young = 0.0_wp, poisson = 0.0_wp, body_force(3) = 0.0_wp
+      !> Contact edges of nonzero amplitude (module notes; empty: none), this body's outward
+      !> normal as edge_sign times the edges' (1 the slave, -1 the master), and the other body's
+      !> stresses less each edge's field, edge_stress(:, j, e).
+      type(contact_edge_type), allocatable :: edges(:)
+      real(wp) :: edge_sign = 1.0_wp
+      real(wp), allocatable :: edge_stress(:, :, :)
    end type grid_contact_type
 
 contains
@@ -188,6 +202,34 @@ contains
       if (self%boundary%nbpoints > 0) &
          & call new_point_cells(self%boundary_cells, self%boundary%bx(1:size(y, 1), 1:self%boundary%nbpoints), error)
    end subroutine new_grid_contact
+
+   !> The contact edges of a 2D body's contact surface (module notes): those of `edges` with a
+   !> nonzero amplitude; sgn = 1 on the slave, -1 on the master (the edges' normals are the
+   !> slave's). The other body's stresses less each edge's field are kept per edge.
+   subroutine set_grid_contact_edges(self, edges, sgn, error)
+      type(grid_contact_type), intent(inout) :: self
+      type(contact_edge_type), intent(in) :: edges(:)
+      real(wp), intent(in) :: sgn
+      type(error_type), allocatable, intent(out) :: error
+      integer :: e, n, stat
+
+      self%edges = pack(edges, edges%amplitude /= 0.0_wp)
+      self%edge_sign = sgn
+      n = size(self%w)
+      if (size(self%edges) == 0) return
+      if (size(self%y, 1) /= 2) then
+         call fatal_error(error, 'grid contact: contact edges are two-dimensional', stat_invalid_input)
+         return
+      end if
+      allocate (self%edge_stress(size(self%stress, 1), n, size(self%edges)), stat=stat)
+      call check_allocation(stat, 'grid contact', 'the other body''s stresses less each contact edge''s field', &
+         & n*size(self%edges), 8*size(self%stress, 1), error)
+      if (allocated(error)) return
+      do e = 1, size(self%edges)
+         self%edge_stress(:, :, e) = self%stress
+         call edge_subtract(self%edges(e), -sgn, self%y, self%edge_stress(:, :, e))
+      end do
+   end subroutine set_grid_contact_edges
 
    !> Sort the points y(1:dim, j) into cells of about points_per_cell points (module notes).
    subroutine new_point_cells(cells, y, error)
@@ -410,7 +452,9 @@ contains
       type(recovered_patch_type), intent(out) :: rec
       type(error_type), allocatable, intent(out) :: error
       class(*), allocatable :: scratch
-      integer :: stat
+      type(patch_type) :: split
+      real(wp) :: dist, best
+      integer :: stat, e, near
 
       ! Out of ws for the call (ws and the scratch are distinct arguments below).
       call move_alloc(ws%contact, scratch)
@@ -420,14 +464,42 @@ contains
             & storage_size(ws)/8, error)
          if (allocated(error)) return
       end if
+      ! The nearest edge within its radius (module notes).
+      near = 0
+      best = huge(1.0_wp)
+      if (allocated(self%edges)) then
+         do e = 1, size(self%edges)
+            dist = norm2(patch%x0(1:2) - self%edges(e)%point)
+            if (dist < self%edges(e)%radius .and. dist < best) then
+               best = dist
+               near = e
+            end if
+         end do
+      end if
       select type (scratch)
       type is (contact_scratch_type)
-         call solve(scratch)
+         if (near == 0) then
+            call solve(scratch, patch, self%stress)
+         else
+            split = patch
+            call edge_subtract(self%edges(near), self%edge_sign, split%x(:, 1:split%npoints), &
+               & split%stress(:, 1:split%npoints))
+            call solve(scratch, split, self%edge_stress(:, :, near))
+            if (.not. allocated(error)) then
+               rec%edge_amplitude = self%edges(near)%amplitude
+               rec%edge_point = self%edges(near)%point
+               rec%edge_tangent = self%edges(near)%tangent
+               rec%edge_normal = self%edge_sign*self%edges(near)%normal
+            end if
+         end if
       end select
       call move_alloc(scratch, ws%contact)
    contains
-      subroutine solve(sc)
+      !> The solve of patch p with the other body's stresses s2.
+      subroutine solve(sc, p, s2)
          type(contact_scratch_type), intent(inout) :: sc
+         type(patch_type), intent(in) :: p
+         real(wp), intent(in) :: s2(:, :)
          type(recovered_patch_type) :: rec2
          type(aux_domain_type) :: aux
          integer, allocatable :: idx(:)
@@ -435,12 +507,12 @@ contains
          real(wp) :: dep, w2
          integer :: n, k
 
-         call contact_points(patch, cx, cn, cw)
+         call contact_points(p, cx, cn, cw)
          ! Each k passes the points in Omega_aux after k doublings (which holds the smaller ones),
          ! so that a patch copies no more of the other body than it can use.
          do k = 0, aux_max_doublings
-            dep = self%depth*patch%h*2.0_wp**k
-            call new_aux_domain(aux, patch%dim, cx, cn, cw, dep, aux_margin(dep, self%depth*patch%h), error)
+            dep = self%depth*p%h*2.0_wp**k
+            call new_aux_domain(aux, p%dim, cx, cn, cw, dep, aux_margin(dep, self%depth*p%h), error)
             if (allocated(error)) return
             call cells_prism(self%cells, self%y, aux, idx, n)
             call prism_boundary(self, aux, sc%bbox)
@@ -448,13 +520,13 @@ contains
             if (self%fe_order > 0 .and. n > 0) then
                if (present(h1) .and. allocated(self%cell)) then
                   w2 = (h1/maxval(self%cell(idx(1:n))))**(2*self%fe_order)
-               else if (patch%npoints > 0) then
+               else if (p%npoints > 0) then
                   ! Uncut elements of one quadrature rule: the largest weights are as the cells' measures.
-                  w2 = (maxval(patch%w(1:patch%npoints))/maxval(self%w(idx(1:n))))**(2.0_wp*self%fe_order/patch%dim)
+                  w2 = (maxval(p%w(1:p%npoints))/maxval(self%w(idx(1:n))))**(2.0_wp*self%fe_order/p%dim)
                end if
             end if
-            call recover_contact_patch(patch, degree, law, self%mu, slip, self%y, self%w, self%stress, self%young, &
-               & self%poisson, self%depth*patch%h, ws, sc%ws2, sc%patch2, rec, rec2, error, &
+            call recover_contact_patch(p, degree, law, self%mu, slip, self%y, self%w, s2, self%young, &
+               & self%poisson, self%depth*p%h, ws, sc%ws2, sc%patch2, rec, rec2, error, &
                & body_force2=self%body_force, max_doublings=k, boundary2=sc%bbox, candidates=idx(1:n), offset=offset, &
                & ratio=ratio, weight2=w2)
             if (.not. allocated(error)) return

@@ -37,7 +37,7 @@ module sprc_io_scene
       & 'inner outer interference point normal load direction angle mode1 mode2 radii bodies'
    character(len=*), parameter :: exact_keys = 'kind '//exact_fields
    character(len=*), parameter :: contact_keys = 'slave master slave_surface master_surface friction mu kappa '// &
-      & 'steps stabilization multiplier'
+      & 'steps stabilization multiplier edges'
 
    character(len=*), parameter :: adapt_keys = 'target max_steps max_dofs strategy fraction max_level'
    character(len=*), parameter :: strategies = 'optimal fraction'
@@ -1059,6 +1059,8 @@ contains
             if (allocated(error)) return
             c%multiplier = default_multiplier
             call get_choice(g, 'multiplier', multipliers, .false., c%multiplier, error)
+            if (allocated(error)) return
+            call nml_get(g, 'edges', c%edges, found, error)
             if (allocated(error)) return
             call nml_check_consumed(g, error)
             if (.not. allocated(error)) call check_pair_unique(g, scene%contacts(1:n), error)

@@ -1,5 +1,5 @@
 !> The stress field of the edge of a frictionless contact zone in 2D: the enrichment of the
-!> SPR-C patches at the edge (sprc_contact_edge_fit), as the singular part is at re-entrant
+!> SPR-C patches at the edge (sprc_recovery_contact_edge_fit), as the singular part is at re-entrant
 !> corners (sprc_estimate_singular). Near the edge of a smooth frictionless contact the
 !> pressure falls like the square root of the distance to the edge, p = K sqrt(-xi) on the
 !> closed side, which no patch polynomial follows; the patches there recover sigma_h - S and

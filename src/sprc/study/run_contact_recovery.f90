@@ -14,7 +14,8 @@ module sprc_study_run_contact_recovery
    use sprc_recovery_contact_operators, only: contact_traction, contact_law_frictionless, contact_law_slip, &
       & contact_law_stick
    use sprc_estimate_contact_patches, only: grid_contact_type, new_grid_contact, point_cells_type, &
-      & new_point_cells, cells_box
+      & new_point_cells, cells_box, set_grid_contact_edges
+   use sprc_recovery_contact_edge_fit, only: contact_edge_type, fit_contact_edge, fit_facets
    use sprc_estimate_fe_input, only: fe_recovery_input
    use sprc_study_spec, only: contact_spec_type
    use sprc_study_model, only: scene_surface, analysis_units_type
@@ -32,6 +33,12 @@ module sprc_study_run_contact_recovery
    private
 
    public :: stabilize_recovered, finish_pair, pair_contact, recovered_tractions, contact_result, paired_point
+
+   !> The range of a contact edge along its tangent, in slave cells from the midpoint of the
+   !> last closed and the first open slave point (`contact_edges`): the multiplier is constant
+   !> over contact cells of two slave cells, so the states place the edge within a contact cell
+   !> either way (doc/scene.md: a - contact_measure within -1.01 h .. +0.75 h).
+   real(wp), parameter :: edge_range(2) = [-2.0_wp, 2.0_wp]
 
 contains
 
@@ -237,6 +244,7 @@ contains
       real(wp) :: t(3), size_e, dist, best
       type(patch_type) :: oboundary
       type(point_cells_type) :: cells
+      type(contact_edge_type), allocatable :: edges(:)
       real(wp), allocatable :: sx(:, :)
       integer, allocatable :: near(:), sel(:)
       integer, allocatable :: surfaces(:), osurfaces(:)
@@ -337,7 +345,87 @@ contains
       call new_grid_contact(contact, surfaces, law, slip, spec%mu, other%x, other%w, other%stress, other%young, &
          & other%poisson, other%body_force(1:d), error, boundary=oboundary, offset=offset, ratio=ratio, &
          & fe_order=study%order, cell=cell)
+      if (allocated(error) .or. d /= 2 .or. friction_kind(spec%friction) /= friction_frictionless) return
+      if (.not. spec%edges) return
+      if (side == 1) then
+         call contact_edges(surface, result, nodes, input, other, edges, error)
+      else
+         call contact_edges(surface, result, other_nodes, other, input, edges, error)
+      end if
+      if (.not. allocated(error)) call set_grid_contact_edges(contact, edges, merge(1.0_wp, -1.0_wp, side == 1), error)
    end subroutine pair_contact
+
+   !> The edges of a 2D frictionless contact zone (sprc_recovery_contact_edge_fit) from the
+   !> slave points' states: a closed slave point and an open one that meets the master surface,
+   !> each the other's nearest point of the other state within the size of the closed point's
+   !> cell. The edge's vertex is their midpoint, its tangent points from the closed to the open
+   !> one, its normal is the closed point's and its length the size of that cell (a facet of
+   !> the caller's meshes: the fit's radius is fit_facets lengths). Point and amplitude are
+   !> fitted to both bodies' FE stresses (slave, master); edges the fit rejects have amplitude 0.
+   subroutine contact_edges(surface, result, slave_nodes, slave, master, edges, error)
+      type(contact_surface_type), intent(in) :: surface
+      type(contact_result_type), intent(in) :: result
+      type(grid_nodes_type), intent(in) :: slave_nodes
+      type(recovery_input_type), intent(in) :: slave, master
+      type(contact_edge_type), allocatable, intent(out) :: edges(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_edge_type), allocatable :: buf(:)
+      type(point_cells_type) :: cells
+      logical, allocatable :: closed(:), open_(:)
+      real(wp) :: h
+      integer :: i, j, m, n
+
+      n = surface%npoint
+      allocate (edges(0))
+      if (size(surface%slave_cell) < n .or. n == 0) return
+      closed = result%state /= contact_open
+      open_ = .not. closed .and. surface%has_master
+      if (.not. (any(closed) .and. any(open_))) return
+      call new_point_cells(cells, surface%x, error)
+      if (allocated(error)) return
+      allocate (buf(n))
+      m = 0
+      do i = 1, n
+         if (.not. closed(i) .or. surface%slave_cell(i) < 1) cycle
+         h = element_size(slave_nodes, surface%slave_cell(i))
+         j = nearest(i, open_, h)
+         if (j == 0) cycle
+         if (nearest(j, closed, h) /= i) cycle
+         m = m + 1
+         buf(m)%vertex = 0.5_wp*(surface%x(1:2, i) + surface%x(1:2, j))
+         buf(m)%point = buf(m)%vertex
+         buf(m)%tangent = (surface%x(1:2, j) - surface%x(1:2, i))/norm2(surface%x(1:2, j) - surface%x(1:2, i))
+         buf(m)%normal = surface%normal(1:2, i)
+         buf(m)%length = h
+         buf(m)%radius = fit_facets*h
+         call fit_contact_edge(buf(m), slave%x, slave%w, slave%stress(1:3, :), master%x, master%w, &
+            & master%stress(1:3, :), edge_range)
+      end do
+      edges = buf(1:m)
+   contains
+      !> The nearest point to point k within distance r among those of mask (0: none; ties to
+      !> the lower index).
+      integer function nearest(k, mask, r) result(best)
+         integer, intent(in) :: k
+         logical, intent(in) :: mask(:)
+         real(wp), intent(in) :: r
+         integer, allocatable :: near(:)
+         real(wp) :: dist, dbest
+         integer :: q, nnear
+
+         best = 0
+         dbest = r
+         call cells_box(cells, surface%x, surface%x(:, k) - r, surface%x(:, k) + r, near, nnear)
+         do q = 1, nnear
+            if (.not. mask(near(q)) .or. near(q) == k) cycle
+            dist = norm2(surface%x(:, near(q)) - surface%x(:, k))
+            if (dist < dbest .or. (dist == dbest .and. near(q) < best)) then
+               dbest = dist
+               best = near(q)
+            end if
+         end do
+      end function nearest
+   end subroutine contact_edges
 
    !> The other body's point paired with a boundary point of normal bn near slave point i, as
    !> the FE contact pairs them (sprc_contact_surface): the slave point and its master point

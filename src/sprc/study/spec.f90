@@ -196,6 +196,8 @@ module sprc_study_spec
       character(len=:), allocatable :: stabilization
       !> The multiplier space: 'constant' | 'linear' (`default_multiplier`).
       character(len=:), allocatable :: multiplier
+      !> SPR-C's contact-edge field at the edges of 2D frictionless contact zones (doc/scene.md).
+      logical :: edges = .true.
    end type contact_spec_type
 
    !> Default of `&adapt max_level`, 2D and 3D: the deepest cell an adaptive

@@ -1,6 +1,7 @@
-!> The edges of frictionless contact zones on a caller's 2D meshes and the amplitude of their
-!> edge field (sprc_recovery_contact_edge), for the SPR-C patches there
-!> (sprc_contact_caller_mesh_recovery).
+!> The edges of frictionless contact zones in 2D and the amplitude of their edge field
+!> (sprc_recovery_contact_edge), for the SPR-C patches there: on a caller's meshes
+!> (sprc_contact_caller_mesh_recovery) and on the grid (sprc_estimate_contact_patches, edges
+!> found from the slave points' states by the study).
 !>
 !> 1. `find_contact_edges`: an edge is a vertex of the slave's contact facets shared by
 !>    exactly one closed facet, frictionless, and an open one (the caller's states): the
@@ -16,7 +17,7 @@
 !>    nscan values, then golden sections). The edge is kept when K > 0 (compression) and the
 !>    S column lowers the residual by the factor keep_ratio at least; else K = 0.
 !>    One scan over the bodies' points per edge (edges are few).
-module sprc_contact_edge_fit
+module sprc_recovery_contact_edge_fit
    use sprc_core_kinds, only: wp
    use sprc_core_dense, only: qr_pivoted, apply_qt
    use sprc_recovery_contact_edge, only: edge_stress
@@ -115,16 +116,25 @@ contains
    !> edge column's projection: with r_b, r_s the parts of the data and of the column
    !> orthogonal to the polynomials, K = r_s.r_b / |r_s|^2 and the squared residual is
    !> |r_b|^2 - (r_s.r_b)^2 / |r_s|^2.
-   pure subroutine fit_contact_edge(edge, x1, w1, s1, x2, w2, s2)
+   pure subroutine fit_contact_edge(edge, x1, w1, s1, x2, w2, s2, range)
       type(contact_edge_type), intent(inout) :: edge
       real(wp), intent(in) :: x1(:, :), w1(:), s1(:, :), x2(:, :), w2(:), s2(:, :)
+      !> The range of s (module notes) when the states place the edge less closely than
+      !> within a facet (default [s_min, s_max]).
+      real(wp), intent(in), optional :: range(2)
       type(cloud_type) :: c(2)
       real(wp), allocatable :: a(:, :), rb(:, :), tau(:), vn(:, :)
       integer, allocatable :: jpvt(:)
-      real(wp) :: lo, hi, best, sb, f1, f2, x3, x4, k, r0
+      real(wp) :: lo, hi, best, sb, f1, f2, x3, x4, k, r0, s_lo, s_hi
       real(wp), parameter :: g = 0.6180339887498949_wp
       integer :: i, it, m, n, r
 
+      s_lo = s_min
+      s_hi = s_max
+      if (present(range)) then
+         s_lo = range(1)
+         s_hi = range(2)
+      end if
       call gather(edge, x1, w1, s1, 1.0_wp, c(1))
       call gather(edge, x2, w2, s2, -1.0_wp, c(2))
       m = 3*(size(c(1)%w) + size(c(2)%w))
@@ -147,15 +157,15 @@ contains
       best = huge(1.0_wp)
       sb = 0.0_wp
       do i = 0, nscan - 1
-         x3 = s_min + (s_max - s_min)*i/real(nscan - 1, wp)
+         x3 = s_lo + (s_hi - s_lo)*i/real(nscan - 1, wp)
          call trial(x3, f1, k)
          if (f1 < best) then
             best = f1
             sb = x3
          end if
       end do
-      lo = max(s_min, sb - (s_max - s_min)/(nscan - 1))
-      hi = min(s_max, sb + (s_max - s_min)/(nscan - 1))
+      lo = max(s_lo, sb - (s_hi - s_lo)/(nscan - 1))
+      hi = min(s_hi, sb + (s_hi - s_lo)/(nscan - 1))
       x3 = hi - g*(hi - lo)
       x4 = lo + g*(hi - lo)
       call trial(x3, f1, k)
@@ -278,4 +288,4 @@ contains
       end do
    end subroutine edge_subtract
 
-end module sprc_contact_edge_fit
+end module sprc_recovery_contact_edge_fit
