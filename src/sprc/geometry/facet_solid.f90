@@ -38,6 +38,8 @@ module sprc_geometry_facet_solid
 
    !> Facets per leaf of the hierarchy.
    integer, parameter :: leaf_size = 4
+   !> The two kinds of hierarchy query (solid_walk).
+   integer, parameter :: query_box = 1, query_segment = 2
    !> Aims of the inside test at one facet before trying another.
    integer, parameter :: max_aims = 4
    !> Most vertices of a facet clipped to a box (a triangle gains at most one per plane).
@@ -218,27 +220,10 @@ contains
       real(wp), intent(in) :: lo(:), hi(:)
       integer, allocatable, intent(inout) :: list(:)
       integer, intent(out) :: n
-      integer :: stack(128), top, node, i, d
+      integer :: d
 
       d = self%dim
-      n = 0
-      if (.not. allocated(list)) allocate (list(64))
-      top = 1
-      stack(1) = 1
-      do while (top > 0)
-         node = stack(top)
-         top = top - 1
-         if (any(self%lo(1:d, node) > hi(1:d)) .or. any(self%hi(1:d, node) < lo(1:d))) cycle
-         if (self%count(node) > 0) then
-            do i = self%first(node), self%first(node) + self%count(node) - 1
-               call push_int(list, n, self%order(i))
-            end do
-         else
-            stack(top + 1) = self%right(node)
-            stack(top + 2) = node + 1
-            top = top + 2
-         end if
-      end do
+      call solid_walk(self, query_box, [lo(1:d), hi(1:d)], list, n)
    end subroutine solid_query_box
 
    !> Facets whose bounding box, padded by `pad`, meets the segment x0 + t n,
@@ -249,19 +234,36 @@ contains
       real(wp), intent(in) :: x0(:), n(:), ta, tb, pad
       integer, allocatable, intent(inout) :: list(:)
       integer, intent(out) :: nlist
-      integer :: stack(128), top, node, i
+      integer :: d
 
-      nlist = 0
+      d = self%dim
+      call solid_walk(self, query_segment, [x0(1:d), n(1:d), ta, tb, pad], list, nlist)
+   end subroutine solid_query_segment
+
+   !> The one hierarchy walk of both queries: the leaves' facets whose node
+   !> box passes the query's test (`kind`, its data packed in q) in
+   !> hierarchy order. A kind flag, not a procedure argument: an internal
+   !> procedure passed as an argument needs an executable-stack trampoline.
+   pure subroutine solid_walk(self, kind, q, list, n)
+      type(facet_solid_type), intent(in) :: self
+      integer, intent(in) :: kind
+      real(wp), intent(in) :: q(:)
+      integer, allocatable, intent(inout) :: list(:)
+      integer, intent(out) :: n
+      integer :: stack(128), top, node, i, d
+
+      d = self%dim
+      n = 0
       if (.not. allocated(list)) allocate (list(64))
       top = 1
       stack(1) = 1
       do while (top > 0)
          node = stack(top)
          top = top - 1
-         if (.not. segment_meets_box(self%dim, x0, n, ta, tb, self%lo(:, node) - pad, self%hi(:, node) + pad)) cycle
+         if (.not. node_passes(node)) cycle
          if (self%count(node) > 0) then
             do i = self%first(node), self%first(node) + self%count(node) - 1
-               call push_int(list, nlist, self%order(i))
+               call push_int(list, n, self%order(i))
             end do
          else
             stack(top + 1) = self%right(node)
@@ -269,7 +271,17 @@ contains
             top = top + 2
          end if
       end do
-   end subroutine solid_query_segment
+   contains
+      pure logical function node_passes(k)
+         integer, intent(in) :: k
+         if (kind == query_box) then
+            node_passes = .not. (any(self%lo(1:d, k) > q(d + 1:2*d)) .or. any(self%hi(1:d, k) < q(1:d)))
+         else
+            node_passes = segment_meets_box(d, q(1:d), q(d + 1:2*d), q(2*d + 1), q(2*d + 2), &
+                                            self%lo(1:d, k) - q(2*d + 3), self%hi(1:d, k) + q(2*d + 3))
+         end if
+      end function node_passes
+   end subroutine solid_walk
 
    !> Slab test: does x0 + t n, t in [ta, tb], meet the closed box [lo, hi]?
    pure logical function segment_meets_box(d, x0, n, ta, tb, lo, hi) result(meets)
