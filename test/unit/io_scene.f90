@@ -9,6 +9,7 @@ module sprc_test_scene
    use sprc_io_namelist, only: read_text_file
    use sprc_io_scene, only: scene_type, read_scene, read_scene_text, default_scene_text, scene_summary, recovery_degree
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, replaced
+   use sprc_study_spec, only: auto_multiplier
    implicit none
    private
 
@@ -54,6 +55,7 @@ contains
          new_unittest('summary_real_format', test_summary_reals), &
          new_unittest('contact_accepted', test_contact), &
          new_unittest('contact_defaults', test_contact_defaults), &
+         new_unittest('contact_multiplier_auto', test_contact_multiplier_auto), &
          new_unittest('contact_shrink_fit', test_shrink_fit), &
          new_unittest('contact_hertz_roller', test_hertz_roller), &
          new_unittest('contact_on_polygon_group', test_contact_group), &
@@ -620,6 +622,30 @@ contains
       call check(error, index(scene_summary(s), 'kappa = 10000.0 (default), steps = 1, stabilization = fe') > 0, &
          & 'summary gives kappa, steps and stabilization with their defaults')
    end subroutine test_contact_defaults
+
+   !> `multiplier` absent or 'auto' resolves when the scene is read: linear
+   !> for Q2 in 2D, constant for Q1 and in 3D; a space written stays.
+   subroutine test_contact_multiplier_auto(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: order(4) = ["levels=3        ", "levels=3 order=2", &
+         & "levels=3 order=2", "levels=3 order=2"], &
+         & written(4) = [character(len=26) :: '', '', "multiplier='auto' ", "multiplier='constant' "], &
+         & expected(4) = [character(len=8) :: 'constant', 'linear', 'linear', 'constant']
+      type(scene_type) :: s
+      integer :: k
+      do k = 1, size(order)
+         call read_ok(replaced(replaced(contact_text, 'levels=3', trim(order(k))), '&contact ', &
+            & '&contact '//trim(written(k))//' '), s, error)
+         if (allocated(error)) return
+         call check(error, s%contacts(1)%multiplier == trim(expected(k)), trim(order(k))//' '//trim(written(k))// &
+            & ': multiplier '//s%contacts(1)%multiplier//', expected '//trim(expected(k)))
+         if (allocated(error)) return
+      end do
+      call check(error, index(scene_summary(s), 'multiplier = constant') > 0, 'the summary gives the space')
+      if (allocated(error)) return
+      call check(error, auto_multiplier(3, 2) == 'constant' .and. auto_multiplier(3, 1) == 'constant', &
+         & '3D resolves to constant')
+   end subroutine test_contact_multiplier_auto
 
    !> The shrink fit: bc stages, a body with its own level-0 cell, the compound exact kind.
    subroutine test_shrink_fit(error)

@@ -12,8 +12,9 @@
 !>   cells is not inf-sup stable; eliminated cell by cell (lambda_c = pbar +
 !>   gamma gbar, SPD above the trace-inverse bound). `multiplier='linear'`
 !>   (`node_cells`): hats of the cells' vertex lattice along the surface,
-!>   eliminated node by node (mass lumped), a closed node's hat cut to the
-!>   points its closed nodes own (`cut_edges`).
+!>   eliminated node by node (mass lumped), the active set per point
+!>   (`next_set`: the edge where the pressure or the gap changes sign), a
+!>   closed node's hat cut to its closed points (`cut_edges`).
 !> - Frame: at point i lambda_c acts as R_i lambda_c, R_i the least rotation from the
 !>   cell's mean normal to n_i (`frame_rotation`): a uniform pressure on a curved
 !>   surface is in the space (a Cartesian constant costs Q2 its order).
@@ -123,6 +124,12 @@ module sprc_contact_pair_solve
       !> (its state), and the hats before `cut_edges` masks them.
       integer, allocatable :: owner(:)
       real(wp), allocatable :: phi_full(:)
+      !> Linear multiplier: the points' states (the active set is per point,
+      !> `next_set`) and those the last solve proposes.
+      logical, allocatable :: pclosed(:), pnext(:)
+      !> Linear multiplier: the point sets solved so far (`next_set`).
+      logical, allocatable :: seen(:, :)
+      integer :: nseen = 0
       !> Penalty gamma = kappa E_s/h of each contact cell.
       real(wp), allocatable :: gamma(:)
    end type point_operators_type
@@ -399,8 +406,7 @@ contains
             call evaluate(surface, ops, cells, closed, x, sol, error)
          end if
          if (allocated(error)) return
-         next = sol%lambda_n < 0.0_wp
-         switched = switched_points(ops, closed, next)
+         call next_set(ops, closed, sol%lambda_n, sol%gap, next, switched)
          call timer%stop()
          sol%t_contact = sol%t_contact + timer%elapsed
          if (switched == 0 .and. .not. kept .and. bs%iterative .and. bs%krylov%tolerance > bs%tight) then
@@ -413,6 +419,7 @@ contains
          if (switched >= last_switched) bs%loose = bs%tight
          last_switched = switched
          closed = next
+         if (allocated(ops%pnext)) ops%pclosed = ops%pnext
          if (it == maxit) then
             call fatal_error(error, "contact '"//trim(names(1))//"' on '"//trim(names(2))// &
                & "': the active set did not settle in "//itoa(maxit)//' iterations; '//itoa(switched)//' of '// &
@@ -451,31 +458,36 @@ contains
       closed = closed .and. gmin <= first + sqrt(epsilon(1.0_wp))*h
    end subroutine first_set
 
-   !> The points of the closed contact cells.
-   !> The linear multiplier's closed nodes act on (and carry pressure at)
-   !> only the points whose owner (the node of their largest hat, their
-   !> state) is closed: a closed node next to an open one loses the half of
-   !> its hat beyond the midpoint. Its mean gap would otherwise take in the
-   !> open side's gap, pressing the closed side in, and its pressure would
-   !> run on past the contact edge to the open node. Nodes whose hats change
-   !> are rebuilt; the hats depend on the active set alone.
+   !> The linear multiplier's active set is per point (`next_set`): a node
+   !> is closed when a point of its hat is, and acts on (carries pressure
+   !> at) only its closed points, so its hat ends at the contact edge. Its
+   !> mean gap would otherwise take in the open side's gap, pressing the
+   !> closed side in, and its pressure would run on past the edge. The
+   !> first set closes the points whose owner (the node of their largest
+   !> hat) `first_set` closed. Nodes whose hats change are rebuilt; the
+   !> hats depend on the active set alone.
    subroutine cut_edges(surface, ops, cells, closed, friction, error)
       type(contact_surface_type), intent(in) :: surface
       type(point_operators_type), intent(inout) :: ops
       type(cell_operators_type), intent(inout) :: cells(:)
-      logical, intent(in) :: closed(:)
+      logical, intent(inout) :: closed(:)
       integer, intent(in) :: friction
       type(error_type), allocatable, intent(out) :: error
       real(wp) :: phi(maxval(ops%cell_ptr(2:) - ops%cell_ptr(:ops%ncell)))
-      integer :: c, q0, q1, n
+      integer :: c, q0, q1, n, i
+      if (.not. allocated(ops%pclosed)) then
+         allocate (ops%pclosed(size(ops%owner)), source=.false.)
+         do i = 1, size(ops%owner)
+            if (ops%owner(i) > 0) ops%pclosed(i) = closed(ops%owner(i))
+         end do
+      end if
       do c = 1, ops%ncell
          q0 = ops%cell_ptr(c)
          q1 = ops%cell_ptr(c + 1) - 1
          n = q1 - q0 + 1
-         phi(1:n) = ops%phi_full(q0:q1)
-         if (closed(c)) phi(1:n) = merge(phi(1:n), 0.0_wp, closed(ops%owner(ops%cell_point(q0:q1))))
-         ! A node owning none of its points (a sliver's) keeps its whole hat.
-         if (.not. any(phi(1:n) > 0.0_wp)) phi(1:n) = ops%phi_full(q0:q1)
+         phi(1:n) = merge(ops%phi_full(q0:q1), 0.0_wp, ops%pclosed(ops%cell_point(q0:q1)))
+         closed(c) = any(phi(1:n) > 0.0_wp)
+         if (.not. closed(c)) phi(1:n) = ops%phi_full(q0:q1)
          if (all(phi(1:n) == ops%cell_phi(q0:q1))) cycle
          ops%cell_phi(q0:q1) = phi(1:n)
          call cell_operators(surface, ops, c, merge(friction_stick, friction, friction == friction_coulomb), cells(c), &
@@ -1833,13 +1845,88 @@ contains
       switched = sum(ops%cell_ptr(2:) - ops%cell_ptr(:size(closed)), mask=next .neqv. closed)
    end function switched_points
 
+   !> The next active set from the multipliers lambda_n of the last solve
+   !> and the points that switch. Constant multiplier: the cells with
+   !> lambda_n < 0. Linear multiplier (`cut_edges`), per point: a point in
+   !> the hat of a closed node is closed where the pressure interpolated by
+   !> the closed nodes' whole hats, -sum_j phi_j lambda_j, is positive, so
+   !> the contact edge falls where that pressure changes sign, between
+   !> points, not at a node or a midpoint; any other point takes the state
+   !> of its owner's trial multiplier (a whole hat's, the node open). A
+   !> node is closed when one of its points is.
+   subroutine next_set(ops, closed, lambda_n, gap, next, switched)
+      type(point_operators_type), intent(inout) :: ops
+      logical, intent(in) :: closed(:)
+      real(wp), intent(in) :: lambda_n(:), gap(:)
+      logical, intent(out) :: next(:)
+      integer, intent(out) :: switched
+      real(wp) :: p(size(ops%cell_of_point))
+      logical :: covered(size(ops%cell_of_point))
+      integer :: c, q, i, k
+
+      if (.not. allocated(ops%pclosed)) then
+         next = lambda_n < 0.0_wp
+         switched = switched_points(ops, closed, next)
+         return
+      end if
+      p = 0.0_wp
+      covered = .false.
+      do c = 1, ops%ncell
+         if (.not. closed(c)) cycle
+         do q = ops%cell_ptr(c), ops%cell_ptr(c + 1) - 1
+            i = ops%cell_point(q)
+            p(i) = p(i) - ops%phi_full(q)*lambda_n(c)
+            covered(i) = covered(i) .or. ops%phi_full(q) > 0.0_wp
+         end do
+      end do
+      if (.not. allocated(ops%pnext)) allocate (ops%pnext(size(p)))
+      do i = 1, size(p)
+         if (covered(i) .and. ops%pclosed(i)) then
+            ops%pnext(i) = p(i) > 0.0_wp
+         else if (covered(i)) then
+            ops%pnext(i) = gap(i) < 0.0_wp
+         else if (ops%owner(i) > 0) then
+            ops%pnext(i) = lambda_n(ops%owner(i)) < 0.0_wp
+         else
+            ops%pnext(i) = .false.
+         end if
+      end do
+      do c = 1, ops%ncell
+         next(c) = any(ops%pnext(ops%cell_point(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1)) .and. &
+            & ops%phi_full(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1) > 0.0_wp)
+      end do
+      switched = count(ops%pnext .neqv. ops%pclosed)
+      call remember_set(ops)
+      do k = 1, ops%nseen
+         if (switched == 0) exit
+         if (.not. all(ops%seen(:, k) .eqv. ops%pnext)) cycle
+         ops%pnext = ops%pclosed
+         next = closed
+         switched = 0
+      end do
+   end subroutine next_set
+
+   !> Append the points' current set to those solved (`ops%seen`).
+   pure subroutine remember_set(ops)
+      type(point_operators_type), intent(inout) :: ops
+      logical, allocatable :: grown(:, :)
+      if (.not. allocated(ops%seen)) allocate (ops%seen(size(ops%pclosed), 4))
+      if (ops%nseen == size(ops%seen, 2)) then
+         allocate (grown(size(ops%seen, 1), 2*ops%nseen))
+         grown(:, 1:ops%nseen) = ops%seen
+         call move_alloc(grown, ops%seen)
+      end if
+      ops%nseen = ops%nseen + 1
+      ops%seen(:, ops%nseen) = ops%pclosed
+   end subroutine remember_set
+
    !> The active set repeated after a solve to `active_set_tolerance`: solve
    !> the same system again (its preconditioner set up) to the final
    !> tolerance from that solution and evaluate again; `switched` says
    !> whether the set still repeats.
    subroutine confirm_set(surface, ops, cells, closed, bs, f, x, sol, next, switched, error, pstar)
       type(contact_surface_type), intent(in) :: surface
-      type(point_operators_type), intent(in) :: ops
+      type(point_operators_type), intent(inout) :: ops
       type(cell_operators_type), intent(in) :: cells(:)
       logical, intent(in) :: closed(:)
       type(block_solver_type), intent(inout) :: bs
@@ -1855,8 +1942,7 @@ contains
       call krylov_solve(bs%krylov, f, x, sol, error)
       if (.not. allocated(error)) call evaluate(surface, ops, cells, closed, x, sol, error, pstar)
       if (allocated(error)) return
-      next = sol%lambda_n < 0.0_wp
-      switched = switched_points(ops, closed, next)
+      call next_set(ops, closed, sol%lambda_n, sol%gap, next, switched)
    end subroutine confirm_set
 
    !> The blocks (masters) of `dof` with a component in `touched` (0: none).
@@ -1990,7 +2076,9 @@ contains
                i = pts(j)
                phi = ops%cell_phi(ops%cell_ptr(c) + j - 1)
                ! A point's state is that of its largest basis function's cell (its owner).
-               if (allocated(ops%owner)) then
+               if (allocated(ops%pclosed)) then
+                  sol%closed(i) = ops%pclosed(i)
+               else if (allocated(ops%owner)) then
                   sol%closed(i) = closed(ops%owner(i))
                else if (phi > largest(pts(j))) then
                   largest(i) = phi
@@ -2098,7 +2186,7 @@ contains
       type(timer_type) :: timer
       real(wp), allocatable :: f(:), x(:)
       integer, allocatable :: offset(:)
-      integer :: it, maxit, p, c, switched, b, stat
+      integer :: it, maxit, p, c, switched, b, stat, moved
       logical, allocatable :: next(:)
 
       maxit = default_max_iterations
@@ -2146,11 +2234,12 @@ contains
             associate (w => work(p))
                call evaluate(pairs(p)%surface, w%ops, w%cells, w%closed, x, sols(p), error)
                if (allocated(error)) return
-               next = sols(p)%lambda_n < 0.0_wp
-               do c = 1, w%ops%ncell
-                  if (next(c) .neqv. w%closed(c)) switched = switched + w%ops%cell_ptr(c + 1) - w%ops%cell_ptr(c)
-               end do
+               if (allocated(next)) deallocate (next)
+               allocate (next(size(w%closed)))
+               call next_set(w%ops, w%closed, sols(p)%lambda_n, sols(p)%gap, next, moved)
+               switched = switched + moved
                w%closed = next
+               if (allocated(w%ops%pnext)) w%ops%pclosed = w%ops%pnext
             end associate
          end do
          call timer%stop()

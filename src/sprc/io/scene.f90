@@ -13,7 +13,7 @@ module sprc_io_scene
       & contact_spec_type, recovery_degree, default_stabilization, contact_unsupported, default_max_level, &
       & contact_components, projected_poisson, solver_names, auto_iterative_min_dofs, auto_never, default_gamma, &
       & auto_coupled_iterative_min_dofs, &
-      & gamma_note, grid_max_level, default_multiplier
+      & gamma_note, grid_max_level, default_multiplier, auto_multiplier
    use sprc_io_scene_facets, only: load_facets, facet_kind, facet_summary, group_surface
    use sprc_io_namelist, only: nml_group_type, parse_namelist, read_text_file, nml_get, nml_get_array, &
       & nml_has, nml_check_consumed, nml_field_error, nml_group_error, nml_item_text
@@ -54,7 +54,7 @@ module sprc_io_scene
       & 'compound_sphere layered_cylinder layered_sphere hertz_cylinder hertz_sphere corner'
    character(len=*), parameter :: frictions = 'frictionless coulomb stick'
    character(len=*), parameter :: stabilizations = 'fe recovered'
-   character(len=*), parameter :: multipliers = 'constant linear'
+   character(len=*), parameter :: multipliers = 'auto constant linear'
 
    !> Deepest uniform level accepted, 2D and 3D: 4^14 and 8^9 cells are already
    !> far beyond what a direct solver handles.
@@ -1060,6 +1060,7 @@ contains
             c%multiplier = default_multiplier
             call get_choice(g, 'multiplier', multipliers, .false., c%multiplier, error)
             if (allocated(error)) return
+            if (c%multiplier == 'auto') c%multiplier = auto_multiplier(scene%dim, scene%order)
             call nml_get(g, 'edges', c%edges, found, error)
             if (allocated(error)) return
             call nml_check_consumed(g, error)

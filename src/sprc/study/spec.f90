@@ -20,7 +20,7 @@ module sprc_study_spec
    public :: scene_type, body_spec_type, shape_spec_type, bc_spec_type, exact_spec_type, contact_spec_type
    public :: adapt_spec_type, default_max_level
    public :: recovery_degree, contact_unsupported, contact_components
-   public :: default_kappa, default_stabilization, kappa_range, kappa_note, default_multiplier
+   public :: default_kappa, default_stabilization, kappa_range, kappa_note, default_multiplier, auto_multiplier
    public :: projected_poisson, solver_names, auto_iterative_min_dofs, auto_never, default_gamma, gamma_note
    public :: auto_coupled_iterative_min_dofs
    public :: grid_max_level
@@ -46,8 +46,9 @@ module sprc_study_spec
    !> the recovered variant gives the same results to 4 digits at 1.0-1.15x
    !> the time (README "Contact", figures in the commit that chose it).
    character(len=*), parameter :: default_stabilization = 'fe'
-   !> Default of `&contact multiplier` (doc/scene.md).
-   character(len=*), parameter :: default_multiplier = 'constant'
+   !> Default of `&contact multiplier` (doc/scene.md): 'auto', resolved by
+   !> `auto_multiplier` when the scene is read.
+   character(len=*), parameter :: default_multiplier = 'auto'
 
    !> One elastic body.
    type :: body_spec_type
@@ -194,7 +195,7 @@ module sprc_study_spec
       integer :: steps = 1
       !> Source of the stabilization stress: 'fe' | 'recovered'.
       character(len=:), allocatable :: stabilization
-      !> The multiplier space: 'constant' | 'linear' (`default_multiplier`).
+      !> The multiplier space: 'constant' | 'linear' ('auto' resolved when read, `auto_multiplier`).
       character(len=:), allocatable :: multiplier
       !> SPR-C's contact-edge field at the edges of 2D frictionless contact zones (doc/scene.md).
       logical :: edges = .true.
@@ -269,6 +270,22 @@ module sprc_study_spec
    end type scene_type
 
 contains
+
+   !> The multiplier space of `multiplier = 'auto'` (doc/scene.md): linear
+   !> for Q2 in 2D, where the constant one leaves the interface pressure on
+   !> a floor the Q2 solution falls below (the compound cylinder's pressure
+   !> stalls at rate 0.4 from the third level), constant elsewhere (Q1: the
+   !> linear one is worse at the coarsest levels; 3D: several times the
+   !> solve time). doc/benchmarks.md has the measurements.
+   pure function auto_multiplier(dim, order) result(name)
+      integer, intent(in) :: dim, order
+      character(len=:), allocatable :: name
+      if (dim == 2 .and. order == 2) then
+         name = 'linear'
+      else
+         name = 'constant'
+      end if
+   end function auto_multiplier
 
    !> '' when `kappa` lies in the safe range of `stabilization` ('fe':
    !> `kappa_range`; 'recovered': down to `kappa_min_recovered`), else a
