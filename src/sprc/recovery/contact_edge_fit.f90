@@ -17,6 +17,15 @@
 !>    nscan values, then golden sections). The edge is kept when K > 0 (compression) and the
 !>    S column lowers the residual by the factor keep_ratio at least; else K = 0.
 !>    One scan over the bodies' points per edge (edges are few).
+!> 3. `fit_edge_gap`: the edge point from the gap on the open side instead, where the caller
+!>    has the deformed gaps of the open points: beyond the edge of a smooth frictionless contact
+!>    the gap opens like the 3/2 power of the distance to the edge (the displacement of
+!>    the edge field S: g = C xi^(3/2) (1 + O(xi))). The gap is the FE displacements', which
+!>    converge an order faster than their stresses, and it is read where the FE states are
+!>    settled (gap_window facet lengths beyond the vertex), while the stresses next to the
+!>    edge carry the states' error (a contact zone closed per contact cell ends up to a cell
+!>    off). The fit g = xi_+^(3/2) (c0 + c1 (xi - xi_v)/L) by least squares over s, as in 2.;
+!>    kept when c0 > 0 (the gap opens) on gap_min_points points at least.
 module sprc_recovery_contact_edge_fit
    use sprc_core_kinds, only: wp
    use sprc_core_dense, only: qr_pivoted, apply_qt
@@ -24,7 +33,7 @@ module sprc_recovery_contact_edge_fit
    implicit none
    private
 
-   public :: contact_edge_type, find_contact_edges, fit_contact_edge, edge_subtract
+   public :: contact_edge_type, find_contact_edges, fit_contact_edge, edge_subtract, fit_edge_gap
    public :: fit_facets, s_min, s_max
 
    !> Fit and enrichment radius, in facet lengths from the vertex.
@@ -34,6 +43,10 @@ module sprc_recovery_contact_edge_fit
    !> The edge field must lower the fit's residual to this fraction at least.
    real(wp), parameter :: keep_ratio = 0.95_wp
    integer, parameter :: nscan = 17, ngolden = 30
+   !> The open points of the gap fit: from gap_window(1) to gap_window(2) facet lengths beyond
+   !> the vertex along t (module notes, 3), at least gap_min_points of them.
+   real(wp), parameter :: gap_window(2) = [1.5_wp, 6.0_wp]
+   integer, parameter :: gap_min_points = 4
    !> Quadratic terms per component of the smooth part.
    integer, parameter :: nsmooth = 6
 
@@ -209,6 +222,90 @@ contains
          f = r0*sqrt(max(0.0_wp, 1.0_wp - sr**2/(ss*bb)))
       end subroutine trial
    end subroutine fit_contact_edge
+
+   !> The edge point s (in facet lengths from the vertex along t) of the gap fit (module notes,
+   !> 3) to the open surface points x(2, n) with their gaps gap(n), over [range(1), range(2)];
+   !> ok false (s = 0) where the fit is not kept.
+   pure subroutine fit_edge_gap(edge, x, gap, range, s, ok)
+      type(contact_edge_type), intent(in) :: edge
+      real(wp), intent(in) :: x(:, :), gap(:), range(2)
+      real(wp), intent(out) :: s
+      logical, intent(out) :: ok
+      real(wp), allocatable :: xi(:), g(:)
+      real(wp) :: best, f, f1, f2, x3, x4, lo, hi, c0
+      real(wp), parameter :: gr = 0.6180339887498949_wp
+      logical :: inside(size(gap))
+      integer :: i, it
+
+      s = 0.0_wp
+      ok = .false.
+      do i = 1, size(gap)
+         f = dot_product(x(1:2, i) - edge%vertex, edge%tangent)/edge%length
+         inside(i) = f >= gap_window(1) .and. f <= gap_window(2) .and. &
+            & norm2(x(1:2, i) - edge%vertex) <= (gap_window(2) + 1.0_wp)*edge%length
+      end do
+      if (count(inside) < gap_min_points) return
+      xi = pack([(dot_product(x(1:2, i) - edge%vertex, edge%tangent)/edge%length, i=1, size(gap))], inside)
+      g = pack(gap, inside)
+      if (.not. (maxval(abs(g)) > 0.0_wp)) return
+      g = g/maxval(abs(g))
+      best = huge(1.0_wp)
+      do i = 0, nscan - 1
+         x3 = range(1) + (range(2) - range(1))*i/real(nscan - 1, wp)
+         call trial(x3, f, c0)
+         if (f < best) then
+            best = f
+            s = x3
+         end if
+      end do
+      lo = max(range(1), s - (range(2) - range(1))/(nscan - 1))
+      hi = min(range(2), s + (range(2) - range(1))/(nscan - 1))
+      x3 = hi - gr*(hi - lo)
+      x4 = lo + gr*(hi - lo)
+      call trial(x3, f1, c0)
+      call trial(x4, f2, c0)
+      do it = 1, ngolden
+         if (f1 < f2) then
+            hi = x4
+            x4 = x3
+            f2 = f1
+            x3 = hi - gr*(hi - lo)
+            call trial(x3, f1, c0)
+         else
+            lo = x3
+            x3 = x4
+            f1 = f2
+            x4 = lo + gr*(hi - lo)
+            call trial(x4, f2, c0)
+         end if
+      end do
+      s = 0.5_wp*(lo + hi)
+      call trial(s, f, c0)
+      ok = c0 > 0.0_wp
+      if (.not. ok) s = 0.0_wp
+   contains
+      !> Squared residual f and leading coefficient c0 of the two-term fit with the edge at s.
+      pure subroutine trial(st, f, c0)
+         real(wp), intent(in) :: st
+         real(wp), intent(out) :: f, c0
+         real(wp) :: p0(size(g)), p1(size(g)), a11, a12, a22, b1, b2, det, c1
+
+         p0 = max(xi - st, 0.0_wp)**1.5_wp
+         p1 = p0*xi
+         a11 = dot_product(p0, p0)
+         a12 = dot_product(p0, p1)
+         a22 = dot_product(p1, p1)
+         b1 = dot_product(p0, g)
+         b2 = dot_product(p1, g)
+         det = a11*a22 - a12**2
+         c0 = 0.0_wp
+         f = dot_product(g, g)
+         if (.not. (det > sqrt(epsilon(1.0_wp))*a11*a22)) return
+         c0 = (a22*b1 - a12*b2)/det
+         c1 = (a11*b2 - a12*b1)/det
+         f = sum((c0*p0 + c1*p1 - g)**2)
+      end subroutine trial
+   end subroutine fit_edge_gap
 
    !> The points of one body within the radius of the vertex.
    pure subroutine gather(edge, x, w, s, sgn, c)
