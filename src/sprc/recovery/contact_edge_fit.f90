@@ -25,7 +25,16 @@
 !>    settled (gap_window facet lengths beyond the vertex), while the stresses next to the
 !>    edge carry the states' error (a contact zone closed per contact cell ends up to a cell
 !>    off). The fit g = xi_+^(3/2) (c0 + c1 (xi - xi_v)/L) by least squares over s, as in 2.;
-!>    kept when c0 > 0 (the gap opens) on gap_min_points points at least.
+!>    kept when the gap opens (C > 0, C the coefficient of xi^(3/2) at the edge) on
+!>    gap_min_points points at least.
+!> 4. `gap_amplitude`: the amplitude of the edge field that opens the gap C xi^(3/2): the
+!>    surface slope of an elastic half-plane under the pressure p (plane analysis, two
+!>    bodies) is g' = 2/(pi E*) (principal value of the integral of p(t)/(x - t)); with
+!>    p = K sqrt(-t) its part that varies with x beyond the edge is 2 K sqrt(xi)/E*, so
+!>    g = (4 K/(3 E*)) xi^(3/2) and K = 3 E* C / 4, 1/E* = sum of the bodies' 1/E' (E' =
+!>    E/(1 - nu^2) in plane strain, E in plane stress). The gap, a displacement, sets K where
+!>    the stresses near the edge carry the states' error (Hertz: K = p0 sqrt(2/a) and C =
+!>    (2 sqrt 2/3) sqrt(a)/R, Johnson 1985 eq. 4.45).
 module sprc_recovery_contact_edge_fit
    use sprc_core_kinds, only: wp
    use sprc_core_dense, only: qr_pivoted, apply_qt
@@ -33,7 +42,7 @@ module sprc_recovery_contact_edge_fit
    implicit none
    private
 
-   public :: contact_edge_type, find_contact_edges, fit_contact_edge, edge_subtract, fit_edge_gap
+   public :: contact_edge_type, find_contact_edges, fit_contact_edge, edge_subtract, fit_edge_gap, gap_amplitude
    public :: fit_facets, s_min, s_max
 
    !> Fit and enrichment radius, in facet lengths from the vertex.
@@ -224,20 +233,22 @@ contains
    end subroutine fit_contact_edge
 
    !> The edge point s (in facet lengths from the vertex along t) of the gap fit (module notes,
-   !> 3) to the open surface points x(2, n) with their gaps gap(n), over [range(1), range(2)];
-   !> ok false (s = 0) where the fit is not kept.
-   pure subroutine fit_edge_gap(edge, x, gap, range, s, ok)
+   !> 3) to the open surface points x(2, n) with their gaps gap(n), over [range(1), range(2)],
+   !> and the coefficient c of xi^(3/2) at the edge (gap units per length^(3/2)); ok false
+   !> (s = 0, c = 0) where the fit is not kept.
+   pure subroutine fit_edge_gap(edge, x, gap, range, s, c, ok)
       type(contact_edge_type), intent(in) :: edge
       real(wp), intent(in) :: x(:, :), gap(:), range(2)
-      real(wp), intent(out) :: s
+      real(wp), intent(out) :: s, c
       logical, intent(out) :: ok
       real(wp), allocatable :: xi(:), g(:)
-      real(wp) :: best, f, f1, f2, x3, x4, lo, hi, c0
+      real(wp) :: best, f, f1, f2, x3, x4, lo, hi, c0, gmax
       real(wp), parameter :: gr = 0.6180339887498949_wp
       logical :: inside(size(gap))
       integer :: i, it
 
       s = 0.0_wp
+      c = 0.0_wp
       ok = .false.
       do i = 1, size(gap)
          f = dot_product(x(1:2, i) - edge%vertex, edge%tangent)/edge%length
@@ -247,8 +258,9 @@ contains
       if (count(inside) < gap_min_points) return
       xi = pack([(dot_product(x(1:2, i) - edge%vertex, edge%tangent)/edge%length, i=1, size(gap))], inside)
       g = pack(gap, inside)
-      if (.not. (maxval(abs(g)) > 0.0_wp)) return
-      g = g/maxval(abs(g))
+      gmax = maxval(abs(g))
+      if (.not. (gmax > 0.0_wp)) return
+      g = g/gmax
       best = huge(1.0_wp)
       do i = 0, nscan - 1
          x3 = range(1) + (range(2) - range(1))*i/real(nscan - 1, wp)
@@ -283,8 +295,10 @@ contains
       call trial(s, f, c0)
       ok = c0 > 0.0_wp
       if (.not. ok) s = 0.0_wp
+      if (ok) c = c0*gmax/edge%length**1.5_wp
    contains
-      !> Squared residual f and leading coefficient c0 of the two-term fit with the edge at s.
+      !> Squared residual f and the coefficient c0 of xi^(3/2) at the edge (data units, xi in
+      !> facet lengths) of the two-term fit with the edge at st.
       pure subroutine trial(st, f, c0)
          real(wp), intent(in) :: st
          real(wp), intent(out) :: f, c0
@@ -304,8 +318,25 @@ contains
          c0 = (a22*b1 - a12*b2)/det
          c1 = (a11*b2 - a12*b1)/det
          f = sum((c0*p0 + c1*p1 - g)**2)
+         c0 = c0 + c1*st
       end subroutine trial
    end subroutine fit_edge_gap
+
+   !> The amplitude K = 3 E* c / 4 of the edge field that opens the gap c xi^(3/2) between two
+   !> bodies of moduli young(1:2) and Poisson's ratios poisson(1:2) (module notes, 4); plane
+   !> stress where `plane_stress`, else plane strain.
+   pure real(wp) function gap_amplitude(c, young, poisson, plane_stress)
+      real(wp), intent(in) :: c, young(2), poisson(2)
+      logical, intent(in) :: plane_stress
+      real(wp) :: compliance
+
+      if (plane_stress) then
+         compliance = sum(1.0_wp/young)
+      else
+         compliance = sum((1.0_wp - poisson**2)/young)
+      end if
+      gap_amplitude = 0.75_wp*c/compliance
+   end function gap_amplitude
 
    !> The points of one body within the radius of the vertex.
    pure subroutine gather(edge, x, w, s, sgn, c)

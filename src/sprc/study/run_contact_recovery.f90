@@ -15,7 +15,8 @@ module sprc_study_run_contact_recovery
       & contact_law_stick
    use sprc_estimate_contact_patches, only: grid_contact_type, new_grid_contact, point_cells_type, &
       & new_point_cells, cells_box, set_grid_contact_edges
-   use sprc_recovery_contact_edge_fit, only: contact_edge_type, fit_contact_edge, fit_facets, fit_edge_gap
+   use sprc_recovery_contact_edge_fit, only: contact_edge_type, fit_contact_edge, fit_facets, fit_edge_gap, gap_amplitude
+   use sprc_core_material, only: plane_stress
    use sprc_estimate_fe_input, only: fe_recovery_input
    use sprc_study_spec, only: contact_spec_type
    use sprc_study_model, only: scene_surface, analysis_units_type
@@ -286,9 +287,11 @@ contains
       if (d == 2 .and. friction_kind(spec%friction) == friction_frictionless .and. spec%edges .and. &
          & present(other_nodes)) then
          if (side == 1) then
-            call contact_edges(surface, result, nodes, input, other, edges, error)
+            call contact_edges(surface, result, study%bodies(spec%slave_index)%units%strain, nodes, input, other, &
+               & edges, error)
          else
-            call contact_edges(surface, result, other_nodes, other, input, edges, error)
+            call contact_edges(surface, result, study%bodies(spec%slave_index)%units%strain, other_nodes, other, &
+               & input, edges, error)
          end if
          if (allocated(error)) return
       end if
@@ -368,17 +371,19 @@ contains
    !> each the other's nearest point of the other state within the size of the closed point's
    !> cell. The edge's vertex is their midpoint, its tangent points from the closed to the open
    !> one, its normal is the closed point's and its length the size of that cell (a facet of
-   !> the caller's meshes: the fit's radius is fit_facets lengths). The point comes from the FE
-   !> gaps of the open slave points beyond it (fit_edge_gap), where that fit is kept, else with
-   !> the amplitude from both bodies' FE stresses (slave, master); the amplitude always from the
-   !> stresses; edges the fit rejects have amplitude 0. The states place the edge within a
+   !> the caller's meshes: the fit's radius is fit_facets lengths). Point and amplitude come
+   !> from the FE gaps of the open slave points beyond it (fit_edge_gap, gap_amplitude) where
+   !> that fit is kept, else from both bodies' FE stresses (slave, master); the stress fit
+   !> decides whether the edge is kept (its amplitude 0 otherwise). The states place the edge within a
    !> contact cell only, and the stresses next to it carry that error; the gaps a few cells
    !> beyond do not. Within an edge's radius the edge's side, not the point's state, then makes
    !> a boundary point closed or open in the patches (`pair_contact`): the patches' contact and
    !> free-surface rows agree with the edge field (which is traction-free on the open side).
-   subroutine contact_edges(surface, result, slave_nodes, slave, master, edges, error)
+   subroutine contact_edges(surface, result, strain, slave_nodes, slave, master, edges, error)
       type(contact_surface_type), intent(in) :: surface
       type(contact_result_type), intent(in) :: result
+      !> The pair's displacement unit: result%gap/strain is in the bodies' units.
+      real(wp), intent(in) :: strain
       type(grid_nodes_type), intent(in) :: slave_nodes
       type(recovery_input_type), intent(in) :: slave, master
       type(contact_edge_type), allocatable, intent(out) :: edges(:)
@@ -387,7 +392,7 @@ contains
       type(point_cells_type) :: cells
       logical, allocatable :: closed(:), open_(:)
       real(wp), allocatable :: xo(:, :), go(:)
-      real(wp) :: h, s, range(2)
+      real(wp) :: h, s, c, range(2)
       logical :: ok
       integer :: i, j, m, n
 
@@ -398,7 +403,7 @@ contains
       open_ = .not. closed .and. surface%has_master
       if (.not. (any(closed) .and. any(open_))) return
       xo = reshape(pack(surface%x(1:2, :), spread(open_, 1, 2)), [2, count(open_)])
-      go = pack(result%gap, open_)
+      go = pack(result%gap, open_)/strain
       call new_point_cells(cells, surface%x, error)
       if (allocated(error)) return
       allocate (buf(n))
@@ -416,11 +421,13 @@ contains
          buf(m)%normal = surface%normal(1:2, i)
          buf(m)%length = h
          buf(m)%radius = fit_facets*h
-         call fit_edge_gap(buf(m), xo, go, edge_range, s, ok)
+         call fit_edge_gap(buf(m), xo, go, edge_range, s, c, ok)
          if (.not. ok) range = edge_range
          if (ok) range = [s, s]
          call fit_contact_edge(buf(m), slave%x, slave%w, slave%stress(1:3, :), master%x, master%w, &
             & master%stress(1:3, :), range)
+         if (ok .and. buf(m)%amplitude > 0.0_wp) buf(m)%amplitude = gap_amplitude(c, [slave%young, master%young], &
+            & [slave%poisson, master%poisson], slave%analysis == plane_stress)
       end do
       edges = buf(1:m)
    contains
@@ -528,7 +535,10 @@ contains
 
    !> p_fe_stress, p_spr, p_sprc and ts_sprc of a contact result (scene units) from the slave
    !> body's FE stresses and recovered fields (SPR, SPR-C where run) at its slave points:
-   !> p = -n.sigma.n, ts = |sigma n - (n.sigma n) n| (sprc_recovery_contact_operators).
+   !> p = max(-n.sigma.n, 0), ts = |sigma n - (n.sigma n) n| (sprc_recovery_contact_operators):
+   !> a contact carries no tension, so a tensile normal stress (an open point, or a stress that
+   !> overshoots past the edge of the contact zone) is a contact pressure of 0, for the FE
+   !> stresses as for the recovered ones.
    !> SPR-C's field there comes from the coupled contact patches (`finish_pair`).
    subroutine recovered_tractions(surface, bl, run, units, result, error)
       type(contact_surface_type), intent(in) :: surface
@@ -556,6 +566,7 @@ contains
                if (allocated(error)) return
             end if
             call contact_traction(d, surface%normal(:, i), sigma, p, ts)
+            p = max(p, 0.0_wp)
             select case (m)
             case (0)
                result%p_fe_stress(i) = p*unit
