@@ -623,15 +623,15 @@ contains
    !> (example/scenes/hertz_cylinder.nml, level 6: h = a/3.2, its exact pressure): the recovered
    !> pressure's relative L2 error over the slave surface against the FE stresses' (-n.sigma_h.n),
    !> with the field and without it. The issue's target is a factor 3 at h = a/6.4 and a/12.8
-   !> (doc/benchmarks.md, measured 3.76 and 3.01); at this coarse level half of it, 1.5, is
-   !> stated. With the edge point and amplitude fitted to the stresses alone (the FE states place
-   !> the edge within a contact cell only) the factor was 1.37, without the field 1.34 (before
-   !> pressures were clipped at 0; 1.33 after); with point and amplitude from the gaps beyond
-   !> the edge and the patches' states on the edge's side 1.89. The field must also beat the
-   !> polynomials alone.
+   !> (doc/benchmarks.md, measured 3.76 and 3.01). The claim at this coarse level is the gain
+   !> of point and amplitude from the gaps beyond the edge: 1.89 with them, 1.54 with both fitted
+   !> to the stresses (the FE states place the edge within a contact cell only; the patches'
+   !> states on the edge's side and pressures clipped at 0 alike), 1.37 before either, 1.33
+   !> without the field. The bound, 1.75, lies between the first two. The field must also beat
+   !> the polynomials alone.
    subroutine test_hertz_cylinder_sprc_edge(error)
       type(error_type), allocatable, intent(out) :: error
-      real(wp), parameter :: factor = 1.5_wp
+      real(wp), parameter :: factor = 1.75_wp
       real(wp) :: rel(2), fe_stress
       integer :: k
 
