@@ -147,9 +147,8 @@ contains
       type(cloud_type) :: c(2)
       real(wp), allocatable :: a(:, :), rb(:, :), tau(:), vn(:, :)
       integer, allocatable :: jpvt(:)
-      real(wp) :: lo, hi, best, sb, f1, f2, x3, x4, k, r0, s_lo, s_hi
-      real(wp), parameter :: g = 0.6180339887498949_wp
-      integer :: i, it, m, n, r
+      real(wp) :: best, sb, k, r0, s_lo, s_hi
+      integer :: i, m, n, r
 
       s_lo = s_min
       s_hi = s_max
@@ -176,42 +175,19 @@ contains
       rb(1:r, 1) = 0.0_wp
       ! relative residual without the edge field
       r0 = norm2(rb(:, 1))/r0
-      best = huge(1.0_wp)
-      sb = 0.0_wp
-      do i = 0, nscan - 1
-         x3 = s_lo + (s_hi - s_lo)*i/real(nscan - 1, wp)
-         call trial(x3, f1, k)
-         if (f1 < best) then
-            best = f1
-            sb = x3
-         end if
-      end do
-      lo = max(s_lo, sb - (s_hi - s_lo)/(nscan - 1))
-      hi = min(s_hi, sb + (s_hi - s_lo)/(nscan - 1))
-      x3 = hi - g*(hi - lo)
-      x4 = lo + g*(hi - lo)
-      call trial(x3, f1, k)
-      call trial(x4, f2, k)
-      do it = 1, ngolden
-         if (f1 < f2) then
-            hi = x4
-            x4 = x3
-            f2 = f1
-            x3 = hi - g*(hi - lo)
-            call trial(x3, f1, k)
-         else
-            lo = x3
-            x3 = x4
-            f1 = f2
-            x4 = lo + g*(hi - lo)
-            call trial(x4, f2, k)
-         end if
-      end do
-      sb = 0.5_wp*(lo + hi)
+      sb = scan_minimum(residual, s_lo, s_hi)
       call trial(sb, best, k)
       edge%point = edge%vertex + sb*edge%length*edge%tangent
       if (k > 0.0_wp .and. best < keep_ratio*r0) edge%amplitude = k
    contains
+      !> The relative residual with the edge at vertex + s L t.
+      pure real(wp) function residual(s)
+         real(wp), intent(in) :: s
+         real(wp) :: k
+
+         call trial(s, residual, k)
+      end function residual
+
       !> Relative residual f and amplitude k with the edge at vertex + s L t.
       pure subroutine trial(s, f, k)
          real(wp), intent(in) :: s
@@ -242,10 +218,9 @@ contains
       real(wp), intent(out) :: s, c
       logical, intent(out) :: ok
       real(wp), allocatable :: xi(:), g(:)
-      real(wp) :: best, f, f1, f2, x3, x4, lo, hi, c0, gmax
-      real(wp), parameter :: gr = 0.6180339887498949_wp
+      real(wp) :: f, c0, gmax
       logical :: inside(size(gap))
-      integer :: i, it
+      integer :: i
 
       s = 0.0_wp
       c = 0.0_wp
@@ -261,42 +236,20 @@ contains
       gmax = maxval(abs(g))
       if (.not. (gmax > 0.0_wp)) return
       g = g/gmax
-      best = huge(1.0_wp)
-      do i = 0, nscan - 1
-         x3 = range(1) + (range(2) - range(1))*i/real(nscan - 1, wp)
-         call trial(x3, f, c0)
-         if (f < best) then
-            best = f
-            s = x3
-         end if
-      end do
-      lo = max(range(1), s - (range(2) - range(1))/(nscan - 1))
-      hi = min(range(2), s + (range(2) - range(1))/(nscan - 1))
-      x3 = hi - gr*(hi - lo)
-      x4 = lo + gr*(hi - lo)
-      call trial(x3, f1, c0)
-      call trial(x4, f2, c0)
-      do it = 1, ngolden
-         if (f1 < f2) then
-            hi = x4
-            x4 = x3
-            f2 = f1
-            x3 = hi - gr*(hi - lo)
-            call trial(x3, f1, c0)
-         else
-            lo = x3
-            x3 = x4
-            f1 = f2
-            x4 = lo + gr*(hi - lo)
-            call trial(x4, f2, c0)
-         end if
-      end do
-      s = 0.5_wp*(lo + hi)
+      s = scan_minimum(residual, range(1), range(2))
       call trial(s, f, c0)
       ok = c0 > 0.0_wp
       if (.not. ok) s = 0.0_wp
       if (ok) c = c0*gmax/edge%length**1.5_wp
    contains
+      !> The squared residual with the edge at st.
+      pure real(wp) function residual(st)
+         real(wp), intent(in) :: st
+         real(wp) :: c0
+
+         call trial(st, residual, c0)
+      end function residual
+
       !> Squared residual f and the coefficient c0 of xi^(3/2) at the edge (data units, xi in
       !> facet lengths) of the two-term fit with the edge at st.
       pure subroutine trial(st, f, c0)
@@ -321,6 +274,54 @@ contains
          c0 = c0 + c1*st
       end subroutine trial
    end subroutine fit_edge_gap
+
+   !> The minimiser of f over [lo, hi] (lo <= hi): a scan of nscan values, then ngolden golden
+   !> sections in the bracket of one scan step either side of the best.
+   pure real(wp) function scan_minimum(f, lo, hi) result(s)
+      interface
+         pure real(wp) function f(x)
+            import :: wp
+            real(wp), intent(in) :: x
+         end function f
+      end interface
+      real(wp), intent(in) :: lo, hi
+      real(wp), parameter :: g = 0.6180339887498949_wp
+      real(wp) :: best, a, b, x3, x4, f1, f2
+      integer :: i, it
+
+      best = huge(1.0_wp)
+      s = lo
+      do i = 0, nscan - 1
+         x3 = lo + (hi - lo)*i/real(nscan - 1, wp)
+         f1 = f(x3)
+         if (f1 < best) then
+            best = f1
+            s = x3
+         end if
+      end do
+      a = max(lo, s - (hi - lo)/(nscan - 1))
+      b = min(hi, s + (hi - lo)/(nscan - 1))
+      x3 = b - g*(b - a)
+      x4 = a + g*(b - a)
+      f1 = f(x3)
+      f2 = f(x4)
+      do it = 1, ngolden
+         if (f1 < f2) then
+            b = x4
+            x4 = x3
+            f2 = f1
+            x3 = b - g*(b - a)
+            f1 = f(x3)
+         else
+            a = x3
+            x3 = x4
+            f1 = f2
+            x4 = a + g*(b - a)
+            f2 = f(x4)
+         end if
+      end do
+      s = 0.5_wp*(a + b)
+   end function scan_minimum
 
    !> The amplitude K = 3 E* c / 4 of the edge field that opens the gap c xi^(3/2) between two
    !> bodies of moduli young(1:2) and Poisson's ratios poisson(1:2) (module notes, 4); plane
