@@ -58,7 +58,7 @@ contains
          new_unittest('hertz_2d_linear_multiplier', test_hertz_2d_linear), &
          new_unittest('contact_cells_master_ratio', test_master_levels), &
          new_unittest('hertz_2d_master_1pct_coarser', test_hertz_2d_coarser_master), &
-         new_unittest('hertz_2d_sprc_contact_edge', test_hertz_2d_sprc_edge), &
+         new_unittest('hertz_cylinder_sprc_contact_edge', test_hertz_cylinder_sprc_edge), &
          new_unittest('kappa_decades', test_kappa_decades), &
          new_unittest('incline_stick_exact_frictionless_not', test_incline), &
          new_unittest('bodies_in_contact_share_units', test_units), &
@@ -620,50 +620,52 @@ contains
       call check(error, rel < bound, 'relative L2 pressure error '//real_text(rel)//' >= '//real_text(bound))
    end subroutine test_hertz_2d_coarser_master
 
-   !> SPR-C's contact-edge field (doc/scene.md `&contact edges`) on the Hertz case of
-   !> `test_hertz_2d` at level 5 (h = a/12.8 on the contact): the recovered pressure's relative
-   !> L2 error over the slave surface against Hertz's p0 sqrt(1 - x^2/a^2) is smaller with the
-   !> field than without it (edges = .false.: polynomials only, which cannot follow the square
-   !> root at x = a). Measured 4.71e-2 against 4.92e-2: the fitted edge point is as good as the
-   !> FE data near the edge, whose closed zone ends within a contact cell of a, and that error
-   !> dominates (doc/benchmarks.md); the test shows the field acts and lowers the error, not by
-   !> how much. Equal errors (the field not applied) fail.
-   subroutine test_hertz_2d_sprc_edge(error)
+   !> SPR-C's contact-edge field (doc/scene.md `&contact edges`) on the Hertz cylinder
+   !> (example/scenes/hertz_cylinder.nml, level 6: h = a/3.2, its exact pressure): the recovered
+   !> pressure's relative L2 error over the slave surface against the FE stresses' (-n.sigma_h.n),
+   !> with the field and without it. The issue's target is a factor 3 at h = a/6.4 and a/12.8
+   !> (doc/benchmarks.md, measured 3.76 and 3.01). The claim at this coarse level is the gain
+   !> of point and amplitude from the gaps beyond the edge: 1.89 with them, 1.54 with both fitted
+   !> to the stresses (the FE states place the edge within a contact cell only; the patches'
+   !> states on the edge's side and pressures clipped at 0 alike), 1.37 before either, 1.33
+   !> without the field. The bound, 1.75, lies between the first two. The field must also beat
+   !> the polynomials alone.
+   subroutine test_hertz_cylinder_sprc_edge(error)
       type(error_type), allocatable, intent(out) :: error
-      real(wp) :: rel(2)
+      real(wp), parameter :: factor = 1.75_wp
+      real(wp) :: rel(2), fe_stress
       integer :: k
 
       do k = 1, 2
-         call sprc_pressure_error(merge('.true. ', '.false.', k == 1), rel(k), error)
+         call sprc_pressure_error(merge('.true. ', '.false.', k == 1), rel(k), fe_stress, error)
          if (allocated(error)) return
       end do
       call check(error, rel(1) < rel(2), 'err_p_sprc with the edge field '//real_text(rel(1))// &
          & ', without '//real_text(rel(2))//': not smaller')
-   end subroutine test_hertz_2d_sprc_edge
+      if (allocated(error)) return
+      call check(error, factor*rel(1) <= fe_stress, 'err_p_sprc with the edge field '//real_text(rel(1))// &
+         & ', of the FE stresses '//real_text(fe_stress)//': not '//real_text(factor)//' times smaller')
+   end subroutine test_hertz_cylinder_sprc_edge
 
-   !> The relative L2 error of SPR-C's pressure on the Hertz case at level 5, with edges = `edges`.
-   subroutine sprc_pressure_error(edges, rel, error)
+   !> err_p_sprc and err_p_fe_stress of the Hertz cylinder at level 6 with edges = `edges`.
+   subroutine sprc_pressure_error(edges, rel, fe_stress, error)
       character(len=*), intent(in) :: edges
-      real(wp), intent(out) :: rel
+      real(wp), intent(out) :: rel, fe_stress
       type(error_type), allocatable, intent(out) :: error
-      real(wp), parameter :: a = 0.05_wp, load = 1.0788436_wp, pi = acos(-1.0_wp)
       type(level_type) :: result
       character(len=:), allocatable :: text
-      real(wp), allocatable :: p_ex(:)
-      real(wp) :: p0
 
       rel = huge(1.0_wp)
-      call read_text_file(hertz_2d, text, error)
+      fe_stress = 0.0_wp
+      call read_text_file('example/scenes/hertz_cylinder.nml', text, error)
       if (allocated(error)) return
-      text = replaced(text, "recovery = 'none'", "recovery = 'sprc'")
+      text = replaced(text, "recovery = 'both'", "recovery = 'sprc'")
+      text = replaced(text, "output   = 'out/hertz_cylinder'", "output   = ''")
       text = replaced(text, '&contact ', '&contact edges='//trim(edges)//' ')
-      call run_text(text, 5, result, error)
+      call run_text(text, 6, result, error)
       if (allocated(error)) return
-      p0 = 2.0_wp*load/(pi*a)
-      associate (c => result%contacts(1))
-         p_ex = p0*sqrt(max(0.0_wp, 1.0_wp - (c%x(1, :)/a)**2))
-         rel = sqrt(sum(c%weight*(c%p_sprc - p_ex)**2)/sum(c%weight*p_ex**2))
-      end associate
+      rel = result%row%err_p_sprc
+      fe_stress = result%row%err_p_fe_stress
    end subroutine sprc_pressure_error
 
    !> `test_hertz_2d_linear` with the multiplier space `multiplier`.

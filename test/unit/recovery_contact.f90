@@ -31,6 +31,7 @@ module sprc_test_contact_recovery
    use sprc_exact_hertz, only: cattaneo_mindlin_traction
    use sprc_contact_surface, only: contact_surface_type, new_contact_surface
    use sprc_study_run_contact_recovery, only: paired_point
+   use sprc_recovery_contact_edge_fit, only: contact_edge_type, fit_edge_gap, gap_amplitude
    implicit none
    private
 
@@ -89,7 +90,8 @@ contains
          new_unittest('aux_candidates', test_aux_candidates), &
          new_unittest('qr_max_steps', test_qr_max_steps), &
          new_unittest('cells_prism', test_cells_prism), &
-         new_unittest('cattaneo_mindlin_sprc', test_cattaneo_sprc) &
+         new_unittest('cattaneo_mindlin_sprc', test_cattaneo_sprc), &
+         new_unittest('edge_gap_fit', test_edge_gap_fit) &
          ]
    end subroutine collect_contact_recovery
 
@@ -1370,5 +1372,56 @@ contains
             & rtoa(err_sprc)//', FE '//rtoa(err_fe))
       end associate
    end subroutine test_cattaneo_sprc
+
+   !> The gap fit of a contact edge (sprc_recovery_contact_edge_fit, fit_edge_gap) on a line at
+   !> 30 degrees, points every 0.37 facet lengths: gaps of the model g = C xi_+^(3/2) (1 + c xi)
+   !> with the edge at s = 0.37 and s = -1.21 facet lengths from the vertex are found to the
+   !> golden sections' bracket (the scan's step 4/16 shrunk by 0.618^30, 3e-7 facet lengths;
+   !> 1e-6 stated), and the coefficient of xi^(3/2) at the edge, 3e-4 (1 + 0.2 s)/L^(3/2) per
+   !> length^(3/2), to the same relative tier. A gap that closes (C < 0) is not kept. Last the
+   !> amplitude of the gap that Hertz's pressure opens (Johnson 1985 eq. 4.45: p0 sqrt(2/a)
+   !> from C = (2 sqrt 2/3) sqrt(a)/R; two materials, plane strain; a plane stress E* likewise)
+   !> to round-off (8 eps).
+   subroutine test_edge_gap_fit(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_edge_type) :: edge
+      real(wp), parameter :: length = 0.02_wp, se(2) = [0.37_wp, -1.21_wp]
+      real(wp) :: x(2, 40), gap(40), xi(40), s, c, c_ex, e_star, a, p0
+      real(wp), parameter :: young(2) = [210.0_wp, 70.0_wp], nu(2) = [0.3_wp, 0.33_wp], r = 0.8_wp, load = 0.9_wp
+      logical :: ok
+      integer :: i, k
+
+      edge%vertex = [0.3_wp, 0.1_wp]
+      edge%tangent = [cos(acos(-1.0_wp)/6), sin(acos(-1.0_wp)/6)]
+      edge%length = length
+      do k = 1, 2
+         do i = 1, size(gap)
+            xi(i) = 0.37_wp*(i - 3)
+            x(:, i) = edge%vertex + xi(i)*length*edge%tangent
+         end do
+         gap = 3.0e-4_wp*max(xi - se(k), 0.0_wp)**1.5_wp*(1.0_wp + 0.2_wp*xi)
+         call fit_edge_gap(edge, x, gap, [-2.0_wp, 2.0_wp], s, c, ok)
+         call check(error, ok .and. abs(s - se(k)) < 1.0e-6_wp, 'edge at '//rtoa(se(k))//': fitted at '//rtoa(s))
+         if (allocated(error)) return
+         c_ex = 3.0e-4_wp*(1.0_wp + 0.2_wp*se(k))/length**1.5_wp
+         call check(error, abs(c - c_ex) < 1.0e-6_wp*c_ex, 'edge at '//rtoa(se(k))//': coefficient '//rtoa(c)// &
+            & ', expected '//rtoa(c_ex))
+         if (allocated(error)) return
+      end do
+      call fit_edge_gap(edge, x, -gap, [-2.0_wp, 2.0_wp], s, c, ok)
+      call check(error, .not. ok, 'a closing gap kept as an edge at '//rtoa(s))
+      if (allocated(error)) return
+      do k = 1, 2
+         if (k == 1) e_star = 1.0_wp/sum((1.0_wp - nu**2)/young)
+         if (k == 2) e_star = 1.0_wp/sum(1.0_wp/young)
+         a = sqrt(4.0_wp*load*r/(acos(-1.0_wp)*e_star))
+         p0 = 2.0_wp*load/(acos(-1.0_wp)*a)
+         c = 2.0_wp*sqrt(2.0_wp)/3.0_wp*sqrt(a)/r
+         s = gap_amplitude(c, young, nu, k == 2)
+         call check(error, abs(s - p0*sqrt(2.0_wp/a)) <= 8*epsilon(1.0_wp)*s, 'Hertz amplitude '//rtoa(s)// &
+            & ', expected '//rtoa(p0*sqrt(2.0_wp/a)))
+         if (allocated(error)) return
+      end do
+   end subroutine test_edge_gap_fit
 
 end module sprc_test_contact_recovery

@@ -17,6 +17,24 @@
 !>    nscan values, then golden sections). The edge is kept when K > 0 (compression) and the
 !>    S column lowers the residual by the factor keep_ratio at least; else K = 0.
 !>    One scan over the bodies' points per edge (edges are few).
+!> 3. `fit_edge_gap`: the edge point from the gap on the open side instead, where the caller
+!>    has the deformed gaps of the open points: beyond the edge of a smooth frictionless contact
+!>    the gap opens like the 3/2 power of the distance to the edge (the displacement of
+!>    the edge field S: g = C xi^(3/2) (1 + O(xi))). The gap is the FE displacements', which
+!>    converge an order faster than their stresses, and it is read where the FE states are
+!>    settled (gap_window facet lengths beyond the vertex), while the stresses next to the
+!>    edge carry the states' error (a contact zone closed per contact cell ends up to a cell
+!>    off). The fit g = xi_+^(3/2) (c0 + c1 (xi - xi_v)/L) by least squares over s, as in 2.;
+!>    kept when the gap opens (C > 0, C the coefficient of xi^(3/2) at the edge) on
+!>    gap_min_points points at least.
+!> 4. `gap_amplitude`: the amplitude of the edge field that opens the gap C xi^(3/2): the
+!>    surface slope of an elastic half-plane under the pressure p (plane analysis, two
+!>    bodies) is g' = 2/(pi E*) (principal value of the integral of p(t)/(x - t)); with
+!>    p = K sqrt(-t) its part that varies with x beyond the edge is 2 K sqrt(xi)/E*, so
+!>    g = (4 K/(3 E*)) xi^(3/2) and K = 3 E* C / 4, 1/E* = sum of the bodies' 1/E' (E' =
+!>    E/(1 - nu^2) in plane strain, E in plane stress). The gap, a displacement, sets K where
+!>    the stresses near the edge carry the states' error (Hertz: K = p0 sqrt(2/a) and C =
+!>    (2 sqrt 2/3) sqrt(a)/R, Johnson 1985 eq. 4.45).
 module sprc_recovery_contact_edge_fit
    use sprc_core_kinds, only: wp
    use sprc_core_dense, only: qr_pivoted, apply_qt
@@ -24,7 +42,7 @@ module sprc_recovery_contact_edge_fit
    implicit none
    private
 
-   public :: contact_edge_type, find_contact_edges, fit_contact_edge, edge_subtract
+   public :: contact_edge_type, find_contact_edges, fit_contact_edge, edge_subtract, fit_edge_gap, gap_amplitude
    public :: fit_facets, s_min, s_max
 
    !> Fit and enrichment radius, in facet lengths from the vertex.
@@ -34,6 +52,10 @@ module sprc_recovery_contact_edge_fit
    !> The edge field must lower the fit's residual to this fraction at least.
    real(wp), parameter :: keep_ratio = 0.95_wp
    integer, parameter :: nscan = 17, ngolden = 30
+   !> The open points of the gap fit: from gap_window(1) to gap_window(2) facet lengths beyond
+   !> the vertex along t (module notes, 3), at least gap_min_points of them.
+   real(wp), parameter :: gap_window(2) = [1.5_wp, 6.0_wp]
+   integer, parameter :: gap_min_points = 4
    !> Quadratic terms per component of the smooth part.
    integer, parameter :: nsmooth = 6
 
@@ -125,9 +147,8 @@ contains
       type(cloud_type) :: c(2)
       real(wp), allocatable :: a(:, :), rb(:, :), tau(:), vn(:, :)
       integer, allocatable :: jpvt(:)
-      real(wp) :: lo, hi, best, sb, f1, f2, x3, x4, k, r0, s_lo, s_hi
-      real(wp), parameter :: g = 0.6180339887498949_wp
-      integer :: i, it, m, n, r
+      real(wp) :: best, sb, k, r0, s_lo, s_hi
+      integer :: i, m, n, r
 
       s_lo = s_min
       s_hi = s_max
@@ -154,42 +175,19 @@ contains
       rb(1:r, 1) = 0.0_wp
       ! relative residual without the edge field
       r0 = norm2(rb(:, 1))/r0
-      best = huge(1.0_wp)
-      sb = 0.0_wp
-      do i = 0, nscan - 1
-         x3 = s_lo + (s_hi - s_lo)*i/real(nscan - 1, wp)
-         call trial(x3, f1, k)
-         if (f1 < best) then
-            best = f1
-            sb = x3
-         end if
-      end do
-      lo = max(s_lo, sb - (s_hi - s_lo)/(nscan - 1))
-      hi = min(s_hi, sb + (s_hi - s_lo)/(nscan - 1))
-      x3 = hi - g*(hi - lo)
-      x4 = lo + g*(hi - lo)
-      call trial(x3, f1, k)
-      call trial(x4, f2, k)
-      do it = 1, ngolden
-         if (f1 < f2) then
-            hi = x4
-            x4 = x3
-            f2 = f1
-            x3 = hi - g*(hi - lo)
-            call trial(x3, f1, k)
-         else
-            lo = x3
-            x3 = x4
-            f1 = f2
-            x4 = lo + g*(hi - lo)
-            call trial(x4, f2, k)
-         end if
-      end do
-      sb = 0.5_wp*(lo + hi)
+      sb = scan_minimum(residual, s_lo, s_hi)
       call trial(sb, best, k)
       edge%point = edge%vertex + sb*edge%length*edge%tangent
       if (k > 0.0_wp .and. best < keep_ratio*r0) edge%amplitude = k
    contains
+      !> The relative residual with the edge at vertex + s L t.
+      pure real(wp) function residual(s)
+         real(wp), intent(in) :: s
+         real(wp) :: k
+
+         call trial(s, residual, k)
+      end function residual
+
       !> Relative residual f and amplitude k with the edge at vertex + s L t.
       pure subroutine trial(s, f, k)
          real(wp), intent(in) :: s
@@ -209,6 +207,137 @@ contains
          f = r0*sqrt(max(0.0_wp, 1.0_wp - sr**2/(ss*bb)))
       end subroutine trial
    end subroutine fit_contact_edge
+
+   !> The edge point s (in facet lengths from the vertex along t) of the gap fit (module notes,
+   !> 3) to the open surface points x(2, n) with their gaps gap(n), over [range(1), range(2)],
+   !> and the coefficient c of xi^(3/2) at the edge (gap units per length^(3/2)); ok false
+   !> (s = 0, c = 0) where the fit is not kept.
+   pure subroutine fit_edge_gap(edge, x, gap, range, s, c, ok)
+      type(contact_edge_type), intent(in) :: edge
+      real(wp), intent(in) :: x(:, :), gap(:), range(2)
+      real(wp), intent(out) :: s, c
+      logical, intent(out) :: ok
+      real(wp), allocatable :: xi(:), g(:)
+      real(wp) :: f, c0, gmax
+      logical :: inside(size(gap))
+      integer :: i
+
+      s = 0.0_wp
+      c = 0.0_wp
+      ok = .false.
+      do i = 1, size(gap)
+         f = dot_product(x(1:2, i) - edge%vertex, edge%tangent)/edge%length
+         inside(i) = f >= gap_window(1) .and. f <= gap_window(2) .and. &
+            & norm2(x(1:2, i) - edge%vertex) <= (gap_window(2) + 1.0_wp)*edge%length
+      end do
+      if (count(inside) < gap_min_points) return
+      xi = pack([(dot_product(x(1:2, i) - edge%vertex, edge%tangent)/edge%length, i=1, size(gap))], inside)
+      g = pack(gap, inside)
+      gmax = maxval(abs(g))
+      if (.not. (gmax > 0.0_wp)) return
+      g = g/gmax
+      s = scan_minimum(residual, range(1), range(2))
+      call trial(s, f, c0)
+      ok = c0 > 0.0_wp
+      if (.not. ok) s = 0.0_wp
+      if (ok) c = c0*gmax/edge%length**1.5_wp
+   contains
+      !> The squared residual with the edge at st.
+      pure real(wp) function residual(st)
+         real(wp), intent(in) :: st
+         real(wp) :: c0
+
+         call trial(st, residual, c0)
+      end function residual
+
+      !> Squared residual f and the coefficient c0 of xi^(3/2) at the edge (data units, xi in
+      !> facet lengths) of the two-term fit with the edge at st.
+      pure subroutine trial(st, f, c0)
+         real(wp), intent(in) :: st
+         real(wp), intent(out) :: f, c0
+         real(wp) :: p0(size(g)), p1(size(g)), a11, a12, a22, b1, b2, det, c1
+
+         p0 = max(xi - st, 0.0_wp)**1.5_wp
+         p1 = p0*xi
+         a11 = dot_product(p0, p0)
+         a12 = dot_product(p0, p1)
+         a22 = dot_product(p1, p1)
+         b1 = dot_product(p0, g)
+         b2 = dot_product(p1, g)
+         det = a11*a22 - a12**2
+         c0 = 0.0_wp
+         f = dot_product(g, g)
+         if (.not. (det > sqrt(epsilon(1.0_wp))*a11*a22)) return
+         c0 = (a22*b1 - a12*b2)/det
+         c1 = (a11*b2 - a12*b1)/det
+         f = sum((c0*p0 + c1*p1 - g)**2)
+         c0 = c0 + c1*st
+      end subroutine trial
+   end subroutine fit_edge_gap
+
+   !> The minimiser of f over [lo, hi] (lo <= hi): a scan of nscan values, then ngolden golden
+   !> sections in the bracket of one scan step either side of the best.
+   pure real(wp) function scan_minimum(f, lo, hi) result(s)
+      interface
+         pure real(wp) function f(x)
+            import :: wp
+            real(wp), intent(in) :: x
+         end function f
+      end interface
+      real(wp), intent(in) :: lo, hi
+      real(wp), parameter :: g = 0.6180339887498949_wp
+      real(wp) :: best, a, b, x3, x4, f1, f2
+      integer :: i, it
+
+      best = huge(1.0_wp)
+      s = lo
+      do i = 0, nscan - 1
+         x3 = lo + (hi - lo)*i/real(nscan - 1, wp)
+         f1 = f(x3)
+         if (f1 < best) then
+            best = f1
+            s = x3
+         end if
+      end do
+      a = max(lo, s - (hi - lo)/(nscan - 1))
+      b = min(hi, s + (hi - lo)/(nscan - 1))
+      x3 = b - g*(b - a)
+      x4 = a + g*(b - a)
+      f1 = f(x3)
+      f2 = f(x4)
+      do it = 1, ngolden
+         if (f1 < f2) then
+            b = x4
+            x4 = x3
+            f2 = f1
+            x3 = b - g*(b - a)
+            f1 = f(x3)
+         else
+            a = x3
+            x3 = x4
+            f1 = f2
+            x4 = a + g*(b - a)
+            f2 = f(x4)
+         end if
+      end do
+      s = 0.5_wp*(a + b)
+   end function scan_minimum
+
+   !> The amplitude K = 3 E* c / 4 of the edge field that opens the gap c xi^(3/2) between two
+   !> bodies of moduli young(1:2) and Poisson's ratios poisson(1:2) (module notes, 4); plane
+   !> stress where `plane_stress`, else plane strain.
+   pure real(wp) function gap_amplitude(c, young, poisson, plane_stress)
+      real(wp), intent(in) :: c, young(2), poisson(2)
+      logical, intent(in) :: plane_stress
+      real(wp) :: compliance
+
+      if (plane_stress) then
+         compliance = sum(1.0_wp/young)
+      else
+         compliance = sum((1.0_wp - poisson**2)/young)
+      end if
+      gap_amplitude = 0.75_wp*c/compliance
+   end function gap_amplitude
 
    !> The points of one body within the radius of the vertex.
    pure subroutine gather(edge, x, w, s, sgn, c)

@@ -15,7 +15,8 @@ module sprc_study_run_contact_recovery
       & contact_law_stick
    use sprc_estimate_contact_patches, only: grid_contact_type, new_grid_contact, point_cells_type, &
       & new_point_cells, cells_box, set_grid_contact_edges
-   use sprc_recovery_contact_edge_fit, only: contact_edge_type, fit_contact_edge, fit_facets
+   use sprc_recovery_contact_edge_fit, only: contact_edge_type, fit_contact_edge, fit_facets, fit_edge_gap, gap_amplitude
+   use sprc_core_material, only: plane_stress
    use sprc_estimate_fe_input, only: fe_recovery_input
    use sprc_study_spec, only: contact_spec_type
    use sprc_study_model, only: scene_surface, analysis_units_type
@@ -220,7 +221,8 @@ contains
    !> The contact surface of side b (1 slave, 2 master) for its recovery (sprc_estimate_contact_patches):
    !> each of the body's boundary points on its contact shape takes the state of the nearest
    !> slave point (side 2: nearest master point of a slave point) within the size of its
-   !> element, else open; closed states give the law (frictionless; stick; Coulomb: stick
+   !> element, else open (within the radius of a fitted contact edge: the edge's side,
+   !> `contact_edges`); closed states give the law (frictionless; stick; Coulomb: stick
    !> or slip) and, for slip, the slip direction of the body relative to the other: opposed
    !> to the contact's FE tangential traction on the slave (`result%t_fe`) on the slave side,
    !> along it on the master side.
@@ -249,6 +251,7 @@ contains
       integer, allocatable :: near(:), sel(:)
       integer, allocatable :: surfaces(:), osurfaces(:)
       integer :: nb, e, k, i, j, inear, mnear, d, o, nnear, stat
+      logical :: closed
 
       d = study%dim
       nb = size(input%bw)
@@ -281,6 +284,17 @@ contains
       end if
       call new_point_cells(cells, sx, error)
       if (allocated(error)) return
+      if (d == 2 .and. friction_kind(spec%friction) == friction_frictionless .and. spec%edges .and. &
+         & present(other_nodes)) then
+         if (side == 1) then
+            call contact_edges(surface, result, study%bodies(spec%slave_index)%units%strain, nodes, input, other, &
+               & edges, error)
+         else
+            call contact_edges(surface, result, study%bodies(spec%slave_index)%units%strain, other_nodes, other, &
+               & input, edges, error)
+         end if
+         if (allocated(error)) return
+      end if
       do e = 1, nodes%n_elements
          if (input%belem_ptr(e + 1) == input%belem_ptr(e)) cycle
          size_e = element_size(nodes, e)
@@ -300,7 +314,10 @@ contains
                end if
             end do
             if (inear == 0 .or. best > size_e) cycle
-            if (result%state(inear) == contact_open) cycle
+            closed = result%state(inear) /= contact_open
+            ! Near a fitted contact edge its side decides (module notes of contact_edges).
+            if (allocated(edges) .and. surface%has_master(inear)) call edge_side(edges, input%bx(1:2, k), closed)
+            if (.not. closed) cycle
             if (surface%has_master(inear)) call paired_point(surface, side, inear, mnear, sx, sel, near(1:nnear), &
                & input%bn(:, k), offset(:, k), ratio(k))
             select case (friction_kind(spec%friction))
@@ -345,14 +362,8 @@ contains
       call new_grid_contact(contact, surfaces, law, slip, spec%mu, other%x, other%w, other%stress, other%young, &
          & other%poisson, other%body_force(1:d), error, boundary=oboundary, offset=offset, ratio=ratio, &
          & fe_order=study%order, cell=cell)
-      if (allocated(error) .or. d /= 2 .or. friction_kind(spec%friction) /= friction_frictionless) return
-      if (.not. spec%edges) return
-      if (side == 1) then
-         call contact_edges(surface, result, nodes, input, other, edges, error)
-      else
-         call contact_edges(surface, result, other_nodes, other, input, edges, error)
-      end if
-      if (.not. allocated(error)) call set_grid_contact_edges(contact, edges, merge(1.0_wp, -1.0_wp, side == 1), error)
+      if (allocated(error) .or. .not. allocated(edges)) return
+      call set_grid_contact_edges(contact, edges, merge(1.0_wp, -1.0_wp, side == 1), error)
    end subroutine pair_contact
 
    !> The edges of a 2D frictionless contact zone (sprc_recovery_contact_edge_fit) from the
@@ -360,11 +371,19 @@ contains
    !> each the other's nearest point of the other state within the size of the closed point's
    !> cell. The edge's vertex is their midpoint, its tangent points from the closed to the open
    !> one, its normal is the closed point's and its length the size of that cell (a facet of
-   !> the caller's meshes: the fit's radius is fit_facets lengths). Point and amplitude are
-   !> fitted to both bodies' FE stresses (slave, master); edges the fit rejects have amplitude 0.
-   subroutine contact_edges(surface, result, slave_nodes, slave, master, edges, error)
+   !> the caller's meshes: the fit's radius is fit_facets lengths). Point and amplitude come
+   !> from the FE gaps of the open slave points beyond it (fit_edge_gap, gap_amplitude) where
+   !> that fit is kept, else from both bodies' FE stresses (slave, master); the stress fit
+   !> decides whether the edge is kept (its amplitude 0 otherwise). The states place the edge within a
+   !> contact cell only, and the stresses next to it carry that error; the gaps a few cells
+   !> beyond do not. Within an edge's radius the edge's side, not the point's state, then makes
+   !> a boundary point closed or open in the patches (`pair_contact`): the patches' contact and
+   !> free-surface rows agree with the edge field (which is traction-free on the open side).
+   subroutine contact_edges(surface, result, strain, slave_nodes, slave, master, edges, error)
       type(contact_surface_type), intent(in) :: surface
       type(contact_result_type), intent(in) :: result
+      !> The pair's displacement unit: result%gap/strain is in the bodies' units.
+      real(wp), intent(in) :: strain
       type(grid_nodes_type), intent(in) :: slave_nodes
       type(recovery_input_type), intent(in) :: slave, master
       type(contact_edge_type), allocatable, intent(out) :: edges(:)
@@ -372,7 +391,9 @@ contains
       type(contact_edge_type), allocatable :: buf(:)
       type(point_cells_type) :: cells
       logical, allocatable :: closed(:), open_(:)
-      real(wp) :: h
+      real(wp), allocatable :: xo(:, :), go(:)
+      real(wp) :: h, s, c, range(2)
+      logical :: ok
       integer :: i, j, m, n
 
       n = surface%npoint
@@ -381,6 +402,8 @@ contains
       closed = result%state /= contact_open
       open_ = .not. closed .and. surface%has_master
       if (.not. (any(closed) .and. any(open_))) return
+      xo = reshape(pack(surface%x(1:2, :), spread(open_, 1, 2)), [2, count(open_)])
+      go = pack(result%gap, open_)/strain
       call new_point_cells(cells, surface%x, error)
       if (allocated(error)) return
       allocate (buf(n))
@@ -398,8 +421,13 @@ contains
          buf(m)%normal = surface%normal(1:2, i)
          buf(m)%length = h
          buf(m)%radius = fit_facets*h
+         call fit_edge_gap(buf(m), xo, go, edge_range, s, c, ok)
+         if (.not. ok) range = edge_range
+         if (ok) range = [s, s]
          call fit_contact_edge(buf(m), slave%x, slave%w, slave%stress(1:3, :), master%x, master%w, &
-            & master%stress(1:3, :), edge_range)
+            & master%stress(1:3, :), range)
+         if (ok .and. buf(m)%amplitude > 0.0_wp) buf(m)%amplitude = gap_amplitude(c, [slave%young, master%young], &
+            & [slave%poisson, master%poisson], slave%analysis == plane_stress)
       end do
       edges = buf(1:m)
    contains
@@ -426,6 +454,29 @@ contains
          end do
       end function nearest
    end subroutine contact_edges
+
+   !> Whether the boundary point x lies on the closed side of the nearest edge of nonzero
+   !> amplitude within the edge's radius (xi = (x - x_e).t <= 0); `closed` unchanged where
+   !> no such edge is near.
+   pure subroutine edge_side(edges, x, closed)
+      type(contact_edge_type), intent(in) :: edges(:)
+      real(wp), intent(in) :: x(2)
+      logical, intent(inout) :: closed
+      real(wp) :: dist, best
+      integer :: e, near
+
+      near = 0
+      best = huge(1.0_wp)
+      do e = 1, size(edges)
+         if (edges(e)%amplitude == 0.0_wp) cycle
+         dist = norm2(x - edges(e)%point)
+         if (dist < edges(e)%radius .and. dist < best) then
+            best = dist
+            near = e
+         end if
+      end do
+      if (near > 0) closed = dot_product(x - edges(near)%point, edges(near)%tangent) <= 0.0_wp
+   end subroutine edge_side
 
    !> The other body's point paired with a boundary point of normal bn near slave point i, as
    !> the FE contact pairs them (sprc_contact_surface): the slave point and its master point
@@ -484,7 +535,10 @@ contains
 
    !> p_fe_stress, p_spr, p_sprc and ts_sprc of a contact result (scene units) from the slave
    !> body's FE stresses and recovered fields (SPR, SPR-C where run) at its slave points:
-   !> p = -n.sigma.n, ts = |sigma n - (n.sigma n) n| (sprc_recovery_contact_operators).
+   !> p = max(-n.sigma.n, 0), ts = |sigma n - (n.sigma n) n| (sprc_recovery_contact_operators):
+   !> a contact carries no tension, so a tensile normal stress (an open point, or a stress that
+   !> overshoots past the edge of the contact zone) is a contact pressure of 0, for the FE
+   !> stresses as for the recovered ones.
    !> SPR-C's field there comes from the coupled contact patches (`finish_pair`).
    subroutine recovered_tractions(surface, bl, run, units, result, error)
       type(contact_surface_type), intent(in) :: surface
@@ -512,6 +566,7 @@ contains
                if (allocated(error)) return
             end if
             call contact_traction(d, surface%normal(:, i), sigma, p, ts)
+            p = max(p, 0.0_wp)
             select case (m)
             case (0)
                result%p_fe_stress(i) = p*unit
