@@ -158,13 +158,16 @@ contains
    end subroutine spr_normal_equations
 
    !> The normal-equation solve of `spr_normal_equations` for nt terms: a(1:nt, 1:ns), or
-   !> done = .false. if the Cholesky pivot is not positive or kappa_F(R) > spr_normal_kappa.
+   !> done = .false. if a Cholesky pivot is not positive or kappa_F(R) > spr_normal_kappa.
+   !> R^-1, computed for kappa_F anyway, also gives a = R^-1 (R^-T b) by two triangular
+   !> products: independent sums instead of chains of divisions.
    pure subroutine normal_solve(nt, np, ns, pw, stress, a, done)
       integer, intent(in) :: nt, np, ns
       real(wp), intent(in) :: pw(:, :), stress(:, :)
       real(wp), intent(out) :: a(spr_normal_terms, 6)
       logical, intent(out) :: done
-      real(wp) :: r(spr_normal_terms, spr_normal_terms), y(spr_normal_terms), d, rf, rif
+      real(wp) :: r(spr_normal_terms, spr_normal_terms), ri(spr_normal_terms, spr_normal_terms)
+      real(wp) :: b(spr_normal_terms, 6), t(spr_normal_terms), dinv(spr_normal_terms), d, rf, rif
       integer :: i, j, c
 
       done = .false.
@@ -174,37 +177,37 @@ contains
             r(i, j) = dot_product(pw(1:np, i), pw(1:np, j))
          end do
          do c = 1, ns
-            a(j, c) = dot_product(pw(1:np, j), stress(c, 1:np))
+            b(j, c) = dot_product(pw(1:np, j), stress(c, 1:np))
          end do
       end do
-      ! Cholesky in place.
+      ! Cholesky in place, with the pivots' reciprocals.
       rf = 0.0_wp
       do j = 1, nt
          do i = 1, j - 1
-            r(i, j) = (r(i, j) - dot_product(r(1:i - 1, i), r(1:i - 1, j)))/r(i, i)
+            r(i, j) = (r(i, j) - dot_product(r(1:i - 1, i), r(1:i - 1, j)))*dinv(i)
          end do
          d = r(j, j) - dot_product(r(1:j - 1, j), r(1:j - 1, j))
          if (.not. (d > 0.0_wp)) return
          r(j, j) = sqrt(d)
+         dinv(j) = 1.0_wp/r(j, j)
          rf = rf + dot_product(r(1:j, j), r(1:j, j))
       end do
-      ! |R^-1|_F, column by column (R y = e_j).
+      ! R^-1 column by column (R y = e_j) and |R^-1|_F.
       rif = 0.0_wp
       do j = 1, nt
-         y(j) = 1.0_wp/r(j, j)
+         ri(j, j) = dinv(j)
          do i = j - 1, 1, -1
-            y(i) = -dot_product(r(i, i + 1:j), y(i + 1:j))/r(i, i)
+            ri(i, j) = -dot_product(r(i, i + 1:j), ri(i + 1:j, j))*dinv(i)
          end do
-         rif = rif + dot_product(y(1:j), y(1:j))
+         rif = rif + dot_product(ri(1:j, j), ri(1:j, j))
       end do
       if (.not. (rf*rif <= spr_normal_kappa**2)) return
-      ! R^T y = b, then R a = y, per component.
       do c = 1, ns
          do i = 1, nt
-            a(i, c) = (a(i, c) - dot_product(r(1:i - 1, i), a(1:i - 1, c)))/r(i, i)
+            t(i) = dot_product(ri(1:i, i), b(1:i, c))
          end do
-         do i = nt, 1, -1
-            a(i, c) = (a(i, c) - dot_product(r(i, i + 1:nt), a(i + 1:nt, c)))/r(i, i)
+         do i = 1, nt
+            a(i, c) = dot_product(ri(i, i:nt), t(i:nt))
          end do
       end do
       done = all(abs(a(1:nt, 1:ns)) <= huge(1.0_wp))
