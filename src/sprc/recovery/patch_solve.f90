@@ -160,14 +160,18 @@ contains
    !> The normal-equation solve of `spr_normal_equations` for nt terms: a(1:nt, 1:ns), or
    !> done = .false. if a Cholesky pivot is not positive or kappa_F(R) > spr_normal_kappa.
    !> R^-1, computed for kappa_F anyway, also gives a = R^-1 (R^-T b) by two triangular
-   !> products: independent sums instead of chains of divisions.
+   !> products: independent sums instead of chains of divisions. Past the Gram matrix the
+   !> system is padded to m = spr_normal_terms with an identity block (and zero data): its
+   !> Cholesky factor, inverse and solution are exactly block-diagonal (the products with the
+   !> padding are exact zeros), and constant loop bounds let the compiler unroll the tiny
+   !> loops; kappa_F sums the first nt columns only.
    pure subroutine normal_solve(nt, np, ns, pw, stress, a, done)
       integer, intent(in) :: nt, np, ns
       real(wp), intent(in) :: pw(:, :), stress(:, :)
       real(wp), intent(out) :: a(spr_normal_terms, 6)
       logical, intent(out) :: done
-      real(wp) :: r(spr_normal_terms, spr_normal_terms), ri(spr_normal_terms, spr_normal_terms)
-      real(wp) :: b(spr_normal_terms, 6), t(spr_normal_terms), dinv(spr_normal_terms), d, rf, rif
+      integer, parameter :: m = spr_normal_terms
+      real(wp) :: r(m, m), ri(m, m), b(m, 6), t(m), dinv(m), d, rf, rif
       integer :: i, j, c
 
       done = .false.
@@ -180,9 +184,19 @@ contains
             b(j, c) = dot_product(pw(1:np, j), stress(c, 1:np))
          end do
       end do
+      ! The padding, entry by entry (whole-array zeroing was a `rep stos` per patch).
+      do j = nt + 1, m
+         do i = 1, j - 1
+            r(i, j) = 0.0_wp
+         end do
+         r(j, j) = 1.0_wp
+         do c = 1, ns
+            b(j, c) = 0.0_wp
+         end do
+      end do
       ! Cholesky in place, with the pivots' reciprocals.
       rf = 0.0_wp
-      do j = 1, nt
+      do j = 1, m
          do i = 1, j - 1
             r(i, j) = (r(i, j) - dot_product(r(1:i - 1, i), r(1:i - 1, j)))*dinv(i)
          end do
@@ -190,24 +204,24 @@ contains
          if (.not. (d > 0.0_wp)) return
          r(j, j) = sqrt(d)
          dinv(j) = 1.0_wp/r(j, j)
-         rf = rf + dot_product(r(1:j, j), r(1:j, j))
+         if (j <= nt) rf = rf + dot_product(r(1:j, j), r(1:j, j))
       end do
       ! R^-1 column by column (R y = e_j) and |R^-1|_F.
       rif = 0.0_wp
-      do j = 1, nt
+      do j = 1, m
          ri(j, j) = dinv(j)
          do i = j - 1, 1, -1
             ri(i, j) = -dot_product(r(i, i + 1:j), ri(i + 1:j, j))*dinv(i)
          end do
-         rif = rif + dot_product(ri(1:j, j), ri(1:j, j))
+         if (j <= nt) rif = rif + dot_product(ri(1:j, j), ri(1:j, j))
       end do
       if (.not. (rf*rif <= spr_normal_kappa**2)) return
       do c = 1, ns
-         do i = 1, nt
+         do i = 1, m
             t(i) = dot_product(ri(1:i, i), b(1:i, c))
          end do
-         do i = 1, nt
-            a(i, c) = dot_product(ri(i, i:nt), t(i:nt))
+         do i = 1, m
+            a(i, c) = dot_product(ri(i, i:m), t(i:m))
          end do
       end do
       done = all(abs(a(1:nt, 1:ns)) <= huge(1.0_wp))
