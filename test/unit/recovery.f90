@@ -35,7 +35,7 @@ module sprc_test_recovery
    use sprc_recovery_workspace, only: recovery_workspace_type, workspace_init, workspace_reserve
    use sprc_recovery_patch_solve, only: recover_spr, recover_sprc
    use sprc_recovery_flops, only: flops_gemm, flops_gemv, flops_syrk, flops_geqrf, flops_ormqr_left, flops_trtrs, &
-      & flops_sysv, design_matrix_flops
+      & flops_sysv, flops_potrf, flops_trtri, design_matrix_flops
    use sprc_recovery_estimate, only: eval_recovered, eval_union, zz_error_integral
    use sprc_core_dense, only: qr_pivoted, apply_qt, apply_q, solve_upper
    use sprc_testsuite, only: unittest_type, new_unittest, check, test_failed, error_type
@@ -98,6 +98,7 @@ contains
          new_unittest('flop_formulas', test_flop_formulas), &
          new_unittest('dense_kernels', test_dense_kernels), &
          new_unittest('flop_count_spr', test_flop_count_spr), &
+         new_unittest('spr_normal_equations_vs_qr', test_spr_normal_equations), &
          new_unittest('flop_count_sprc', test_flop_count_sprc), &
          new_unittest('flop_count_sprc_traction', test_flop_count_traction) &
          ]
@@ -1605,6 +1606,7 @@ contains
       integer(i8), parameter :: nt = 3, ns = 3
 
       call flop_patch(patch)
+      ws%normal_equations = .false.
       call recover_spr(patch, 1, ws, rec, error)
       if (allocated(error)) return
       call check(error, ws%flops == 0 .and. ws%design_flops == 0 .and. ws%lapack_seconds == 0.0_wp, &
@@ -1623,7 +1625,165 @@ contains
       call recover_spr(patch, 1, ws, rec, error)
       if (allocated(error)) return
       call check(error, ws%flops, 2*expected, 'SPR flops accumulate over solves')
+      if (allocated(error)) return
+      ! The normal equations (this patch is well conditioned): dsyrk + dgemm, dpotrf, dtrtri,
+      ! two dtrtrs, and no QR.
+      ws%normal_equations = .true.
+      ws%flops = 0
+      call recover_spr(patch, 1, ws, rec, error)
+      if (allocated(error)) return
+      call check(error, ws%flops, np*nt*(nt + 1) + 2*nt*ns*np + 2*(nt**3 + 1)/3 + 2*nt**2*ns, &
+         & 'SPR 2D p=1 normal-equation flops')
    end subroutine test_flop_count_spr
+
+   !> SPR by the normal equations against the pivoted QR (ws%normal_equations off), on
+   !> well-conditioned patches (2D p=1: an interior lattice patch, a corner element, a rotated
+   !> one, scattered points; 3D p=1: a hex lattice patch; degree 0): the same coefficients to
+   !> 8 np eps kappa^2 relative to the largest (kappa = kappa_F(R) of the QR's R, module notes),
+   !> the normal equations taken (their flop count alone). A thin patch (kappa > 100) and a
+   !> collinear one take the QR: the same bits, and the rank error as before.
+   subroutine test_spr_normal_equations(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(patch_type) :: patch
+      real(wp) :: g(2), c, sn
+      integer :: i, j, k, a, b
+
+      g = 0.5_wp + [-0.5_wp, 0.5_wp]/sqrt(3.0_wp)
+      ! Interior patch of four unit squares around the origin, 2 x 2 Gauss points each.
+      call patch_reset(patch, 2, plane_stress, 1.0_wp, 0.3_wp, [0.0_wp, 0.0_wp], sqrt(2.0_wp))
+      do j = -1, 0
+         do i = -1, 0
+            do b = 1, 2
+               do a = 1, 2
+                  call add2([i + g(a), j + g(b)])
+               end do
+            end do
+         end do
+      end do
+      call compare(1, .true., 'interior lattice patch')
+      if (allocated(error)) return
+      call compare(0, .true., 'degree 0')
+      if (allocated(error)) return
+      ! Corner: one element.
+      call patch_reset(patch, 2, plane_stress, 1.0_wp, 0.3_wp, [0.0_wp, 0.0_wp], sqrt(2.0_wp))
+      do b = 1, 2
+         do a = 1, 2
+            call add2([g(a), g(b)])
+         end do
+      end do
+      call compare(1, .true., 'corner element')
+      if (allocated(error)) return
+      ! Rotated by 0.3 rad, off the origin, tiny scale.
+      c = cos(0.3_wp)
+      sn = sin(0.3_wp)
+      call patch_reset(patch, 2, plane_stress, 1.0_wp, 0.3_wp, [1.0e-3_wp, 2.0e-3_wp], 1.0e-3_wp*sqrt(2.0_wp))
+      do j = -1, 0
+         do i = -1, 0
+            do b = 1, 2
+               do a = 1, 2
+                  call add2(1.0e-3_wp*([1.0_wp, 2.0_wp] + [c*(i + g(a)) - sn*(j + g(b)), sn*(i + g(a)) + c*(j + g(b))]))
+               end do
+            end do
+         end do
+      end do
+      call compare(1, .true., 'rotated patch')
+      if (allocated(error)) return
+      ! Scattered points.
+      call patch_reset(patch, 2, plane_stress, 1.0_wp, 0.3_wp, [0.1_wp, -0.2_wp], 1.0_wp)
+      do i = 1, 9
+         call add2([0.1_wp + 0.8_wp*cos(2.1_wp*i), -0.2_wp + 0.7_wp*sin(1.7_wp*i)])
+      end do
+      call compare(1, .true., 'scattered points')
+      if (allocated(error)) return
+      ! 3D: eight unit cubes around the origin, 2 x 2 x 2 Gauss points each.
+      call patch_reset(patch, 3, solid, 1.0_wp, 0.3_wp, [0.0_wp, 0.0_wp, 0.0_wp], sqrt(3.0_wp))
+      do k = 0, 63
+         call patch_add_point(patch, [ibits(k, 0, 1) - 1 + g(1 + ibits(k, 3, 1)), ibits(k, 1, 1) - 1 + &
+            & g(1 + ibits(k, 4, 1)), ibits(k, 2, 1) - 1 + g(1 + ibits(k, 5, 1))], 0.125_wp, &
+            & [(field3(k, i), i = 1, 6)])
+      end do
+      call compare(1, .true., '3D lattice patch')
+      if (allocated(error)) return
+      ! Thin: points in a strip 1e-3 high (kappa ~ 1e3): the QR, bit for bit.
+      call patch_reset(patch, 2, plane_stress, 1.0_wp, 0.3_wp, [0.0_wp, 0.0_wp], 1.0_wp)
+      do i = 1, 8
+         call add2([-0.9_wp + 0.25_wp*i, 1.0e-3_wp*sin(3.0_wp*i)])
+      end do
+      call compare(1, .false., 'thin patch')
+      if (allocated(error)) return
+      ! Collinear: rank 2 < 3, the same stat_singular from either setting.
+      call patch_reset(patch, 2, plane_stress, 1.0_wp, 0.3_wp, [0.0_wp, 0.0_wp], 1.0_wp)
+      do i = 1, 6
+         call add2([-1.0_wp + 0.4_wp*i, 0.1_wp - 0.2_wp*i])
+      end do
+      call compare(1, .false., 'collinear patch')
+   contains
+      subroutine add2(x)
+         real(wp), intent(in) :: x(2)
+         call patch_add_point(patch, x, 0.25_wp, [1.0_wp + x(1) - 2.0_wp*x(2) + 0.01_wp*sin(30.0_wp*x(1)), &
+            & x(1)*x(2) - 3.0_wp, 0.5_wp + 0.01_wp*cos(20.0_wp*x(2))])
+      end subroutine add2
+      pure real(wp) function field3(k, i)
+         integer, intent(in) :: k, i
+         field3 = real(i, wp) + 0.3_wp*k - 0.01_wp*i*k**2 + 0.01_wp*sin(real(7*k + i, wp))
+      end function field3
+      !> Solve by both settings; fast: the normal equations must be taken and agree to round-off,
+      !> else the two must give the same bits (or the same error).
+      subroutine compare(degree, fast, what)
+         integer, intent(in) :: degree
+         logical, intent(in) :: fast
+         character(len=*), intent(in) :: what
+         type(recovery_workspace_type) :: wq, wn
+         type(recovered_patch_type) :: rq, rn
+         type(error_type), allocatable :: eq, en
+         real(wp) :: kappa, tol
+         integer :: nt, ns, np
+         integer(i8) :: normal_flops
+
+         wq%normal_equations = .false.
+         wn%timing = .true.
+         call recover_spr(patch, degree, wq, rq, eq)
+         call recover_spr(patch, degree, wn, rn, en)
+         if (allocated(eq) .or. allocated(en)) then
+            call check(error, allocated(eq) .and. allocated(en) .and. .not. fast, what//': an error from one setting')
+            if (allocated(error)) return
+            call check(error, eq%stat == stat_singular .and. en%stat == eq%stat .and. en%message == eq%message, &
+               & what//': the same rank error')
+            return
+         end if
+         nt = wq%nt
+         ns = wq%ns
+         np = patch%npoints
+         normal_flops = flops_syrk(nt, np) + flops_gemm(nt, ns, np) + flops_potrf(nt) + flops_trtri(nt) + &
+            & 2*flops_trtrs(nt, ns)
+         if (.not. fast) then
+            call check(error, wn%flops > normal_flops .and. all(rn%coef == rq%coef), what//': the QR, same bits')
+            return
+         end if
+         call check(error, wn%flops == normal_flops .and. rn%basis_rank == nt, what//': normal equations taken')
+         if (allocated(error)) return
+         kappa = kappa_f(wq%qr(1:nt, 1:nt))
+         tol = 8*np*epsilon(1.0_wp)*kappa**2*maxval(abs(rq%coef))
+         call check(error, maxval(abs(rn%coef - rq%coef)) <= tol, what//': normal equations = QR to round-off')
+      end subroutine compare
+      !> |R|_F |R^-1|_F of an upper triangular R (columns of R^-1 by back substitution).
+      pure real(wp) function kappa_f(r)
+         real(wp), intent(in) :: r(:, :)
+         real(wp) :: y(size(r, 1)), s
+         integer :: n, i, j
+         n = size(r, 1)
+         s = 0.0_wp
+         do j = 1, n
+            y = 0.0_wp
+            y(j) = 1.0_wp/r(j, j)
+            do i = j - 1, 1, -1
+               y(i) = -dot_product(r(i, i + 1:j), y(i + 1:j))/r(i, i)
+            end do
+            s = s + sum(y**2)
+         end do
+         kappa_f = sqrt(s*sum([(sum(r(1:j, j)**2), j=1, n)]))
+      end function kappa_f
+   end subroutine test_spr_normal_equations
 
    !> SPR-C, 2D p=1, interior patch (equilibrium only; no compatibility below p=2): its
    !> kernels, counted as the LAPACK/BLAS calls of the same operations, with their sizes, written out here; the kept-row counts come from the result

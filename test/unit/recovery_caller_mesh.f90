@@ -80,6 +80,7 @@ contains
       type(unittest_type), allocatable, intent(out) :: testsuite(:)
       testsuite = [ &
          new_unittest('linear_quad4', test_linear_quad4), &
+         new_unittest('spr_linear_chunks', test_spr_chunks), &
          new_unittest('linear_tri3', test_linear_tri3), &
          new_unittest('linear_hex8', test_linear_hex8), &
          new_unittest('linear_tet4', test_linear_tet4), &
@@ -556,6 +557,24 @@ contains
       call build_case(c, elem_quad4, 4, f_linear, 0.0_wp)
       call check_exact(c, error, 'quad4')
    end subroutine test_linear_quad4
+
+   !> SPR on linear elements solves its patches in chunks and keeps no records
+   !> (patches_to_nodal): a 128^2 quad4 mesh has 16,641 patches, more than one chunk, and a
+   !> linear field is reproduced at every node, the last chunk's included (a chunk's values
+   !> stored at another chunk's nodes, or left out, would not be).
+   subroutine test_spr_chunks(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(case_type) :: c
+      type(mesh_recovery_type) :: res
+
+      call build_case(c, elem_quad4, 128, f_linear, 0.0_wp)
+      call recover_on_mesh(c%dim, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1000.0_wp, 0.3_wp, &
+         & mesh_method_spr, res, error, body_force=c%body(1:c%dim))
+      if (allocated(error)) return
+      call check(error, res%n_patches == 129**2 .and. .not. allocated(res%recs), '16,641 patches, no records kept')
+      if (allocated(error)) return
+      call check(error, nodal_error(c, res) <= tol .and. res%eta <= tol, 'nodal stresses exact at every node')
+   end subroutine test_spr_chunks
 
    subroutine test_linear_tri3(error)
       type(error_type), allocatable, intent(out) :: error

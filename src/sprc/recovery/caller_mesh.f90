@@ -23,7 +23,8 @@
 !>
 !> Output: nodal values (vertex nodes: the patch polynomial; other nodes the union, eq. 102,
 !> in their first element; unused nodes zero); the field sigma*(x) (SPR eq. 101, SPR-C eq.
-!> 102); element and total ZZ errors and eta, summed scaled by powers of two so any finite
+!> 102); the patch polynomials, except for SPR on linear elements, whose field needs only
+!> the nodal values (then the patches are solved in chunks and their records dropped); element and total ZZ errors and eta, summed scaled by powers of two so any finite
 !> stresses give finite results. `mesh_recovery_eval` finds a point's element through bins
 !> (sprc_recovery_caller_mesh_bins) unless given: the lowest-index element holding it.
 !>
@@ -76,6 +77,9 @@ module sprc_recovery_caller_mesh
    !> mesh_recovery_eval bins the elements when at least this many points are searched
    !> (building the bins costs about a few scans over the elements).
    integer, parameter :: bins_min_points = 4
+   !> Patches per chunk of `patches_to_nodal`: a buffer of a few MB, and few enough chunks
+   !> that the loop's per-call set-up (each thread's element stamps) stays small.
+   integer, parameter :: patch_chunk = 16384
 
    !> Result of `recover_on_mesh` (module notes). Components are public plain data.
    type :: mesh_recovery_type
@@ -89,8 +93,9 @@ module sprc_recovery_caller_mesh
       !> Copy of the mesh: nodes x(dim, nnode), connectivity(nen, nelem), element boxes.
       real(wp), allocatable :: x(:, :), box_lo(:, :), box_hi(:, :)
       integer, allocatable :: connectivity(:, :)
-      !> The patches: node of each (ascending), patch of each node (0: none), recovered polynomials,
-      !> expansion rounds and final element count of each.
+      !> The patches: node of each (ascending), patch of each node (0: none), recovered polynomials
+      !> (not kept, recs unallocated, for SPR on linear elements: module notes), expansion rounds
+      !> and final element count of each.
       integer :: n_patches = 0
       integer, allocatable :: patch_node(:), patch_of_node(:), patch_rounds(:), patch_elements(:)
       type(recovered_patch_type), allocatable :: recs(:)
@@ -108,6 +113,10 @@ module sprc_recovery_caller_mesh
       !> nodal values; ZZ estimate.
       real(wp) :: t_check = 0.0_wp, t_topology = 0.0_wp, t_points = 0.0_wp, t_patches = 0.0_wp, &
          & t_nodal = 0.0_wp, t_estimate = 0.0_wp
+      !> Process CPU time (s, all threads) of the input checks and the topology, the set-up a
+      !> library holding a built mesh and spaces does before its estimator is called: a
+      !> benchmark subtracts it to compare like with like.
+      real(wp) :: cpu_setup = 0.0_wp
    end type mesh_recovery_type
 
    !> The solver of a body's contact patches (module notes): `solve` recovers a filled patch
@@ -226,7 +235,7 @@ contains
       real(wp), pointer, contiguous :: gxi(:, :, :)
       integer :: deg, rounds, ref, st
       logical :: ci
-      real(wp) :: t(0:6)
+      real(wp) :: t(0:6), c(0:1)
 
       deg = auto_degree(method == mesh_method_sprc, element_degree(element_type))
       if (present(degree)) deg = degree
@@ -237,6 +246,7 @@ contains
       ref = mesh_reference_unit
       if (present(reference)) ref = reference
       t(0) = wall_time()
+      call cpu_time(c(0))
       call check_mesh_options(dim, analysis, element_type, method, deg, rounds, young, poisson, error)
       if (allocated(error)) return
       if (ref /= mesh_reference_unit .and. ref /= mesh_reference_symmetric) then
@@ -267,6 +277,8 @@ contains
          if (allocated(error)) return
       end if
       t(2) = wall_time()
+      call cpu_time(c(1))
+      result%cpu_setup = c(1) - c(0)
       ! The caller's reference coordinates are used in place (checked, not copied), or on
       ! [-1, 1]^dim mapped onto the element library's [0, 1]^dim once.
       if (present(gauss_xi)) then
@@ -975,11 +987,19 @@ contains
       src%c_indices = r%c_indices
       opt = patch_loop_type(dim=r%dim, degree=r%degree, rounds_limit=rounds, sprc=src%sprc)
       opt%cap = patch_capacity(src, r%dim, r%degree, topo%ne_ptr, topo%ne_list, r%patch_node)
-      allocate (r%recs(r%n_patches), r%patch_rounds(r%n_patches), r%patch_elements(r%n_patches), stat=st)
-      call check_allocation(st, 'recover_on_mesh', 'the patch records', r%n_patches, storage_size(r%recs)/8 + 8, error)
+      allocate (r%patch_rounds(r%n_patches), r%patch_elements(r%n_patches), stat=st)
+      call check_allocation(st, 'recover_on_mesh', 'the patch counts', r%n_patches, 8, error)
       if (allocated(error)) return
-      call run_patch_loop(opt, src, topo%ne_ptr, topo%ne_list, r%connectivity, r%patch_node, r%recs, &
-         & r%patch_rounds, r%patch_elements, ip, error)
+      if (keeps_records(r)) then
+         allocate (r%recs(r%n_patches), stat=st)
+         call check_allocation(st, 'recover_on_mesh', 'the patch records', r%n_patches, storage_size(r%recs)/8, error)
+         if (allocated(error)) return
+         call run_patch_loop(opt, src, topo%ne_ptr, topo%ne_list, r%connectivity, r%patch_node, r%recs, &
+            & r%patch_rounds, r%patch_elements, ip, error)
+         if (.not. allocated(error)) r%n_tolerance_bites = count(r%recs%tolerance_bites)
+      else
+         call patches_to_nodal(r, topo, opt, src, ip, error)
+      end if
       if (allocated(error)) then
          if (ip == 0) return
          n = r%patch_node(ip)
@@ -995,8 +1015,59 @@ contains
       r%n_expanded = count(r%patch_rounds > 0)
       r%max_rounds_used = 0
       if (r%n_patches > 0) r%max_rounds_used = maxval(r%patch_rounds)
-      r%n_tolerance_bites = count(r%recs%tolerance_bites)
    end subroutine recover_patches
+
+   !> Whether the result keeps every patch's record: SPR-C (its field is the union of the
+   !> patches, eq. 102), and elements with nodes besides the vertices (their nodal values are
+   !> the union). SPR on linear elements needs the patches only for the nodal values (its field
+   !> is their interpolation, eq. 101): `patches_to_nodal` keeps none.
+   pure logical function keeps_records(r)
+      type(mesh_recovery_type), intent(in) :: r
+      keeps_records = r%method /= mesh_method_spr .or. r%nen /= r%nvertex
+   end function keeps_records
+
+   !> The patch loop in chunks of patch_chunk patches into one buffer of records, each
+   !> chunk's nodal values taken from its records at once: the records of a whole mesh (a
+   !> few hundred bytes per patch, and a heap block for each one's coefficients) are never
+   !> allocated and the nodal values are evaluated while the records are in cache. Same
+   !> solves, same values, as the loop over all patches. ip: the failing patch, as
+   !> run_patch_loop's (0 if none).
+   subroutine patches_to_nodal(r, topo, opt, src, ip, error)
+      type(mesh_recovery_type), intent(inout) :: r
+      type(topology_type), intent(in) :: topo
+      type(patch_loop_type), intent(in) :: opt
+      type(mesh_source_type), intent(in) :: src
+      integer, intent(out) :: ip
+      type(error_type), allocatable, intent(out) :: error
+      type(recovered_patch_type), allocatable :: buf(:)
+      integer :: i0, m, k, n, st
+
+      ip = 0
+      r%n_tolerance_bites = 0
+      allocate (buf(min(patch_chunk, r%n_patches)), stat=st)
+      call check_allocation(st, 'recover_on_mesh', 'the patch records of a chunk', min(patch_chunk, r%n_patches), &
+         & storage_size(buf)/8, error)
+      if (allocated(error)) return
+      allocate (r%nodal(r%nstress, r%nnode), stat=st)
+      call check_allocation(st, 'recover_on_mesh', 'the nodal stresses', r%nnode, 8*r%nstress, error)
+      if (allocated(error)) return
+      do i0 = 1, r%n_patches, patch_chunk
+         m = min(patch_chunk, r%n_patches - i0 + 1)
+         call run_patch_loop(opt, src, topo%ne_ptr, topo%ne_list, r%connectivity, r%patch_node(i0:i0 + m - 1), &
+            & buf(1:m), r%patch_rounds(i0:i0 + m - 1), r%patch_elements(i0:i0 + m - 1), ip, error)
+         if (allocated(error)) then
+            if (ip > 0) ip = i0 + ip - 1
+            return
+         end if
+         !$omp parallel do schedule(static) private(n)
+         do k = 1, m
+            n = r%patch_node(i0 + k - 1)
+            call eval_recovered_points(buf(k), r%x(:, n:n), r%nodal(:, n:n))
+         end do
+         !$omp end parallel do
+         r%n_tolerance_bites = r%n_tolerance_bites + count(buf(1:m)%tolerance_bites)
+      end do
+   end subroutine patches_to_nodal
 
    !> Solve a filled patch: by the contact solver if it holds a contact point (module
    !> notes), else the default. law / slip / pair of its boundary points in mesh_fill's order.
@@ -1127,14 +1198,17 @@ contains
       real(wp) :: xi(3)
       integer :: n, e, a, st
 
-      allocate (r%nodal(r%nstress, r%nnode), stat=st)
-      call check_allocation(st, 'recover_on_mesh', 'the nodal stresses', r%nnode, 8*r%nstress, error)
-      if (allocated(error)) return
+      if (.not. allocated(r%nodal)) then
+         allocate (r%nodal(r%nstress, r%nnode), stat=st)
+         call check_allocation(st, 'recover_on_mesh', 'the nodal stresses', r%nnode, 8*r%nstress, error)
+         if (allocated(error)) return
+      end if
       !$omp parallel do schedule(static) private(e, a, xi)
       do n = 1, r%nnode
          ! Each branch writes the whole column (a zero fill first was a memset call per node).
          if (r%patch_of_node(n) > 0) then
-            call eval_recovered_points(r%recs(r%patch_of_node(n)), r%x(:, n:n), r%nodal(:, n:n))
+            ! Without records (patches_to_nodal) the vertex values are already in place.
+            if (allocated(r%recs)) call eval_recovered_points(r%recs(r%patch_of_node(n)), r%x(:, n:n), r%nodal(:, n:n))
          else if (topo%ne_ptr(n + 1) > topo%ne_ptr(n)) then
             e = topo%ne_list(topo%ne_ptr(n))
             a = findloc(r%connectivity(:, e), n, dim=1)

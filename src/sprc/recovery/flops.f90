@@ -17,6 +17,8 @@
 !> | dtrtrs n, nrhs           | n^2 nrhs                     | (exact, as xTRSM)        |
 !> | dsysv  n, nrhs           | n^3 / 3 + 2 n^2 nrhs         | dsytrf + n^2/2 + 19 n/6, |
 !> |                          |                              | dsytrs O(n nrhs)         |
+!> | dpotrf n                 | n^3 / 3                      | + n^2 / 2 + n / 6        |
+!> | dtrtri n                 | n^3 / 3                      | + 2 n / 3                |
 !>
 !> dgeqp3 is counted as dgeqrf: its column-norm updates add O(m n), lower order. Fractional
 !> leading terms are rounded to the nearest integer. All arithmetic is in integer(i8): the
@@ -30,6 +32,7 @@ module sprc_recovery_flops
    private
 
    public :: flops_gemm, flops_gemv, flops_syrk, flops_geqrf, flops_ormqr_left, flops_trtrs, flops_sysv
+   public :: flops_potrf, flops_trtri
    public :: design_matrix_flops
 
 contains
@@ -80,6 +83,18 @@ contains
       integer, intent(in) :: n, nrhs
       f = (int(n, i8)**3 + 1_i8)/3_i8 + 2_i8*int(n, i8)**2*nrhs
    end function flops_sysv
+
+   !> dpotrf of order n (LAWN 41 leading term n^3 / 3, rounded to the nearest integer).
+   pure integer(i8) function flops_potrf(n) result(f)
+      integer, intent(in) :: n
+      f = (int(n, i8)**3 + 1_i8)/3_i8
+   end function flops_potrf
+
+   !> dtrtri of order n (LAWN 41 leading term n^3 / 3, rounded to the nearest integer).
+   pure integer(i8) function flops_trtri(n) result(f)
+      integer, intent(in) :: n
+      f = (int(n, i8)**3 + 1_i8)/3_i8
+   end function flops_trtri
 
    !> Hand count of the design matrix at np points (solve's `prepare`): scaling
    !> s = (x - x0)/h, 2 dim np; basis recurrence, one multiply per term after the first,

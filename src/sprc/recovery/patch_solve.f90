@@ -23,6 +23,17 @@
 !>   minimiser is computed by orthogonal transformations only (`project_constraints`):
 !>   cond(sqrt(W) P) instead of the KKT matrix's cond(P)^2, and no LAPACK call overhead.
 !>
+!> Normal equations (SPR only): with G = P^T P = R^T R (Cholesky), kappa_2(P) = kappa_2(R)
+!> <= kappa_F(R) = |R|_F |R^-1|_F, computed from R (a few nt^3 flops, far below the QR's
+!> np nt^2). When kappa_F(R) <= spr_normal_kappa the basis has full rank with room (the
+!> pivoted QR's |R_nn|/|R_11| >= 1/kappa_2(P), far above recovery_rank_tol, so it would keep
+!> every pivot and drop none), and the normal equations' forward error, of order
+!> eps kappa^2, is within a factor spr_normal_kappa of the QR's eps kappa: the coefficients
+!> agree with the QR's to round-off (tested against it). This is the usual SPR patch of
+!> linear elements (kappa of a few in patch-scaled coordinates), where the QR's column norms
+!> and reflector chains dominated the loop; any other patch, and every SPR-C patch, takes
+!> the pivoted QR. `ws%normal_equations` = .false. forces the QR (tests).
+!>
 !> Rank: pivots below `recovery_rank_tol` |R_11| are dropped; a dropped pivot above
 !> `recovery_bite_ratio` means the tolerance, not exact dependence, decided a rank, and is
 !> reported (`tolerance_bites`, `max_dropped_ratio`). A basis of rank < nterms returns
@@ -48,7 +59,7 @@ module sprc_recovery_patch_solve
       & ncompat_equations
    use sprc_recovery_workspace, only: recovery_workspace_type, workspace_reserve, workspace_tic, workspace_toc
    use sprc_recovery_flops, only: flops_gemm, flops_gemv, flops_syrk, flops_geqrf, flops_ormqr_left, flops_trtrs, &
-      & design_matrix_flops
+      & flops_potrf, flops_trtri, design_matrix_flops
    implicit none
    private
 
@@ -63,6 +74,11 @@ module sprc_recovery_patch_solve
    real(wp), parameter :: traction_rank_tol = 1.0e-8_wp
    !> Traction rows only for patches with a traction point within traction_reach h of the node.
    real(wp), parameter :: traction_reach = 0.1_wp
+   !> Largest kappa_F(R) for which SPR solves the normal equations (module notes): their
+   !> error eps kappa^2 is then at most spr_normal_kappa times the QR's eps kappa.
+   real(wp), parameter :: spr_normal_kappa = 100.0_wp
+   !> Largest basis solved by the normal equations (degree 1 in 3D).
+   integer, parameter :: spr_normal_terms = 4
    !> A traction face whose unit normals differ by more than this (1 - cos) is curved.
    real(wp), parameter :: flat_face_tol = 1.0e-10_wp
    !> Floor of the traction weight (1 - rho)^4 (`traction_focus`).
@@ -84,10 +100,132 @@ contains
       type(recovered_patch_type), intent(out) :: rec
       type(error_type), allocatable, intent(out) :: error
 
-      call prepare(patch, degree, ws, rec, .false., 'recover_spr', error)
+      logical :: done
+
+      call design_matrix(patch, degree, ws, rec, .false., 'recover_spr', error)
+      if (allocated(error)) return
+      if (ws%normal_equations) then
+         call spr_normal_equations(patch, ws, rec, done)
+         if (done) return
+      end if
+      call factor_design(ws, rec, degree, patch%npoints, 'recover_spr', error)
       if (allocated(error)) return
       call least_squares(patch, ws, rec, .false., 0, 'recover_spr', error)
    end subroutine recover_spr
+
+   !> SPR's least squares by the normal equations (P^T P) A = P^T sigma, Cholesky P^T P = R^T R,
+   !> taken only when R proves the basis well conditioned (module notes, "Normal equations"):
+   !> kappa_F(R) = |R|_F |R^-1|_F <= spr_normal_kappa. done = .false.: not taken; the caller
+   !> factors the basis by pivoted QR instead. Bases of up to spr_normal_terms terms (degree 1:
+   !> 3 terms in 2D, 4 in 3D), in fixed-size storage; a constant nt per branch lets the compiler
+   !> unroll the tiny loops.
+   subroutine spr_normal_equations(patch, ws, rec, done)
+      type(patch_type), intent(in) :: patch
+      type(recovery_workspace_type), intent(inout) :: ws
+      type(recovered_patch_type), intent(inout) :: rec
+      logical, intent(out) :: done
+      real(wp) :: a(spr_normal_terms, 6)
+      integer :: i, c
+
+      integer :: np, nt, ns
+
+      done = .false.
+      np = patch%npoints
+      nt = ws%nt
+      ns = ws%ns
+      if (np < nt .or. nt > spr_normal_terms) return
+      call workspace_tic(ws)
+      select case (nt)
+      case (3)
+         call normal_solve(3, np, ns, ws%pw, patch%stress, a, done)
+      case (4)
+         call normal_solve(4, np, ns, ws%pw, patch%stress, a, done)
+      case default
+         call normal_solve(nt, np, ns, ws%pw, patch%stress, a, done)
+      end select
+      ! Counted as dsyrk + dgemm (P^T P, P^T sigma), dpotrf, dtrtri (the condition estimate)
+      ! and two dtrtrs, whether taken or not.
+      call workspace_toc(ws, flops_syrk(nt, np) + flops_gemm(nt, ns, np) + flops_potrf(nt) + flops_trtri(nt) + &
+         & 2*flops_trtrs(nt, ns))
+      if (.not. done) return
+      rec%basis_rank = nt
+      call coef_storage(rec, nt, ns)
+      do c = 1, ns
+         do i = 1, nt
+            rec%coef(i, c) = a(i, c)
+         end do
+      end do
+   end subroutine spr_normal_equations
+
+   !> The normal-equation solve of `spr_normal_equations` for nt terms: a(1:nt, 1:ns), or
+   !> done = .false. if a Cholesky pivot is not positive or kappa_F(R) > spr_normal_kappa.
+   !> R^-1, computed for kappa_F anyway, also gives a = R^-1 (R^-T b) by two triangular
+   !> products: independent sums instead of chains of divisions. Past the Gram matrix the
+   !> system is padded to m = spr_normal_terms with an identity block (and zero data): its
+   !> Cholesky factor, inverse and solution are exactly block-diagonal (the products with the
+   !> padding are exact zeros), and constant loop bounds let the compiler unroll the tiny
+   !> loops; kappa_F sums the first nt columns only.
+   pure subroutine normal_solve(nt, np, ns, pw, stress, a, done)
+      integer, intent(in) :: nt, np, ns
+      real(wp), intent(in) :: pw(:, :), stress(:, :)
+      real(wp), intent(out) :: a(spr_normal_terms, 6)
+      logical, intent(out) :: done
+      integer, parameter :: m = spr_normal_terms
+      real(wp) :: r(m, m), ri(m, m), b(m, 6), t(m), dinv(m), d, rf, rif
+      integer :: i, j, c
+
+      done = .false.
+      ! Gram matrix (upper triangle) and right-hand sides: sums over the points in order.
+      do j = 1, nt
+         do i = 1, j
+            r(i, j) = dot_product(pw(1:np, i), pw(1:np, j))
+         end do
+         do c = 1, ns
+            b(j, c) = dot_product(pw(1:np, j), stress(c, 1:np))
+         end do
+      end do
+      ! The padding, entry by entry (whole-array zeroing was a `rep stos` per patch).
+      do j = nt + 1, m
+         do i = 1, j - 1
+            r(i, j) = 0.0_wp
+         end do
+         r(j, j) = 1.0_wp
+         do c = 1, ns
+            b(j, c) = 0.0_wp
+         end do
+      end do
+      ! Cholesky in place, with the pivots' reciprocals.
+      rf = 0.0_wp
+      do j = 1, m
+         do i = 1, j - 1
+            r(i, j) = (r(i, j) - dot_product(r(1:i - 1, i), r(1:i - 1, j)))*dinv(i)
+         end do
+         d = r(j, j) - dot_product(r(1:j - 1, j), r(1:j - 1, j))
+         if (.not. (d > 0.0_wp)) return
+         r(j, j) = sqrt(d)
+         dinv(j) = 1.0_wp/r(j, j)
+         if (j <= nt) rf = rf + dot_product(r(1:j, j), r(1:j, j))
+      end do
+      ! R^-1 column by column (R y = e_j) and |R^-1|_F.
+      rif = 0.0_wp
+      do j = 1, m
+         ri(j, j) = dinv(j)
+         do i = j - 1, 1, -1
+            ri(i, j) = -dot_product(r(i, i + 1:j), ri(i + 1:j, j))*dinv(i)
+         end do
+         if (j <= nt) rif = rif + dot_product(ri(1:j, j), ri(1:j, j))
+      end do
+      if (.not. (rf*rif <= spr_normal_kappa**2)) return
+      do c = 1, ns
+         do i = 1, m
+            t(i) = dot_product(ri(1:i, i), b(1:i, c))
+         end do
+         do i = 1, m
+            a(i, c) = dot_product(ri(i, i:m), t(i:m))
+         end do
+      end do
+      done = all(abs(a(1:nt, 1:ns)) <= huge(1.0_wp))
+   end subroutine normal_solve
 
    !> SPR-C by integral least squares with the constraints switched on in `patch`
    !> (use_equilibrium, use_compatibility, use_boundary, all_boundary_kinds); see the module
@@ -146,7 +284,22 @@ contains
       logical, intent(in) :: weighted
       character(len=*), intent(in) :: context
       type(error_type), allocatable, intent(out) :: error
-      integer :: i, np, nt, r
+
+      call design_matrix(patch, degree, ws, rec, weighted, context, error)
+      if (allocated(error)) return
+      call factor_design(ws, rec, degree, patch%npoints, context, error)
+   end subroutine prepare
+
+   !> Validate, reserve, scale the points and fill the (weighted) design matrix ws%pw.
+   subroutine design_matrix(patch, degree, ws, rec, weighted, context, error)
+      type(patch_type), intent(in) :: patch
+      integer, intent(in) :: degree
+      type(recovery_workspace_type), intent(inout) :: ws
+      type(recovered_patch_type), intent(inout) :: rec
+      logical, intent(in) :: weighted
+      character(len=*), intent(in) :: context
+      type(error_type), allocatable, intent(out) :: error
+      integer :: i, np, nt
       real(wp) :: wsum
       character(len=160) :: buf
 
@@ -192,7 +345,19 @@ contains
          ws%wn(1:np) = 1.0_wp
       end if
       if (ws%timing) ws%design_flops = ws%design_flops + design_matrix_flops(patch%dim, np, nt, weighted)
+   end subroutine design_matrix
 
+   !> Pivoted QR of the design matrix (in ws%qr) and its rank: stat_singular below nt.
+   subroutine factor_design(ws, rec, degree, np, context, error)
+      type(recovery_workspace_type), intent(inout) :: ws
+      type(recovered_patch_type), intent(inout) :: rec
+      integer, intent(in) :: degree, np
+      character(len=*), intent(in) :: context
+      type(error_type), allocatable, intent(out) :: error
+      integer :: nt, r
+      character(len=160) :: buf
+
+      nt = ws%nt
       ws%qr(1:np, 1:nt) = ws%pw(1:np, 1:nt)
       call workspace_tic(ws)
       call qr_pivoted(np, nt, ws%qr, ws%jpvt_p, ws%tau_p, ws%vn, recovery_bite_ratio)
@@ -205,7 +370,7 @@ contains
             & " points); too few or aligned points: expand the patch")') r, nt, degree, np
          call fatal_error(error, context//': '//trim(buf), stat_singular)
       end if
-   end subroutine prepare
+   end subroutine factor_design
 
    !> Rank from the diagonal of a pivoted-QR R: |R_kk| > tol |R_11| (tol: recovery_rank_tol
    !> unless given).

@@ -76,6 +76,9 @@ module sprc_recovery_workspace
       !> Householder scalars and pivots of the basis QR (tau_p, jpvt_p) and of the others.
       real(wp), allocatable :: tau(:), tau_p(:)
       integer, allocatable :: jpvt(:), jpvt_p(:)
+      !> SPR may solve a well-conditioned patch by the normal equations (sprc_recovery_patch_solve,
+      !> "Normal equations"); .false.: always the pivoted QR (tests compare the two).
+      logical :: normal_equations = .true.
       !> If true, the solves accumulate the wall time spent inside the dense kernels
       !> (sprc_core_dense and the small products) and their nominal flop counts.
       logical :: timing = .false.
