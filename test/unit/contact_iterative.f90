@@ -68,6 +68,7 @@ contains
          new_unittest('incline_3d_coulomb_stick_uniform', test_incline_3d), &
          new_unittest('hertz_sphere_loose_active_sets', test_hertz_sphere_loose), &
          new_unittest('hertz_sphere_first_set', test_hertz_sphere_first_set), &
+         new_unittest('vee_groove_widened_first_set', test_vee_groove), &
          new_unittest('patch_2d_recovered', test_recovered), &
          new_unittest('auto_rule_for_pairs', test_auto_rule), &
          new_unittest('coupled_memory_estimate', test_coupled_memory), &
@@ -258,6 +259,17 @@ contains
       call check(error, direct%contacts(1)%iterations <= 2, itoa(direct%contacts(1)%iterations)// &
          & ' active-set iterations, at most 2 expected')
    end subroutine test_hertz_sphere_first_set
+
+   !> The wedge in a V-groove (test/data/contact/vee_groove.nml), whose
+   !> first active set leaves it free (sprc_contact_pair_solve's
+   !> `widen_first_set`): the kept block-system pattern of the iterative
+   !> path takes the widened set.
+   subroutine test_vee_groove(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: text
+      call read_text_file('test/data/contact/vee_groove.nml', text, error)
+      if (.not. allocated(error)) call same_as_direct(text, 4, 'cg+gmg', error)
+   end subroutine test_vee_groove
 
    !> The Hertz sphere scene without recovery or output, its load (the top
    !> traction and the exact solution's force) times `factor`.

@@ -19,7 +19,8 @@
 !>   surface is in the space (a Cartesian constant costs Q2 its order).
 !> - Points: the slave's cut-cell surface points cut at the master grid's planes.
 !> - Active set: primal-dual per contact cell from the first contact (`first_set`:
-!>   the cells with g0 <= h at the smallest gap), one factorization per
+!>   the cells with g0 <= h at the smallest gap; every g0 <= h cell if that
+!>   leaves a body free, `widen_first_set`), one factorization per
 !>   iteration, until the set repeats (else stat_not_converged); a body the
 !>   closed cells and its conditions leave free is stat_singular, named.
 !> - Friction: stick and Coulomb take the cell normal as the mean bisector of the
@@ -233,7 +234,8 @@ module sprc_contact_pair_solve
    type :: pair_work_type
       type(point_operators_type) :: ops
       type(cell_operators_type), allocatable :: cells(:)
-      logical, allocatable :: closed(:)
+      !> The active set, and the candidate cells (g0 <= h) of `first_set`.
+      logical, allocatable :: closed(:), wide(:)
    end type pair_work_type
 
 contains
@@ -300,13 +302,13 @@ contains
       type(csr_type) :: k
       type(timer_type) :: timer
       real(wp), allocatable :: f(:), x(:)
-      logical, allocatable :: closed(:), next(:)
+      logical, allocatable :: closed(:), next(:), wide(:)
       integer, allocatable :: state(:)
       real(wp), allocatable :: slip(:, :), tau(:, :), pstar(:, :)
       type(block_solver_type), target :: own
       type(block_solver_type), pointer :: bs
-      integer :: it, maxit, n, c, switched, stat, last_switched
-      logical :: kept
+      integer :: it, maxit, n, c, switched, stat, last_switched, attempt
+      logical :: kept, again
 
       call check_pair(slave, master, surface, friction, kappa, error)
       if (.not. allocated(error) .and. present(recovered)) call check_recovered(surface, friction, recovered, error)
@@ -324,7 +326,7 @@ contains
             & error)
          if (allocated(error)) return
       end do
-      call first_set(slave, surface, ops, closed)
+      call first_set(slave, surface, ops, closed, wide)
       if (present(recovered)) then
          call cell_tractions(surface, ops, cells, recovered, pstar, error)
          if (allocated(error)) return
@@ -371,22 +373,26 @@ contains
          sol%iterations = it
          call timer%reset()
          call timer%start()
-         if (allocated(ops%owner) .and. .not. present(recovered)) then
-            call cut_edges(surface, ops, cells, closed, friction, error)
-            if (allocated(error)) return
-         end if
-         if (kept) then
-            call factored_solve(slave, master, ops, cells, closed, pstar, names, it, factor, x, sol, error, share, &
-               & bounds)
-         else if (present(recovered)) then
-            call block_system(slave, master, ops, cells, closed, k, f, error, pstar)
-         else if (bs%iterative .and. .not. present(share)) then
-            call kept_system(slave, master, ops, cells, closed, bs, k, f, error)
-         else
-            call block_system(slave, master, ops, cells, closed, k, f, error)
-         end if
-         if (.not. (allocated(error) .or. kept)) &
-            & call check_held(slave, master, k, names, closed_points(ops, closed), it, error, share, bounds)
+         do attempt = 1, 2
+            if (allocated(ops%owner) .and. .not. present(recovered)) then
+               call cut_edges(surface, ops, cells, closed, friction, error)
+               if (allocated(error)) return
+            end if
+            if (kept) then
+               call factored_solve(slave, master, ops, cells, closed, pstar, names, it, factor, x, sol, error, &
+                  & share, bounds)
+            else if (present(recovered)) then
+               call block_system(slave, master, ops, cells, closed, k, f, error, pstar)
+            else if (bs%iterative .and. .not. present(share)) then
+               call kept_system(slave, master, ops, cells, closed, bs, k, f, error)
+            else
+               call block_system(slave, master, ops, cells, closed, k, f, error)
+            end if
+            if (.not. (allocated(error) .or. kept)) &
+               & call check_held(slave, master, k, names, closed_points(ops, closed), it, error, share, bounds)
+            call widen_first_set(it, wide, closed, error, again)
+            if (.not. again) exit
+         end do
          if (.not. (allocated(error) .or. kept)) call solve_block(bs, k, f, x, sol, error)
          call timer%stop()
          sol%t_solve = sol%t_solve + timer%elapsed
@@ -433,23 +439,48 @@ contains
    !> (the round-off of the gaps is eps times the geometry's scale). Closing
    !> every candidate instead ties cells the load never closes, and the
    !> primal-dual iteration then opens them a few per active set; from the
-   !> first contact the penetrating cells close in one set.
-   subroutine first_set(slave, surface, ops, closed)
+   !> first contact the penetrating cells close in one set. `wide` gets the
+   !> candidate cells (`widen_first_set`).
+   subroutine first_set(slave, surface, ops, closed, wide)
       type(elasticity_problem_type), intent(in) :: slave
       type(contact_surface_type), intent(in) :: surface
       type(point_operators_type), intent(in) :: ops
       logical, intent(out) :: closed(:)
+      logical, allocatable, intent(out) :: wide(:)
       real(wp) :: gmin(size(closed)), h(size(closed)), first
       integer :: c
       do c = 1, size(closed)
          gmin(c) = minval(surface%g0(ops%cell_point(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1)))
          h(c) = cell_size(slave, slave%root(surface%slave_cell(ops%cell_point(ops%cell_ptr(c)))))
       end do
-      closed = gmin <= h
+      wide = gmin <= h
+      closed = wide
       if (.not. any(closed)) return
       first = max(minval(gmin, mask=closed), 0.0_wp)
       closed = closed .and. gmin <= first + sqrt(epsilon(1.0_wp))*h
    end subroutine first_set
+
+   !> The first contact need not hold a body that the load closes more
+   !> cells to hold: a wedge pressed into a V-groove touches one flank
+   !> first and, frictionless, slides along it until the other closes. When
+   !> the first active-set iteration's system leaves a body free
+   !> (stat_singular from `check_held`) and the candidate cells `wide` close
+   !> more than `closed`, the iteration starts again, once, from `wide` (the
+   !> primal-dual iteration opens what the load does not close); `again`
+   !> says so and the error is cleared.
+   subroutine widen_first_set(iteration, wide, closed, error, again)
+      integer, intent(in) :: iteration
+      logical, intent(in) :: wide(:)
+      logical, intent(inout) :: closed(:)
+      type(error_type), allocatable, intent(inout) :: error
+      logical, intent(out) :: again
+      again = .false.
+      if (.not. allocated(error) .or. iteration /= 1) return
+      if (error%stat /= stat_singular .or. all(closed .eqv. wide)) return
+      deallocate (error)
+      closed = wide
+      again = .true.
+   end subroutine widen_first_set
 
    !> The points of the closed contact cells.
    !> The linear multiplier's closed nodes act on (and carry pressure at)
@@ -2098,8 +2129,9 @@ contains
       type(timer_type) :: timer
       real(wp), allocatable :: f(:), x(:)
       integer, allocatable :: offset(:)
-      integer :: it, maxit, p, c, switched, b, stat
+      integer :: it, maxit, p, c, switched, b, stat, attempt
       logical, allocatable :: next(:)
+      logical :: again
 
       maxit = default_max_iterations
       if (present(max_iterations)) maxit = max_iterations
@@ -2127,14 +2159,19 @@ contains
          solved%iterations = it
          call timer%reset()
          call timer%start()
-         do p = 1, size(pairs)
-            if (.not. allocated(work(p)%ops%owner)) cycle
-            call cut_edges(pairs(p)%surface, work(p)%ops, work(p)%cells, work(p)%closed, pairs(p)%friction, error)
-            if (allocated(error)) return
+         do attempt = 1, 2
+            do p = 1, size(pairs)
+               if (.not. allocated(work(p)%ops%owner)) cycle
+               call cut_edges(pairs(p)%surface, work(p)%ops, work(p)%cells, work(p)%closed, pairs(p)%friction, &
+                  & error)
+               if (allocated(error)) return
+            end do
+            call assembly_system(bodies, offset, work, k, f, error)
+            if (.not. allocated(error)) call check_held_bodies(bodies, k, &
+               & sum([(closed_points(work(p)%ops, work(p)%closed), p=1, size(pairs))]), it, error)
+            call widen_assembly(it, work, error, again)
+            if (.not. again) exit
          end do
-         call assembly_system(bodies, offset, work, k, f, error)
-         if (.not. allocated(error)) call check_held_bodies(bodies, k, &
-            & sum([(closed_points(work(p)%ops, work(p)%closed), p=1, size(pairs))]), it, error)
          if (.not. allocated(error)) call solve_block(bs, k, f, x, solved, error)
          call timer%stop()
          solved%t_solve = solved%t_solve + timer%elapsed
@@ -2177,6 +2214,24 @@ contains
       end do
    end subroutine solve_contact_assembly
 
+   !> `widen_first_set` for every pair of an assembly: all start again from
+   !> their candidate cells.
+   subroutine widen_assembly(iteration, work, error, again)
+      integer, intent(in) :: iteration
+      type(pair_work_type), intent(inout) :: work(:)
+      type(error_type), allocatable, intent(inout) :: error
+      logical, intent(out) :: again
+      integer :: p
+      again = .false.
+      if (.not. allocated(error) .or. iteration /= 1) return
+      if (error%stat /= stat_singular .or. all([(all(work(p)%closed .eqv. work(p)%wide), p=1, size(work))])) return
+      deallocate (error)
+      do p = 1, size(work)
+         work(p)%closed = work(p)%wide
+      end do
+      again = .true.
+   end subroutine widen_assembly
+
    !> A pair's operators in the assembly's numbering, its cells and first
    !> active set (as `solve_contact_pair`'s).
    subroutine pair_work(bodies, pair, offset, work, error)
@@ -2204,7 +2259,7 @@ contains
             call cell_operators(pair%surface, work%ops, c, pair%friction, work%cells(c), error)
             if (allocated(error)) return
          end do
-         call first_set(slave, pair%surface, work%ops, work%closed)
+         call first_set(slave, pair%surface, work%ops, work%closed, work%wide)
       end associate
    end subroutine pair_work
 
