@@ -232,15 +232,18 @@ contains
    !> (contact radius 0.31, three times the scene's, so the active set grows
    !> from the first contact over several sets): the same report as the
    !> direct solve, and the active-set iterations before the set repeats
-   !> stop at the loose tolerance (sprc_contact_pair_solve's
+   !> stop at the loose tolerances (sprc_contact_pair_solve's
+   !> `changing_set_tolerance` while the set grows, then
    !> `active_set_tolerance`), only the confirming solve at the tight one:
-   !> at most 8 Krylov iterations per active-set iteration on average.
+   !> at most 5 Krylov iterations per active-set iteration on average
+   !> (measured 13 in 3 sets; 21 with every loose solve at
+   !> `active_set_tolerance`).
    subroutine test_hertz_sphere_loose(error)
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: text
 
       call hertz_sphere_text(27.0_wp, text, error)
-      if (.not. allocated(error)) call same_as_direct(text, 3, 'cg+gmg', error, per_solve=8, min_sets=2)
+      if (.not. allocated(error)) call same_as_direct(text, 3, 'cg+gmg', error, per_solve=5, min_sets=2)
    end subroutine test_hertz_sphere_loose
 
    !> The first active set (sprc_contact_pair_solve's `first_set`): the Hertz

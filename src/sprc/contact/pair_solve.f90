@@ -37,7 +37,8 @@
 !>   operators of each new fine matrix, set up anew per active set: a lagged one
 !>   costs CG several times the iterations; on a kept pattern, `kept_system`, only
 !>   the numeric products and coarse factor are redone), warm starts, `contact_tolerance`
-!>   (looser while the set changes: `active_set_tolerance`, `confirm_set`); under
+!>   (looser while the set changes: `changing_set_tolerance`, then
+!>   `active_set_tolerance` once a change does not shrink, `confirm_set`); under
 !>   mpirun (`share`) each rank holds its rows and the solution is gathered.
 !>
 !> Assemblies (`solve_contact_assembly`): several bodies and their pairs in one block
@@ -159,9 +160,11 @@ module sprc_contact_pair_solve
    type :: block_solver_type
       logical :: ready = .false., iterative = .false.
       type(petsc_solver_type) :: krylov
-      !> The Krylov tolerances of the final solve (`contact_tolerance`) and
-      !> of the solves while the active set changes (`active_set_tolerance`).
-      real(wp) :: tight = 0.0_wp, loose = 0.0_wp
+      !> The Krylov tolerances of the final solve (`contact_tolerance`), of
+      !> the solves while the active set changes (`changing_set_tolerance`
+      !> first, `loose` now) and of those once a change did not shrink
+      !> (`active_set_tolerance`).
+      real(wp) :: tight = 0.0_wp, loose = 0.0_wp, careful = 0.0_wp
       !> The cells whose blocks the kept pattern of the iterative block
       !> system holds, and both bodies' K on it (`kept_system`).
       logical, allocatable :: cover(:)
@@ -346,6 +349,8 @@ contains
       call check_allocation(stat, 'contact solve', 'the solution of both bodies', n, 8, error)
       if (.not. allocated(error)) call block_solver_setup(slave, master, ops, kappa, bs, error)
       if (allocated(error)) return
+      ! from every candidate (an interference fit) the set does not grow by rows: `changing_set_tolerance`
+      if (all(closed .eqv. wide)) bs%loose = bs%careful
       if (present(share) .and. (friction == friction_coulomb .or. .not. bs%iterative)) then
          call fatal_error(error, 'contact solve: a block system whose rows are shared out among ranks needs the '// &
             & 'iterative solver and frictionless or stick contact', stat_invalid_input)
@@ -415,8 +420,8 @@ contains
          end if
          if (present(progress)) call progress(1, 1, it, switched)
          if (switched == 0) exit
-         ! loose solves that do not shrink the change of the set: tight ones from here on
-         if (switched >= last_switched) bs%loose = bs%tight
+         ! loose solves that do not shrink the change of the set: tighter ones from here on
+         if (switched >= last_switched) bs%loose = merge(bs%careful, bs%tight, bs%loose > bs%careful)
          last_switched = switched
          closed = next
          if (it == maxit) then
@@ -1809,7 +1814,8 @@ contains
       end associate
       h_over_l = 0.5_wp**max(slave%mesh%grid%max_level, master%mesh%grid%max_level)
       bs%tight = contact_tolerance(h_over_l, slave%degree, slave%dim, kappa)
-      bs%loose = max(active_set_tolerance(h_over_l, slave%dim, kappa), bs%tight)
+      bs%careful = max(active_set_tolerance(h_over_l, slave%dim, kappa), bs%tight)
+      bs%loose = max(changing_set_tolerance(h_over_l, slave%dim), bs%careful)
       bs%krylov%tolerance = bs%tight
    end subroutine block_solver_setup
 
@@ -1854,8 +1860,26 @@ contains
    pure real(wp) function active_set_tolerance(h_over_l, dim, kappa) result(tau)
       real(wp), intent(in) :: h_over_l, kappa
       integer, intent(in) :: dim
-      tau = 1.0e-2_wp*h_over_l**(0.5_wp*dim)/max(kappa, 1.0_wp)
+      tau = changing_set_tolerance(h_over_l, dim)/max(kappa, 1.0_wp)
    end function active_set_tolerance
+
+   !> The Krylov tolerance of the first active-set iterations when the
+   !> first set is a part of the candidates (`first_set`: the set then
+   !> grows from the first contact by rows of cells): `active_set_tolerance`
+   !> without its 1/kappa, 1e-2 (h/L)^(d/2), which keeps the slave's
+   !> traction pbar of a cell within about 1 % of the stress scale but not
+   !> the kappa-amplified gap term gamma gbar, so it may misplace cells
+   !> near the sign change, which the next sets correct. Once a change of
+   !> the set does not shrink, the solves go to `active_set_tolerance`; a
+   !> first set of every candidate (an interference fit, every cell closed
+   !> from the start, whose cells flip at this tolerance) starts there; the
+   !> final set is confirmed at `contact_tolerance` in any case
+   !> (`confirm_set`).
+   pure real(wp) function changing_set_tolerance(h_over_l, dim) result(tau)
+      real(wp), intent(in) :: h_over_l
+      integer, intent(in) :: dim
+      tau = 1.0e-2_wp*h_over_l**(0.5_wp*dim)
+   end function changing_set_tolerance
 
    !> The points whose contact cell changes state from `closed` to `next`.
    pure integer function switched_points(ops, closed, next) result(switched)
