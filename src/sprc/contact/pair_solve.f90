@@ -347,7 +347,11 @@ contains
       n = slave%n_dofs() + master%n_dofs()
       allocate (x(n), source=0.0_wp, stat=stat)
       call check_allocation(stat, 'contact solve', 'the solution of both bodies', n, 8, error)
+      call timer%reset()
+      call timer%start()
       if (.not. allocated(error)) call block_solver_setup(slave, master, ops, kappa, bs, error)
+      call timer%stop()
+      sol%t_solve = timer%elapsed
       if (allocated(error)) return
       ! from every candidate (an interference fit) the set does not grow by rows: `changing_set_tolerance`
       if (all(closed .eqv. wide)) bs%loose = bs%careful
@@ -415,7 +419,11 @@ contains
          call timer%stop()
          sol%t_contact = sol%t_contact + timer%elapsed
          if (switched == 0 .and. .not. kept .and. bs%iterative .and. bs%krylov%tolerance > bs%tight) then
+            call timer%reset()
+            call timer%start()
             call confirm_set(surface, ops, cells, closed, bs, f, x, sol, next, switched, error, pstar)
+            call timer%stop()
+            sol%t_solve = sol%t_solve + timer%elapsed
             if (allocated(error)) return
          end if
          if (present(progress)) call progress(1, 1, it, switched)
