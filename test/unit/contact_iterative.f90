@@ -298,13 +298,14 @@ contains
          & "stabilization='recovered'"), 4, 'cg+gmg', error)
    end subroutine test_recovered
 
-   !> 'auto' for a contact pair's coupled system: iterative from 60,000
+   !> 'auto' for a contact pair's coupled system: iterative from 100,000
    !> unknowns in 3D Q1 (one body: 25,000), never in 2D or for Q2 unless the
    !> direct solve does not fit; 'direct' stays direct.
    subroutine test_auto_rule(error)
       type(error_type), allocatable, intent(out) :: error
       call check(error, use_iterative(solver_auto, 3, 1, 30000) .and. .not. use_iterative(solver_auto, 3, 1, 30000, &
-         & coupled=.true.) .and. use_iterative(solver_auto, 3, 1, 60000, coupled=.true.) .and. .not. &
+         & coupled=.true.) .and. .not. use_iterative(solver_auto, 3, 1, 96258, coupled=.true.) .and. &
+         & use_iterative(solver_auto, 3, 1, 100000, coupled=.true.) .and. .not. &
          & use_iterative(solver_auto, 2, 1, 10**8, coupled=.true.) .and. .not. use_iterative(solver_auto, 3, 2, 10**8, &
          & coupled=.true.) .and. use_iterative(solver_auto, 3, 2, 100, direct_fits=.false., coupled=.true.) .and. &
          & .not. use_iterative(solver_direct, 3, 1, 10**8, coupled=.true.), 'the coupled thresholds')
