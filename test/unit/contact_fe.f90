@@ -50,6 +50,9 @@ contains
          new_unittest('patch_2d_stick_linear', test_patch_2d_stick_linear), &
          new_unittest('patch_3d_q1_linear', test_patch_3d_q1_linear), &
          new_unittest('lost_contact_names_body', test_lost_contact), &
+         new_unittest('vee_groove_held_by_both_flanks', test_vee_groove), &
+         new_unittest('vee_groove_linear_multiplier', test_vee_groove_linear), &
+         new_unittest('vee_groove_assembly_with_lid', test_vee_groove_lid), &
          new_unittest('shrink_fit_q1_plane_strain', test_shrink_q1), &
          new_unittest('shrink_fit_q2_plane_stress_ratio_1000', test_shrink_q2), &
          new_unittest('shrink_fit_q1_plane_stress_ratio_1000', test_shrink_q1_stress), &
@@ -407,6 +410,103 @@ contains
       call check(error, index(failed%message, "body 'upper' is not held: translation y") > 0, &
          & 'message: '//failed%message)
    end subroutine test_lost_contact
+
+   !> A wedge pressed into a V-groove (test/data/contact/vee_groove.nml)
+   !> touches one flank first and is held only once both are closed: the
+   !> first active set (its first contact, one flank) leaves it free to
+   !> slide, and the solve must start again from every candidate cell
+   !> rather than report it not held. Level 4: three contact cells per
+   !> flank (at level 3 one per flank, whose mean gaps leave the rotation
+   !> free). Every point closed, and equilibrium, which the discrete system
+   !> keeps exactly (the slave's rigid translations are in its FE space and
+   !> carry no stress; the load, normal to the top, has no x part): the two
+   !> flanks' normal forces equal to a sqrt(eps) tier (x), each positive,
+   !> and their sum within 1 % of the load's normal share 2 (1.79/sqrt(2))
+   !> (y: the discrete load is the pressure over the top edge as the cut
+   !> cells locate its ends, not exactly 1.79).
+   subroutine test_vee_groove(error)
+      type(error_type), allocatable, intent(out) :: error
+      call vee_groove_case('', 4, error)
+   end subroutine test_vee_groove
+
+   !> The same with the linear multiplier (its closed nodes' hats are cut
+   !> anew for the widened set), at level 5: at level 4 its four nodes, two
+   !> per flank, leave the wedge free even with every node closed.
+   subroutine test_vee_groove_linear(error)
+      type(error_type), allocatable, intent(out) :: error
+      call vee_groove_case(" multiplier='linear'", 5, error)
+   end subroutine test_vee_groove_linear
+
+   !> The same wedge under a lid that carries the pressure (three bodies,
+   !> two pairs: `solve_contact_assembly`): the lid, held in x by a
+   !> symmetry condition on its left side, follows the wedge down as it
+   !> slides along the first flank, so the assembly's first set leaves both
+   !> free. Both flanks close and carry the load: the lid's force is its
+   !> pressure over its top, 1.6, and
+   !> the flanks' forces are equal and sum to 1.6 sqrt(2) to a sqrt(eps)
+   !> tier.
+   subroutine test_vee_groove_lid(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(level_type) :: result
+      character(len=:), allocatable :: text
+      real(wp) :: force(2), share
+      integer :: side
+
+      call read_text_file('test/data/contact/vee_groove.nml', text, error)
+      if (allocated(error)) return
+      text = replaced(text, "&bc    on='wedge_top'  type='pressure' value=1.0 /", &
+         & "&body  name='lid' young=1.0 poisson=0.3 box_min=-0.85, 0.85 box_size=1.7 /"//nl// &
+         & "&shape body='lid' op='add' kind='box' name='lid_box' lower=-1,0.5 upper=0.8,1.5 /"//nl// &
+         & "&shape body='lid' op='intersect' kind='halfspace' name='lid_left' point=-0.8,0 normal=-1,0 /"//nl// &
+         & "&shape body='lid' op='intersect' kind='halfspace' name='lid_top' point=0,1.1 normal=0,1 /"//nl// &
+         & "&shape body='lid' op='intersect' kind='halfspace' name='lid_bottom' point=0,0.9 normal=0,-1 /"//nl// &
+         & "&bc    on='lid_left' type='symmetry' /"//nl// &
+         & "&bc    on='lid_top'  type='pressure' value=1.0 /"//nl// &
+         & "&contact slave='lid' master='wedge' slave_surface='lid_bottom' master_surface='wedge_top' /")
+      call run_text(text, 4, result, error)
+      if (allocated(error)) return
+      ! the lid's pair comes first in the scene
+      associate (c => result%contacts(2))
+         call check(error, all(c%state /= contact_open), itoa(count(c%state == contact_open))//' points open')
+         if (allocated(error)) return
+         share = 1.6_wp/sqrt(2.0_wp)
+         do side = 1, 2
+            force(side) = sum(c%p_fe*c%weight, mask=merge(c%normal(1, :) < 0.0_wp, c%normal(1, :) > 0.0_wp, &
+               & side == 1))
+         end do
+         call check(error, maxval(abs(force - share)) <= sqrt(epsilon(1.0_wp))*share, 'flank forces '// &
+            & real_text(force(1))//', '//real_text(force(2))//' (expected '//real_text(share)//' each)')
+      end associate
+   end subroutine test_vee_groove_lid
+
+   subroutine vee_groove_case(keys, level, error)
+      character(len=*), intent(in) :: keys
+      integer, intent(in) :: level
+      type(error_type), allocatable, intent(out) :: error
+      type(level_type) :: result
+      character(len=:), allocatable :: text
+      real(wp) :: force(2), share
+      integer :: side
+
+      call read_text_file('test/data/contact/vee_groove.nml', text, error)
+      if (allocated(error)) return
+      text = replaced(text, "friction='frictionless'", "friction='frictionless'"//keys)
+      call run_text(text, level, result, error)
+      if (allocated(error)) return
+      associate (c => result%contacts(1))
+         call check(error, all(c%state /= contact_open), itoa(count(c%state == contact_open))//' points open')
+         if (allocated(error)) return
+         share = 1.79_wp/sqrt(2.0_wp)
+         do side = 1, 2
+            ! left flank: outward slave normal (-1, -1)/sqrt(2); right: (1, -1)/sqrt(2)
+            force(side) = sum(c%p_fe*c%weight, mask=merge(c%normal(1, :) < 0.0_wp, c%normal(1, :) > 0.0_wp, &
+               & side == 1))
+         end do
+         call check(error, abs(force(1) - force(2)) <= sqrt(epsilon(1.0_wp))*share .and. all(force > 0.0_wp) .and. &
+            & abs(sum(force) - 2.0_wp*share) <= 1.0e-2_wp*share, 'flank forces '//real_text(force(1))//', '// &
+            & real_text(force(2))//' (expected '//real_text(share)//' each)')
+      end associate
+   end subroutine vee_groove_case
 
    !> Shrink fit (compound cylinder, quarter model): shaft 1 < r < 1.5 + delta
    !> pressed into a hub 1.5 < r < 2 (radial interference delta = 1e-5, small so

@@ -20,7 +20,8 @@
 !>   surface is in the space (a Cartesian constant costs Q2 its order).
 !> - Points: the slave's cut-cell surface points cut at the master grid's planes.
 !> - Active set: primal-dual per contact cell from the first contact (`first_set`:
-!>   the cells with g0 <= h at the smallest gap), one factorization per
+!>   the cells with g0 <= h at the smallest gap; every g0 <= h cell if that
+!>   leaves a body free, `widen_first_set`), one factorization per
 !>   iteration, until the set repeats (else stat_not_converged); a body the
 !>   closed cells and its conditions leave free is stat_singular, named.
 !> - Friction: stick and Coulomb take the cell normal as the mean bisector of the
@@ -37,7 +38,8 @@
 !>   operators of each new fine matrix, set up anew per active set: a lagged one
 !>   costs CG several times the iterations; on a kept pattern, `kept_system`, only
 !>   the numeric products and coarse factor are redone), warm starts, `contact_tolerance`
-!>   (looser while the set changes: `active_set_tolerance`, `confirm_set`); under
+!>   (looser while the set changes: `changing_set_tolerance`, then
+!>   `active_set_tolerance` once a change does not shrink, `confirm_set`); under
 !>   mpirun (`share`) each rank holds its rows and the solution is gathered.
 !>
 !> Assemblies (`solve_contact_assembly`): several bodies and their pairs in one block
@@ -165,9 +167,11 @@ module sprc_contact_pair_solve
    type :: block_solver_type
       logical :: ready = .false., iterative = .false.
       type(petsc_solver_type) :: krylov
-      !> The Krylov tolerances of the final solve (`contact_tolerance`) and
-      !> of the solves while the active set changes (`active_set_tolerance`).
-      real(wp) :: tight = 0.0_wp, loose = 0.0_wp
+      !> The Krylov tolerances of the final solve (`contact_tolerance`), of
+      !> the solves while the active set changes (`changing_set_tolerance`
+      !> first, `loose` now) and of those once a change did not shrink
+      !> (`active_set_tolerance`).
+      real(wp) :: tight = 0.0_wp, loose = 0.0_wp, careful = 0.0_wp
       !> The cells whose blocks the kept pattern of the iterative block
       !> system holds, and both bodies' K on it (`kept_system`).
       logical, allocatable :: cover(:)
@@ -240,7 +244,8 @@ module sprc_contact_pair_solve
    type :: pair_work_type
       type(point_operators_type) :: ops
       type(cell_operators_type), allocatable :: cells(:)
-      logical, allocatable :: closed(:)
+      !> The active set, and the candidate cells (g0 <= h) of `first_set`.
+      logical, allocatable :: closed(:), wide(:)
    end type pair_work_type
 
 contains
@@ -307,13 +312,13 @@ contains
       type(csr_type) :: k
       type(timer_type) :: timer
       real(wp), allocatable :: f(:), x(:)
-      logical, allocatable :: closed(:), next(:)
+      logical, allocatable :: closed(:), next(:), wide(:)
       integer, allocatable :: state(:)
       real(wp), allocatable :: slip(:, :), tau(:, :), pstar(:, :)
       type(block_solver_type), target :: own
       type(block_solver_type), pointer :: bs
-      integer :: it, maxit, n, c, switched, stat, last_switched
-      logical :: kept
+      integer :: it, maxit, n, c, switched, stat, last_switched, attempt
+      logical :: kept, again
 
       call check_pair(slave, master, surface, friction, kappa, error)
       if (.not. allocated(error) .and. present(recovered)) call check_recovered(surface, friction, recovered, error)
@@ -331,7 +336,7 @@ contains
             & error)
          if (allocated(error)) return
       end do
-      call first_set(slave, surface, ops, closed)
+      call first_set(slave, surface, ops, closed, wide)
       if (present(recovered)) then
          call cell_tractions(surface, ops, cells, recovered, pstar, error)
          if (allocated(error)) return
@@ -349,8 +354,14 @@ contains
       n = slave%n_dofs() + master%n_dofs()
       allocate (x(n), source=0.0_wp, stat=stat)
       call check_allocation(stat, 'contact solve', 'the solution of both bodies', n, 8, error)
+      call timer%reset()
+      call timer%start()
       if (.not. allocated(error)) call block_solver_setup(slave, master, ops, kappa, bs, error)
+      call timer%stop()
+      sol%t_solve = timer%elapsed
       if (allocated(error)) return
+      ! from every candidate (an interference fit) the set does not grow by rows: `changing_set_tolerance`
+      if (all(closed .eqv. wide)) bs%loose = bs%careful
       if (present(share) .and. (friction == friction_coulomb .or. .not. bs%iterative)) then
          call fatal_error(error, 'contact solve: a block system whose rows are shared out among ranks needs the '// &
             & 'iterative solver and frictionless or stick contact', stat_invalid_input)
@@ -378,22 +389,28 @@ contains
          sol%iterations = it
          call timer%reset()
          call timer%start()
-         if (allocated(ops%owner) .and. .not. present(recovered)) then
-            call cut_edges(surface, ops, cells, closed, friction, error)
-            if (allocated(error)) return
-         end if
-         if (kept) then
-            call factored_solve(slave, master, ops, cells, closed, pstar, names, it, factor, x, sol, error, share, &
-               & bounds)
-         else if (present(recovered)) then
-            call block_system(slave, master, ops, cells, closed, k, f, error, pstar)
-         else if (bs%iterative .and. .not. present(share)) then
-            call kept_system(slave, master, ops, cells, closed, bs, k, f, error)
-         else
-            call block_system(slave, master, ops, cells, closed, k, f, error)
-         end if
-         if (.not. (allocated(error) .or. kept)) &
-            & call check_held(slave, master, k, names, closed_points(ops, closed), it, error, share, bounds)
+         do attempt = 1, 2
+            if (allocated(ops%owner) .and. .not. present(recovered)) then
+               call cut_edges(surface, ops, cells, closed, friction, error)
+               if (allocated(error)) return
+            end if
+            if (kept) then
+               call factored_solve(slave, master, ops, cells, closed, pstar, names, it, factor, x, sol, error, &
+                  & share, bounds)
+            else if (present(recovered)) then
+               call block_system(slave, master, ops, cells, closed, k, f, error, pstar)
+            else if (bs%iterative .and. .not. present(share)) then
+               call kept_system(slave, master, ops, cells, closed, bs, k, f, error)
+            else
+               call block_system(slave, master, ops, cells, closed, k, f, error)
+            end if
+            if (.not. (allocated(error) .or. kept)) &
+               & call check_held(slave, master, k, names, closed_points(ops, closed), it, error, share, bounds)
+            call widen_first_set(it, wide, closed, error, again)
+            if (.not. again) exit
+            ! the linear multiplier's point states follow the widened cells (`cut_edges`)
+            if (allocated(ops%pclosed)) deallocate (ops%pclosed)
+         end do
          if (.not. (allocated(error) .or. kept)) call solve_block(bs, k, f, x, sol, error)
          call timer%stop()
          sol%t_solve = sol%t_solve + timer%elapsed
@@ -410,13 +427,17 @@ contains
          call timer%stop()
          sol%t_contact = sol%t_contact + timer%elapsed
          if (switched == 0 .and. .not. kept .and. bs%iterative .and. bs%krylov%tolerance > bs%tight) then
+            call timer%reset()
+            call timer%start()
             call confirm_set(surface, ops, cells, closed, bs, f, x, sol, next, switched, error, pstar)
+            call timer%stop()
+            sol%t_solve = sol%t_solve + timer%elapsed
             if (allocated(error)) return
          end if
          if (present(progress)) call progress(1, 1, it, switched)
          if (switched == 0) exit
-         ! loose solves that do not shrink the change of the set: tight ones from here on
-         if (switched >= last_switched) bs%loose = bs%tight
+         ! loose solves that do not shrink the change of the set: tighter ones from here on
+         if (switched >= last_switched) bs%loose = merge(bs%careful, bs%tight, bs%loose > bs%careful)
          last_switched = switched
          closed = next
          if (allocated(ops%pnext)) ops%pclosed = ops%pnext
@@ -440,23 +461,48 @@ contains
    !> (the round-off of the gaps is eps times the geometry's scale). Closing
    !> every candidate instead ties cells the load never closes, and the
    !> primal-dual iteration then opens them a few per active set; from the
-   !> first contact the penetrating cells close in one set.
-   subroutine first_set(slave, surface, ops, closed)
+   !> first contact the penetrating cells close in one set. `wide` gets the
+   !> candidate cells (`widen_first_set`).
+   subroutine first_set(slave, surface, ops, closed, wide)
       type(elasticity_problem_type), intent(in) :: slave
       type(contact_surface_type), intent(in) :: surface
       type(point_operators_type), intent(in) :: ops
       logical, intent(out) :: closed(:)
+      logical, allocatable, intent(out) :: wide(:)
       real(wp) :: gmin(size(closed)), h(size(closed)), first
       integer :: c
       do c = 1, size(closed)
          gmin(c) = minval(surface%g0(ops%cell_point(ops%cell_ptr(c):ops%cell_ptr(c + 1) - 1)))
          h(c) = cell_size(slave, slave%root(surface%slave_cell(ops%cell_point(ops%cell_ptr(c)))))
       end do
-      closed = gmin <= h
+      wide = gmin <= h
+      closed = wide
       if (.not. any(closed)) return
       first = max(minval(gmin, mask=closed), 0.0_wp)
       closed = closed .and. gmin <= first + sqrt(epsilon(1.0_wp))*h
    end subroutine first_set
+
+   !> The first contact need not hold a body that the load closes more
+   !> cells to hold: a wedge pressed into a V-groove touches one flank
+   !> first and, frictionless, slides along it until the other closes. When
+   !> the first active-set iteration's system leaves a body free
+   !> (stat_singular from `check_held`) and the candidate cells `wide` close
+   !> more than `closed`, the iteration starts again, once, from `wide` (the
+   !> primal-dual iteration opens what the load does not close); `again`
+   !> says so and the error is cleared.
+   subroutine widen_first_set(iteration, wide, closed, error, again)
+      integer, intent(in) :: iteration
+      logical, intent(in) :: wide(:)
+      logical, intent(inout) :: closed(:)
+      type(error_type), allocatable, intent(inout) :: error
+      logical, intent(out) :: again
+      again = .false.
+      if (.not. allocated(error) .or. iteration /= 1) return
+      if (error%stat /= stat_singular .or. all(closed .eqv. wide)) return
+      deallocate (error)
+      closed = wide
+      again = .true.
+   end subroutine widen_first_set
 
    !> The linear multiplier's active set is per point (`next_set`): a node
    !> is closed when a point of its hat is, and acts on (carries pressure
@@ -1790,7 +1836,8 @@ contains
       end associate
       h_over_l = 0.5_wp**max(slave%mesh%grid%max_level, master%mesh%grid%max_level)
       bs%tight = contact_tolerance(h_over_l, slave%degree, slave%dim, kappa)
-      bs%loose = max(active_set_tolerance(h_over_l, slave%dim, kappa), bs%tight)
+      bs%careful = max(active_set_tolerance(h_over_l, slave%dim, kappa), bs%tight)
+      bs%loose = max(changing_set_tolerance(h_over_l, slave%dim), bs%careful)
       bs%krylov%tolerance = bs%tight
    end subroutine block_solver_setup
 
@@ -1835,8 +1882,26 @@ contains
    pure real(wp) function active_set_tolerance(h_over_l, dim, kappa) result(tau)
       real(wp), intent(in) :: h_over_l, kappa
       integer, intent(in) :: dim
-      tau = 1.0e-2_wp*h_over_l**(0.5_wp*dim)/max(kappa, 1.0_wp)
+      tau = changing_set_tolerance(h_over_l, dim)/max(kappa, 1.0_wp)
    end function active_set_tolerance
+
+   !> The Krylov tolerance of the first active-set iterations when the
+   !> first set is a part of the candidates (`first_set`: the set then
+   !> grows from the first contact by rows of cells): `active_set_tolerance`
+   !> without its 1/kappa, 1e-2 (h/L)^(d/2), which keeps the slave's
+   !> traction pbar of a cell within about 1 % of the stress scale but not
+   !> the kappa-amplified gap term gamma gbar, so it may misplace cells
+   !> near the sign change, which the next sets correct. Once a change of
+   !> the set does not shrink, the solves go to `active_set_tolerance`; a
+   !> first set of every candidate (an interference fit, every cell closed
+   !> from the start, whose cells flip at this tolerance) starts there; the
+   !> final set is confirmed at `contact_tolerance` in any case
+   !> (`confirm_set`).
+   pure real(wp) function changing_set_tolerance(h_over_l, dim) result(tau)
+      real(wp), intent(in) :: h_over_l
+      integer, intent(in) :: dim
+      tau = 1.0e-2_wp*h_over_l**(0.5_wp*dim)
+   end function changing_set_tolerance
 
    !> The points whose contact cell changes state from `closed` to `next`.
    pure integer function switched_points(ops, closed, next) result(switched)
@@ -2186,8 +2251,9 @@ contains
       type(timer_type) :: timer
       real(wp), allocatable :: f(:), x(:)
       integer, allocatable :: offset(:)
-      integer :: it, maxit, p, c, switched, b, stat, moved
+      integer :: it, maxit, p, c, switched, b, stat, moved, attempt
       logical, allocatable :: next(:)
+      logical :: again
 
       maxit = default_max_iterations
       if (present(max_iterations)) maxit = max_iterations
@@ -2215,14 +2281,19 @@ contains
          solved%iterations = it
          call timer%reset()
          call timer%start()
-         do p = 1, size(pairs)
-            if (.not. allocated(work(p)%ops%owner)) cycle
-            call cut_edges(pairs(p)%surface, work(p)%ops, work(p)%cells, work(p)%closed, pairs(p)%friction, error)
-            if (allocated(error)) return
+         do attempt = 1, 2
+            do p = 1, size(pairs)
+               if (.not. allocated(work(p)%ops%owner)) cycle
+               call cut_edges(pairs(p)%surface, work(p)%ops, work(p)%cells, work(p)%closed, pairs(p)%friction, &
+                  & error)
+               if (allocated(error)) return
+            end do
+            call assembly_system(bodies, offset, work, k, f, error)
+            if (.not. allocated(error)) call check_held_bodies(bodies, k, &
+               & sum([(closed_points(work(p)%ops, work(p)%closed), p=1, size(pairs))]), it, error)
+            call widen_assembly(it, work, error, again)
+            if (.not. again) exit
          end do
-         call assembly_system(bodies, offset, work, k, f, error)
-         if (.not. allocated(error)) call check_held_bodies(bodies, k, &
-            & sum([(closed_points(work(p)%ops, work(p)%closed), p=1, size(pairs))]), it, error)
          if (.not. allocated(error)) call solve_block(bs, k, f, x, solved, error)
          call timer%stop()
          solved%t_solve = solved%t_solve + timer%elapsed
@@ -2266,6 +2337,26 @@ contains
       end do
    end subroutine solve_contact_assembly
 
+   !> `widen_first_set` for every pair of an assembly: all start again from
+   !> their candidate cells.
+   subroutine widen_assembly(iteration, work, error, again)
+      integer, intent(in) :: iteration
+      type(pair_work_type), intent(inout) :: work(:)
+      type(error_type), allocatable, intent(inout) :: error
+      logical, intent(out) :: again
+      integer :: p
+      again = .false.
+      if (.not. allocated(error) .or. iteration /= 1) return
+      if (error%stat /= stat_singular .or. all([(all(work(p)%closed .eqv. work(p)%wide), p=1, size(work))])) return
+      deallocate (error)
+      do p = 1, size(work)
+         work(p)%closed = work(p)%wide
+         ! the linear multiplier's point states follow the widened cells (`cut_edges`)
+         if (allocated(work(p)%ops%pclosed)) deallocate (work(p)%ops%pclosed)
+      end do
+      again = .true.
+   end subroutine widen_assembly
+
    !> A pair's operators in the assembly's numbering, its cells and first
    !> active set (as `solve_contact_pair`'s).
    subroutine pair_work(bodies, pair, offset, work, error)
@@ -2293,7 +2384,7 @@ contains
             call cell_operators(pair%surface, work%ops, c, pair%friction, work%cells(c), error)
             if (allocated(error)) return
          end do
-         call first_set(slave, pair%surface, work%ops, work%closed)
+         call first_set(slave, pair%surface, work%ops, work%closed, work%wide)
       end associate
    end subroutine pair_work
 
