@@ -1,14 +1,15 @@
 #!/usr/bin/env python3
 """Optional yardstick (never in `make test`): MFEM's Zienkiewicz-Zhu estimator, timed on the
 quarter annulus 5 <= r <= 20 of N x N quad4 elements used by example/bench/bench_mesh_recovery,
-or (word `square`) on its axis-aligned N x N unit square (`quad4 squareN` there).
+or (word `square`) on its axis-aligned N x N unit square (`quad4 squareN` there), or (word
+`cube`) on its N^3 hex8 lattice of the unit cube (`hex8 cubeN` there: ties in every coordinate).
 
 Needs PyMFEM (`pip install mfem`, serial). The displacement is the Lame solution interpolated at
 the nodes (pressure 1 inside, E = 1000, nu = 0.3, plane strain), so the estimator sees the same
 kind of field as sprc's benchmark. MFEM's flux space is H1 of the same order, as in its example 21.
 On the square the displacement is the smooth field u = 1e-3 (x^2 y, x y^2 + x) (no Lame solution
-there: the square holds the origin).
-Usage: OMP_NUM_THREADS=1 python3 tools/bench-mfem-zz.py [N [RUNS [annulus|square]]]  (an N x N mesh;
+there: the square holds the origin); on the cube u = 1e-3 (x^2 y, y^2 z + x, z^2 x + y).
+Usage: OMP_NUM_THREADS=1 python3 tools/bench-mfem-zz.py [N [RUNS [annulus|square|cube]]]  (an N x N mesh;
 default 512, 5 runs, the annulus).
 Compare its cpu median with the cpu column of bench_mesh_recovery: on a shared machine CPU time is
 the figure that load does not inflate.
@@ -65,6 +66,17 @@ class Smooth(mfem.VectorPyCoefficient):
         return [1e-3 * x[0] ** 2 * x[1], 1e-3 * (x[0] * x[1] ** 2 + x[0])]
 
 
+def cube(n):
+    return mfem.Mesh.MakeCartesian3D(n, n, n, mfem.Element.HEXAHEDRON, 1.0, 1.0, 1.0)
+
+
+class Smooth3(mfem.VectorPyCoefficient):
+    """A smooth displacement on the unit cube."""
+
+    def EvalValue(self, x):
+        return [1e-3 * x[0] ** 2 * x[1], 1e-3 * (x[1] ** 2 * x[2] + x[0]), 1e-3 * (x[2] ** 2 * x[0] + x[1])]
+
+
 class Lame(mfem.VectorPyCoefficient):
     """Plane-strain Lame displacement of the thick cylinder under unit inner pressure."""
 
@@ -80,16 +92,17 @@ def main():
     n = int(sys.argv[1]) if len(sys.argv) > 1 else 512
     runs = int(sys.argv[2]) if len(sys.argv) > 2 else 5
     kind = sys.argv[3] if len(sys.argv) > 3 else "annulus"
-    mesh = square(n) if kind == "square" else annulus(n, n)
-    fec = mfem.H1_FECollection(1, 2)
-    fes = mfem.FiniteElementSpace(mesh, fec, 2)
+    dim = 3 if kind == "cube" else 2
+    mesh = {"square": square, "cube": cube}.get(kind, lambda m: annulus(m, m))(n)
+    fec = mfem.H1_FECollection(1, dim)
+    fes = mfem.FiniteElementSpace(mesh, fec, dim)
     u = mfem.GridFunction(fes)
-    u.ProjectCoefficient(Smooth(2) if kind == "square" else Lame(2))
+    u.ProjectCoefficient({"square": Smooth(2), "cube": Smooth3(3)}.get(kind, Lame(2)))
     lam = YOUNG * NU / ((1 + NU) * (1 - 2 * NU))
     mu = YOUNG / (2 * (1 + NU))
     lam_c, mu_c = mfem.ConstantCoefficient(lam), mfem.ConstantCoefficient(mu)
     integ = mfem.ElasticityIntegrator(lam_c, mu_c)
-    flux_fes = mfem.FiniteElementSpace(mesh, fec, 3)
+    flux_fes = mfem.FiniteElementSpace(mesh, fec, dim * (dim + 1) // 2)
     times, cpus = [], []
     for _ in range(runs):
         est = mfem.ZienkiewiczZhuEstimator(integ, u, flux_fes)
@@ -100,7 +113,7 @@ def main():
         total = est.GetTotalError()
     print("scope: est.GetLocalErrors() only (element fluxes from u, nodal averaging, element errors); "
           "mesh topology, FE spaces and u built before the clock")
-    print(f"MFEM ZZ, {kind}, {mesh.GetNE()} quad4: median {1e3 * float(np.median(times)):.1f} ms "
+    print(f"MFEM ZZ, {kind}, {mesh.GetNE()} {'hex8' if dim == 3 else 'quad4'}: median {1e3 * float(np.median(times)):.1f} ms "
           f"(min {1e3 * min(times):.1f}, max {1e3 * max(times):.1f}), cpu median {1e3 * float(np.median(cpus)):.1f} ms, "
           f"over {runs} runs; eta = {total:.6e}")
 
