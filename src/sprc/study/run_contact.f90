@@ -28,7 +28,7 @@ module sprc_study_run_contact
    use sprc_study_run_estimate, only: recover_body
    use sprc_study_run_bodies, only: exact_error, stage_load
    use sprc_study_run_contact_recovery, only: stabilize_recovered, finish_pair, pair_contact, &
-      & recovered_tractions, contact_result
+      & recovered_tractions, contact_result, pair_edges_type, pair_edges
    implicit none
    private
 
@@ -310,6 +310,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(recovery_input_type), allocatable :: inputs(:)
       type(grid_contact_type), allocatable :: contacts(:)
+      type(pair_edges_type), allocatable :: edges(:)
       integer :: j, b, p, n, side, other
 
       allocate (inputs(size(members)))
@@ -323,6 +324,14 @@ contains
          end if
       end do
       if (.not. any(study%run)) return
+      ! each pair's contact edges once, for both of its sides
+      allocate (edges(size(ks)))
+      do p = 1, size(ks)
+         call pair_edges(study, study%scene%contacts(ks(p)), pairs(p)%surface, results(ks(p)), &
+            & bodies(members(pairs(p)%slave))%problem%mesh%nodes, inputs(pairs(p)%slave), inputs(pairs(p)%master), &
+            & edges(p), error)
+         if (allocated(error)) return
+      end do
       do j = 1, size(members)
          b = members(j)
          allocate (contacts(count(pairs%slave == j) + count(pairs%master == j)))
@@ -340,7 +349,7 @@ contains
             n = n + 1
             call pair_contact(study, study%scene%contacts(ks(p)), pairs(p)%surface, results(ks(p)), side, inputs(j), &
                & bodies(b)%problem%mesh%nodes, inputs(other), contacts(n), error, &
-               & bodies(members(other))%problem%mesh%nodes)
+               & bodies(members(other))%problem%mesh%nodes, edges(p))
             if (allocated(error)) exit
          end do
          if (.not. allocated(error)) call recover_body(study, study%bodies(b), bodies(b), inputs(j), error, contacts)

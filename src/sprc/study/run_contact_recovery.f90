@@ -34,6 +34,14 @@ module sprc_study_run_contact_recovery
    private
 
    public :: stabilize_recovered, finish_pair, pair_contact, recovered_tractions, contact_result, paired_point
+   public :: pair_edges_type, pair_edges
+
+   !> The fitted contact edges of a pair (`pair_edges`), computed once and given to both
+   !> sides' `pair_contact`; not allocated where the pair has no edge field (3D, friction,
+   !> `edges = .false.`).
+   type :: pair_edges_type
+      type(contact_edge_type), allocatable :: edges(:)
+   end type pair_edges_type
 
    !> The range of a contact edge along its tangent, in slave cells from the midpoint of the
    !> last closed and the first open slave point (`contact_edges`): the multiplier is constant
@@ -153,6 +161,7 @@ contains
       type(recovery_input_type) :: inputs(2)
       type(contact_result_type) :: result
       type(grid_contact_type) :: contact(1)
+      type(pair_edges_type) :: edges
       type(recovered_field_type) :: field
       real(wp) :: sigma(6), tn(3, 6)
       integer :: i, d, s, stat
@@ -162,8 +171,11 @@ contains
       call contact_result(surface, sol, spec, study%bodies(s)%units, result, error)
       if (.not. allocated(error)) call fe_recovery_input(bodies(s)%problem, inputs(1), error)
       if (.not. allocated(error)) call fe_recovery_input(bodies(spec%master_index)%problem, inputs(2), error)
+      if (.not. allocated(error)) call pair_edges(study, spec, surface, result, bodies(s)%problem%mesh%nodes, &
+         & inputs(1), inputs(2), edges, error)
       if (.not. allocated(error)) call pair_contact(study, spec, surface, result, 1, inputs(1), &
-         & bodies(s)%problem%mesh%nodes, inputs(2), contact(1), error, bodies(spec%master_index)%problem%mesh%nodes)
+         & bodies(s)%problem%mesh%nodes, inputs(2), contact(1), error, bodies(spec%master_index)%problem%mesh%nodes, &
+         & edges)
       if (allocated(error)) return
       associate (mesh => bodies(s)%problem%mesh)
          call recover_grid(inputs(1), mesh%grid, mesh%nodes, mesh%hanging, method_sprc, study%degree(2), field, &
@@ -194,6 +206,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(recovery_input_type) :: inputs(2)
       type(grid_contact_type) :: contacts(2)
+      type(pair_edges_type) :: edges
       integer :: b, k(2)
 
       k = [spec%slave_index, spec%master_index]
@@ -206,9 +219,13 @@ contains
          end if
       end do
       if (.not. any(study%run)) return
+      call pair_edges(study, spec, surface, result, bodies(k(1))%problem%mesh%nodes, inputs(1), inputs(2), edges, &
+         & error)
+      if (allocated(error)) return
       do b = 1, 2
          call pair_contact(study, spec, surface, result, b, inputs(b), &
-            & bodies(k(b))%problem%mesh%nodes, inputs(3 - b), contacts(b), error, bodies(k(3 - b))%problem%mesh%nodes)
+            & bodies(k(b))%problem%mesh%nodes, inputs(3 - b), contacts(b), error, bodies(k(3 - b))%problem%mesh%nodes, &
+            & edges)
          if (.not. allocated(error)) &
             & call recover_body(study, study%bodies(k(b)), bodies(k(b)), inputs(b), error, contacts(b:b))
          if (allocated(error)) then
@@ -228,7 +245,8 @@ contains
    !> along it on the master side.
    !> The other body's volume points, FE stresses and boundary points (its contact surface
    !> left out) are `other`'s.
-   subroutine pair_contact(study, spec, surface, result, side, input, nodes, other, contact, error, other_nodes)
+   subroutine pair_contact(study, spec, surface, result, side, input, nodes, other, contact, error, other_nodes, &
+      & edges)
       type(study_type), intent(in) :: study
       type(contact_spec_type), intent(in) :: spec
       type(contact_surface_type), intent(in) :: surface
@@ -241,12 +259,14 @@ contains
       !> The other body's nodes: with them its fit weighs by the cells' sizes (the grid contact's
       !> fe_order and cell, sprc_estimate_contact_patches).
       type(grid_nodes_type), intent(in), optional :: other_nodes
+      !> The pair's contact edges (`pair_edges`): points within an edge's radius take its side.
+      type(pair_edges_type), intent(in), optional :: edges
       integer, allocatable :: law(:)
       real(wp), allocatable :: slip(:, :), offset(:, :), ratio(:), cell(:)
       real(wp) :: t(3), size_e, dist, best
       type(patch_type) :: oboundary
       type(point_cells_type) :: cells
-      type(contact_edge_type), allocatable :: edges(:)
+      logical :: edged
       real(wp), allocatable :: sx(:, :)
       integer, allocatable :: near(:), sel(:)
       integer, allocatable :: surfaces(:), osurfaces(:)
@@ -284,17 +304,8 @@ contains
       end if
       call new_point_cells(cells, sx, error)
       if (allocated(error)) return
-      if (d == 2 .and. friction_kind(spec%friction) == friction_frictionless .and. spec%edges .and. &
-         & present(other_nodes)) then
-         if (side == 1) then
-            call contact_edges(surface, result, study%bodies(spec%slave_index)%units%strain, nodes, input, other, &
-               & edges, error)
-         else
-            call contact_edges(surface, result, study%bodies(spec%slave_index)%units%strain, other_nodes, other, &
-               & input, edges, error)
-         end if
-         if (allocated(error)) return
-      end if
+      edged = .false.
+      if (present(edges)) edged = allocated(edges%edges)
       do e = 1, nodes%n_elements
          if (input%belem_ptr(e + 1) == input%belem_ptr(e)) cycle
          size_e = element_size(nodes, e)
@@ -316,7 +327,9 @@ contains
             if (inear == 0 .or. best > size_e) cycle
             closed = result%state(inear) /= contact_open
             ! Near a fitted contact edge its side decides (module notes of contact_edges).
-            if (allocated(edges) .and. surface%has_master(inear)) call edge_side(edges, input%bx(1:2, k), closed)
+            if (edged) then
+               if (surface%has_master(inear)) call edge_side(edges%edges, input%bx(1:2, k), closed)
+            end if
             if (.not. closed) cycle
             if (surface%has_master(inear)) call paired_point(surface, side, inear, mnear, sx, sel, near(1:nnear), &
                & input%bn(:, k), offset(:, k), ratio(k))
@@ -362,9 +375,25 @@ contains
       call new_grid_contact(contact, surfaces, law, slip, spec%mu, other%x, other%w, other%stress, other%young, &
          & other%poisson, other%body_force(1:d), error, boundary=oboundary, offset=offset, ratio=ratio, &
          & fe_order=study%order, cell=cell)
-      if (allocated(error) .or. .not. allocated(edges)) return
-      call set_grid_contact_edges(contact, edges, merge(1.0_wp, -1.0_wp, side == 1), error)
+      if (allocated(error) .or. .not. edged) return
+      call set_grid_contact_edges(contact, edges%edges, merge(1.0_wp, -1.0_wp, side == 1), error)
    end subroutine pair_contact
+
+   !> The contact edges of a pair (`contact_edges`) for both sides' `pair_contact`: 2D
+   !> frictionless pairs with `edges` on only (set%edges not allocated otherwise).
+   subroutine pair_edges(study, spec, surface, result, slave_nodes, slave, master, set, error)
+      type(study_type), intent(in) :: study
+      type(contact_spec_type), intent(in) :: spec
+      type(contact_surface_type), intent(in) :: surface
+      type(contact_result_type), intent(in) :: result
+      type(grid_nodes_type), intent(in) :: slave_nodes
+      type(recovery_input_type), intent(in) :: slave, master
+      type(pair_edges_type), intent(out) :: set
+      type(error_type), allocatable, intent(out) :: error
+      if (study%dim /= 2 .or. friction_kind(spec%friction) /= friction_frictionless .or. .not. spec%edges) return
+      call contact_edges(surface, result, study%bodies(spec%slave_index)%units%strain, slave_nodes, slave, master, &
+         & set%edges, error)
+   end subroutine pair_edges
 
    !> The edges of a 2D frictionless contact zone (sprc_recovery_contact_edge_fit) from the
    !> slave points' states: a closed slave point and an open one that meets the master surface,
