@@ -6,7 +6,10 @@
 !>   quad9 = 28, hex27 = 29 (VTK node order, sprc_recovery_caller_mesh_element);
 !> - analysis: plane stress = 1, plane strain = 2, solid (3D) = 3;
 !> - method: SPR = 1, SPR-C = 2 (patch degree 'auto': SPR at the element degree p, SPR-C at
-!>   p + 1 for quad9 and hex27);
+!>   p + 1 for quad9 and hex27), plus optionally the flags of the C API: 256 the patch degree
+!>   p + 1, 512 the degree p (SPRC_RECOVERY_P_PLUS_1, SPRC_RECOVERY_P; not both), and for
+!>   sprc_recover_contact_mesh 1024 no edge field at the edges of frictionless contact zones
+!>   (SPRC_CONTACT_NO_EDGES);
 !> - facet kind: traction = 1 (value in ftrac), symmetry = 2, free = 3 (zero traction),
 !>   pressure = 4 (p = ftrac(1, f), t = -p n with the facet's own normal at each point);
 !> - stat: 0 success, 1 invalid input, 2 singular (a patch stayed rank deficient),
@@ -18,7 +21,8 @@ module sprc_legacy
    use sprc_core_error, only: error_type, stat_success, fatal_error
    use sprc_core_error, only: stat_invalid_input
    use sprc_core_text, only: itoa
-   use sprc_recovery_caller_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval
+   use sprc_recovery_caller_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, coded_degree
+   use sprc_recovery_caller_mesh_check, only: method_code_type, decode_method
    use sprc_contact_caller_mesh_recovery, only: contact_body_type, contact_pair_type, mesh_contact_recovery_type, &
       & recover_contact_on_mesh
    implicit none
@@ -58,6 +62,7 @@ contains
       integer, intent(out) :: stat
       character(len=*), intent(out) :: errmsg
       type(mesh_recovery_type) :: result
+      type(method_code_type) :: code
       type(error_type), allocatable :: error
 
       nodal = 0.0d0
@@ -67,9 +72,11 @@ contains
       spts = 0.0d0
       stat = stat_success
       errmsg = ''
-      call recover_on_mesh(ndim, analysis, real(coords, wp), etype, conn, real(gp, wp), real(gw, wp), real(gs, wp), &
-         & real(young, wp), real(poisson, wp), method, result, error, body_force=real(bforce, wp), &
-         & facet_nodes=fnodes, facet_kind=fkind, facet_traction=real(ftrac, wp))
+      call decode_method('sprc_recover_mesh', method, .false., code, error)
+      if (.not. allocated(error)) call recover_on_mesh(ndim, analysis, real(coords, wp), etype, conn, real(gp, wp), &
+         & real(gw, wp), real(gs, wp), real(young, wp), real(poisson, wp), code%method, result, error, &
+         & body_force=real(bforce, wp), facet_nodes=fnodes, facet_kind=fkind, facet_traction=real(ftrac, wp), &
+         & degree=coded_degree(code, etype))
       if (.not. allocated(error)) call mesh_recovery_eval(result, real(xpts, wp), spts, error, epts)
       if (allocated(error)) then
          stat = error%stat
@@ -120,6 +127,7 @@ contains
       type(contact_body_type) :: bodies(2)
       type(contact_pair_type) :: pairs(1)
       type(mesh_contact_recovery_type) :: res
+      type(method_code_type) :: code
       type(error_type), allocatable :: error
 
       nodal1 = 0.0d0
@@ -151,7 +159,9 @@ contains
       pairs(1)%slave_slip => cslip1
       pairs(1)%master_slip => cslip2
       pairs(1)%mu = mu
-      call recover_contact_on_mesh(bodies, pairs, method, res, error)
+      call decode_method('sprc_recover_contact_mesh', method, .true., code, error)
+      if (.not. allocated(error)) call recover_contact_on_mesh(bodies, pairs, code%method, res, error, &
+         & degree_above=code%degree_above, edges=code%edges)
       if (.not. allocated(error)) then
          if (res%pairs(1)%npoints > mpts) call fatal_error(error, 'sprc_recover_contact_mesh: mpts = '//itoa(mpts)// &
             & ' but the contact facets have '//itoa(res%pairs(1)%npoints)//' points (npts)', stat_invalid_input)

@@ -518,7 +518,7 @@ contains
       real(wp), allocatable, target :: slip(:, :)
       integer, allocatable :: law1(:), law2(:)
       real(wp), allocatable :: slip1(:, :), slip2(:, :), nodal1(:, :), nodal2(:, :), e1(:), e2(:), xc(:, :), pc(:), &
-         & pcm(:), jc(:, :)
+         & pcm(:), jc(:, :), nodal_auto(:, :)
       real(wp) :: g1, g2, eta1, eta2
       integer :: npts, stat, n1, n2
       character(len=200) :: msg
@@ -539,13 +539,8 @@ contains
       slip2 = spread(-slip(:, 1), 2, n2)
       allocate (nodal1(3, size(pb%c(1)%x, 2)), nodal2(3, size(pb%c(2)%x, 2)), e1(size(pb%c(1)%gw, 2)), &
          & e2(size(pb%c(2)%gw, 2)), xc(2, 2*n1), pc(2*n1), pcm(2*n1), jc(2, 2*n1))
-      associate (c1 => pb%c(1), c2 => pb%c(2))
-         call sprc_recover_contact_mesh(2, 3, c1%analysis, mesh_method_sprc, size(c1%x, 2), c1%x, c1%etype, &
-            & size(c1%conn, 1), size(c1%conn, 2), c1%conn, size(c1%gw, 1), c1%gp, c1%gw, c1%gs, 1.0d3, 0.3d0, &
-            & size(c2%x, 2), c2%x, c2%etype, size(c2%conn, 1), size(c2%conn, 2), c2%conn, size(c2%gw, 1), c2%gp, &
-            & c2%gw, c2%gs, 1.0d3, 0.3d0, 2, n1, pb%facets1, law1, slip1, 2, n2, pb%facets2, law2, slip2, mu, 2*n1, &
-            & nodal1, e1, g1, eta1, nodal2, e2, g2, eta2, npts, xc, pc, pcm, jc, stat, msg)
-      end associate
+      call legacy(mesh_method_sprc, 2*n1)
+      nodal_auto = nodal1
       call check(error, stat == 0, 'legacy stat: '//trim(msg))
       if (allocated(error)) return
       call check(error, npts == res%pairs(1)%npoints .and. same(nodal1, res%bodies(1)%nodal) .and. &
@@ -553,16 +548,34 @@ contains
          & same1(pcm, res%pairs(1)%pressure_master) .and. same(jc, res%pairs(1)%jump) .and. &
          & same1([g1, eta2], [res%bodies(1)%err, res%bodies(2)%eta]), 'legacy and modern results differ')
       if (allocated(error)) return
-      associate (c1 => pb%c(1), c2 => pb%c(2))
-         call sprc_recover_contact_mesh(2, 3, c1%analysis, mesh_method_sprc, size(c1%x, 2), c1%x, c1%etype, &
-            & size(c1%conn, 1), size(c1%conn, 2), c1%conn, size(c1%gw, 1), c1%gp, c1%gw, c1%gs, 1.0d3, 0.3d0, &
-            & size(c2%x, 2), c2%x, c2%etype, size(c2%conn, 1), size(c2%conn, 2), c2%conn, size(c2%gw, 1), c2%gp, &
-            & c2%gw, c2%gs, 1.0d3, 0.3d0, 2, n1, pb%facets1, law1, slip1, 2, n2, pb%facets2, law2, slip2, mu, 3, &
-            & nodal1, e1, g1, eta1, nodal2, e2, g2, eta2, npts, xc, pc, pcm, jc, stat, msg)
-      end associate
+      ! The C API's flags: SPRC_RECOVERY_P_PLUS_1 (each body at degree 2 instead of 'auto' 1).
+      call recover_contact_on_mesh(bodies, pairs, mesh_method_sprc, res, error, degree_above=1)
+      if (allocated(error)) return
+      call legacy(mesh_method_sprc + 256, 2*n1)
+      call check(error, stat == 0 .and. same(nodal1, res%bodies(1)%nodal) .and. same1(pc, res%pairs(1)%pressure) &
+         & .and. maxval(abs(nodal1 - nodal_auto)) > 1.0e-9_wp*maxval(abs(nodal_auto)), &
+         & 'legacy with SPRC_RECOVERY_P_PLUS_1 equals degree_above = 1 (and differs from auto): '//trim(msg))
+      if (allocated(error)) return
+      call legacy(mesh_method_sprc + 1024 + 2048, 2*n1)
+      call check(error, stat == stat_invalid_input .and. index(msg, 'method = 3074 has unknown flag bits') > 0 .and. &
+         & index(msg, 'SPRC_CONTACT_NO_EDGES = 1024') > 0 .and. .not. any(abs(nodal1) > 0.0_wp), &
+         & 'legacy with an unknown flag: '//trim(msg))
+      if (allocated(error)) return
+      call legacy(mesh_method_sprc, 3)
       call check(error, stat == stat_invalid_input .and. index(msg, 'mpts = 3') > 0 .and. .not. any(abs(nodal1) > 0.0_wp), &
          & 'legacy with too little room: '//trim(msg))
    contains
+      !> The legacy call with method code `method` and room for `mpts` points.
+      subroutine legacy(method, mpts)
+         integer, intent(in) :: method, mpts
+         associate (c1 => pb%c(1), c2 => pb%c(2))
+            call sprc_recover_contact_mesh(2, 3, c1%analysis, method, size(c1%x, 2), c1%x, c1%etype, &
+               & size(c1%conn, 1), size(c1%conn, 2), c1%conn, size(c1%gw, 1), c1%gp, c1%gw, c1%gs, 1.0d3, 0.3d0, &
+               & size(c2%x, 2), c2%x, c2%etype, size(c2%conn, 1), size(c2%conn, 2), c2%conn, size(c2%gw, 1), &
+               & c2%gp, c2%gw, c2%gs, 1.0d3, 0.3d0, 2, n1, pb%facets1, law1, slip1, 2, n2, pb%facets2, law2, slip2, &
+               & mu, mpts, nodal1, e1, g1, eta1, nodal2, e2, g2, eta2, npts, xc, pc, pcm, jc, stat, msg)
+         end associate
+      end subroutine legacy
       pure logical function same(a, b)
          real(wp), intent(in) :: a(:, :), b(:, :)
          same = .not. any(abs(a - b) > 0.0_wp)

@@ -1489,13 +1489,13 @@ contains
       type(case_type) :: c
       type(mesh_recovery_type) :: res
       integer, allocatable :: fn(:, :), fk(:)
-      double precision, allocatable :: nodal(:, :), elerr(:), ftrac(:, :)
+      double precision, allocatable :: nodal(:, :), elerr(:), ftrac(:, :), nodal_auto(:, :)
       double precision :: glerr, eta, xpts(2, 2), spts(3, 2), bf(2)
       integer :: stat, epts(2)
       character(len=200) :: msg
       integer, allocatable :: conn(:, :)
 
-      call build_case(c, elem_quad4, 3, f_linear, 0.2_wp)
+      call build_case(c, elem_quad4, 3, f_quadratic, 0.2_wp)
       call side_facets(c, 2, 1, fn)
       allocate (fk(size(fn, 2)), ftrac(2, size(fn, 2)), nodal(3, size(c%x, 2)), elerr(size(c%conn, 2)))
       fk = facet_free
@@ -1515,6 +1515,30 @@ contains
          & [res%err, res%eta]), 'legacy outputs equal the modern result')
       if (allocated(error)) return
       call check(error, len_trim(msg) == 0 .and. glerr > 0.0d0, 'blank errmsg, positive estimate')
+      if (allocated(error)) return
+      ! The C API's degree flag: SPR-C at p + 1 = 2 on quad4 ('auto' is p).
+      nodal_auto = nodal
+      call recover_on_mesh(2, c%analysis, c%x, c%etype, c%conn, c%gp, c%gw, c%gs, 1.0e3_wp, 0.3_wp, 2, res, error, &
+         & body_force=c%body(1:2), facet_nodes=fn, facet_kind=fk, degree=2)
+      if (allocated(error)) return
+      call sprc_recover_mesh(2, size(c%x, 2), c%x, elem_quad4, 4, size(c%conn, 2), c%conn, size(c%gw, 1), c%gp, c%gw, &
+         & 3, c%gs, plane_stress, 1.0d3, 0.3d0, 2 + 256, bf, size(fn, 2), 2, fn, fk, ftrac, 2, xpts, epts, nodal, elerr, &
+         & glerr, eta, spts, stat, msg)
+      call check(error, stat == 0 .and. same(nodal, res%nodal) .and. same([glerr, eta], [res%err, res%eta]) .and. &
+         & maxval(abs(nodal - nodal_auto)) > 1.0d-6*maxval(abs(nodal_auto)), &
+         & 'legacy with SPRC_RECOVERY_P_PLUS_1 equals degree 2 (and differs from auto): '//trim(msg))
+      if (allocated(error)) return
+      call sprc_recover_mesh(2, size(c%x, 2), c%x, elem_quad4, 4, size(c%conn, 2), c%conn, size(c%gw, 1), c%gp, c%gw, &
+         & 3, c%gs, plane_stress, 1.0d3, 0.3d0, 2 + 1024, bf, size(fn, 2), 2, fn, fk, ftrac, 2, xpts, epts, nodal, &
+         & elerr, glerr, eta, spts, stat, msg)
+      call check(error, stat == stat_invalid_input .and. index(msg, 'method = 1026 has unknown flag bits') > 0 .and. &
+         & maxval(abs(nodal)) <= 0.0d0, 'legacy: the contact flag on a plain recovery: '//trim(msg))
+      if (allocated(error)) return
+      call sprc_recover_mesh(2, size(c%x, 2), c%x, elem_quad4, 4, size(c%conn, 2), c%conn, size(c%gw, 1), c%gp, c%gw, &
+         & 3, c%gs, plane_stress, 1.0d3, 0.3d0, 3 + 256, bf, size(fn, 2), 2, fn, fk, ftrac, 2, xpts, epts, nodal, &
+         & elerr, glerr, eta, spts, stat, msg)
+      call check(error, stat == stat_invalid_input .and. index(msg, 'method = 259 is not SPR (1) or SPR-C (2)') > 0, &
+         & 'legacy: method 3 with a flag: '//trim(msg))
       if (allocated(error)) return
       allocate (conn, source=c%conn)
       conn(2, 5) = 99

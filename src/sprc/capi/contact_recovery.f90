@@ -15,13 +15,13 @@ module sprc_capi_contact_recovery
    use sprc_core_text, only: itoa
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_out_of_memory
    use sprc_core_material, only: voigt_size
-   use sprc_recovery_caller_mesh, only: mesh_method_spr, mesh_method_sprc, mesh_reference_unit, mesh_reference_symmetric
+   use sprc_recovery_caller_mesh, only: mesh_reference_unit, mesh_reference_symmetric
+   use sprc_recovery_caller_mesh_check, only: method_code_type, decode_method
    use sprc_recovery_caller_mesh_element, only: element_facet_nodes, facet_npoints
    use sprc_contact_caller_mesh_recovery, only: contact_body_type, contact_pair_type, mesh_contact_recovery_type, &
       & recover_contact_on_mesh
    use sprc_capi_error, only: capi_error_type, get_capi_error, set_capi_error
-   use sprc_capi_recovery, only: capi_recovery_type, mesh_sizes_type, check_sizes, check_pointers, one_based, &
-      & check_method_flags, method_mask, flag_p, flag_p_plus_1
+   use sprc_capi_recovery, only: capi_recovery_type, mesh_sizes_type, check_sizes, check_pointers, one_based
    implicit none
    private
 
@@ -35,10 +35,6 @@ module sprc_capi_contact_recovery
       type(contact_pair_type), allocatable :: pairs(:)
       integer :: nbody = 0, npair = 0
    end type capi_contact_input_type
-
-   !> Flag OR-ed into sprc_recover_contact's method (sprc.h SPRC_CONTACT_NO_EDGES): no edge
-   !> field at the edges of frictionless contact zones.
-   integer(c_int), parameter :: flag_no_edges = 1024
 
    type :: capi_contact_recovery_type
       type(mesh_contact_recovery_type) :: result
@@ -238,21 +234,14 @@ contains
       type(capi_contact_input_type), pointer :: in
       type(capi_contact_recovery_type), pointer :: rec
       type(error_type), allocatable :: error
-      integer :: stat, m
-      logical :: edges
+      type(method_code_type) :: code
+      integer :: stat
 
       rech = c_null_ptr
       if (.not. get_input(errh, inh, 'sprc_recover_contact', err, in)) return
-      call check_method_flags('sprc_recover_contact', iand(method, not(flag_no_edges)), error)
+      call decode_method('sprc_recover_contact', int(method), .true., code, error)
       if (allocated(error)) then
          call set_capi_error(err, error)
-         return
-      end if
-      m = iand(method, method_mask)
-      if (m /= mesh_method_spr .and. m /= mesh_method_sprc) then
-         call set_capi_error(err, message='sprc_recover_contact: method = '//itoa(method)// &
-            & ' is not SPRC_METHOD_SPR (1) or SPRC_METHOD_SPRC (2), optionally with a degree flag', &
-            & stat=stat_invalid_input)
          return
       end if
       allocate (rec, stat=stat)
@@ -260,14 +249,8 @@ contains
          call set_capi_error(err, message='sprc_recover_contact: out of memory', stat=stat_out_of_memory)
          return
       end if
-      edges = iand(method, flag_no_edges) == 0
-      if (iand(method, ior(flag_p, flag_p_plus_1)) /= 0) then
-         call recover_contact_on_mesh(in%bodies(1:in%nbody), in%pairs(1:in%npair), m, rec%result, error, &
-            & c_indices=.true., degree_above=merge(1, 0, iand(method, flag_p_plus_1) /= 0), edges=edges)
-      else
-         call recover_contact_on_mesh(in%bodies(1:in%nbody), in%pairs(1:in%npair), m, rec%result, error, &
-            & c_indices=.true., edges=edges)
-      end if
+      call recover_contact_on_mesh(in%bodies(1:in%nbody), in%pairs(1:in%npair), code%method, rec%result, error, &
+         & c_indices=.true., degree_above=code%degree_above, edges=code%edges)
       if (allocated(error)) then
          deallocate (rec)
          error%message = 'sprc_recover_contact: '//error%message

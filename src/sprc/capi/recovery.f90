@@ -15,17 +15,15 @@ module sprc_capi_recovery
    use sprc_core_error, only: error_type, fatal_error, stat_invalid_input, stat_out_of_memory
    use sprc_core_alloc, only: check_allocation
    use sprc_core_material, only: voigt_size
-   use sprc_recovery_caller_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, mesh_method_sprc, &
+   use sprc_recovery_caller_mesh, only: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, coded_degree, &
       & mesh_reference_unit, mesh_reference_symmetric
-   use sprc_recovery_patch_loop, only: auto_degree
-   use sprc_recovery_caller_mesh_element, only: element_known, element_nodes, element_facet_nodes, element_name, &
-      & element_degree
+   use sprc_recovery_caller_mesh_check, only: method_code_type, decode_method
+   use sprc_recovery_caller_mesh_element, only: element_known, element_nodes, element_facet_nodes, element_name
    use sprc_capi_error, only: capi_error_type, get_capi_error, set_capi_error
    implicit none
    private
 
-   public :: capi_recovery_type, mesh_sizes_type, check_sizes, check_pointers, one_based, method_mask, flag_p, &
-      & flag_p_plus_1, check_method_flags
+   public :: capi_recovery_type, mesh_sizes_type, check_sizes, check_pointers, one_based
    public :: sprc_recover, sprc_recover_xi, sprc_recover_reference, sprc_get_recovery_nodal_stress, &
       & sprc_get_recovery_element_error, &
       & sprc_get_recovery_global_error, sprc_get_recovery_eta, sprc_eval_recovery, sprc_delete_recovery
@@ -34,11 +32,6 @@ module sprc_capi_recovery
    type :: capi_recovery_type
       type(mesh_recovery_type) :: result
    end type capi_recovery_type
-
-   !> Flags OR-ed into `method` (sprc.h SPRC_RECOVERY_P_PLUS_1, SPRC_RECOVERY_P): patch degree
-   !> one above the element's, or the element's; neither: 'auto' (the library's default). The
-   !> low byte is the method proper.
-   integer(c_int), parameter :: flag_p_plus_1 = 256, flag_p = 512, method_mask = 255
 
    !> Sizes and codes of one `sprc_recover` call, checked before any array is touched.
    type :: mesh_sizes_type
@@ -125,14 +118,15 @@ contains
       real(wp), allocatable :: bf(:), ft(:, :)
       integer(c_int), pointer :: conn_c(:, :), fn_c(:, :), fk_c(:)
       integer, allocatable :: conn(:, :), fn(:, :), fk(:)
-      integer :: stat, degree
+      type(method_code_type) :: code
+      integer :: stat
 
       rech = c_null_ptr
       if (.not. get_capi_error(errh, err)) return
       sz = mesh_sizes_type(dim, analysis, nnode, element_type, nen, nelem, ngp, voigt_size(analysis), nfacet, &
          & facet_nnode)
       call check_sizes(sz, error)
-      if (.not. allocated(error)) call check_method_flags('sprc_recover', method, error)
+      if (.not. allocated(error)) call decode_method('sprc_recover', int(method), .false., code, error)
       if (.not. allocated(error) .and. reference /= mesh_reference_unit .and. reference /= mesh_reference_symmetric) &
          & call fail(error, 'sprc_recover: reference = '//itoa(reference)//' is not SPRC_REFERENCE_UNIT ('// &
          & itoa(mesh_reference_unit)//') or SPRC_REFERENCE_SYMMETRIC ('//itoa(mesh_reference_symmetric)//')')
@@ -187,18 +181,16 @@ contains
          return
       end if
       ! Unallocated bf, fn, fk, ft reach the optional dummies as absent (F2008).
-      degree = auto_degree(iand(method, method_mask) == mesh_method_sprc, element_degree(element_type))
-      if (iand(method, flag_p) /= 0) degree = element_degree(element_type)
-      if (iand(method, flag_p_plus_1) /= 0) degree = element_degree(element_type) + 1
       if (c_associated(gauss_xi)) then
          call c_f_pointer(gauss_xi, gxi, [dim, ngp, nelem])
          call recover_on_mesh(dim, analysis, x, element_type, conn, gp, gw, gs, young, poisson, &
-            & int(iand(method, method_mask)), rec%result, error, body_force=bf, facet_nodes=fn, facet_kind=fk, &
-            & facet_traction=ft, degree=degree, c_indices=.true., gauss_xi=gxi, reference=int(reference))
+            & code%method, rec%result, error, body_force=bf, facet_nodes=fn, facet_kind=fk, &
+            & facet_traction=ft, degree=coded_degree(code, int(element_type)), c_indices=.true., gauss_xi=gxi, &
+            & reference=int(reference))
       else
          call recover_on_mesh(dim, analysis, x, element_type, conn, gp, gw, gs, young, poisson, &
-            & int(iand(method, method_mask)), rec%result, error, body_force=bf, facet_nodes=fn, facet_kind=fk, &
-            & facet_traction=ft, degree=degree, c_indices=.true.)
+            & code%method, rec%result, error, body_force=bf, facet_nodes=fn, facet_kind=fk, &
+            & facet_traction=ft, degree=coded_degree(code, int(element_type)), c_indices=.true.)
       end if
       if (allocated(error)) then
          deallocate (rec)
@@ -438,21 +430,6 @@ contains
          ok = .true.
       end if
    end function check_out
-
-   !> The degree flags OR-ed into `method` of entry `entry`: no unknown bit, not both.
-   pure subroutine check_method_flags(entry, method, error)
-      character(len=*), intent(in) :: entry
-      integer(c_int), intent(in) :: method
-      type(error_type), allocatable, intent(out) :: error
-
-      if (iand(method, not(ior(method_mask, ior(flag_p_plus_1, flag_p)))) /= 0) then
-         call fail(error, entry//': method = '//itoa(method)//' has unknown flag bits (the flags are '// &
-            & 'SPRC_RECOVERY_P_PLUS_1 = 256 and SPRC_RECOVERY_P = 512)')
-      else if (iand(method, flag_p_plus_1) /= 0 .and. iand(method, flag_p) /= 0) then
-         call fail(error, entry//': method = '//itoa(method)//' sets both SPRC_RECOVERY_P_PLUS_1 and '// &
-            & 'SPRC_RECOVERY_P')
-      end if
-   end subroutine check_method_flags
 
    pure subroutine fail(error, message)
       type(error_type), allocatable, intent(out) :: error

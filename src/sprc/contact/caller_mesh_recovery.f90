@@ -161,7 +161,7 @@ contains
    !> Recover bodies in contact (module notes). method mesh_method_sprc (contact-aware) or
    !> mesh_method_spr; degree and max_rounds as recover_on_mesh's (degree 0 or absent: each
    !> body's 'auto'); `degree_above` (0 or 1, the C and Python flags) sets each body's degree
-   !> to its element's plus it instead of 'auto' (a positive `degree` wins). `edges` (default
+   !> to its element's plus it instead of 'auto' (a positive `degree` wins); -1 is 'auto'. `edges` (default
    !> true): the patches at the edges of frictionless contact zones in 2D take the edge field
    !> (module notes); false: polynomials only.
    subroutine recover_contact_on_mesh(bodies, pairs, method, result, error, degree, max_rounds, c_indices, &
@@ -185,9 +185,9 @@ contains
       call check_input(bodies, pairs, method, ci, error)
       if (allocated(error)) return
       if (present(degree_above)) then
-         if (degree_above /= 0 .and. degree_above /= 1) then
+         if (degree_above < -1 .or. degree_above > 1) then
             call fatal_error(error, 'recover_contact: degree_above = '//itoa(degree_above)//' is not 0 (the '// &
-               & 'element''s degree) or 1 (one above)', stat_invalid_input)
+               & 'element''s degree), 1 (one above) or -1 (''auto'')', stat_invalid_input)
             return
          end if
       end if
@@ -240,7 +240,9 @@ contains
       integer :: deg
 
       deg = auto_degree(method == mesh_method_sprc, element_degree(body%element_type))
-      if (present(degree_above)) deg = element_degree(body%element_type) + degree_above
+      if (present(degree_above)) then
+         if (degree_above >= 0) deg = element_degree(body%element_type) + degree_above
+      end if
       if (present(degree)) then
          if (degree > 0) deg = degree
       end if

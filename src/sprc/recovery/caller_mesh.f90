@@ -60,11 +60,12 @@ module sprc_recovery_caller_mesh
    use sprc_recovery_caller_mesh_check, only: check_mesh_options, check_mesh_arrays, check_mesh_facets, &
       & check_duplicate_nodes, check_duplicate_elements, vec_str, entry_name, index_name, &
       & mesh_reference_unit, mesh_reference_symmetric, reference_cell_name, &
-      & mesh_method_spr, mesh_method_sprc, facet_traction, facet_symmetry, facet_free, facet_pressure
+      & mesh_method_spr, mesh_method_sprc, facet_traction, facet_symmetry, facet_free, facet_pressure, &
+      & method_code_type
    implicit none
    private
 
-   public :: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, mesh_default_max_rounds
+   public :: mesh_recovery_type, recover_on_mesh, mesh_recovery_eval, mesh_default_max_rounds, coded_degree
    public :: mesh_method_spr, mesh_method_sprc, facet_traction, facet_symmetry, facet_free, facet_pressure
    public :: mesh_reference_unit, mesh_reference_symmetric
    public :: elem_tri3, elem_quad4, elem_tet4, elem_hex8, elem_quad9, elem_hex27
@@ -181,6 +182,16 @@ module sprc_recovery_caller_mesh
    end type mesh_source_type
 
 contains
+
+   !> The patch degree a decoded method code asks for on elements of type `element_type`:
+   !> the element's degree plus `degree_above`, or 'auto' (`auto_degree`).
+   pure integer function coded_degree(code, element_type) result(degree)
+      type(method_code_type), intent(in) :: code
+      integer, intent(in) :: element_type
+
+      degree = auto_degree(code%method == mesh_method_sprc, element_degree(element_type))
+      if (code%degree_above >= 0) degree = element_degree(element_type) + code%degree_above
+   end function coded_degree
 
    !> Recover the stresses of a caller's mesh and estimate the error (module notes). Errors
    !> name the argument and index: invalid input (stat_invalid_input), a point whose

@@ -27,9 +27,25 @@ module sprc_recovery_caller_mesh_check
       & check_duplicate_elements, vec_str, entry_name, index_name
    public :: mesh_reference_unit, mesh_reference_symmetric, reference_cell_name
    public :: mesh_method_spr, mesh_method_sprc, facet_traction, facet_symmetry, facet_free, facet_pressure
+   public :: method_code_type, decode_method, method_flag_p_plus_1, method_flag_p, method_flag_no_edges, method_mask
 
    !> Recovery methods (values are part of the C API; never renumber).
    integer, parameter :: mesh_method_spr = 1, mesh_method_sprc = 2
+   !> Flags OR-ed into an integer method code by the C and legacy entries (values are part of
+   !> the C API, sprc.h SPRC_RECOVERY_P_PLUS_1, SPRC_RECOVERY_P, SPRC_CONTACT_NO_EDGES): the
+   !> patch degree one above the element's, or the element's (neither: 'auto'); for contact
+   !> entries only, no edge field at the edges of contact zones. The low byte is the method.
+   integer, parameter :: method_flag_p_plus_1 = 256, method_flag_p = 512, method_flag_no_edges = 1024, &
+      & method_mask = 255
+
+   !> An integer method code split into the method proper and its flags.
+   type :: method_code_type
+      !> `mesh_method_spr` or `mesh_method_sprc`; the patch degree above the element's: 1,
+      !> 0, or -1 for 'auto'.
+      integer :: method = 0, degree_above = -1
+      !> The edge field at the edges of contact zones (contact entries).
+      logical :: edges = .true.
+   end type method_code_type
    !> Conventions of the caller's reference coordinates (gauss_xi; values are part of the C
    !> API, SPRC_REFERENCE_*): 'unit' quads and hexes on [0, 1]^dim (the element library's own),
    !> 'symmetric' on [-1, 1]^dim (most FE codes'); triangles and tetrahedra are the unit
@@ -43,6 +59,40 @@ module sprc_recovery_caller_mesh_check
       & facet_pressure = bc_pressure
 
 contains
+
+   !> Split `code`, the `method` argument of entry `entry`, into the method and its flags:
+   !> SPR or SPR-C, no unknown bit (SPRC_CONTACT_NO_EDGES is known to `contact` entries
+   !> only), not both degree flags.
+   pure subroutine decode_method(entry, code, contact, decoded, error)
+      character(len=*), intent(in) :: entry
+      integer, intent(in) :: code
+      logical, intent(in) :: contact
+      type(method_code_type), intent(out) :: decoded
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: flags
+      integer :: known
+
+      known = ior(method_mask, ior(method_flag_p_plus_1, method_flag_p))
+      flags = 'SPRC_RECOVERY_P_PLUS_1 = 256 and SPRC_RECOVERY_P = 512'
+      if (contact) then
+         known = ior(known, method_flag_no_edges)
+         flags = 'SPRC_RECOVERY_P_PLUS_1 = 256, SPRC_RECOVERY_P = 512 and SPRC_CONTACT_NO_EDGES = 1024'
+      end if
+      if (iand(code, not(known)) /= 0) then
+         call fail(error, entry//': method = '//itoa(code)//' has unknown flag bits (the flags are '//flags//')')
+      else if (iand(code, method_flag_p_plus_1) /= 0 .and. iand(code, method_flag_p) /= 0) then
+         call fail(error, entry//': method = '//itoa(code)//' sets both SPRC_RECOVERY_P_PLUS_1 and '// &
+            & 'SPRC_RECOVERY_P')
+      else if (iand(code, method_mask) /= mesh_method_spr .and. iand(code, method_mask) /= mesh_method_sprc) then
+         call fail(error, entry//': method = '//itoa(code)//' is not SPR (1) or SPR-C (2), optionally with '// &
+            & 'the flags '//flags)
+      else
+         decoded%method = iand(code, method_mask)
+         if (iand(code, method_flag_p) /= 0) decoded%degree_above = 0
+         if (iand(code, method_flag_p_plus_1) /= 0) decoded%degree_above = 1
+         decoded%edges = iand(code, method_flag_no_edges) == 0
+      end if
+   end subroutine decode_method
 
    !> Codes and scalars: dim, analysis (and its fit to dim), element type (and its dim),
    !> method, degree, expansion rounds, material.
