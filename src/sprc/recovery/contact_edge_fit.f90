@@ -73,6 +73,44 @@ module sprc_recovery_contact_edge_fit
       real(wp) :: sign = 1.0_wp
    end type cloud_type
 
+   !> A function of one variable for `scan_minimum`. A type rather than a procedure argument:
+   !> an internal procedure passed as an argument needs a trampoline on the stack, which
+   !> marks the shared library as needing an executable stack, and loaders that refuse one
+   !> (glibc 2.41 on) then refuse the library.
+   type, abstract :: objective_type
+   contains
+      procedure(objective_value), deferred :: value
+   end type objective_type
+
+   abstract interface
+      pure real(wp) function objective_value(self, s)
+         import :: objective_type, wp
+         class(objective_type), intent(in) :: self
+         real(wp), intent(in) :: s
+      end function objective_value
+   end interface
+
+   !> `fit_contact_edge`'s data: the edge, the two clouds, the factored polynomial columns
+   !> (pivoted QR of rank r, m rows), the data orthogonal to them (rb(m, 1)) and the relative
+   !> residual without the edge field.
+   type, extends(objective_type) :: stress_fit_type
+      type(contact_edge_type) :: edge
+      type(cloud_type) :: c(2)
+      real(wp), allocatable :: a(:, :), tau(:), rb(:, :)
+      integer :: m = 0, r = 0
+      real(wp) :: r0 = 0.0_wp
+   contains
+      procedure :: value => stress_fit_value
+   end type stress_fit_type
+
+   !> `fit_edge_gap`'s data: the open points' positions xi (in facet lengths) and gaps g
+   !> (scaled to a largest of 1).
+   type, extends(objective_type) :: gap_fit_type
+      real(wp), allocatable :: xi(:), g(:)
+   contains
+      procedure :: value => gap_fit_value
+   end type gap_fit_type
+
 contains
 
    !> The edges of the slave's contact facets (module notes, 1). nodes(2, nnode); facets(nfn,
@@ -144,11 +182,11 @@ contains
       !> The range of s (module notes) when the states place the edge less closely than
       !> within a facet (default [s_min, s_max]).
       real(wp), intent(in), optional :: range(2)
-      type(cloud_type) :: c(2)
-      real(wp), allocatable :: a(:, :), rb(:, :), tau(:), vn(:, :)
+      type(stress_fit_type) :: fit
+      real(wp), allocatable :: vn(:, :)
       integer, allocatable :: jpvt(:)
       real(wp) :: best, sb, k, r0, s_lo, s_hi
-      integer :: i, m, n, r
+      integer :: i, m, n
 
       s_lo = s_min
       s_hi = s_max
@@ -156,57 +194,64 @@ contains
          s_lo = range(1)
          s_hi = range(2)
       end if
-      call gather(edge, x1, w1, s1, 1.0_wp, c(1))
-      call gather(edge, x2, w2, s2, -1.0_wp, c(2))
-      m = 3*(size(c(1)%w) + size(c(2)%w))
+      call gather(edge, x1, w1, s1, 1.0_wp, fit%c(1))
+      call gather(edge, x2, w2, s2, -1.0_wp, fit%c(2))
+      m = 3*(size(fit%c(1)%w) + size(fit%c(2)%w))
       n = 2*3*nsmooth
       edge%amplitude = 0.0_wp
       if (m < 2*(n + 1)) return
-      allocate (a(m, n), rb(m, 1), tau(n), vn(n, 2), jpvt(n))
-      call smooth_columns(edge, c, a, rb(:, 1))
-      if (.not. (norm2(rb) > 0.0_wp)) return
-      r0 = norm2(rb)
-      call qr_pivoted(m, n, a, jpvt, tau, vn)
-      r = 0
+      fit%edge = edge
+      fit%m = m
+      allocate (fit%a(m, n), fit%rb(m, 1), fit%tau(n), vn(n, 2), jpvt(n))
+      call smooth_columns(edge, fit%c, fit%a, fit%rb(:, 1))
+      if (.not. (norm2(fit%rb) > 0.0_wp)) return
+      r0 = norm2(fit%rb)
+      call qr_pivoted(m, n, fit%a, jpvt, fit%tau, vn)
       do i = 1, n
-         if (abs(a(i, i)) > 1.0e3_wp*epsilon(1.0_wp)*real(m, wp)*abs(a(1, 1))) r = i
+         if (abs(fit%a(i, i)) > 1.0e3_wp*epsilon(1.0_wp)*real(m, wp)*abs(fit%a(1, 1))) fit%r = i
       end do
-      call apply_qt(m, r, a, tau, 1, rb)
-      rb(1:r, 1) = 0.0_wp
+      call apply_qt(m, fit%r, fit%a, fit%tau, 1, fit%rb)
+      fit%rb(1:fit%r, 1) = 0.0_wp
       ! relative residual without the edge field
-      r0 = norm2(rb(:, 1))/r0
-      sb = scan_minimum(residual, s_lo, s_hi)
-      call trial(sb, best, k)
+      fit%r0 = norm2(fit%rb(:, 1))/r0
+      sb = scan_minimum(fit, s_lo, s_hi)
+      call stress_fit_trial(fit, sb, best, k)
       edge%point = edge%vertex + sb*edge%length*edge%tangent
-      if (k > 0.0_wp .and. best < keep_ratio*r0) edge%amplitude = k
-   contains
-      !> The relative residual with the edge at vertex + s L t.
-      pure real(wp) function residual(s)
-         real(wp), intent(in) :: s
-         real(wp) :: k
-
-         call trial(s, residual, k)
-      end function residual
-
-      !> Relative residual f and amplitude k with the edge at vertex + s L t.
-      pure subroutine trial(s, f, k)
-         real(wp), intent(in) :: s
-         real(wp), intent(out) :: f, k
-         real(wp) :: rs(m, 1), ss, sr, bb
-
-         call edge_column(edge, c, edge%vertex + s*edge%length*edge%tangent, rs(:, 1))
-         call apply_qt(m, r, a, tau, 1, rs)
-         rs(1:r, 1) = 0.0_wp
-         ss = dot_product(rs(:, 1), rs(:, 1))
-         sr = dot_product(rs(:, 1), rb(:, 1))
-         bb = dot_product(rb(:, 1), rb(:, 1))
-         k = 0.0_wp
-         f = r0
-         if (.not. (ss > 0.0_wp) .or. .not. (bb > 0.0_wp)) return
-         k = sr/ss
-         f = r0*sqrt(max(0.0_wp, 1.0_wp - sr**2/(ss*bb)))
-      end subroutine trial
+      if (k > 0.0_wp .and. best < keep_ratio*fit%r0) edge%amplitude = k
    end subroutine fit_contact_edge
+
+   !> The relative residual with the edge at vertex + s L t.
+   pure real(wp) function stress_fit_value(self, s) result(f)
+      class(stress_fit_type), intent(in) :: self
+      real(wp), intent(in) :: s
+      real(wp) :: k
+
+      call stress_fit_trial(self, s, f, k)
+   end function stress_fit_value
+
+   !> Relative residual f and amplitude k with the edge at vertex + s L t: with r_b, r_s the
+   !> parts of the data and of the edge column orthogonal to the polynomials, k = r_s.r_b /
+   !> |r_s|^2.
+   pure subroutine stress_fit_trial(fit, s, f, k)
+      type(stress_fit_type), intent(in) :: fit
+      real(wp), intent(in) :: s
+      real(wp), intent(out) :: f, k
+      real(wp) :: rs(fit%m, 1), ss, sr, bb
+
+      associate (edge => fit%edge)
+         call edge_column(edge, fit%c, edge%vertex + s*edge%length*edge%tangent, rs(:, 1))
+      end associate
+      call apply_qt(fit%m, fit%r, fit%a, fit%tau, 1, rs)
+      rs(1:fit%r, 1) = 0.0_wp
+      ss = dot_product(rs(:, 1), rs(:, 1))
+      sr = dot_product(rs(:, 1), fit%rb(:, 1))
+      bb = dot_product(fit%rb(:, 1), fit%rb(:, 1))
+      k = 0.0_wp
+      f = fit%r0
+      if (.not. (ss > 0.0_wp) .or. .not. (bb > 0.0_wp)) return
+      k = sr/ss
+      f = fit%r0*sqrt(max(0.0_wp, 1.0_wp - sr**2/(ss*bb)))
+   end subroutine stress_fit_trial
 
    !> The edge point s (in facet lengths from the vertex along t) of the gap fit (module notes,
    !> 3) to the open surface points x(2, n) with their gaps gap(n), over [range(1), range(2)],
@@ -217,7 +262,7 @@ contains
       real(wp), intent(in) :: x(:, :), gap(:), range(2)
       real(wp), intent(out) :: s, c
       logical, intent(out) :: ok
-      real(wp), allocatable :: xi(:), g(:)
+      type(gap_fit_type) :: fit
       real(wp) :: f, c0, gmax
       logical :: inside(size(gap))
       integer :: i
@@ -231,59 +276,56 @@ contains
             & norm2(x(1:2, i) - edge%vertex) <= (gap_window(2) + 1.0_wp)*edge%length
       end do
       if (count(inside) < gap_min_points) return
-      xi = pack([(dot_product(x(1:2, i) - edge%vertex, edge%tangent)/edge%length, i=1, size(gap))], inside)
-      g = pack(gap, inside)
-      gmax = maxval(abs(g))
+      fit%xi = pack([(dot_product(x(1:2, i) - edge%vertex, edge%tangent)/edge%length, i=1, size(gap))], inside)
+      fit%g = pack(gap, inside)
+      gmax = maxval(abs(fit%g))
       if (.not. (gmax > 0.0_wp)) return
-      g = g/gmax
-      s = scan_minimum(residual, range(1), range(2))
-      call trial(s, f, c0)
+      fit%g = fit%g/gmax
+      s = scan_minimum(fit, range(1), range(2))
+      call gap_fit_trial(fit, s, f, c0)
       ok = c0 > 0.0_wp
       if (.not. ok) s = 0.0_wp
       if (ok) c = c0*gmax/edge%length**1.5_wp
-   contains
-      !> The squared residual with the edge at st.
-      pure real(wp) function residual(st)
-         real(wp), intent(in) :: st
-         real(wp) :: c0
-
-         call trial(st, residual, c0)
-      end function residual
-
-      !> Squared residual f and the coefficient c0 of xi^(3/2) at the edge (data units, xi in
-      !> facet lengths) of the two-term fit with the edge at st.
-      pure subroutine trial(st, f, c0)
-         real(wp), intent(in) :: st
-         real(wp), intent(out) :: f, c0
-         real(wp) :: p0(size(g)), p1(size(g)), a11, a12, a22, b1, b2, det, c1
-
-         p0 = max(xi - st, 0.0_wp)**1.5_wp
-         p1 = p0*xi
-         a11 = dot_product(p0, p0)
-         a12 = dot_product(p0, p1)
-         a22 = dot_product(p1, p1)
-         b1 = dot_product(p0, g)
-         b2 = dot_product(p1, g)
-         det = a11*a22 - a12**2
-         c0 = 0.0_wp
-         f = dot_product(g, g)
-         if (.not. (det > sqrt(epsilon(1.0_wp))*a11*a22)) return
-         c0 = (a22*b1 - a12*b2)/det
-         c1 = (a11*b2 - a12*b1)/det
-         f = sum((c0*p0 + c1*p1 - g)**2)
-         c0 = c0 + c1*st
-      end subroutine trial
    end subroutine fit_edge_gap
+
+   !> The squared residual of the gap fit with the edge at st.
+   pure real(wp) function gap_fit_value(self, s) result(f)
+      class(gap_fit_type), intent(in) :: self
+      real(wp), intent(in) :: s
+      real(wp) :: c0
+
+      call gap_fit_trial(self, s, f, c0)
+   end function gap_fit_value
+
+   !> Squared residual f and the coefficient c0 of xi^(3/2) at the edge (data units, xi in
+   !> facet lengths) of the two-term fit with the edge at st.
+   pure subroutine gap_fit_trial(fit, st, f, c0)
+      type(gap_fit_type), intent(in) :: fit
+      real(wp), intent(in) :: st
+      real(wp), intent(out) :: f, c0
+      real(wp) :: p0(size(fit%g)), p1(size(fit%g)), a11, a12, a22, b1, b2, det, c1
+
+      p0 = max(fit%xi - st, 0.0_wp)**1.5_wp
+      p1 = p0*fit%xi
+      a11 = dot_product(p0, p0)
+      a12 = dot_product(p0, p1)
+      a22 = dot_product(p1, p1)
+      b1 = dot_product(p0, fit%g)
+      b2 = dot_product(p1, fit%g)
+      det = a11*a22 - a12**2
+      c0 = 0.0_wp
+      f = dot_product(fit%g, fit%g)
+      if (.not. (det > sqrt(epsilon(1.0_wp))*a11*a22)) return
+      c0 = (a22*b1 - a12*b2)/det
+      c1 = (a11*b2 - a12*b1)/det
+      f = sum((c0*p0 + c1*p1 - fit%g)**2)
+      c0 = c0 + c1*st
+   end subroutine gap_fit_trial
 
    !> The minimiser of f over [lo, hi] (lo <= hi): a scan of nscan values, then ngolden golden
    !> sections in the bracket of one scan step either side of the best.
-   pure real(wp) function scan_minimum(f, lo, hi) result(s)
-      interface
-         pure real(wp) function f(x)
-            import :: wp
-            real(wp), intent(in) :: x
-         end function f
-      end interface
+   pure real(wp) function scan_minimum(objective, lo, hi) result(s)
+      class(objective_type), intent(in) :: objective
       real(wp), intent(in) :: lo, hi
       real(wp), parameter :: g = 0.6180339887498949_wp
       real(wp) :: best, a, b, x3, x4, f1, f2
@@ -293,7 +335,7 @@ contains
       s = lo
       do i = 0, nscan - 1
          x3 = lo + (hi - lo)*i/real(nscan - 1, wp)
-         f1 = f(x3)
+         f1 = objective%value(x3)
          if (f1 < best) then
             best = f1
             s = x3
@@ -303,21 +345,21 @@ contains
       b = min(hi, s + (hi - lo)/(nscan - 1))
       x3 = b - g*(b - a)
       x4 = a + g*(b - a)
-      f1 = f(x3)
-      f2 = f(x4)
+      f1 = objective%value(x3)
+      f2 = objective%value(x4)
       do it = 1, ngolden
          if (f1 < f2) then
             b = x4
             x4 = x3
             f2 = f1
             x3 = b - g*(b - a)
-            f1 = f(x3)
+            f1 = objective%value(x3)
          else
             a = x3
             x3 = x4
             f1 = f2
             x4 = a + g*(b - a)
-            f2 = f(x4)
+            f2 = objective%value(x4)
          end if
       end do
       s = 0.5_wp*(a + b)
