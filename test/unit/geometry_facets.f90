@@ -20,8 +20,9 @@ module sprc_test_facets
    use sprc_core_kinds, only: wp
    use sprc_geometry_region, only: cell_outside, cell_inside, cell_cut
    use sprc_geometry_facets, only: facet_set_type
-   use sprc_geometry_shape, only: shape_type, new_facet_shape, new_box, new_cylinder, new_disk
-   use sprc_geometry_body, only: body_type, new_body, csg_add, csg_subtract
+   use sprc_geometry_shape, only: shape_type, new_facet_shape, new_box, new_cylinder, new_disk, new_halfspace
+   use sprc_geometry_body, only: body_type, new_body, csg_add, csg_subtract, csg_intersect
+   use sprc_core_text, only: itoa
    use sprc_grid_quadrature, only: cut_quadrature_type, new_cut_quadrature, cell_rule_type, cell_rule, &
       & default_points
    use sprc_grid_facet_rule, only: facet_rule_type, facet_cell_rule, compress_min_factor
@@ -37,7 +38,8 @@ module sprc_test_facets
    !> Grid sums: measure, boundary measure, sum w x.n, |sum w n|, smallest weight.
    type :: sums_type
       real(wp) :: vol = 0.0_wp, area = 0.0_wp, div = 0.0_wp, flux(3) = 0.0_wp, wmin = huge(1.0_wp)
-      integer :: ncut = 0, nunresolved = 0
+      !> Cut cells, unresolved boxes, the most surface points of one cell.
+      integer :: ncut = 0, nunresolved = 0, nsurf_max = 0
    end type sums_type
 
 contains
@@ -52,6 +54,7 @@ contains
          new_unittest('cavity', test_cavity), &
          new_unittest('polygons_2d', test_polygons), &
          new_unittest('mixed_csg', test_mixed), &
+         new_unittest('mixed_planes_compressed', test_mixed_planes), &
          new_unittest('classification', test_classification), &
          new_unittest('shape_errors', test_shape_errors), &
          new_unittest('compressed_rule', test_compressed), &
@@ -235,6 +238,53 @@ contains
       i = count([half(1:dim)*2**level/2.0_wp - nint(half(1:dim)*2**level/2.0_wp) /= 0.0_wp])
       if (i == 0) call check(error, got%nunresolved, 0, name//' with faces on grid planes: unresolved boxes')
    end subroutine mixed_case
+
+   !> A faceted box cut by an exact oblique halfspace (3D, faces off the grid
+   !> planes) against the same body from a primitive box: cells where the
+   !> halfspace meets a facet are halved (`mixed_box`), and their planar
+   !> surface points are compressed plane by plane (`compress_planes`). The
+   !> measures and the integral of x.n over the boundary agree within the
+   !> unresolved boxes' bound (`mixed_case`; |x| <= |half| on it), and no cell
+   !> keeps more than 7 M surface points (M = 21, the moments of degree 5 in
+   !> the plane; a cell meets at most six facet planes and the halfspace):
+   !> without the compression the worst cell keeps several thousand.
+   subroutine test_mixed_planes(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(facet_set_type) :: set
+      type(shape_type) :: box, cut
+      type(body_type) :: exact_body, mixed_body
+      type(sums_type) :: ref, got
+      real(wp) :: a, half(3), normal(3)
+      integer, parameter :: level = 3, m2 = 21
+
+      half = [0.53_wp, 0.47_wp, 0.29_wp]
+      normal = [0.3_wp, 0.2_wp, 1.0_wp]
+      call facets_box(set, [0.0_wp, 0.0_wp, 0.0_wp], half, [0.0_wp, 0.0_wp, 0.0_wp])
+      call new_box(box, 'plate', -half, half, error)
+      if (.not. allocated(error)) call new_halfspace(cut, 'cut', [0.05_wp, -0.03_wp, 0.07_wp], normal, error)
+      if (allocated(error)) return
+      call new_body(exact_body, 'exact')
+      call exact_body%add_shape(csg_add, box, error)
+      if (.not. allocated(error)) call exact_body%add_shape(csg_intersect, cut, error)
+      if (allocated(error)) return
+      call make_body(set, mixed_body, error)
+      if (.not. allocated(error)) call mixed_body%add_shape(csg_intersect, cut, error)
+      if (allocated(error)) return
+      call grid_sums(exact_body, 3, level, -1.0_wp, 2.0_wp, ref, error)
+      if (allocated(error)) return
+      call grid_sums(mixed_body, 3, level, -1.0_wp, 2.0_wp, got, error)
+      if (allocated(error)) return
+      a = 2.0_wp/2**level/2**4
+      call check(error, got%vol, ref%vol, tol_rel*ref%vol + got%nunresolved*a**3, 'mixed planes volume')
+      if (allocated(error)) return
+      call check(error, got%area, ref%area, tol_rel*ref%area + got%nunresolved*3*a**2, 'mixed planes boundary measure')
+      if (allocated(error)) return
+      call check(error, got%div, ref%div, tol_rel*ref%area + got%nunresolved*3*a**2*norm2(half), &
+         & 'mixed planes: the integral of x.n')
+      if (allocated(error)) return
+      call check(error, got%wmin > 0.0_wp .and. got%nsurf_max <= 7*m2, 'mixed planes: '//itoa(got%nsurf_max)// &
+         & ' surface points in one cell (at most '//itoa(7*m2)//'), weights positive')
+   end subroutine test_mixed_planes
 
    !> Classes of boxes against a unit cube [0, 1]^3 given as facets: inside,
    !> outside, cut, and the tie rules (a facet on a box face, a box touching the
@@ -548,6 +598,7 @@ contains
                call cell_rule(quad, body, lo(1:dim), hi(1:dim), rule, error)
                if (allocated(error)) return
                if (rule%cls == cell_cut) sums%ncut = sums%ncut + 1
+               sums%nsurf_max = max(sums%nsurf_max, rule%nsurf)
                sums%nunresolved = sums%nunresolved + rule%nunresolved
                sums%vol = sums%vol + sum(rule%vol_w(1:rule%nvol))
                do q = 1, rule%nsurf

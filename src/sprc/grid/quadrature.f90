@@ -400,11 +400,92 @@ contains
          call mixed_box(quad, body, lo, hi, lo, hi, 0, rule)
          if (rule%nvol > compress_min_factor*moment_count(quad%dim, 2*quad%q - 1)) &
             & call compress_points(rule%facets, quad%dim, lo, hi, 2*quad%q - 1, rule%vol_x, rule%vol_w, rule%nvol)
+         if (quad%dim == 3) call compress_planes(quad, rule)
       else
          call saye_rule(quad, body, lo, hi, rule, active(1:n))
       end if
       call add_face_parts(quad, body, lo, hi, rule)
    end subroutine cut_rule
+
+   !> The surface points of a 3D cell a faceted solid cuts, compressed plane by
+   !> plane: points of one surface id with one normal (the fragments of one
+   !> facet, or of a halfspace in `mixed_box`'s boxes) lie in one plane, and
+   !> where more than M of them do (M the moments of total degree 2q - 1 in two
+   !> variables, 21 for q = 3; the NNLS is cheap at that size) `compress_points`
+   !> keeps at most M of them,
+   !> with positive weights and the same moments in the plane's coordinates:
+   !> the degree the fanned Gauss rules integrate exactly. Without it a cell
+   !> where a facet meets another surface keeps the points of every box
+   !> `mixed_box` halved it into (thousands). Curved pieces (normals that
+   !> differ point to point) stay as they are.
+   pure subroutine compress_planes(quad, rule)
+      type(cut_quadrature_type), intent(in) :: quad
+      type(cell_rule_type), intent(inout) :: rule
+      real(wp), allocatable :: y(:, :), w(:), x(:, :), nrm(:, :), wt(:)
+      integer, allocatable :: members(:), shp(:)
+      logical :: taken(rule%nsurf)
+      real(wp) :: t1(3), t2(3), lo2(2), hi2(2)
+      integer :: i, j, k, m2, ng, nout
+
+      m2 = moment_count(2, 2*quad%q - 1)
+      if (rule%nsurf <= m2) return
+      taken = .false.
+      allocate (x(3, rule%nsurf), wt(rule%nsurf), nrm(3, rule%nsurf), shp(rule%nsurf), members(rule%nsurf))
+      nout = 0
+      do i = 1, rule%nsurf
+         if (taken(i)) cycle
+         ng = 0
+         do j = i, rule%nsurf
+            if (taken(j) .or. rule%surf_shape(j) /= rule%surf_shape(i)) cycle
+            if (any(rule%surf_n(:, j) /= rule%surf_n(:, i))) cycle
+            taken(j) = .true.
+            ng = ng + 1
+            members(ng) = j
+         end do
+         if (ng > m2) then
+            call plane_basis(rule%surf_n(:, i), t1, t2)
+            allocate (y(3, ng), w(ng))
+            do k = 1, ng
+               y(:, k) = [dot_product(t1, rule%surf_x(:, members(k))), dot_product(t2, rule%surf_x(:, members(k))), &
+                  & real(members(k), wp)]
+               w(k) = rule%surf_w(members(k))
+            end do
+            lo2 = minval(y(1:2, :), dim=2)
+            hi2 = maxval(y(1:2, :), dim=2)
+            call compress_points(rule%facets, 2, lo2, hi2, 2*quad%q - 1, y, w, ng)
+            members(1:ng) = nint(y(3, 1:ng))
+         else
+            allocate (w(ng))
+            w = rule%surf_w(members(1:ng))
+         end if
+         do k = 1, ng
+            nout = nout + 1
+            x(:, nout) = rule%surf_x(:, members(k))
+            wt(nout) = w(k)
+            nrm(:, nout) = rule%surf_n(:, members(k))
+            shp(nout) = rule%surf_shape(members(k))
+         end do
+         if (allocated(y)) deallocate (y)
+         deallocate (w)
+      end do
+      rule%nsurf = nout
+      rule%surf_x(:, 1:nout) = x(:, 1:nout)
+      rule%surf_w(1:nout) = wt(1:nout)
+      rule%surf_n(:, 1:nout) = nrm(:, 1:nout)
+      rule%surf_shape(1:nout) = shp(1:nout)
+   end subroutine compress_planes
+
+   !> Two unit vectors spanning the plane of unit normal n (with n, right-handed).
+   pure subroutine plane_basis(n, t1, t2)
+      real(wp), intent(in) :: n(3)
+      real(wp), intent(out) :: t1(3), t2(3)
+      real(wp) :: e(3)
+      e = 0.0_wp
+      e(minloc(abs(n), dim=1)) = 1.0_wp
+      t1 = [n(2)*e(3) - n(3)*e(2), n(3)*e(1) - n(1)*e(3), n(1)*e(2) - n(2)*e(1)]
+      t1 = t1/norm2(t1)
+      t2 = [n(2)*t1(3) - n(3)*t1(2), n(3)*t1(1) - n(1)*t1(3), n(1)*t1(2) - n(2)*t1(1)]
+   end subroutine plane_basis
 
    !> Volume and surface rule of the box [lo, hi] by dimension reduction on the
    !> quadrics of the shapes `active` (no boundary parts on its faces).
