@@ -633,7 +633,8 @@ contains
       line = 'level='//itoa(row%level)//' body='//row%body//' internal='//itoa(row%internal)// &
          ' cut='//itoa(row%cut)//' external='//itoa(row%external)//' measure='//trim(adjustl(m))// &
          ' boundary_measure='//trim(adjustl(bm))//' points='//itoa(row%points)//' t_mesh='//trim(adjustl(t))// &
-         ' t_quadrature='//trim(adjustl(tq))//' volume_points='//itoa(row%volume_points)
+         ' t_quadrature='//trim(adjustl(tq))//' volume_points='//itoa(row%volume_points)// &
+         ' surface_points='//itoa(row%surface_points)//' unresolved='//itoa(row%unresolved)
       if (.not. allocated(row%surfaces)) return
       do i = 1, size(row%surfaces)
          write (m, '(es24.16)') row%surfaces(i)%measure

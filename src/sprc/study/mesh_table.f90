@@ -39,9 +39,13 @@ module sprc_study_mesh_table
       !> part of boundary_measure (the surface points the quadrature tags with its shape,
       !> or its group).
       type(surface_measure_type), allocatable :: surfaces(:)
-      !> Gauss points per direction used; volume points of all cells' rules.
+      !> Gauss points per direction used; volume and surface points of all cells' rules.
       integer :: points = 0
-      integer(i8) :: volume_points = 0
+      integer(i8) :: volume_points = 0, surface_points = 0
+      !> Boxes the cut-cell quadrature integrated without resolving the geometry
+      !> (sprc_grid_quadrature `nunresolved`: where a faceted surface meets another
+      !> surface at the smallest box, or no height direction at max_depth).
+      integer(i8) :: unresolved = 0
       !> Seconds to build, classify and balance the grid, and to build the rules.
       real(wp) :: t_mesh = 0.0_wp, t_quadrature = 0.0_wp
    end type mesh_row_type
@@ -131,7 +135,7 @@ contains
             call timer%reset()
             call timer%start()
             call integrate_measures(grid, bodies(b), quad, rows(k)%measure, rows(k)%boundary_measure, by_surface, &
-               & rows(k)%volume_points, error)
+               & rows(k)%volume_points, error, rows(k)%surface_points, rows(k)%unresolved)
             call timer%stop()
             rows(k)%t_quadrature = timer%elapsed
             if (allocated(error)) return
@@ -150,14 +154,16 @@ contains
    !> digits are the quadrature's, not the summation's; by_surface(i) is the
    !> part of boundary_measure whose points the quadrature tags with surface
    !> id i (sprc_geometry_body): a shape's includes its groups'. npoints: the
-   !> volume points of all rules.
-   subroutine integrate_measures(grid, body, quad, measure, boundary_measure, by_surface, npoints, error)
+   !> volume points of all rules; nsurf their surface points; unresolved the
+   !> boxes integrated without resolving the geometry.
+   subroutine integrate_measures(grid, body, quad, measure, boundary_measure, by_surface, npoints, error, nsurf, &
+         & unresolved)
       type(grid_type), intent(in) :: grid
       type(body_type), intent(in) :: body
       type(cut_quadrature_type), intent(in) :: quad
       real(wp), intent(out) :: measure, boundary_measure
       real(wp), allocatable, intent(out) :: by_surface(:)
-      integer(i8), intent(out) :: npoints
+      integer(i8), intent(out) :: npoints, nsurf, unresolved
       type(error_type), allocatable, intent(out) :: error
       type(cell_rule_type) :: rule
       real(wp) :: lo(3), hi(3), vol(2), surf(2)
@@ -169,12 +175,16 @@ contains
       surf = 0.0_wp
       allocate (acc(2, body%nsurface()), source=0.0_wp)
       npoints = 0
+      nsurf = 0
+      unresolved = 0
       do leaf = 1, grid%n_leaves
          call grid%leaf_box(leaf, lo(1:d), hi(1:d))
          call cell_rule(quad, body, lo(1:d), hi(1:d), rule, error)
          if (allocated(error)) return
          call neumaier_add(vol, rule%vol_w(1:rule%nvol))
          npoints = npoints + rule%nvol
+         nsurf = nsurf + rule%nsurf
+         unresolved = unresolved + rule%nunresolved
          call neumaier_add(surf, rule%surf_w(1:rule%nsurf))
          do q = 1, rule%nsurf
             id = rule%surf_shape(q)
@@ -286,7 +296,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(grid_type) :: grid
       real(wp) :: boundary_measure
-      integer(i8) :: npoints
+      integer(i8) :: npoints, nsurf, unresolved
 
       call grid%build(body, scene%dim, scene%bodies(b)%box_min, scene%bodies(b)%box_size, level, &
          & scene%refine_boundary, error)
@@ -294,7 +304,8 @@ contains
          error%message = "body '"//body%name//"', level "//itoa(level)//': '//error%message
          return
       end if
-      call integrate_measures(grid, body, quad, measure, boundary_measure, by_surface, npoints, error)
+      call integrate_measures(grid, body, quad, measure, boundary_measure, by_surface, npoints, error, nsurf, &
+         & unresolved)
    end subroutine body_measures
 
    !> The error for surface id of body b (a shape i's whole surface, or a
