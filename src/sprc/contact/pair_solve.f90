@@ -810,21 +810,115 @@ contains
       end do
       call join_rows(error)
       if (allocated(error)) return
+      call constant_alone(error)
+      if (allocated(error)) return
       call node_lists(node, phi, nn, ops, error)
    contains
+      !> A contact cell that shares none of its nodes with another cell (its
+      !> neighbours along the surface of another normal axis or size: a
+      !> coarse ring, a quarter turn of a few cells) gets one node with
+      !> phi = 1, the constant multiplier's cell: its own hats would add a
+      !> slope that no neighbour ties, over master cells that may be as
+      !> large as the cell itself where `turns_too_far` narrowed it (a
+      !> closed fit at a coarse level: the slopes oscillate, one node in
+      !> tension). Nodes renumbered 1..nn.
+      subroutine constant_alone(error)
+         type(error_type), allocatable, intent(out) :: error
+         integer, allocatable :: first(:), newid(:), single(:)
+         logical, allocatable :: shared(:), alone(:)
+         allocate (first(nn), newid(nn), shared(nn), alone(ops%ncell), single(ops%ncell), stat=stat)
+         call check_allocation(stat, 'contact cells', 'the nodes'' cells', nn + ops%ncell, 12, error)
+         if (allocated(error)) return
+         first = 0
+         shared = .false.
+         do i = 1, surface%npoint
+            c = ops%cell_of_point(i)
+            do v = 1, nc
+               m = node(v, i)
+               if (m == 0) cycle
+               if (first(m) == 0) first(m) = c
+               shared(m) = shared(m) .or. first(m) /= c
+            end do
+         end do
+         alone = .true.
+         single = huge(1)
+         do i = 1, surface%npoint
+            c = ops%cell_of_point(i)
+            if (c == 0) cycle
+            do v = 1, nc
+               if (node(v, i) == 0) cycle
+               alone(c) = alone(c) .and. .not. shared(node(v, i))
+               single(c) = min(single(c), node(v, i))
+            end do
+         end do
+         if (.not. any(alone)) return
+         do i = 1, surface%npoint
+            c = ops%cell_of_point(i)
+            if (c == 0) cycle
+            if (.not. alone(c)) cycle
+            node(:, i) = 0
+            phi(:, i) = 0.0_wp
+            node(1, i) = single(c)
+            phi(1, i) = 1.0_wp
+         end do
+         newid = 0
+         do i = 1, surface%npoint
+            do v = 1, nc
+               if (node(v, i) > 0) newid(node(v, i)) = 1
+            end do
+         end do
+         m = 0
+         do j = 1, nn
+            if (newid(j) == 0) cycle
+            m = m + 1
+            newid(j) = m
+         end do
+         nn = m
+         do i = 1, surface%npoint
+            do v = 1, nc
+               if (node(v, i) > 0) node(v, i) = newid(node(v, i))
+            end do
+         end do
+      end subroutine constant_alone
+
       !> One node per vertex over neighbouring rows (union-find, the lower
-      !> index the root): nodes renumbered 1..nn, node(:, :) remapped.
+      !> index the root) where the surface passes from one row to the other
+      !> (`passes`): nodes renumbered 1..nn, node(:, :) remapped.
       subroutine join_rows(error)
          type(error_type), allocatable, intent(out) :: error
-         allocate (parent(nn), id(nn), stat=stat)
-         call check_allocation(stat, 'contact cells', 'the nodes'' classes', nn, 8, error)
+         integer, allocatable :: ptr(:), list(:), fill(:)
+         allocate (parent(nn), id(nn), ptr(nn + 1), fill(nn), stat=stat)
+         call check_allocation(stat, 'contact cells', 'the nodes'' classes', nn, 16, error)
          if (allocated(error)) return
+         fill = 0
+         do i = 1, surface%npoint
+            do v = 1, nc
+               if (node(v, i) > 0) fill(node(v, i)) = fill(node(v, i)) + 1
+            end do
+         end do
+         ptr(1) = 1
+         do m = 1, nn
+            ptr(m + 1) = ptr(m) + fill(m)
+         end do
+         allocate (list(ptr(nn + 1) - 1), stat=stat)
+         call check_allocation(stat, 'contact cells', 'the nodes'' points', ptr(nn + 1) - 1, 4, error)
+         if (allocated(error)) return
+         fill = 0
+         do i = 1, surface%npoint
+            do v = 1, nc
+               m = node(v, i)
+               if (m == 0) cycle
+               list(ptr(m) + fill(m)) = i
+               fill(m) = fill(m) + 1
+            end do
+         end do
          parent = [(m, m=1, nn)]
          do m = 1, nn
             vkey(1:d + 2) = keys(:, m)
             vkey(1 + vkey(1)) = vkey(1 + vkey(1)) + vkey(d + 2)
             r = find_key(vkey(1:d + 2), .false.)
-            if (r > 0) call join(m, r)
+            if (r == 0) cycle
+            if (passes(list(ptr(m):ptr(m + 1) - 1), list(ptr(r):ptr(r + 1) - 1))) call join(m, r)
          end do
          nn = 0
          do m = 1, size(parent)
@@ -843,6 +937,30 @@ contains
             end do
          end do
       end subroutine join_rows
+
+      !> Whether the surface runs from the points `a` of one node to the
+      !> points `b` of the node of the same vertex in the neighbouring row:
+      !> a point of each within two slave-cell diagonals of each other (the
+      !> points nearest the crossing of the rows' common face lie each
+      !> within a cell's diagonal of it). Two parts of the surface that
+      !> merely lie in neighbouring rows (the two flanks of a V-groove)
+      !> keep their own nodes: one node on both would constrain only the
+      !> mean of their gaps, and leave free the motions that move them
+      !> oppositely.
+      logical function passes(a, b)
+         integer, intent(in) :: a(:), b(:)
+         integer :: ia, ib
+         real(wp) :: reach
+         passes = .true.
+         do ia = 1, size(a)
+            do ib = 1, size(b)
+               reach = 2.0_wp*sqrt(real(d, wp))*max(cell_size(slave, surface%slave_cell(a(ia))), &
+                  & cell_size(slave, surface%slave_cell(b(ib))))
+               if (norm2(surface%x(:, a(ia)) - surface%x(:, b(ib))) <= reach) return
+            end do
+         end do
+         passes = .false.
+      end function passes
 
       !> The node of `key` (0 if absent and not `add`).
       integer function find_key(key, add) result(found)
