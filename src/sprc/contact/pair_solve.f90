@@ -216,6 +216,10 @@ module sprc_contact_pair_solve
       !> Seconds of the contact operators and active-set evaluation, and of the
       !> block assemblies and solves.
       real(wp) :: t_contact = 0.0_wp, t_solve = 0.0_wp
+      !> What a caller should tell the user about the solve ('' for nothing):
+      !> the linear multiplier's active set ended by repeating an earlier
+      !> one (`next_set`), a cycle the solve cut short.
+      character(len=:), allocatable :: warning
    end type contact_solution_type
 
    !> A body of an assembly (`solve_contact_assembly`): its assembled problem and its name.
@@ -317,9 +321,10 @@ contains
       real(wp), allocatable :: slip(:, :), tau(:, :), pstar(:, :)
       type(block_solver_type), target :: own
       type(block_solver_type), pointer :: bs
-      integer :: it, maxit, n, c, switched, stat, last_switched, attempt
+      integer :: it, maxit, n, c, switched, stat, last_switched, attempt, cycled
       logical :: kept, again
 
+      sol%warning = ''
       call check_pair(slave, master, surface, friction, kappa, error)
       if (.not. allocated(error) .and. present(recovered)) call check_recovered(surface, friction, recovered, error)
       if (allocated(error)) return
@@ -423,18 +428,20 @@ contains
             call evaluate(surface, ops, cells, closed, x, sol, error)
          end if
          if (allocated(error)) return
-         call next_set(ops, closed, sol%lambda_n, sol%gap, next, switched)
+         call next_set(ops, closed, sol%lambda_n, sol%gap, next, switched, cycled)
          call timer%stop()
          sol%t_contact = sol%t_contact + timer%elapsed
          if (switched == 0 .and. .not. kept .and. bs%iterative .and. bs%krylov%tolerance > bs%tight) then
             call timer%reset()
             call timer%start()
-            call confirm_set(surface, ops, cells, closed, bs, f, x, sol, next, switched, error, pstar)
+            call confirm_set(surface, ops, cells, closed, bs, f, x, sol, next, switched, cycled, error, pstar)
             call timer%stop()
             sol%t_solve = sol%t_solve + timer%elapsed
             if (allocated(error)) return
          end if
          if (present(progress)) call progress(1, 1, it, switched)
+         if (cycled > 0) sol%warning = cycle_warning("contact '"//trim(names(1))//"' on '"//trim(names(2))//"'", &
+            & it, cycled)
          if (switched == 0) exit
          ! loose solves that do not shrink the change of the set: tighter ones from here on
          if (switched >= last_switched) bs%loose = merge(bs%careful, bs%tight, bs%loose > bs%careful)
@@ -2037,16 +2044,20 @@ contains
    !> points, not at a node or a midpoint; any other point takes the state
    !> of its owner's trial multiplier (a whole hat's, the node open). A
    !> node is closed when one of its points is.
-   subroutine next_set(ops, closed, lambda_n, gap, next, switched)
+   subroutine next_set(ops, closed, lambda_n, gap, next, switched, cycled)
       type(point_operators_type), intent(inout) :: ops
       logical, intent(in) :: closed(:)
       real(wp), intent(in) :: lambda_n(:), gap(:)
       logical, intent(out) :: next(:)
       integer, intent(out) :: switched
+      !> The points that would have switched into a set solved before (the
+      !> set then repeats and the iteration ends on it); 0 otherwise.
+      integer, intent(out) :: cycled
       real(wp) :: p(size(ops%cell_of_point))
       logical :: covered(size(ops%cell_of_point))
       integer :: c, q, i, k
 
+      cycled = 0
       if (.not. allocated(ops%pclosed)) then
          next = lambda_n < 0.0_wp
          switched = switched_points(ops, closed, next)
@@ -2083,6 +2094,7 @@ contains
       do k = 1, ops%nseen
          if (switched == 0) exit
          if (.not. all(ops%seen(:, k) .eqv. ops%pnext)) cycle
+         cycled = switched
          ops%pnext = ops%pclosed
          next = closed
          switched = 0
@@ -2107,7 +2119,7 @@ contains
    !> the same system again (its preconditioner set up) to the final
    !> tolerance from that solution and evaluate again; `switched` says
    !> whether the set still repeats.
-   subroutine confirm_set(surface, ops, cells, closed, bs, f, x, sol, next, switched, error, pstar)
+   subroutine confirm_set(surface, ops, cells, closed, bs, f, x, sol, next, switched, cycled, error, pstar)
       type(contact_surface_type), intent(in) :: surface
       type(point_operators_type), intent(inout) :: ops
       type(cell_operators_type), intent(in) :: cells(:)
@@ -2117,16 +2129,28 @@ contains
       real(wp), intent(inout) :: x(:)
       type(contact_solution_type), intent(inout) :: sol
       logical, intent(out) :: next(:)
-      integer, intent(out) :: switched
+      integer, intent(out) :: switched, cycled
       type(error_type), allocatable, intent(out) :: error
       real(wp), intent(in), optional :: pstar(:, :)
 
+      cycled = 0
       bs%krylov%tolerance = bs%tight
       call krylov_solve(bs%krylov, f, x, sol, error)
       if (.not. allocated(error)) call evaluate(surface, ops, cells, closed, x, sol, error, pstar)
       if (allocated(error)) return
-      call next_set(ops, closed, sol%lambda_n, sol%gap, next, switched)
+      call next_set(ops, closed, sol%lambda_n, sol%gap, next, switched, cycled)
    end subroutine confirm_set
+
+   !> The warning of a pair `what` whose active set repeated an earlier one
+   !> at active-set iteration `iteration` with `cycled` points switching.
+   pure function cycle_warning(what, iteration, cycled) result(text)
+      character(len=*), intent(in) :: what
+      integer, intent(in) :: iteration, cycled
+      character(len=:), allocatable :: text
+      text = what//': the active set repeated an earlier one at active-set iteration '//itoa(iteration)//' ('// &
+         & itoa(cycled)//' points switching back and forth, their pressure near zero); the solution of the '// &
+         & 'repeated set is kept'
+   end function cycle_warning
 
    !> The blocks (masters) of `dof` with a component in `touched` (0: none).
    pure function kept_masters(touched, dof) result(keep)
@@ -2369,7 +2393,7 @@ contains
       type(timer_type) :: timer
       real(wp), allocatable :: f(:), x(:)
       integer, allocatable :: offset(:)
-      integer :: it, maxit, p, c, switched, b, stat, moved, attempt
+      integer :: it, maxit, p, c, switched, b, stat, moved, attempt, cycled
       logical, allocatable :: next(:)
       logical :: again
 
@@ -2378,6 +2402,9 @@ contains
       allocate (sols(size(pairs)), work(size(pairs)), offset(size(bodies) + 1), stat=stat)
       call check_allocation(stat, 'contact assembly', 'the pairs', size(pairs), 64, error)
       if (allocated(error)) return
+      do p = 1, size(pairs)
+         sols(p)%warning = ''
+      end do
       offset(1) = 0
       do b = 1, size(bodies)
          offset(b + 1) = offset(b) + bodies(b)%problem%n_dofs()
@@ -2425,7 +2452,8 @@ contains
                if (allocated(error)) return
                if (allocated(next)) deallocate (next)
                allocate (next(size(w%closed)))
-               call next_set(w%ops, w%closed, sols(p)%lambda_n, sols(p)%gap, next, moved)
+               call next_set(w%ops, w%closed, sols(p)%lambda_n, sols(p)%gap, next, moved, cycled)
+               if (cycled > 0) sols(p)%warning = cycle_warning(pair_name(bodies, pairs(p)), it, cycled)
                switched = switched + moved
                w%closed = next
                if (allocated(w%ops%pnext)) w%ops%pclosed = w%ops%pnext
