@@ -14,7 +14,10 @@
 !>   (`node_cells`): hats of the cells' vertex lattice along the surface,
 !>   eliminated node by node (mass lumped), the active set per point
 !>   (`next_set`: the edge where the pressure or the gap changes sign), a
-!>   closed node's hat cut to its closed points (`cut_edges`).
+!>   closed node's hat cut to its closed points (`cut_edges`); nodes joined
+!>   across rows only where the surface passes (`join_rows`), a cell that
+!>   shares no node one constant node (`constant_alone`); a set repeating an
+!>   earlier one ends the iteration with a warning (`cycle_warning`).
 !> - Frame: at point i lambda_c acts as R_i lambda_c, R_i the least rotation from the
 !>   cell's mean normal to n_i (`frame_rotation`): a uniform pressure on a curved
 !>   surface is in the space (a Cartesian constant costs Q2 its order).
