@@ -185,6 +185,7 @@ contains
                rows(i) = result%row
                if (h5%opened()) call write_level_fields(h5, study, result, error)
             end if
+            if (.not. allocated(error) .and. rank == 0) call print_contact_warnings('level', levels(i), result)
             if (.not. allocated(error) .and. allocated(result%contacts)) then
                n_contact = n_contact + 1
                contact_levels(n_contact)%level = levels(i)
@@ -285,6 +286,7 @@ contains
          rows(n_rows) = result%row
          if (h5%opened()) call write_level_fields(h5, study, result, error, step=run%step)
          if (allocated(error)) call fail_with(error)
+         if (rank == 0) call print_contact_warnings('step', run%step, result)
          if (allocated(result%contacts)) then
             n_contact = n_contact + 1
             contact_levels(n_contact)%level = run%step
@@ -400,6 +402,21 @@ contains
 
 
    !> Lines 'warning: ...' on standard error, each as 'sprc: warning: ...'.
+   !> The contact solves' warnings of a level (or adaptive step) `n`, each
+   !> as 'sprc: warning: level n: ...'.
+   subroutine print_contact_warnings(what, n, result)
+      character(len=*), intent(in) :: what
+      integer, intent(in) :: n
+      type(level_type), intent(in) :: result
+      integer :: p
+      if (.not. allocated(result%contacts)) return
+      do p = 1, size(result%contacts)
+         if (.not. allocated(result%contacts(p)%warning)) cycle
+         if (len(result%contacts(p)%warning) == 0) cycle
+         write (error_unit, '(a,i0,a)') 'sprc: warning: '//what//' ', n, ': '//result%contacts(p)%warning
+      end do
+   end subroutine print_contact_warnings
+
    subroutine print_warnings(text)
       character(len=*), intent(in) :: text
       integer :: start, nl

@@ -69,7 +69,8 @@ contains
          new_unittest('layered_rings_q2_plane_strain', test_rings_q2_strain), &
          new_unittest('layered_rings_q2_plane_stress', test_rings_q2_stress), &
          new_unittest('layered_sphere_q1', test_layered_sphere), &
-         new_unittest('two_rollers', test_two_rollers) &
+         new_unittest('two_rollers', test_two_rollers), &
+         new_unittest('unloaded_fits_cycle_warned', test_cycle_warned) &
          ]
    end subroutine collect_contact_assembly
 
@@ -281,5 +282,34 @@ contains
          if (allocated(error)) return
       end do
    end subroutine test_two_rollers
+
+   !> Two closed fits under no load (the shaft and hub of
+   !> test/data/contact/closed_fit_unloaded.nml, the hub in a third ring
+   !> fixed outside; stick, one assembly, level 4): the linear multiplier's
+   !> set cycles on round-off in the assembly's iteration too; the pair whose
+   !> set repeated carries the warning (the hub's pair comes first in the
+   !> scene).
+   subroutine test_cycle_warned(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(level_type) :: result
+      character(len=:), allocatable :: text
+
+      call read_text_file('test/data/contact/closed_fit_unloaded.nml', text, error)
+      if (allocated(error)) return
+      text = replaced(text, "&body name='hub' young=1.0 poisson=0.25 /", &
+         & "&body name='hub' young=1.0 poisson=0.25 box_min=-2.03,-2.02 box_size=4.1 /"//new_line('a')// &
+         & "&body name='ring' young=1.0 poisson=0.25 /"//new_line('a')// &
+         & "&shape body='ring' op='add' kind='disk' name='ring_out' center=0.013,0.021 radius=2.5 /"// &
+         & new_line('a')//"&shape body='ring' op='subtract' kind='disk' name='ring_in' center=0.013,0.021 "// &
+         & "radius=2 /"//new_line('a')//"&contact slave='hub' master='ring' slave_surface='hub_out' "// &
+         & "master_surface='ring_in' friction='stick' /")
+      text = replaced(text, "&bc on='hub_out' type='displacement'", "&bc on='ring_out' type='displacement'")
+      call run_text(text, 4, result, error)
+      if (allocated(error)) return
+      call check(error, allocated(result%contacts(1)%warning), 'a warning')
+      if (allocated(error)) return
+      call check(error, index(result%contacts(1)%warning, "contact 'hub' on 'ring': the active set repeated an "// &
+         & 'earlier one at active-set iteration ') == 1, "warning '"//result%contacts(1)%warning//"'")
+   end subroutine test_cycle_warned
 
 end module sprc_test_contact_assembly

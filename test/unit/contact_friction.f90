@@ -19,6 +19,7 @@ module sprc_test_contact_friction
    use sprc_test_study, only: run_text
    use sprc_contact_result, only: contact_open
    use sprc_testsuite, only: unittest_type, new_unittest, check, full_tier
+   use sprc_io_namelist, only: read_text_file
    implicit none
    private
 
@@ -37,6 +38,7 @@ contains
          new_unittest('sphere_q2_stick_coulomb', test_sphere_q2), &
          new_unittest('sphere_q1_three_laws', test_sphere_q1), &
          new_unittest('closed_fit_2d_held', test_closed_fit_2d), &
+         new_unittest('unloaded_fit_cycle_warned', test_cycle_warned), &
          new_unittest('closed_fit_3d_held', test_closed_fit_3d) &
          ]
    end subroutine collect_contact_friction
@@ -242,6 +244,25 @@ contains
       call closed_fit(3, 'stick', 0, error)
       if (.not. allocated(error)) call closed_fit(3, 'frictionless', 2, error)
    end subroutine test_closed_fit_3d
+
+   !> A closed fit under no load (test/data/contact/closed_fit_unloaded.nml,
+   !> stick, level 4): every pressure is round-off, the linear multiplier's
+   !> active set cycles until a set repeats, and the run ends on that set;
+   !> the level's contact result carries a warning naming the pair and the
+   !> iteration (the driver prints it).
+   subroutine test_cycle_warned(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(level_type) :: result
+      character(len=:), allocatable :: text
+
+      call read_text_file('test/data/contact/closed_fit_unloaded.nml', text, error)
+      if (.not. allocated(error)) call run_text(text, 4, result, error)
+      if (allocated(error)) return
+      call check(error, allocated(result%contacts(1)%warning), 'a warning')
+      if (allocated(error)) return
+      call check(error, index(result%contacts(1)%warning, "contact 'shaft' on 'hub': the active set repeated an "// &
+         & 'earlier one at active-set iteration ') == 1, "warning '"//result%contacts(1)%warning//"'")
+   end subroutine test_cycle_warned
 
    subroutine closed_fit(dim, law, nplanes, error)
       integer, intent(in) :: dim, nplanes

@@ -624,13 +624,13 @@ contains
    end subroutine test_contact_defaults
 
    !> `multiplier` absent or 'auto' resolves when the scene is read: linear
-   !> for Q2 in 2D, constant for Q1 and in 3D; a space written stays.
+   !> in 2D (Q1 and Q2), constant in 3D; a space written stays.
    subroutine test_contact_multiplier_auto(error)
       type(error_type), allocatable, intent(out) :: error
       character(len=*), parameter :: order(4) = ["levels=3        ", "levels=3 order=2", &
          & "levels=3 order=2", "levels=3 order=2"], &
          & written(4) = [character(len=26) :: '', '', "multiplier='auto' ", "multiplier='constant' "], &
-         & expected(4) = [character(len=8) :: 'constant', 'linear', 'linear', 'constant']
+         & expected(4) = [character(len=8) :: 'linear', 'linear', 'linear', 'constant']
       type(scene_type) :: s
       integer :: k
       do k = 1, size(order)

@@ -14,7 +14,10 @@
 !>   (`node_cells`): hats of the cells' vertex lattice along the surface,
 !>   eliminated node by node (mass lumped), the active set per point
 !>   (`next_set`: the edge where the pressure or the gap changes sign), a
-!>   closed node's hat cut to its closed points (`cut_edges`).
+!>   closed node's hat cut to its closed points (`cut_edges`); nodes joined
+!>   across rows only where the surface passes (`join_rows`), a cell that
+!>   shares no node one constant node (`constant_alone`); a set repeating an
+!>   earlier one ends the iteration with a warning (`cycle_warning`).
 !> - Frame: at point i lambda_c acts as R_i lambda_c, R_i the least rotation from the
 !>   cell's mean normal to n_i (`frame_rotation`): a uniform pressure on a curved
 !>   surface is in the space (a Cartesian constant costs Q2 its order).
@@ -216,6 +219,10 @@ module sprc_contact_pair_solve
       !> Seconds of the contact operators and active-set evaluation, and of the
       !> block assemblies and solves.
       real(wp) :: t_contact = 0.0_wp, t_solve = 0.0_wp
+      !> What a caller should tell the user about the solve ('' for nothing):
+      !> the linear multiplier's active set ended by repeating an earlier
+      !> one (`next_set`), a cycle the solve cut short.
+      character(len=:), allocatable :: warning
    end type contact_solution_type
 
    !> A body of an assembly (`solve_contact_assembly`): its assembled problem and its name.
@@ -317,9 +324,10 @@ contains
       real(wp), allocatable :: slip(:, :), tau(:, :), pstar(:, :)
       type(block_solver_type), target :: own
       type(block_solver_type), pointer :: bs
-      integer :: it, maxit, n, c, switched, stat, last_switched, attempt
+      integer :: it, maxit, n, c, switched, stat, last_switched, attempt, cycled
       logical :: kept, again
 
+      sol%warning = ''
       call check_pair(slave, master, surface, friction, kappa, error)
       if (.not. allocated(error) .and. present(recovered)) call check_recovered(surface, friction, recovered, error)
       if (allocated(error)) return
@@ -423,18 +431,20 @@ contains
             call evaluate(surface, ops, cells, closed, x, sol, error)
          end if
          if (allocated(error)) return
-         call next_set(ops, closed, sol%lambda_n, sol%gap, next, switched)
+         call next_set(ops, closed, sol%lambda_n, sol%gap, next, switched, cycled)
          call timer%stop()
          sol%t_contact = sol%t_contact + timer%elapsed
          if (switched == 0 .and. .not. kept .and. bs%iterative .and. bs%krylov%tolerance > bs%tight) then
             call timer%reset()
             call timer%start()
-            call confirm_set(surface, ops, cells, closed, bs, f, x, sol, next, switched, error, pstar)
+            call confirm_set(surface, ops, cells, closed, bs, f, x, sol, next, switched, cycled, error, pstar)
             call timer%stop()
             sol%t_solve = sol%t_solve + timer%elapsed
             if (allocated(error)) return
          end if
          if (present(progress)) call progress(1, 1, it, switched)
+         if (cycled > 0) sol%warning = cycle_warning("contact '"//trim(names(1))//"' on '"//trim(names(2))//"'", &
+            & it, cycled)
          if (switched == 0) exit
          ! loose solves that do not shrink the change of the set: tighter ones from here on
          if (switched >= last_switched) bs%loose = merge(bs%careful, bs%tight, bs%loose > bs%careful)
@@ -810,21 +820,115 @@ contains
       end do
       call join_rows(error)
       if (allocated(error)) return
+      call constant_alone(error)
+      if (allocated(error)) return
       call node_lists(node, phi, nn, ops, error)
    contains
+      !> A contact cell that shares none of its nodes with another cell (its
+      !> neighbours along the surface of another normal axis or size: a
+      !> coarse ring, a quarter turn of a few cells) gets one node with
+      !> phi = 1, the constant multiplier's cell: its own hats would add a
+      !> slope that no neighbour ties, over master cells that may be as
+      !> large as the cell itself where `turns_too_far` narrowed it (a
+      !> closed fit at a coarse level: the slopes oscillate, one node in
+      !> tension). Nodes renumbered 1..nn.
+      subroutine constant_alone(error)
+         type(error_type), allocatable, intent(out) :: error
+         integer, allocatable :: first(:), newid(:), single(:)
+         logical, allocatable :: shared(:), alone(:)
+         allocate (first(nn), newid(nn), shared(nn), alone(ops%ncell), single(ops%ncell), stat=stat)
+         call check_allocation(stat, 'contact cells', 'the nodes'' cells', nn + ops%ncell, 12, error)
+         if (allocated(error)) return
+         first = 0
+         shared = .false.
+         do i = 1, surface%npoint
+            c = ops%cell_of_point(i)
+            do v = 1, nc
+               m = node(v, i)
+               if (m == 0) cycle
+               if (first(m) == 0) first(m) = c
+               shared(m) = shared(m) .or. first(m) /= c
+            end do
+         end do
+         alone = .true.
+         single = huge(1)
+         do i = 1, surface%npoint
+            c = ops%cell_of_point(i)
+            if (c == 0) cycle
+            do v = 1, nc
+               if (node(v, i) == 0) cycle
+               alone(c) = alone(c) .and. .not. shared(node(v, i))
+               single(c) = min(single(c), node(v, i))
+            end do
+         end do
+         if (.not. any(alone)) return
+         do i = 1, surface%npoint
+            c = ops%cell_of_point(i)
+            if (c == 0) cycle
+            if (.not. alone(c)) cycle
+            node(:, i) = 0
+            phi(:, i) = 0.0_wp
+            node(1, i) = single(c)
+            phi(1, i) = 1.0_wp
+         end do
+         newid = 0
+         do i = 1, surface%npoint
+            do v = 1, nc
+               if (node(v, i) > 0) newid(node(v, i)) = 1
+            end do
+         end do
+         m = 0
+         do j = 1, nn
+            if (newid(j) == 0) cycle
+            m = m + 1
+            newid(j) = m
+         end do
+         nn = m
+         do i = 1, surface%npoint
+            do v = 1, nc
+               if (node(v, i) > 0) node(v, i) = newid(node(v, i))
+            end do
+         end do
+      end subroutine constant_alone
+
       !> One node per vertex over neighbouring rows (union-find, the lower
-      !> index the root): nodes renumbered 1..nn, node(:, :) remapped.
+      !> index the root) where the surface passes from one row to the other
+      !> (`passes`): nodes renumbered 1..nn, node(:, :) remapped.
       subroutine join_rows(error)
          type(error_type), allocatable, intent(out) :: error
-         allocate (parent(nn), id(nn), stat=stat)
-         call check_allocation(stat, 'contact cells', 'the nodes'' classes', nn, 8, error)
+         integer, allocatable :: ptr(:), list(:), fill(:)
+         allocate (parent(nn), id(nn), ptr(nn + 1), fill(nn), stat=stat)
+         call check_allocation(stat, 'contact cells', 'the nodes'' classes', nn, 16, error)
          if (allocated(error)) return
+         fill = 0
+         do i = 1, surface%npoint
+            do v = 1, nc
+               if (node(v, i) > 0) fill(node(v, i)) = fill(node(v, i)) + 1
+            end do
+         end do
+         ptr(1) = 1
+         do m = 1, nn
+            ptr(m + 1) = ptr(m) + fill(m)
+         end do
+         allocate (list(ptr(nn + 1) - 1), stat=stat)
+         call check_allocation(stat, 'contact cells', 'the nodes'' points', ptr(nn + 1) - 1, 4, error)
+         if (allocated(error)) return
+         fill = 0
+         do i = 1, surface%npoint
+            do v = 1, nc
+               m = node(v, i)
+               if (m == 0) cycle
+               list(ptr(m) + fill(m)) = i
+               fill(m) = fill(m) + 1
+            end do
+         end do
          parent = [(m, m=1, nn)]
          do m = 1, nn
             vkey(1:d + 2) = keys(:, m)
             vkey(1 + vkey(1)) = vkey(1 + vkey(1)) + vkey(d + 2)
             r = find_key(vkey(1:d + 2), .false.)
-            if (r > 0) call join(m, r)
+            if (r == 0) cycle
+            if (passes(list(ptr(m):ptr(m + 1) - 1), list(ptr(r):ptr(r + 1) - 1))) call join(m, r)
          end do
          nn = 0
          do m = 1, size(parent)
@@ -843,6 +947,30 @@ contains
             end do
          end do
       end subroutine join_rows
+
+      !> Whether the surface runs from the points `a` of one node to the
+      !> points `b` of the node of the same vertex in the neighbouring row:
+      !> a point of each within two slave-cell diagonals of each other (the
+      !> points nearest the crossing of the rows' common face lie each
+      !> within a cell's diagonal of it). Two parts of the surface that
+      !> merely lie in neighbouring rows (the two flanks of a V-groove)
+      !> keep their own nodes: one node on both would constrain only the
+      !> mean of their gaps, and leave free the motions that move them
+      !> oppositely.
+      logical function passes(a, b)
+         integer, intent(in) :: a(:), b(:)
+         integer :: ia, ib
+         real(wp) :: reach
+         passes = .true.
+         do ia = 1, size(a)
+            do ib = 1, size(b)
+               reach = 2.0_wp*sqrt(real(d, wp))*max(cell_size(slave, surface%slave_cell(a(ia))), &
+                  & cell_size(slave, surface%slave_cell(b(ib))))
+               if (norm2(surface%x(:, a(ia)) - surface%x(:, b(ib))) <= reach) return
+            end do
+         end do
+         passes = .false.
+      end function passes
 
       !> The node of `key` (0 if absent and not `add`).
       integer function find_key(key, add) result(found)
@@ -1919,16 +2047,20 @@ contains
    !> points, not at a node or a midpoint; any other point takes the state
    !> of its owner's trial multiplier (a whole hat's, the node open). A
    !> node is closed when one of its points is.
-   subroutine next_set(ops, closed, lambda_n, gap, next, switched)
+   subroutine next_set(ops, closed, lambda_n, gap, next, switched, cycled)
       type(point_operators_type), intent(inout) :: ops
       logical, intent(in) :: closed(:)
       real(wp), intent(in) :: lambda_n(:), gap(:)
       logical, intent(out) :: next(:)
       integer, intent(out) :: switched
+      !> The points that would have switched into a set solved before (the
+      !> set then repeats and the iteration ends on it); 0 otherwise.
+      integer, intent(out) :: cycled
       real(wp) :: p(size(ops%cell_of_point))
       logical :: covered(size(ops%cell_of_point))
       integer :: c, q, i, k
 
+      cycled = 0
       if (.not. allocated(ops%pclosed)) then
          next = lambda_n < 0.0_wp
          switched = switched_points(ops, closed, next)
@@ -1965,6 +2097,7 @@ contains
       do k = 1, ops%nseen
          if (switched == 0) exit
          if (.not. all(ops%seen(:, k) .eqv. ops%pnext)) cycle
+         cycled = switched
          ops%pnext = ops%pclosed
          next = closed
          switched = 0
@@ -1989,7 +2122,7 @@ contains
    !> the same system again (its preconditioner set up) to the final
    !> tolerance from that solution and evaluate again; `switched` says
    !> whether the set still repeats.
-   subroutine confirm_set(surface, ops, cells, closed, bs, f, x, sol, next, switched, error, pstar)
+   subroutine confirm_set(surface, ops, cells, closed, bs, f, x, sol, next, switched, cycled, error, pstar)
       type(contact_surface_type), intent(in) :: surface
       type(point_operators_type), intent(inout) :: ops
       type(cell_operators_type), intent(in) :: cells(:)
@@ -1999,16 +2132,28 @@ contains
       real(wp), intent(inout) :: x(:)
       type(contact_solution_type), intent(inout) :: sol
       logical, intent(out) :: next(:)
-      integer, intent(out) :: switched
+      integer, intent(out) :: switched, cycled
       type(error_type), allocatable, intent(out) :: error
       real(wp), intent(in), optional :: pstar(:, :)
 
+      cycled = 0
       bs%krylov%tolerance = bs%tight
       call krylov_solve(bs%krylov, f, x, sol, error)
       if (.not. allocated(error)) call evaluate(surface, ops, cells, closed, x, sol, error, pstar)
       if (allocated(error)) return
-      call next_set(ops, closed, sol%lambda_n, sol%gap, next, switched)
+      call next_set(ops, closed, sol%lambda_n, sol%gap, next, switched, cycled)
    end subroutine confirm_set
+
+   !> The warning of a pair `what` whose active set repeated an earlier one
+   !> at active-set iteration `iteration` with `cycled` points switching.
+   pure function cycle_warning(what, iteration, cycled) result(text)
+      character(len=*), intent(in) :: what
+      integer, intent(in) :: iteration, cycled
+      character(len=:), allocatable :: text
+      text = what//': the active set repeated an earlier one at active-set iteration '//itoa(iteration)//' ('// &
+         & itoa(cycled)//' points switching back and forth, their pressure near zero); the solution of the '// &
+         & 'repeated set is kept'
+   end function cycle_warning
 
    !> The blocks (masters) of `dof` with a component in `touched` (0: none).
    pure function kept_masters(touched, dof) result(keep)
@@ -2251,7 +2396,7 @@ contains
       type(timer_type) :: timer
       real(wp), allocatable :: f(:), x(:)
       integer, allocatable :: offset(:)
-      integer :: it, maxit, p, c, switched, b, stat, moved, attempt
+      integer :: it, maxit, p, c, switched, b, stat, moved, attempt, cycled
       logical, allocatable :: next(:)
       logical :: again
 
@@ -2260,6 +2405,9 @@ contains
       allocate (sols(size(pairs)), work(size(pairs)), offset(size(bodies) + 1), stat=stat)
       call check_allocation(stat, 'contact assembly', 'the pairs', size(pairs), 64, error)
       if (allocated(error)) return
+      do p = 1, size(pairs)
+         sols(p)%warning = ''
+      end do
       offset(1) = 0
       do b = 1, size(bodies)
          offset(b + 1) = offset(b) + bodies(b)%problem%n_dofs()
@@ -2307,7 +2455,8 @@ contains
                if (allocated(error)) return
                if (allocated(next)) deallocate (next)
                allocate (next(size(w%closed)))
-               call next_set(w%ops, w%closed, sols(p)%lambda_n, sols(p)%gap, next, moved)
+               call next_set(w%ops, w%closed, sols(p)%lambda_n, sols(p)%gap, next, moved, cycled)
+               if (cycled > 0) sols(p)%warning = cycle_warning(pair_name(bodies, pairs(p)), it, cycled)
                switched = switched + moved
                w%closed = next
                if (allocated(w%ops%pnext)) w%ops%pclosed = w%ops%pnext

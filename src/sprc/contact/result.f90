@@ -49,6 +49,9 @@ module sprc_contact_result
       real(wp), allocatable :: p_star(:)
       !> Iterations of the contact nonlinearity summed over all increments.
       integer :: iterations = 0
+      !> What the solve warns of ('' for nothing; the contact solution's
+      !> `warning`): a driver prints it.
+      character(len=:), allocatable :: warning
    end type contact_result_type
 
 contains

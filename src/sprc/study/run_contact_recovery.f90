@@ -631,6 +631,8 @@ contains
       result%ts_fe = (sol%tangential*units%modulus)*units%strain
       result%t_fe = (sol%traction_t*units%modulus)*units%strain
       result%iterations = sol%iterations
+      result%warning = ''
+      if (allocated(sol%warning)) result%warning = sol%warning
    end subroutine contact_result
 
 end module sprc_study_run_contact_recovery

@@ -272,15 +272,16 @@ module sprc_study_spec
 contains
 
    !> The multiplier space of `multiplier = 'auto'` (doc/scene.md): linear
-   !> for Q2 in 2D, where the constant one leaves the interface pressure on
-   !> a floor the Q2 solution falls below (the compound cylinder's pressure
-   !> stalls at rate 0.4 from the third level), constant elsewhere (Q1: the
-   !> linear one is worse at the coarsest levels; 3D: several times the
-   !> solve time). doc/benchmarks.md has the measurements.
+   !> in 2D, where the constant one leaves the Q2 interface pressure on a
+   !> floor the Q2 solution falls below (the compound cylinder's pressure
+   !> stalls at rate 0.4 from the third level) and the Q1 pressure at its
+   !> own projection error (Hertz: several times the linear one's);
+   !> constant in 3D (several times the solve time). `order` is kept for
+   !> callers. doc/benchmarks.md has the measurements.
    pure function auto_multiplier(dim, order) result(name)
       integer, intent(in) :: dim, order
       character(len=:), allocatable :: name
-      if (dim == 2 .and. order == 2) then
+      if (dim == 2) then
          name = 'linear'
       else
          name = 'constant'
