@@ -1537,7 +1537,8 @@ contains
       call sprc_recover_mesh(2, size(c%x, 2), c%x, elem_quad4, 4, size(c%conn, 2), c%conn, size(c%gw, 1), c%gp, c%gw, &
          & 3, c%gs, plane_stress, 1.0d3, 0.3d0, 3 + 256, bf, size(fn, 2), 2, fn, fk, ftrac, 2, xpts, epts, nodal, &
          & elerr, glerr, eta, spts, stat, msg)
-      call check(error, stat == stat_invalid_input .and. index(msg, 'method = 259 is not SPR (1) or SPR-C (2)') > 0, &
+      call check(error, stat == stat_invalid_input .and. &
+         & index(msg, 'method = 259 is not SPRC_METHOD_SPR (1) or SPRC_METHOD_SPRC (2)') > 0, &
          & 'legacy: method 3 with a flag: '//trim(msg))
       if (allocated(error)) return
       allocate (conn, source=c%conn)

@@ -84,8 +84,8 @@ contains
          call fail(error, entry//': method = '//itoa(code)//' sets both SPRC_RECOVERY_P_PLUS_1 and '// &
             & 'SPRC_RECOVERY_P')
       else if (iand(code, method_mask) /= mesh_method_spr .and. iand(code, method_mask) /= mesh_method_sprc) then
-         call fail(error, entry//': method = '//itoa(code)//' is not SPR (1) or SPR-C (2), optionally with '// &
-            & 'the flags '//flags)
+         call fail(error, entry//': method = '//itoa(code)//' is not SPRC_METHOD_SPR (1) or SPRC_METHOD_SPRC (2), '// &
+            & 'optionally with the flags '//flags)
       else
          decoded%method = iand(code, method_mask)
          if (iand(code, method_flag_p) /= 0) decoded%degree_above = 0
