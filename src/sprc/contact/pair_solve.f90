@@ -884,12 +884,18 @@ contains
             newid(j) = m
          end do
          nn = m
+         call remap(newid)
+      end subroutine constant_alone
+
+      !> Every node index in node(:, :) replaced by map(index).
+      subroutine remap(map)
+         integer, intent(in) :: map(:)
          do i = 1, surface%npoint
             do v = 1, nc
-               if (node(v, i) > 0) node(v, i) = newid(node(v, i))
+               if (node(v, i) > 0) node(v, i) = map(node(v, i))
             end do
          end do
-      end subroutine constant_alone
+      end subroutine remap
 
       !> One node per vertex over neighbouring rows (union-find, the lower
       !> index the root) where the surface passes from one row to the other
@@ -941,11 +947,7 @@ contains
          do m = 1, size(parent)
             id(m) = id(root_of(m))
          end do
-         do i = 1, surface%npoint
-            do v = 1, nc
-               if (node(v, i) > 0) node(v, i) = id(node(v, i))
-            end do
-         end do
+         call remap(id)
       end subroutine join_rows
 
       !> Whether the surface runs from the points `a` of one node to the
